@@ -1,0 +1,1 @@
+//! Slipgate: .map to BSP29/BSP2 compiler.

@@ -1,0 +1,1012 @@
+//! Minimal safe bindings to Embree 3 (tested against 3.13.5 on Debian).
+//!
+//! Only triangle meshes, single-level scenes and occlusion / closest-hit
+//! queries are exposed. The raw declarations in [`sys`] mirror
+//! `<embree3/rtcore*.h>`; their layouts are checked in the unit tests.
+
+use std::ffi::{CStr, CString, c_char, c_void};
+use std::fmt;
+use std::sync::{Arc, Mutex, PoisonError};
+
+/// Raw declarations for the subset of the Embree 3 C API we use.
+#[allow(non_camel_case_types, non_snake_case, dead_code)]
+pub mod sys {
+    use std::ffi::{c_char, c_int, c_uint, c_void};
+
+    #[repr(C)]
+    pub struct RTCDeviceTy {
+        _opaque: [u8; 0],
+    }
+    #[repr(C)]
+    pub struct RTCSceneTy {
+        _opaque: [u8; 0],
+    }
+    #[repr(C)]
+    pub struct RTCGeometryTy {
+        _opaque: [u8; 0],
+    }
+    #[repr(C)]
+    pub struct RTCFilterFunctionNArguments {
+        _opaque: [u8; 0],
+    }
+    pub type RTCDevice = *mut RTCDeviceTy;
+    pub type RTCScene = *mut RTCSceneTy;
+    pub type RTCGeometry = *mut RTCGeometryTy;
+
+    // C enums are plain integers here: a Rust enum would be UB for any
+    // value Embree returns that we did not list.
+    pub type RTCError = c_uint;
+    pub const RTC_ERROR_NONE: RTCError = 0;
+    pub const RTC_ERROR_UNKNOWN: RTCError = 1;
+    pub const RTC_ERROR_INVALID_ARGUMENT: RTCError = 2;
+    pub const RTC_ERROR_INVALID_OPERATION: RTCError = 3;
+    pub const RTC_ERROR_OUT_OF_MEMORY: RTCError = 4;
+    pub const RTC_ERROR_UNSUPPORTED_CPU: RTCError = 5;
+    pub const RTC_ERROR_CANCELLED: RTCError = 6;
+
+    pub type RTCSceneFlags = c_uint;
+    pub const RTC_SCENE_FLAG_NONE: RTCSceneFlags = 0;
+    pub const RTC_SCENE_FLAG_ROBUST: RTCSceneFlags = 1 << 2;
+
+    pub type RTCBuildQuality = c_uint;
+    pub const RTC_BUILD_QUALITY_HIGH: RTCBuildQuality = 2;
+
+    pub type RTCGeometryType = c_uint;
+    pub const RTC_GEOMETRY_TYPE_TRIANGLE: RTCGeometryType = 0;
+
+    pub type RTCBufferType = c_uint;
+    pub const RTC_BUFFER_TYPE_INDEX: RTCBufferType = 0;
+    pub const RTC_BUFFER_TYPE_VERTEX: RTCBufferType = 1;
+
+    pub type RTCFormat = c_uint;
+    pub const RTC_FORMAT_UINT3: RTCFormat = 0x5003;
+    pub const RTC_FORMAT_FLOAT3: RTCFormat = 0x9003;
+
+    pub type RTCIntersectContextFlags = c_uint;
+    pub const RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT: RTCIntersectContextFlags = 0;
+    pub const RTC_INTERSECT_CONTEXT_FLAG_COHERENT: RTCIntersectContextFlags = 1;
+
+    pub const RTC_INVALID_GEOMETRY_ID: c_uint = !0;
+    /// From the installed `rtcore_config.h`; changes the layout of
+    /// `RTCHit` and `RTCIntersectContext`.
+    pub const RTC_MAX_INSTANCE_LEVEL_COUNT: usize = 1;
+
+    pub type RTCErrorFunction =
+        Option<unsafe extern "C" fn(user_ptr: *mut c_void, code: RTCError, msg: *const c_char)>;
+    pub type RTCFilterFunctionN =
+        Option<unsafe extern "C" fn(args: *const RTCFilterFunctionNArguments)>;
+
+    /// `struct RTCIntersectContext` for `RTC_MAX_INSTANCE_LEVEL_COUNT == 1`
+    /// and `RTC_MIN_WIDTH == 0` (no `instStackSize` / `minWidthDistanceFactor`).
+    #[repr(C)]
+    #[derive(Debug, Clone, Copy)]
+    pub struct RTCIntersectContext {
+        pub flags: RTCIntersectContextFlags,
+        pub filter: RTCFilterFunctionN,
+        pub instID: [c_uint; RTC_MAX_INSTANCE_LEVEL_COUNT],
+    }
+
+    #[repr(C, align(16))]
+    #[derive(Debug, Clone, Copy, Default)]
+    pub struct RTCRay {
+        pub org_x: f32,
+        pub org_y: f32,
+        pub org_z: f32,
+        pub tnear: f32,
+        pub dir_x: f32,
+        pub dir_y: f32,
+        pub dir_z: f32,
+        pub time: f32,
+        pub tfar: f32,
+        pub mask: c_uint,
+        pub id: c_uint,
+        pub flags: c_uint,
+    }
+
+    #[repr(C, align(16))]
+    #[derive(Debug, Clone, Copy, Default)]
+    pub struct RTCHit {
+        pub Ng_x: f32,
+        pub Ng_y: f32,
+        pub Ng_z: f32,
+        pub u: f32,
+        pub v: f32,
+        pub primID: c_uint,
+        pub geomID: c_uint,
+        pub instID: [c_uint; RTC_MAX_INSTANCE_LEVEL_COUNT],
+    }
+
+    #[repr(C)]
+    #[derive(Debug, Clone, Copy, Default)]
+    pub struct RTCRayHit {
+        pub ray: RTCRay,
+        pub hit: RTCHit,
+    }
+
+    #[repr(C, align(64))]
+    #[derive(Debug, Clone, Copy)]
+    pub struct RTCRay16 {
+        pub org_x: [f32; 16],
+        pub org_y: [f32; 16],
+        pub org_z: [f32; 16],
+        pub tnear: [f32; 16],
+        pub dir_x: [f32; 16],
+        pub dir_y: [f32; 16],
+        pub dir_z: [f32; 16],
+        pub time: [f32; 16],
+        pub tfar: [f32; 16],
+        pub mask: [c_uint; 16],
+        pub id: [c_uint; 16],
+        pub flags: [c_uint; 16],
+    }
+
+    #[repr(C, align(64))]
+    #[derive(Debug, Clone, Copy)]
+    pub struct RTCHit16 {
+        pub Ng_x: [f32; 16],
+        pub Ng_y: [f32; 16],
+        pub Ng_z: [f32; 16],
+        pub u: [f32; 16],
+        pub v: [f32; 16],
+        pub primID: [c_uint; 16],
+        pub geomID: [c_uint; 16],
+        pub instID: [[c_uint; 16]; RTC_MAX_INSTANCE_LEVEL_COUNT],
+    }
+
+    #[repr(C)]
+    #[derive(Debug, Clone, Copy)]
+    pub struct RTCRayHit16 {
+        pub ray: RTCRay16,
+        pub hit: RTCHit16,
+    }
+
+    unsafe extern "C" {
+        pub fn rtcNewDevice(config: *const c_char) -> RTCDevice;
+        pub fn rtcReleaseDevice(device: RTCDevice);
+        pub fn rtcGetDeviceError(device: RTCDevice) -> RTCError;
+        pub fn rtcSetDeviceErrorFunction(
+            device: RTCDevice,
+            error: RTCErrorFunction,
+            user_ptr: *mut c_void,
+        );
+
+        pub fn rtcNewScene(device: RTCDevice) -> RTCScene;
+        pub fn rtcReleaseScene(scene: RTCScene);
+        pub fn rtcSetSceneFlags(scene: RTCScene, flags: RTCSceneFlags);
+        pub fn rtcSetSceneBuildQuality(scene: RTCScene, quality: RTCBuildQuality);
+        pub fn rtcAttachGeometry(scene: RTCScene, geometry: RTCGeometry) -> c_uint;
+        pub fn rtcCommitScene(scene: RTCScene);
+
+        pub fn rtcNewGeometry(device: RTCDevice, ty: RTCGeometryType) -> RTCGeometry;
+        pub fn rtcSetNewGeometryBuffer(
+            geometry: RTCGeometry,
+            ty: RTCBufferType,
+            slot: c_uint,
+            format: RTCFormat,
+            byte_stride: usize,
+            item_count: usize,
+        ) -> *mut c_void;
+        pub fn rtcCommitGeometry(geometry: RTCGeometry);
+        pub fn rtcReleaseGeometry(geometry: RTCGeometry);
+
+        pub fn rtcIntersect1(
+            scene: RTCScene,
+            context: *mut RTCIntersectContext,
+            rayhit: *mut RTCRayHit,
+        );
+        pub fn rtcOccluded1(scene: RTCScene, context: *mut RTCIntersectContext, ray: *mut RTCRay);
+        pub fn rtcOccluded16(
+            valid: *const c_int,
+            scene: RTCScene,
+            context: *mut RTCIntersectContext,
+            ray: *mut RTCRay16,
+        );
+    }
+}
+
+/// An Embree API failure or input rejected before reaching Embree.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum EmbreeError {
+    /// Embree reported an error code during `op`.
+    Api {
+        op: &'static str,
+        /// An `RTC_ERROR_*` value.
+        code: u32,
+        /// Best-effort text from Embree's error callback (the callback is
+        /// per device, so under concurrent failures it may be another thread's).
+        message: Option<String>,
+    },
+    /// Input rejected before reaching Embree (e.g. a vertex index out of range).
+    InvalidInput(String),
+}
+
+fn error_code_name(code: u32) -> &'static str {
+    match code {
+        sys::RTC_ERROR_NONE => "no error",
+        sys::RTC_ERROR_UNKNOWN => "unknown error",
+        sys::RTC_ERROR_INVALID_ARGUMENT => "invalid argument",
+        sys::RTC_ERROR_INVALID_OPERATION => "invalid operation",
+        sys::RTC_ERROR_OUT_OF_MEMORY => "out of memory",
+        sys::RTC_ERROR_UNSUPPORTED_CPU => "unsupported CPU",
+        sys::RTC_ERROR_CANCELLED => "cancelled",
+        _ => "unrecognised error code",
+    }
+}
+
+impl fmt::Display for EmbreeError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Api { op, code, message } => {
+                write!(f, "embree {op} failed: {} ({code})", error_code_name(*code))?;
+                match message {
+                    Some(m) => write!(f, ": {m}"),
+                    None => Ok(()),
+                }
+            }
+            Self::InvalidInput(why) => write!(f, "invalid input: {why}"),
+        }
+    }
+}
+
+impl std::error::Error for EmbreeError {}
+
+/// Owns the device handle plus the slot the error callback writes into.
+struct DeviceInner {
+    raw: sys::RTCDevice,
+    // Boxed so the address handed to Embree as `userPtr` never moves.
+    last_message: Box<Mutex<Option<String>>>,
+}
+
+// SAFETY: Embree devices may be used from any thread; every Embree error
+// code is per thread, and our message slot is behind a Mutex.
+unsafe impl Send for DeviceInner {}
+// SAFETY: as above; we only call thread-safe Embree entry points via `&self`.
+unsafe impl Sync for DeviceInner {}
+
+impl DeviceInner {
+    /// Turns the calling thread's pending Embree error (if any) into `Err`.
+    fn check(&self, op: &'static str) -> Result<(), EmbreeError> {
+        // SAFETY: `raw` is a live device for as long as `self` exists.
+        let code = unsafe { sys::rtcGetDeviceError(self.raw) };
+        if code == sys::RTC_ERROR_NONE {
+            return Ok(());
+        }
+        let message = self
+            .last_message
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .take();
+        Err(EmbreeError::Api { op, code, message })
+    }
+}
+
+impl Drop for DeviceInner {
+    fn drop(&mut self) {
+        // SAFETY: we hold one reference; scenes/geometries hold their own, and
+        // every Rust scene keeps this `DeviceInner` (and thus the callback's
+        // user pointer) alive through an `Arc`.
+        unsafe { sys::rtcReleaseDevice(self.raw) };
+    }
+}
+
+unsafe extern "C" fn record_error(user_ptr: *mut c_void, _code: sys::RTCError, msg: *const c_char) {
+    if user_ptr.is_null() || msg.is_null() {
+        return;
+    }
+    // SAFETY: `user_ptr` is the boxed Mutex registered in `Device::new`, which
+    // outlives the device; `msg` is a NUL-terminated string valid for this call.
+    let (slot, text) = unsafe {
+        (
+            &*user_ptr.cast::<Mutex<Option<String>>>(),
+            CStr::from_ptr(msg).to_string_lossy().into_owned(),
+        )
+    };
+    // Must not panic across the FFI boundary: tolerate poisoning.
+    *slot.lock().unwrap_or_else(PoisonError::into_inner) = Some(text);
+}
+
+/// An Embree device; cheap to clone (reference counted).
+#[derive(Clone)]
+pub struct Device {
+    inner: Arc<DeviceInner>,
+}
+
+impl fmt::Debug for Device {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Device")
+            .field("raw", &self.inner.raw)
+            .finish()
+    }
+}
+
+impl Device {
+    /// Creates a device whose BVH builder uses at most `threads` threads
+    /// (0 = all hardware threads). The count is capped at the machine's
+    /// parallelism so Embree's TBB pool does not oversubscribe alongside rayon.
+    ///
+    /// # Errors
+    /// Fails if Embree cannot create a device (e.g. unsupported CPU).
+    pub fn new(threads: usize) -> Result<Self, EmbreeError> {
+        let hw = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
+        let threads = if threads == 0 { hw } else { threads.min(hw) };
+        let config = CString::new(format!("threads={threads},set_affinity=0"))
+            .map_err(|_| EmbreeError::InvalidInput("device config contained NUL".into()))?;
+        // SAFETY: `config` is a valid NUL-terminated string for the call.
+        let raw = unsafe { sys::rtcNewDevice(config.as_ptr()) };
+        if raw.is_null() {
+            // SAFETY: passing NULL is the documented way to get the
+            // error of a failed device construction.
+            let code = unsafe { sys::rtcGetDeviceError(std::ptr::null_mut()) };
+            return Err(EmbreeError::Api {
+                op: "rtcNewDevice",
+                code,
+                message: None,
+            });
+        }
+        let inner = DeviceInner {
+            raw,
+            last_message: Box::new(Mutex::new(None)),
+        };
+        let user_ptr = std::ptr::from_ref::<Mutex<Option<String>>>(&inner.last_message).cast_mut();
+        // SAFETY: `raw` is live; `user_ptr` points into a Box owned by `inner`
+        // that is freed only after `rtcReleaseDevice` in `DeviceInner::drop`.
+        unsafe { sys::rtcSetDeviceErrorFunction(raw, Some(record_error), user_ptr.cast()) };
+        inner.check("rtcSetDeviceErrorFunction")?;
+        Ok(Self {
+            inner: Arc::new(inner),
+        })
+    }
+}
+
+/// Owns one scene reference and keeps the device alive.
+struct SceneHandle {
+    raw: sys::RTCScene,
+    device: Arc<DeviceInner>,
+}
+
+impl Drop for SceneHandle {
+    fn drop(&mut self) {
+        // SAFETY: `raw` is a live scene we hold one reference to.
+        unsafe { sys::rtcReleaseScene(self.raw) };
+    }
+}
+
+/// Releases a geometry handle on every exit path of `add_triangle_mesh`.
+struct GeometryGuard(sys::RTCGeometry);
+
+impl Drop for GeometryGuard {
+    fn drop(&mut self) {
+        // SAFETY: the guard owns exactly one reference to a live geometry.
+        unsafe { sys::rtcReleaseGeometry(self.0) };
+    }
+}
+
+/// Collects geometry for a [`Scene`]; call [`SceneBuilder::commit`] to build.
+pub struct SceneBuilder {
+    handle: SceneHandle,
+    robust: bool,
+}
+
+// SAFETY: Embree objects are not tied to the creating thread; `&mut self`
+// methods keep modifications sequential as Embree requires.
+unsafe impl Send for SceneBuilder {}
+
+impl SceneBuilder {
+    /// Starts an empty scene on `device`.
+    ///
+    /// # Errors
+    /// Returns the Embree error if the scene cannot be created.
+    pub fn new(device: &Device) -> Result<Self, EmbreeError> {
+        // SAFETY: the device is live for the duration of the call.
+        let raw = unsafe { sys::rtcNewScene(device.inner.raw) };
+        if raw.is_null() {
+            device.inner.check("rtcNewScene")?;
+            return Err(EmbreeError::Api {
+                op: "rtcNewScene",
+                code: sys::RTC_ERROR_UNKNOWN,
+                message: None,
+            });
+        }
+        let handle = SceneHandle {
+            raw,
+            device: Arc::clone(&device.inner),
+        };
+        Ok(Self {
+            handle,
+            robust: false,
+        })
+    }
+
+    /// Enables `RTC_SCENE_FLAG_ROBUST`: slower, but avoids rays leaking
+    /// through shared edges (useful for light leaks at brush seams).
+    pub fn set_robust(&mut self, robust: bool) {
+        self.robust = robust;
+    }
+
+    /// Adds a triangle mesh and returns the geometry id Embree reports in
+    /// [`Hit::geom_id`]. Ids are assigned sequentially from 0.
+    ///
+    /// # Errors
+    /// [`EmbreeError::InvalidInput`] for an out-of-range vertex index, or the
+    /// Embree error if creating the geometry fails.
+    pub fn add_triangle_mesh(
+        &mut self,
+        vertices: &[[f32; 3]],
+        triangles: &[[u32; 3]],
+    ) -> Result<u32, EmbreeError> {
+        // Embree does not bounds-check indices; a bad one would read out of
+        // bounds during the build or traversal.
+        if let Some(bad) = triangles
+            .iter()
+            .flatten()
+            .find(|&&i| i as usize >= vertices.len())
+        {
+            return Err(EmbreeError::InvalidInput(format!(
+                "vertex index {bad} out of range ({} vertices)",
+                vertices.len()
+            )));
+        }
+        // Primitive ids are 32-bit.
+        if u32::try_from(triangles.len()).is_err() {
+            return Err(EmbreeError::InvalidInput(
+                "more than u32::MAX triangles".into(),
+            ));
+        }
+        let dev = &self.handle.device;
+        // SAFETY: the device is live.
+        let raw = unsafe { sys::rtcNewGeometry(dev.raw, sys::RTC_GEOMETRY_TYPE_TRIANGLE) };
+        if raw.is_null() {
+            dev.check("rtcNewGeometry")?;
+            return Err(EmbreeError::Api {
+                op: "rtcNewGeometry",
+                code: sys::RTC_ERROR_UNKNOWN,
+                message: None,
+            });
+        }
+        let geom = GeometryGuard(raw);
+        set_buffer(
+            dev,
+            geom.0,
+            sys::RTC_BUFFER_TYPE_VERTEX,
+            sys::RTC_FORMAT_FLOAT3,
+            vertices,
+        )?;
+        set_buffer(
+            dev,
+            geom.0,
+            sys::RTC_BUFFER_TYPE_INDEX,
+            sys::RTC_FORMAT_UINT3,
+            triangles,
+        )?;
+        // SAFETY: `geom.0` is live and both buffers are set.
+        unsafe { sys::rtcCommitGeometry(geom.0) };
+        dev.check("rtcCommitGeometry")?;
+        // SAFETY: scene and geometry are live and belong to the same device.
+        let id = unsafe { sys::rtcAttachGeometry(self.handle.raw, geom.0) };
+        dev.check("rtcAttachGeometry")?;
+        // `geom` drops here: the scene now holds its own reference.
+        Ok(id)
+    }
+
+    /// Builds the BVH (build quality HIGH). The result is immutable.
+    ///
+    /// # Errors
+    /// Returns the Embree error if the build fails (e.g. out of memory).
+    pub fn commit(self) -> Result<Scene, EmbreeError> {
+        let flags = if self.robust {
+            sys::RTC_SCENE_FLAG_ROBUST
+        } else {
+            sys::RTC_SCENE_FLAG_NONE
+        };
+        let h = &self.handle;
+        // SAFETY: the scene is live and not being queried or modified elsewhere
+        // (we own the builder by value).
+        unsafe {
+            sys::rtcSetSceneFlags(h.raw, flags);
+            sys::rtcSetSceneBuildQuality(h.raw, sys::RTC_BUILD_QUALITY_HIGH);
+            sys::rtcCommitScene(h.raw);
+        }
+        h.device.check("rtcCommitScene")?;
+        Ok(Scene {
+            handle: self.handle,
+        })
+    }
+}
+
+/// Copies `data` into a new Embree-owned geometry buffer (Embree pads
+/// vertex buffers for its 16-byte SSE loads itself).
+fn set_buffer<T: Copy>(
+    dev: &DeviceInner,
+    geom: sys::RTCGeometry,
+    ty: sys::RTCBufferType,
+    format: sys::RTCFormat,
+    data: &[T],
+) -> Result<(), EmbreeError> {
+    // SAFETY: `geom` is live; stride/count describe `data` exactly.
+    let dst =
+        unsafe { sys::rtcSetNewGeometryBuffer(geom, ty, 0, format, size_of::<T>(), data.len()) };
+    dev.check("rtcSetNewGeometryBuffer")?;
+    if dst.is_null() {
+        return if data.is_empty() {
+            Ok(())
+        } else {
+            Err(EmbreeError::Api {
+                op: "rtcSetNewGeometryBuffer",
+                code: sys::RTC_ERROR_OUT_OF_MEMORY,
+                message: None,
+            })
+        };
+    }
+    // SAFETY: Embree allocated at least `len * size_of::<T>()` bytes at `dst`;
+    // the regions cannot overlap; copying bytes needs no alignment.
+    unsafe {
+        std::ptr::copy_nonoverlapping(
+            data.as_ptr().cast::<u8>(),
+            dst.cast::<u8>(),
+            size_of_val(data),
+        );
+    }
+    Ok(())
+}
+
+/// A committed, immutable scene. Queries take `&self` and may run from
+/// many threads at once.
+pub struct Scene {
+    handle: SceneHandle,
+}
+
+// SAFETY: after commit Embree allows concurrent queries on a scene from any
+// thread, and `Scene` exposes no way to modify it.
+unsafe impl Send for Scene {}
+// SAFETY: as above.
+unsafe impl Sync for Scene {}
+
+/// Closest-hit result of [`Scene::intersect`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hit {
+    /// Ray parameter of the hit (distance if `dir` is unit length).
+    pub t: f32,
+    pub geom_id: u32,
+    /// Triangle index within the geometry.
+    pub prim_id: u32,
+    /// Barycentrics: `p = (1-u-v)*p0 + u*p1 + v*p2`.
+    pub u: f32,
+    pub v: f32,
+    /// Unnormalised geometric normal, `(p1-p0) x (p2-p0)`.
+    pub ng: [f32; 3],
+}
+
+/// Embree requires `0 <= tnear <= tfar` and finite origin/direction;
+/// anything else is treated as an empty segment that hits nothing.
+fn ray_ok(org: [f32; 3], dir: [f32; 3], tnear: f32, tfar: f32) -> bool {
+    org.iter().chain(&dir).all(|c| c.is_finite()) && tnear >= 0.0 && tnear <= tfar
+}
+
+fn make_ray(org: [f32; 3], dir: [f32; 3], tnear: f32, tfar: f32) -> sys::RTCRay {
+    sys::RTCRay {
+        org_x: org[0],
+        org_y: org[1],
+        org_z: org[2],
+        tnear,
+        dir_x: dir[0],
+        dir_y: dir[1],
+        dir_z: dir[2],
+        time: 0.0,
+        tfar,
+        // All bits set so geometry masks (if compiled in) never hide anything.
+        mask: !0,
+        id: 0,
+        flags: 0,
+    }
+}
+
+/// Equivalent of the header-inline `rtcInitIntersectContext`.
+fn context(coherent: bool) -> sys::RTCIntersectContext {
+    sys::RTCIntersectContext {
+        flags: if coherent {
+            sys::RTC_INTERSECT_CONTEXT_FLAG_COHERENT
+        } else {
+            sys::RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT
+        },
+        filter: None,
+        instID: [sys::RTC_INVALID_GEOMETRY_ID; sys::RTC_MAX_INSTANCE_LEVEL_COUNT],
+    }
+}
+
+impl Scene {
+    /// True if anything lies on the segment `org + t*dir`, `t` in `[tnear, tfar]`.
+    #[must_use]
+    pub fn occluded(&self, org: [f32; 3], dir: [f32; 3], tnear: f32, tfar: f32) -> bool {
+        if !ray_ok(org, dir, tnear, tfar) {
+            return false;
+        }
+        let mut ray = make_ray(org, dir, tnear, tfar);
+        let mut ctx = context(false);
+        // SAFETY: committed live scene; `ray` is 16-byte aligned by its type;
+        // both pointers are valid for the call.
+        unsafe { sys::rtcOccluded1(self.handle.raw, &raw mut ctx, &raw mut ray) };
+        // Embree marks a hit by setting tfar to -inf.
+        ray.tfar == f32::NEG_INFINITY
+    }
+
+    /// Closest hit on the segment, if any.
+    #[must_use]
+    pub fn intersect(&self, org: [f32; 3], dir: [f32; 3], tnear: f32, tfar: f32) -> Option<Hit> {
+        if !ray_ok(org, dir, tnear, tfar) {
+            return None;
+        }
+        let mut rh = sys::RTCRayHit {
+            ray: make_ray(org, dir, tnear, tfar),
+            hit: sys::RTCHit {
+                geomID: sys::RTC_INVALID_GEOMETRY_ID,
+                instID: [sys::RTC_INVALID_GEOMETRY_ID; sys::RTC_MAX_INSTANCE_LEVEL_COUNT],
+                ..Default::default()
+            },
+        };
+        let mut ctx = context(false);
+        // SAFETY: committed live scene; `rh` is 16-byte aligned and initialised
+        // as `rtcIntersect1` requires (geomID = invalid).
+        unsafe { sys::rtcIntersect1(self.handle.raw, &raw mut ctx, &raw mut rh) };
+        (rh.hit.geomID != sys::RTC_INVALID_GEOMETRY_ID).then_some(Hit {
+            t: rh.ray.tfar,
+            geom_id: rh.hit.geomID,
+            prim_id: rh.hit.primID,
+            u: rh.hit.u,
+            v: rh.hit.v,
+            ng: [rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z],
+        })
+    }
+
+    /// Occlusion test for the active lanes of `packet`; bit `i` of the result
+    /// is set if lane `i` is blocked. Embree overwrites `tfar` of blocked
+    /// lanes, so call [`RayPacket16::set`] again before reusing a lane.
+    /// `coherent` hints that the rays share origin/direction roughly.
+    pub fn occluded16(&self, packet: &mut RayPacket16, coherent: bool) -> u16 {
+        if packet.active_mask() == 0 {
+            return 0;
+        }
+        let mut ctx = context(coherent);
+        // SAFETY: committed live scene; the valid mask and ray packet are both
+        // 64-byte aligned by their types and fully initialised.
+        unsafe {
+            sys::rtcOccluded16(
+                packet.valid.0.as_ptr(),
+                self.handle.raw,
+                &raw mut ctx,
+                &raw mut packet.rays,
+            );
+        }
+        (0..16)
+            .filter(|&i| packet.valid.0[i] != 0 && packet.rays.tfar[i] == f32::NEG_INFINITY)
+            .fold(0, |m, i| m | (1 << i))
+    }
+}
+
+#[repr(C, align(64))]
+#[derive(Debug, Clone, Copy)]
+struct ValidMask([i32; 16]);
+
+/// Up to 16 rays for [`Scene::occluded16`], in Embree's structure-of-arrays layout.
+#[derive(Debug, Clone, Copy)]
+pub struct RayPacket16 {
+    // Embree wants -1 for an active lane and 0 for an inactive one.
+    valid: ValidMask,
+    rays: sys::RTCRay16,
+}
+
+impl Default for RayPacket16 {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl RayPacket16 {
+    /// A packet with every lane inactive.
+    #[must_use]
+    pub fn new() -> Self {
+        let ray = make_ray([0.0; 3], [0.0, 0.0, 1.0], 0.0, 0.0);
+        Self {
+            valid: ValidMask([0; 16]),
+            rays: sys::RTCRay16 {
+                org_x: [0.0; 16],
+                org_y: [0.0; 16],
+                org_z: [0.0; 16],
+                tnear: [0.0; 16],
+                dir_x: [0.0; 16],
+                dir_y: [0.0; 16],
+                dir_z: [ray.dir_z; 16],
+                time: [0.0; 16],
+                tfar: [0.0; 16],
+                mask: [ray.mask; 16],
+                id: [0; 16],
+                flags: [0; 16],
+            },
+        }
+    }
+
+    /// Loads a ray into `lane` and activates it (an invalid segment, see
+    /// [`Scene::occluded`], leaves the lane inactive). Panics if `lane >= 16`.
+    pub fn set(&mut self, lane: usize, org: [f32; 3], dir: [f32; 3], tnear: f32, tfar: f32) {
+        let r = &mut self.rays;
+        [r.org_x[lane], r.org_y[lane], r.org_z[lane]] = org;
+        [r.dir_x[lane], r.dir_y[lane], r.dir_z[lane]] = dir;
+        r.tnear[lane] = tnear;
+        r.tfar[lane] = tfar;
+        self.valid.0[lane] = if ray_ok(org, dir, tnear, tfar) { -1 } else { 0 };
+    }
+
+    /// Deactivates every lane.
+    pub fn clear(&mut self) {
+        self.valid.0 = [0; 16];
+    }
+
+    /// Bit `i` is set if lane `i` is active.
+    #[must_use]
+    pub fn active_mask(&self) -> u16 {
+        (0..16)
+            .filter(|&i| self.valid.0[i] != 0)
+            .fold(0, |m, i| m | (1 << i))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::mem::{align_of, offset_of, size_of};
+
+    /// Numbers printed by a gcc program (`sizeof`/`_Alignof`/`offsetof`)
+    /// compiled against the installed Embree 3.13.5 headers.
+    #[test]
+    fn layouts_match_c_headers() {
+        use sys::*;
+        assert_eq!((size_of::<RTCRay>(), align_of::<RTCRay>()), (48, 16));
+        assert_eq!(offset_of!(RTCRay, tnear), 12);
+        assert_eq!(offset_of!(RTCRay, dir_x), 16);
+        assert_eq!(offset_of!(RTCRay, time), 28);
+        assert_eq!(offset_of!(RTCRay, tfar), 32);
+        assert_eq!(offset_of!(RTCRay, mask), 36);
+        assert_eq!(offset_of!(RTCRay, id), 40);
+        assert_eq!(offset_of!(RTCRay, flags), 44);
+
+        assert_eq!((size_of::<RTCHit>(), align_of::<RTCHit>()), (32, 16));
+        assert_eq!(offset_of!(RTCHit, u), 12);
+        assert_eq!(offset_of!(RTCHit, v), 16);
+        assert_eq!(offset_of!(RTCHit, primID), 20);
+        assert_eq!(offset_of!(RTCHit, geomID), 24);
+        assert_eq!(offset_of!(RTCHit, instID), 28);
+
+        assert_eq!((size_of::<RTCRayHit>(), align_of::<RTCRayHit>()), (80, 16));
+        assert_eq!(offset_of!(RTCRayHit, hit), 48);
+
+        assert_eq!((size_of::<RTCRay16>(), align_of::<RTCRay16>()), (768, 64));
+        assert_eq!(offset_of!(RTCRay16, tnear), 192);
+        assert_eq!(offset_of!(RTCRay16, dir_x), 256);
+        assert_eq!(offset_of!(RTCRay16, tfar), 512);
+        assert_eq!(offset_of!(RTCRay16, mask), 576);
+        assert_eq!(offset_of!(RTCRay16, flags), 704);
+
+        assert_eq!((size_of::<RTCHit16>(), align_of::<RTCHit16>()), (512, 64));
+        assert_eq!(offset_of!(RTCHit16, primID), 320);
+        assert_eq!(offset_of!(RTCHit16, geomID), 384);
+        assert_eq!(offset_of!(RTCHit16, instID), 448);
+        assert_eq!(
+            (size_of::<RTCRayHit16>(), align_of::<RTCRayHit16>()),
+            (1280, 64)
+        );
+        assert_eq!(offset_of!(RTCRayHit16, hit), 768);
+
+        assert_eq!(
+            (
+                size_of::<RTCIntersectContext>(),
+                align_of::<RTCIntersectContext>()
+            ),
+            (24, 8)
+        );
+        assert_eq!(offset_of!(RTCIntersectContext, filter), 8);
+        assert_eq!(offset_of!(RTCIntersectContext, instID), 16);
+
+        assert_eq!(align_of::<ValidMask>(), 64);
+        assert_eq!(offset_of!(RayPacket16, rays) % 64, 0);
+    }
+
+    fn device() -> Device {
+        Device::new(2).expect("embree device")
+    }
+
+    /// Unit quad in the z = 0 plane, x and y in [0, 1].
+    fn quad_scene(robust: bool) -> (Scene, u32, u32) {
+        let mut b = SceneBuilder::new(&device()).expect("scene");
+        b.set_robust(robust);
+        let quad = b
+            .add_triangle_mesh(
+                &[
+                    [0.0, 0.0, 0.0],
+                    [1.0, 0.0, 0.0],
+                    [1.0, 1.0, 0.0],
+                    [0.0, 1.0, 0.0],
+                ],
+                &[[0, 1, 2], [0, 2, 3]],
+            )
+            .expect("quad");
+        // A second geometry further along +z, to check geom ids and closest hit.
+        let far = b
+            .add_triangle_mesh(
+                &[[-5.0, -5.0, 3.0], [5.0, -5.0, 3.0], [0.0, 5.0, 3.0]],
+                &[[0, 1, 2]],
+            )
+            .expect("tri");
+        (b.commit().expect("commit"), quad, far)
+    }
+
+    #[test]
+    fn quad_blocks_ray_through_it_only() {
+        for robust in [false, true] {
+            let (scene, _, _) = quad_scene(robust);
+            let down = [0.0, 0.0, -1.0];
+            assert!(scene.occluded([0.5, 0.5, 1.0], down, 0.0, 10.0));
+            assert!(!scene.occluded([1.5, 0.5, 1.0], down, 0.0, 10.0));
+            // Segment ending before the quad.
+            assert!(!scene.occluded([0.5, 0.5, 1.0], down, 0.0, 0.5));
+            // Invalid segments hit nothing instead of reaching Embree.
+            assert!(!scene.occluded([0.5, 0.5, 1.0], down, 2.0, 1.0));
+            assert!(!scene.occluded([f32::NAN, 0.5, 1.0], down, 0.0, 10.0));
+        }
+    }
+
+    #[test]
+    fn intersect_reports_t_and_geom_id() {
+        let (scene, quad, far) = quad_scene(false);
+        assert_ne!(quad, far);
+        let hit = scene
+            .intersect([0.25, 0.75, -2.0], [0.0, 0.0, 1.0], 0.0, f32::INFINITY)
+            .expect("hit quad");
+        assert_eq!(hit.geom_id, quad);
+        assert_eq!(hit.prim_id, 1);
+        assert!((hit.t - 2.0).abs() < 1e-5, "t = {}", hit.t);
+        assert!(hit.ng[2] > 0.0, "counter-clockwise winding faces +z");
+        // Starting past the quad reaches the far triangle.
+        let hit = scene
+            .intersect([0.25, 0.75, 1.0], [0.0, 0.0, 1.0], 0.0, f32::INFINITY)
+            .expect("hit far tri");
+        assert_eq!((hit.geom_id, hit.prim_id), (far, 0));
+        assert!((hit.t - 2.0).abs() < 1e-5);
+        assert!(
+            scene
+                .intersect([9.0, 9.0, -1.0], [0.0, 0.0, 1.0], 0.0, 100.0)
+                .is_none()
+        );
+    }
+
+    #[test]
+    fn rejects_out_of_range_index() {
+        let mut b = SceneBuilder::new(&device()).expect("scene");
+        let err = b
+            .add_triangle_mesh(&[[0.0; 3]; 3], &[[0, 1, 3]])
+            .unwrap_err();
+        assert!(matches!(err, EmbreeError::InvalidInput(_)), "{err}");
+    }
+
+    /// Tiny xorshift so the test needs no dependencies.
+    struct Rng(u64);
+    impl Rng {
+        fn f(&mut self) -> f32 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            (self.0 >> 40) as f32 / (1u64 << 24) as f32
+        }
+        fn v(&mut self, s: f32) -> [f32; 3] {
+            [
+                (self.f() * 2.0 - 1.0) * s,
+                (self.f() * 2.0 - 1.0) * s,
+                (self.f() * 2.0 - 1.0) * s,
+            ]
+        }
+    }
+
+    #[test]
+    fn occluded16_matches_occluded() {
+        // Axis-aligned box [-1, 1]^3 as 12 triangles.
+        let verts: Vec<[f32; 3]> = (0..8)
+            .map(|i| {
+                [
+                    (i & 1) as f32 * 2.0 - 1.0,
+                    ((i >> 1) & 1) as f32 * 2.0 - 1.0,
+                    (i >> 2) as f32 * 2.0 - 1.0,
+                ]
+            })
+            .collect();
+        let faces = [
+            [0, 1, 3, 2],
+            [4, 6, 7, 5],
+            [0, 4, 5, 1],
+            [2, 3, 7, 6],
+            [0, 2, 6, 4],
+            [1, 5, 7, 3],
+        ];
+        let tris: Vec<[u32; 3]> = faces
+            .iter()
+            .flat_map(|f| [[f[0], f[1], f[2]], [f[0], f[2], f[3]]])
+            .collect();
+        let mut b = SceneBuilder::new(&device()).expect("scene");
+        b.add_triangle_mesh(&verts, &tris).expect("box");
+        let scene = b.commit().expect("commit");
+
+        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        let (mut hits, mut misses) = (0, 0);
+        for round in 0..200 {
+            let mut packet = RayPacket16::new();
+            let mut expected = 0u16;
+            for lane in 0..16 {
+                // Leave some lanes inactive to exercise the valid mask.
+                if (round + lane) % 7 == 0 {
+                    continue;
+                }
+                let org = rng.v(4.0);
+                let dir = rng.v(1.0);
+                let tfar = rng.f() * 8.0;
+                packet.set(lane, org, dir, 0.0, tfar);
+                if scene.occluded(org, dir, 0.0, tfar) {
+                    expected |= 1 << lane;
+                }
+            }
+            let got = scene.occluded16(&mut packet, round % 2 == 0);
+            assert_eq!(got, expected, "round {round}");
+            assert_eq!(got & !packet.active_mask(), 0);
+            hits += expected.count_ones();
+            misses += packet.active_mask().count_ones() - expected.count_ones();
+        }
+        // Make sure the random rays actually exercise both outcomes.
+        assert!(hits > 100 && misses > 100, "hits {hits} misses {misses}");
+    }
+
+    #[test]
+    fn scene_is_send_sync_and_queryable_from_threads() {
+        fn assert_send_sync<T: Send + Sync>() {}
+        assert_send_sync::<Scene>();
+        assert_send_sync::<Device>();
+        let (scene, _, _) = quad_scene(false);
+        std::thread::scope(|s| {
+            for i in 0..4 {
+                let scene = &scene;
+                s.spawn(move || {
+                    let x = 0.1 + 0.2 * i as f32;
+                    assert!(scene.occluded([x, 0.5, 1.0], [0.0, 0.0, -1.0], 0.0, 10.0));
+                });
+            }
+        });
+    }
+
+    #[test]
+    fn embree_errors_carry_code_and_message() {
+        let dev = device();
+        // SAFETY: live device; the geometry is released by the guard.
+        let geom = GeometryGuard(unsafe {
+            sys::rtcNewGeometry(dev.inner.raw, sys::RTC_GEOMETRY_TYPE_TRIANGLE)
+        });
+        // A 3-byte stride is not 4-byte aligned, which Embree rejects.
+        let err = set_buffer(
+            &dev.inner,
+            geom.0,
+            sys::RTC_BUFFER_TYPE_VERTEX,
+            sys::RTC_FORMAT_FLOAT3,
+            &[[0u8; 3]],
+        )
+        .unwrap_err();
+        let EmbreeError::Api { code, message, .. } = &err else {
+            panic!("unexpected {err:?}");
+        };
+        assert_eq!(*code, sys::RTC_ERROR_INVALID_OPERATION, "{err}");
+        assert!(message.is_some(), "{err}");
+        // The error is consumed: the next check on this thread is clean.
+        assert!(dev.inner.check("noop").is_ok());
+    }
+
+    #[test]
+    fn empty_meshes_are_allowed() {
+        let mut b = SceneBuilder::new(&device()).expect("scene");
+        assert_eq!(b.add_triangle_mesh(&[], &[]), Ok(0));
+        let scene = b.commit().expect("commit");
+        assert!(!scene.occluded([0.0; 3], [1.0, 0.0, 0.0], 0.0, 1.0));
+    }
+}

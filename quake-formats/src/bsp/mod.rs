@@ -1,0 +1,494 @@
+//! BSP29 and BSP2 files: one typed model, two on-disk encodings.
+//!
+//! The model stores every index as `u32`/`i32` and every bound as `f32`, wide enough for both
+//! versions. Each record type knows its encoding per version ([`Record`]); lumps are read and
+//! written by one generic pair of functions. Trailing BSPX lumps are kept as named byte blobs.
+
+pub mod limits;
+mod records;
+mod validate;
+
+pub use records::{
+    ClipNode, Face, Leaf, Model, Node, Plane as BspPlane, TexInfo, contents, texinfo_flags,
+};
+pub use validate::{Problem, Severity, validate};
+
+use crate::bytes::{PutLe, Reader};
+use crate::error::{FormatError, Result};
+use crate::layout::{Layout, place};
+use crate::miptex::TextureLump;
+use limits::*;
+use records::Record;
+
+/// Which on-disk encoding a BSP uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BspVersion {
+    /// Quake's original: 16-bit indices and bounds.
+    Bsp29,
+    /// The "BSP2" extension: 32-bit indices, float bounds.
+    Bsp2,
+}
+
+impl std::fmt::Display for BspVersion {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            BspVersion::Bsp29 => "BSP29",
+            BspVersion::Bsp2 => "BSP2",
+        })
+    }
+}
+
+const BSP29_MAGIC: [u8; 4] = 29i32.to_le_bytes();
+const BSP2_MAGIC: [u8; 4] = *b"BSP2";
+const BSPX_MAGIC: [u8; 4] = *b"BSPX";
+const HEADER_LEN: usize = 4 + 15 * 8;
+const BSPX_ENTRY_LEN: usize = 24 + 8;
+
+/// The lumps in header order.
+pub const LUMP_NAMES: [&str; 15] = [
+    "entities",
+    "planes",
+    "textures",
+    "vertexes",
+    "visibility",
+    "nodes",
+    "texinfo",
+    "faces",
+    "lighting",
+    "clipnodes",
+    "leafs",
+    "marksurfaces",
+    "edges",
+    "surfedges",
+    "models",
+];
+
+/// The order lumps are laid out in a freshly written file (the order common compilers use).
+const FILE_ORDER: [usize; 15] = [1, 10, 3, 5, 6, 7, 9, 11, 13, 12, 14, 8, 4, 0, 2];
+
+/// An extension lump stored after the standard ones (BSPX), kept verbatim.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BspxLump {
+    /// 24-byte NUL-padded name as stored.
+    pub raw_name: [u8; 24],
+    pub data: Vec<u8>,
+}
+
+impl BspxLump {
+    pub fn name(&self) -> String {
+        let end = self.raw_name.iter().position(|&b| b == 0).unwrap_or(24);
+        crate::bytes::latin1_to_string(&self.raw_name[..end])
+    }
+}
+
+/// A whole BSP file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Bsp {
+    pub version: BspVersion,
+    /// The entity lump's text as bytes, including its terminating NUL.
+    pub entities: Vec<u8>,
+    pub planes: Vec<BspPlane>,
+    pub textures: TextureLump,
+    pub vertices: Vec<[f32; 3]>,
+    /// Compressed PVS rows; leaves point into it with `vis_offset`.
+    pub visibility: Vec<u8>,
+    pub nodes: Vec<Node>,
+    pub texinfo: Vec<TexInfo>,
+    pub faces: Vec<Face>,
+    /// 8-bit lightmaps; faces point into it with `light_offset`.
+    pub lighting: Vec<u8>,
+    pub clipnodes: Vec<ClipNode>,
+    pub leafs: Vec<Leaf>,
+    pub marksurfaces: Vec<u32>,
+    pub edges: Vec<[u32; 2]>,
+    pub surfedges: Vec<i32>,
+    pub models: Vec<Model>,
+    pub bspx: Vec<BspxLump>,
+    /// How the file this came from was laid out (for byte-identical rewrites).
+    layout: Option<(BspVersion, Layout)>,
+}
+
+impl Default for Bsp {
+    fn default() -> Self {
+        Bsp::new(BspVersion::Bsp29)
+    }
+}
+
+/// A lump's location in the header.
+#[derive(Debug, Clone, Copy)]
+struct LumpEntry {
+    offset: usize,
+    len: usize,
+}
+
+impl Bsp {
+    pub fn new(version: BspVersion) -> Bsp {
+        Bsp {
+            version,
+            entities: Vec::new(),
+            planes: Vec::new(),
+            textures: TextureLump::default(),
+            vertices: Vec::new(),
+            visibility: Vec::new(),
+            nodes: Vec::new(),
+            texinfo: Vec::new(),
+            faces: Vec::new(),
+            lighting: Vec::new(),
+            clipnodes: Vec::new(),
+            leafs: Vec::new(),
+            marksurfaces: Vec::new(),
+            edges: Vec::new(),
+            surfedges: Vec::new(),
+            models: Vec::new(),
+            bspx: Vec::new(),
+            layout: None,
+        }
+    }
+
+    /// Parse a BSP29 or BSP2 file. Structural damage (truncation, lumps outside the file, sizes
+    /// that are not whole records) is an error; bad indices are left to [`validate`].
+    pub fn read(data: &[u8]) -> Result<Bsp> {
+        let mut r = Reader::new(data, "BSP header");
+        let magic = r.array::<4>()?;
+        let version = match magic {
+            BSP29_MAGIC => BspVersion::Bsp29,
+            BSP2_MAGIC => BspVersion::Bsp2,
+            _ => return Err(FormatError::UnknownBspVersion(u32::from_le_bytes(magic))),
+        };
+        let mut entries = [LumpEntry { offset: 0, len: 0 }; 15];
+        for (i, entry) in entries.iter_mut().enumerate() {
+            let offset = r.i32()?;
+            let len = r.i32()?;
+            if offset < 0 || len < 0 || offset as i64 + len as i64 > data.len() as i64 {
+                return Err(FormatError::LumpOutOfFile {
+                    lump: LUMP_NAMES[i],
+                    offset: offset as i64,
+                    length: len as i64,
+                    file_len: data.len(),
+                });
+            }
+            *entry = LumpEntry {
+                offset: offset as usize,
+                len: len as usize,
+            };
+        }
+        let lump = |i: usize| &data[entries[i].offset..entries[i].offset + entries[i].len];
+        let mut bsp = Bsp::new(version);
+        bsp.entities = lump(0).to_vec();
+        bsp.planes = read_records(lump(1), version)?;
+        bsp.textures = TextureLump::decode(lump(2))?;
+        bsp.vertices = read_records(lump(3), version)?;
+        bsp.visibility = lump(4).to_vec();
+        bsp.nodes = read_records(lump(5), version)?;
+        bsp.texinfo = read_records(lump(6), version)?;
+        bsp.faces = read_records(lump(7), version)?;
+        bsp.lighting = lump(8).to_vec();
+        bsp.clipnodes = read_records(lump(9), version)?;
+        bsp.leafs = read_records(lump(10), version)?;
+        bsp.marksurfaces = read_records(lump(11), version)?;
+        bsp.edges = read_records(lump(12), version)?;
+        bsp.surfedges = read_records(lump(13), version)?;
+        bsp.models = read_records(lump(14), version)?;
+
+        let mut segments: Vec<(usize, usize)> = FILE_ORDER
+            .iter()
+            .map(|&i| (entries[i].offset, entries[i].len))
+            .collect();
+        let lumps_end = entries.iter().map(|e| e.offset + e.len).max().unwrap_or(0);
+        if let Some((dir, lumps)) = read_bspx(data, lumps_end)? {
+            segments.push(dir);
+            for (segment, lump) in lumps {
+                segments.push(segment);
+                bsp.bspx.push(lump);
+            }
+        }
+        bsp.layout = Some((version, Layout::record(data, HEADER_LEN, segments)));
+        Ok(bsp)
+    }
+
+    /// Encode in `self.version`. A file read and written back unchanged is byte-identical.
+    /// Writing BSP29 fails with [`FormatError::Bsp29Limit`] when the data does not fit it.
+    pub fn write(&self) -> Result<Vec<u8>> {
+        let v = self.version;
+        if v == BspVersion::Bsp29 {
+            self.check_bsp29_limits()?;
+        }
+        let mut lumps: [Vec<u8>; 15] = Default::default();
+        lumps[0] = self.entities.clone();
+        lumps[1] = write_records(&self.planes, v)?;
+        lumps[2] = self.textures.encode();
+        lumps[3] = write_records(&self.vertices, v)?;
+        lumps[4] = self.visibility.clone();
+        lumps[5] = write_records(&self.nodes, v)?;
+        lumps[6] = write_records(&self.texinfo, v)?;
+        lumps[7] = write_records(&self.faces, v)?;
+        lumps[8] = self.lighting.clone();
+        lumps[9] = write_records(&self.clipnodes, v)?;
+        lumps[10] = write_records(&self.leafs, v)?;
+        lumps[11] = write_records(&self.marksurfaces, v)?;
+        lumps[12] = write_records(&self.edges, v)?;
+        lumps[13] = write_records(&self.surfedges, v)?;
+        lumps[14] = write_records(&self.models, v)?;
+
+        let mut segments: Vec<&[u8]> = FILE_ORDER.iter().map(|&i| lumps[i].as_slice()).collect();
+        let bspx_dir_len = if self.bspx.is_empty() {
+            0
+        } else {
+            8 + BSPX_ENTRY_LEN * self.bspx.len()
+        };
+        let mut lens: Vec<usize> = segments.iter().map(|s| s.len()).collect();
+        if !self.bspx.is_empty() {
+            lens.push(bspx_dir_len);
+            lens.extend(self.bspx.iter().map(|l| l.data.len()));
+        }
+        let layout = self
+            .layout
+            .as_ref()
+            .filter(|(lv, _)| *lv == v)
+            .map(|(_, l)| l);
+        let placement = place(layout, HEADER_LEN, &lens);
+
+        let mut header = Vec::with_capacity(HEADER_LEN);
+        header.extend_from_slice(match v {
+            BspVersion::Bsp29 => &BSP29_MAGIC,
+            BspVersion::Bsp2 => &BSP2_MAGIC,
+        });
+        for lump in 0..15 {
+            let slot = FILE_ORDER.iter().position(|&i| i == lump).unwrap_or(0);
+            header.put_i32(placement.offsets[slot] as i32);
+            header.put_i32(lumps[lump].len() as i32);
+        }
+        let mut bspx_dir = Vec::with_capacity(bspx_dir_len);
+        if !self.bspx.is_empty() {
+            bspx_dir.extend_from_slice(&BSPX_MAGIC);
+            bspx_dir.put_u32(self.bspx.len() as u32);
+            for (i, l) in self.bspx.iter().enumerate() {
+                bspx_dir.extend_from_slice(&l.raw_name);
+                bspx_dir.put_u32(placement.offsets[16 + i] as u32);
+                bspx_dir.put_u32(l.data.len() as u32);
+            }
+            segments.push(&bspx_dir);
+            segments.extend(self.bspx.iter().map(|l| l.data.as_slice()));
+        }
+        Ok(placement.assemble(&header, &segments))
+    }
+
+    /// Same data in another encoding; fails when converting to BSP29 would exceed its limits.
+    pub fn converted(&self, version: BspVersion) -> Result<Bsp> {
+        let mut out = self.clone();
+        out.version = version;
+        if version == BspVersion::Bsp29 {
+            out.check_bsp29_limits()?;
+        }
+        Ok(out)
+    }
+
+    /// Every BSP29 format limit, checked before any record is narrowed.
+    pub fn check_bsp29_limits(&self) -> Result<()> {
+        let counts = [
+            ("the node count", self.nodes.len(), BSP29_MAX_NODES),
+            ("the leaf count", self.leafs.len(), BSP29_MAX_LEAFS),
+            (
+                "the clip node count",
+                self.clipnodes.len(),
+                BSP29_MAX_CLIPNODES,
+            ),
+            ("the plane count", self.planes.len(), BSP29_MAX_PLANES),
+            ("the vertex count", self.vertices.len(), BSP29_MAX_VERTICES),
+            ("the face count", self.faces.len(), BSP29_MAX_FACES),
+            (
+                "the mark surface count",
+                self.marksurfaces.len(),
+                BSP29_MAX_MARKSURFACES,
+            ),
+            ("the texinfo count", self.texinfo.len(), BSP29_MAX_TEXINFO),
+        ];
+        for (what, count, max) in counts {
+            if count > max {
+                return Err(FormatError::Bsp29Limit { what, count, max });
+            }
+        }
+        if let Some(f) = self
+            .faces
+            .iter()
+            .find(|f| f.num_edges as usize > BSP29_MAX_FACE_EDGES)
+        {
+            return Err(FormatError::Bsp29Limit {
+                what: "a face's edge count",
+                count: f.num_edges as usize,
+                max: BSP29_MAX_FACE_EDGES,
+            });
+        }
+        let out_of_range = |b: &[f32; 3]| b.iter().any(|c| c.abs() > BSP29_MAX_COORD);
+        let bounds_ok = self
+            .nodes
+            .iter()
+            .map(|n| (n.mins, n.maxs))
+            .chain(self.leafs.iter().map(|l| (l.mins, l.maxs)))
+            .all(|(a, b)| !out_of_range(&a) && !out_of_range(&b));
+        if !bounds_ok {
+            return Err(FormatError::Bsp29Limit {
+                what: "a node or leaf bound (map units from the origin)",
+                count: 32768,
+                max: BSP29_MAX_COORD as usize,
+            });
+        }
+        Ok(())
+    }
+
+    /// The entity lump as text (Quake text is Latin-1, not UTF-8), without the trailing NUL.
+    pub fn entity_text(&self) -> String {
+        let end = self
+            .entities
+            .iter()
+            .position(|&b| b == 0)
+            .unwrap_or(self.entities.len());
+        crate::bytes::latin1_to_string(&self.entities[..end])
+    }
+
+    /// Replace the entity lump with `text` plus the terminating NUL engines expect.
+    pub fn set_entity_text(&mut self, text: &str) {
+        self.entities = crate::bytes::string_to_latin1(text);
+        self.entities.push(0);
+    }
+
+    /// The vertices of a face in winding order (edges followed by their direction).
+    /// Indices are bounds-checked; a broken face yields `None`.
+    pub fn face_vertices(&self, face: &Face) -> Option<Vec<[f32; 3]>> {
+        let first = face.first_edge as usize;
+        let surfedges = self.surfedges.get(first..first + face.num_edges as usize)?;
+        surfedges
+            .iter()
+            .map(|&se| {
+                let edge = self.edges.get(se.unsigned_abs() as usize)?;
+                let v = if se >= 0 { edge[0] } else { edge[1] };
+                self.vertices.get(v as usize).copied()
+            })
+            .collect()
+    }
+
+    /// The leaf containing `point`, walking the world model's hull 0 tree.
+    pub fn leaf_at(&self, point: [f32; 3]) -> Option<usize> {
+        let mut node = *self.models.first()?.head_nodes.first()?;
+        let mut steps = 0;
+        while node >= 0 {
+            let n = self.nodes.get(node as usize)?;
+            let plane = self.planes.get(n.plane as usize)?;
+            let d = plane.normal[0] * point[0]
+                + plane.normal[1] * point[1]
+                + plane.normal[2] * point[2]
+                - plane.dist;
+            node = n.children[usize::from(d < 0.0)];
+            steps += 1;
+            if steps > self.nodes.len() {
+                return None; // a cycle in a damaged file
+            }
+        }
+        Some((-(node + 1)) as usize)
+    }
+}
+
+fn read_records<T: Record>(data: &[u8], v: BspVersion) -> Result<Vec<T>> {
+    let size = T::size(v);
+    if data.len() % size != 0 {
+        return Err(FormatError::LumpSize {
+            lump: T::LUMP,
+            length: data.len(),
+            record: size,
+        });
+    }
+    let mut r = Reader::new(data, T::LUMP);
+    (0..data.len() / size).map(|_| T::read(&mut r, v)).collect()
+}
+
+fn write_records<T: Record>(records: &[T], v: BspVersion) -> Result<Vec<u8>> {
+    let mut out = Vec::with_capacity(records.len() * T::size(v));
+    for rec in records {
+        rec.write(&mut out, v)?;
+    }
+    Ok(out)
+}
+
+type BspxSegments = ((usize, usize), Vec<((usize, usize), BspxLump)>);
+
+/// The BSPX directory that may follow the standard lumps (4-byte aligned).
+fn read_bspx(data: &[u8], lumps_end: usize) -> Result<Option<BspxSegments>> {
+    let dir_ofs = lumps_end.next_multiple_of(4);
+    if data.len() < dir_ofs + 8 || data[dir_ofs..dir_ofs + 4] != BSPX_MAGIC {
+        return Ok(None);
+    }
+    let mut r = Reader::at(data, dir_ofs + 4, "BSPX directory");
+    let count = r.u32()? as usize;
+    if count > data.len() / BSPX_ENTRY_LEN {
+        return Err(FormatError::BadLump {
+            lump: "BSPX",
+            detail: format!("directory claims {count} lumps"),
+        });
+    }
+    let mut lumps = Vec::with_capacity(count);
+    for i in 0..count {
+        let raw_name = r.array::<24>()?;
+        let offset = r.u32()? as usize;
+        let len = r.u32()? as usize;
+        if offset.checked_add(len).is_none_or(|end| end > data.len()) {
+            return Err(FormatError::BadLump {
+                lump: "BSPX",
+                detail: format!("lump {i}: offset {offset} + length {len} is past the file's end"),
+            });
+        }
+        let lump = BspxLump {
+            raw_name,
+            data: data[offset..offset + len].to_vec(),
+        };
+        lumps.push(((offset, len), lump));
+    }
+    Ok(Some(((dir_ofs, 8 + BSPX_ENTRY_LEN * count), lumps)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn empty_bsp_round_trips_in_both_versions() {
+        for v in [BspVersion::Bsp29, BspVersion::Bsp2] {
+            let mut bsp = Bsp::new(v);
+            bsp.set_entity_text("{\n\"classname\" \"worldspawn\"\n}\n");
+            let bytes = bsp.write().expect("write");
+            let back = Bsp::read(&bytes).expect("read");
+            assert_eq!(back.version, v);
+            assert_eq!(back.entities, bsp.entities);
+            assert_eq!(back.write().expect("rewrite"), bytes);
+        }
+    }
+
+    #[test]
+    fn truncated_header_is_an_error_not_a_panic() {
+        let bsp = Bsp::new(BspVersion::Bsp29).write().expect("write");
+        for len in 0..HEADER_LEN {
+            assert!(Bsp::read(&bsp[..len]).is_err());
+        }
+    }
+
+    #[test]
+    fn wrong_version_is_named() {
+        let mut bytes = Bsp::new(BspVersion::Bsp29).write().expect("write");
+        bytes[0] = 30;
+        let err = Bsp::read(&bytes).expect_err("version 30");
+        assert!(err.to_string().contains("0x0000001e"), "{err}");
+    }
+
+    #[test]
+    fn bsp29_limit_says_use_bsp2() {
+        let mut bsp = Bsp::new(BspVersion::Bsp29);
+        bsp.vertices = vec![[0.0; 3]; BSP29_MAX_VERTICES + 1];
+        let err = bsp.write().expect_err("too many vertices");
+        assert!(err.to_string().contains("BSP2"), "{err}");
+        assert!(
+            bsp.converted(BspVersion::Bsp2)
+                .expect("bsp2")
+                .write()
+                .is_ok()
+        );
+    }
+}

@@ -1,0 +1,465 @@
+//! The fixed-size records of the BSP lumps and their per-version encodings.
+
+use super::BspVersion;
+use crate::bytes::{PutLe, Reader};
+use crate::error::{FormatError, Result};
+
+/// Leaf and clip node contents values.
+pub mod contents {
+    pub const EMPTY: i32 = -1;
+    pub const SOLID: i32 = -2;
+    pub const WATER: i32 = -3;
+    pub const SLIME: i32 = -4;
+    pub const LAVA: i32 = -5;
+    pub const SKY: i32 = -6;
+}
+
+/// Texinfo flags.
+pub mod texinfo_flags {
+    /// Sky or liquid: no lightmap, drawn warped; engines skip its extents check.
+    pub const SPECIAL: i32 = 1;
+}
+
+/// One record type of a lump, with its size and encoding in each version.
+pub(super) trait Record: Sized {
+    const LUMP: &'static str;
+    fn size(v: BspVersion) -> usize;
+    fn read(r: &mut Reader, v: BspVersion) -> Result<Self>;
+    fn write(&self, out: &mut Vec<u8>, v: BspVersion) -> Result<()>;
+}
+
+/// Narrow a value into a BSP29 16-bit field; `BSP29_*` limits are checked before this, so a
+/// failure here means a value (not a count) is out of range.
+fn narrow<T: TryFrom<i64>>(value: i64, lump: &'static str, field: &'static str) -> Result<T> {
+    T::try_from(value).map_err(|_| FormatError::BadLump {
+        lump,
+        detail: format!(
+            "{field} value {value} does not fit BSP29's 16-bit field; write BSP2 instead (--bsp2)"
+        ),
+    })
+}
+
+/// The BSP's plane record (`f32`), as opposed to [`crate::geom::Plane`] (`f64`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Plane {
+    pub normal: [f32; 3],
+    pub dist: f32,
+    /// 0..2 axial X/Y/Z, 3..5 mostly X/Y/Z.
+    pub kind: i32,
+}
+
+impl Record for Plane {
+    const LUMP: &'static str = "planes";
+    fn size(_: BspVersion) -> usize {
+        20
+    }
+    fn read(r: &mut Reader, _: BspVersion) -> Result<Self> {
+        Ok(Plane {
+            normal: r.f32x3()?,
+            dist: r.f32()?,
+            kind: r.i32()?,
+        })
+    }
+    fn write(&self, out: &mut Vec<u8>, _: BspVersion) -> Result<()> {
+        out.put_f32x3(self.normal);
+        out.put_f32(self.dist);
+        out.put_i32(self.kind);
+        Ok(())
+    }
+}
+
+impl Record for [f32; 3] {
+    const LUMP: &'static str = "vertexes";
+    fn size(_: BspVersion) -> usize {
+        12
+    }
+    fn read(r: &mut Reader, _: BspVersion) -> Result<Self> {
+        r.f32x3()
+    }
+    fn write(&self, out: &mut Vec<u8>, _: BspVersion) -> Result<()> {
+        out.put_f32x3(*self);
+        Ok(())
+    }
+}
+
+/// Bounds stored as `i16` in BSP29 and `f32` in BSP2.
+fn read_bounds(r: &mut Reader, v: BspVersion) -> Result<([f32; 3], [f32; 3])> {
+    match v {
+        BspVersion::Bsp29 => {
+            let mut b = [0f32; 6];
+            for c in &mut b {
+                *c = r.i16()? as f32;
+            }
+            Ok(([b[0], b[1], b[2]], [b[3], b[4], b[5]]))
+        }
+        BspVersion::Bsp2 => Ok((r.f32x3()?, r.f32x3()?)),
+    }
+}
+
+fn write_bounds(out: &mut Vec<u8>, v: BspVersion, mins: [f32; 3], maxs: [f32; 3]) {
+    match v {
+        BspVersion::Bsp29 => {
+            // Outward rounding keeps the box conservative; limits were checked beforehand.
+            for c in mins {
+                out.put_i16(c.floor().clamp(-32768.0, 32767.0) as i16);
+            }
+            for c in maxs {
+                out.put_i16(c.ceil().clamp(-32768.0, 32767.0) as i16);
+            }
+        }
+        BspVersion::Bsp2 => {
+            out.put_f32x3(mins);
+            out.put_f32x3(maxs);
+        }
+    }
+}
+
+/// A 16-bit (BSP29) or 32-bit (BSP2) signed child or index.
+fn read_wide_i(r: &mut Reader, v: BspVersion) -> Result<i32> {
+    match v {
+        BspVersion::Bsp29 => Ok(r.i16()? as i32),
+        BspVersion::Bsp2 => r.i32(),
+    }
+}
+
+fn write_wide_i(
+    out: &mut Vec<u8>,
+    v: BspVersion,
+    value: i32,
+    lump: &'static str,
+    field: &'static str,
+) -> Result<()> {
+    match v {
+        BspVersion::Bsp29 => out.put_i16(narrow(value as i64, lump, field)?),
+        BspVersion::Bsp2 => out.put_i32(value),
+    }
+    Ok(())
+}
+
+/// A 16-bit (BSP29) or 32-bit (BSP2) unsigned index.
+fn read_wide_u(r: &mut Reader, v: BspVersion) -> Result<u32> {
+    match v {
+        BspVersion::Bsp29 => Ok(r.u16()? as u32),
+        BspVersion::Bsp2 => r.u32(),
+    }
+}
+
+fn write_wide_u(
+    out: &mut Vec<u8>,
+    v: BspVersion,
+    value: u32,
+    lump: &'static str,
+    field: &'static str,
+) -> Result<()> {
+    match v {
+        BspVersion::Bsp29 => out.put_u16(narrow(value as i64, lump, field)?),
+        BspVersion::Bsp2 => out.put_u32(value),
+    }
+    Ok(())
+}
+
+/// An interior node of the hull 0 tree. A child `>= 0` is a node, `< 0` is leaf `-(child + 1)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Node {
+    pub plane: u32,
+    pub children: [i32; 2],
+    pub mins: [f32; 3],
+    pub maxs: [f32; 3],
+    pub first_face: u32,
+    pub num_faces: u32,
+}
+
+impl Record for Node {
+    const LUMP: &'static str = "nodes";
+    fn size(v: BspVersion) -> usize {
+        match v {
+            BspVersion::Bsp29 => 24,
+            BspVersion::Bsp2 => 44,
+        }
+    }
+    fn read(r: &mut Reader, v: BspVersion) -> Result<Self> {
+        let plane = r.u32()?;
+        let children = [read_wide_i(r, v)?, read_wide_i(r, v)?];
+        let (mins, maxs) = read_bounds(r, v)?;
+        Ok(Node {
+            plane,
+            children,
+            mins,
+            maxs,
+            first_face: read_wide_u(r, v)?,
+            num_faces: read_wide_u(r, v)?,
+        })
+    }
+    fn write(&self, out: &mut Vec<u8>, v: BspVersion) -> Result<()> {
+        out.put_u32(self.plane);
+        for c in self.children {
+            write_wide_i(out, v, c, Self::LUMP, "child")?;
+        }
+        write_bounds(out, v, self.mins, self.maxs);
+        write_wide_u(out, v, self.first_face, Self::LUMP, "first face")?;
+        write_wide_u(out, v, self.num_faces, Self::LUMP, "face count")
+    }
+}
+
+/// A convex region of the hull 0 tree.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Leaf {
+    pub contents: i32,
+    /// Byte offset of this leaf's compressed PVS row, or -1 for none.
+    pub vis_offset: i32,
+    pub mins: [f32; 3],
+    pub maxs: [f32; 3],
+    pub first_marksurface: u32,
+    pub num_marksurfaces: u32,
+    /// Ambient sound levels: water, sky, slime, lava.
+    pub ambient: [u8; 4],
+}
+
+impl Record for Leaf {
+    const LUMP: &'static str = "leafs";
+    fn size(v: BspVersion) -> usize {
+        match v {
+            BspVersion::Bsp29 => 28,
+            BspVersion::Bsp2 => 44,
+        }
+    }
+    fn read(r: &mut Reader, v: BspVersion) -> Result<Self> {
+        let contents = r.i32()?;
+        let vis_offset = r.i32()?;
+        let (mins, maxs) = read_bounds(r, v)?;
+        Ok(Leaf {
+            contents,
+            vis_offset,
+            mins,
+            maxs,
+            first_marksurface: read_wide_u(r, v)?,
+            num_marksurfaces: read_wide_u(r, v)?,
+            ambient: r.array()?,
+        })
+    }
+    fn write(&self, out: &mut Vec<u8>, v: BspVersion) -> Result<()> {
+        out.put_i32(self.contents);
+        out.put_i32(self.vis_offset);
+        write_bounds(out, v, self.mins, self.maxs);
+        write_wide_u(
+            out,
+            v,
+            self.first_marksurface,
+            Self::LUMP,
+            "first mark surface",
+        )?;
+        write_wide_u(
+            out,
+            v,
+            self.num_marksurfaces,
+            Self::LUMP,
+            "mark surface count",
+        )?;
+        out.extend_from_slice(&self.ambient);
+        Ok(())
+    }
+}
+
+/// A node of a clipping hull (1 and 2). A child `>= 0` is a clip node, `< 0` is contents.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClipNode {
+    pub plane: u32,
+    pub children: [i32; 2],
+}
+
+impl Record for ClipNode {
+    const LUMP: &'static str = "clipnodes";
+    fn size(v: BspVersion) -> usize {
+        match v {
+            BspVersion::Bsp29 => 8,
+            BspVersion::Bsp2 => 12,
+        }
+    }
+    fn read(r: &mut Reader, v: BspVersion) -> Result<Self> {
+        Ok(ClipNode {
+            plane: r.u32()?,
+            children: [read_wide_i(r, v)?, read_wide_i(r, v)?],
+        })
+    }
+    fn write(&self, out: &mut Vec<u8>, v: BspVersion) -> Result<()> {
+        out.put_u32(self.plane);
+        for c in self.children {
+            write_wide_i(out, v, c, Self::LUMP, "child")?;
+        }
+        Ok(())
+    }
+}
+
+/// Texture projection: `s = dot(p, vecs[0].xyz) + vecs[0].w`, likewise `t` with `vecs[1]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TexInfo {
+    pub vecs: [[f32; 4]; 2],
+    pub miptex: u32,
+    pub flags: i32,
+}
+
+impl Record for TexInfo {
+    const LUMP: &'static str = "texinfo";
+    fn size(_: BspVersion) -> usize {
+        40
+    }
+    fn read(r: &mut Reader, _: BspVersion) -> Result<Self> {
+        let mut vecs = [[0f32; 4]; 2];
+        for row in &mut vecs {
+            for c in row.iter_mut() {
+                *c = r.f32()?;
+            }
+        }
+        Ok(TexInfo {
+            vecs,
+            miptex: r.u32()?,
+            flags: r.i32()?,
+        })
+    }
+    fn write(&self, out: &mut Vec<u8>, _: BspVersion) -> Result<()> {
+        for row in self.vecs {
+            for c in row {
+                out.put_f32(c);
+            }
+        }
+        out.put_u32(self.miptex);
+        out.put_i32(self.flags);
+        Ok(())
+    }
+}
+
+/// A drawable polygon: a run of surfedges on one plane with one texinfo and up to four styles.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Face {
+    pub plane: u32,
+    /// 1 when the face looks along the plane's back side.
+    pub side: u32,
+    pub first_edge: u32,
+    pub num_edges: u32,
+    pub texinfo: u32,
+    /// Light styles; 255 marks an empty slot.
+    pub styles: [u8; 4],
+    /// Byte offset of the first lightmap in the lighting lump, or -1 for none.
+    pub light_offset: i32,
+}
+
+impl Record for Face {
+    const LUMP: &'static str = "faces";
+    fn size(v: BspVersion) -> usize {
+        match v {
+            BspVersion::Bsp29 => 20,
+            BspVersion::Bsp2 => 28,
+        }
+    }
+    fn read(r: &mut Reader, v: BspVersion) -> Result<Self> {
+        Ok(Face {
+            plane: read_wide_u(r, v)?,
+            side: read_wide_u(r, v)?,
+            first_edge: r.u32()?,
+            num_edges: read_wide_u(r, v)?,
+            texinfo: read_wide_u(r, v)?,
+            styles: r.array()?,
+            light_offset: r.i32()?,
+        })
+    }
+    fn write(&self, out: &mut Vec<u8>, v: BspVersion) -> Result<()> {
+        write_wide_u(out, v, self.plane, Self::LUMP, "plane")?;
+        write_wide_u(out, v, self.side, Self::LUMP, "side")?;
+        out.put_u32(self.first_edge);
+        write_wide_u(out, v, self.num_edges, Self::LUMP, "edge count")?;
+        write_wide_u(out, v, self.texinfo, Self::LUMP, "texinfo")?;
+        out.extend_from_slice(&self.styles);
+        out.put_i32(self.light_offset);
+        Ok(())
+    }
+}
+
+impl Record for u32 {
+    const LUMP: &'static str = "marksurfaces";
+    fn size(v: BspVersion) -> usize {
+        match v {
+            BspVersion::Bsp29 => 2,
+            BspVersion::Bsp2 => 4,
+        }
+    }
+    fn read(r: &mut Reader, v: BspVersion) -> Result<Self> {
+        read_wide_u(r, v)
+    }
+    fn write(&self, out: &mut Vec<u8>, v: BspVersion) -> Result<()> {
+        write_wide_u(out, v, *self, Self::LUMP, "face")
+    }
+}
+
+impl Record for [u32; 2] {
+    const LUMP: &'static str = "edges";
+    fn size(v: BspVersion) -> usize {
+        2 * <u32 as Record>::size(v)
+    }
+    fn read(r: &mut Reader, v: BspVersion) -> Result<Self> {
+        Ok([read_wide_u(r, v)?, read_wide_u(r, v)?])
+    }
+    fn write(&self, out: &mut Vec<u8>, v: BspVersion) -> Result<()> {
+        for &i in self {
+            write_wide_u(out, v, i, Self::LUMP, "vertex")?;
+        }
+        Ok(())
+    }
+}
+
+impl Record for i32 {
+    const LUMP: &'static str = "surfedges";
+    fn size(_: BspVersion) -> usize {
+        4
+    }
+    fn read(r: &mut Reader, _: BspVersion) -> Result<Self> {
+        r.i32()
+    }
+    fn write(&self, out: &mut Vec<u8>, _: BspVersion) -> Result<()> {
+        out.put_i32(*self);
+        Ok(())
+    }
+}
+
+/// A brush model: the world (model 0) or a brush entity, with one head node per hull.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Model {
+    pub mins: [f32; 3],
+    pub maxs: [f32; 3],
+    pub origin: [f32; 3],
+    /// Hull 0 node, then clip node heads of hulls 1..3.
+    pub head_nodes: [i32; 4],
+    /// Leaves of this model that have PVS rows (the world's count excludes leaf 0).
+    pub vis_leafs: i32,
+    pub first_face: u32,
+    pub num_faces: u32,
+}
+
+impl Record for Model {
+    const LUMP: &'static str = "models";
+    fn size(_: BspVersion) -> usize {
+        64
+    }
+    fn read(r: &mut Reader, _: BspVersion) -> Result<Self> {
+        Ok(Model {
+            mins: r.f32x3()?,
+            maxs: r.f32x3()?,
+            origin: r.f32x3()?,
+            head_nodes: [r.i32()?, r.i32()?, r.i32()?, r.i32()?],
+            vis_leafs: r.i32()?,
+            first_face: r.u32()?,
+            num_faces: r.u32()?,
+        })
+    }
+    fn write(&self, out: &mut Vec<u8>, _: BspVersion) -> Result<()> {
+        out.put_f32x3(self.mins);
+        out.put_f32x3(self.maxs);
+        out.put_f32x3(self.origin);
+        for h in self.head_nodes {
+            out.put_i32(h);
+        }
+        out.put_i32(self.vis_leafs);
+        out.put_u32(self.first_face);
+        out.put_u32(self.num_faces);
+        Ok(())
+    }
+}

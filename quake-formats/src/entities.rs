@@ -1,0 +1,168 @@
+//! The entity lump: `{ "key" "value" ... }` blocks, kept as ordered key/value pairs.
+
+use crate::error::{FormatError, Result};
+
+/// One entity: its key/value pairs in file order (keys may repeat; the first one wins on lookup,
+/// as in Quake's `ValueForKey`).
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct Entity {
+    pub pairs: Vec<(String, String)>,
+}
+
+impl Entity {
+    pub fn get(&self, key: &str) -> Option<&str> {
+        self.pairs
+            .iter()
+            .find(|(k, _)| k == key)
+            .map(|(_, v)| v.as_str())
+    }
+
+    pub fn classname(&self) -> &str {
+        self.get("classname").unwrap_or("")
+    }
+
+    /// Set `key`, replacing its first occurrence or appending it.
+    pub fn set(&mut self, key: &str, value: impl Into<String>) {
+        let value = value.into();
+        match self.pairs.iter_mut().find(|(k, _)| k == key) {
+            Some(pair) => pair.1 = value,
+            None => self.pairs.push((key.to_string(), value)),
+        }
+    }
+
+    pub fn remove(&mut self, key: &str) {
+        self.pairs.retain(|(k, _)| k != key);
+    }
+
+    /// A key parsed as numbers separated by spaces (`"origin" "0 0 24"`).
+    pub fn get_floats<const N: usize>(&self, key: &str) -> Option<[f64; N]> {
+        let mut out = [0.0; N];
+        let mut parts = self.get(key)?.split_whitespace();
+        for slot in &mut out {
+            *slot = parts.next()?.parse().ok()?;
+        }
+        Some(out)
+    }
+
+    pub fn get_float(&self, key: &str) -> Option<f64> {
+        self.get(key)?.trim().parse().ok()
+    }
+}
+
+/// Parse entity text. Quake's format has no escapes: a value runs to the next `"`.
+pub fn parse_entities(text: &str) -> Result<Vec<Entity>> {
+    let mut entities = Vec::new();
+    let mut current: Option<Entity> = None;
+    let mut pending_key: Option<String> = None;
+    let mut line = 1;
+    let mut chars = text.chars().peekable();
+    let syntax = |line: usize, detail: &str| FormatError::Syntax {
+        line,
+        detail: detail.to_string(),
+    };
+    while let Some(c) = chars.next() {
+        match c {
+            '\n' => line += 1,
+            c if c.is_whitespace() || c == '\0' => {}
+            '/' if chars.peek() == Some(&'/') => {
+                for c in chars.by_ref() {
+                    if c == '\n' {
+                        line += 1;
+                        break;
+                    }
+                }
+            }
+            '{' => {
+                if current.is_some() {
+                    return Err(syntax(line, "'{' inside an entity"));
+                }
+                current = Some(Entity::default());
+            }
+            '}' => {
+                let entity = current
+                    .take()
+                    .ok_or_else(|| syntax(line, "'}' without '{'"))?;
+                if pending_key.is_some() {
+                    return Err(syntax(line, "key without a value"));
+                }
+                entities.push(entity);
+            }
+            '"' => {
+                let entity = current
+                    .as_mut()
+                    .ok_or_else(|| syntax(line, "string outside an entity"))?;
+                let start_line = line;
+                let mut s = String::new();
+                loop {
+                    match chars.next() {
+                        Some('"') => break,
+                        Some('\n') => {
+                            line += 1;
+                            s.push('\n');
+                        }
+                        Some(c) => s.push(c),
+                        None => return Err(syntax(start_line, "unterminated string")),
+                    }
+                }
+                match pending_key.take() {
+                    None => pending_key = Some(s),
+                    Some(key) => entity.pairs.push((key, s)),
+                }
+            }
+            other => return Err(syntax(line, &format!("unexpected character {other:?}"))),
+        }
+    }
+    if current.is_some() {
+        return Err(syntax(line, "missing '}' at end of entities"));
+    }
+    Ok(entities)
+}
+
+/// Entity text as compilers write it: one pair per line.
+pub fn write_entities(entities: &[Entity]) -> String {
+    let mut out = String::new();
+    for e in entities {
+        out.push_str("{\n");
+        for (k, v) in &e.pairs {
+            out.push('"');
+            out.push_str(k);
+            out.push_str("\" \"");
+            out.push_str(v);
+            out.push_str("\"\n");
+        }
+        out.push_str("}\n");
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    #[test]
+    fn parses_pairs_in_order() {
+        let text = "{\n\"classname\" \"worldspawn\"\n\"wad\" \"a.wad\"\n}\n{\"classname\" \"light\" \"origin\" \"1 2 3\"}";
+        let ents = parse_entities(text).expect("parse");
+        assert_eq!(ents.len(), 2);
+        assert_eq!(ents[0].classname(), "worldspawn");
+        assert_eq!(ents[1].get_floats::<3>("origin"), Some([1.0, 2.0, 3.0]));
+    }
+
+    #[test]
+    fn errors_name_the_line() {
+        let err = parse_entities("{\n\"a\" \"b\"\n\"c\"\n}").expect_err("dangling key");
+        assert!(err.to_string().contains("line 4"), "{err}");
+        let err = parse_entities("{\n\"a\" \"b").expect_err("unterminated");
+        assert!(err.to_string().contains("line 2"), "{err}");
+    }
+
+    proptest! {
+        #[test]
+        fn write_then_parse_is_identity(pairs in proptest::collection::vec(("[^\"\\x00]{0,12}", "[^\"\\x00]{0,20}"), 0..8), n in 0usize..4) {
+            let ents: Vec<Entity> = (0..n).map(|_| Entity { pairs: pairs.clone() }).collect();
+            let text = write_entities(&ents);
+            prop_assert_eq!(parse_entities(&text).expect("parse"), ents);
+        }
+    }
+}

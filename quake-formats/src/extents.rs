@@ -1,0 +1,107 @@
+//! A face's lightmap extents: its texture-space bounds snapped to the 16-texel grid.
+//!
+//! Computed one way for everyone (compiler, light, viewer, validator), in the precision engines
+//! use: vertex and texture-vector components are `f32` in the file and are multiplied and summed
+//! in `f64`, as QuakeSpasm and its descendants do, so our luxel grid lands where theirs does.
+
+use crate::bsp::limits::LIGHTMAP_SCALE;
+
+/// The lightmap rectangle of a face, in texels.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LightmapExtents {
+    /// Texture coordinates of luxel (0, 0): the face's minimum s/t rounded down to the grid.
+    pub tex_mins: [i32; 2],
+    /// Size of the rectangle in texels, a multiple of 16.
+    pub extents: [i32; 2],
+}
+
+impl LightmapExtents {
+    pub fn from_points(points: &[[f32; 3]], vecs: &[[f32; 4]; 2]) -> LightmapExtents {
+        let mut mins = [f64::INFINITY; 2];
+        let mut maxs = [f64::NEG_INFINITY; 2];
+        for p in points {
+            for axis in 0..2 {
+                let v = &vecs[axis];
+                let val = p[0] as f64 * v[0] as f64
+                    + p[1] as f64 * v[1] as f64
+                    + p[2] as f64 * v[2] as f64
+                    + v[3] as f64;
+                mins[axis] = mins[axis].min(val);
+                maxs[axis] = maxs[axis].max(val);
+            }
+        }
+        let scale = LIGHTMAP_SCALE as f64;
+        let mut tex_mins = [0; 2];
+        let mut extents = [0; 2];
+        for axis in 0..2 {
+            if points.is_empty() {
+                break;
+            }
+            let lo = (mins[axis] / scale).floor() as i32;
+            let hi = (maxs[axis] / scale).ceil() as i32;
+            tex_mins[axis] = lo * LIGHTMAP_SCALE;
+            extents[axis] = (hi - lo) * LIGHTMAP_SCALE;
+        }
+        LightmapExtents { tex_mins, extents }
+    }
+
+    /// Luxels across (s) and down (t): one per grid line, so extent/16 + 1.
+    pub fn luxel_size(&self) -> [usize; 2] {
+        [
+            (self.extents[0] / LIGHTMAP_SCALE) as usize + 1,
+            (self.extents[1] / LIGHTMAP_SCALE) as usize + 1,
+        ]
+    }
+
+    pub fn luxel_count(&self) -> usize {
+        let [w, h] = self.luxel_size();
+        w * h
+    }
+
+    /// Texture coordinates (s, t) of luxel (x, y).
+    pub fn luxel_st(&self, x: usize, y: usize) -> [f64; 2] {
+        [
+            (self.tex_mins[0] + x as i32 * LIGHTMAP_SCALE) as f64,
+            (self.tex_mins[1] + y as i32 * LIGHTMAP_SCALE) as f64,
+        ]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const AXIAL: [[f32; 4]; 2] = [[1.0, 0.0, 0.0, 0.0], [0.0, -1.0, 0.0, 0.0]];
+
+    #[test]
+    fn a_64_unit_square_has_5x5_luxels() {
+        let pts = [
+            [0.0, 0.0, 0.0],
+            [64.0, 0.0, 0.0],
+            [64.0, 64.0, 0.0],
+            [0.0, 64.0, 0.0],
+        ];
+        let e = LightmapExtents::from_points(&pts, &AXIAL);
+        assert_eq!(e.tex_mins, [0, -64]);
+        assert_eq!(e.extents, [64, 64]);
+        assert_eq!(e.luxel_size(), [5, 5]);
+    }
+
+    #[test]
+    fn off_grid_points_round_outward() {
+        let pts = [[1.5, 0.0, 0.0], [30.25, -17.0, 0.0], [8.0, 3.0, 0.0]];
+        let e = LightmapExtents::from_points(&pts, &AXIAL);
+        assert_eq!(e.tex_mins, [0, -16]);
+        assert_eq!(e.extents, [32, 48]);
+    }
+
+    #[test]
+    fn imprecise_plane_just_below_a_grid_line_stays_on_it() {
+        // 31.999998 in f32 sits below 32: the grid must extend to 48, exactly as engines do.
+        let pts = [[0.0, 0.0, 0.0], [31.999998, 0.0, 0.0]];
+        let e = LightmapExtents::from_points(&pts, &AXIAL);
+        assert_eq!(e.extents[0], 32);
+        let pts = [[0.0, 0.0, 0.0], [32.000004, 0.0, 0.0]];
+        assert_eq!(LightmapExtents::from_points(&pts, &AXIAL).extents[0], 48);
+    }
+}

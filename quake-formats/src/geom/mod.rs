@@ -1,0 +1,36 @@
+//! Geometry in `f64`: vectors, planes, convex windings and the one epsilon policy every tool uses.
+//!
+//! # Epsilon policy
+//!
+//! All geometry is computed in `f64`; values are rounded to `f32` only when written into a file.
+//! Three tolerances exist, each with one meaning:
+//!
+//! - [`ON_EPSILON`]: a point closer than this (in map units) to a plane is *on* it. Used when
+//!   classifying or splitting windings, so slivers thinner than this are not created.
+//! - [`NORMAL_EPSILON`] and [`DIST_EPSILON`]: two planes are the *same* plane when their normals
+//!   differ by less than `NORMAL_EPSILON` per component and their distances by less than
+//!   `DIST_EPSILON`. Used when planes are deduplicated.
+//! - [`POINT_EPSILON`]: two vertices closer than this per component are the same vertex (welding,
+//!   shared edges, T-junction detection).
+//!
+//! Windings never grow past [`MAX_WORLD_COORD`]; a base winding for a plane spans that extent.
+
+mod plane;
+mod vec3;
+mod winding;
+
+pub use plane::{Plane, PlaneSide};
+pub use vec3::{Bounds, Vec3};
+pub use winding::{Split, Winding};
+
+/// Distance within which a point lies on a plane.
+pub const ON_EPSILON: f64 = 0.01;
+/// Per-component tolerance for two plane normals to be equal.
+pub const NORMAL_EPSILON: f64 = 1e-6;
+/// Tolerance for two plane distances to be equal.
+pub const DIST_EPSILON: f64 = 0.001;
+/// Per-component tolerance for two vertices to be the same vertex.
+pub const POINT_EPSILON: f64 = 0.001;
+/// Half-size of the world cube that base windings span. BSP2 stores float coordinates; this leaves
+/// room for maps far beyond BSP29's ±32767 while keeping f64 precision well under `ON_EPSILON`.
+pub const MAX_WORLD_COORD: f64 = 1.0e6;

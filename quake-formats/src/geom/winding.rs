@@ -1,0 +1,295 @@
+use super::{Bounds, MAX_WORLD_COORD, ON_EPSILON, Plane, PlaneSide, Vec3};
+
+/// A convex polygon, its points in clockwise order seen from the front of its plane (Quake's
+/// convention, matching [`Plane::from_points`]).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Winding {
+    pub points: Vec<Vec3>,
+}
+
+/// The result of splitting a winding by a plane.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Split {
+    Front(Winding),
+    Back(Winding),
+    /// Coplanar; `facing_front` tells whether the winding faces the same way as the plane.
+    On {
+        winding: Winding,
+        facing_front: bool,
+    },
+    Both {
+        front: Winding,
+        back: Winding,
+    },
+}
+
+impl Winding {
+    pub fn new(points: Vec<Vec3>) -> Self {
+        Winding { points }
+    }
+
+    /// A huge square on `plane`, spanning the whole world.
+    pub fn base_for_plane(plane: &Plane) -> Winding {
+        let n = plane.normal;
+        // Pick the major axis; "up" is any axis not parallel to it.
+        let ax = n.x.abs();
+        let ay = n.y.abs();
+        let az = n.z.abs();
+        let up = if az >= ax && az >= ay {
+            Vec3::new(1.0, 0.0, 0.0)
+        } else {
+            Vec3::new(0.0, 0.0, 1.0)
+        };
+        let up = (up - n * up.dot(n))
+            .normalized()
+            .unwrap_or(Vec3::new(0.0, 1.0, 0.0));
+        let right = up.cross(n);
+        let origin = n * plane.dist;
+        let size = MAX_WORLD_COORD * 4.0;
+        let up = up * size;
+        let right = right * size;
+        Winding::new(vec![
+            origin - right + up,
+            origin + right + up,
+            origin + right - up,
+            origin - right - up,
+        ])
+    }
+
+    pub fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.points.is_empty()
+    }
+
+    pub fn bounds(&self) -> Bounds {
+        let mut b = Bounds::EMPTY;
+        for &p in &self.points {
+            b.add_point(p);
+        }
+        b
+    }
+
+    pub fn center(&self) -> Vec3 {
+        let sum = self.points.iter().fold(Vec3::ZERO, |acc, &p| acc + p);
+        sum / self.points.len().max(1) as f64
+    }
+
+    pub fn area(&self) -> f64 {
+        let mut total = Vec3::ZERO;
+        for i in 2..self.points.len() {
+            let d1 = self.points[i - 1] - self.points[0];
+            let d2 = self.points[i] - self.points[0];
+            total += d1.cross(d2);
+        }
+        total.length() * 0.5
+    }
+
+    /// The plane the winding lies on, from its (clockwise) point order.
+    pub fn plane(&self) -> Option<Plane> {
+        let n = self.points.len();
+        if n < 3 {
+            return None;
+        }
+        // Newell's method: robust for slightly non-planar or near-degenerate polygons.
+        let mut normal = Vec3::ZERO;
+        for i in 0..n {
+            let a = self.points[i];
+            let b = self.points[(i + 1) % n];
+            normal.x += (a.y - b.y) * (a.z + b.z);
+            normal.y += (a.z - b.z) * (a.x + b.x);
+            normal.z += (a.x - b.x) * (a.y + b.y);
+        }
+        // Newell gives the counter-clockwise normal; ours is clockwise-from-front.
+        let normal = (-normal).normalized()?;
+        Some(Plane::new(normal, normal.dot(self.center())))
+    }
+
+    pub fn reversed(&self) -> Winding {
+        Winding::new(self.points.iter().rev().copied().collect())
+    }
+
+    /// Classify the winding against a plane without splitting it.
+    pub fn side_of(&self, plane: &Plane) -> PlaneSide {
+        let mut front = false;
+        let mut back = false;
+        for &p in &self.points {
+            match plane.side_of_point(p) {
+                PlaneSide::Front => front = true,
+                PlaneSide::Back => back = true,
+                _ => {}
+            }
+        }
+        match (front, back) {
+            (true, true) => PlaneSide::Cross,
+            (true, false) => PlaneSide::Front,
+            (false, true) => PlaneSide::Back,
+            (false, false) => PlaneSide::On,
+        }
+    }
+
+    /// Split by `plane`; points within [`ON_EPSILON`] of it count as on it.
+    pub fn split(&self, plane: &Plane) -> Split {
+        let dists: Vec<f64> = self.points.iter().map(|&p| plane.distance(p)).collect();
+        let sides: Vec<PlaneSide> = dists
+            .iter()
+            .map(|&d| {
+                if d > ON_EPSILON {
+                    PlaneSide::Front
+                } else if d < -ON_EPSILON {
+                    PlaneSide::Back
+                } else {
+                    PlaneSide::On
+                }
+            })
+            .collect();
+        let has_front = sides.contains(&PlaneSide::Front);
+        let has_back = sides.contains(&PlaneSide::Back);
+        match (has_front, has_back) {
+            (false, false) => {
+                let facing_front = self
+                    .plane()
+                    .is_some_and(|own| own.normal.dot(plane.normal) > 0.0);
+                return Split::On {
+                    winding: self.clone(),
+                    facing_front,
+                };
+            }
+            (true, false) => return Split::Front(self.clone()),
+            (false, true) => return Split::Back(self.clone()),
+            (true, true) => {}
+        }
+        let n = self.points.len();
+        let mut front = Vec::with_capacity(n + 2);
+        let mut back = Vec::with_capacity(n + 2);
+        for i in 0..n {
+            let p = self.points[i];
+            match sides[i] {
+                PlaneSide::On => {
+                    front.push(p);
+                    back.push(p);
+                    continue;
+                }
+                PlaneSide::Front => front.push(p),
+                _ => back.push(p),
+            }
+            let j = (i + 1) % n;
+            if sides[j] == PlaneSide::On || sides[j] == sides[i] {
+                continue;
+            }
+            let q = self.points[j];
+            let t = dists[i] / (dists[i] - dists[j]);
+            let mut mid = p.lerp(q, t);
+            // Keep axial coordinates exact so splits by axial planes do not drift.
+            for axis in 0..3 {
+                if plane.normal[axis] == 1.0 {
+                    mid[axis] = plane.dist;
+                } else if plane.normal[axis] == -1.0 {
+                    mid[axis] = -plane.dist;
+                }
+            }
+            front.push(mid);
+            back.push(mid);
+        }
+        Split::Both {
+            front: Winding::new(front),
+            back: Winding::new(back),
+        }
+    }
+
+    /// The part in front of `plane` (on-plane windings are kept when `keep_on` is set).
+    pub fn clip_front(&self, plane: &Plane, keep_on: bool) -> Option<Winding> {
+        match self.split(plane) {
+            Split::Front(w) => Some(w),
+            Split::Both { front, .. } => Some(front),
+            Split::On { winding, .. } if keep_on => Some(winding),
+            _ => None,
+        }
+    }
+
+    /// True when the winding is too small to matter: fewer than three points, or every edge
+    /// shorter than [`ON_EPSILON`] apart from at most two.
+    pub fn is_tiny(&self) -> bool {
+        if self.points.len() < 3 {
+            return true;
+        }
+        let n = self.points.len();
+        let long_edges = (0..n)
+            .filter(|&i| (self.points[(i + 1) % n] - self.points[i]).length() > ON_EPSILON)
+            .count();
+        long_edges < 3
+    }
+
+    pub fn is_finite(&self) -> bool {
+        self.points.iter().all(|p| p.is_finite())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn square(z: f64) -> Winding {
+        // Clockwise seen from +Z.
+        Winding::new(vec![
+            Vec3::new(0.0, 0.0, z),
+            Vec3::new(0.0, 64.0, z),
+            Vec3::new(64.0, 64.0, z),
+            Vec3::new(64.0, 0.0, z),
+        ])
+    }
+
+    #[test]
+    fn plane_of_clockwise_square_faces_up() {
+        let p = square(8.0).plane().expect("plane");
+        assert!(p.normal.near(Vec3::new(0.0, 0.0, 1.0), 1e-12));
+        assert!((p.dist - 8.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn base_winding_lies_on_plane_and_faces_it() {
+        let plane = Plane::new(Vec3::new(0.6, 0.0, 0.8), 100.0);
+        let w = Winding::base_for_plane(&plane);
+        for p in &w.points {
+            assert!(plane.distance(*p).abs() < 1e-6);
+        }
+        let own = w.plane().expect("plane");
+        assert!(own.normal.near(plane.normal, 1e-9));
+    }
+
+    #[test]
+    fn split_square_in_half() {
+        let plane = Plane::new(Vec3::new(1.0, 0.0, 0.0), 16.0);
+        match square(0.0).split(&plane) {
+            Split::Both { front, back } => {
+                assert!((front.area() - 48.0 * 64.0).abs() < 1e-9);
+                assert!((back.area() - 16.0 * 64.0).abs() < 1e-9);
+            }
+            other => panic!("expected a split, got {other:?}"),
+        }
+    }
+
+    proptest! {
+        #[test]
+        fn split_preserves_area(nx in -1.0f64..1.0, ny in -1.0f64..1.0, nz in -1.0f64..1.0, d in -80.0f64..80.0) {
+            let Some(normal) = Vec3::new(nx, ny, nz).normalized() else { return Ok(()); };
+            let w = square(3.0);
+            let plane = Plane::new(normal, d);
+            let total = w.area();
+            let parts: f64 = match w.split(&plane) {
+                Split::Both { front, back } => {
+                    for p in front.points.iter() { prop_assert!(plane.distance(*p) > -ON_EPSILON * 1.01); }
+                    for p in back.points.iter() { prop_assert!(plane.distance(*p) < ON_EPSILON * 1.01); }
+                    front.area() + back.area()
+                }
+                Split::Front(f) | Split::Back(f) => f.area(),
+                Split::On { winding, .. } => winding.area(),
+            };
+            // Near-tangent cuts may shave a sliver thinner than ON_EPSILON.
+            prop_assert!((parts - total).abs() < 64.0 * ON_EPSILON * 4.0);
+        }
+    }
+}

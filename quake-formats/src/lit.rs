@@ -1,0 +1,55 @@
+//! `.lit` files: coloured lightmaps beside a BSP. A header `QLIT` + version 1, then three bytes
+//! (RGB) for every byte of the BSP's lighting lump, in the same order.
+
+use crate::bytes::{PutLe, Reader};
+use crate::error::{FormatError, Result};
+
+const LIT_MAGIC: [u8; 4] = *b"QLIT";
+const LIT_VERSION: i32 = 1;
+
+pub fn write_lit(rgb: &[u8]) -> Vec<u8> {
+    let mut out = Vec::with_capacity(8 + rgb.len());
+    out.extend_from_slice(&LIT_MAGIC);
+    out.put_i32(LIT_VERSION);
+    out.extend_from_slice(rgb);
+    out
+}
+
+/// The RGB data; its length must be three times the lighting lump's.
+pub fn read_lit(data: &[u8], lighting_len: usize) -> Result<Vec<u8>> {
+    let mut r = Reader::new(data, ".lit header");
+    let magic = r.array::<4>()?;
+    let version = r.i32()?;
+    let bad = |detail: String| FormatError::BadLump {
+        lump: ".lit",
+        detail,
+    };
+    if magic != LIT_MAGIC {
+        return Err(bad(format!("magic {magic:?} is not QLIT")));
+    }
+    if version != LIT_VERSION {
+        return Err(bad(format!("version {version} is not 1")));
+    }
+    let rgb = &data[8..];
+    if rgb.len() != lighting_len * 3 {
+        return Err(bad(format!(
+            "{} bytes of colour for a {lighting_len}-byte lighting lump (expected {})",
+            rgb.len(),
+            lighting_len * 3
+        )));
+    }
+    Ok(rgb.to_vec())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_trip_and_size_check() {
+        let rgb = vec![1, 2, 3, 4, 5, 6];
+        let file = write_lit(&rgb);
+        assert_eq!(read_lit(&file, 2).expect("read"), rgb);
+        assert!(read_lit(&file, 3).is_err());
+    }
+}

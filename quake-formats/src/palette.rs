@@ -1,0 +1,106 @@
+//! The 768-byte palette (256 RGB colours) that indexes every texture pixel.
+
+use crate::error::{FormatError, Result};
+
+/// Palette indices from here up are "fullbright": drawn unlit by engines.
+pub const FIRST_FULLBRIGHT: u8 = 224;
+
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Palette {
+    pub colors: [[u8; 3]; 256],
+}
+
+impl Palette {
+    pub fn from_bytes(data: &[u8]) -> Result<Palette> {
+        if data.len() != 768 {
+            return Err(FormatError::PaletteSize(data.len()));
+        }
+        let mut colors = [[0u8; 3]; 256];
+        for (c, rgb) in colors.iter_mut().zip(data.chunks_exact(3)) {
+            c.copy_from_slice(rgb);
+        }
+        Ok(Palette { colors })
+    }
+
+    pub fn to_bytes(&self) -> Vec<u8> {
+        self.colors.iter().flatten().copied().collect()
+    }
+
+    /// Slipgate's own palette, used when no game palette is given: 14 ramps of 16 shades
+    /// (greys, then hues around the colour wheel), then 32 fullbright colours. Defined here,
+    /// not taken from any game's data.
+    pub fn slipgate() -> Palette {
+        let mut colors = [[0u8; 3]; 256];
+        // Base hues (r, g, b) for the ramps; ramp 0 is grey.
+        const HUES: [[f64; 3]; 14] = [
+            [1.0, 1.0, 1.0],
+            [0.55, 0.42, 0.30],
+            [0.62, 0.50, 0.36],
+            [0.45, 0.45, 0.55],
+            [0.75, 0.35, 0.25],
+            [0.35, 0.55, 0.30],
+            [0.30, 0.40, 0.70],
+            [0.80, 0.65, 0.30],
+            [0.60, 0.30, 0.55],
+            [0.35, 0.60, 0.60],
+            [0.70, 0.55, 0.45],
+            [0.50, 0.55, 0.35],
+            [0.85, 0.45, 0.10],
+            [0.40, 0.30, 0.25],
+        ];
+        for (ramp, hue) in HUES.iter().enumerate() {
+            for shade in 0..16 {
+                let level = (shade as f64 + 1.0) / 16.0;
+                let c = &mut colors[ramp * 16 + shade];
+                for ch in 0..3 {
+                    c[ch] = (255.0 * (hue[ch] * level).min(1.0)).round() as u8;
+                }
+            }
+        }
+        // Fullbrights: fire, light fixtures and magic, each a ramp of 8 bright shades.
+        const BRIGHT: [[f64; 3]; 4] = [
+            [1.0, 0.55, 0.15],
+            [1.0, 0.95, 0.70],
+            [0.45, 0.65, 1.0],
+            [1.0, 0.25, 0.20],
+        ];
+        for (ramp, hue) in BRIGHT.iter().enumerate() {
+            for shade in 0..8 {
+                let level = 0.6 + 0.4 * (shade as f64 + 1.0) / 8.0;
+                let c = &mut colors[FIRST_FULLBRIGHT as usize + ramp * 8 + shade];
+                for ch in 0..3 {
+                    c[ch] = (255.0 * (hue[ch] * level).min(1.0)).round() as u8;
+                }
+            }
+        }
+        Palette { colors }
+    }
+
+    /// The index of the nearest non-fullbright colour (squared RGB distance).
+    pub fn nearest(&self, rgb: [u8; 3]) -> u8 {
+        let mut best = (u32::MAX, 0u8);
+        for (i, c) in self.colors[..FIRST_FULLBRIGHT as usize].iter().enumerate() {
+            let d: u32 = (0..3)
+                .map(|k| (c[k] as i32 - rgb[k] as i32).pow(2) as u32)
+                .sum();
+            if d < best.0 {
+                best = (d, i as u8);
+            }
+        }
+        best.1
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_trip_and_nearest() {
+        let p = Palette::slipgate();
+        assert_eq!(Palette::from_bytes(&p.to_bytes()).expect("768 bytes"), p);
+        let white = p.nearest([255, 255, 255]);
+        assert_eq!(white, 15);
+        assert!(Palette::from_bytes(&[0; 767]).is_err());
+    }
+}

@@ -1,0 +1,177 @@
+//! `.prt` portal files (PRT1), the compiler's hand-off to vis.
+//!
+//! ```text
+//! PRT1
+//! <leaf count>          (leaves that have PVS rows: BSP leaves minus leaf 0)
+//! <portal count>
+//! <points> <leaf a> <leaf b> (x y z ) (x y z ) ...
+//! ```
+//! Leaf numbers here count from BSP leaf 1.
+
+use crate::error::{FormatError, Result};
+use crate::geom::{Vec3, Winding};
+
+/// A portal between two vis leaves.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PrtPortal {
+    pub leafs: [u32; 2],
+    pub winding: Winding,
+}
+
+/// A whole portal file.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct PortalFile {
+    pub num_leafs: u32,
+    pub portals: Vec<PrtPortal>,
+}
+
+impl PortalFile {
+    pub fn parse(text: &str) -> Result<PortalFile> {
+        let mut lines = text.lines().enumerate().map(|(i, l)| (i + 1, l.trim()));
+        let mut next = |what: &str| -> Result<(usize, &str)> {
+            lines
+                .by_ref()
+                .find(|(_, l)| !l.is_empty())
+                .ok_or_else(|| FormatError::Syntax {
+                    line: 0,
+                    detail: format!("portal file ends before {what}"),
+                })
+        };
+        let (line, magic) = next("the PRT1 header")?;
+        if magic != "PRT1" {
+            return Err(FormatError::Syntax {
+                line,
+                detail: format!("expected PRT1, found {magic:?}"),
+            });
+        }
+        let num = |(line, s): (usize, &str), what: &str| -> Result<u32> {
+            s.parse().map_err(|_| FormatError::Syntax {
+                line,
+                detail: format!("{what}: {s:?} is not a count"),
+            })
+        };
+        let num_leafs = num(next("the leaf count")?, "leaf count")?;
+        let num_portals = num(next("the portal count")?, "portal count")?;
+        let mut portals = Vec::with_capacity(num_portals as usize);
+        for _ in 0..num_portals {
+            let (line, text) = next("all portals")?;
+            portals.push(parse_portal(line, text, num_leafs)?);
+        }
+        Ok(PortalFile { num_leafs, portals })
+    }
+
+    pub fn write(&self) -> String {
+        let mut out = format!("PRT1\n{}\n{}\n", self.num_leafs, self.portals.len());
+        for p in &self.portals {
+            out.push_str(&format!(
+                "{} {} {}",
+                p.winding.len(),
+                p.leafs[0],
+                p.leafs[1]
+            ));
+            for v in &p.winding.points {
+                out.push_str(&format!(
+                    " ({} {} {} )",
+                    fmt_coord(v.x),
+                    fmt_coord(v.y),
+                    fmt_coord(v.z)
+                ));
+            }
+            out.push('\n');
+        }
+        out
+    }
+}
+
+/// Coordinates as the shortest text that reads back to the same `f32` (what vis gets anyway).
+fn fmt_coord(v: f64) -> String {
+    format!("{}", v as f32)
+}
+
+fn parse_portal(line: usize, text: &str, num_leafs: u32) -> Result<PrtPortal> {
+    let err = |detail: String| FormatError::Syntax { line, detail };
+    let cleaned = text.replace(['(', ')'], " ");
+    let mut fields = cleaned.split_whitespace();
+    let mut int = |what: &str| -> Result<u32> {
+        let f = fields
+            .next()
+            .ok_or_else(|| err(format!("missing {what}")))?;
+        f.parse()
+            .map_err(|_| err(format!("{what} {f:?} is not a number")))
+    };
+    let count = int("point count")?;
+    let a = int("first leaf")?;
+    let b = int("second leaf")?;
+    if a >= num_leafs || b >= num_leafs {
+        return Err(err(format!(
+            "leaf {a} or {b} is not below the leaf count {num_leafs}"
+        )));
+    }
+    if !(3..=1024).contains(&count) {
+        return Err(err(format!("portal with {count} points")));
+    }
+    let mut coords = Vec::with_capacity(count as usize * 3);
+    for f in fields {
+        let v: f64 = f
+            .parse()
+            .map_err(|_| err(format!("coordinate {f:?} is not a number")))?;
+        if !v.is_finite() {
+            return Err(err(format!("coordinate {f:?} is not finite")));
+        }
+        coords.push(v);
+    }
+    if coords.len() != count as usize * 3 {
+        return Err(err(format!(
+            "expected {} coordinates, found {}",
+            count * 3,
+            coords.len()
+        )));
+    }
+    let points = coords
+        .chunks(3)
+        .map(|c| Vec3::new(c[0], c[1], c[2]))
+        .collect();
+    Ok(PrtPortal {
+        leafs: [a, b],
+        winding: Winding::new(points),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_trip() {
+        let file = PortalFile {
+            num_leafs: 3,
+            portals: vec![PrtPortal {
+                leafs: [0, 2],
+                winding: Winding::new(vec![
+                    Vec3::new(0.0, 0.0, 0.0),
+                    Vec3::new(0.0, 64.5, 0.0),
+                    Vec3::new(-1e-3, 64.0, 128.0),
+                ]),
+            }],
+        };
+        let text = file.write();
+        assert!(text.starts_with("PRT1\n3\n1\n3 0 2 ("));
+        let back = PortalFile::parse(&text).expect("parse");
+        assert_eq!(back.portals[0].leafs, [0, 2]);
+        for (a, b) in back.portals[0]
+            .winding
+            .points
+            .iter()
+            .zip(&file.portals[0].winding.points)
+        {
+            assert!(a.near(*b, 1e-6));
+        }
+    }
+
+    #[test]
+    fn bad_leaf_names_line() {
+        let err =
+            PortalFile::parse("PRT1\n2\n1\n3 0 5 (0 0 0) (1 0 0) (0 1 0)\n").expect_err("leaf 5");
+        assert!(err.to_string().contains("line 4"), "{err}");
+    }
+}

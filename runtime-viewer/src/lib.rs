@@ -1,0 +1,1 @@
+//! Slipgate: surface-cached software renderer for compiled BSPs.

@@ -1,0 +1,1 @@
+//! Slipgate: portal-flow potentially visible sets.
