@@ -1,1 +1,84 @@
-fn main() {}
+//! `slipgate`: the one command. Each subcommand is a thin shell over a library stage.
+
+mod inspect;
+
+use anyhow::Result;
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "slipgate",
+    version,
+    about = "Compile Quake .map files to BSP (qbsp, vis, light) and preview them",
+    long_about = "Compile Quake .map files to BSP29/BSP2 (qbsp, vis, light) and preview them with a \
+                  software renderer.\n\nericw-tools' single-dash spellings (-bsp2, -fast, -extra4, \
+                  -soft, ...) are accepted as aliases of the double-dash options."
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Print a BSP's lump counts and sizes and validate it (exit 1 when it has errors)
+    Info(inspect::InfoArgs),
+    /// Rewrite a BSP (optionally as BSP29 or BSP2) or a WAD; unchanged data is byte-identical
+    Convert(inspect::ConvertArgs),
+}
+
+/// ericw-tools writes long options with one dash (`-extra4`); clap wants two. Negative numbers
+/// and short flags (`-h`) are left alone.
+fn normalise_single_dash(args: impl Iterator<Item = String>) -> Vec<String> {
+    args.enumerate()
+        .map(|(i, a)| {
+            let is_ericw_long = i > 0
+                && a.len() > 2
+                && a.starts_with('-')
+                && !a.starts_with("--")
+                && a[1..].starts_with(|c: char| c.is_ascii_alphabetic())
+                && a[1..]
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
+            if is_ericw_long { format!("-{a}") } else { a }
+        })
+        .collect()
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse_from(normalise_single_dash(std::env::args()));
+    match run(cli.command) {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+fn run(command: Command) -> Result<ExitCode> {
+    match command {
+        Command::Info(args) => inspect::info(&args),
+        Command::Convert(args) => inspect::convert(&args).map(|()| ExitCode::SUCCESS),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn single_dash_long_options_become_double_dash() {
+        let args = [
+            "slipgate", "light", "-extra4", "-soft", "-h", "--pos", "-100", "x.bsp",
+        ];
+        let out = normalise_single_dash(args.iter().map(|s| s.to_string()));
+        assert_eq!(
+            out,
+            [
+                "slipgate", "light", "--extra4", "--soft", "-h", "--pos", "-100", "x.bsp"
+            ]
+        );
+    }
+}

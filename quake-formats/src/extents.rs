@@ -6,6 +6,9 @@
 
 use crate::bsp::limits::LIGHTMAP_SCALE;
 
+/// Grid lines beyond this (2^25 luxels, far past any real map) are clamped.
+const GRID_CLAMP: f64 = (1 << 25) as f64;
+
 /// The lightmap rectangle of a face, in texels.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct LightmapExtents {
@@ -37,8 +40,10 @@ impl LightmapExtents {
             if points.is_empty() {
                 break;
             }
-            let lo = (mins[axis] / scale).floor() as i32;
-            let hi = (maxs[axis] / scale).ceil() as i32;
+            // Damaged files can hold absurd coordinates; clamping keeps the arithmetic in range
+            // (such a face fails every size check downstream anyway).
+            let lo = (mins[axis] / scale).floor().clamp(-GRID_CLAMP, GRID_CLAMP) as i32;
+            let hi = (maxs[axis] / scale).ceil().clamp(-GRID_CLAMP, GRID_CLAMP) as i32;
             tex_mins[axis] = lo * LIGHTMAP_SCALE;
             extents[axis] = (hi - lo) * LIGHTMAP_SCALE;
         }
@@ -70,6 +75,13 @@ impl LightmapExtents {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn absurd_coordinates_do_not_overflow() {
+        let pts = [[-3.0e38, 0.0, 0.0], [3.0e38, f32::NAN, 0.0]];
+        let e = LightmapExtents::from_points(&pts, &AXIAL);
+        assert!(e.luxel_count() > 0);
+    }
 
     const AXIAL: [[f32; 4]; 2] = [[1.0, 0.0, 0.0, 0.0], [0.0, -1.0, 0.0, 0.0]];
 

@@ -1,0 +1,216 @@
+//! Damaged files give errors or validator problems that name the lump and index, never a panic.
+
+use proptest::prelude::*;
+use quake_formats::bsp::{BspPlane, Face, Leaf, Model, Node, TexInfo, contents};
+use quake_formats::miptex::MipTex;
+use quake_formats::{Bsp, BspVersion, FormatError, Severity, validate};
+
+/// A one-face BSP built by hand: a 64x64 floor quad in one leaf.
+fn tiny_bsp(version: BspVersion) -> Bsp {
+    let mut bsp = Bsp::new(version);
+    bsp.set_entity_text("{\n\"classname\" \"worldspawn\"\n}\n");
+    bsp.planes.push(BspPlane {
+        normal: [0.0, 0.0, 1.0],
+        dist: 0.0,
+        kind: 2,
+    });
+    let mips = [vec![1u8; 256], vec![2; 64], vec![3; 16], vec![4; 4]];
+    bsp.textures
+        .textures
+        .push(Some(MipTex::new("floor", 16, 16, mips)));
+    bsp.vertices = vec![
+        [0.0, 0.0, 0.0],
+        [0.0, 64.0, 0.0],
+        [64.0, 64.0, 0.0],
+        [64.0, 0.0, 0.0],
+    ];
+    bsp.edges = vec![[0, 0], [0, 1], [1, 2], [2, 3], [3, 0]];
+    bsp.surfedges = vec![1, 2, 3, 4];
+    bsp.texinfo.push(TexInfo {
+        vecs: [[1.0, 0.0, 0.0, 0.0], [0.0, -1.0, 0.0, 0.0]],
+        miptex: 0,
+        flags: 0,
+    });
+    bsp.faces.push(Face {
+        plane: 0,
+        side: 0,
+        first_edge: 0,
+        num_edges: 4,
+        texinfo: 0,
+        styles: [0, 255, 255, 255],
+        light_offset: 0,
+    });
+    bsp.lighting = vec![128; 25];
+    bsp.marksurfaces = vec![0];
+    let leaf = |contents, marks| Leaf {
+        contents,
+        vis_offset: -1,
+        mins: [0.0; 3],
+        maxs: [64.0, 64.0, 64.0],
+        first_marksurface: 0,
+        num_marksurfaces: marks,
+        ambient: [0; 4],
+    };
+    bsp.leafs = vec![leaf(contents::SOLID, 0), leaf(contents::EMPTY, 1)];
+    bsp.nodes.push(Node {
+        plane: 0,
+        children: [-2, -1],
+        mins: [0.0; 3],
+        maxs: [64.0, 64.0, 64.0],
+        first_face: 0,
+        num_faces: 1,
+    });
+    bsp.models.push(Model {
+        mins: [0.0; 3],
+        maxs: [64.0, 64.0, 64.0],
+        origin: [0.0; 3],
+        head_nodes: [0, -1, -1, -1],
+        vis_leafs: 1,
+        first_face: 0,
+        num_faces: 1,
+    });
+    bsp
+}
+
+#[test]
+fn tiny_bsp_is_valid_in_both_versions() {
+    for v in [BspVersion::Bsp29, BspVersion::Bsp2] {
+        let bsp = tiny_bsp(v);
+        assert_eq!(validate(&bsp), vec![]);
+        let bytes = bsp.write().expect("write");
+        assert_eq!(
+            Bsp::read(&bytes).expect("read").write().expect("rewrite"),
+            bytes
+        );
+        assert_eq!(bsp.leaf_at([32.0, 32.0, 8.0]), Some(1));
+        assert_eq!(bsp.leaf_at([32.0, 32.0, -8.0]), Some(0));
+    }
+}
+
+#[test]
+fn truncation_anywhere_is_an_error() {
+    let bytes = tiny_bsp(BspVersion::Bsp29).write().expect("write");
+    for len in 0..bytes.len() {
+        assert!(
+            Bsp::read(&bytes[..len]).is_err(),
+            "truncated to {len} bytes was accepted"
+        );
+    }
+}
+
+#[test]
+fn lump_past_the_end_names_the_lump() {
+    let mut bytes = tiny_bsp(BspVersion::Bsp29).write().expect("write");
+    // Lump 7 (faces): its length field sits at 4 + 7 * 8 + 4.
+    let at = 4 + 7 * 8 + 4;
+    bytes[at..at + 4].copy_from_slice(&100_000i32.to_le_bytes());
+    let err = Bsp::read(&bytes).expect_err("faces past the end");
+    assert!(
+        matches!(err, FormatError::LumpOutOfFile { lump: "faces", .. }),
+        "{err}"
+    );
+}
+
+#[test]
+fn wrong_record_size_names_the_lump() {
+    let mut bytes = tiny_bsp(BspVersion::Bsp29).write().expect("write");
+    let at = 4 + 12 * 8 + 4; // edges length
+    let len = i32::from_le_bytes(bytes[at..at + 4].try_into().expect("4 bytes"));
+    bytes[at..at + 4].copy_from_slice(&(len - 1).to_le_bytes());
+    let err = Bsp::read(&bytes).expect_err("odd edge lump");
+    assert!(err.to_string().contains("edges lump"), "{err}");
+}
+
+#[test]
+fn out_of_range_indices_are_named() {
+    let mut bsp = tiny_bsp(BspVersion::Bsp29);
+    bsp.faces[0].texinfo = 9;
+    bsp.edges[2][1] = 77;
+    bsp.nodes[0].children[0] = -40;
+    bsp.lighting.truncate(10);
+    let problems: Vec<String> = validate(&bsp).iter().map(|p| p.to_string()).collect();
+    let expect = [
+        "faces[0]: texinfo 9 is out of range (0..1)",
+        "edges[2]: vertex 77 is out of range (0..4)",
+        "nodes[0]: child leaf 39 is out of range (0..2)",
+    ];
+    for e in expect {
+        assert!(
+            problems.iter().any(|p| p.contains(e)),
+            "missing {e:?} in {problems:?}"
+        );
+    }
+}
+
+#[test]
+fn nan_is_a_problem() {
+    let mut bsp = tiny_bsp(BspVersion::Bsp2);
+    bsp.vertices[1][2] = f32::NAN;
+    let problems = validate(&bsp);
+    assert!(
+        problems
+            .iter()
+            .any(|p| p.lump == "vertexes" && p.index == 1 && p.severity == Severity::Error)
+    );
+}
+
+#[test]
+fn wrong_version_is_an_error() {
+    let mut bytes = tiny_bsp(BspVersion::Bsp29).write().expect("write");
+    bytes[..4].copy_from_slice(b"IBSP");
+    assert!(matches!(
+        Bsp::read(&bytes),
+        Err(FormatError::UnknownBspVersion(_))
+    ));
+}
+
+fn flip_bytes(mut bytes: Vec<u8>, flips: &[(usize, u8)]) -> Vec<u8> {
+    let len = bytes.len();
+    for &(at, value) in flips {
+        bytes[at % len] ^= value;
+    }
+    bytes
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(512))]
+
+    #[test]
+    fn random_byte_flips_never_panic(flips in proptest::collection::vec((any::<usize>(), 1u8..), 1..8), v2 in any::<bool>()) {
+        let version = if v2 { BspVersion::Bsp2 } else { BspVersion::Bsp29 };
+        let bytes = flip_bytes(tiny_bsp(version).write().expect("write"), &flips);
+        if let Ok(bsp) = Bsp::read(&bytes) {
+            let _ = validate(&bsp);
+            let _ = bsp.write();
+            let _ = bsp.leaf_at([1.0, 2.0, 3.0]);
+        }
+    }
+}
+
+/// The same on a real map when the corpus is present (fewer cases: it is larger).
+#[test]
+fn random_byte_flips_on_a_corpus_bsp_never_panic() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../shared/corpus/public/bsp/librequake/start.bsp");
+    let Ok(original) = std::fs::read(&path) else {
+        eprintln!(
+            "SKIPPED: {} not found (needs ../shared/corpus)",
+            path.display()
+        );
+        return;
+    };
+    let mut runner = proptest::test_runner::TestRunner::new(ProptestConfig::with_cases(64));
+    runner
+        .run(
+            &proptest::collection::vec((any::<usize>(), 1u8..), 1..16),
+            |flips| {
+                let bytes = flip_bytes(original.clone(), &flips);
+                if let Ok(bsp) = Bsp::read(&bytes) {
+                    let _ = validate(&bsp);
+                    let _ = bsp.leaf_at([0.0, 0.0, 0.0]);
+                }
+                Ok(())
+            },
+        )
+        .expect("no panics");
+}

@@ -1,0 +1,122 @@
+//! `info` and `convert`: looking at and rewriting files without compiling anything.
+
+use anyhow::{Context, Result, bail};
+use quake_formats::bsp::LUMP_NAMES;
+use quake_formats::fsutil::{read_file, write_atomic};
+use quake_formats::wad::Wad;
+use quake_formats::{Bsp, BspVersion, Severity, validate};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(clap::Args, Debug)]
+pub struct InfoArgs {
+    /// The BSP file to inspect
+    file: PathBuf,
+}
+
+#[derive(clap::Args, Debug)]
+pub struct ConvertArgs {
+    /// Input BSP or WAD
+    input: PathBuf,
+    /// Output file (written atomically)
+    output: PathBuf,
+    /// Write BSP2 (32-bit indices, float bounds)
+    #[arg(long, conflicts_with = "bsp29")]
+    bsp2: bool,
+    /// Write BSP29 (fails with a clear error when the map exceeds its limits)
+    #[arg(long)]
+    bsp29: bool,
+}
+
+pub fn info(args: &InfoArgs) -> Result<ExitCode> {
+    let bytes = read_file(&args.file)?;
+    let bsp = Bsp::read(&bytes).with_context(|| format!("{}", args.file.display()))?;
+    println!(
+        "{}: {} ({} bytes)",
+        args.file.display(),
+        bsp.version,
+        bytes.len()
+    );
+    let counts = [
+        bsp.entities.len(),
+        bsp.planes.len(),
+        bsp.textures.textures.len(),
+        bsp.vertices.len(),
+        bsp.visibility.len(),
+        bsp.nodes.len(),
+        bsp.texinfo.len(),
+        bsp.faces.len(),
+        bsp.lighting.len(),
+        bsp.clipnodes.len(),
+        bsp.leafs.len(),
+        bsp.marksurfaces.len(),
+        bsp.edges.len(),
+        bsp.surfedges.len(),
+        bsp.models.len(),
+    ];
+    // Entities, visibility and lighting are byte blobs; the other lumps count records.
+    const BYTE_LUMPS: [usize; 3] = [0, 4, 8];
+    for (i, (name, count)) in LUMP_NAMES.iter().zip(counts).enumerate() {
+        let unit = if BYTE_LUMPS.contains(&i) {
+            " bytes"
+        } else {
+            ""
+        };
+        println!("  {name:<13} {count:>9}{unit}");
+    }
+    for lump in &bsp.bspx {
+        println!("  BSPX {:<8} {:>9} bytes", lump.name(), lump.data.len());
+    }
+    let entities = quake_formats::entities::parse_entities(&bsp.entity_text()).unwrap_or_default();
+    println!(
+        "  {} entities, {} brush models",
+        entities.len(),
+        bsp.models.len()
+    );
+
+    let problems = validate(&bsp);
+    let errors = problems
+        .iter()
+        .filter(|p| p.severity == Severity::Error)
+        .count();
+    for p in &problems {
+        println!("{p}");
+    }
+    if problems.is_empty() {
+        println!("valid: no problems found");
+    } else {
+        println!("{errors} error(s), {} warning(s)", problems.len() - errors);
+    }
+    Ok(if errors > 0 {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+pub fn convert(args: &ConvertArgs) -> Result<()> {
+    let bytes = read_file(&args.input)?;
+    let name = args.input.display();
+    let out = if bytes.starts_with(b"WAD2") {
+        if args.bsp2 || args.bsp29 {
+            bail!("{name}: --bsp2/--bsp29 apply to BSP files, not WADs");
+        }
+        Wad::read(&bytes)
+            .with_context(|| format!("{name}"))?
+            .write()
+    } else {
+        let bsp = Bsp::read(&bytes).with_context(|| format!("{name}"))?;
+        let version = if args.bsp2 {
+            BspVersion::Bsp2
+        } else if args.bsp29 {
+            BspVersion::Bsp29
+        } else {
+            bsp.version
+        };
+        let converted = bsp.converted(version).with_context(|| format!("{name}"))?;
+        converted.write().with_context(|| format!("{name}"))?
+    };
+    write_atomic(&args.output, &out)?;
+    println!("wrote {} ({} bytes)", args.output.display(), out.len());
+    Ok(())
+}

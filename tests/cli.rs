@@ -1,0 +1,114 @@
+//! End-to-end tests of the `slipgate` command: exit codes, `info`, `convert`.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn slipgate(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_slipgate"))
+        .args(args)
+        .output()
+        .expect("run slipgate")
+}
+
+fn corpus(rel: &str) -> Option<PathBuf> {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/corpus")
+        .join(rel);
+    if p.exists() {
+        Some(p)
+    } else {
+        eprintln!(
+            "SKIPPED: {} not found (needs ../shared/corpus)",
+            p.display()
+        );
+        None
+    }
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("slipgate-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir.join(name)
+}
+
+#[test]
+fn bad_usage_exits_2_and_bad_input_exits_1() {
+    assert_eq!(slipgate(&["no-such-command"]).status.code(), Some(2));
+    assert_eq!(slipgate(&["info"]).status.code(), Some(2));
+    let missing = slipgate(&["info", "/nonexistent/x.bsp"]);
+    assert_eq!(missing.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&missing.stderr).contains("/nonexistent/x.bsp"));
+
+    let junk = scratch("junk.bsp");
+    std::fs::write(&junk, b"this is not a bsp file at all").expect("write");
+    let out = slipgate(&["info", junk.to_str().expect("utf8")]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("junk.bsp"));
+}
+
+#[test]
+fn info_counts_and_validates_a_corpus_bsp() {
+    let Some(bsp) = corpus("public/bsp/librequake/start.bsp") else {
+        return;
+    };
+    let out = slipgate(&["info", bsp.to_str().expect("utf8")]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{text}");
+    assert!(text.contains("BSP29"));
+    assert!(text.contains("faces              1620"), "{text}");
+    assert!(text.contains("valid: no problems found"));
+}
+
+#[test]
+fn info_exits_1_on_a_damaged_bsp() {
+    let Some(bsp) = corpus("public/bsp/librequake/start.bsp") else {
+        return;
+    };
+    let mut bytes = std::fs::read(bsp).expect("read");
+    // Point marksurface 0 at face 60000.
+    let ofs = i32::from_le_bytes(bytes[4 + 11 * 8..4 + 11 * 8 + 4].try_into().expect("4")) as usize;
+    bytes[ofs..ofs + 2].copy_from_slice(&60000u16.to_le_bytes());
+    let damaged = scratch("damaged.bsp");
+    std::fs::write(&damaged, bytes).expect("write");
+    let out = slipgate(&["info", damaged.to_str().expect("utf8")]);
+    assert_eq!(out.status.code(), Some(1));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("marksurfaces[0]: face 60000 is out of range"),
+        "{text}"
+    );
+}
+
+#[test]
+fn convert_round_trips_and_accepts_ericw_spelling() {
+    let Some(bsp) = corpus("public/bsp/librequake/start.bsp") else {
+        return;
+    };
+    let original = std::fs::read(&bsp).expect("read");
+    let same = scratch("same.bsp");
+    let v2 = scratch("v2.bsp");
+    let back = scratch("back.bsp");
+    let s = |p: &Path| p.to_str().expect("utf8").to_string();
+    assert!(slipgate(&["convert", &s(&bsp), &s(&same)]).status.success());
+    assert!(
+        std::fs::read(&same).expect("read") == original,
+        "same-version rewrite differs"
+    );
+    assert!(
+        slipgate(&["convert", &s(&bsp), &s(&v2), "-bsp2"])
+            .status
+            .success()
+    );
+    assert!(std::fs::read(&v2).expect("read").starts_with(b"BSP2"));
+    assert!(
+        slipgate(&["convert", &s(&v2), &s(&back), "--bsp29"])
+            .status
+            .success()
+    );
+    let out = slipgate(&["info", &s(&back)]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+}
