@@ -253,10 +253,10 @@ impl Bsp {
             BspVersion::Bsp29 => &BSP29_MAGIC,
             BspVersion::Bsp2 => &BSP2_MAGIC,
         });
-        for lump in 0..15 {
+        for (lump, bytes) in lumps.iter().enumerate() {
             let slot = FILE_ORDER.iter().position(|&i| i == lump).unwrap_or(0);
             header.put_i32(placement.offsets[slot] as i32);
-            header.put_i32(lumps[lump].len() as i32);
+            header.put_i32(bytes.len() as i32);
         }
         let mut bspx_dir = Vec::with_capacity(bspx_dir_len);
         if !self.bspx.is_empty() {
@@ -390,7 +390,7 @@ impl Bsp {
 
 fn read_records<T: Record>(data: &[u8], v: BspVersion) -> Result<Vec<T>> {
     let size = T::size(v);
-    if data.len() % size != 0 {
+    if !data.len().is_multiple_of(size) {
         return Err(FormatError::LumpSize {
             lump: T::LUMP,
             length: data.len(),
