@@ -1,0 +1,58 @@
+//! `mapgen [OUT_DIR]`: regenerate the maps and WAD.
+
+use anyhow::Context;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+#[derive(clap::Args, Debug, Clone)]
+pub struct Args {
+    /// Directory to write into (default: the `maps/` directory of the source tree)
+    pub out_dir: Option<PathBuf>,
+    /// Write counts and timings as JSON to this file
+    #[arg(long, value_name = "FILE.json")]
+    pub stats: Option<PathBuf>,
+}
+
+/// The `maps/` directory this crate lives in.
+pub fn default_out_dir() -> PathBuf {
+    let gen_dir = Path::new(env!("CARGO_MANIFEST_DIR"));
+    gen_dir.parent().unwrap_or(gen_dir).to_path_buf()
+}
+
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    let start = Instant::now();
+    let dir = args.out_dir.clone().unwrap_or_else(default_out_dir);
+    let files = crate::write_all(&dir)?;
+    let seconds = start.elapsed().as_secs_f64();
+    for f in &files {
+        eprintln!(
+            "{:<24} {:>8} bytes {:>4} brushes {:>3} entities",
+            f.path,
+            f.bytes.len(),
+            f.brushes,
+            f.entities
+        );
+    }
+    eprintln!(
+        "wrote {} files to {} in {:.3} s",
+        files.len(),
+        dir.display(),
+        seconds
+    );
+    if let Some(path) = &args.stats {
+        let list: Vec<serde_json::Value> = files
+            .iter()
+            .map(|f| {
+                serde_json::json!({
+                    "path": f.path, "bytes": f.bytes.len(),
+                    "brushes": f.brushes, "entities": f.entities,
+                })
+            })
+            .collect();
+        let stats = serde_json::json!({ "files": list, "seconds": seconds });
+        let text = serde_json::to_string_pretty(&stats)?;
+        quake_formats::fsutil::write_atomic(path, text.as_bytes())
+            .with_context(|| format!("writing stats to {}", path.display()))?;
+    }
+    Ok(())
+}
