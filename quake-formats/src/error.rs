@@ -52,7 +52,8 @@ pub enum FormatError {
     PaletteSize(usize),
     #[error("line {line}: {detail}")]
     Syntax { line: usize, detail: String },
-    #[error("{path}: {source}")]
+    /// The OS error is the `source`, so `{:#}` chains print it once.
+    #[error("{}", path.display())]
     Io {
         path: PathBuf,
         #[source]

@@ -1,0 +1,266 @@
+//! `slipgate-view`: render a BSP to PNG, or fly through it and report frame rates.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::bail;
+use quake_formats::geom::Vec3;
+
+use crate::camera::Camera;
+use crate::image::write_png;
+use crate::reference::{compare, render_reference};
+use crate::render::{Frame, FrameStats, RenderOptions, Renderer};
+use crate::surface_cache::CacheStats;
+use crate::world::World;
+
+#[derive(clap::Args, Debug, Clone)]
+pub struct Args {
+    /// The compiled map (BSP29 or BSP2); a `.lit` beside it is used for coloured light.
+    pub map: PathBuf,
+    /// PNG to write.
+    #[arg(long, default_value = "shot.png")]
+    pub out: PathBuf,
+    /// Picture size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "640x480", value_parser = parse_size)]
+    pub size: (usize, usize),
+    /// Eye position (default: info_player_start, 22 units above its origin).
+    #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], allow_negative_numbers = true)]
+    pub pos: Option<Vec<f64>>,
+    /// Pitch (positive looks down), yaw, roll in degrees (default: the start's angle).
+    #[arg(long, num_args = 3, value_names = ["P", "Y", "R"], allow_negative_numbers = true)]
+    pub angles: Option<Vec<f64>>,
+    /// Horizontal field of view in degrees.
+    #[arg(long, default_value_t = 90.0)]
+    pub fov: f64,
+    /// Pixels between exact perspective divides along a span (1 = exact).
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=256))]
+    pub span_step: u32,
+    /// Palette (768 bytes); default: gfx/palette.lmp above the map's folder, else Slipgate's.
+    #[arg(long)]
+    pub palette: Option<PathBuf>,
+    /// Surface cache budget in MiB.
+    #[arg(long, default_value_t = 64)]
+    pub cache_mb: usize,
+    /// Also render with the reference ray caster, report the difference and write it beside
+    /// the output as NAME.reference.png.
+    #[arg(long)]
+    pub reference: bool,
+    /// Fly through the map for this many frames and report frame rates (no PNG).
+    #[arg(long, value_name = "FRAMES")]
+    pub bench: Option<usize>,
+    /// With --bench: empty the surface cache before every frame.
+    #[arg(long)]
+    pub no_cache: bool,
+    /// Write counts and timings as JSON.
+    #[arg(long, value_name = "FILE.json")]
+    pub stats: Option<PathBuf>,
+}
+
+fn parse_size(s: &str) -> Result<(usize, usize), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("size {s:?} is not WIDTHxHEIGHT"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<usize>()
+            .ok()
+            .filter(|&n| (1..=16384).contains(&n))
+            .ok_or_else(|| format!("size {s:?}: {v:?} is not a number from 1 to 16384"))
+    };
+    Ok((parse(w)?, parse(h)?))
+}
+
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    let start = Instant::now();
+    let world = World::load(&args.map, args.palette.as_deref())?;
+    let load_time = start.elapsed().as_secs_f64();
+    let camera = initial_camera(&world, args)?;
+    let options = RenderOptions {
+        span_step: args.span_step,
+        use_cache: !args.no_cache,
+        cache_budget: args.cache_mb << 20,
+        ..RenderOptions::default()
+    };
+    let mut renderer = Renderer::new(&world, options);
+    let mut report = serde_json::json!({
+        "map": args.map,
+        "load": world.stats,
+        "load_seconds": load_time,
+        "palette": format!("{:?}", world.palette_source),
+    });
+
+    if let Some(frames) = args.bench {
+        let bench = run_bench(&world, &mut renderer, &camera, frames.max(1));
+        eprintln!(
+            "{frames} frames at {}x{}: {:.1} fps, cache hit rate {:.1}%, per frame: visibility {:.2} ms, edges {:.2} ms, spans {:.2} ms, surfaces {:.2} ms, raster {:.2} ms",
+            camera.width,
+            camera.height,
+            bench.fps,
+            bench.cache.hit_rate() * 100.0,
+            bench.mean.time_visibility * 1e3,
+            bench.mean.time_edges * 1e3,
+            bench.mean.time_spans * 1e3,
+            bench.mean.time_surfaces * 1e3,
+            bench.mean.time_raster * 1e3,
+        );
+        report["bench"] = serde_json::json!({
+            "frames": frames,
+            "width": camera.width,
+            "height": camera.height,
+            "fps": bench.fps,
+            "cache_hit_rate": bench.cache.hit_rate(),
+            "cache": bench.cache,
+            "mean_frame": bench.mean,
+        });
+    } else {
+        let mut frame = Frame::new(camera.width, camera.height);
+        let stats = renderer.render(&world, &camera, &mut frame);
+        write_png(&frame, &args.out)?;
+        eprintln!(
+            "{}: {}x{} in {:.1} ms (load {:.0} ms): {} leaves in PVS, {} drawn, {} surfaces, {} spans, cache {} built ({} KiB); wrote {}",
+            args.map.display(),
+            camera.width,
+            camera.height,
+            stats.total_time() * 1e3,
+            load_time * 1e3,
+            stats.visibility.pvs_leaves,
+            stats.visibility.drawn_leaves,
+            stats.visibility.candidates,
+            stats.edges.spans,
+            stats.cache.misses,
+            stats.cache.bytes_built / 1024,
+            args.out.display()
+        );
+        report["frame"] = serde_json::to_value(&stats)?;
+        if args.reference {
+            let reference = render_reference(&world, &camera, &renderer.styles, options.time);
+            let path = args.out.with_extension("reference.png");
+            write_png(&reference, &path)?;
+            let diff = compare(&frame, &reference);
+            eprintln!(
+                "reference: mean difference {:.2}/255 ({:.2} where the face agrees), max {}, {:.2}% of pixels show another face; wrote {}",
+                diff.mean_diff,
+                diff.mean_diff_same_face,
+                diff.max_diff,
+                diff.face_mismatch * 100.0,
+                path.display()
+            );
+            report["reference"] = serde_json::to_value(diff)?;
+        }
+    }
+    if let Some(path) = &args.stats {
+        let text = serde_json::to_string_pretty(&report)?;
+        quake_formats::fsutil::write_atomic(path, text.as_bytes())?;
+    }
+    Ok(())
+}
+
+fn initial_camera(world: &World, args: &Args) -> anyhow::Result<Camera> {
+    let numbers = args.pos.iter().chain(&args.angles).flatten();
+    if numbers.clone().any(|v| !v.is_finite()) || !(1.0..=179.0).contains(&args.fov) {
+        bail!("--pos and --angles must be finite numbers and --fov between 1 and 179 degrees");
+    }
+    let start = world.player_start();
+    let origin = match (&args.pos, start) {
+        (Some(p), _) => Vec3::new(p[0], p[1], p[2]),
+        (None, Some((o, _))) => o,
+        (None, None) => bail!(
+            "{}: no info_player_start (or other spawn spot); give --pos X Y Z",
+            args.map.display()
+        ),
+    };
+    let angles = match &args.angles {
+        Some(a) => [a[0], a[1], a[2]],
+        None => [0.0, start.map_or(0.0, |(_, yaw)| yaw), 0.0],
+    };
+    let (width, height) = args.size;
+    Ok(Camera {
+        origin,
+        angles,
+        width,
+        height,
+        fov_x: args.fov,
+    })
+}
+
+struct BenchResult {
+    fps: f64,
+    cache: CacheStats,
+    mean: FrameStats,
+}
+
+/// Render `frames` frames along a path through the map's spawn spots (turning as it goes), or a
+/// full turn on the spot when there is only one.
+fn run_bench(
+    world: &World,
+    renderer: &mut Renderer,
+    camera: &Camera,
+    frames: usize,
+) -> BenchResult {
+    let mut spots = world.spots();
+    if spots.is_empty() {
+        spots.push((camera.origin, camera.angles[1]));
+    }
+    let progress = indicatif::ProgressBar::new(frames as u64);
+    if !std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+        progress.set_draw_target(indicatif::ProgressDrawTarget::hidden());
+    }
+    let mut frame = Frame::new(camera.width, camera.height);
+    let mut cache = CacheStats::default();
+    let mut sum = FrameStats::default();
+    let start = Instant::now();
+    for i in 0..frames {
+        let along = i as f64 / frames as f64 * spots.len() as f64;
+        let (a, b) = (
+            along.floor() as usize % spots.len(),
+            (along.floor() as usize + 1) % spots.len(),
+        );
+        let f = along.fract();
+        let origin = if spots.len() > 1 {
+            spots[a].0.lerp(spots[b].0, f)
+        } else {
+            spots[0].0
+        };
+        let cam = Camera {
+            origin,
+            angles: [0.0, spots[a].1 + 360.0 * i as f64 / frames as f64, 0.0],
+            ..*camera
+        };
+        let s = renderer.render(world, &cam, &mut frame);
+        cache.add(&s.cache);
+        sum.time_visibility += s.time_visibility;
+        sum.time_edges += s.time_edges;
+        sum.time_spans += s.time_spans;
+        sum.time_surfaces += s.time_surfaces;
+        sum.time_raster += s.time_raster;
+        progress.inc(1);
+    }
+    progress.finish_and_clear();
+    let elapsed = start.elapsed().as_secs_f64();
+    let n = frames as f64;
+    let mean = FrameStats {
+        time_visibility: sum.time_visibility / n,
+        time_edges: sum.time_edges / n,
+        time_spans: sum.time_spans / n,
+        time_surfaces: sum.time_surfaces / n,
+        time_raster: sum.time_raster / n,
+        ..FrameStats::default()
+    };
+    BenchResult {
+        fps: n / elapsed,
+        cache,
+        mean,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_parse() {
+        assert_eq!(parse_size("320x200"), Ok((320, 200)));
+        assert!(parse_size("320").is_err());
+        assert!(parse_size("0x10").is_err());
+    }
+}

@@ -1,0 +1,219 @@
+//! The reference renderer: one ray per pixel centre through the BSP tree, exact perspective, the
+//! same lit texels and mip choice as the fast renderer. Slow and simple on purpose: it defines
+//! what the fast renderer should draw. [`compare`] measures how far a frame is from it.
+
+use std::collections::HashMap;
+
+use quake_formats::bsp::contents;
+use quake_formats::geom::Vec3;
+
+use crate::camera::{Camera, NEAR_CLIP, View};
+use crate::render::Frame;
+use crate::surface_cache::{LightStyles, LitSurface, build_lit_surface, choose_mip};
+use crate::textures::{TextureKind, WarpTable, liquid_color, sky_color};
+use crate::world::{Surface, World};
+
+/// How far rays go (depth units).
+const MAX_DEPTH: f64 = 1.0e6;
+/// A hit point this close (map units) outside a polygon's edge still counts as inside.
+const EDGE_TOLERANCE: f64 = 1e-4;
+
+enum Trace {
+    Miss,
+    Hit(u32, f64),
+    Blocked,
+}
+
+/// Draw `camera`'s view by ray casting; lighting with `styles`, liquids warped at `time`.
+pub fn render_reference(world: &World, camera: &Camera, styles: &LightStyles, time: f64) -> Frame {
+    let view = camera.view();
+    let warp = WarpTable::new(time);
+    let mut frame = Frame::new(camera.width, camera.height);
+    let mut lit: HashMap<(u32, usize), LitSurface> = HashMap::new();
+    for y in 0..camera.height {
+        for x in 0..camera.width {
+            let (xc, yc) = (x as f64 + 0.5, y as f64 + 0.5);
+            let dir = view.ray(xc, yc);
+            let Some((face, depth)) = first_hit(world, &view, dir) else {
+                continue;
+            };
+            let Some(surface) = world.surfaces[face as usize].as_ref() else {
+                continue;
+            };
+            let i = y * camera.width + x;
+            frame.faces[i] = face;
+            let tex = &world.textures[surface.texture];
+            let (s, t) = surface.st(view.origin + dir * depth);
+            let ext = surface.extents;
+            frame.pixels[i] = match surface.kind {
+                TextureKind::Sky => sky_color(tex, &world.palette, dir),
+                TextureKind::Liquid => {
+                    let texel = |c: f64, axis: usize| {
+                        let rel = (c - ext.tex_mins[axis] as f64).floor();
+                        rel.clamp(0.0, (ext.extents[axis].max(1) - 1) as f64) as i32
+                            + ext.tex_mins[axis]
+                    };
+                    liquid_color(tex, &world.palette, &warp, texel(s, 0), texel(t, 1))
+                }
+                TextureKind::Lit => {
+                    let mip = choose_mip(&view, surface);
+                    let ls = lit
+                        .entry((face, mip))
+                        .or_insert_with(|| build_lit_surface(world, surface, mip, styles));
+                    let texel = |c: f64, axis: usize, size: usize| {
+                        let rel = ((c - ext.tex_mins[axis] as f64) / (1 << mip) as f64).floor();
+                        rel.clamp(0.0, (size - 1) as f64) as usize
+                    };
+                    ls.texels[texel(t, 1, ls.height) * ls.width + texel(s, 0, ls.width)]
+                }
+            };
+        }
+    }
+    frame
+}
+
+/// The nearest face along `dir` (depth-scaled: the point is `origin + dir * depth`).
+fn first_hit(world: &World, view: &View, dir: Vec3) -> Option<(u32, f64)> {
+    let world_hit = match world.root() {
+        Some(root) => match trace(world, root, view.origin, dir, NEAR_CLIP, MAX_DEPTH) {
+            Trace::Hit(f, d) => Some((f, d)),
+            Trace::Miss | Trace::Blocked => None,
+        },
+        None => None,
+    };
+    let mut best = world_hit;
+    for &f in &world.brush_faces {
+        let Some(s) = world.surfaces[f as usize].as_ref() else {
+            continue;
+        };
+        let eye = s.plane.distance(view.origin);
+        let along = s.plane.normal.dot(dir);
+        if eye <= 0.0 || along >= 0.0 {
+            continue;
+        }
+        let depth = -eye / along;
+        if depth < NEAR_CLIP || best.is_some_and(|(_, d)| d <= depth) {
+            continue;
+        }
+        if inside(s, view.origin + dir * depth) {
+            best = Some((f, depth));
+        }
+    }
+    best
+}
+
+/// Front-to-back along the ray; the tree has no cycles ([`World::new`] checked).
+fn trace(world: &World, child: i32, o: Vec3, dir: Vec3, t0: f64, t1: f64) -> Trace {
+    let bsp = &world.bsp;
+    if child < 0 {
+        return match bsp.leafs.get((-(child + 1)) as usize) {
+            Some(l) if l.contents != contents::SOLID => Trace::Miss,
+            _ => Trace::Blocked,
+        };
+    }
+    let (Some(node), Some(plane)) = (
+        bsp.nodes.get(child as usize),
+        world.node_plane(child as usize),
+    ) else {
+        return Trace::Blocked;
+    };
+    let d0 = plane.distance(o + dir * t0);
+    let d1 = plane.distance(o + dir * t1);
+    if d0 >= 0.0 && d1 >= 0.0 {
+        return trace(world, node.children[0], o, dir, t0, t1);
+    }
+    if d0 < 0.0 && d1 < 0.0 {
+        return trace(world, node.children[1], o, dir, t0, t1);
+    }
+    let near = usize::from(d0 < 0.0);
+    let tm = (t0 + (t1 - t0) * d0 / (d0 - d1)).clamp(t0, t1);
+    match trace(world, node.children[near], o, dir, t0, tm) {
+        Trace::Miss => {}
+        other => return other,
+    }
+    let p = o + dir * tm;
+    let first = node.first_face as usize;
+    for f in first..first + node.num_faces as usize {
+        let Some(face) = bsp.faces.get(f) else { break };
+        if face.side as usize != near {
+            continue;
+        }
+        if let Some(s) = world.surfaces[f].as_ref()
+            && inside(s, p)
+        {
+            return Trace::Hit(f as u32, tm);
+        }
+    }
+    trace(world, node.children[1 - near], o, dir, tm, t1)
+}
+
+/// Whether `p` (on the surface's plane) lies inside its convex polygon, either winding.
+fn inside(s: &Surface, p: Vec3) -> bool {
+    let n = s.points.len();
+    let (mut pos, mut neg) = (false, false);
+    for i in 0..n {
+        let (a, b) = (s.points[i], s.points[(i + 1) % n]);
+        let edge = b - a;
+        let len = edge.length();
+        if len < 1e-9 {
+            continue;
+        }
+        let side = edge.cross(p - a).dot(s.plane.normal) / len;
+        pos |= side > EDGE_TOLERANCE;
+        neg |= side < -EDGE_TOLERANCE;
+        if pos && neg {
+            return false;
+        }
+    }
+    true
+}
+
+/// How two frames differ.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Comparison {
+    pub pixels: usize,
+    /// Mean absolute difference per colour channel (0..255) over all pixels.
+    pub mean_diff: f64,
+    /// The same over pixels where both drew the same face: texture-mapping error alone.
+    pub mean_diff_same_face: f64,
+    pub max_diff: u8,
+    /// Fraction of pixels whose colour differs at all.
+    pub differing_pixels: f64,
+    /// Fraction of pixels showing a different face: sorting, clipping or crack errors.
+    pub face_mismatch: f64,
+}
+
+pub fn compare(a: &Frame, b: &Frame) -> Comparison {
+    assert_eq!(
+        (a.width, a.height),
+        (b.width, b.height),
+        "frames of different sizes"
+    );
+    let pixels = a.pixels.len();
+    let (mut total, mut same_total, mut same_count) = (0u64, 0u64, 0usize);
+    let (mut max_diff, mut differing, mut mismatched) = (0u8, 0usize, 0usize);
+    for i in 0..pixels {
+        let (ca, cb) = (a.pixels[i], b.pixels[i]);
+        let diff: u32 = (0..3)
+            .map(|k| ((ca >> (8 * k)) & 255).abs_diff((cb >> (8 * k)) & 255))
+            .inspect(|&d| max_diff = max_diff.max(d as u8))
+            .sum();
+        total += diff as u64;
+        differing += usize::from(diff != 0);
+        if a.faces[i] == b.faces[i] {
+            same_total += diff as u64;
+            same_count += 1;
+        } else {
+            mismatched += 1;
+        }
+    }
+    let frac = |n: usize| n as f64 / pixels.max(1) as f64;
+    Comparison {
+        pixels,
+        mean_diff: total as f64 / (3 * pixels.max(1)) as f64,
+        mean_diff_same_face: same_total as f64 / (3 * same_count.max(1)) as f64,
+        max_diff,
+        differing_pixels: frac(differing),
+        face_mismatch: frac(mismatched),
+    }
+}

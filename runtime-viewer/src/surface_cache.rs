@@ -1,0 +1,367 @@
+//! The surface cache: each visible surface's texture tiled over its lightmap rectangle and lit,
+//! built once per (face, mip level) and reused until its light styles change. A byte budget with
+//! least-recently-used eviction bounds it.
+//!
+//! Shading is done in RGB rather than through an 8-bit colormap: a texel's palette colour is
+//! multiplied by light / 128 and clamped (128 = the texture's own colour, as the middle row of
+//! Quake's colormap; fullbright palette entries stay unlit). That keeps `.lit` colour exact.
+
+use std::collections::HashMap;
+use std::time::{Duration, Instant};
+
+use quake_formats::bsp::limits::MAX_LIGHTMAPS;
+
+use crate::camera::{NEAR_CLIP, View};
+use crate::world::{Surface, World};
+
+/// Light value of a face without a lightmap (engines draw those fully lit).
+const UNLIT_LIGHT: u32 = 255;
+/// Style value for normal light ('m').
+pub const NORMAL_STYLE: u32 = 256;
+
+/// Current brightness of the 256 light styles; `NORMAL_STYLE` is unchanged light.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LightStyles {
+    pub values: [u32; 256],
+}
+
+impl Default for LightStyles {
+    fn default() -> Self {
+        LightStyles {
+            values: [NORMAL_STYLE; 256],
+        }
+    }
+}
+
+impl LightStyles {
+    /// Quake's pattern letters: 'a' is dark, 'm' normal, 'z' double.
+    pub fn letter_value(c: u8) -> u32 {
+        (c.clamp(b'a', b'z') - b'a') as u32 * NORMAL_STYLE / 12
+    }
+
+    fn of(&self, surface: &Surface) -> [u32; MAX_LIGHTMAPS] {
+        std::array::from_fn(|i| match surface.styles[i] {
+            crate::world::NO_STYLE => 0,
+            s => self.values[s as usize],
+        })
+    }
+}
+
+/// Largest cached surface side in texels; bigger surfaces use a coarser mip level.
+pub const MAX_CACHE_EXTENT: i32 = 2048;
+
+/// Mip level for a surface: from the texels per pixel at its nearest point (its nearest vertex,
+/// no nearer than the near clip plane), one level per doubling, coarser when the surface would
+/// not fit [`MAX_CACHE_EXTENT`]. Shared with the reference renderer.
+pub fn choose_mip(view: &View, surface: &Surface) -> usize {
+    let nearest = surface
+        .points
+        .iter()
+        .map(|&p| view.depth(p))
+        .fold(f64::INFINITY, f64::min)
+        .max(NEAR_CLIP);
+    let texels_per_unit = surface.s_axis.length().max(surface.t_axis.length());
+    let texels_per_pixel = nearest * texels_per_unit / view.scale;
+    let mut mip = match texels_per_pixel {
+        t if t <= 1.0 => 0,
+        t if t <= 2.0 => 1,
+        t if t <= 4.0 => 2,
+        _ => 3,
+    };
+    let widest = surface.extents.extents[0].max(surface.extents.extents[1]);
+    while mip < 3 && widest >> mip > MAX_CACHE_EXTENT {
+        mip += 1;
+    }
+    mip
+}
+
+/// A lit surface at one mip level: `width` x `height` texels, 0x00RRGGBB. Texel (u, v) shows
+/// texture coordinates (tex_mins + (u, v) * 2^mip).
+#[derive(Debug, Clone)]
+pub struct LitSurface {
+    pub width: usize,
+    pub height: usize,
+    pub texels: Vec<u32>,
+}
+
+/// Light and texture a surface at `mip`: each texel's light is the bilinear blend of the four
+/// luxels around its corner, the styles summed with their current values.
+pub fn build_lit_surface(
+    world: &World,
+    surface: &Surface,
+    mip: usize,
+    styles: &LightStyles,
+) -> LitSurface {
+    let ext = surface.extents;
+    let width = ((ext.extents[0] >> mip) as usize).max(1);
+    let height = ((ext.extents[1] >> mip) as usize).max(1);
+    let [lw, lh] = ext.luxel_size();
+    let count = lw * lh;
+    let mut block = vec![[0u32; 3]; count];
+    match surface.light {
+        Some(ofs) => {
+            let values = styles.of(surface);
+            for (style, &value) in values.iter().enumerate().take(surface.style_count()) {
+                let map = &world.light[ofs + style * count..ofs + (style + 1) * count];
+                for (b, l) in block.iter_mut().zip(map) {
+                    for c in 0..3 {
+                        b[c] += l[c] as u32 * value;
+                    }
+                }
+            }
+        }
+        None => block.fill([UNLIT_LIGHT * NORMAL_STYLE; 3]),
+    }
+    let tex = &world.textures[surface.texture];
+    let (s0, t0) = (ext.tex_mins[0] >> mip, ext.tex_mins[1] >> mip);
+    let mut texels = Vec::with_capacity(width * height);
+    for v in 0..height {
+        let pv = v << mip;
+        let (ly, fy) = ((pv >> 4).min(lh - 1), (pv & 15) as u32);
+        let ly1 = (ly + 1).min(lh - 1);
+        for u in 0..width {
+            let pu = u << mip;
+            let (lx, fx) = ((pu >> 4).min(lw - 1), (pu & 15) as u32);
+            let lx1 = (lx + 1).min(lw - 1);
+            let (a, b) = (block[ly * lw + lx], block[ly * lw + lx1]);
+            let (c, d) = (block[ly1 * lw + lx], block[ly1 * lw + lx1]);
+            let light: [u32; 3] = std::array::from_fn(|k| {
+                let top = a[k] * (16 - fx) + b[k] * fx;
+                let bottom = c[k] * (16 - fx) + d[k] * fx;
+                ((top as u64 * (16 - fy) as u64 + bottom as u64 * fy as u64) >> 16) as u32
+            });
+            let idx = tex.index_at(mip, s0 + u as i32, t0 + v as i32);
+            texels.push(world.palette.shade(idx, light));
+        }
+    }
+    LitSurface {
+        width,
+        height,
+        texels,
+    }
+}
+
+#[derive(Debug, Clone, Copy, Default, serde::Serialize)]
+pub struct CacheStats {
+    pub hits: u64,
+    pub misses: u64,
+    /// Misses caused by a light style changing under a cached surface.
+    pub style_rebuilds: u64,
+    pub bytes_built: u64,
+    pub evictions: u64,
+    pub bytes_resident: u64,
+    #[serde(skip)]
+    pub build_time: Duration,
+}
+
+impl CacheStats {
+    pub fn hit_rate(&self) -> f64 {
+        let total = self.hits + self.misses;
+        if total == 0 {
+            1.0
+        } else {
+            self.hits as f64 / total as f64
+        }
+    }
+
+    pub fn add(&mut self, o: &CacheStats) {
+        self.hits += o.hits;
+        self.misses += o.misses;
+        self.style_rebuilds += o.style_rebuilds;
+        self.bytes_built += o.bytes_built;
+        self.evictions += o.evictions;
+        self.bytes_resident = o.bytes_resident;
+        self.build_time += o.build_time;
+    }
+}
+
+#[derive(Debug)]
+struct Entry {
+    surface: LitSurface,
+    styles: [u32; MAX_LIGHTMAPS],
+    last_used: u64,
+}
+
+impl Entry {
+    fn bytes(&self) -> usize {
+        self.surface.texels.len() * 4
+    }
+}
+
+#[derive(Debug)]
+pub struct SurfaceCache {
+    entries: HashMap<(u32, u8), Entry>,
+    bytes: usize,
+    budget: usize,
+    frame: u64,
+    /// This frame's statistics (reset by [`SurfaceCache::begin_frame`]).
+    pub stats: CacheStats,
+}
+
+impl SurfaceCache {
+    pub fn new(budget_bytes: usize) -> SurfaceCache {
+        SurfaceCache {
+            entries: HashMap::new(),
+            bytes: 0,
+            budget: budget_bytes,
+            frame: 0,
+            stats: CacheStats::default(),
+        }
+    }
+
+    pub fn begin_frame(&mut self) {
+        self.frame += 1;
+        self.stats = CacheStats {
+            bytes_resident: self.bytes as u64,
+            ..CacheStats::default()
+        };
+    }
+
+    pub fn clear(&mut self) {
+        self.entries.clear();
+        self.bytes = 0;
+    }
+
+    /// The lit surface for `face` at `mip`, built now if absent or lit by old style values.
+    pub fn get(
+        &mut self,
+        world: &World,
+        face: u32,
+        mip: usize,
+        styles: &LightStyles,
+    ) -> Option<&LitSurface> {
+        let surface = world.surfaces.get(face as usize)?.as_ref()?;
+        let key = (face, mip as u8);
+        let current = styles.of(surface);
+        let fresh = match self.entries.get_mut(&key) {
+            Some(e) if e.styles == current => {
+                e.last_used = self.frame;
+                self.stats.hits += 1;
+                false
+            }
+            Some(_) => {
+                self.stats.style_rebuilds += 1;
+                true
+            }
+            None => true,
+        };
+        if fresh {
+            self.stats.misses += 1;
+            let start = Instant::now();
+            let entry = Entry {
+                surface: build_lit_surface(world, surface, mip, styles),
+                styles: current,
+                last_used: self.frame,
+            };
+            self.stats.build_time += start.elapsed();
+            self.stats.bytes_built += entry.bytes() as u64;
+            self.bytes += entry.bytes();
+            if let Some(old) = self.entries.insert(key, entry) {
+                self.bytes -= old.bytes();
+            }
+            if self.bytes > self.budget {
+                self.evict();
+            }
+            self.stats.bytes_resident = self.bytes as u64;
+        }
+        self.entries.get(&key).map(|e| &e.surface)
+    }
+
+    /// Drop least recently used entries (never this frame's) until 3/4 of the budget is used.
+    fn evict(&mut self) {
+        let mut old: Vec<(u64, (u32, u8))> = self
+            .entries
+            .iter()
+            .filter(|(_, e)| e.last_used < self.frame)
+            .map(|(k, e)| (e.last_used, *k))
+            .collect();
+        old.sort_unstable();
+        let target = self.budget / 4 * 3;
+        for (_, key) in old {
+            if self.bytes <= target {
+                break;
+            }
+            if let Some(e) = self.entries.remove(&key) {
+                self.bytes -= e.bytes();
+                self.stats.evictions += 1;
+            }
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.entries.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.entries.is_empty()
+    }
+
+    pub fn bytes(&self) -> usize {
+        self.bytes
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_room::room;
+
+    #[test]
+    fn least_recently_used_surfaces_go_first() {
+        let world = room(0);
+        let styles = LightStyles::default();
+        let one = build_lit_surface(
+            &world,
+            world.surfaces[0].as_ref().expect("wall"),
+            0,
+            &styles,
+        );
+        let size = one.texels.len() * 4;
+        // Over budget, entries not used this frame go oldest first until 3/4 of it is used.
+        let mut cache = SurfaceCache::new(size * 9 / 2);
+        cache.begin_frame();
+        for face in [0, 1, 2] {
+            cache.get(&world, face, 0, &styles);
+        }
+        cache.begin_frame();
+        cache.get(&world, 0, 0, &styles);
+        cache.get(&world, 3, 0, &styles);
+        cache.begin_frame();
+        cache.get(&world, 4, 0, &styles);
+        assert_eq!(cache.stats.evictions, 2);
+        assert!(cache.bytes() <= size * 9 / 2 / 4 * 3);
+        cache.begin_frame();
+        for face in [0, 3, 4] {
+            cache.get(&world, face, 0, &styles);
+        }
+        assert_eq!((cache.stats.hits, cache.stats.misses), (3, 0));
+        cache.get(&world, 1, 0, &styles);
+        assert_eq!(cache.stats.misses, 1, "face 1 was evicted");
+    }
+
+    #[test]
+    fn lightmap_is_bilinear_between_luxels() {
+        let world = room(0);
+        let s = world.surfaces[2].as_ref().expect("wall");
+        let lit = build_lit_surface(&world, s, 0, &LightStyles::default());
+        let ofs = s.light.expect("lit");
+        let tex = &world.textures[0];
+        let [lw, _] = s.extents.luxel_size();
+        let expect = |u: usize, light: u32| {
+            let idx = tex.index_at(0, s.extents.tex_mins[0] + u as i32, s.extents.tex_mins[1]);
+            world.palette.shade(idx, [light; 3])
+        };
+        let (l0, l1) = (world.light[ofs][0] as u32, world.light[ofs + 1][0] as u32);
+        assert!(lw > 2 && l0 != l1);
+        assert_eq!(lit.texels[0], expect(0, l0));
+        assert_eq!(lit.texels[16], expect(16, l1));
+        assert_eq!(lit.texels[8], expect(8, (l0 + l1) / 2));
+    }
+
+    #[test]
+    fn style_letters() {
+        assert_eq!(LightStyles::letter_value(b'a'), 0);
+        assert_eq!(LightStyles::letter_value(b'm'), NORMAL_STYLE);
+        assert_eq!(LightStyles::letter_value(b'z'), NORMAL_STYLE * 25 / 12);
+    }
+}

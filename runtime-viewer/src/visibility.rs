@@ -1,0 +1,236 @@
+//! Which surfaces might be seen, in front-to-back order: the camera's leaf and its PVS row,
+//! nodes culled by the frustum, faces culled by facing, and a sort key per face from the order
+//! of the BSP walk (smaller keys are nearer).
+
+use quake_formats::bsp::contents;
+use quake_formats::geom::Vec3;
+use quake_formats::visrle::decompress_row;
+
+use crate::camera::View;
+use crate::world::World;
+
+/// Faces this close to the eye's plane are edge-on and skipped.
+const BACKFACE_EPSILON: f64 = 0.01;
+
+/// A surface to draw: a world face, or a brush model fragment (`leaf`, index in that leaf).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Candidate {
+    pub face: u32,
+    pub key: u32,
+    pub fragment: Option<(u32, u32)>,
+    /// Bit i set: the polygon may cross frustum plane i and must be clipped against it.
+    pub clip_flags: u8,
+}
+
+#[derive(Debug, Clone, Default, serde::Serialize)]
+pub struct VisStats {
+    pub camera_leaf: usize,
+    /// Leaves the PVS row (or its absence) lets through.
+    pub pvs_leaves: usize,
+    /// Leaves reached by the walk after frustum culling.
+    pub drawn_leaves: usize,
+    pub frustum_culled: usize,
+    pub backfaces: usize,
+    pub candidates: usize,
+}
+
+/// Frame-stamped marks, kept between frames so nothing is cleared per frame.
+#[derive(Debug, Clone)]
+pub struct Visibility {
+    frame: u32,
+    leaf_mark: Vec<u32>,
+    node_mark: Vec<u32>,
+    face_mark: Vec<u32>,
+}
+
+struct Walk<'a> {
+    world: &'a World,
+    view: &'a View,
+    out: &'a mut Vec<Candidate>,
+    stats: VisStats,
+    key: u32,
+}
+
+impl Visibility {
+    pub fn new(world: &World) -> Visibility {
+        Visibility {
+            frame: 0,
+            leaf_mark: vec![0; world.bsp.leafs.len()],
+            node_mark: vec![0; world.bsp.nodes.len()],
+            face_mark: vec![0; world.bsp.faces.len()],
+        }
+    }
+
+    /// Fill `out` with this view's candidates in front-to-back order.
+    pub fn collect(&mut self, world: &World, view: &View, out: &mut Vec<Candidate>) -> VisStats {
+        out.clear();
+        self.frame = self.frame.wrapping_add(1).max(1);
+        let o = view.origin;
+        let camera_leaf = world.bsp.leaf_at(o.to_f32()).unwrap_or(0);
+        let pvs_leaves = self.mark_leaves(world, camera_leaf);
+        let mut walk = Walk {
+            world,
+            view,
+            out,
+            stats: VisStats {
+                camera_leaf,
+                pvs_leaves,
+                ..VisStats::default()
+            },
+            key: 0,
+        };
+        if let Some(root) = world.root() {
+            self.walk(&mut walk, root, 0b1111);
+        }
+        walk.stats.candidates = walk.out.len();
+        walk.stats
+    }
+
+    /// Mark the leaves in the camera leaf's PVS row and every node above them.
+    fn mark_leaves(&mut self, world: &World, camera_leaf: usize) -> usize {
+        let bsp = &world.bsp;
+        let vis_leafs = bsp
+            .models
+            .first()
+            .map_or(0, |m| m.vis_leafs.max(0) as usize);
+        let vis_offset = bsp.leafs.get(camera_leaf).map_or(-1, |l| l.vis_offset);
+        let row = match usize::try_from(vis_offset) {
+            Ok(ofs)
+                if camera_leaf != 0 && !bsp.visibility.is_empty() && ofs < bsp.visibility.len() =>
+            {
+                Some(decompress_row(&bsp.visibility[ofs..], vis_leafs.div_ceil(8)).0)
+            }
+            // Outside the map, or no vis data: everything is visible, as in engines.
+            _ => None,
+        };
+        let mut count = 0;
+        for leaf in 1..bsp.leafs.len() {
+            let bit = leaf - 1;
+            let visible = match &row {
+                Some(row) => row.get(bit / 8).is_some_and(|b| b & (1 << (bit % 8)) != 0),
+                None => true,
+            };
+            if !visible && leaf != camera_leaf {
+                continue;
+            }
+            count += 1;
+            self.leaf_mark[leaf] = self.frame;
+            let mut node = world.leaf_parent[leaf];
+            while node >= 0 && self.node_mark[node as usize] != self.frame {
+                self.node_mark[node as usize] = self.frame;
+                node = world.node_parent[node as usize];
+            }
+        }
+        count
+    }
+
+    /// Recursion depth is bounded by the node count: [`World::new`] checked the tree has no cycles.
+    fn walk(&mut self, w: &mut Walk, child: i32, mut clip_flags: u8) {
+        let bsp = &w.world.bsp;
+        let (mins, maxs) = if child < 0 {
+            let leaf = (-(child + 1)) as usize;
+            match bsp.leafs.get(leaf) {
+                Some(l) if self.leaf_mark[leaf] == self.frame && l.contents != contents::SOLID => {
+                    (l.mins, l.maxs)
+                }
+                _ => return,
+            }
+        } else {
+            match bsp.nodes.get(child as usize) {
+                Some(n) if self.node_mark[child as usize] == self.frame => (n.mins, n.maxs),
+                _ => return,
+            }
+        };
+        for (i, plane) in w.view.frustum.iter().enumerate() {
+            if clip_flags & (1 << i) == 0 {
+                continue;
+            }
+            // The box corners furthest along and against the plane's normal.
+            let corner = |toward: bool| {
+                Vec3::new(
+                    pick((plane.normal.x >= 0.0) == toward, mins[0], maxs[0]),
+                    pick((plane.normal.y >= 0.0) == toward, mins[1], maxs[1]),
+                    pick((plane.normal.z >= 0.0) == toward, mins[2], maxs[2]),
+                )
+            };
+            if plane.distance(corner(true)) < 0.0 {
+                w.stats.frustum_culled += 1;
+                return;
+            }
+            if plane.distance(corner(false)) >= 0.0 {
+                clip_flags &= !(1 << i);
+            }
+        }
+        if child < 0 {
+            self.visit_leaf(w, (-(child + 1)) as usize, clip_flags);
+            return;
+        }
+        let node = &bsp.nodes[child as usize];
+        let Some(plane) = w.world.node_plane(child as usize) else {
+            return;
+        };
+        let d = plane.distance(w.view.origin);
+        let near = usize::from(d < 0.0);
+        self.walk(w, node.children[near], clip_flags);
+        if d.abs() > BACKFACE_EPSILON {
+            // Faces on this node that look towards the eye's side.
+            let facing_side = near as u32;
+            let first = node.first_face as usize;
+            for f in first..first + node.num_faces as usize {
+                let Some(face) = bsp.faces.get(f) else { break };
+                if self.face_mark.get(f) != Some(&self.frame) {
+                    continue;
+                }
+                if face.side != facing_side {
+                    w.stats.backfaces += 1;
+                    continue;
+                }
+                w.out.push(Candidate {
+                    face: f as u32,
+                    key: w.key,
+                    fragment: None,
+                    clip_flags,
+                });
+            }
+        }
+        w.key += 1;
+        self.walk(w, node.children[1 - near], clip_flags);
+    }
+
+    fn visit_leaf(&mut self, w: &mut Walk, leaf: usize, clip_flags: u8) {
+        w.stats.drawn_leaves += 1;
+        let bsp = &w.world.bsp;
+        let l = &bsp.leafs[leaf];
+        let first = l.first_marksurface as usize;
+        let marks = bsp
+            .marksurfaces
+            .get(first..first + l.num_marksurfaces as usize)
+            .unwrap_or_default();
+        for &f in marks {
+            if let Some(m) = self.face_mark.get_mut(f as usize) {
+                *m = self.frame;
+            }
+        }
+        // Brush model pieces in this leaf sort together; their order within it is by depth.
+        for (i, frag) in w.world.leaf_fragments[leaf].iter().enumerate() {
+            let Some(s) = &w.world.surfaces[frag.face as usize] else {
+                continue;
+            };
+            if s.plane.distance(w.view.origin) <= BACKFACE_EPSILON {
+                w.stats.backfaces += 1;
+                continue;
+            }
+            w.out.push(Candidate {
+                face: frag.face,
+                key: w.key,
+                fragment: Some((leaf as u32, i as u32)),
+                clip_flags,
+            });
+        }
+        w.key += 1;
+    }
+}
+
+fn pick(first: bool, a: f32, b: f32) -> f64 {
+    if first { b as f64 } else { a as f64 }
+}

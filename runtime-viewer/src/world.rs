@@ -1,0 +1,409 @@
+//! A loaded map in the shape the renderer wants: per-face surfaces with their texture axes and
+//! lightmap rectangles, textures, the palette, lightmaps as RGB, node/leaf parents, and brush
+//! models cut into the world's leaves so they sort with the world.
+
+use std::path::Path;
+
+use quake_formats::Bsp;
+use quake_formats::bsp::{contents, limits::MAX_LIGHTMAPS, texinfo_flags};
+use quake_formats::entities::{Entity, parse_entities};
+use quake_formats::extents::LightmapExtents;
+use quake_formats::geom::{Plane, Split, Vec3, Winding};
+use quake_formats::palette::Palette;
+
+use crate::error::{Result, ViewerError};
+use crate::textures::{PackedPalette, PaletteSource, Texture, TextureKind, find_palette};
+
+/// Style slot value that marks "no lightmap here".
+pub const NO_STYLE: u8 = 255;
+
+/// A face ready to draw, in world space (brush model faces are moved by their entity's origin).
+#[derive(Debug, Clone)]
+pub struct Surface {
+    /// The face's plane, facing the side it is seen from.
+    pub plane: Plane,
+    pub points: Vec<Vec3>,
+    /// Texture coordinates: `s = s_axis · p + s_offset`, likewise t.
+    pub s_axis: Vec3,
+    pub s_offset: f64,
+    pub t_axis: Vec3,
+    pub t_offset: f64,
+    pub texture: usize,
+    pub kind: TextureKind,
+    pub extents: LightmapExtents,
+    pub styles: [u8; MAX_LIGHTMAPS],
+    /// First luxel in [`World::light`], when the face has a complete lightmap.
+    pub light: Option<usize>,
+}
+
+impl Surface {
+    pub fn st(&self, p: Vec3) -> (f64, f64) {
+        (
+            self.s_axis.dot(p) + self.s_offset,
+            self.t_axis.dot(p) + self.t_offset,
+        )
+    }
+
+    pub fn style_count(&self) -> usize {
+        self.styles.iter().take_while(|&&s| s != NO_STYLE).count()
+    }
+}
+
+/// A piece of a brush model face lying in one world leaf.
+#[derive(Debug, Clone)]
+pub struct Fragment {
+    pub face: u32,
+    pub points: Vec<Vec3>,
+}
+
+/// Counts for the load summary.
+#[derive(Debug, Clone, Default, serde::Serialize)]
+pub struct LoadStats {
+    pub faces: usize,
+    pub drawable_faces: usize,
+    pub textures: usize,
+    pub missing_textures: usize,
+    pub brush_models_drawn: usize,
+    pub brush_model_fragments: usize,
+    pub coloured_light: bool,
+}
+
+#[derive(Debug)]
+pub struct World {
+    pub bsp: Bsp,
+    pub palette: PackedPalette,
+    pub palette_source: PaletteSource,
+    pub textures: Vec<Texture>,
+    /// One per BSP face; `None` for faces too broken to draw.
+    pub surfaces: Vec<Option<Surface>>,
+    /// Lightmap samples as RGB, one per byte of the lighting lump.
+    pub light: Vec<[u8; 3]>,
+    pub node_parent: Vec<i32>,
+    pub leaf_parent: Vec<i32>,
+    /// Brush model fragments per world leaf.
+    pub leaf_fragments: Vec<Vec<Fragment>>,
+    /// Faces of the brush models that entities show.
+    pub brush_faces: Vec<u32>,
+    pub entities: Vec<Entity>,
+    pub stats: LoadStats,
+}
+
+impl World {
+    /// Load `path`, its `.lit` when one sits beside it, and the palette (see [`find_palette`]).
+    pub fn load(path: &Path, palette: Option<&Path>) -> Result<World> {
+        let format = |path: &Path| {
+            let path = path.to_path_buf();
+            move |error| ViewerError::format(&path, error)
+        };
+        let data = quake_formats::fsutil::read_file(path).map_err(format(path))?;
+        let bsp = Bsp::read(&data).map_err(format(path))?;
+        let lit_path = path.with_extension("lit");
+        let lit = if lit_path.is_file() {
+            let data = quake_formats::fsutil::read_file(&lit_path).map_err(format(&lit_path))?;
+            Some(
+                quake_formats::lit::read_lit(&data, bsp.lighting.len())
+                    .map_err(format(&lit_path))?,
+            )
+        } else {
+            None
+        };
+        let (palette, source) = find_palette(path, palette)?;
+        World::new(bsp, &palette, source, lit).map_err(|detail| ViewerError::BadMap {
+            path: path.to_path_buf(),
+            detail,
+        })
+    }
+
+    /// Build from parts; `lit` is the RGB data of a `.lit` file matching `bsp.lighting`.
+    pub fn new(
+        bsp: Bsp,
+        palette: &Palette,
+        palette_source: PaletteSource,
+        lit: Option<Vec<u8>>,
+    ) -> Result<World, String> {
+        let entities = parse_entities(&bsp.entity_text()).map_err(|e| format!("entities: {e}"))?;
+        let mut stats = LoadStats {
+            faces: bsp.faces.len(),
+            coloured_light: lit.is_some(),
+            ..LoadStats::default()
+        };
+        let mut textures: Vec<Texture> = bsp
+            .textures
+            .textures
+            .iter()
+            .map(|t| Texture::from_miptex(t.as_ref()))
+            .collect();
+        stats.missing_textures = bsp
+            .textures
+            .textures
+            .iter()
+            .filter(|t| t.as_ref().is_none_or(|t| t.mips.is_none()))
+            .count();
+        // Faces naming a texture the lump does not have get a checkerboard at the end.
+        let fallback_texture = textures.len();
+        textures.push(Texture::checker(String::new()));
+        stats.textures = textures.len();
+
+        let light: Vec<[u8; 3]> = match &lit {
+            Some(rgb) => rgb.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+            None => bsp.lighting.iter().map(|&l| [l; 3]).collect(),
+        };
+
+        // Each drawn brush model's entity origin moves its faces.
+        let mut model_origin: Vec<Option<Vec3>> = vec![None; bsp.models.len()];
+        if let Some(slot) = model_origin.first_mut() {
+            *slot = Some(Vec3::ZERO);
+        }
+        for e in &entities {
+            let Some(index) = e.get("model").and_then(|m| m.strip_prefix('*')) else {
+                continue;
+            };
+            let Ok(index) = index.parse::<usize>() else {
+                continue;
+            };
+            // Triggers are invisible in game.
+            if index == 0 || e.classname().starts_with("trigger_") {
+                continue;
+            }
+            if let Some(slot) = model_origin.get_mut(index) {
+                let o = e.get_floats::<3>("origin").unwrap_or([0.0; 3]);
+                *slot = Some(Vec3::new(o[0], o[1], o[2]));
+            }
+        }
+        let mut face_origin: Vec<Option<(usize, Vec3)>> = vec![None; bsp.faces.len()];
+        for (m, (model, origin)) in bsp.models.iter().zip(&model_origin).enumerate() {
+            let Some(origin) = origin else { continue };
+            let first = model.first_face as usize;
+            let end = (first + model.num_faces as usize).min(bsp.faces.len());
+            for slot in face_origin.get_mut(first..end).unwrap_or_default() {
+                *slot = Some((m, *origin));
+            }
+        }
+
+        let surfaces: Vec<Option<Surface>> = (0..bsp.faces.len())
+            .map(|f| {
+                let origin = face_origin[f].map_or(Vec3::ZERO, |(_, o)| o);
+                build_surface(&bsp, f, origin, &textures, fallback_texture, light.len())
+            })
+            .collect();
+        stats.drawable_faces = surfaces.iter().flatten().count();
+
+        let (node_parent, leaf_parent) = parents(&bsp)?;
+        let mut leaf_fragments = vec![Vec::new(); bsp.leafs.len()];
+        let mut brush_faces = Vec::new();
+        for (f, fo) in face_origin.iter().enumerate() {
+            let (Some((model, _)), Some(surface)) = (fo, &surfaces[f]) else {
+                continue;
+            };
+            if *model == 0
+                || textures[surface.texture]
+                    .name
+                    .eq_ignore_ascii_case("trigger")
+            {
+                continue;
+            }
+            brush_faces.push(f as u32);
+            let winding = Winding::new(surface.points.clone());
+            cut_into_leaves(&bsp, f as u32, winding, &mut leaf_fragments);
+        }
+        stats.brush_models_drawn = model_origin.iter().skip(1).flatten().count();
+        stats.brush_model_fragments = leaf_fragments.iter().map(Vec::len).sum();
+
+        Ok(World {
+            bsp,
+            palette: PackedPalette::new(palette),
+            palette_source,
+            textures,
+            surfaces,
+            light,
+            node_parent,
+            leaf_parent,
+            leaf_fragments,
+            brush_faces,
+            entities,
+            stats,
+        })
+    }
+
+    /// The world model's root node.
+    pub fn root(&self) -> Option<i32> {
+        self.bsp.models.first().map(|m| m.head_nodes[0])
+    }
+
+    pub fn node_plane(&self, node: usize) -> Option<Plane> {
+        let n = self.bsp.nodes.get(node)?;
+        let p = self.bsp.planes.get(n.plane as usize)?;
+        Some(Plane::new(Vec3::from_f32(p.normal), p.dist as f64))
+    }
+
+    /// Where the player starts: `info_player_start` (else a deathmatch, coop or intermission
+    /// spot), eye height 22 above its origin, and its yaw (`angle`, or `mangle`'s yaw).
+    pub fn player_start(&self) -> Option<(Vec3, f64)> {
+        const SPOTS: [&str; 4] = [
+            "info_player_start",
+            "info_player_deathmatch",
+            "info_player_coop",
+            "info_intermission",
+        ];
+        SPOTS.iter().find_map(|class| {
+            let e = self.entities.iter().find(|e| e.classname() == *class)?;
+            let o = e.get_floats::<3>("origin")?;
+            let yaw = e
+                .get_float("angle")
+                .or_else(|| e.get_floats::<3>("mangle").map(|m| m[1]))
+                .unwrap_or(0.0);
+            let eye = if *class == "info_intermission" {
+                0.0
+            } else {
+                22.0
+            };
+            Some((Vec3::new(o[0], o[1], o[2] + eye), yaw))
+        })
+    }
+
+    /// Spawn and intermission spots in entity order, for a flythrough path.
+    pub fn spots(&self) -> Vec<(Vec3, f64)> {
+        self.entities
+            .iter()
+            .filter(|e| {
+                e.classname().starts_with("info_player") || e.classname() == "info_intermission"
+            })
+            .filter_map(|e| {
+                let o = e.get_floats::<3>("origin")?;
+                Some((
+                    Vec3::new(o[0], o[1], o[2] + 22.0),
+                    e.get_float("angle").unwrap_or(0.0),
+                ))
+            })
+            .collect()
+    }
+}
+
+fn build_surface(
+    bsp: &Bsp,
+    f: usize,
+    origin: Vec3,
+    textures: &[Texture],
+    fallback_texture: usize,
+    light_len: usize,
+) -> Option<Surface> {
+    let face = &bsp.faces[f];
+    let raw_points = bsp.face_vertices(face)?;
+    if raw_points.len() < 3 {
+        return None;
+    }
+    let ti = bsp.texinfo.get(face.texinfo as usize)?;
+    let bp = bsp.planes.get(face.plane as usize)?;
+    let mut plane = Plane::new(Vec3::from_f32(bp.normal), bp.dist as f64);
+    if face.side != 0 {
+        plane = plane.flipped();
+    }
+    plane.dist += plane.normal.dot(origin);
+    let extents = LightmapExtents::from_points(&raw_points, &ti.vecs);
+    let axis = |v: [f32; 4]| Vec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
+    let (s_axis, t_axis) = (axis(ti.vecs[0]), axis(ti.vecs[1]));
+    let texture = if (ti.miptex as usize) < fallback_texture {
+        ti.miptex as usize
+    } else {
+        fallback_texture
+    };
+    let kind = textures[texture].kind(ti.flags & texinfo_flags::SPECIAL != 0);
+    let styles = face.styles;
+    let styles_used = styles.iter().take_while(|&&s| s != NO_STYLE).count();
+    let light = usize::try_from(face.light_offset)
+        .ok()
+        .filter(|&ofs| styles_used > 0 && ofs + styles_used * extents.luxel_count() <= light_len);
+    Some(Surface {
+        plane,
+        points: raw_points
+            .iter()
+            .map(|&p| Vec3::from_f32(p) + origin)
+            .collect(),
+        s_axis,
+        s_offset: ti.vecs[0][3] as f64 - s_axis.dot(origin),
+        t_axis,
+        t_offset: ti.vecs[1][3] as f64 - t_axis.dot(origin),
+        texture,
+        kind,
+        extents,
+        styles,
+        light,
+    })
+}
+
+/// Parent node of every node and leaf in the world tree (-1 for the root and for anything the
+/// world tree does not reach). Fails when a node is reached twice: everything that walks the tree
+/// relies on it being a tree.
+fn parents(bsp: &Bsp) -> Result<(Vec<i32>, Vec<i32>), String> {
+    let mut node_parent = vec![-1; bsp.nodes.len()];
+    let mut leaf_parent = vec![-1; bsp.leafs.len()];
+    let mut seen = vec![false; bsp.nodes.len()];
+    let Some(root) = bsp.models.first().map(|m| m.head_nodes[0]) else {
+        return Ok((node_parent, leaf_parent));
+    };
+    let mut stack = vec![root];
+    while let Some(n) = stack.pop() {
+        let Some(node) = usize::try_from(n).ok().and_then(|i| bsp.nodes.get(i)) else {
+            continue;
+        };
+        if std::mem::replace(&mut seen[n as usize], true) {
+            return Err(format!(
+                "node {n} is reached twice from the world's root: the node tree is damaged"
+            ));
+        }
+        for &child in &node.children {
+            if child >= 0 {
+                if let Some(p) = node_parent.get_mut(child as usize) {
+                    *p = n;
+                    stack.push(child);
+                }
+            } else if let Some(p) = leaf_parent.get_mut((-(child + 1)) as usize) {
+                *p = n;
+            }
+        }
+    }
+    Ok((node_parent, leaf_parent))
+}
+
+/// Push a brush model face down the world tree, keeping the pieces in non-solid leaves. A piece
+/// lying on a node's plane follows the side it faces.
+fn cut_into_leaves(bsp: &Bsp, face: u32, winding: Winding, out: &mut [Vec<Fragment>]) {
+    let Some(root) = bsp.models.first().map(|m| m.head_nodes[0]) else {
+        return;
+    };
+    let mut stack = vec![(root, winding)];
+    while let Some((n, w)) = stack.pop() {
+        if n < 0 {
+            let leaf = (-(n + 1)) as usize;
+            if let (Some(l), Some(slot)) = (bsp.leafs.get(leaf), out.get_mut(leaf))
+                && l.contents != contents::SOLID
+            {
+                slot.push(Fragment {
+                    face,
+                    points: w.points,
+                });
+            }
+            continue;
+        }
+        let Some(node) = bsp.nodes.get(n as usize) else {
+            continue;
+        };
+        let Some(p) = bsp.planes.get(node.plane as usize) else {
+            continue;
+        };
+        let plane = Plane::new(Vec3::from_f32(p.normal), p.dist as f64);
+        let [front, back] = node.children;
+        match w.split(&plane) {
+            Split::Front(w) => stack.push((front, w)),
+            Split::Back(w) => stack.push((back, w)),
+            Split::On {
+                winding,
+                facing_front,
+            } => stack.push((if facing_front { front } else { back }, winding)),
+            Split::Both { front: f, back: b } => {
+                stack.push((front, f));
+                stack.push((back, b));
+            }
+        }
+    }
+}
