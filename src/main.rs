@@ -22,6 +22,10 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// Compute lightmaps with Embree-traced shadow rays (writes the BSP, and .lit for coloured light)
+    Light(light::cli::Args),
+    /// Render a compiled map to PNG with the software renderer (or fly through it with --bench)
+    View(runtime_viewer::cli::Args),
     /// Print a BSP's lump counts and sizes and validate it (exit 1 when it has errors)
     Info(inspect::InfoArgs),
     /// Rewrite a BSP (optionally as BSP29 or BSP2) or a WAD; unchanged data is byte-identical
@@ -59,6 +63,8 @@ fn main() -> ExitCode {
 
 fn run(command: Command) -> Result<ExitCode> {
     match command {
+        Command::Light(args) => light::cli::run(&args).map(|()| ExitCode::SUCCESS),
+        Command::View(args) => runtime_viewer::cli::run(&args).map(|()| ExitCode::SUCCESS),
         Command::Info(args) => inspect::info(&args),
         Command::Convert(args) => inspect::convert(&args).map(|()| ExitCode::SUCCESS),
     }

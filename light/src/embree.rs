@@ -201,6 +201,12 @@ pub mod sys {
             context: *mut RTCIntersectContext,
             ray: *mut RTCRay16,
         );
+        pub fn rtcIntersect16(
+            valid: *const c_int,
+            scene: RTCScene,
+            context: *mut RTCIntersectContext,
+            rayhit: *mut RTCRayHit16,
+        );
     }
 }
 
@@ -680,6 +686,48 @@ impl Scene {
             .filter(|&i| packet.valid.0[i] != 0 && packet.rays.tfar[i] == f32::NEG_INFINITY)
             .fold(0, |m, i| m | (1 << i))
     }
+
+    /// Closest hit for the active lanes of `packet`: the geometry id each lane
+    /// hit first, or [`sys::RTC_INVALID_GEOMETRY_ID`] for a miss or an
+    /// inactive lane. Embree shortens `tfar` of lanes that hit, so call
+    /// [`RayPacket16::set`] again before reusing a lane.
+    pub fn first_hit_geom16(&self, packet: &mut RayPacket16, coherent: bool) -> [u32; 16] {
+        let mut ids = [sys::RTC_INVALID_GEOMETRY_ID; 16];
+        if packet.active_mask() == 0 {
+            return ids;
+        }
+        let mut rayhit = sys::RTCRayHit16 {
+            ray: packet.rays,
+            hit: sys::RTCHit16 {
+                Ng_x: [0.0; 16],
+                Ng_y: [0.0; 16],
+                Ng_z: [0.0; 16],
+                u: [0.0; 16],
+                v: [0.0; 16],
+                primID: [0; 16],
+                geomID: [sys::RTC_INVALID_GEOMETRY_ID; 16],
+                instID: [[sys::RTC_INVALID_GEOMETRY_ID; 16]; sys::RTC_MAX_INSTANCE_LEVEL_COUNT],
+            },
+        };
+        let mut ctx = context(coherent);
+        // SAFETY: committed live scene; the valid mask and ray-hit packet are
+        // 64-byte aligned by their types and fully initialised (geomID invalid).
+        unsafe {
+            sys::rtcIntersect16(
+                packet.valid.0.as_ptr(),
+                self.handle.raw,
+                &raw mut ctx,
+                &raw mut rayhit,
+            );
+        }
+        packet.rays = rayhit.ray;
+        for (i, id) in ids.iter_mut().enumerate() {
+            if packet.valid.0[i] != 0 {
+                *id = rayhit.hit.geomID[i];
+            }
+        }
+        ids
+    }
 }
 
 #[repr(C, align(64))]
@@ -958,6 +1006,27 @@ mod tests {
         }
         // Make sure the random rays actually exercise both outcomes.
         assert!(hits > 100 && misses > 100, "hits {hits} misses {misses}");
+    }
+
+    #[test]
+    fn first_hit_geom16_matches_intersect() {
+        let (scene, quad, far) = quad_scene(false);
+        let mut packet = RayPacket16::new();
+        let up = [0.0, 0.0, 1.0];
+        packet.set(0, [0.5, 0.5, -1.0], up, 0.0, 100.0);
+        packet.set(1, [0.5, 0.5, 1.0], up, 0.0, 100.0);
+        packet.set(2, [9.0, 9.0, -1.0], up, 0.0, 100.0);
+        packet.set(3, [0.5, 0.5, -1.0], up, 0.0, 0.5);
+        let ids = scene.first_hit_geom16(&mut packet, true);
+        assert_eq!(ids[0], quad);
+        assert_eq!(ids[1], far);
+        assert_eq!(ids[2], sys::RTC_INVALID_GEOMETRY_ID);
+        assert_eq!(ids[3], sys::RTC_INVALID_GEOMETRY_ID, "segment stops short");
+        assert!(
+            ids[4..]
+                .iter()
+                .all(|&id| id == sys::RTC_INVALID_GEOMETRY_ID)
+        );
     }
 
     #[test]

@@ -1,4 +1,401 @@
-//! Slipgate lighting support: a small, safe wrapper around Embree 3 used
-//! for visibility (shadow) and nearest-hit ray queries.
+//! Slipgate's `light`: lightmaps on Quake's 16-texel grid from the map's
+//! light entities, with shadows traced by Embree.
+//!
+//! Pipeline ([`compute_lighting`] then [`apply_lighting`]):
+//! 1. [`faces`]: every face as world-space geometry with its lightmap extents
+//!    (from the shared `quake_formats::extents`).
+//! 2. [`scene`]: one Embree scene of the opaque world (and `_shadow 1` brush
+//!    models), sky faces as their own geometry.
+//! 3. [`lights`]: light entities, suns and sky domes, minlight, switchable
+//!    styles; [`surface`] expands `_surface` templates.
+//! 4. [`samples`]: sample points per luxel (supersampled with `--extra`),
+//!    pulled out of solid. Kept as a structure for a later bounce pass.
+//! 5. [`trace`]: each face against the lights that can reach it (range,
+//!    plane side and PVS culling from [`visibility`]), 16-ray packets.
+//! 6. [`output`]: minlight, `--soft`, scale, clamp, lump and `.lit` bytes.
+//!
+//! Sky faces block point lights (the sky brush is solid) and are what sun
+//! rays look for; liquids (`*` textures) let light through, as in id's tool.
 
+pub mod bench;
+pub mod cli;
 pub mod embree;
+pub mod faces;
+pub mod lights;
+pub mod output;
+pub mod samples;
+pub mod scene;
+pub mod surface;
+pub mod trace;
+pub mod visibility;
+
+use std::collections::HashMap;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
+
+use quake_formats::Bsp;
+use quake_formats::entities::{parse_entities, write_entities};
+use quake_formats::geom::{Bounds, Vec3};
+use rayon::prelude::*;
+
+use crate::embree::{Device, EmbreeError};
+use crate::faces::{FaceKind, face_geometry};
+use crate::lights::{GlobalOverrides, parse_lights};
+use crate::output::{FaceLightmap, Finish, finish_face};
+use crate::samples::{PlacementCounts, face_samples};
+use crate::scene::TraceScene;
+use crate::trace::{TraceCounts, TraceSetup, light_face};
+use crate::visibility::Visibility;
+
+/// Everything that can stop lighting a map.
+#[derive(Debug, thiserror::Error)]
+pub enum LightError {
+    #[error("entity lump: {0}")]
+    Entities(#[from] quake_formats::FormatError),
+    #[error("entity {index} ({classname}): {detail}")]
+    Entity {
+        index: usize,
+        classname: String,
+        detail: String,
+    },
+    #[error("face {index}: {detail}")]
+    BadFace { index: usize, detail: String },
+    #[error("more switchable lights (distinct targetnames) than light styles 32..254")]
+    TooManySwitchableLights,
+    #[error("{0}")]
+    Embree(#[from] EmbreeError),
+}
+
+/// How much work to spend per luxel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum Quality {
+    /// One sample per luxel.
+    Default,
+    /// `--extra`: 2x2 samples per luxel.
+    Extra,
+    /// `--extra4`: 4x4 samples per luxel.
+    Extra4,
+    /// `--reference`: 16x16 samples per luxel, no light culling.
+    Reference,
+}
+
+impl Quality {
+    pub fn samples_per_axis(self) -> usize {
+        match self {
+            Quality::Default => 1,
+            Quality::Extra => 2,
+            Quality::Extra4 => 4,
+            Quality::Reference => 16,
+        }
+    }
+}
+
+/// Options of one lighting run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Options {
+    pub quality: Quality,
+    /// `--soft`: box filter radius over final luxels (0 = off).
+    pub soft_radius: usize,
+    /// `--gate`: contributions below this many light units count as zero.
+    pub gate: f64,
+    pub overrides: GlobalOverrides,
+    /// Light only these faces (others keep no lightmap); for measurements.
+    pub only_faces: Option<Vec<usize>>,
+    /// `--no-cull`: consider every light for every face (implied by `Reference`).
+    pub no_cull: bool,
+    pub progress: bool,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            quality: Quality::Default,
+            soft_radius: 0,
+            gate: 0.001,
+            overrides: GlobalOverrides::default(),
+            only_faces: None,
+            no_cull: false,
+            progress: false,
+        }
+    }
+}
+
+/// Counts and timings of a run (`--stats`).
+#[derive(Debug, Clone, Default, serde::Serialize)]
+pub struct Stats {
+    pub faces: usize,
+    pub faces_lit: usize,
+    pub luxels: u64,
+    pub samples: u64,
+    pub scene_triangles: usize,
+    pub point_lights: usize,
+    pub surface_lights: usize,
+    pub sun_directions: usize,
+    pub switchable_styles: usize,
+    pub coloured: bool,
+    pub shadow_rays: u64,
+    pub sun_rays: u64,
+    pub placement_rays: u64,
+    pub points_pulled_back: u64,
+    pub points_moved_to_centre: u64,
+    pub face_light_pairs: u64,
+    pub face_light_pairs_culled: u64,
+    pub faces_with_dropped_styles: u64,
+    pub seconds_setup: f64,
+    pub seconds_trace: f64,
+    pub seconds_total: f64,
+    /// All rays cast (shadow + sun + placement) per second of tracing.
+    pub rays_per_second: f64,
+}
+
+/// The result of lighting: final lightmaps of the lit faces, the entity
+/// text with assigned styles, and whether a `.lit` is needed.
+#[derive(Debug, Clone)]
+pub struct Lighting {
+    pub lightmaps: Vec<FaceLightmap>,
+    pub entity_text: Option<String>,
+    pub coloured: bool,
+    pub stats: Stats,
+}
+
+/// Everything built before tracing, reusable by later passes and benchmarks.
+pub struct Prepared {
+    pub faces: Vec<faces::FaceGeom>,
+    pub scene: TraceScene,
+    pub vis: Visibility,
+    pub lights: lights::MapLights,
+    /// Entity lights followed by surface-light copies.
+    pub point_lights: Vec<lights::PointLight>,
+    pub light_leafs: Vec<Option<u32>>,
+    pub sun_distance: f32,
+    pub surface_lights: usize,
+    pub entity_text: Option<String>,
+}
+
+/// Reads faces, entities and visibility and builds the Embree scene.
+///
+/// # Errors
+/// Bad entities or faces, or an Embree failure.
+pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
+    let mut entities = parse_entities(&bsp.entity_text())?;
+    let map_lights = parse_lights(&mut entities, &options.overrides)?;
+    let entity_text = (!map_lights.switchable_styles.is_empty()).then(|| write_entities(&entities));
+    let origin_of = |m: usize| {
+        map_lights
+            .model_origins
+            .get(&m)
+            .copied()
+            .unwrap_or(Vec3::ZERO)
+    };
+    let faces = face_geometry(bsp, origin_of)?;
+    // Embree's own threads only build the BVH; rayon does the tracing.
+    let device = Device::new(rayon::current_num_threads())?;
+    let scene = TraceScene::build(&device, &faces, &map_lights.shadow_models)?;
+    let vis = Visibility::new(bsp, &faces);
+    let surface =
+        surface::expand_templates(&map_lights.templates, &faces, surface::DEFAULT_SPACING);
+    let surface_lights = surface.len();
+    let mut point_lights = map_lights.points.clone();
+    point_lights.extend(surface);
+    let light_leafs = point_lights
+        .iter()
+        .map(|l| vis.open_leaf_at(bsp, l.origin))
+        .collect();
+    let mut bounds = Bounds::EMPTY;
+    for p in faces.iter().flat_map(|f| &f.points) {
+        bounds.add_point(*p);
+    }
+    let diagonal = if bounds.is_empty() {
+        1.0
+    } else {
+        (bounds.maxs - bounds.mins).length()
+    };
+    Ok(Prepared {
+        faces,
+        scene,
+        vis,
+        lights: map_lights,
+        point_lights,
+        light_leafs,
+        sun_distance: (diagonal * 2.0 + 1024.0) as f32,
+        surface_lights,
+        entity_text,
+    })
+}
+
+fn progress_bar(len: usize, show: bool) -> indicatif::ProgressBar {
+    if !show {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::with_draw_target(
+        Some(len as u64),
+        indicatif::ProgressDrawTarget::stderr(),
+    );
+    if let Ok(style) =
+        indicatif::ProgressStyle::with_template("light {bar:40} {pos}/{len} faces {elapsed}")
+    {
+        bar.set_style(style);
+    }
+    bar
+}
+
+/// Lights every lit face of `bsp` (or `options.only_faces`).
+///
+/// # Errors
+/// Bad entities or faces, or an Embree failure.
+pub fn compute_lighting(bsp: &Bsp, options: &Options) -> Result<Lighting, LightError> {
+    let start = Instant::now();
+    let prep = prepare(bsp, options)?;
+    let setup_done = Instant::now();
+    let setup = TraceSetup {
+        bsp,
+        faces: &prep.faces,
+        scene: &prep.scene,
+        vis: &prep.vis,
+        lights: &prep.point_lights,
+        light_leafs: &prep.light_leafs,
+        suns: &prep.lights.suns,
+        cull: !options.no_cull && options.quality != Quality::Reference,
+        gate: options.gate,
+        sun_distance: prep.sun_distance,
+    };
+    let finish = Finish {
+        rangescale: prep.lights.rangescale,
+        gamma: prep.lights.gamma,
+        soft_radius: options.soft_radius,
+    };
+    let wanted: Vec<usize> = match &options.only_faces {
+        Some(list) => list.clone(),
+        None => (0..prep.faces.len()).collect(),
+    };
+    let lit_faces: Vec<usize> = wanted
+        .into_iter()
+        .filter(|&f| prep.faces.get(f).is_some_and(|g| g.kind == FaceKind::Lit))
+        .collect();
+    let per_axis = options.quality.samples_per_axis();
+    let bar = progress_bar(lit_faces.len(), options.progress);
+    let dropped = AtomicU64::new(0);
+    let results: Vec<(FaceLightmap, PlacementCounts, TraceCounts, u64)> = lit_faces
+        .par_iter()
+        .map(|&f| {
+            let geom = &prep.faces[f];
+            let (samples, placement) = face_samples(geom, per_axis, &prep.scene, bsp);
+            let (light, counts) = light_face(&setup, &samples);
+            // A brush model's own `_minlight` wins; otherwise worldspawn's applies.
+            let minlight = prep
+                .lights
+                .minlight
+                .get(&geom.model)
+                .or_else(|| prep.lights.minlight.get(&0))
+                .copied();
+            let (map, d) = finish_face(light, minlight, &finish);
+            if d > 0 {
+                dropped.fetch_add(1, Ordering::Relaxed);
+            }
+            bar.inc(1);
+            (map, placement, counts, samples.points.len() as u64)
+        })
+        .collect();
+    bar.finish_and_clear();
+    let trace_done = Instant::now();
+
+    let mut placement = PlacementCounts::default();
+    let mut counts = TraceCounts::default();
+    let mut stats = Stats {
+        faces: bsp.faces.len(),
+        faces_lit: results.len(),
+        scene_triangles: prep.scene.triangles,
+        point_lights: prep.lights.points.len(),
+        surface_lights: prep.surface_lights,
+        sun_directions: prep.lights.suns.len(),
+        switchable_styles: prep.lights.switchable_styles.len(),
+        coloured: prep.lights.is_coloured(),
+        faces_with_dropped_styles: dropped.load(Ordering::Relaxed),
+        ..Stats::default()
+    };
+    let mut lightmaps = Vec::with_capacity(results.len());
+    for (map, p, c, samples) in results {
+        placement.add(&p);
+        counts.add(&c);
+        stats.luxels += (map.width * map.height) as u64;
+        stats.samples += samples;
+        lightmaps.push(map);
+    }
+    stats.shadow_rays = counts.shadow_rays;
+    stats.sun_rays = counts.sun_rays;
+    stats.placement_rays = placement.rays;
+    stats.points_pulled_back = placement.pulled_back;
+    stats.points_moved_to_centre = placement.to_centre;
+    stats.face_light_pairs = counts.pairs;
+    stats.face_light_pairs_culled = counts.pairs_culled;
+    stats.seconds_setup = (setup_done - start).as_secs_f64();
+    stats.seconds_trace = (trace_done - setup_done).as_secs_f64();
+    stats.seconds_total = start.elapsed().as_secs_f64();
+    stats.rays_per_second = (counts.rays() + placement.rays) as f64 / stats.seconds_trace.max(1e-9);
+    Ok(Lighting {
+        lightmaps,
+        entity_text: prep.entity_text,
+        coloured: stats.coloured,
+        stats,
+    })
+}
+
+/// Writes `lighting` into `bsp` (lighting lump, face styles and offsets,
+/// entity styles) and returns the `.lit` file bytes when the map is coloured.
+pub fn apply_lighting(bsp: &mut Bsp, lighting: &Lighting) -> Option<Vec<u8>> {
+    let rgb = output::write_lighting(bsp, &lighting.lightmaps);
+    if let Some(text) = &lighting.entity_text {
+        bsp.set_entity_text(text);
+    }
+    lighting
+        .coloured
+        .then(|| quake_formats::lit::write_lit(&rgb))
+}
+
+/// Per-luxel difference between two lightings of the same faces, in 8-bit levels.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct ErrorStats {
+    /// Luxels compared (every style of every face both lightings share).
+    pub luxels: u64,
+    pub rmse: f64,
+    pub max: u8,
+    /// Luxels that differ by more than 8 levels.
+    pub over_8: u64,
+}
+
+/// Compares grey lightmaps face by face and style by style (a style only one
+/// side has counts against zero).
+pub fn compare(a: &Lighting, reference: &Lighting) -> ErrorStats {
+    let by_face: HashMap<usize, &FaceLightmap> =
+        reference.lightmaps.iter().map(|m| (m.face, m)).collect();
+    let mut e = ErrorStats::default();
+    let mut sq = 0.0f64;
+    for m in &a.lightmaps {
+        let Some(r) = by_face.get(&m.face) else {
+            continue;
+        };
+        let mut styles: Vec<u8> = m.styles.clone();
+        styles.extend(r.styles.iter().filter(|s| !m.styles.contains(s)));
+        let zeros = vec![0u8; m.width * m.height];
+        for s in styles {
+            let pick = |f: &FaceLightmap| {
+                f.styles
+                    .iter()
+                    .position(|&x| x == s)
+                    .map_or(zeros.clone(), |i| f.grey[i].clone())
+            };
+            for (x, y) in pick(m).iter().zip(pick(r).iter()) {
+                let d = x.abs_diff(*y);
+                e.luxels += 1;
+                sq += f64::from(d) * f64::from(d);
+                e.max = e.max.max(d);
+                e.over_8 += u64::from(d > 8);
+            }
+        }
+    }
+    e.rmse = (sq / e.luxels.max(1) as f64).sqrt();
+    e
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,68 @@
+//! The tracer's ceiling: the same kind of shadow rays the lighting pass casts
+//! (sample points to the lights that survive culling, 16 neighbouring samples
+//! per packet), traced in a bare loop with no lighting arithmetic around it.
+
+use std::time::Instant;
+
+use quake_formats::Bsp;
+use rayon::prelude::*;
+
+use crate::Prepared;
+use crate::embree::RayPacket16;
+use crate::faces::FaceKind;
+use crate::samples::face_samples;
+
+/// One shadow ray: origin, unit direction, length.
+type Ray = ([f32; 3], [f32; 3], f32);
+
+/// Result of [`bare_occlusion`].
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct BareOcclusion {
+    pub rays: u64,
+    pub seconds: f64,
+    pub rays_per_second: f64,
+}
+
+/// Collects up to `max_rays` shadow rays (default sampling, plane-side and
+/// range culling) and times tracing them with `rtcOccluded16` on all threads.
+pub fn bare_occlusion(bsp: &Bsp, prep: &Prepared, gate: f64, max_rays: usize) -> BareOcclusion {
+    let mut rays: Vec<Ray> = Vec::new();
+    'faces: for face in prep.faces.iter().filter(|f| f.kind == FaceKind::Lit) {
+        let (samples, _) = face_samples(face, 1, &prep.scene, bsp);
+        for light in &prep.point_lights {
+            if face.plane.distance(light.origin) <= 0.0 {
+                continue;
+            }
+            let range = light.range(gate);
+            for p in &samples.points {
+                let d = light.origin - quake_formats::geom::Vec3::from_f32(*p);
+                let dist = d.length();
+                if dist > range || dist < 1e-3 {
+                    continue;
+                }
+                rays.push((*p, (d / dist).to_f32(), dist as f32 - 0.1));
+                if rays.len() >= max_rays {
+                    break 'faces;
+                }
+            }
+        }
+    }
+    let start = Instant::now();
+    let blocked: u64 = rays
+        .par_chunks(16)
+        .map(|chunk| {
+            let mut packet = RayPacket16::new();
+            for (lane, &(o, d, t)) in chunk.iter().enumerate() {
+                packet.set(lane, o, d, 0.0, t);
+            }
+            u64::from(prep.scene.occluded16(&mut packet).count_ones())
+        })
+        .sum();
+    let seconds = start.elapsed().as_secs_f64();
+    debug_assert!(blocked <= rays.len() as u64);
+    BareOcclusion {
+        rays: rays.len() as u64,
+        seconds,
+        rays_per_second: rays.len() as f64 / seconds.max(1e-9),
+    }
+}

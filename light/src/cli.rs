@@ -1,0 +1,189 @@
+//! Command line of `slipgate-light` (mounted by the lead as `slipgate light`).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use quake_formats::Bsp;
+use quake_formats::fsutil::{read_file, write_atomic};
+
+use crate::lights::GlobalOverrides;
+use crate::{ErrorStats, Options, Quality, compare, compute_lighting};
+
+/// Light a BSP: compute lightmaps from its light entities.
+#[derive(clap::Args, Debug, Clone)]
+pub struct Args {
+    /// The BSP to light.
+    pub bsp: PathBuf,
+    /// Where to write the lit BSP (default: overwrite the input). A `.lit` goes beside it.
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// 2x2 samples per luxel.
+    #[arg(long, conflicts_with_all = ["extra4", "reference"])]
+    pub extra: bool,
+    /// 4x4 samples per luxel.
+    #[arg(long, conflicts_with = "reference")]
+    pub extra4: bool,
+    /// The slow exact answer: 16x16 samples per luxel and no light culling.
+    #[arg(long)]
+    pub reference: bool,
+    /// Average each luxel with its neighbours within N luxels (default 1).
+    #[arg(long, value_name = "N", num_args = 0..=1, default_missing_value = "1")]
+    pub soft: Option<usize>,
+    /// Light contributions below this (in light units) count as zero.
+    #[arg(long, default_value_t = 0.001)]
+    pub gate: f64,
+    /// Scale every light's fade distance (overrides worldspawn `_dist`).
+    #[arg(long)]
+    pub dist: Option<f64>,
+    /// Scale brightness to bytes (overrides worldspawn `_range`, default 0.5).
+    #[arg(long)]
+    pub range: Option<f64>,
+    /// Directions per sun penumbra and per sky dome.
+    #[arg(long, default_value_t = 100)]
+    pub sunsamples: usize,
+    /// Consider every light for every face (no range, plane-side or PVS culling).
+    #[arg(long)]
+    pub no_cull: bool,
+    /// Write counts and timings as JSON.
+    #[arg(long, value_name = "FILE.json")]
+    pub stats: Option<PathBuf>,
+    /// Measurement: light only every Nth face (the others get no lightmap).
+    #[arg(long, value_name = "N")]
+    pub face_stride: Option<usize>,
+    /// Measurement: also light the same faces with --reference and report the error.
+    #[arg(long)]
+    pub compare_reference: bool,
+    /// Measurement: time a bare occlusion loop over up to this many shadow rays.
+    #[arg(long, value_name = "RAYS")]
+    pub bench_occlusion: Option<usize>,
+}
+
+impl Args {
+    fn options(&self, quality: Quality) -> Options {
+        Options {
+            quality,
+            soft_radius: self.soft.unwrap_or(0),
+            gate: self.gate,
+            overrides: GlobalOverrides {
+                dist: self.dist,
+                range: self.range,
+                sunsamples: self.sunsamples,
+            },
+            only_faces: None,
+            no_cull: self.no_cull,
+            progress: true,
+        }
+    }
+
+    fn quality(&self) -> Quality {
+        if self.reference {
+            Quality::Reference
+        } else if self.extra4 {
+            Quality::Extra4
+        } else if self.extra {
+            Quality::Extra
+        } else {
+            Quality::Default
+        }
+    }
+}
+
+fn lit_path(bsp: &Path) -> PathBuf {
+    bsp.with_extension("lit")
+}
+
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    let path = &args.bsp;
+    let data = read_file(path)?;
+    let mut bsp = Bsp::read(&data).with_context(|| format!("{}", path.display()))?;
+    let mut options = args.options(args.quality());
+    if let Some(stride) = args.face_stride {
+        anyhow::ensure!(stride > 0, "--face-stride must be at least 1");
+        options.only_faces = Some((0..bsp.faces.len()).step_by(stride).collect());
+    }
+    let lighting =
+        compute_lighting(&bsp, &options).with_context(|| format!("lighting {}", path.display()))?;
+    let s = &lighting.stats;
+    let rays = s.shadow_rays + s.sun_rays + s.placement_rays;
+    eprintln!(
+        "light: {} of {} faces, {} luxels ({} samples), {} point + {} surface lights, {} sun directions",
+        s.faces_lit,
+        s.faces,
+        s.luxels,
+        s.samples,
+        s.point_lights,
+        s.surface_lights,
+        s.sun_directions
+    );
+    eprintln!(
+        "light: {rays} rays ({} shadow, {} sun, {} placement) in {:.2} s trace + {:.2} s setup: {:.2} Mrays/s",
+        s.shadow_rays,
+        s.sun_rays,
+        s.placement_rays,
+        s.seconds_trace,
+        s.seconds_setup,
+        s.rays_per_second / 1e6
+    );
+    if s.faces_with_dropped_styles > 0 {
+        eprintln!(
+            "light: warning: {} faces are reached by more than 4 light styles; the dimmest were dropped",
+            s.faces_with_dropped_styles
+        );
+    }
+
+    let mut extra = serde_json::Map::new();
+    if args.compare_reference {
+        let mut reference = options.clone();
+        reference.quality = Quality::Reference;
+        reference.soft_radius = 0;
+        let exact = compute_lighting(&bsp, &reference)?;
+        let e: ErrorStats = compare(&lighting, &exact);
+        eprintln!(
+            "light: against --reference ({:.2} s, {} rays): RMSE {:.3}, max {} levels over {} luxels ({} differ by more than 8)",
+            exact.stats.seconds_total,
+            exact.stats.shadow_rays + exact.stats.sun_rays + exact.stats.placement_rays,
+            e.rmse,
+            e.max,
+            e.luxels,
+            e.over_8
+        );
+        extra.insert("error_vs_reference".into(), serde_json::to_value(e)?);
+        extra.insert(
+            "reference_seconds".into(),
+            serde_json::to_value(exact.stats.seconds_total)?,
+        );
+    }
+    if let Some(max_rays) = args.bench_occlusion {
+        let prep = crate::prepare(&bsp, &options)?;
+        let b = crate::bench::bare_occlusion(&bsp, &prep, options.gate, max_rays);
+        eprintln!(
+            "light: bare occlusion loop: {} rays in {:.3} s: {:.2} Mrays/s",
+            b.rays,
+            b.seconds,
+            b.rays_per_second / 1e6
+        );
+        extra.insert("bare_occlusion".into(), serde_json::to_value(b)?);
+    }
+
+    let lit = crate::apply_lighting(&mut bsp, &lighting);
+    let out = args.output.as_ref().unwrap_or(path);
+    write_atomic(out, &bsp.write()?)?;
+    let lit_file = lit_path(out);
+    match lit {
+        Some(bytes) => write_atomic(&lit_file, &bytes)?,
+        None if lit_file.exists() => eprintln!(
+            "light: warning: {} is left over from an earlier run and no longer matches (no coloured lights now)",
+            lit_file.display()
+        ),
+        None => {}
+    }
+    if let Some(stats_path) = &args.stats {
+        let mut json = serde_json::to_value(&lighting.stats)?;
+        if let serde_json::Value::Object(map) = &mut json {
+            map.extend(extra);
+            map.insert("quality".into(), serde_json::to_value(options.quality)?);
+        }
+        write_atomic(stats_path, serde_json::to_string_pretty(&json)?.as_bytes())?;
+    }
+    Ok(())
+}

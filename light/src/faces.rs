@@ -1,0 +1,121 @@
+//! The faces of a BSP as geometry the light tool works with: world-space
+//! polygon, facing plane, texture projection and lightmap extents.
+
+use quake_formats::Bsp;
+use quake_formats::bsp::texinfo_flags;
+use quake_formats::extents::LightmapExtents;
+use quake_formats::geom::{Plane, Vec3};
+
+use crate::LightError;
+
+/// What a face is for lighting and shadowing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FaceKind {
+    /// Has a lightmap and blocks light.
+    Lit,
+    /// Sky: no lightmap; blocks lights, and sun rays that reach it see the sky.
+    Sky,
+    /// Water, slime, lava, teleporters (`*` textures): no lightmap, and
+    /// transparent to light (Quake's own light tool let light through them).
+    Liquid,
+}
+
+/// One face, ready for sampling.
+#[derive(Debug, Clone)]
+pub struct FaceGeom {
+    pub index: usize,
+    /// The brush model it belongs to (0 = world).
+    pub model: usize,
+    pub kind: FaceKind,
+    pub texture: String,
+    /// Vertices in world space (the model's `origin` offset applied).
+    pub points: Vec<Vec3>,
+    /// The plane the face looks out of (the BSP plane flipped for back-side faces), world space.
+    pub plane: Plane,
+    /// Texture projection `s = vecs[0].xyz · p + vecs[0].w` in model space.
+    pub vecs: [[f32; 4]; 2],
+    /// Offset from model space to world space.
+    pub origin: Vec3,
+    pub extents: LightmapExtents,
+}
+
+impl FaceGeom {
+    /// The mean of the vertices (inside the face: faces are convex).
+    pub fn centroid(&self) -> Vec3 {
+        let sum = self.points.iter().fold(Vec3::ZERO, |a, &p| a + p);
+        sum / self.points.len().max(1) as f64
+    }
+}
+
+/// Every face of `bsp` with its model; `origins` gives per-model offsets.
+///
+/// # Errors
+/// [`LightError::BadFace`] for a face whose indices run outside the file.
+pub fn face_geometry(
+    bsp: &Bsp,
+    origin_of: impl Fn(usize) -> Vec3,
+) -> Result<Vec<FaceGeom>, LightError> {
+    let mut model_of = vec![0usize; bsp.faces.len()];
+    for (m, model) in bsp.models.iter().enumerate() {
+        let first = model.first_face as usize;
+        let end = (first + model.num_faces as usize).min(bsp.faces.len());
+        for slot in model_of.get_mut(first..end).into_iter().flatten() {
+            *slot = m;
+        }
+    }
+    bsp.faces
+        .iter()
+        .enumerate()
+        .map(|(index, face)| {
+            let bad = |detail: &str| LightError::BadFace {
+                index,
+                detail: detail.to_string(),
+            };
+            let verts = bsp
+                .face_vertices(face)
+                .filter(|v| v.len() >= 3)
+                .ok_or_else(|| bad("edge or vertex index out of range, or fewer than 3 edges"))?;
+            let ti = bsp
+                .texinfo
+                .get(face.texinfo as usize)
+                .ok_or_else(|| bad("texinfo index out of range"))?;
+            let bp = bsp
+                .planes
+                .get(face.plane as usize)
+                .ok_or_else(|| bad("plane index out of range"))?;
+            let texture = bsp
+                .textures
+                .textures
+                .get(ti.miptex as usize)
+                .and_then(Option::as_ref)
+                .map(quake_formats::miptex::MipTex::name)
+                .unwrap_or_default();
+            let lower = texture.to_ascii_lowercase();
+            let kind = if ti.flags & texinfo_flags::SPECIAL == 0 {
+                FaceKind::Lit
+            } else if lower.starts_with("sky") {
+                FaceKind::Sky
+            } else {
+                FaceKind::Liquid
+            };
+            let model = model_of[index];
+            let origin = origin_of(model);
+            let mut plane = Plane::new(Vec3::from_f32(bp.normal), f64::from(bp.dist));
+            if face.side != 0 {
+                plane = plane.flipped();
+            }
+            plane.dist += plane.normal.dot(origin);
+            Ok(FaceGeom {
+                index,
+                model,
+                kind,
+                texture,
+                points: verts.iter().map(|&v| Vec3::from_f32(v) + origin).collect(),
+                plane,
+                vecs: ti.vecs,
+                origin,
+                extents: LightmapExtents::from_points(&verts, &ti.vecs),
+            })
+        })
+        .collect()
+}

@@ -1,0 +1,819 @@
+//! Light sources read from the entity lump, and the formulas that turn a
+//! light and a distance into brightness.
+//!
+//! Keys follow ericw-tools' documented meanings. Brightness is kept in
+//! "light units" (a `light 300` entity gives 300 at its origin with linear
+//! falloff); the range scale (`_range`, default 0.5) maps light units to
+//! lightmap bytes at the very end.
+
+use std::collections::HashMap;
+
+use quake_formats::entities::Entity;
+use quake_formats::geom::Vec3;
+
+use crate::LightError;
+
+/// `light` value of a light entity without one (or with `light 0`, as
+/// ericw-tools treats it).
+pub const DEFAULT_LIGHT: f64 = 300.0;
+/// Spotlight cone (full angle, degrees) when `angle` is absent.
+pub const DEFAULT_SPOT_ANGLE: f64 = 40.0;
+/// Angle-of-incidence weight when `_anglescale` is absent.
+pub const DEFAULT_ANGLESCALE: f64 = 0.5;
+/// Lightmap bytes per light unit when `_range` is absent.
+pub const DEFAULT_RANGESCALE: f64 = 0.5;
+/// First style given to switchable lights (styles below are the engine's
+/// animated presets).
+pub const FIRST_SWITCHABLE_STYLE: u8 = 32;
+/// Distance (map units) at which the 1/x and 1/x² formulas give `light`.
+const FALLOFF_SCALE: f64 = 128.0;
+
+/// How brightness falls off with distance (the `delay` key).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Falloff {
+    /// 0: `light - dist * wait`.
+    Linear,
+    /// 1: `light * 128 / (dist * wait)`.
+    Inverse,
+    /// 2: `light * 128² / (dist * wait)²` (brighter than `light` within 128 units).
+    InverseSquare,
+    /// 3: `light` at any distance.
+    Constant,
+    /// 4: "local minlight": raises what the light sees to `light`, never adds.
+    LocalMin,
+    /// 5: `light * 128² / (dist * wait + 128)²`: inverse square without the
+    /// bright spot near the source.
+    InverseSquareSoft,
+}
+
+impl Falloff {
+    fn from_delay(delay: i64) -> Option<Falloff> {
+        Some(match delay {
+            0 => Falloff::Linear,
+            1 => Falloff::Inverse,
+            2 => Falloff::InverseSquare,
+            3 => Falloff::Constant,
+            4 => Falloff::LocalMin,
+            5 => Falloff::InverseSquareSoft,
+            _ => return None,
+        })
+    }
+}
+
+/// A spotlight's cone.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Spot {
+    /// Unit direction the light shines in.
+    pub dir: Vec3,
+    /// Cosine of half the outer cone angle: dimmer than this is dark.
+    pub cos_outer: f64,
+    /// Cosine of half the inner (`_softangle`) cone: full brightness inside.
+    pub cos_inner: f64,
+}
+
+impl Spot {
+    /// A cone of full angle `angle` degrees (non-positive means the default
+    /// 40) with an optional soft inner cone of `softangle` degrees.
+    pub fn new(dir: Vec3, angle: f64, softangle: f64) -> Spot {
+        let angle = if angle > 0.0 {
+            angle.min(360.0)
+        } else {
+            DEFAULT_SPOT_ANGLE
+        };
+        let cos_outer = (angle.to_radians() / 2.0).cos();
+        let cos_inner = if softangle > 0.0 && softangle < angle {
+            (softangle.to_radians() / 2.0).cos()
+        } else {
+            cos_outer
+        };
+        Spot {
+            dir,
+            cos_outer,
+            cos_inner,
+        }
+    }
+
+    /// Brightness factor for a point in unit direction `to_point` from the
+    /// light: 1 inside the inner cone, 0 outside the outer one, linear in the
+    /// cosine between them.
+    pub fn factor(&self, to_point: Vec3) -> f64 {
+        let c = self.dir.dot(to_point);
+        if c < self.cos_outer {
+            0.0
+        } else if c >= self.cos_inner {
+            1.0
+        } else {
+            (c - self.cos_outer) / (self.cos_inner - self.cos_outer)
+        }
+    }
+}
+
+/// The angle-of-incidence term: `scale * cos + (1 - scale)` for a surface
+/// facing the light (`cos > 0`), else 0.
+pub fn angle_factor(cos_incidence: f64, anglescale: f64) -> f64 {
+    if cos_incidence <= 0.0 {
+        0.0
+    } else {
+        anglescale * cos_incidence + (1.0 - anglescale)
+    }
+}
+
+/// A light at a point (an entity, or one copy of a `_surface` template).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointLight {
+    pub origin: Vec3,
+    /// Brightness in light units; negative lights subtract.
+    pub light: f64,
+    /// Distance scale of the falloff: `wait` times the global `_dist`.
+    pub atten: f64,
+    pub falloff: Falloff,
+    /// Per-channel colour, 1.0 = white.
+    pub color: Vec3,
+    pub style: u8,
+    pub spot: Option<Spot>,
+    pub anglescale: f64,
+    /// Entity index it came from (for messages).
+    pub entity: usize,
+}
+
+impl PointLight {
+    /// Brightness at `dist` units from the light before angle and cone terms.
+    pub fn value_at(&self, dist: f64) -> f64 {
+        // Distances under one unit are clamped so 1/x stays finite.
+        let scaled = (dist * self.atten).max(1.0);
+        match self.falloff {
+            Falloff::Linear => {
+                if self.light >= 0.0 {
+                    (self.light - scaled).max(0.0)
+                } else {
+                    (self.light + scaled).min(0.0)
+                }
+            }
+            Falloff::Inverse => self.light * FALLOFF_SCALE / scaled,
+            Falloff::InverseSquare => self.light * (FALLOFF_SCALE / scaled).powi(2),
+            Falloff::Constant | Falloff::LocalMin => self.light,
+            Falloff::InverseSquareSoft => {
+                self.light * (FALLOFF_SCALE / (dist * self.atten + FALLOFF_SCALE)).powi(2)
+            }
+        }
+    }
+
+    /// Distance beyond which `|value_at|` stays below `gate` light units.
+    pub fn range(&self, gate: f64) -> f64 {
+        let l = self.light.abs();
+        let gate = gate.max(1e-9);
+        let r = match self.falloff {
+            Falloff::Linear => l,
+            Falloff::Inverse => l * FALLOFF_SCALE / gate,
+            Falloff::InverseSquare => FALLOFF_SCALE * (l / gate).sqrt(),
+            Falloff::InverseSquareSoft => FALLOFF_SCALE * ((l / gate).sqrt() - 1.0).max(0.0),
+            Falloff::Constant | Falloff::LocalMin => return f64::INFINITY,
+        };
+        r / self.atten
+    }
+
+    /// Brightness this light adds at a point `dist` away in unit direction
+    /// `to_point` (from the light), on a surface whose normal makes cosine
+    /// `cos_incidence` with the direction back to the light.
+    pub fn contribution(&self, dist: f64, to_point: Vec3, cos_incidence: f64) -> f64 {
+        let angle = if self.falloff == Falloff::LocalMin {
+            f64::from(u8::from(cos_incidence > 0.0))
+        } else {
+            angle_factor(cos_incidence, self.anglescale)
+        };
+        if angle == 0.0 {
+            return 0.0;
+        }
+        let spot = self.spot.map_or(1.0, |s| s.factor(to_point));
+        if spot == 0.0 {
+            return 0.0;
+        }
+        self.value_at(dist) * angle * spot
+    }
+}
+
+/// One direction of sunlight (a sun with a penumbra or a sky dome is many).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SunLight {
+    /// Unit vector pointing towards the sun.
+    pub to_sun: Vec3,
+    /// Brightness this direction adds at full incidence.
+    pub light: f64,
+    pub color: Vec3,
+    pub style: u8,
+    pub anglescale: f64,
+}
+
+/// A minimum light level: no luxel of style 0 ends up darker than this.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Minlight {
+    pub level: f64,
+    pub color: Vec3,
+}
+
+/// A `_surface` light: copied over every face whose texture is `texture`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SurfaceTemplate {
+    pub texture: String,
+    /// The light each copy starts from (origin and spot are set per copy).
+    pub light: PointLight,
+    /// Distance of each copy in front of its face (`_surface_offset`).
+    pub offset: f64,
+    /// Copies shine along the face normal (`_surface_spotlight 1`).
+    pub spotlight: bool,
+    pub spot_angle: f64,
+}
+
+/// Settings that command-line options may override.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GlobalOverrides {
+    /// `--dist`: overrides worldspawn `_dist`.
+    pub dist: Option<f64>,
+    /// `--range`: overrides worldspawn `_range`.
+    pub range: Option<f64>,
+    /// `--sunsamples`: directions for a sun penumbra and for each sky dome.
+    pub sunsamples: usize,
+}
+
+impl Default for GlobalOverrides {
+    fn default() -> Self {
+        GlobalOverrides {
+            dist: None,
+            range: None,
+            sunsamples: 100,
+        }
+    }
+}
+
+/// Everything the entity lump says about lighting.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MapLights {
+    pub points: Vec<PointLight>,
+    pub suns: Vec<SunLight>,
+    pub templates: Vec<SurfaceTemplate>,
+    /// Minlight per model index (0 = world, from worldspawn).
+    pub minlight: HashMap<usize, Minlight>,
+    /// Brush models that cast shadows (`_shadow 1`).
+    pub shadow_models: Vec<usize>,
+    /// Offset of each brush model with an `origin` key (rotating entities).
+    pub model_origins: HashMap<usize, Vec3>,
+    /// Lightmap bytes per light unit.
+    pub rangescale: f64,
+    pub gamma: f64,
+    /// Styles given to switchable lights (`targetname` -> style), also
+    /// written back into the entities as `style`.
+    pub switchable_styles: Vec<(String, u8)>,
+}
+
+impl MapLights {
+    /// True if any light, sun or minlight is not white (a `.lit` is needed).
+    pub fn is_coloured(&self) -> bool {
+        let grey = |c: &Vec3| c.x != c.y || c.y != c.z;
+        self.points.iter().any(|l| grey(&l.color))
+            || self.suns.iter().any(|s| grey(&s.color))
+            || self.templates.iter().any(|t| grey(&t.light.color))
+            || self.minlight.values().any(|m| grey(&m.color))
+    }
+}
+
+/// Reads a numeric key of entity `index`, naming the entity on failure.
+struct Keys<'a> {
+    entity: &'a Entity,
+    index: usize,
+}
+
+impl Keys<'_> {
+    fn bad(&self, key: &str, want: &str) -> LightError {
+        LightError::Entity {
+            index: self.index,
+            classname: self.entity.classname().to_string(),
+            detail: format!(
+                "key \"{key}\" is \"{}\", expected {want}",
+                self.entity.get(key).unwrap_or("")
+            ),
+        }
+    }
+
+    fn float(&self, key: &str) -> Result<Option<f64>, LightError> {
+        match self.entity.get(key) {
+            None => Ok(None),
+            Some(v) if v.trim().is_empty() => Ok(None),
+            Some(_) => self
+                .entity
+                .get_float(key)
+                .filter(|f| f.is_finite())
+                .map(Some)
+                .ok_or_else(|| self.bad(key, "a number")),
+        }
+    }
+
+    /// The first of `keys` that is present.
+    fn float_any(&self, keys: &[&str]) -> Result<Option<f64>, LightError> {
+        for k in keys {
+            if let Some(v) = self.float(k)? {
+                return Ok(Some(v));
+            }
+        }
+        Ok(None)
+    }
+
+    fn vec3(&self, key: &str) -> Result<Option<Vec3>, LightError> {
+        match self.entity.get(key) {
+            None => Ok(None),
+            Some(v) if v.trim().is_empty() => Ok(None),
+            Some(_) => self
+                .entity
+                .get_floats::<3>(key)
+                .filter(|f| f.iter().all(|c| c.is_finite()))
+                .map(|[x, y, z]| Some(Vec3::new(x, y, z)))
+                .ok_or_else(|| self.bad(key, "three numbers")),
+        }
+    }
+
+    /// A colour in 0..255 or 0..1 notation, as 1.0 = full channel.
+    fn color_any(&self, keys: &[&str]) -> Result<Vec3, LightError> {
+        for k in keys {
+            if let Some(c) = self.vec3(k)? {
+                return Ok(normalize_color(c));
+            }
+        }
+        Ok(Vec3::new(1.0, 1.0, 1.0))
+    }
+
+    fn style(&self) -> Result<u8, LightError> {
+        match self.float("style")? {
+            None => Ok(0),
+            Some(s) if s.fract() == 0.0 && (0.0..=254.0).contains(&s) => Ok(s as u8),
+            Some(_) => Err(self.bad("style", "a whole number from 0 to 254")),
+        }
+    }
+}
+
+/// ericw-tools' colour rule: components all within 0..1 are fractions,
+/// otherwise they are 0..255.
+pub fn normalize_color(c: Vec3) -> Vec3 {
+    if c.x <= 1.0 && c.y <= 1.0 && c.z <= 1.0 {
+        c
+    } else {
+        c / 255.0
+    }
+}
+
+/// Unit vector of a "yaw pitch roll" triple (degrees; pitch 90 is up).
+pub fn mangle_to_vec(yaw: f64, pitch: f64) -> Vec3 {
+    let (y, p) = (yaw.to_radians(), pitch.to_radians());
+    Vec3::new(y.cos() * p.cos(), y.sin() * p.cos(), p.sin())
+}
+
+/// `n` unit directions spread evenly (a Fibonacci spiral) over the cap of
+/// half-angle `half_angle_deg` around unit `center`; `[center]` for `n <= 1`
+/// or a zero cap. Deterministic.
+pub fn cap_directions(center: Vec3, half_angle_deg: f64, n: usize) -> Vec<Vec3> {
+    if n <= 1 || half_angle_deg <= 0.0 {
+        return vec![center];
+    }
+    let helper = if center.z.abs() < 0.9 {
+        Vec3::new(0.0, 0.0, 1.0)
+    } else {
+        Vec3::new(1.0, 0.0, 0.0)
+    };
+    let u = helper.cross(center).normalized().unwrap_or(helper);
+    let v = center.cross(u);
+    let cos_cap = half_angle_deg.min(180.0).to_radians().cos();
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    (0..n)
+        .map(|i| {
+            // Uniform in z is uniform in solid angle.
+            let z = 1.0 - (1.0 - cos_cap) * (i as f64 + 0.5) / n as f64;
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            let phi = golden * i as f64;
+            u * (r * phi.cos()) + v * (r * phi.sin()) + center * z
+        })
+        .collect()
+}
+
+/// Splits `light` evenly over `dirs`.
+fn suns_over(
+    dirs: Vec<Vec3>,
+    light: f64,
+    color: Vec3,
+    style: u8,
+    anglescale: f64,
+) -> Vec<SunLight> {
+    let each = light / dirs.len().max(1) as f64;
+    dirs.into_iter()
+        .map(|to_sun| SunLight {
+            to_sun,
+            light: each,
+            color,
+            style,
+            anglescale,
+        })
+        .collect()
+}
+
+fn model_index(e: &Entity) -> Option<usize> {
+    e.get("model")?.strip_prefix('*')?.parse().ok()
+}
+
+/// Reads every light from `entities` and assigns styles to switchable
+/// lights (writing `style` into those entities).
+///
+/// # Errors
+/// [`LightError::Entity`] for a key that does not parse.
+pub fn parse_lights(
+    entities: &mut [Entity],
+    overrides: &GlobalOverrides,
+) -> Result<MapLights, LightError> {
+    let switchable_styles = assign_switchable_styles(entities)?;
+    let world = entities
+        .iter()
+        .position(|e| e.classname() == "worldspawn")
+        .unwrap_or(usize::MAX);
+    let empty = Entity::default();
+    let wk = Keys {
+        entity: entities.get(world).unwrap_or(&empty),
+        index: world,
+    };
+    let scaledist = overrides.dist.or(wk.float("_dist")?).unwrap_or(1.0);
+    let rangescale = overrides
+        .range
+        .or(wk.float("_range")?)
+        .unwrap_or(DEFAULT_RANGESCALE);
+    let gamma = wk.float("_gamma")?.filter(|g| *g > 0.0).unwrap_or(1.0);
+    let global_anglescale = wk
+        .float_any(&["_anglescale", "_anglesense"])?
+        .unwrap_or(DEFAULT_ANGLESCALE)
+        .clamp(0.0, 1.0);
+    let sunsamples = overrides.sunsamples.max(1);
+
+    let mut out = MapLights {
+        points: Vec::new(),
+        suns: Vec::new(),
+        templates: Vec::new(),
+        minlight: HashMap::new(),
+        shadow_models: Vec::new(),
+        model_origins: HashMap::new(),
+        rangescale,
+        gamma,
+        switchable_styles,
+    };
+
+    // Worldspawn: minlight, sun, sky domes.
+    let world_min = wk.float_any(&["_minlight", "light"])?.unwrap_or(0.0);
+    if world_min != 0.0 {
+        let color = wk.color_any(&["_minlight_color", "_mincolor"])?;
+        out.minlight.insert(
+            0,
+            Minlight {
+                level: world_min,
+                color,
+            },
+        );
+    }
+    if let Some(sun) = wk.float("_sunlight")?.filter(|s| *s != 0.0) {
+        let mangle = wk
+            .vec3("_sun_mangle")?
+            .or(wk.vec3("_sunlight_mangle")?)
+            .unwrap_or(Vec3::new(0.0, -90.0, 0.0));
+        let penumbra = wk.float("_sunlight_penumbra")?.unwrap_or(0.0);
+        let color = wk.color_any(&["_sunlight_color"])?;
+        let dirs = cap_directions(-mangle_to_vec(mangle.x, mangle.y), penumbra, sunsamples);
+        out.suns
+            .extend(suns_over(dirs, sun, color, 0, global_anglescale));
+    }
+    for (key, colors, up) in [
+        ("_sunlight2", ["_sunlight2_color", "_sunlight_color2"], 1.0),
+        ("_sunlight3", ["_sunlight3_color", "_sunlight_color3"], -1.0),
+    ] {
+        if let Some(dome) = wk.float(key)?.filter(|s| *s != 0.0) {
+            let color = wk.color_any(&colors)?;
+            let dirs = cap_directions(Vec3::new(0.0, 0.0, up), 90.0, sunsamples);
+            out.suns
+                .extend(suns_over(dirs, dome, color, 0, global_anglescale));
+        }
+    }
+
+    let origins: HashMap<&str, Vec3> = entities
+        .iter()
+        .filter_map(|e| {
+            let [x, y, z] = e.get_floats::<3>("origin")?;
+            Some((e.get("targetname")?, Vec3::new(x, y, z)))
+        })
+        .collect();
+
+    for (index, e) in entities.iter().enumerate() {
+        let k = Keys { entity: e, index };
+        if let Some(model) = model_index(e).filter(|&m| m > 0) {
+            if k.float("_shadow")?.unwrap_or(0.0) == 1.0 {
+                out.shadow_models.push(model);
+            }
+            if let Some(o) = k.vec3("origin")? {
+                out.model_origins.insert(model, o);
+            }
+            if let Some(level) = k.float("_minlight")?.filter(|m| *m != 0.0) {
+                let color = k.color_any(&["_minlight_color", "_mincolor"])?;
+                out.minlight.insert(model, Minlight { level, color });
+            }
+            continue;
+        }
+        if !e.classname().starts_with("light") || k.float("_nostaticlight")? == Some(1.0) {
+            continue;
+        }
+        let origin = k.vec3("origin")?.unwrap_or(Vec3::ZERO);
+        let light = match k.float("light")? {
+            None => DEFAULT_LIGHT,
+            Some(0.0) => DEFAULT_LIGHT,
+            Some(l) => l,
+        };
+        let color = k.color_any(&["_color"])?;
+        let style = k.style()?;
+        let anglescale = k
+            .float_any(&["_anglescale", "_anglesense"])?
+            .unwrap_or(global_anglescale)
+            .clamp(0.0, 1.0);
+        // The direction a spotlight (or a `_sun` entity) shines in.
+        let aim = match (k.vec3("mangle")?, e.get("target")) {
+            (Some(m), _) => Some(mangle_to_vec(m.x, m.y)),
+            (None, Some(t)) => origins.get(t).and_then(|&to| (to - origin).normalized()),
+            (None, None) => None,
+        };
+        if k.float("_sun")? == Some(1.0) {
+            let to_sun = -aim.unwrap_or(Vec3::new(0.0, 0.0, -1.0));
+            let deviance = k.float("_deviance")?.unwrap_or(0.0);
+            let dirs = cap_directions(to_sun, deviance, sunsamples);
+            out.suns
+                .extend(suns_over(dirs, light, color, style, anglescale));
+            continue;
+        }
+        let mut dome = false;
+        for (key, up) in [("_sunlight2", 1.0), ("_sunlight3", -1.0)] {
+            if k.float(key)? == Some(1.0) {
+                let dirs = cap_directions(Vec3::new(0.0, 0.0, up), 90.0, sunsamples);
+                out.suns
+                    .extend(suns_over(dirs, light, color, style, anglescale));
+                dome = true;
+            }
+        }
+        if dome {
+            continue;
+        }
+        let delay = k.float("delay")?.unwrap_or(0.0);
+        let falloff = Falloff::from_delay(delay as i64)
+            .filter(|_| delay.fract() == 0.0)
+            .ok_or_else(|| k.bad("delay", "0, 1, 2, 3, 4 or 5"))?;
+        let wait = k.float("wait")?.filter(|w| *w > 0.0).unwrap_or(1.0);
+        let angle = k.float("angle")?.unwrap_or(DEFAULT_SPOT_ANGLE);
+        let softangle = k.float("_softangle")?.unwrap_or(0.0);
+        let point = PointLight {
+            origin,
+            light,
+            atten: wait * scaledist,
+            falloff,
+            color,
+            style,
+            spot: aim.map(|dir| Spot::new(dir, angle, softangle)),
+            anglescale,
+            entity: index,
+        };
+        match e.get("_surface").filter(|t| !t.is_empty()) {
+            Some(texture) => out.templates.push(SurfaceTemplate {
+                texture: texture.to_string(),
+                light: PointLight {
+                    spot: None,
+                    ..point
+                },
+                offset: k.float("_surface_offset")?.unwrap_or(2.0),
+                spotlight: k.float("_surface_spotlight")? == Some(1.0),
+                spot_angle: angle,
+            }),
+            None => out.points.push(point),
+        }
+    }
+    Ok(out)
+}
+
+/// Gives each `targetname` of a light entity without an explicit `style` its
+/// own style from 32 up (lights sharing a name share it) and writes it into
+/// the entity, so the game's switching code finds it.
+fn assign_switchable_styles(entities: &mut [Entity]) -> Result<Vec<(String, u8)>, LightError> {
+    let mut assigned: Vec<(String, u8)> = Vec::new();
+    for (index, e) in entities.iter_mut().enumerate() {
+        if !e.classname().starts_with("light") {
+            continue;
+        }
+        let Some(name) = e.get("targetname").filter(|n| !n.is_empty()) else {
+            continue;
+        };
+        let k = Keys { entity: e, index };
+        if k.style()? != 0 {
+            continue;
+        }
+        let style = match assigned.iter().find(|(n, _)| n == name) {
+            Some(&(_, s)) => s,
+            None => {
+                let next = FIRST_SWITCHABLE_STYLE as usize + assigned.len();
+                let s = u8::try_from(next)
+                    .ok()
+                    .filter(|s| *s <= quake_formats::bsp::limits::MAX_LIGHTSTYLE)
+                    .ok_or(LightError::TooManySwitchableLights)?;
+                assigned.push((name.to_string(), s));
+                s
+            }
+        };
+        e.set("style", style.to_string());
+    }
+    Ok(assigned)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use quake_formats::entities::parse_entities;
+
+    fn light(falloff: Falloff, value: f64, wait: f64) -> PointLight {
+        PointLight {
+            origin: Vec3::ZERO,
+            light: value,
+            atten: wait,
+            falloff,
+            color: Vec3::new(1.0, 1.0, 1.0),
+            style: 0,
+            spot: None,
+            anglescale: 0.5,
+            entity: 0,
+        }
+    }
+
+    fn close(a: f64, b: f64) -> bool {
+        (a - b).abs() < 1e-9 * b.abs().max(1.0)
+    }
+
+    #[test]
+    fn linear_falloff_reaches_zero_at_light_over_wait() {
+        let l = light(Falloff::Linear, 300.0, 1.0);
+        assert!(close(l.value_at(0.0), 299.0), "clamped to 1 unit");
+        assert!(close(l.value_at(100.0), 200.0));
+        assert_eq!(l.value_at(400.0), 0.0);
+        assert!(close(l.range(0.001), 300.0));
+        let l = light(Falloff::Linear, 300.0, 2.0);
+        assert!(close(l.value_at(100.0), 100.0));
+        assert!(close(l.range(0.001), 150.0));
+        let neg = light(Falloff::Linear, -100.0, 1.0);
+        assert!(close(neg.value_at(40.0), -60.0));
+        assert_eq!(neg.value_at(500.0), 0.0);
+    }
+
+    #[test]
+    fn inverse_falloffs_equal_light_at_128_units() {
+        for f in [Falloff::Inverse, Falloff::InverseSquare] {
+            let l = light(f, 200.0, 1.0);
+            assert!(close(l.value_at(128.0), 200.0), "{f:?}");
+            let at = l.range(0.5);
+            assert!(close(l.value_at(at), 0.5), "{f:?} range");
+        }
+        let inv = light(Falloff::Inverse, 200.0, 1.0);
+        assert!(close(inv.value_at(256.0), 100.0));
+        let sq = light(Falloff::InverseSquare, 200.0, 1.0);
+        assert!(close(sq.value_at(256.0), 50.0));
+        assert!(close(sq.value_at(64.0), 800.0), "bright near the source");
+        // Wait scales distance.
+        let sq2 = light(Falloff::InverseSquare, 200.0, 2.0);
+        assert!(close(sq2.value_at(64.0), 200.0));
+    }
+
+    #[test]
+    fn soft_inverse_square_is_light_at_the_source() {
+        let l = light(Falloff::InverseSquareSoft, 300.0, 1.0);
+        assert!(close(l.value_at(0.0), 300.0));
+        assert!(close(l.value_at(128.0), 75.0));
+        assert!(close(l.value_at(l.range(0.25)), 0.25));
+    }
+
+    #[test]
+    fn constant_and_local_min_ignore_distance() {
+        for f in [Falloff::Constant, Falloff::LocalMin] {
+            let l = light(f, 50.0, 1.0);
+            assert_eq!(l.value_at(1.0e5), 50.0);
+            assert_eq!(l.range(0.001), f64::INFINITY);
+        }
+        // Local minlight has no angle term: any surface facing it gets the full value.
+        let l = light(Falloff::LocalMin, 50.0, 1.0);
+        assert_eq!(l.contribution(10.0, Vec3::new(1.0, 0.0, 0.0), 0.01), 50.0);
+        assert_eq!(l.contribution(10.0, Vec3::new(1.0, 0.0, 0.0), -0.5), 0.0);
+    }
+
+    #[test]
+    fn angle_factor_blends_cosine() {
+        assert_eq!(angle_factor(1.0, 0.5), 1.0);
+        assert!(close(angle_factor(0.0001, 0.5), 0.50005));
+        assert_eq!(angle_factor(-0.1, 0.5), 0.0);
+        assert!(close(angle_factor(0.5, 1.0), 0.5));
+        assert_eq!(angle_factor(0.3, 0.0), 1.0);
+    }
+
+    #[test]
+    fn spotlight_cone_edges() {
+        let down = Vec3::new(0.0, 0.0, -1.0);
+        let at = |deg: f64| {
+            let r = deg.to_radians();
+            Vec3::new(r.sin(), 0.0, -r.cos())
+        };
+        // Default 40 degrees: 20 each side of the axis.
+        let s = Spot::new(down, 0.0, 0.0);
+        assert_eq!(s.factor(at(0.0)), 1.0);
+        assert_eq!(s.factor(at(19.9)), 1.0);
+        assert_eq!(s.factor(at(20.1)), 0.0);
+        // 60 degree cone with a 20 degree soft inner cone.
+        let s = Spot::new(down, 60.0, 20.0);
+        assert_eq!(s.factor(at(9.9)), 1.0);
+        assert_eq!(s.factor(at(30.1)), 0.0);
+        let mid = s.factor(at(20.0));
+        let want = (20f64.to_radians().cos() - 30f64.to_radians().cos())
+            / (10f64.to_radians().cos() - 30f64.to_radians().cos());
+        assert!(close(mid, want) && mid > 0.0 && mid < 1.0, "{mid}");
+        // A soft angle wider than the cone is ignored.
+        let s = Spot::new(down, 30.0, 50.0);
+        assert_eq!(s.cos_inner, s.cos_outer);
+    }
+
+    #[test]
+    fn mangle_points_where_documented() {
+        let v = mangle_to_vec(0.0, -90.0);
+        assert!(v.near(Vec3::new(0.0, 0.0, -1.0), 1e-12));
+        let v = mangle_to_vec(90.0, 0.0);
+        assert!(v.near(Vec3::new(0.0, 1.0, 0.0), 1e-12));
+    }
+
+    #[test]
+    fn cap_directions_stay_in_the_cap_and_are_unit() {
+        let c = Vec3::new(0.0, 0.6, 0.8);
+        let dirs = cap_directions(c, 10.0, 50);
+        assert_eq!(dirs.len(), 50);
+        for d in &dirs {
+            assert!((d.length() - 1.0).abs() < 1e-9);
+            assert!(d.dot(c) >= 10f64.to_radians().cos() - 1e-9);
+        }
+        let hemi = cap_directions(Vec3::new(0.0, 0.0, 1.0), 90.0, 200);
+        let mean_z: f64 = hemi.iter().map(|d| d.z).sum::<f64>() / 200.0;
+        assert!((mean_z - 0.5).abs() < 0.01, "uniform hemisphere: {mean_z}");
+    }
+
+    #[test]
+    fn parses_keys_and_assigns_switchable_styles() {
+        let text = r#"
+{ "classname" "worldspawn" "light" "20" "_sunlight" "100" "_sun_mangle" "0 -90 0" "_sunlight_color" "255 128 0" }
+{ "classname" "light" "origin" "0 0 64" "delay" "2" "wait" "2" "_color" "1 0.5 0.5" }
+{ "classname" "light_fluoro" "origin" "0 0 0" "targetname" "door" }
+{ "classname" "light" "origin" "8 0 0" "targetname" "door" "light" "200" }
+{ "classname" "light" "origin" "8 0 0" "targetname" "other" "style" "5" }
+{ "classname" "light" "origin" "0 0 0" "target" "t1" "angle" "60" }
+{ "classname" "info_null" "origin" "0 0 -100" "targetname" "t1" }
+{ "classname" "light" "_surface" "sky4" "light" "100" }
+{ "classname" "func_door" "model" "*1" "_shadow" "1" "_minlight" "10" }
+"#;
+        let mut ents = parse_entities(text).expect("parse");
+        let lights = parse_lights(&mut ents, &GlobalOverrides::default()).expect("lights");
+        assert_eq!(lights.points.len(), 5);
+        let p = &lights.points[0];
+        assert_eq!(p.falloff, Falloff::InverseSquare);
+        assert_eq!(p.atten, 2.0);
+        assert_eq!(p.light, DEFAULT_LIGHT);
+        assert_eq!(p.color, Vec3::new(1.0, 0.5, 0.5));
+        assert_eq!(lights.points[1].style, 32);
+        assert_eq!(lights.points[2].style, 32, "same targetname, same style");
+        assert_eq!(lights.points[3].style, 5, "explicit style kept");
+        let spot = lights.points[4].spot.expect("spotlight");
+        assert!(spot.dir.near(Vec3::new(0.0, 0.0, -1.0), 1e-12));
+        assert!(close(spot.cos_outer, 30f64.to_radians().cos()));
+        assert_eq!(ents[2].get("style"), Some("32"));
+        assert_eq!(ents[4].get("style"), Some("5"));
+        assert_eq!(lights.switchable_styles, vec![("door".to_string(), 32)]);
+        assert_eq!(lights.templates.len(), 1);
+        assert_eq!(lights.templates[0].texture, "sky4");
+        assert_eq!(lights.suns.len(), 1, "no penumbra: one direction");
+        assert!(lights.suns[0].to_sun.near(Vec3::new(0.0, 0.0, 1.0), 1e-12));
+        assert!(close(lights.suns[0].color.y, 128.0 / 255.0));
+        assert_eq!(lights.minlight[&0].level, 20.0);
+        assert_eq!(lights.minlight[&1].level, 10.0);
+        assert_eq!(lights.shadow_models, vec![1]);
+        assert!(lights.is_coloured());
+    }
+
+    #[test]
+    fn bad_numbers_name_the_entity() {
+        let mut ents = parse_entities(
+            "{ \"classname\" \"worldspawn\" }\n{ \"classname\" \"light\" \"light\" \"bright\" }",
+        )
+        .expect("parse");
+        let err = parse_lights(&mut ents, &GlobalOverrides::default()).expect_err("bad light");
+        let msg = err.to_string();
+        assert!(
+            msg.contains("entity 1") && msg.contains("\"light\""),
+            "{msg}"
+        );
+        let mut ents =
+            parse_entities("{ \"classname\" \"light\" \"delay\" \"7\" }").expect("parse");
+        assert!(parse_lights(&mut ents, &GlobalOverrides::default()).is_err());
+    }
+}

@@ -1,0 +1,22 @@
+//! `slipgate-light`: light a BSP.
+
+use clap::Parser;
+
+#[derive(Parser)]
+#[command(
+    name = "slipgate-light",
+    version,
+    about = "Compute lightmaps for a Quake BSP"
+)]
+struct Cli {
+    #[command(flatten)]
+    args: light::cli::Args,
+}
+
+fn main() {
+    let cli = Cli::parse();
+    if let Err(e) = light::cli::run(&cli.args) {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}

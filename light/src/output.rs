@@ -1,0 +1,224 @@
+//! From light units to the bytes engines read: minlight, the `--soft`
+//! filter, range scale, gamma, clamping, and the lighting lump (plus the
+//! `.lit` colour data) with each face's `styles` and `light_offset`.
+
+use quake_formats::Bsp;
+use quake_formats::bsp::limits::MAX_LIGHTMAPS;
+
+use crate::lights::Minlight;
+use crate::trace::FaceLight;
+
+/// Style slot value for "unused".
+const NO_STYLE: u8 = 255;
+
+/// A face's final lightmaps: up to four styles, grey bytes and RGB bytes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FaceLightmap {
+    pub face: usize,
+    pub width: usize,
+    pub height: usize,
+    /// Style of each lightmap, style 0 first.
+    pub styles: Vec<u8>,
+    /// One byte per luxel per style: the mean of the RGB channels.
+    pub grey: Vec<Vec<u8>>,
+    pub rgb: Vec<Vec<[u8; 3]>>,
+}
+
+/// How light units become bytes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Finish {
+    pub rangescale: f64,
+    pub gamma: f64,
+    /// `--soft` box filter radius in luxels (0 = off).
+    pub soft_radius: usize,
+}
+
+/// Averages each luxel with its neighbours within `radius` (staying inside the face's grid).
+pub fn soft_filter(
+    luxels: &[[f32; 3]],
+    width: usize,
+    height: usize,
+    radius: usize,
+) -> Vec<[f32; 3]> {
+    debug_assert_eq!(luxels.len(), width * height);
+    if radius == 0 {
+        return luxels.to_vec();
+    }
+    let mut out = Vec::with_capacity(luxels.len());
+    for y in 0..height {
+        for x in 0..width {
+            let mut acc = [0.0f32; 3];
+            let mut count = 0.0f32;
+            for ny in y.saturating_sub(radius)..(y + radius + 1).min(height) {
+                for nx in x.saturating_sub(radius)..(x + radius + 1).min(width) {
+                    let v = luxels[ny * width + nx];
+                    for c in 0..3 {
+                        acc[c] += v[c];
+                    }
+                    count += 1.0;
+                }
+            }
+            out.push(acc.map(|a| a / count));
+        }
+    }
+    out
+}
+
+/// Light units to bytes: scale, gamma, then scale all channels down together
+/// if the brightest exceeds 255 (keeps the hue).
+pub fn to_bytes(c: [f32; 3], finish: &Finish) -> [u8; 3] {
+    let mut v = c.map(|x| (f64::from(x) * finish.rangescale).max(0.0));
+    if finish.gamma != 1.0 {
+        v = v.map(|x| 255.0 * (x / 255.0).powf(1.0 / finish.gamma));
+    }
+    let max = v[0].max(v[1]).max(v[2]);
+    if max > 255.0 {
+        v = v.map(|x| x * 255.0 / max);
+    }
+    v.map(|x| x.round().clamp(0.0, 255.0) as u8)
+}
+
+/// Finishes one face. Returns the lightmap and how many styles were dropped
+/// for exceeding four.
+pub fn finish_face(
+    light: FaceLight,
+    minlight: Option<Minlight>,
+    finish: &Finish,
+) -> (FaceLightmap, usize) {
+    let (w, h) = (light.width, light.height);
+    let mut maps: Vec<(u8, Vec<[u8; 3]>, u64)> = Vec::new();
+    for (style, mut luxels) in light.styles {
+        if style == 0
+            && let Some(m) = minlight
+        {
+            let floor = [0, 1, 2].map(|c| (m.level * m.color[c]) as f32);
+            for l in &mut luxels {
+                for (v, f) in l.iter_mut().zip(floor) {
+                    *v = v.max(f);
+                }
+            }
+        }
+        let filtered = soft_filter(&luxels, w, h, finish.soft_radius);
+        let rgb: Vec<[u8; 3]> = filtered.iter().map(|&c| to_bytes(c, finish)).collect();
+        let energy: u64 = rgb.iter().flatten().map(|&b| u64::from(b)).sum();
+        // Style 0 is always written (a face without a lightmap renders fullbright).
+        if style == 0 || energy > 0 {
+            maps.push((style, rgb, energy));
+        }
+    }
+    // Style 0 stays first; the brightest of the others fill the remaining slots.
+    maps[1..].sort_by_key(|m| std::cmp::Reverse(m.2));
+    let dropped = maps.len().saturating_sub(MAX_LIGHTMAPS);
+    maps.truncate(MAX_LIGHTMAPS);
+    let grey = maps
+        .iter()
+        .map(|(_, rgb, _)| {
+            rgb.iter()
+                .map(|c| ((u16::from(c[0]) + u16::from(c[1]) + u16::from(c[2]) + 1) / 3) as u8)
+                .collect()
+        })
+        .collect();
+    (
+        FaceLightmap {
+            face: light.face,
+            width: w,
+            height: h,
+            styles: maps.iter().map(|m| m.0).collect(),
+            grey,
+            rgb: maps.into_iter().map(|m| m.1).collect(),
+        },
+        dropped,
+    )
+}
+
+/// Replaces the lighting lump with `maps` (faces not listed get no
+/// lightmap) and returns the `.lit` RGB payload matching it.
+pub fn write_lighting(bsp: &mut Bsp, maps: &[FaceLightmap]) -> Vec<u8> {
+    let mut grey = Vec::new();
+    let mut rgb = Vec::new();
+    for f in &mut bsp.faces {
+        f.styles = [NO_STYLE; 4];
+        f.light_offset = -1;
+    }
+    for m in maps {
+        let face = &mut bsp.faces[m.face];
+        face.light_offset = grey.len() as i32;
+        for (slot, &s) in m.styles.iter().enumerate() {
+            face.styles[slot] = s;
+        }
+        for (g, c) in m.grey.iter().zip(&m.rgb) {
+            grey.extend_from_slice(g);
+            rgb.extend(c.iter().flatten());
+        }
+    }
+    bsp.lighting = grey;
+    rgb
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const PLAIN: Finish = Finish {
+        rangescale: 0.5,
+        gamma: 1.0,
+        soft_radius: 0,
+    };
+
+    #[test]
+    fn bytes_scale_and_keep_hue_when_clamping() {
+        assert_eq!(to_bytes([300.0, 300.0, 300.0], &PLAIN), [150; 3]);
+        assert_eq!(to_bytes([-20.0, 0.0, 1.0], &PLAIN), [0, 0, 1]);
+        assert_eq!(to_bytes([1020.0, 510.0, 0.0], &PLAIN), [255, 128, 0]);
+    }
+
+    #[test]
+    fn soft_filter_averages_inside_the_grid() {
+        let mut l = vec![[0.0f32; 3]; 9];
+        l[4] = [9.0; 3];
+        let f = soft_filter(&l, 3, 3, 1);
+        assert_eq!(f[4], [1.0; 3]);
+        assert_eq!(f[0], [9.0 / 4.0; 3], "corner averages 4 luxels");
+        assert_eq!(soft_filter(&l, 3, 3, 0), l);
+    }
+
+    #[test]
+    fn dark_styles_are_dropped_and_only_four_kept() {
+        let styles = [0u8, 32, 33, 34, 35, 36]
+            .iter()
+            .enumerate()
+            .map(|(i, &s)| (s, vec![[i as f32 * 10.0; 3]; 2]))
+            .chain([(40, vec![[0.0; 3]; 2])])
+            .collect();
+        let light = FaceLight {
+            face: 0,
+            width: 2,
+            height: 1,
+            styles,
+        };
+        let (m, dropped) = finish_face(light, None, &PLAIN);
+        assert_eq!(m.styles, vec![0, 36, 35, 34]);
+        assert_eq!(
+            dropped, 2,
+            "two lit styles over the limit (the dark one is not counted)"
+        );
+        assert_eq!(m.grey[0], vec![0, 0], "style 0 kept although dark");
+    }
+
+    #[test]
+    fn minlight_raises_style_zero() {
+        let light = FaceLight {
+            face: 0,
+            width: 1,
+            height: 1,
+            styles: vec![(0, vec![[10.0; 3]])],
+        };
+        let m = Minlight {
+            level: 40.0,
+            color: quake_formats::geom::Vec3::new(1.0, 0.5, 0.5),
+        };
+        let (out, _) = finish_face(light, Some(m), &PLAIN);
+        assert_eq!(out.rgb[0], vec![[20, 10, 10]]);
+        assert_eq!(out.grey[0], vec![13]);
+    }
+}

@@ -1,0 +1,199 @@
+//! Potentially-visible-set culling: a light can only reach a world face if
+//! one of the leaves that hold the face is in the PVS of the light's leaf, and
+//! a face can only see the sky if one of its leaves sees a leaf holding a sky
+//! face. Anything without vis data (no vis lump, a leaf without a row, a
+//! light in solid, a brush-model face) is treated as visible.
+
+use quake_formats::Bsp;
+use quake_formats::bsp::contents;
+use quake_formats::geom::Vec3;
+use quake_formats::visrle::decompress_row;
+
+use crate::faces::{FaceGeom, FaceKind};
+
+/// Decompressed PVS rows plus which leaves hold each face.
+pub struct Visibility {
+    /// Row per leaf (bit `j` = leaf `j + 1`), `None` = sees everything.
+    rows: Vec<Option<Vec<u8>>>,
+    /// World leaves holding each face (empty for brush-model faces).
+    face_leafs: Vec<Vec<u32>>,
+    /// Per leaf: its PVS holds a leaf with a sky face.
+    leaf_sees_sky: Vec<bool>,
+    leaf_contents: Vec<i32>,
+}
+
+fn bit(row: &[u8], leaf: u32) -> bool {
+    // Leaf 0 (the shared solid leaf) has no bit.
+    leaf > 0
+        && row
+            .get((leaf as usize - 1) / 8)
+            .is_some_and(|b| b & (1 << ((leaf - 1) % 8)) != 0)
+}
+
+impl Visibility {
+    pub fn new(bsp: &Bsp, faces: &[FaceGeom]) -> Visibility {
+        let vis_leafs = bsp
+            .models
+            .first()
+            .map_or(0, |m| m.vis_leafs.max(0) as usize);
+        let row_len = vis_leafs.div_ceil(8);
+        let rows: Vec<Option<Vec<u8>>> = bsp
+            .leafs
+            .iter()
+            .map(|leaf| {
+                let ofs = usize::try_from(leaf.vis_offset).ok()?;
+                let data = bsp.visibility.get(ofs..)?;
+                let (row, complete) = decompress_row(data, row_len);
+                complete.then_some(row)
+            })
+            .collect();
+        let mut face_leafs = vec![Vec::new(); faces.len()];
+        for (leaf_index, leaf) in bsp.leafs.iter().enumerate() {
+            let first = leaf.first_marksurface as usize;
+            let marks = bsp
+                .marksurfaces
+                .get(first..first + leaf.num_marksurfaces as usize)
+                .unwrap_or(&[]);
+            for &f in marks {
+                // Some compilers also mark brush-model faces; those move, so never cull them.
+                if faces.get(f as usize).is_some_and(|g| g.model == 0) {
+                    face_leafs[f as usize].push(leaf_index as u32);
+                }
+            }
+        }
+        let mut sky_leafs: Vec<u32> = faces
+            .iter()
+            .filter(|f| f.kind == FaceKind::Sky)
+            .flat_map(|f| face_leafs[f.index].iter().copied())
+            .collect();
+        sky_leafs.sort_unstable();
+        sky_leafs.dedup();
+        let leaf_sees_sky = rows
+            .iter()
+            .enumerate()
+            .map(|(leaf, row)| match row {
+                None => true,
+                Some(row) => sky_leafs.iter().any(|&s| s as usize == leaf || bit(row, s)),
+            })
+            .collect();
+        Visibility {
+            rows,
+            face_leafs,
+            leaf_sees_sky,
+            leaf_contents: bsp.leafs.iter().map(|l| l.contents).collect(),
+        }
+    }
+
+    /// The world leaf containing `p`, unless it is solid (no culling then).
+    pub fn open_leaf_at(&self, bsp: &Bsp, p: Vec3) -> Option<u32> {
+        let leaf = bsp.leaf_at(p.to_f32())?;
+        (self.leaf_contents.get(leaf) != Some(&contents::SOLID)).then_some(leaf as u32)
+    }
+
+    fn is_liquid(&self, leaf: u32) -> bool {
+        matches!(
+            self.leaf_contents.get(leaf as usize),
+            Some(&(contents::WATER | contents::SLIME | contents::LAVA))
+        )
+    }
+
+    /// False only if vis data proves nothing in `light_leaf` can see `face`.
+    /// Light crossing a liquid surface is never culled: some vis tools treat
+    /// liquids as opaque, but light passes through them.
+    pub fn may_reach(&self, light_leaf: Option<u32>, face: usize) -> bool {
+        let Some(light_leaf) = light_leaf else {
+            return true;
+        };
+        let Some(Some(row)) = self.rows.get(light_leaf as usize) else {
+            return true;
+        };
+        let leafs = &self.face_leafs[face];
+        leafs.is_empty()
+            || self.is_liquid(light_leaf)
+            || leafs
+                .iter()
+                .any(|&l| l == light_leaf || bit(row, l) || self.is_liquid(l))
+    }
+
+    /// False only if vis data proves `face` cannot see any sky face.
+    pub fn may_see_sky(&self, face: usize) -> bool {
+        let leafs = &self.face_leafs[face];
+        leafs.is_empty()
+            || leafs
+                .iter()
+                .any(|&l| self.leaf_sees_sky.get(l as usize).copied().unwrap_or(true))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::faces::FaceGeom;
+    use quake_formats::bsp::{Leaf, Model};
+    use quake_formats::extents::LightmapExtents;
+    use quake_formats::geom::Plane;
+
+    fn face(index: usize, model: usize) -> FaceGeom {
+        FaceGeom {
+            index,
+            model,
+            kind: FaceKind::Lit,
+            texture: String::new(),
+            points: Vec::new(),
+            plane: Plane::new(Vec3::new(0.0, 0.0, 1.0), 0.0),
+            vecs: [[0.0; 4]; 2],
+            origin: Vec3::ZERO,
+            extents: LightmapExtents::from_points(&[], &[[0.0; 4]; 2]),
+        }
+    }
+
+    /// Leaves 1 and 2 see only themselves; both faces are marked in leaf 2.
+    fn two_rooms(leaf2_contents: i32) -> (Bsp, Vec<FaceGeom>) {
+        let mut bsp = Bsp::default();
+        let leaf = |contents, vis_offset, first| Leaf {
+            contents,
+            vis_offset,
+            mins: [0.0; 3],
+            maxs: [0.0; 3],
+            first_marksurface: first,
+            num_marksurfaces: if first == 0 { 0 } else { 2 },
+            ambient: [0; 4],
+        };
+        bsp.leafs = vec![
+            leaf(contents::SOLID, -1, 0),
+            leaf(contents::EMPTY, 0, 0),
+            leaf(leaf2_contents, 1, 0),
+        ];
+        bsp.leafs[2].num_marksurfaces = 2;
+        bsp.marksurfaces = vec![0, 1];
+        bsp.visibility = vec![0b01, 0b10];
+        bsp.models = vec![Model {
+            mins: [0.0; 3],
+            maxs: [0.0; 3],
+            origin: [0.0; 3],
+            head_nodes: [0; 4],
+            vis_leafs: 2,
+            first_face: 0,
+            num_faces: 1,
+        }];
+        (bsp, vec![face(0, 0), face(1, 1)])
+    }
+
+    #[test]
+    fn pvs_culls_world_faces_but_never_brush_model_faces() {
+        let (bsp, faces) = two_rooms(contents::EMPTY);
+        let vis = Visibility::new(&bsp, &faces);
+        assert!(!vis.may_reach(Some(1), 0), "world face in an unseen leaf");
+        assert!(vis.may_reach(Some(2), 0));
+        // Regression: marksurfaces listing a door's faces made lights skip the door.
+        assert!(vis.may_reach(Some(1), 1));
+        assert!(vis.may_reach(None, 0), "light in solid: no culling");
+    }
+
+    #[test]
+    fn light_into_liquid_is_not_culled() {
+        let (bsp, faces) = two_rooms(contents::WATER);
+        let vis = Visibility::new(&bsp, &faces);
+        assert!(vis.may_reach(Some(1), 0));
+    }
+}
