@@ -22,6 +22,8 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// Compile a .map to BSP29 (or BSP2), writing the .prt portal file and a .pts pointfile on a leak
+    Bsp(bsp_compiler::cli::Args),
     /// Compute lightmaps with Embree-traced shadow rays (writes the BSP, and .lit for coloured light)
     Light(light::cli::Args),
     /// Render a compiled map to PNG with the software renderer (or fly through it with --bench)
@@ -63,6 +65,7 @@ fn main() -> ExitCode {
 
 fn run(command: Command) -> Result<ExitCode> {
     match command {
+        Command::Bsp(args) => bsp_compiler::cli::run(&args).map(|()| ExitCode::SUCCESS),
         Command::Light(args) => light::cli::run(&args).map(|()| ExitCode::SUCCESS),
         Command::View(args) => runtime_viewer::cli::run(&args).map(|()| ExitCode::SUCCESS),
         Command::Info(args) => inspect::info(&args),

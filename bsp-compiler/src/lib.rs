@@ -1,1 +1,31 @@
 //! Slipgate: .map to BSP29/BSP2 compiler.
+//!
+//! Stages, each a module with typed input and output: [`map`] (parsing), [`texinfo`] and
+//! [`wad_lookup`] (textures), [`brush`] (brush windings), [`tree`] (the BSP tree, which also does
+//! the CSG), [`portals`], [`outside`] (filling and leaks), [`faces`] (faces from portals, merging,
+//! subdivision), [`hulls`] (clip hulls), [`weld`] (shared vertices, T-junctions) and `emit`.
+//! [`compile()`] runs them all.
+
+pub mod brush;
+pub mod cli;
+mod compile;
+pub mod csg;
+mod emit;
+pub mod faces;
+pub mod hulls;
+pub mod map;
+pub mod outside;
+pub mod planes;
+pub mod portals;
+pub mod texinfo;
+pub mod tree;
+pub mod wad_lookup;
+pub mod warnings;
+pub mod weld;
+
+pub use compile::{
+    CompileError, CompileOptions, CompileOutput, CompileStats, MapSource, MapTexInfo, compile,
+};
+pub use outside::Leak;
+pub use tree::SplitHeuristic;
+pub use warnings::Warning;

@@ -26,8 +26,14 @@ pub struct Args {
     /// The slow exact answer: 16x16 samples per luxel and no light culling.
     #[arg(long)]
     pub reference: bool,
-    /// Average each luxel with its neighbours within N luxels (default 1).
-    #[arg(long, value_name = "N", num_args = 0..=1, default_missing_value = "1")]
+    /// Average each luxel with its neighbours within N luxels (`--soft` = 1, `--soft=N`).
+    #[arg(
+        long,
+        value_name = "N",
+        num_args = 0..=1,
+        require_equals = true,
+        default_missing_value = "1"
+    )]
     pub soft: Option<usize>,
     /// Light contributions below this (in light units) count as zero.
     #[arg(long, default_value_t = 0.001)]

@@ -1,0 +1,344 @@
+//! Convex brushes: a set of planes with one winding per side, built from a map brush or split
+//! from another brush by a node plane.
+
+use crate::planes::{PlaneId, PlaneSet};
+use quake_formats::geom::{Bounds, MAX_WORLD_COORD, ON_EPSILON, Plane, Split, Winding};
+
+/// Brush fragments smaller than this (cubic units) are dropped as numerical slivers.
+const MIN_VOLUME: f64 = 0.1;
+
+/// One bounding plane of a brush with the polygon the brush has on it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Side {
+    pub plane: PlaneId,
+    /// The outward normal is the canonical plane's normal negated.
+    pub flipped: bool,
+    /// Clockwise seen from outside the brush.
+    pub winding: Winding,
+    /// The map face this side came from (texinfo index), `None` for cuts and bevels.
+    pub texinfo: Option<u32>,
+    /// Set once a node plane the side lies on splits the space above it.
+    pub used: bool,
+}
+
+/// A convex volume of one contents type.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Brush {
+    pub sides: Vec<Side>,
+    pub bounds: Bounds,
+    pub contents: i32,
+    /// Index of the map brush this came from, within its model.
+    pub source: u32,
+}
+
+/// A plane of a brush being built, with the texinfo of its map face.
+#[derive(Debug, Clone, Copy)]
+pub struct BrushPlane {
+    pub plane: Plane,
+    pub texinfo: Option<u32>,
+}
+
+/// Why a map brush cannot be built.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum BrushError {
+    #[error("has {0} planes, fewer than 4")]
+    TooFewPlanes(usize),
+    #[error("face {0} has collinear points")]
+    NoPlane(usize),
+    #[error("faces {0} and {1} lie on the same plane")]
+    DuplicatePlane(usize, usize),
+    #[error("faces {0} and {1} face each other on one plane: no volume")]
+    OppositePlanes(usize, usize),
+    #[error("has no volume")]
+    NoVolume,
+    #[error("reaches beyond ±{MAX_WORLD_COORD} units")]
+    TooLarge,
+}
+
+fn outward_plane(planes: &PlaneSet, plane: PlaneId, flipped: bool) -> Plane {
+    let p = planes.get(plane);
+    if flipped { p.flipped() } else { *p }
+}
+
+impl Brush {
+    /// The brush bounded by `faces` (outward planes). Planes that do not touch the brush are
+    /// dropped.
+    pub fn from_planes(
+        faces: &[BrushPlane],
+        planes: &mut PlaneSet,
+        contents: i32,
+        source: u32,
+    ) -> Result<Brush, BrushError> {
+        if faces.len() < 4 {
+            return Err(BrushError::TooFewPlanes(faces.len()));
+        }
+        for (i, a) in faces.iter().enumerate() {
+            for (j, b) in faces.iter().enumerate().skip(i + 1) {
+                if a.plane.same_as(&b.plane) {
+                    return Err(BrushError::DuplicatePlane(i, j));
+                }
+                if a.plane.same_as(&b.plane.flipped()) {
+                    return Err(BrushError::OppositePlanes(i, j));
+                }
+            }
+        }
+        let mut sides = Vec::with_capacity(faces.len());
+        for (i, face) in faces.iter().enumerate() {
+            let mut w = Some(Winding::base_for_plane(&face.plane));
+            for (j, other) in faces.iter().enumerate() {
+                if i == j {
+                    continue;
+                }
+                w = w.and_then(|w| w.clip_front(&other.plane.flipped(), false));
+            }
+            let Some(w) = w.filter(|w| !w.is_tiny()) else {
+                continue;
+            };
+            let (plane, flipped) = planes.insert(&face.plane);
+            sides.push(Side {
+                plane,
+                flipped,
+                winding: w,
+                texinfo: face.texinfo,
+                used: false,
+            });
+        }
+        let brush = Brush::with_sides(sides, contents, source).ok_or(BrushError::NoVolume)?;
+        let limit = MAX_WORLD_COORD * 0.5;
+        if (0..3).any(|i| brush.bounds.mins[i] < -limit || brush.bounds.maxs[i] > limit) {
+            return Err(BrushError::TooLarge);
+        }
+        Ok(brush)
+    }
+
+    /// A brush from finished sides, or `None` when it is too small to keep.
+    fn with_sides(sides: Vec<Side>, contents: i32, source: u32) -> Option<Brush> {
+        if sides.len() < 4 {
+            return None;
+        }
+        let mut bounds = Bounds::EMPTY;
+        for s in &sides {
+            for &p in &s.winding.points {
+                bounds.add_point(p);
+            }
+        }
+        let brush = Brush {
+            sides,
+            bounds,
+            contents,
+            source,
+        };
+        (brush.volume() >= MIN_VOLUME).then_some(brush)
+    }
+
+    pub fn outward(&self, side: &Side, planes: &PlaneSet) -> Plane {
+        outward_plane(planes, side.plane, side.flipped)
+    }
+
+    pub fn volume(&self) -> f64 {
+        let Some(corner) = self.sides.first().and_then(|s| s.winding.points.first()) else {
+            return 0.0;
+        };
+        self.sides
+            .iter()
+            .filter_map(|s| {
+                let plane = s.winding.plane()?;
+                Some(s.winding.area() * -plane.distance(*corner))
+            })
+            .sum::<f64>()
+            / 3.0
+    }
+
+    /// Which side of `plane` the brush is on: (any point in front, any point behind).
+    pub fn sides_of(&self, plane: &Plane) -> (bool, bool) {
+        // The bounding box decides most cases without touching the vertices.
+        let n = plane.normal;
+        let center = self.bounds.center();
+        let half = self.bounds.maxs - center;
+        let radius = half.x * n.x.abs() + half.y * n.y.abs() + half.z * n.z.abs();
+        let d = plane.distance(center);
+        if d - radius > -ON_EPSILON {
+            return (d + radius > ON_EPSILON, false);
+        }
+        if d + radius < ON_EPSILON {
+            return (false, d - radius < -ON_EPSILON);
+        }
+        if plane.axial().is_some() {
+            return (d + radius > ON_EPSILON, d - radius < -ON_EPSILON);
+        }
+        let (mut front, mut back) = (false, false);
+        for s in &self.sides {
+            for &p in &s.winding.points {
+                let d = plane.distance(p);
+                front |= d > ON_EPSILON;
+                back |= d < -ON_EPSILON;
+                if front && back {
+                    return (true, true);
+                }
+            }
+        }
+        (front, back)
+    }
+
+    /// Split by the canonical plane `id`: the parts in front and behind. A brush entirely on one
+    /// side comes back whole on that side.
+    pub fn split(self, id: PlaneId, planes: &PlaneSet) -> (Option<Brush>, Option<Brush>) {
+        let plane = *planes.get(id);
+        match self.sides_of(&plane) {
+            (true, false) => return (Some(self), None),
+            (false, true) => return (None, Some(self)),
+            // On the plane within epsilon: a sliver; keep it where its bulk is.
+            (false, false) => return (Some(self), None),
+            (true, true) => {}
+        }
+        // The new face: the plane's polygon inside the brush.
+        let mut cut = Some(Winding::base_for_plane(&plane));
+        for s in &self.sides {
+            let out = self.outward(s, planes);
+            cut = cut.and_then(|w| w.clip_front(&out.flipped(), false));
+        }
+        let cut = cut.filter(|w| !w.is_tiny());
+        let Some(cut) = cut else {
+            // The plane only grazes the brush: keep it whole on the side holding more of it.
+            let mut max_front: f64 = 0.0;
+            let mut max_back: f64 = 0.0;
+            for s in &self.sides {
+                for &p in &s.winding.points {
+                    let d = plane.distance(p);
+                    max_front = max_front.max(d);
+                    max_back = max_back.max(-d);
+                }
+            }
+            return if max_front >= max_back {
+                (Some(self), None)
+            } else {
+                (None, Some(self))
+            };
+        };
+        let mut front_sides = Vec::with_capacity(self.sides.len() + 1);
+        let mut back_sides = Vec::with_capacity(self.sides.len() + 1);
+        for s in self.sides {
+            match s.winding.split(&plane) {
+                Split::Front(_) => front_sides.push(s),
+                Split::Back(_) => back_sides.push(s),
+                Split::Both { front, back } => {
+                    if !front.is_tiny() {
+                        front_sides.push(Side {
+                            winding: front,
+                            ..s.clone()
+                        });
+                    }
+                    if !back.is_tiny() {
+                        back_sides.push(Side { winding: back, ..s });
+                    }
+                }
+                Split::On { .. } => {}
+            }
+        }
+        // The front part's new face looks back along the plane, the back part's along it.
+        front_sides.push(Side {
+            plane: id,
+            flipped: true,
+            winding: cut.reversed(),
+            texinfo: None,
+            used: true,
+        });
+        back_sides.push(Side {
+            plane: id,
+            flipped: false,
+            winding: cut,
+            texinfo: None,
+            used: true,
+        });
+        (
+            Brush::with_sides(front_sides, self.contents, self.source),
+            Brush::with_sides(back_sides, self.contents, self.source),
+        )
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use quake_formats::geom::Vec3;
+
+    /// The six outward planes of an axial box.
+    pub(crate) fn box_planes(mins: Vec3, maxs: Vec3) -> Vec<BrushPlane> {
+        let mut out = Vec::new();
+        for axis in 0..3 {
+            let mut n = Vec3::ZERO;
+            n[axis] = 1.0;
+            out.push(BrushPlane {
+                plane: Plane::new(n, maxs[axis]),
+                texinfo: Some(0),
+            });
+            out.push(BrushPlane {
+                plane: Plane::new(-n, -mins[axis]),
+                texinfo: Some(0),
+            });
+        }
+        out
+    }
+
+    #[test]
+    fn box_brush_has_six_sides_and_volume() {
+        let mut planes = PlaneSet::new();
+        let b = Brush::from_planes(
+            &box_planes(Vec3::new(0.0, 0.0, 0.0), Vec3::new(64.0, 32.0, 16.0)),
+            &mut planes,
+            -2,
+            0,
+        )
+        .expect("brush");
+        assert_eq!(b.sides.len(), 6);
+        assert!((b.volume() - 64.0 * 32.0 * 16.0).abs() < 1e-6);
+        assert_eq!(planes.len(), 6);
+        for s in &b.sides {
+            let own = s.winding.plane().expect("plane");
+            assert!(own.normal.near(b.outward(s, &planes).normal, 1e-9));
+        }
+    }
+
+    #[test]
+    fn bad_brushes_are_reported() {
+        let mut planes = PlaneSet::new();
+        let mut faces = box_planes(Vec3::ZERO, Vec3::new(8.0, 8.0, 8.0));
+        assert_eq!(
+            Brush::from_planes(&faces[..3], &mut planes, -2, 0),
+            Err(BrushError::TooFewPlanes(3))
+        );
+        faces.push(faces[0]);
+        assert_eq!(
+            Brush::from_planes(&faces, &mut planes, -2, 0),
+            Err(BrushError::DuplicatePlane(0, 6))
+        );
+        // A slab with its top below its bottom has no volume.
+        let mut faces = box_planes(Vec3::ZERO, Vec3::new(8.0, 8.0, 8.0));
+        faces[4].plane = Plane::new(Vec3::new(0.0, 0.0, 1.0), -4.0);
+        assert_eq!(
+            Brush::from_planes(&faces, &mut planes, -2, 0),
+            Err(BrushError::NoVolume)
+        );
+    }
+
+    #[test]
+    fn split_conserves_volume_and_adds_cut_faces() {
+        let mut planes = PlaneSet::new();
+        let b = Brush::from_planes(
+            &box_planes(Vec3::ZERO, Vec3::new(64.0, 64.0, 64.0)),
+            &mut planes,
+            -2,
+            0,
+        )
+        .expect("brush");
+        let (cut, _) = planes.insert(&Plane::new(Vec3::new(0.6, 0.8, 0.0), 40.0));
+        let (f, bk) = b.clone().split(cut, &planes);
+        let (f, bk) = (f.expect("front"), bk.expect("back"));
+        assert!((f.volume() + bk.volume() - b.volume()).abs() < 1e-6);
+        assert!(f.sides.iter().any(|s| s.plane == cut && s.used));
+        // An axial plane outside the brush leaves it whole.
+        let (out, _) = planes.insert(&Plane::new(Vec3::new(1.0, 0.0, 0.0), 100.0));
+        let (f, bk) = b.split(out, &planes);
+        assert!(f.is_none() && bk.is_some());
+    }
+}

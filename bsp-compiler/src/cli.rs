@@ -1,0 +1,106 @@
+//! The command line: `slipgate-bsp [--bsp2] [--wad-dir DIR]... IN.map [OUT.bsp]`.
+
+use crate::{CompileOptions, MapSource, SplitHeuristic, compile};
+use anyhow::{Context, Result};
+use quake_formats::fsutil::write_atomic;
+use quake_formats::pts::write_pointfile;
+use std::path::PathBuf;
+
+#[derive(clap::Args, Debug, Clone)]
+pub struct Args {
+    /// The .map file to compile
+    pub input: PathBuf,
+    /// The BSP to write (default: the input with .bsp); the .prt (and .pts on a leak) go beside it
+    pub output: Option<PathBuf>,
+    /// Write BSP2 (BSP29 is used unless a limit is exceeded)
+    #[arg(long)]
+    pub bsp2: bool,
+    /// A directory to search for the WADs named by worldspawn (repeatable; the map's own
+    /// directory is searched last)
+    #[arg(long = "wad-dir", value_name = "DIR")]
+    pub wad_dirs: Vec<PathBuf>,
+    /// How node planes are chosen: fewest-splits or balanced
+    #[arg(long, default_value = "fewest-splits")]
+    pub heuristic: SplitHeuristic,
+    /// Largest lightmap span of a face in texels before it is cut
+    #[arg(long, default_value_t = 240.0)]
+    pub subdivide: f64,
+    /// Write counts and timings as JSON
+    #[arg(long, value_name = "FILE.json")]
+    pub stats: Option<PathBuf>,
+}
+
+pub fn run(args: &Args) -> Result<()> {
+    let source = MapSource::read(&args.input)?;
+    let options = CompileOptions {
+        bsp2: args.bsp2,
+        wad_dirs: args.wad_dirs.clone(),
+        heuristic: args.heuristic,
+        subdivide: args.subdivide,
+    };
+    let out = compile(&source, &options)?;
+    let bsp_path = args
+        .output
+        .clone()
+        .unwrap_or_else(|| args.input.with_extension("bsp"));
+    let bytes = out.bsp.write().context("encoding the BSP")?;
+    write_atomic(&bsp_path, &bytes)?;
+    write_atomic(
+        &bsp_path.with_extension("prt"),
+        out.portals.write().as_bytes(),
+    )?;
+    let pts_path = bsp_path.with_extension("pts");
+    if let Some(leak) = &out.leak {
+        write_atomic(&pts_path, write_pointfile(&leak.pointfile).as_bytes())?;
+    }
+
+    // Repeated warnings of one kind are summarised after a few.
+    let mut shown = std::collections::HashMap::new();
+    for w in &out.warnings {
+        let kind = std::mem::discriminant(w);
+        let n = shown.entry(kind).or_insert(0usize);
+        *n += 1;
+        if *n <= 10 {
+            eprintln!("warning: {w}");
+        }
+    }
+    for w in &out.warnings {
+        if let Some(n) = shown.remove(&std::mem::discriminant(w))
+            && n > 10
+        {
+            eprintln!("warning: ... and {} more like the above", n - 10);
+        }
+    }
+    let s = &out.stats;
+    println!(
+        "{}: {} brushes ({} bad), {} entities, {} models",
+        args.input.display(),
+        s.brushes,
+        s.bad_brushes,
+        s.entities,
+        s.models
+    );
+    println!(
+        "  {} planes, {} nodes, {} leaves, {} faces, {} splits, {} clipnodes, {} vertices, {} edges",
+        s.planes, s.nodes, s.leaves, s.faces, s.splits, s.clipnodes, s.vertices, s.edges
+    );
+    println!(
+        "  {} portals ({} for vis), {} textures, {} texinfo, {} T-junction vertices added",
+        s.portals, s.vis_portals, s.textures, s.texinfo, s.tjunction_vertices
+    );
+    for (phase, secs) in &s.timings {
+        println!("  {phase:<28} {secs:8.3} s");
+    }
+    println!("wrote {} ({})", bsp_path.display(), s.version);
+    if out.leak.is_some() {
+        eprintln!(
+            "LEAK: the map is open to the void; pointfile written to {}",
+            pts_path.display()
+        );
+    }
+    if let Some(path) = &args.stats {
+        let json = serde_json::to_string_pretty(s)?;
+        write_atomic(path, json.as_bytes())?;
+    }
+    Ok(())
+}

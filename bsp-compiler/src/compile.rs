@@ -1,0 +1,595 @@
+//! The whole compile: parse, build brushes, build each model's trees (in parallel), fill the
+//! outside, make faces, and emit the BSP and portal file.
+
+use crate::brush::{Brush, BrushPlane};
+use crate::csg::mark_hidden_sides;
+use crate::emit::{EmitInput, emit};
+use crate::faces::{FaceStats, FaceTexInfo, ModelFace, faces_from_portals, merge_faces, subdivide};
+use crate::hulls::{HULL_BOXES, expand_brush};
+use crate::map::{MapEntity, MapError, parse_map};
+use crate::outside::{FillOutcome, Leak, Occupant, fill_outside};
+use crate::planes::PlaneSet;
+use crate::portals::{Portals, make_portals};
+use crate::texinfo::TextureRole;
+use crate::tree::{SplitHeuristic, Tree, build_tree};
+use crate::wad_lookup::WadSet;
+use crate::warnings::Warning;
+use quake_formats::bsp::contents;
+use quake_formats::entities::Entity;
+use quake_formats::geom::{Bounds, Vec3};
+use quake_formats::prt::PortalFile;
+use quake_formats::{Bsp, BspVersion, FormatError};
+use rayon::prelude::*;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// A `.map` file's text and where it came from (for messages and WAD lookup).
+#[derive(Debug, Clone)]
+pub struct MapSource {
+    pub path: PathBuf,
+    pub text: String,
+}
+
+impl MapSource {
+    pub fn read(path: &Path) -> Result<MapSource, CompileError> {
+        let bytes = std::fs::read(path).map_err(|source| CompileError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        // Quake text is Latin-1: map each byte to the char of the same value.
+        let text = match String::from_utf8(bytes) {
+            Ok(s) => s,
+            Err(e) => e.into_bytes().iter().map(|&b| b as char).collect(),
+        };
+        Ok(MapSource {
+            path: path.to_path_buf(),
+            text,
+        })
+    }
+}
+
+#[derive(Debug, Clone)]
+pub struct CompileOptions {
+    /// Write BSP2 even when BSP29 would do.
+    pub bsp2: bool,
+    /// Directories searched for WADs (the map's own directory is searched last).
+    pub wad_dirs: Vec<PathBuf>,
+    pub heuristic: SplitHeuristic,
+    /// Largest span of a lit face in texels before it is cut.
+    pub subdivide: f64,
+}
+
+impl Default for CompileOptions {
+    fn default() -> Self {
+        CompileOptions {
+            bsp2: false,
+            wad_dirs: Vec::new(),
+            heuristic: SplitHeuristic::default(),
+            subdivide: 240.0,
+        }
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum CompileError {
+    #[error(transparent)]
+    Map(#[from] MapError),
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{}: the first entity must be worldspawn, found {found:?}", path.display())]
+    NoWorldspawn { path: PathBuf, found: String },
+    #[error("writing the BSP: {0}")]
+    Format(#[from] FormatError),
+}
+
+/// Counts and timings of one compile.
+#[derive(Debug, Clone, Default, serde::Serialize)]
+pub struct CompileStats {
+    pub version: String,
+    pub heuristic: SplitHeuristic,
+    pub entities: usize,
+    pub models: usize,
+    pub brushes: usize,
+    pub bad_brushes: usize,
+    pub planes: usize,
+    pub nodes: usize,
+    pub leaves: usize,
+    pub faces: usize,
+    pub splits: usize,
+    pub clipnodes: usize,
+    pub portals: usize,
+    pub vis_portals: usize,
+    pub vertices: usize,
+    pub edges: usize,
+    pub texinfo: usize,
+    pub textures: usize,
+    pub filled_leaves: usize,
+    pub tjunction_vertices: usize,
+    pub leaked: bool,
+    pub face_stats: FaceStats,
+    /// Phase name and seconds; phases run per model are summed over models (CPU time).
+    pub timings: Vec<(String, f64)>,
+}
+
+/// Everything a compile produces.
+#[derive(Debug, Clone)]
+pub struct CompileOutput {
+    pub bsp: Bsp,
+    pub portals: PortalFile,
+    pub leak: Option<Leak>,
+    pub warnings: Vec<Warning>,
+    pub stats: CompileStats,
+}
+
+/// A map texinfo: projection vectors and texture.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MapTexInfo {
+    pub vecs: [[f64; 4]; 2],
+    /// Index into the texture name list.
+    pub texture: u32,
+    pub role: TextureRole,
+}
+
+/// One model's brushes before tree building.
+struct ModelInput {
+    entity: usize,
+    brushes: Vec<Brush>,
+    /// Grown brushes of hulls 1 and 2.
+    hull_brushes: [Vec<Brush>; 2],
+}
+
+/// One model's trees and faces.
+pub(crate) struct ModelOutput {
+    pub tree: Tree,
+    pub portals: Portals,
+    pub faces: Vec<ModelFace>,
+    pub hulls: [Tree; 2],
+    pub bounds: Bounds,
+    pub fill: Option<FillOutcome>,
+    pub face_stats: FaceStats,
+    pub timings: [f64; 6],
+}
+
+const MODEL_PHASES: [&str; 6] = ["tree", "portals", "outside", "faces", "hulls", "csg"];
+
+/// Entities whose brushes belong to the world.
+fn merges_into_world(classname: &str) -> bool {
+    matches!(
+        classname,
+        "func_group" | "func_detail" | "func_detail_wall" | "func_detail_fence"
+    )
+}
+
+/// Texture names and texinfos, interned in first-use order.
+#[derive(Default)]
+struct TexInfoTable {
+    names: Vec<String>,
+    name_index: HashMap<String, u32>,
+    infos: Vec<MapTexInfo>,
+    info_index: HashMap<([u64; 8], u32), u32>,
+}
+
+impl TexInfoTable {
+    fn intern(&mut self, name: &str, vecs: [[f64; 4]; 2]) -> u32 {
+        let key = name.to_ascii_lowercase();
+        let texture = match self.name_index.get(&key) {
+            Some(&i) => i,
+            None => {
+                let i = self.names.len() as u32;
+                self.names.push(name.to_string());
+                self.name_index.insert(key, i);
+                i
+            }
+        };
+        let bits: [u64; 8] = std::array::from_fn(|i| (vecs[i / 4][i % 4] as f32).to_bits() as u64);
+        if let Some(&i) = self.info_index.get(&(bits, texture)) {
+            return i;
+        }
+        let i = self.infos.len() as u32;
+        self.infos.push(MapTexInfo {
+            vecs,
+            texture,
+            role: TextureRole::of(name),
+        });
+        self.info_index.insert((bits, texture), i);
+        i
+    }
+}
+
+/// Compile a map.
+pub fn compile(
+    source: &MapSource,
+    options: &CompileOptions,
+) -> Result<CompileOutput, CompileError> {
+    let total = Instant::now();
+    let mut timings = Vec::new();
+    let mut warnings = Vec::new();
+    let mut stats = CompileStats {
+        heuristic: options.heuristic,
+        ..CompileStats::default()
+    };
+
+    let t = Instant::now();
+    let map = parse_map(&source.path, &source.text)?;
+    let classname = map
+        .entities
+        .first()
+        .map(|e| e.entity.classname())
+        .unwrap_or("");
+    if classname != "worldspawn" {
+        return Err(CompileError::NoWorldspawn {
+            path: source.path.clone(),
+            found: classname.to_string(),
+        });
+    }
+    stats.entities = map.entities.len();
+    timings.push(("parse".to_string(), t.elapsed().as_secs_f64()));
+
+    let t = Instant::now();
+    let mut planes = PlaneSet::new();
+    let mut table = TexInfoTable::default();
+    let mut models: Vec<ModelInput> = vec![ModelInput {
+        entity: 0,
+        brushes: Vec::new(),
+        hull_brushes: [Vec::new(), Vec::new()],
+    }];
+    let mut entities: Vec<Entity> = Vec::new();
+    let mut occupants = Vec::new();
+    let mut skipped_illusionary = 0;
+    let mut skipped_hint = 0;
+    for (index, ent) in map.entities.iter().enumerate() {
+        let class = ent.entity.classname();
+        if index > 0 && ent.brushes.is_empty() {
+            if let Some([x, y, z]) = ent.entity.get_floats::<3>("origin") {
+                occupants.push(Occupant {
+                    entity: index,
+                    classname: class.to_string(),
+                    origin: Vec3::new(x, y, z),
+                });
+            }
+            entities.push(ent.entity.clone());
+            continue;
+        }
+        if class == "func_detail_illusionary" {
+            skipped_illusionary += ent.brushes.len();
+            continue;
+        }
+        let model = if index == 0 || merges_into_world(class) {
+            0
+        } else {
+            models.push(ModelInput {
+                entity: index,
+                brushes: Vec::new(),
+                hull_brushes: [Vec::new(), Vec::new()],
+            });
+            let mut e = ent.entity.clone();
+            e.set("model", format!("*{}", models.len() - 1));
+            entities.push(e);
+            models.len() - 1
+        };
+        if index == 0 {
+            entities.push(ent.entity.clone());
+        }
+        let is_world = model == 0;
+        let (built, bad, hints) =
+            build_entity_brushes(ent, index, is_world, &mut planes, &mut table, &mut warnings);
+        stats.brushes += ent.brushes.len();
+        stats.bad_brushes += bad;
+        skipped_hint += hints;
+        let m = &mut models[model];
+        for (brush, clip) in built {
+            for (hull, (mins, maxs)) in HULL_BOXES.iter().enumerate() {
+                let in_hulls = matches!(brush.contents, contents::SOLID | contents::SKY) || clip;
+                if in_hulls && let Some(g) = expand_brush(&brush, &mut planes, *mins, *maxs) {
+                    m.hull_brushes[hull].push(g);
+                }
+            }
+            if !clip {
+                m.brushes.push(brush);
+            }
+        }
+    }
+    if skipped_illusionary > 0 {
+        warnings.push(Warning::Unsupported {
+            what: format!("{skipped_illusionary} func_detail_illusionary brushes are left out"),
+        });
+    }
+    if skipped_hint > 0 {
+        warnings.push(Warning::Unsupported {
+            what: format!("{skipped_hint} hint brushes are ignored"),
+        });
+    }
+    for m in &models[1..] {
+        if m.brushes.is_empty() && m.hull_brushes[0].is_empty() {
+            warnings.push(Warning::EmptyBrushEntity {
+                entity: m.entity,
+                classname: map.entities[m.entity].entity.classname().to_string(),
+            });
+        }
+    }
+    timings.push(("brushes".to_string(), t.elapsed().as_secs_f64()));
+
+    let t = Instant::now();
+    let face_texinfos: Vec<FaceTexInfo> = table
+        .infos
+        .iter()
+        .map(|i| FaceTexInfo {
+            vecs: i.vecs,
+            role: i.role,
+        })
+        .collect();
+    let results: Vec<(ModelOutput, Vec<Warning>)> = models
+        .into_par_iter()
+        .enumerate()
+        .map(|(i, m)| {
+            let occ: &[Occupant] = if i == 0 { &occupants } else { &[] };
+            build_model(m, &planes, &face_texinfos, options, occ)
+        })
+        .collect();
+    timings.push(("models (wall)".to_string(), t.elapsed().as_secs_f64()));
+    let mut outputs = Vec::with_capacity(results.len());
+    let mut phase_sums = [0.0; 6];
+    let mut leak = None;
+    for (out, w) in results {
+        warnings.extend(w);
+        for (sum, t) in phase_sums.iter_mut().zip(out.timings) {
+            *sum += t;
+        }
+        stats.splits += out.tree.splits;
+        stats.portals += out.portals.portals.len();
+        let fs = &mut stats.face_stats;
+        fs.from_portals += out.face_stats.from_portals;
+        fs.untextured += out.face_stats.untextured;
+        fs.after_merge += out.face_stats.after_merge;
+        fs.after_subdivide += out.face_stats.after_subdivide;
+        match &out.fill {
+            Some(FillOutcome::Leaked(l)) => {
+                warnings.push(Warning::Leak {
+                    entity: l.entity,
+                    classname: l.classname.clone(),
+                    origin: l.origin,
+                });
+                leak = Some(l.clone());
+            }
+            Some(FillOutcome::NoOccupants) => warnings.push(Warning::NoEntitiesToFlood),
+            Some(FillOutcome::Sealed { filled }) => stats.filled_leaves = *filled,
+            None => {}
+        }
+        outputs.push(out);
+    }
+    for (name, sum) in MODEL_PHASES.iter().zip(phase_sums) {
+        timings.push((format!("  {name} (sum over models)"), sum));
+    }
+    stats.leaked = leak.is_some();
+
+    let t = Instant::now();
+    let mut search = options.wad_dirs.clone();
+    if let Some(dir) = source.path.parent() {
+        search.push(if dir.as_os_str().is_empty() {
+            PathBuf::from(".")
+        } else {
+            dir.to_path_buf()
+        });
+    }
+    let wads = WadSet::load(
+        map.entities[0].entity.get("wad").unwrap_or(""),
+        &search,
+        &mut warnings,
+    );
+    let version = if options.bsp2 {
+        BspVersion::Bsp2
+    } else {
+        BspVersion::Bsp29
+    };
+    let emitted = emit(EmitInput {
+        models: &outputs,
+        planes: &planes,
+        texinfos: &table.infos,
+        texture_names: &table.names,
+        wads: &wads,
+        entities: &entities,
+        version,
+        warnings: &mut warnings,
+    });
+    let mut bsp = emitted.bsp;
+    if bsp.version == BspVersion::Bsp29
+        && let Err(e) = bsp.check_bsp29_limits()
+    {
+        warnings.push(Warning::Unsupported {
+            what: format!("{e}; switching to BSP2 automatically"),
+        });
+        bsp.version = BspVersion::Bsp2;
+    }
+    timings.push(("emit".to_string(), t.elapsed().as_secs_f64()));
+    timings.push(("total".to_string(), total.elapsed().as_secs_f64()));
+
+    stats.version = bsp.version.to_string();
+    stats.models = bsp.models.len();
+    stats.planes = bsp.planes.len();
+    stats.nodes = bsp.nodes.len();
+    stats.leaves = bsp.leafs.len();
+    stats.faces = bsp.faces.len();
+    stats.clipnodes = bsp.clipnodes.len();
+    stats.vertices = bsp.vertices.len();
+    stats.edges = bsp.edges.len();
+    stats.texinfo = bsp.texinfo.len();
+    stats.textures = bsp.textures.textures.len();
+    stats.vis_portals = emitted.portals.portals.len();
+    stats.tjunction_vertices = emitted.tjunction_vertices;
+    stats.timings = timings;
+    Ok(CompileOutput {
+        bsp,
+        portals: emitted.portals,
+        leak,
+        warnings,
+        stats,
+    })
+}
+
+/// Build one entity's brushes: each with whether it is a clip brush. Returns the brushes, the
+/// number of bad brushes and the number of hint brushes skipped.
+fn build_entity_brushes(
+    ent: &MapEntity,
+    entity: usize,
+    is_world: bool,
+    planes: &mut PlaneSet,
+    table: &mut TexInfoTable,
+    warnings: &mut Vec<Warning>,
+) -> (Vec<(Brush, bool)>, usize, usize) {
+    let mut out = Vec::new();
+    let (mut bad, mut hints) = (0, 0);
+    for (bi, mb) in ent.brushes.iter().enumerate() {
+        let mut faces = Vec::with_capacity(mb.faces.len());
+        let mut roles = Vec::with_capacity(mb.faces.len());
+        let mut failure = None;
+        for (fi, f) in mb.faces.iter().enumerate() {
+            let Some(plane) = f.plane() else {
+                failure = Some(crate::brush::BrushError::NoPlane(fi).to_string());
+                break;
+            };
+            let texinfo = table.intern(&f.texture, f.projection.vecs(&plane));
+            roles.push(TextureRole::of(&f.texture));
+            faces.push(BrushPlane {
+                plane,
+                texinfo: Some(texinfo),
+            });
+        }
+        if roles.contains(&TextureRole::Hint) {
+            hints += 1;
+            continue;
+        }
+        let clip = roles.contains(&TextureRole::Clip);
+        let brush_contents = if !is_world {
+            contents::SOLID
+        } else if roles.contains(&TextureRole::Sky) {
+            contents::SKY
+        } else if let Some(c) = roles.iter().find_map(|r| match r {
+            TextureRole::Liquid(c) => Some(*c),
+            _ => None,
+        }) {
+            c
+        } else {
+            contents::SOLID
+        };
+        let built = match failure {
+            Some(reason) => Err(reason),
+            None => Brush::from_planes(&faces, planes, brush_contents, bi as u32)
+                .map_err(|e| e.to_string()),
+        };
+        match built {
+            Ok(b) => out.push((b, clip)),
+            Err(reason) => {
+                bad += 1;
+                warnings.push(Warning::BadBrush {
+                    entity,
+                    brush: bi,
+                    line: mb.line,
+                    reason,
+                });
+            }
+        }
+    }
+    (out, bad, hints)
+}
+
+fn build_model(
+    m: ModelInput,
+    planes: &PlaneSet,
+    texinfos: &[FaceTexInfo],
+    options: &CompileOptions,
+    occupants: &[Occupant],
+) -> (ModelOutput, Vec<Warning>) {
+    let mut warnings = Vec::new();
+    let mut timings = [0.0; 6];
+    let mut bounds = Bounds::EMPTY;
+    for b in m.brushes.iter().chain(m.hull_brushes[0].iter()) {
+        bounds = bounds.union(&b.bounds);
+    }
+    if bounds.is_empty() {
+        bounds = Bounds {
+            mins: Vec3::new(-1.0, -1.0, -1.0),
+            maxs: Vec3::new(1.0, 1.0, 1.0),
+        };
+    }
+    let heuristic = options.heuristic;
+    let t = Instant::now();
+    let mut brushes = m.brushes;
+    let [mut h1, mut h2] = m.hull_brushes;
+    for list in [&mut brushes, &mut h1, &mut h2] {
+        mark_hidden_sides(list, planes);
+    }
+    timings[5] = t.elapsed().as_secs_f64();
+    let ((mut tree, tree_time), (hulls, hull_time)) = rayon::join(
+        || {
+            let t = Instant::now();
+            let tree = build_tree(brushes, planes, heuristic, true);
+            (tree, t.elapsed().as_secs_f64())
+        },
+        || {
+            let t = Instant::now();
+            let (a, b) = rayon::join(
+                || build_tree(h1, planes, heuristic, false),
+                || build_tree(h2, planes, heuristic, false),
+            );
+            ([a, b], t.elapsed().as_secs_f64())
+        },
+    );
+    timings[0] = tree_time;
+    timings[4] = hull_time;
+
+    let t = Instant::now();
+    let portals = make_portals(&tree, planes, &bounds);
+    timings[1] = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let is_world = m.entity == 0;
+    let fill =
+        is_world.then(|| fill_outside(&mut tree, planes, &portals, occupants, &mut warnings));
+    timings[2] = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let mut face_stats = FaceStats::default();
+    let raw = faces_from_portals(&tree, &portals, texinfos, &mut face_stats);
+    let merged = merge_faces(raw, |f| *planes.get(f.plane));
+    face_stats.after_merge = merged.len();
+    let mut faces = Vec::with_capacity(merged.len());
+    for f in merged {
+        let info = &texinfos[f.texinfo as usize];
+        if info.role.is_special() {
+            faces.push(f);
+            continue;
+        }
+        let mut pieces = Vec::new();
+        subdivide(
+            f.winding.clone(),
+            &info.vecs,
+            options.subdivide,
+            &mut pieces,
+        );
+        faces.extend(pieces.into_iter().map(|w| ModelFace {
+            winding: w,
+            ..f.clone()
+        }));
+    }
+    face_stats.after_subdivide = faces.len();
+    timings[3] = t.elapsed().as_secs_f64();
+
+    (
+        ModelOutput {
+            tree,
+            portals,
+            faces,
+            hulls,
+            bounds,
+            fill,
+            face_stats,
+            timings,
+        },
+        warnings,
+    )
+}

@@ -1,0 +1,203 @@
+//! CSG between brushes: a side buried inside other brushes of at least its contents strength
+//! (solid > sky > lava > slime > water) can never be seen, so it never splits the tree. Faces
+//! between touching or overlapping brushes disappear that way, and trees (above all the clip
+//! hulls, whose grown brushes overlap a lot) get far fewer splits.
+//!
+//! This is sound for leaf contents: inside a leaf, the boundary of the stronger brushes' union
+//! is made of visible sides, which have all been used as node planes above the leaf.
+
+use crate::brush::{Brush, Side};
+use crate::planes::PlaneSet;
+use crate::tree::contents_priority;
+use quake_formats::geom::{Bounds, ON_EPSILON, Split, Vec3, Winding};
+use rayon::prelude::*;
+
+/// Mark every side of `brushes` that lies wholly inside other brushes as used. Returns how many.
+pub fn mark_hidden_sides(brushes: &mut [Brush], planes: &PlaneSet) -> usize {
+    let pad = Vec3::new(ON_EPSILON, ON_EPSILON, ON_EPSILON);
+    let padded: Vec<Bounds> = brushes
+        .iter()
+        .map(|b| Bounds {
+            mins: b.bounds.mins - pad,
+            maxs: b.bounds.maxs + pad,
+        })
+        .collect();
+    // Candidates per brush via a sort on mins.x, so big maps do not compare every pair.
+    let mut by_x: Vec<usize> = (0..brushes.len()).collect();
+    by_x.sort_by(|&a, &b| {
+        padded[a]
+            .mins
+            .x
+            .total_cmp(&padded[b].mins.x)
+            .then(a.cmp(&b))
+    });
+    let hidden: Vec<Vec<bool>> = (0..brushes.len())
+        .into_par_iter()
+        .map(|i| {
+            let me = &brushes[i];
+            let prio = contents_priority(me.contents);
+            let end = by_x.partition_point(|&j| padded[j].mins.x <= padded[i].maxs.x);
+            let mut covers: Vec<usize> = by_x[..end]
+                .iter()
+                .copied()
+                .filter(|&j| {
+                    j != i
+                        && padded[j].intersects(&padded[i])
+                        && contents_priority(brushes[j].contents) >= prio
+                })
+                .collect();
+            covers.sort_unstable();
+            me.sides
+                .iter()
+                .map(|s| s.used || buried(s, me, &covers, brushes, planes))
+                .collect()
+        })
+        .collect();
+    let mut count = 0;
+    for (b, flags) in brushes.iter_mut().zip(hidden) {
+        for (s, h) in b.sides.iter_mut().zip(flags) {
+            count += usize::from(h && !s.used);
+            s.used |= h;
+        }
+    }
+    count
+}
+
+/// Whether `side` of `owner` is entirely inside the brushes `covers`.
+fn buried(
+    side: &Side,
+    owner: &Brush,
+    covers: &[usize],
+    brushes: &[Brush],
+    planes: &PlaneSet,
+) -> bool {
+    let own = owner.outward(side, planes);
+    let mut pieces = vec![side.winding.clone()];
+    for &j in covers {
+        let other = &brushes[j];
+        if !other.bounds.intersects(&side.winding.bounds()) {
+            continue;
+        }
+        let mut outside = Vec::new();
+        for w in pieces {
+            clip_outside(w, other, planes, own.normal, &mut outside);
+        }
+        pieces = outside;
+        if pieces.is_empty() {
+            return true;
+        }
+    }
+    false
+}
+
+/// Push the parts of `w` outside `brush`. A part lying on one of its sides counts as inside
+/// when the two face each other (touching brushes) and outside when they face the same way.
+fn clip_outside(
+    w: Winding,
+    brush: &Brush,
+    planes: &PlaneSet,
+    facing: Vec3,
+    out: &mut Vec<Winding>,
+) {
+    let mut rest = w;
+    for s in &brush.sides {
+        let plane = brush.outward(s, planes);
+        match rest.split(&plane) {
+            Split::Front(w) => {
+                out.push(w);
+                return;
+            }
+            Split::Back(w) => rest = w,
+            Split::Both { front, back } => {
+                if !front.is_tiny() {
+                    out.push(front);
+                }
+                rest = back;
+            }
+            Split::On { winding, .. } => {
+                if plane.normal.dot(facing) > 0.0 {
+                    out.push(winding);
+                    return;
+                }
+                rest = winding;
+            }
+        }
+        if rest.is_tiny() {
+            return;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::brush::tests::box_planes;
+    use quake_formats::bsp::contents;
+
+    fn cube(planes: &mut PlaneSet, mins: Vec3, maxs: Vec3, c: i32) -> Brush {
+        Brush::from_planes(&box_planes(mins, maxs), planes, c, 0).expect("brush")
+    }
+
+    #[test]
+    fn touching_faces_are_hidden_and_outer_faces_are_not() {
+        let mut planes = PlaneSet::new();
+        let mut brushes = vec![
+            cube(
+                &mut planes,
+                Vec3::ZERO,
+                Vec3::new(64.0, 64.0, 64.0),
+                contents::SOLID,
+            ),
+            cube(
+                &mut planes,
+                Vec3::new(64.0, 0.0, 0.0),
+                Vec3::new(128.0, 64.0, 64.0),
+                contents::SOLID,
+            ),
+        ];
+        assert_eq!(mark_hidden_sides(&mut brushes, &planes), 2);
+        assert_eq!(
+            brushes
+                .iter()
+                .flat_map(|b| &b.sides)
+                .filter(|s| s.used)
+                .count(),
+            2
+        );
+    }
+
+    #[test]
+    fn solid_inside_water_stays_visible_but_water_inside_solid_does_not() {
+        let mut planes = PlaneSet::new();
+        let mut brushes = vec![
+            cube(
+                &mut planes,
+                Vec3::ZERO,
+                Vec3::new(128.0, 128.0, 128.0),
+                contents::WATER,
+            ),
+            cube(
+                &mut planes,
+                Vec3::new(32.0, 32.0, 32.0),
+                Vec3::new(64.0, 64.0, 64.0),
+                contents::SOLID,
+            ),
+        ];
+        assert_eq!(mark_hidden_sides(&mut brushes, &planes), 0);
+        let mut brushes = vec![
+            cube(
+                &mut planes,
+                Vec3::ZERO,
+                Vec3::new(128.0, 128.0, 128.0),
+                contents::SOLID,
+            ),
+            cube(
+                &mut planes,
+                Vec3::new(32.0, 32.0, 32.0),
+                Vec3::new(64.0, 64.0, 64.0),
+                contents::WATER,
+            ),
+        ];
+        assert_eq!(mark_hidden_sides(&mut brushes, &planes), 6);
+    }
+}

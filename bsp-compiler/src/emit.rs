@@ -1,0 +1,411 @@
+//! Writing the compiled models into a [`Bsp`]: planes, textures, shared vertices and edges,
+//! faces, nodes, leaves (leaf 0 is the shared solid leaf), clip nodes and models; and the
+//! world's portals into a PRT1 file.
+
+use crate::compile::{MapTexInfo, ModelOutput};
+use crate::faces::ModelFace;
+use crate::hulls::emit_clipnodes;
+use crate::planes::{PlaneId, PlaneSet};
+use crate::tree::Tree;
+use crate::wad_lookup::WadSet;
+use crate::warnings::Warning;
+use crate::weld::{VertexWelder, fix_tjunctions};
+use quake_formats::bsp::{BspPlane, Face, Leaf, Model, Node, TexInfo, contents, texinfo_flags};
+use quake_formats::entities::{Entity, write_entities};
+use quake_formats::geom::{Bounds, Plane, Vec3};
+use quake_formats::prt::{PortalFile, PrtPortal};
+use quake_formats::{Bsp, BspVersion};
+use std::collections::HashMap;
+
+pub(crate) struct EmitInput<'a> {
+    pub models: &'a [ModelOutput],
+    pub planes: &'a PlaneSet,
+    pub texinfos: &'a [MapTexInfo],
+    pub texture_names: &'a [String],
+    pub wads: &'a WadSet,
+    pub entities: &'a [Entity],
+    pub version: BspVersion,
+    pub warnings: &'a mut Vec<Warning>,
+}
+
+pub(crate) struct Emitted {
+    pub bsp: Bsp,
+    pub portals: PortalFile,
+    pub tjunction_vertices: usize,
+}
+
+/// Planes written on first use.
+struct PlaneTable<'a> {
+    source: &'a PlaneSet,
+    index: Vec<u32>,
+    planes: Vec<BspPlane>,
+}
+
+impl PlaneTable<'_> {
+    fn get(&mut self, id: PlaneId) -> u32 {
+        if self.index[id as usize] == u32::MAX {
+            self.index[id as usize] = self.push(self.source.get(id));
+        }
+        self.index[id as usize]
+    }
+
+    fn push(&mut self, p: &Plane) -> u32 {
+        self.planes.push(BspPlane {
+            normal: p.normal.to_f32(),
+            dist: p.dist as f32,
+            kind: p.quake_type(),
+        });
+        (self.planes.len() - 1) as u32
+    }
+}
+
+/// Texinfos and textures written on first use.
+struct TextureTable<'a> {
+    infos: &'a [MapTexInfo],
+    info_index: Vec<u32>,
+    texture_index: Vec<u32>,
+    out_infos: Vec<TexInfo>,
+    used_textures: Vec<u32>,
+}
+
+impl TextureTable<'_> {
+    fn get(&mut self, id: u32) -> u32 {
+        if self.info_index[id as usize] == u32::MAX {
+            let info = &self.infos[id as usize];
+            let tex = info.texture as usize;
+            if self.texture_index[tex] == u32::MAX {
+                self.texture_index[tex] = self.used_textures.len() as u32;
+                self.used_textures.push(info.texture);
+            }
+            self.info_index[id as usize] = self.out_infos.len() as u32;
+            self.out_infos.push(TexInfo {
+                vecs: info.vecs.map(|row| row.map(|c| c as f32)),
+                miptex: self.texture_index[tex],
+                flags: if info.role.is_special() {
+                    texinfo_flags::SPECIAL
+                } else {
+                    0
+                },
+            });
+        }
+        self.info_index[id as usize]
+    }
+}
+
+/// The internal nodes of a model's tree in output order (pre-order, all-solid subtrees left out).
+fn node_order(tree: &Tree, solid: &[bool]) -> Vec<u32> {
+    let mut order = Vec::new();
+    let mut stack = vec![0u32];
+    while let Some(n) = stack.pop() {
+        let node = &tree.nodes[n as usize];
+        if solid[n as usize] || node.is_leaf() {
+            continue;
+        }
+        order.push(n);
+        stack.push(node.children[1]);
+        stack.push(node.children[0]);
+    }
+    order
+}
+
+/// A face in output order with its welded polygon.
+struct PendingFace<'a> {
+    model: usize,
+    face: &'a ModelFace,
+    vertices: Vec<u32>,
+}
+
+pub(crate) fn emit(input: EmitInput) -> Emitted {
+    let mut bsp = Bsp::new(input.version);
+    let mut planes = PlaneTable {
+        source: input.planes,
+        index: vec![u32::MAX; input.planes.len()],
+        planes: Vec::new(),
+    };
+    let mut textures = TextureTable {
+        infos: input.texinfos,
+        info_index: vec![u32::MAX; input.texinfos.len()],
+        texture_index: vec![u32::MAX; input.texture_names.len()],
+        out_infos: Vec::new(),
+        used_textures: Vec::new(),
+    };
+
+    // Faces in output order: model by model, node by node.
+    let solids: Vec<Vec<bool>> = input.models.iter().map(|m| m.tree.all_solid()).collect();
+    let orders: Vec<Vec<u32>> = input
+        .models
+        .iter()
+        .zip(&solids)
+        .map(|(m, s)| node_order(&m.tree, s))
+        .collect();
+    let mut welder = VertexWelder::default();
+    let mut pending = Vec::new();
+    for (mi, m) in input.models.iter().enumerate() {
+        let mut by_node: Vec<Vec<usize>> = vec![Vec::new(); m.tree.nodes.len()];
+        for (fi, f) in m.faces.iter().enumerate() {
+            by_node[f.node as usize].push(fi);
+        }
+        for &n in &orders[mi] {
+            for &fi in &by_node[n as usize] {
+                let face = &m.faces[fi];
+                let vertices = face
+                    .winding
+                    .points
+                    .iter()
+                    .map(|&p| welder.weld(p))
+                    .collect();
+                pending.push(PendingFace {
+                    model: mi,
+                    face,
+                    vertices,
+                });
+            }
+        }
+    }
+    let mut polygons: Vec<Vec<u32>> = pending
+        .iter_mut()
+        .map(|f| std::mem::take(&mut f.vertices))
+        .collect();
+    let tjunction_vertices = fix_tjunctions(&welder.positions, &mut polygons);
+    bsp.vertices = welder.positions.iter().map(|p| p.to_f32()).collect();
+
+    // Faces, edges and, per model node and leaf, which faces they hold.
+    bsp.edges.push([0, 0]); // edge 0 cannot be negated, so it is never used
+    let mut edge_index: HashMap<(u32, u32), (u32, bool)> = HashMap::new();
+    let mut node_faces: HashMap<(usize, u32), (u32, u32)> = HashMap::new();
+    let mut leaf_faces: HashMap<(usize, u32), Vec<u32>> = HashMap::new();
+    let mut model_faces: Vec<(u32, u32)> = vec![(0, 0); input.models.len()];
+    for (pf, mut poly) in pending.iter().zip(polygons) {
+        poly.dedup();
+        while poly.len() > 1 && poly.first() == poly.last() {
+            poly.pop();
+        }
+        if poly.len() < 3 {
+            continue;
+        }
+        let f = pf.face;
+        let face_index = bsp.faces.len() as u32;
+        let first_edge = bsp.surfedges.len() as u32;
+        for k in 0..poly.len() {
+            let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+            match edge_index.get_mut(&(b, a)) {
+                Some((e, reused)) if !*reused => {
+                    *reused = true;
+                    bsp.surfedges.push(-(*e as i32));
+                }
+                _ => {
+                    let e = bsp.edges.len() as u32;
+                    bsp.edges.push([a, b]);
+                    edge_index.insert((a, b), (e, false));
+                    bsp.surfedges.push(e as i32);
+                }
+            }
+        }
+        let special = input.texinfos[f.texinfo as usize].role.is_special();
+        bsp.faces.push(Face {
+            plane: planes.get(f.plane),
+            side: u32::from(f.back),
+            first_edge,
+            num_edges: poly.len() as u32,
+            texinfo: textures.get(f.texinfo),
+            styles: if special {
+                [255; 4]
+            } else {
+                [0, 255, 255, 255]
+            },
+            light_offset: -1,
+        });
+        let range = node_faces
+            .entry((pf.model, f.node))
+            .or_insert((face_index, 0));
+        range.1 += 1;
+        let range = &mut model_faces[pf.model];
+        if range.1 == 0 {
+            range.0 = face_index;
+        }
+        range.1 += 1;
+        for &leaf in &f.leaves {
+            leaf_faces
+                .entry((pf.model, leaf))
+                .or_default()
+                .push(face_index);
+        }
+    }
+
+    // Nodes, leaves and models.
+    bsp.leafs.push(Leaf {
+        contents: contents::SOLID,
+        vis_offset: -1,
+        mins: [0.0; 3],
+        maxs: [0.0; 3],
+        first_marksurface: 0,
+        num_marksurfaces: 0,
+        ambient: [0; 4],
+    });
+    let mut world_leaf_index: HashMap<u32, u32> = HashMap::new();
+    for (mi, m) in input.models.iter().enumerate() {
+        let (first_face, num_faces) = model_faces[mi];
+        let leaves_before = bsp.leafs.len();
+        let mut w = TreeWriter {
+            model: mi,
+            output: m,
+            solid: &solids[mi],
+            bsp: &mut bsp,
+            planes: &mut planes,
+            node_faces: &node_faces,
+            leaf_faces: &leaf_faces,
+            leaf_index: HashMap::new(),
+        };
+        let (mut head, _) = w.node(0);
+        if head < 0 {
+            // Engines start at a node: give a one-leaf model a node with the leaf on both sides.
+            let plane = w.planes.push(&Plane::new(Vec3::new(0.0, 0.0, 1.0), 0.0));
+            w.bsp.nodes.push(Node {
+                plane,
+                children: [head, head],
+                mins: m.bounds.mins.to_f32(),
+                maxs: m.bounds.maxs.to_f32(),
+                first_face: 0,
+                num_faces: 0,
+            });
+            head = (w.bsp.nodes.len() - 1) as i32;
+        }
+        if mi == 0 {
+            world_leaf_index = std::mem::take(&mut w.leaf_index);
+        }
+        let mut clip_heads = [contents::EMPTY; 2];
+        for (hull, tree) in m.hulls.iter().enumerate() {
+            clip_heads[hull] = emit_clipnodes(tree, &mut |id| planes.get(id), &mut bsp.clipnodes);
+        }
+        bsp.models.push(Model {
+            mins: m.bounds.mins.to_f32(),
+            maxs: m.bounds.maxs.to_f32(),
+            origin: [0.0; 3],
+            head_nodes: [head, clip_heads[0], clip_heads[1], 0],
+            vis_leafs: (bsp.leafs.len() - leaves_before) as i32,
+            first_face,
+            num_faces,
+        });
+    }
+    if bsp.clipnodes.is_empty() {
+        for m in &mut bsp.models {
+            m.head_nodes[3] = contents::EMPTY;
+        }
+    }
+
+    let mut used = Vec::with_capacity(textures.used_textures.len());
+    for &t in &textures.used_textures {
+        used.push(Some(
+            input
+                .wads
+                .miptex(&input.texture_names[t as usize], input.warnings),
+        ));
+    }
+    bsp.textures.textures = used;
+    bsp.texinfo = textures.out_infos;
+    bsp.planes = planes.planes;
+    bsp.set_entity_text(&write_entities(input.entities));
+
+    let portals = world_portal_file(&input.models[0], &world_leaf_index, bsp.models[0].vis_leafs);
+    Emitted {
+        bsp,
+        portals,
+        tjunction_vertices,
+    }
+}
+
+struct TreeWriter<'a, 'b> {
+    model: usize,
+    output: &'a ModelOutput,
+    solid: &'a [bool],
+    bsp: &'b mut Bsp,
+    planes: &'b mut PlaneTable<'a>,
+    node_faces: &'b HashMap<(usize, u32), (u32, u32)>,
+    leaf_faces: &'b HashMap<(usize, u32), Vec<u32>>,
+    /// Tree leaf to BSP leaf.
+    leaf_index: HashMap<u32, u32>,
+}
+
+impl TreeWriter<'_, '_> {
+    /// Write tree node `n`; returns its child value and bounds (empty for the solid leaf).
+    fn node(&mut self, n: u32) -> (i32, Bounds) {
+        let tree = &self.output.tree;
+        if self.solid[n as usize] {
+            return (-1, Bounds::EMPTY);
+        }
+        let node = &tree.nodes[n as usize];
+        let Some(plane) = node.plane else {
+            let bounds = self.output.portals.leaf_bounds(n);
+            // A sliver leaf whose portals were all too small to keep: fall back to the model's box.
+            let bounds = if bounds.is_empty() {
+                self.output.bounds
+            } else {
+                bounds
+            };
+            let marks = self.leaf_faces.get(&(self.model, n));
+            let first = self.bsp.marksurfaces.len() as u32;
+            self.bsp.marksurfaces.extend(marks.into_iter().flatten());
+            let index = self.bsp.leafs.len() as u32;
+            self.bsp.leafs.push(Leaf {
+                contents: node.contents,
+                vis_offset: -1,
+                mins: bounds.mins.to_f32(),
+                maxs: bounds.maxs.to_f32(),
+                first_marksurface: first,
+                num_marksurfaces: self.bsp.marksurfaces.len() as u32 - first,
+                ambient: [0; 4],
+            });
+            self.leaf_index.insert(n, index);
+            return (-(index as i32) - 1, bounds);
+        };
+        let index = self.bsp.nodes.len();
+        let (first_face, num_faces) = self
+            .node_faces
+            .get(&(self.model, n))
+            .copied()
+            .unwrap_or((0, 0));
+        self.bsp.nodes.push(Node {
+            plane: self.planes.get(plane),
+            children: [0, 0],
+            mins: [0.0; 3],
+            maxs: [0.0; 3],
+            first_face,
+            num_faces,
+        });
+        let (front, fb) = self.node(node.children[0]);
+        let (back, bb) = self.node(node.children[1]);
+        let bounds = fb.union(&bb);
+        let out = &mut self.bsp.nodes[index];
+        out.children = [front, back];
+        out.mins = bounds.mins.to_f32();
+        out.maxs = bounds.maxs.to_f32();
+        (index as i32, bounds)
+    }
+}
+
+/// The PRT1 file: portals between world leaves of the same contents, numbered from BSP leaf 1.
+fn world_portal_file(
+    world: &ModelOutput,
+    leaf_index: &HashMap<u32, u32>,
+    vis_leafs: i32,
+) -> PortalFile {
+    let mut portals = Vec::new();
+    for p in &world.portals.portals {
+        let (Some(&a), Some(&b)) = (leaf_index.get(&p.nodes[0]), leaf_index.get(&p.nodes[1]))
+        else {
+            continue;
+        };
+        let tree = &world.tree.nodes;
+        if tree[p.nodes[0] as usize].contents != tree[p.nodes[1] as usize].contents {
+            continue;
+        }
+        portals.push(PrtPortal {
+            leafs: [a - 1, b - 1],
+            winding: p.winding.clone(),
+        });
+    }
+    PortalFile {
+        num_leafs: vis_leafs.max(0) as u32,
+        portals,
+    }
+}

@@ -1,0 +1,341 @@
+//! Faces: made from the portals where leaf contents change, textured from the brush side lying
+//! on the portal, then merged (coplanar, same texinfo) and subdivided for lightmaps.
+
+use crate::planes::PlaneId;
+use crate::portals::Portals;
+use crate::texinfo::TextureRole;
+use crate::tree::{Tree, TreeNode, contents_priority};
+use quake_formats::bsp::contents;
+use quake_formats::bsp::limits::MAX_SURFACE_EXTENT;
+use quake_formats::extents::LightmapExtents;
+use quake_formats::geom::{ON_EPSILON, POINT_EPSILON, Plane, Split, Vec3, Winding};
+
+/// A face of one model, before vertices and edges are shared.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelFace {
+    /// The tree node whose plane the face lies on.
+    pub node: u32,
+    pub plane: PlaneId,
+    /// Faces the back of the plane.
+    pub back: bool,
+    /// Map texinfo index.
+    pub texinfo: u32,
+    /// Clockwise seen from the side the face is looked at from.
+    pub winding: Winding,
+    /// Tree leaves the face can be seen from.
+    pub leaves: Vec<u32>,
+}
+
+/// What face making needs to know about a map texinfo.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FaceTexInfo {
+    pub vecs: [[f64; 4]; 2],
+    pub role: TextureRole,
+}
+
+/// Face counts for the summary.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+pub struct FaceStats {
+    pub from_portals: usize,
+    /// Portal faces whose texture had to be guessed (no brush side found on the portal).
+    pub untextured: usize,
+    pub after_merge: usize,
+    pub after_subdivide: usize,
+}
+
+fn can_look_out(c: i32) -> bool {
+    matches!(
+        c,
+        contents::EMPTY | contents::WATER | contents::SLIME | contents::LAVA
+    )
+}
+
+/// The texinfo of the side of `leaf`'s brushes on `plane` facing out of it (`flipped` as in
+/// [`crate::brush::Side`]).
+fn side_texinfo(leaf: &TreeNode, plane: PlaneId, flipped: bool) -> Option<u32> {
+    let sides = || leaf.brushes.iter().flat_map(|b| b.sides.iter());
+    sides()
+        .find(|s| s.plane == plane && s.flipped == flipped && s.texinfo.is_some())
+        .or_else(|| sides().find(|s| s.plane == plane && s.texinfo.is_some()))
+        .or_else(|| sides().find(|s| s.texinfo.is_some()))
+        .and_then(|s| s.texinfo)
+}
+
+/// Faces on every portal between leaves of different contents, seen from each side that is not
+/// solid, textured by the stronger side's brushes.
+pub fn faces_from_portals(
+    tree: &Tree,
+    portals: &Portals,
+    texinfos: &[FaceTexInfo],
+    stats: &mut FaceStats,
+) -> Vec<ModelFace> {
+    let mut faces = Vec::new();
+    for p in &portals.portals {
+        let (Some(node), Some(plane)) = (p.on_node, p.plane_id) else {
+            continue;
+        };
+        let [a, b] = p.nodes;
+        if a == portals.outside || b == portals.outside {
+            continue;
+        }
+        let (ca, cb) = (
+            tree.nodes[a as usize].contents,
+            tree.nodes[b as usize].contents,
+        );
+        if contents_priority(ca) == contents_priority(cb) {
+            continue;
+        }
+        let owner_is_front = contents_priority(ca) > contents_priority(cb);
+        let owner = if owner_is_front { a } else { b };
+        let owner_node = &tree.nodes[owner as usize];
+        // The owner's side looks out of it: backwards along the plane when it is in front.
+        let exact = owner_node
+            .brushes
+            .iter()
+            .flat_map(|br| br.sides.iter())
+            .any(|s| s.plane == plane && s.flipped == owner_is_front && s.texinfo.is_some());
+        let Some(texinfo) = side_texinfo(owner_node, plane, owner_is_front) else {
+            continue;
+        };
+        if !texinfos[texinfo as usize].role.is_drawn() {
+            continue;
+        }
+        for (viewer, front) in [(a, true), (b, false)] {
+            if !can_look_out(tree.nodes[viewer as usize].contents) {
+                continue;
+            }
+            stats.from_portals += 1;
+            stats.untextured += usize::from(!exact);
+            faces.push(ModelFace {
+                node,
+                plane,
+                back: !front,
+                texinfo,
+                winding: if front {
+                    p.winding.clone()
+                } else {
+                    p.winding.reversed()
+                },
+                leaves: vec![viewer],
+            });
+        }
+    }
+    faces
+}
+
+/// The two polygons joined along a shared edge, if the result is convex.
+fn try_merge(a: &Winding, b: &Winding, normal: Vec3) -> Option<Winding> {
+    let (n, m) = (a.len(), b.len());
+    let mut shared = None;
+    'outer: for i in 0..n {
+        let (p1, p2) = (a.points[i], a.points[(i + 1) % n]);
+        for j in 0..m {
+            if b.points[j].near(p2, POINT_EPSILON) && b.points[(j + 1) % m].near(p1, POINT_EPSILON)
+            {
+                shared = Some((i, j));
+                break 'outer;
+            }
+        }
+    }
+    let (i, j) = shared?;
+    let mut points: Vec<Vec3> = (1..=n).map(|k| a.points[(i + k) % n]).collect();
+    points.extend((2..m).map(|k| b.points[(j + k) % m]));
+    simplify_convex(points, normal)
+}
+
+/// Drop collinear points; `None` if the polygon is not convex (clockwise about `normal`).
+fn simplify_convex(mut points: Vec<Vec3>, normal: Vec3) -> Option<Winding> {
+    let mut k = 0;
+    while k < points.len() && points.len() >= 3 {
+        let len = points.len();
+        let prev = points[(k + len - 1) % len];
+        let cur = points[k];
+        let next = points[(k + 1) % len];
+        let Some(dir) = (next - prev).normalized() else {
+            points.remove(k);
+            continue;
+        };
+        let off = (cur - prev) - dir * (cur - prev).dot(dir);
+        if off.length() < ON_EPSILON {
+            points.remove(k);
+            continue;
+        }
+        if (cur - prev).cross(next - cur).dot(normal) > 0.0 {
+            return None;
+        }
+        k += 1;
+    }
+    (points.len() >= 3).then(|| Winding::new(points))
+}
+
+/// Merge faces that share a node, side and texinfo wherever the union stays convex.
+pub fn merge_faces(
+    mut faces: Vec<ModelFace>,
+    plane_of: impl Fn(&ModelFace) -> Plane,
+) -> Vec<ModelFace> {
+    faces.sort_by_key(|f| (f.node, f.back, f.texinfo));
+    let mut out: Vec<ModelFace> = Vec::with_capacity(faces.len());
+    let mut start = 0;
+    while start < faces.len() {
+        let key = (faces[start].node, faces[start].back, faces[start].texinfo);
+        let end = start
+            + faces[start..]
+                .iter()
+                .take_while(|f| (f.node, f.back, f.texinfo) == key)
+                .count();
+        let mut group: Vec<ModelFace> = faces[start..end].to_vec();
+        let normal = plane_of(&group[0]).normal * if key.1 { -1.0 } else { 1.0 };
+        loop {
+            let mut merged_any = false;
+            let mut i = 0;
+            while i < group.len() {
+                let mut j = i + 1;
+                while j < group.len() {
+                    let touching = group[i]
+                        .winding
+                        .bounds()
+                        .intersects(&group[j].winding.bounds());
+                    if touching
+                        && let Some(w) = try_merge(&group[i].winding, &group[j].winding, normal)
+                    {
+                        let other = group.remove(j);
+                        group[i].winding = w;
+                        group[i].leaves.extend(other.leaves);
+                        group[i].leaves.sort_unstable();
+                        group[i].leaves.dedup();
+                        merged_any = true;
+                        j = i + 1;
+                    } else {
+                        j += 1;
+                    }
+                }
+                i += 1;
+            }
+            if !merged_any {
+                break;
+            }
+        }
+        out.extend(group);
+        start = end;
+    }
+    out
+}
+
+fn f32_vecs(vecs: &[[f64; 4]; 2]) -> [[f32; 4]; 2] {
+    vecs.map(|row| row.map(|c| c as f32))
+}
+
+/// Lightmap extents of a winding as engines will compute them from the written file.
+pub fn winding_extents(w: &Winding, vecs: &[[f64; 4]; 2]) -> LightmapExtents {
+    let points: Vec<[f32; 3]> = w.points.iter().map(|p| p.to_f32()).collect();
+    LightmapExtents::from_points(&points, &f32_vecs(vecs))
+}
+
+/// Cut a lit face so each piece spans at most `size` texels along s and t, and its lightmap
+/// extents stay within the engine limit.
+pub fn subdivide(w: Winding, vecs: &[[f64; 4]; 2], size: f64, out: &mut Vec<Winding>) {
+    let within = |w: &Winding| {
+        let e = winding_extents(w, vecs);
+        e.extents[0] <= MAX_SURFACE_EXTENT && e.extents[1] <= MAX_SURFACE_EXTENT
+    };
+    let mut pending = vec![(w, size)];
+    let mut pieces = Vec::new();
+    while let Some((w, size)) = pending.pop() {
+        match cut_once(&w, vecs, size) {
+            Some((back, front)) => {
+                pending.push((front, size));
+                pending.push((back, size));
+            }
+            // Rounding pushed the extents over the limit: cut this piece smaller.
+            None if !within(&w) && size > 32.0 => pending.push((w, size - 16.0)),
+            None => pieces.push(w),
+        }
+    }
+    out.extend(pieces);
+}
+
+/// One cut along s or t, `size - 16` texels past the minimum (leaving room for the 16-texel
+/// grid rounding), or `None` when the winding is small enough.
+fn cut_once(w: &Winding, vecs: &[[f64; 4]; 2], size: f64) -> Option<(Winding, Winding)> {
+    for row in vecs {
+        let axis = Vec3::new(row[0], row[1], row[2]);
+        let len = axis.length();
+        if len == 0.0 {
+            continue;
+        }
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for p in &w.points {
+            let s = p.dot(axis);
+            lo = lo.min(s);
+            hi = hi.max(s);
+        }
+        if hi - lo <= size {
+            continue;
+        }
+        let plane = Plane::new(axis / len, (lo + size - 16.0) / len);
+        if let Split::Both { front, back } = w.split(&plane) {
+            return Some((back, front));
+        }
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square(x0: f64, y0: f64, size: f64) -> Winding {
+        // Clockwise seen from +Z.
+        Winding::new(vec![
+            Vec3::new(x0, y0, 0.0),
+            Vec3::new(x0, y0 + size, 0.0),
+            Vec3::new(x0 + size, y0 + size, 0.0),
+            Vec3::new(x0 + size, y0, 0.0),
+        ])
+    }
+
+    const UP: Vec3 = Vec3::new(0.0, 0.0, 1.0);
+
+    #[test]
+    fn adjacent_squares_merge_into_a_rectangle() {
+        let w = try_merge(&square(0.0, 0.0, 64.0), &square(64.0, 0.0, 64.0), UP).expect("merge");
+        assert_eq!(w.len(), 4);
+        assert!((w.area() - 2.0 * 64.0 * 64.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn l_shapes_do_not_merge() {
+        let big = square(0.0, 0.0, 64.0);
+        let small = Winding::new(vec![
+            Vec3::new(64.0, 0.0, 0.0),
+            Vec3::new(64.0, 32.0, 0.0),
+            Vec3::new(96.0, 32.0, 0.0),
+            Vec3::new(96.0, 0.0, 0.0),
+        ]);
+        // They share only part of an edge: no common edge, no merge.
+        assert!(try_merge(&big, &small, UP).is_none());
+    }
+
+    #[test]
+    fn subdivision_keeps_extents_within_limits() {
+        let vecs = [[1.0, 0.0, 0.0, 0.0], [0.0, -1.0, 0.0, 0.0]];
+        let mut out = Vec::new();
+        subdivide(square(-8.0, 3.0, 1000.0), &vecs, 240.0, &mut out);
+        assert!(out.len() >= 25);
+        let area: f64 = out.iter().map(Winding::area).sum();
+        assert!((area - 1000.0 * 1000.0).abs() < 1e-3);
+        for w in &out {
+            let e = winding_extents(w, &vecs);
+            assert!(e.extents[0] <= MAX_SURFACE_EXTENT && e.extents[1] <= MAX_SURFACE_EXTENT);
+        }
+        // Scaled textures are cut in texture space.
+        let mut out = Vec::new();
+        subdivide(
+            square(0.0, 0.0, 128.0),
+            &[[4.0, 0.0, 0.0, 0.0], [0.0, -4.0, 0.0, 0.0]],
+            240.0,
+            &mut out,
+        );
+        assert!(out.len() >= 9);
+    }
+}

@@ -1,0 +1,22 @@
+use bsp_compiler::cli::{Args, run};
+use clap::Parser;
+use std::process::ExitCode;
+
+/// Compile a Quake .map into a BSP (BSP29 or BSP2) and its .prt portal file.
+#[derive(Parser)]
+#[command(name = "slipgate-bsp", version)]
+struct Cli {
+    #[command(flatten)]
+    args: Args,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(&cli.args) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

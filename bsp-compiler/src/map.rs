@@ -1,0 +1,409 @@
+//! `.map` parsing: the standard Quake format and Valve 220, into entities with brushes.
+//!
+//! Syntax errors name the file, line and column plus the entity and brush being read. Brush
+//! geometry is not checked here (see [`crate::brush`]).
+
+use crate::texinfo::Projection;
+use quake_formats::entities::Entity;
+use quake_formats::geom::{Plane, Vec3};
+use std::path::{Path, PathBuf};
+
+/// A syntax error in a `.map` file.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{}:{line}:{column}: {message} (entity {entity}{})", file.display(), brush.map(|b| format!(", brush {b}")).unwrap_or_default())]
+pub struct MapError {
+    pub file: PathBuf,
+    pub line: usize,
+    pub column: usize,
+    pub entity: usize,
+    pub brush: Option<usize>,
+    pub message: String,
+}
+
+/// One brush face as written: three points, a texture name and its projection.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MapFace {
+    pub points: [Vec3; 3],
+    pub texture: String,
+    pub projection: Projection,
+    pub line: usize,
+}
+
+impl MapFace {
+    /// The face's plane (outward facing), snapped; `None` when the points are collinear.
+    pub fn plane(&self) -> Option<Plane> {
+        let [a, b, c] = self.points;
+        Plane::from_points(a, b, c).map(|p| p.snapped())
+    }
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct MapBrush {
+    pub faces: Vec<MapFace>,
+    pub line: usize,
+}
+
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct MapEntity {
+    pub entity: Entity,
+    pub brushes: Vec<MapBrush>,
+    pub line: usize,
+}
+
+/// A parsed `.map` file.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct MapFile {
+    pub entities: Vec<MapEntity>,
+}
+
+/// Parse `text`; `file` is only used in error messages.
+pub fn parse_map(file: &Path, text: &str) -> Result<MapFile, MapError> {
+    let mut p = Parser {
+        lex: Lexer::new(text),
+        file,
+        entity: 0,
+        brush: None,
+    };
+    let mut entities = Vec::new();
+    loop {
+        p.lex.skip_blank();
+        if p.lex.at_end() {
+            break;
+        }
+        p.entity = entities.len();
+        p.brush = None;
+        entities.push(p.entity_block()?);
+    }
+    Ok(MapFile { entities })
+}
+
+struct Lexer<'a> {
+    text: &'a [u8],
+    pos: usize,
+    line: usize,
+    line_start: usize,
+}
+
+impl<'a> Lexer<'a> {
+    fn new(text: &'a str) -> Self {
+        Lexer {
+            text: text.as_bytes(),
+            pos: 0,
+            line: 1,
+            line_start: 0,
+        }
+    }
+
+    fn at_end(&self) -> bool {
+        self.pos >= self.text.len()
+    }
+
+    fn column(&self) -> usize {
+        self.pos - self.line_start + 1
+    }
+
+    fn bump(&mut self) -> Option<u8> {
+        let c = *self.text.get(self.pos)?;
+        self.pos += 1;
+        if c == b'\n' {
+            self.line += 1;
+            self.line_start = self.pos;
+        }
+        Some(c)
+    }
+
+    /// Skip whitespace (CR and LF alike) and `//` comments.
+    fn skip_blank(&mut self) {
+        while let Some(&c) = self.text.get(self.pos) {
+            if c.is_ascii_whitespace() {
+                self.bump();
+            } else if c == b'/' && self.text.get(self.pos + 1) == Some(&b'/') {
+                while let Some(c) = self.bump() {
+                    if c == b'\n' {
+                        break;
+                    }
+                }
+            } else {
+                break;
+            }
+        }
+    }
+
+    fn peek(&mut self) -> Option<u8> {
+        self.skip_blank();
+        self.text.get(self.pos).copied()
+    }
+
+    /// A run of non-blank bytes; `stop_at_brackets` also ends it at `( ) [ ] { }`.
+    fn word(&mut self, stop_at_brackets: bool) -> &'a str {
+        self.skip_blank();
+        let start = self.pos;
+        while let Some(&c) = self.text.get(self.pos) {
+            if c.is_ascii_whitespace() || (stop_at_brackets && b"()[]{}\"".contains(&c)) {
+                break;
+            }
+            self.pos += 1;
+        }
+        // Bytes come from a &str and we only stop at ASCII, so this is valid UTF-8.
+        std::str::from_utf8(&self.text[start..self.pos]).unwrap_or("")
+    }
+}
+
+struct Parser<'a> {
+    lex: Lexer<'a>,
+    file: &'a Path,
+    entity: usize,
+    brush: Option<usize>,
+}
+
+impl Parser<'_> {
+    fn error(&self, message: impl Into<String>) -> MapError {
+        MapError {
+            file: self.file.to_path_buf(),
+            line: self.lex.line,
+            column: self.lex.column(),
+            entity: self.entity,
+            brush: self.brush,
+            message: message.into(),
+        }
+    }
+
+    fn expect(&mut self, c: u8) -> Result<(), MapError> {
+        match self.lex.peek() {
+            Some(found) if found == c => {
+                self.lex.bump();
+                Ok(())
+            }
+            Some(found) => Err(self.error(format!(
+                "expected '{}', found '{}'",
+                c as char, found as char
+            ))),
+            None => Err(self.error(format!(
+                "expected '{}', found the end of the file",
+                c as char
+            ))),
+        }
+    }
+
+    fn number(&mut self) -> Result<f64, MapError> {
+        self.lex.skip_blank();
+        let (line, column) = (self.lex.line, self.lex.column());
+        let word = self.lex.word(true);
+        match word.parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            _ => {
+                let mut e = self.error(if word.is_empty() {
+                    "expected a number".to_string()
+                } else {
+                    format!("expected a number, found {word:?}")
+                });
+                e.line = line;
+                e.column = column;
+                Err(e)
+            }
+        }
+    }
+
+    fn quoted(&mut self) -> Result<String, MapError> {
+        self.expect(b'"')?;
+        let start = self.lex.pos;
+        loop {
+            match self.lex.bump() {
+                Some(b'"') => break,
+                Some(_) => {}
+                None => return Err(self.error("unterminated string")),
+            }
+        }
+        Ok(String::from_utf8_lossy(&self.lex.text[start..self.lex.pos - 1]).into_owned())
+    }
+
+    fn entity_block(&mut self) -> Result<MapEntity, MapError> {
+        let line = self.lex.line;
+        self.expect(b'{')?;
+        let mut entity = MapEntity {
+            line,
+            ..MapEntity::default()
+        };
+        loop {
+            match self.lex.peek() {
+                Some(b'"') => {
+                    let key = self.quoted()?;
+                    let value = self.quoted()?;
+                    entity.entity.pairs.push((key, value));
+                }
+                Some(b'{') => {
+                    self.brush = Some(entity.brushes.len());
+                    entity.brushes.push(self.brush_block()?);
+                    self.brush = None;
+                }
+                Some(b'}') => {
+                    self.lex.bump();
+                    return Ok(entity);
+                }
+                Some(_) => {
+                    let word = self.lex.word(true).to_string();
+                    return Err(self.error(format!(
+                        "expected a \"key\", a brush or '}}', found {word:?}"
+                    )));
+                }
+                None => return Err(self.error("the file ends inside an entity")),
+            }
+        }
+    }
+
+    fn brush_block(&mut self) -> Result<MapBrush, MapError> {
+        let line = self.lex.line;
+        self.expect(b'{')?;
+        let mut faces = Vec::new();
+        loop {
+            match self.lex.peek() {
+                Some(b'(') => faces.push(self.face()?),
+                Some(b'}') => {
+                    self.lex.bump();
+                    return Ok(MapBrush { faces, line });
+                }
+                Some(_) => {
+                    let word = self.lex.word(true).to_string();
+                    return Err(self.error(format!(
+                        "expected a brush face '(' or '}}', found {word:?} (only Quake and Valve 220 brushes are supported)"
+                    )));
+                }
+                None => return Err(self.error("the file ends inside a brush")),
+            }
+        }
+    }
+
+    fn point(&mut self) -> Result<Vec3, MapError> {
+        self.expect(b'(')?;
+        let p = Vec3::new(self.number()?, self.number()?, self.number()?);
+        self.expect(b')')?;
+        Ok(p)
+    }
+
+    fn axis(&mut self) -> Result<[f64; 4], MapError> {
+        self.expect(b'[')?;
+        let v = [
+            self.number()?,
+            self.number()?,
+            self.number()?,
+            self.number()?,
+        ];
+        self.expect(b']')?;
+        Ok(v)
+    }
+
+    fn face(&mut self) -> Result<MapFace, MapError> {
+        let line = self.lex.line;
+        let points = [self.point()?, self.point()?, self.point()?];
+        let texture = match self.lex.peek() {
+            Some(b'"') => self.quoted()?,
+            _ => self.lex.word(false).to_string(),
+        };
+        if texture.is_empty() {
+            return Err(self.error("expected a texture name"));
+        }
+        let projection = if self.lex.peek() == Some(b'[') {
+            let u = self.axis()?;
+            let v = self.axis()?;
+            let _rotation = self.number()?;
+            let scale = [self.number()?, self.number()?];
+            Projection::Valve { u, v, scale }
+        } else {
+            let shift = [self.number()?, self.number()?];
+            let rotation = self.number()?;
+            let scale = [self.number()?, self.number()?];
+            Projection::Standard {
+                shift,
+                rotation,
+                scale,
+            }
+        };
+        // Quake 2/3-style surface flags and values may follow on the same line: ignore them.
+        while self
+            .lex
+            .peek()
+            .is_some_and(|c| c == b'-' || c == b'+' || c == b'.' || c.is_ascii_digit())
+            && self.lex.line == line
+        {
+            self.number()?;
+        }
+        Ok(MapFace {
+            points,
+            texture,
+            projection,
+            line,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<MapFile, MapError> {
+        parse_map(Path::new("t.map"), text)
+    }
+
+    #[test]
+    fn standard_format_with_comments_and_crlf() {
+        let text = "// a comment\r\n{\r\n\"classname\" \"worldspawn\"\r\n{\r\n( 0 0 0 ) ( 0 1 0 ) ( 1 0 0 ) +0floor 16 -8 90 0.5 2 // trailing\r\n}\r\n}\r\n";
+        let map = parse(text).expect("parse");
+        assert_eq!(map.entities.len(), 1);
+        let face = &map.entities[0].brushes[0].faces[0];
+        assert_eq!(face.texture, "+0floor");
+        assert_eq!(face.line, 5);
+        assert_eq!(
+            face.projection,
+            Projection::Standard {
+                shift: [16.0, -8.0],
+                rotation: 90.0,
+                scale: [0.5, 2.0]
+            }
+        );
+    }
+
+    #[test]
+    fn valve_format_and_scientific_floats() {
+        let text = "{\n\"mapversion\" \"220\"\n{\n( 1e1 0 0 ) ( 0 -1.5E+1 0 ) ( .5 0 1 ) {fence [ 1 0 0 -16 ] [ 0 0 -1 0 ] 0 1 1\n}\n}";
+        let map = parse(text).expect("parse");
+        let face = &map.entities[0].brushes[0].faces[0];
+        assert_eq!(face.points[0].x, 10.0);
+        assert_eq!(face.points[1].y, -15.0);
+        assert_eq!(face.points[2].x, 0.5);
+        assert_eq!(face.texture, "{fence");
+        assert!(matches!(face.projection, Projection::Valve { .. }));
+    }
+
+    #[test]
+    fn ignores_quake2_style_surface_values() {
+        let text = "{\n{\n( 0 0 0 ) ( 0 1 0 ) ( 1 0 0 ) a 0 0 0 1 1 0 0 0\n( 0 0 0 ) ( 0 1 0 ) ( 1 0 0 ) b 0 0 0 1 1\n}\n}";
+        let map = parse(text).expect("parse");
+        assert_eq!(map.entities[0].brushes[0].faces.len(), 2);
+    }
+
+    #[test]
+    fn errors_name_line_column_entity_and_brush() {
+        let text = "{\n\"classname\" \"worldspawn\"\n}\n{\n\"classname\" \"func_door\"\n{\n( 0 0 0 ) ( 0 1 0 ) ( 1 0 x ) a 0 0 0 1 1\n}\n}\n";
+        let err = parse(text).expect_err("bad number");
+        assert_eq!((err.line, err.column), (7, 27));
+        assert_eq!((err.entity, err.brush), (1, Some(0)));
+        let msg = err.to_string();
+        assert!(msg.starts_with("t.map:7:27:"), "{msg}");
+        assert!(msg.contains("entity 1, brush 0"), "{msg}");
+    }
+
+    #[test]
+    fn unterminated_entity_is_an_error() {
+        let err = parse("{\n\"classname\" \"worldspawn\"\n").expect_err("eof");
+        assert!(err.message.contains("ends inside an entity"));
+        let err = parse("{ \"a\" \"b\" }\n}").expect_err("stray brace");
+        assert_eq!(err.entity, 1);
+    }
+
+    #[test]
+    fn nan_is_not_a_number() {
+        let err =
+            parse("{\n{\n( nan 0 0 ) ( 0 1 0 ) ( 1 0 0 ) a 0 0 0 1 1\n}\n}").expect_err("nan");
+        assert!(err.message.contains("expected a number"));
+    }
+}

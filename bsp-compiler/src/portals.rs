@@ -1,0 +1,265 @@
+//! Portals: the polygons where two leaves of a tree touch, found by cutting each node's plane
+//! polygon by the portals already bounding the node and then splitting those by the node plane.
+//! A box of six portals around the whole tree joins it to an "outside" leaf.
+
+use crate::planes::{PlaneId, PlaneSet};
+use crate::tree::Tree;
+use quake_formats::geom::{Bounds, Plane, Split, Vec3, Winding};
+
+/// Space left between the map and the outside box.
+const OUTSIDE_MARGIN: f64 = 8.0;
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Portal {
+    /// Faces `nodes[0]`.
+    pub plane: Plane,
+    /// The node whose plane the portal lies on (`None` for the outside box); its front child side
+    /// is `nodes[0]`.
+    pub on_node: Option<u32>,
+    pub plane_id: Option<PlaneId>,
+    pub winding: Winding,
+    /// Tree node indices; `Portals::outside` is the outside leaf.
+    pub nodes: [u32; 2],
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Portals {
+    /// Live portals only (every portal separates two leaves).
+    pub portals: Vec<Portal>,
+    /// Portal indices touching each tree node (leaves only), plus the outside leaf last.
+    pub leaf_portals: Vec<Vec<u32>>,
+    /// Index of the outside leaf (one past the tree's nodes).
+    pub outside: u32,
+}
+
+impl Portals {
+    /// The leaf on the other side of portal `p` from `leaf`.
+    pub fn other(&self, p: u32, leaf: u32) -> u32 {
+        let nodes = self.portals[p as usize].nodes;
+        if nodes[0] == leaf { nodes[1] } else { nodes[0] }
+    }
+
+    /// The bounds of a leaf's region: the union of its portals.
+    pub fn leaf_bounds(&self, leaf: u32) -> Bounds {
+        let mut b = Bounds::EMPTY;
+        for &p in &self.leaf_portals[leaf as usize] {
+            b = b.union(&self.portals[p as usize].winding.bounds());
+        }
+        b
+    }
+}
+
+/// Portalize `tree`, whose contents lie within `bounds`.
+pub fn make_portals(tree: &Tree, planes: &PlaneSet, bounds: &Bounds) -> Portals {
+    let outside = tree.nodes.len() as u32;
+    let mut b = Builder {
+        portals: Vec::new(),
+        node_portals: vec![Vec::new(); tree.nodes.len() + 1],
+    };
+    let box_planes = b.outside_box(bounds, outside);
+    // The half-spaces bounding each node: the outside box, then the planes above it.
+    let mut bounding: Vec<Vec<Plane>> = vec![Vec::new(); tree.nodes.len()];
+    bounding[0] = box_planes;
+    let mut stack = vec![0u32];
+    while let Some(node) = stack.pop() {
+        let n = &tree.nodes[node as usize];
+        let Some(plane_id) = n.plane else { continue };
+        let plane = *planes.get(plane_id);
+        let above = std::mem::take(&mut bounding[node as usize]);
+        b.make_node_portal(node, plane_id, &plane, n.children, &above);
+        let mut front = above.clone();
+        front.push(plane);
+        let mut back = above;
+        back.push(plane.flipped());
+        bounding[n.children[0] as usize] = front;
+        bounding[n.children[1] as usize] = back;
+        b.split_node_portals(node, &plane, n.children);
+        stack.push(n.children[1]);
+        stack.push(n.children[0]);
+    }
+    // Compact: drop dead portals and renumber.
+    let mut new_index = vec![u32::MAX; b.portals.len()];
+    let mut portals = Vec::new();
+    for (i, p) in b.portals.into_iter().enumerate() {
+        if !p.winding.is_empty() {
+            new_index[i] = portals.len() as u32;
+            portals.push(p);
+        }
+    }
+    let leaf_portals = b
+        .node_portals
+        .into_iter()
+        .map(|list| {
+            list.into_iter()
+                .map(|p| new_index[p as usize])
+                .filter(|&p| p != u32::MAX)
+                .collect()
+        })
+        .collect();
+    Portals {
+        portals,
+        leaf_portals,
+        outside,
+    }
+}
+
+struct Builder {
+    portals: Vec<Portal>,
+    node_portals: Vec<Vec<u32>>,
+}
+
+impl Builder {
+    fn add(&mut self, portal: Portal) {
+        let id = self.portals.len() as u32;
+        self.node_portals[portal.nodes[0] as usize].push(id);
+        self.node_portals[portal.nodes[1] as usize].push(id);
+        self.portals.push(portal);
+    }
+
+    /// The six portals to the outside leaf; returns their (inward-facing) planes.
+    fn outside_box(&mut self, bounds: &Bounds, outside: u32) -> Vec<Plane> {
+        let mins = bounds.mins - Vec3::new(OUTSIDE_MARGIN, OUTSIDE_MARGIN, OUTSIDE_MARGIN);
+        let maxs = bounds.maxs + Vec3::new(OUTSIDE_MARGIN, OUTSIDE_MARGIN, OUTSIDE_MARGIN);
+        let mut box_planes = Vec::new();
+        for axis in 0..3 {
+            let mut n = Vec3::ZERO;
+            n[axis] = 1.0;
+            // Facing inwards, so the tree (node 0) is in front.
+            box_planes.push(Plane::new(n, mins[axis]));
+            box_planes.push(Plane::new(-n, -maxs[axis]));
+        }
+        for (i, plane) in box_planes.iter().enumerate() {
+            let mut w = Some(Winding::base_for_plane(plane));
+            for (j, other) in box_planes.iter().enumerate() {
+                if i != j {
+                    w = w.and_then(|w| w.clip_front(other, false));
+                }
+            }
+            if let Some(w) = w {
+                self.add(Portal {
+                    plane: *plane,
+                    on_node: None,
+                    plane_id: None,
+                    winding: w,
+                    nodes: [0, outside],
+                });
+            }
+        }
+        box_planes
+    }
+
+    fn make_node_portal(
+        &mut self,
+        node: u32,
+        plane_id: PlaneId,
+        plane: &Plane,
+        children: [u32; 2],
+        above: &[Plane],
+    ) {
+        let mut w = Some(Winding::base_for_plane(plane));
+        for keep in above {
+            w = w.and_then(|w| w.clip_front(keep, false));
+        }
+        for &pid in &self.node_portals[node as usize] {
+            let p = &self.portals[pid as usize];
+            let keep = if p.nodes[0] == node {
+                p.plane
+            } else {
+                p.plane.flipped()
+            };
+            w = w.and_then(|w| w.clip_front(&keep, false));
+        }
+        if let Some(w) = w.filter(|w| !w.is_tiny()) {
+            self.add(Portal {
+                plane: *plane,
+                on_node: Some(node),
+                plane_id: Some(plane_id),
+                winding: w,
+                nodes: children,
+            });
+        }
+    }
+
+    fn split_node_portals(&mut self, node: u32, plane: &Plane, children: [u32; 2]) {
+        let list = std::mem::take(&mut self.node_portals[node as usize]);
+        for pid in list {
+            let p = &self.portals[pid as usize];
+            let side = usize::from(p.nodes[0] != node);
+            let other = p.nodes[1 - side];
+            self.node_portals[other as usize].retain(|&x| x != pid);
+            let (front, back) = match p.winding.split(plane) {
+                Split::Front(w) => (Some(w), None),
+                Split::Back(w) => (None, Some(w)),
+                Split::Both { front, back } => (
+                    Some(front).filter(|w| !w.is_tiny()),
+                    Some(back).filter(|w| !w.is_tiny()),
+                ),
+                Split::On { .. } => (None, None),
+            };
+            let place = |this: &mut Builder, w: Winding, child: u32, reuse: bool| {
+                let mut portal = this.portals[pid as usize].clone();
+                portal.winding = w;
+                portal.nodes[side] = child;
+                if reuse {
+                    this.portals[pid as usize] = portal;
+                    this.node_portals[child as usize].push(pid);
+                    this.node_portals[other as usize].push(pid);
+                } else {
+                    this.add(portal);
+                }
+            };
+            match (front, back) {
+                (None, None) => self.portals[pid as usize].winding = Winding::default(),
+                (Some(f), None) => place(self, f, children[0], true),
+                (None, Some(b)) => place(self, b, children[1], true),
+                (Some(f), Some(b)) => {
+                    place(self, f, children[0], true);
+                    place(self, b, children[1], false);
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::brush::Brush;
+    use crate::brush::tests::box_planes;
+    use crate::tree::{SplitHeuristic, build_tree};
+    use quake_formats::bsp::contents;
+
+    #[test]
+    fn portals_of_a_single_box_close_every_leaf() {
+        let mut planes = PlaneSet::new();
+        let b = Brush::from_planes(
+            &box_planes(Vec3::ZERO, Vec3::new(64.0, 64.0, 64.0)),
+            &mut planes,
+            contents::SOLID,
+            0,
+        )
+        .expect("brush");
+        let bounds = b.bounds;
+        let tree = build_tree(vec![b], &planes, SplitHeuristic::FewestSplits, true);
+        let portals = make_portals(&tree, &planes, &bounds);
+        // The solid leaf is enclosed by six portals, each a 64x64 square.
+        let solid = tree
+            .nodes
+            .iter()
+            .position(|n| n.is_leaf() && n.contents == contents::SOLID)
+            .expect("solid leaf") as u32;
+        let around = &portals.leaf_portals[solid as usize];
+        assert_eq!(around.len(), 6);
+        let area: f64 = around
+            .iter()
+            .map(|&p| portals.portals[p as usize].winding.area())
+            .sum();
+        assert!((area - 6.0 * 64.0 * 64.0).abs() < 1e-6, "{area}");
+        assert_eq!(portals.leaf_bounds(solid).maxs, Vec3::new(64.0, 64.0, 64.0));
+        // Every portal's plane faces its first node.
+        for p in &portals.portals {
+            let own = p.winding.plane().expect("plane");
+            assert!(own.normal.dot(p.plane.normal) > 0.99);
+        }
+    }
+}

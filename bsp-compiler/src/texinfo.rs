@@ -1,0 +1,249 @@
+//! Texture projections of both `.map` formats, and what a texture name means to the compiler.
+
+use quake_formats::bsp::contents;
+use quake_formats::geom::{Plane, Vec3};
+
+/// How a face's texture is projected, as written in the `.map` file.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Projection {
+    /// Quake's format: axes picked from the face normal, then rotated, scaled and shifted.
+    Standard {
+        shift: [f64; 2],
+        rotation: f64,
+        scale: [f64; 2],
+    },
+    /// Valve 220: explicit axes with offsets, then scaled.
+    Valve {
+        u: [f64; 4],
+        v: [f64; 4],
+        scale: [f64; 2],
+    },
+}
+
+/// For each of the six base directions: the normal it matches, then the s and t axes.
+const BASE_AXES: [[Vec3; 3]; 6] = [
+    [
+        Vec3::new(0.0, 0.0, 1.0),
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.0, -1.0, 0.0),
+    ],
+    [
+        Vec3::new(0.0, 0.0, -1.0),
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.0, -1.0, 0.0),
+    ],
+    [
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.0, 1.0, 0.0),
+        Vec3::new(0.0, 0.0, -1.0),
+    ],
+    [
+        Vec3::new(-1.0, 0.0, 0.0),
+        Vec3::new(0.0, 1.0, 0.0),
+        Vec3::new(0.0, 0.0, -1.0),
+    ],
+    [
+        Vec3::new(0.0, 1.0, 0.0),
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, -1.0),
+    ],
+    [
+        Vec3::new(0.0, -1.0, 0.0),
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, -1.0),
+    ],
+];
+
+fn nonzero_scale(s: f64) -> f64 {
+    if s == 0.0 { 1.0 } else { s }
+}
+
+impl Projection {
+    /// The texinfo vectors (`s = p·vecs[0].xyz + vecs[0].w`) for a face on `plane`.
+    pub fn vecs(&self, plane: &Plane) -> [[f64; 4]; 2] {
+        match *self {
+            Projection::Valve { u, v, scale } => {
+                let (su, sv) = (nonzero_scale(scale[0]), nonzero_scale(scale[1]));
+                [
+                    [u[0] / su, u[1] / su, u[2] / su, u[3]],
+                    [v[0] / sv, v[1] / sv, v[2] / sv, v[3]],
+                ]
+            }
+            Projection::Standard {
+                shift,
+                rotation,
+                scale,
+            } => {
+                // The closest base direction wins; earlier entries win ties, as in Quake.
+                let mut best = 0;
+                let mut best_dot = 0.0;
+                for (i, axes) in BASE_AXES.iter().enumerate() {
+                    let d = plane.normal.dot(axes[0]);
+                    if d > best_dot {
+                        best_dot = d;
+                        best = i;
+                    }
+                }
+                let mut axes = [BASE_AXES[best][1], BASE_AXES[best][2]];
+                let (sin, cos) = match rotation {
+                    0.0 => (0.0, 1.0),
+                    90.0 => (1.0, 0.0),
+                    180.0 => (0.0, -1.0),
+                    270.0 => (-1.0, 0.0),
+                    r => r.to_radians().sin_cos(),
+                };
+                let first_nonzero = |v: Vec3| (0..3).find(|&i| v[i] != 0.0).unwrap_or(2);
+                let sv = first_nonzero(axes[0]);
+                let tv = first_nonzero(axes[1]);
+                for axis in &mut axes {
+                    let (s, t) = (axis[sv], axis[tv]);
+                    axis[sv] = cos * s - sin * t;
+                    axis[tv] = sin * s + cos * t;
+                }
+                let mut out = [[0.0; 4]; 2];
+                for i in 0..2 {
+                    let sc = nonzero_scale(scale[i]);
+                    out[i] = [axes[i].x / sc, axes[i].y / sc, axes[i].z / sc, shift[i]];
+                }
+                out
+            }
+        }
+    }
+}
+
+/// What a texture name tells the compiler about a face and its brush.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TextureRole {
+    /// Drawn and lit.
+    Normal,
+    /// `sky*`: drawn unlit, makes its brush sky.
+    Sky,
+    /// `*name`: drawn unlit and warped, makes its brush a liquid (water, slime or lava).
+    Liquid(i32),
+    /// `clip`: the brush only exists in the clip hulls.
+    Clip,
+    /// `skip`: the face is dropped.
+    Skip,
+    /// `trigger`: the face is not drawn.
+    Trigger,
+    /// `hint`: a splitter only; the brush is neither drawn nor solid.
+    Hint,
+}
+
+impl TextureRole {
+    pub fn of(name: &str) -> TextureRole {
+        let lower = name.to_ascii_lowercase();
+        if lower.starts_with("sky") {
+            TextureRole::Sky
+        } else if let Some(rest) = lower.strip_prefix('*') {
+            TextureRole::Liquid(if rest.contains("lava") {
+                contents::LAVA
+            } else if rest.contains("slime") {
+                contents::SLIME
+            } else {
+                contents::WATER
+            })
+        } else {
+            match lower.as_str() {
+                "clip" => TextureRole::Clip,
+                "skip" => TextureRole::Skip,
+                "trigger" => TextureRole::Trigger,
+                "hint" | "hintskip" => TextureRole::Hint,
+                _ => TextureRole::Normal,
+            }
+        }
+    }
+
+    /// Faces with these textures get no lightmap and are not subdivided (`TEX_SPECIAL`).
+    pub fn is_special(self) -> bool {
+        matches!(self, TextureRole::Sky | TextureRole::Liquid(_))
+    }
+
+    /// Faces with these textures never become BSP faces.
+    pub fn is_drawn(self) -> bool {
+        !matches!(
+            self,
+            TextureRole::Clip | TextureRole::Skip | TextureRole::Trigger | TextureRole::Hint
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn standard(shift: [f64; 2], rotation: f64, scale: [f64; 2]) -> Projection {
+        Projection::Standard {
+            shift,
+            rotation,
+            scale,
+        }
+    }
+
+    fn plane(n: Vec3) -> Plane {
+        Plane::new(n, 0.0)
+    }
+
+    #[test]
+    fn floor_uses_x_and_minus_y() {
+        let v = standard([0.0, 0.0], 0.0, [1.0, 1.0]).vecs(&plane(Vec3::new(0.0, 0.0, 1.0)));
+        assert_eq!(v, [[1.0, 0.0, 0.0, 0.0], [0.0, -1.0, 0.0, 0.0]]);
+    }
+
+    #[test]
+    fn walls_use_their_base_axes() {
+        let v = standard([0.0, 0.0], 0.0, [1.0, 1.0]).vecs(&plane(Vec3::new(-1.0, 0.0, 0.0)));
+        assert_eq!(v, [[0.0, 1.0, 0.0, 0.0], [0.0, 0.0, -1.0, 0.0]]);
+        let v = standard([0.0, 0.0], 0.0, [1.0, 1.0]).vecs(&plane(Vec3::new(0.0, 1.0, 0.0)));
+        assert_eq!(v, [[1.0, 0.0, 0.0, 0.0], [0.0, 0.0, -1.0, 0.0]]);
+    }
+
+    #[test]
+    fn rotation_scale_and_shift() {
+        // e1m1's "SLIPBOTSD 0 0 90 -1 1" on an X wall.
+        let v = standard([0.0, 0.0], 90.0, [-1.0, 1.0]).vecs(&plane(Vec3::new(1.0, 0.0, 0.0)));
+        // s axis (0,1,0) rotated by 90 becomes (0,0,1); t axis (0,0,-1) becomes (0,1,0).
+        assert_eq!(v[0], [0.0, 0.0, -1.0, 0.0]);
+        assert_eq!(v[1], [0.0, 1.0, 0.0, 0.0]);
+        let v = standard([16.0, -8.0], 0.0, [2.0, 0.5]).vecs(&plane(Vec3::new(0.0, 0.0, 1.0)));
+        assert_eq!(v, [[0.5, 0.0, 0.0, 16.0], [0.0, -2.0, 0.0, -8.0]]);
+    }
+
+    #[test]
+    fn sloped_face_picks_the_closest_axis() {
+        let n = Vec3::new(0.6, 0.0, 0.8);
+        let v = standard([0.0, 0.0], 0.0, [1.0, 1.0]).vecs(&plane(n));
+        assert_eq!(v[0], [1.0, 0.0, 0.0, 0.0]);
+        let n = Vec3::new(0.8, 0.0, 0.6);
+        let v = standard([0.0, 0.0], 0.0, [1.0, 1.0]).vecs(&plane(n));
+        assert_eq!(v[0], [0.0, 1.0, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn valve_axes_are_divided_by_scale() {
+        let p = Projection::Valve {
+            u: [0.0, 1.0, 0.0, -16.0],
+            v: [0.0, 0.0, -1.0, 4.0],
+            scale: [0.5, 2.0],
+        };
+        let v = p.vecs(&plane(Vec3::new(1.0, 0.0, 0.0)));
+        assert_eq!(v, [[0.0, 2.0, 0.0, -16.0], [0.0, 0.0, -0.5, 4.0]]);
+    }
+
+    #[test]
+    fn roles_from_names() {
+        assert_eq!(TextureRole::of("SKY4"), TextureRole::Sky);
+        assert_eq!(
+            TextureRole::of("*lava1"),
+            TextureRole::Liquid(contents::LAVA)
+        );
+        assert_eq!(
+            TextureRole::of("*04mwat2"),
+            TextureRole::Liquid(contents::WATER)
+        );
+        assert_eq!(TextureRole::of("CLIP"), TextureRole::Clip);
+        assert_eq!(TextureRole::of("wall1"), TextureRole::Normal);
+        assert!(TextureRole::of("*slime0").is_special());
+        assert!(!TextureRole::of("skip").is_drawn());
+    }
+}

@@ -1,0 +1,101 @@
+//! Things wrong with a map that the compiler works around.
+
+use quake_formats::geom::Vec3;
+use std::path::PathBuf;
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum Warning {
+    /// A brush that cannot be built; it is skipped.
+    BadBrush {
+        entity: usize,
+        brush: usize,
+        line: usize,
+        reason: String,
+    },
+    MissingWad {
+        name: String,
+    },
+    UnreadableWad {
+        path: PathBuf,
+        reason: String,
+    },
+    /// The face gets a placeholder texture.
+    MissingTexture {
+        name: String,
+    },
+    /// A point entity whose origin is inside a solid or sky brush (it does not flood).
+    EntityInSolid {
+        entity: usize,
+        classname: String,
+        origin: Vec3,
+    },
+    /// The map is open to the void.
+    Leak {
+        entity: usize,
+        classname: String,
+        origin: Vec3,
+    },
+    /// No point entity lies in open space, so the outside cannot be told from the inside.
+    NoEntitiesToFlood,
+    /// A brush entity with no usable brushes.
+    EmptyBrushEntity {
+        entity: usize,
+        classname: String,
+    },
+    /// Something the compiler does not do yet; the map compiles without it.
+    Unsupported {
+        what: String,
+    },
+}
+
+impl std::fmt::Display for Warning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let v = |p: &Vec3| format!("({} {} {})", p.x, p.y, p.z);
+        match self {
+            Warning::BadBrush {
+                entity,
+                brush,
+                line,
+                reason,
+            } => write!(
+                f,
+                "line {line}: entity {entity}, brush {brush}: {reason}; brush skipped"
+            ),
+            Warning::MissingWad { name } => write!(f, "WAD {name} not found in the search path"),
+            Warning::UnreadableWad { path, reason } => {
+                write!(f, "{}: not a usable WAD: {reason}", path.display())
+            }
+            Warning::MissingTexture { name } => {
+                write!(
+                    f,
+                    "texture {name} not found in any WAD; using a placeholder"
+                )
+            }
+            Warning::EntityInSolid {
+                entity,
+                classname,
+                origin,
+            } => write!(
+                f,
+                "entity {entity} ({classname}) at {} is inside a solid brush",
+                v(origin)
+            ),
+            Warning::Leak {
+                entity,
+                classname,
+                origin,
+            } => write!(
+                f,
+                "LEAK: entity {entity} ({classname}) at {} can reach the void; outside not removed, see the .pts pointfile",
+                v(origin)
+            ),
+            Warning::NoEntitiesToFlood => {
+                write!(f, "no point entity in open space: outside filling skipped")
+            }
+            Warning::EmptyBrushEntity { entity, classname } => {
+                write!(f, "entity {entity} ({classname}) has no usable brushes")
+            }
+            Warning::Unsupported { what } => write!(f, "not supported yet: {what}"),
+        }
+    }
+}

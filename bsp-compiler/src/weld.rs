@@ -1,0 +1,138 @@
+//! Shared vertices: welding equal points and inserting the vertices that lie on another face's
+//! edge (T-junctions), which would otherwise show as cracks.
+
+use quake_formats::geom::{POINT_EPSILON, Vec3};
+use std::collections::HashMap;
+
+/// Distance from an edge within which a vertex counts as lying on it.
+const TJUNCTION_EPSILON: f64 = 0.02;
+/// Cell size of the T-junction search grid.
+const GRID: f64 = 64.0;
+
+/// Points welded within [`POINT_EPSILON`], numbered in first-seen order.
+#[derive(Debug, Default)]
+pub struct VertexWelder {
+    pub positions: Vec<Vec3>,
+    cells: HashMap<[i64; 3], Vec<u32>>,
+}
+
+impl VertexWelder {
+    fn cell(p: Vec3) -> [i64; 3] {
+        // Cells several epsilons wide; neighbours are searched, so the size only affects speed.
+        let c = |v: f64| (v / (POINT_EPSILON * 16.0)).floor() as i64;
+        [c(p.x), c(p.y), c(p.z)]
+    }
+
+    pub fn weld(&mut self, p: Vec3) -> u32 {
+        let [x, y, z] = Self::cell(p);
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    if let Some(ids) = self.cells.get(&[x + dx, y + dy, z + dz])
+                        && let Some(&id) = ids
+                            .iter()
+                            .find(|&&id| self.positions[id as usize].near(p, POINT_EPSILON))
+                    {
+                        return id;
+                    }
+                }
+            }
+        }
+        let id = self.positions.len() as u32;
+        self.positions.push(p);
+        self.cells.entry([x, y, z]).or_default().push(id);
+        id
+    }
+}
+
+/// Insert into each polygon (vertex indices into `positions`) every vertex lying inside one of
+/// its edges. Returns how many vertices were inserted.
+pub fn fix_tjunctions(positions: &[Vec3], polygons: &mut [Vec<u32>]) -> usize {
+    let cell = |p: Vec3| {
+        [
+            (p.x / GRID).floor() as i64,
+            (p.y / GRID).floor() as i64,
+            (p.z / GRID).floor() as i64,
+        ]
+    };
+    let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+    for (i, &p) in positions.iter().enumerate() {
+        grid.entry(cell(p)).or_default().push(i as u32);
+    }
+    let mut inserted = 0;
+    let mut on_edge: Vec<(f64, u32)> = Vec::new();
+    for poly in polygons.iter_mut() {
+        let mut out = Vec::with_capacity(poly.len());
+        for k in 0..poly.len() {
+            let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+            out.push(a);
+            let (pa, pb) = (positions[a as usize], positions[b as usize]);
+            let d = pb - pa;
+            let len2 = d.dot(d);
+            if len2 < POINT_EPSILON * POINT_EPSILON {
+                continue;
+            }
+            let pad = Vec3::new(TJUNCTION_EPSILON, TJUNCTION_EPSILON, TJUNCTION_EPSILON);
+            let (lo, hi) = (cell(pa.min(pb) - pad), cell(pa.max(pb) + pad));
+            on_edge.clear();
+            for x in lo[0]..=hi[0] {
+                for y in lo[1]..=hi[1] {
+                    for z in lo[2]..=hi[2] {
+                        let Some(ids) = grid.get(&[x, y, z]) else {
+                            continue;
+                        };
+                        for &v in ids {
+                            if v == a || v == b {
+                                continue;
+                            }
+                            let pv = positions[v as usize];
+                            let t = (pv - pa).dot(d) / len2;
+                            let along = t * len2.sqrt();
+                            if along <= POINT_EPSILON || along >= len2.sqrt() - POINT_EPSILON {
+                                continue;
+                            }
+                            if (pa + d * t - pv).length() < TJUNCTION_EPSILON {
+                                on_edge.push((t, v));
+                            }
+                        }
+                    }
+                }
+            }
+            on_edge.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+            inserted += on_edge.len();
+            out.extend(on_edge.iter().map(|&(_, v)| v));
+        }
+        *poly = out;
+    }
+    inserted
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn close_points_weld() {
+        let mut w = VertexWelder::default();
+        let a = w.weld(Vec3::new(64.0, 0.0, 0.0));
+        let b = w.weld(Vec3::new(64.0 - POINT_EPSILON * 0.5, 0.0, 0.0));
+        let c = w.weld(Vec3::new(64.0 + POINT_EPSILON * 3.0, 0.0, 0.0));
+        assert_eq!(a, b);
+        assert_ne!(a, c);
+    }
+
+    #[test]
+    fn vertex_on_an_edge_is_inserted() {
+        // A big square next to two small ones: the small ones' shared corner lies on its edge.
+        let positions = vec![
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(0.0, 64.0, 0.0),
+            Vec3::new(64.0, 64.0, 0.0),
+            Vec3::new(64.0, 0.0, 0.0),
+            Vec3::new(64.0, 32.0, 0.0),
+        ];
+        let mut polys = vec![vec![0, 1, 2, 3]];
+        assert_eq!(fix_tjunctions(&positions, &mut polys), 1);
+        assert_eq!(polys[0], vec![0, 1, 2, 4, 3]);
+    }
+}
