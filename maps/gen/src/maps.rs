@@ -105,8 +105,9 @@ pub fn demo() -> Map {
         ),
     ]);
     let mut lights = vec![
-        light([128., 128., 160.], 250),
-        light([384., 384., 160.], 250),
+        // Beside (not on) the func_detail pillars at 96..128 and 384..416.
+        light([176., 176., 160.], 250),
+        light([336., 336., 160.], 250),
         light([640., 256., 96.], 200),
         light([896., 256., 192.], 300).key("_color", "128 160 255"),
         light([1152., 256., 192.], 250),
@@ -208,7 +209,8 @@ pub fn demo220() -> Map {
                 .key("mapversion", "220")
                 .brushes(world),
             player_start([48., 48., 24.], 45),
-            light([192., 128., 128.], 300),
+            // Clear of the rotated pillar around (192 128).
+            light([96., 200., 128.], 300),
         ],
     );
     map.format = MapFormat::Valve220;
