@@ -1,5 +1,6 @@
 //! `slipgate`: the one command. Each subcommand is a thin shell over a library stage.
 
+mod build;
 mod inspect;
 
 use anyhow::Result;
@@ -22,6 +23,8 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// Build a map start to finish: bsp, vis, light, and a PNG preview
+    Build(build::BuildArgs),
     /// Compile a .map to BSP29 (or BSP2), writing the .prt portal file and a .pts pointfile on a leak
     Bsp(bsp_compiler::cli::Args),
     /// Compute lightmaps with Embree-traced shadow rays (writes the BSP, and .lit for coloured light)
@@ -65,6 +68,7 @@ fn main() -> ExitCode {
 
 fn run(command: Command) -> Result<ExitCode> {
     match command {
+        Command::Build(args) => build::build(&args).map(|()| ExitCode::SUCCESS),
         Command::Bsp(args) => bsp_compiler::cli::run(&args).map(|()| ExitCode::SUCCESS),
         Command::Light(args) => light::cli::run(&args).map(|()| ExitCode::SUCCESS),
         Command::View(args) => runtime_viewer::cli::run(&args).map(|()| ExitCode::SUCCESS),

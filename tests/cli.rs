@@ -112,3 +112,44 @@ fn convert_round_trips_and_accepts_ericw_spelling() {
         String::from_utf8_lossy(&out.stdout)
     );
 }
+
+#[test]
+fn build_runs_the_whole_pipeline_on_the_demo_map() {
+    let maps = Path::new(env!("CARGO_MANIFEST_DIR")).join("maps");
+    let dir = scratch("build");
+    std::fs::create_dir_all(&dir).expect("dir");
+    for f in ["demo.map", "slipgate.wad"] {
+        std::fs::copy(maps.join(f), dir.join(f)).expect("copy");
+    }
+    let map = dir.join("demo.map");
+    let out = slipgate(&[
+        "build",
+        map.to_str().expect("utf8"),
+        "--size",
+        "160x100",
+        "-extra",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for ext in ["bsp", "prt", "png"] {
+        assert!(map.with_extension(ext).exists(), "no .{ext} written");
+    }
+    assert!(
+        !map.with_extension("pts").exists(),
+        "the demo map is sealed"
+    );
+    let info = slipgate(&["info", map.with_extension("bsp").to_str().expect("utf8")]);
+    let text = String::from_utf8_lossy(&info.stdout);
+    assert!(info.status.success(), "{text}");
+    assert!(text.contains("valid: no problems found"), "{text}");
+    let lighting: usize = text
+        .lines()
+        .find(|l| l.trim_start().starts_with("lighting"))
+        .and_then(|l| l.split_whitespace().nth(1))
+        .and_then(|n| n.parse().ok())
+        .expect("lighting line");
+    assert!(lighting > 0, "the build left the map unlit");
+}

@@ -177,10 +177,15 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let lit_file = lit_path(out);
     match lit {
         Some(bytes) => write_atomic(&lit_file, &bytes)?,
-        None if lit_file.exists() => eprintln!(
-            "light: warning: {} is left over from an earlier run and no longer matches (no coloured lights now)",
-            lit_file.display()
-        ),
+        None if lit_file.exists() => {
+            // Engines would load a stale .lit over the new lightmaps.
+            std::fs::remove_file(&lit_file)
+                .with_context(|| format!("removing stale {}", lit_file.display()))?;
+            eprintln!(
+                "light: removed {} (left from an earlier run; no light is coloured now)",
+                lit_file.display()
+            );
+        }
         None => {}
     }
     if let Some(stats_path) = &args.stats {

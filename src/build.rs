@@ -1,0 +1,91 @@
+//! `build`: the whole pipeline on one map, stage after stage, the way a mapper's compile profile
+//! runs qbsp, vis and light, ending with a preview picture.
+
+use anyhow::{Context, Result};
+use clap::{Args, FromArgMatches};
+use std::ffi::OsString;
+use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(clap::Args, Debug)]
+pub struct BuildArgs {
+    /// The .map to build; outputs go beside it (MAP.bsp, MAP.prt, MAP.png)
+    map: PathBuf,
+    /// Write BSP2 even when BSP29's limits hold
+    #[arg(long)]
+    bsp2: bool,
+    /// Extra folders to search for the WADs the map names
+    #[arg(long = "wad-dir", value_name = "DIR")]
+    wad_dirs: Vec<PathBuf>,
+    /// Light with 2x2 samples per luxel
+    #[arg(long)]
+    extra: bool,
+    /// Light with 4x4 samples per luxel
+    #[arg(long)]
+    extra4: bool,
+    /// Filter lightmaps so shadow edges do not stair-step
+    #[arg(long)]
+    soft: bool,
+    /// Preview size, WIDTHxHEIGHT
+    #[arg(long, default_value = "640x480")]
+    size: String,
+    /// Skip the preview picture
+    #[arg(long)]
+    no_preview: bool,
+}
+
+/// Parse a stage's own arguments, so `build` runs exactly what the stage's command would.
+fn stage_args<A: Args + FromArgMatches>(name: &'static str, argv: Vec<OsString>) -> Result<A> {
+    let command = A::augment_args(clap::Command::new(name).no_binary_name(true));
+    let matches = command
+        .try_get_matches_from(argv)
+        .with_context(|| format!("arguments for the {name} stage"))?;
+    Ok(A::from_arg_matches(&matches)?)
+}
+
+pub fn build(args: &BuildArgs) -> Result<()> {
+    let start = Instant::now();
+    let bsp = args.map.with_extension("bsp");
+
+    let mut argv: Vec<OsString> = vec![args.map.clone().into(), bsp.clone().into()];
+    if args.bsp2 {
+        argv.push("--bsp2".into());
+    }
+    for dir in &args.wad_dirs {
+        argv.extend(["--wad-dir".into(), dir.clone().into()]);
+    }
+    eprintln!("== bsp");
+    bsp_compiler::cli::run(&stage_args("bsp", argv)?)?;
+
+    let mut argv: Vec<OsString> = vec![bsp.clone().into()];
+    for (on, flag) in [
+        (args.extra, "--extra"),
+        (args.extra4, "--extra4"),
+        (args.soft, "--soft"),
+    ] {
+        if on {
+            argv.push(flag.into());
+        }
+    }
+    eprintln!("== light");
+    light::cli::run(&stage_args("light", argv)?)?;
+
+    if !args.no_preview {
+        let png = args.map.with_extension("png");
+        let argv: Vec<OsString> = vec![
+            bsp.clone().into(),
+            "--out".into(),
+            png.into(),
+            "--size".into(),
+            args.size.clone().into(),
+        ];
+        eprintln!("== view");
+        runtime_viewer::cli::run(&stage_args("view", argv)?)?;
+    }
+    eprintln!(
+        "build: {} in {:.2} s",
+        args.map.display(),
+        start.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
