@@ -16,6 +16,19 @@ pub enum PlaneSide {
     Cross,
 }
 
+impl PlaneSide {
+    /// The side of a point at signed distance `d` from a plane.
+    pub fn of_distance(d: f64) -> PlaneSide {
+        if d > ON_EPSILON {
+            PlaneSide::Front
+        } else if d < -ON_EPSILON {
+            PlaneSide::Back
+        } else {
+            PlaneSide::On
+        }
+    }
+}
+
 impl Plane {
     pub fn new(normal: Vec3, dist: f64) -> Self {
         Plane { normal, dist }
@@ -37,14 +50,7 @@ impl Plane {
     }
 
     pub fn side_of_point(&self, p: Vec3) -> PlaneSide {
-        let d = self.distance(p);
-        if d > ON_EPSILON {
-            PlaneSide::Front
-        } else if d < -ON_EPSILON {
-            PlaneSide::Back
-        } else {
-            PlaneSide::On
-        }
+        PlaneSide::of_distance(self.distance(p))
     }
 
     /// Same plane (same facing) within the plane epsilons.

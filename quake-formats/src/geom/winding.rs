@@ -133,18 +133,7 @@ impl Winding {
     /// Split by `plane`; points within [`ON_EPSILON`] of it count as on it.
     pub fn split(&self, plane: &Plane) -> Split {
         let dists: Vec<f64> = self.points.iter().map(|&p| plane.distance(p)).collect();
-        let sides: Vec<PlaneSide> = dists
-            .iter()
-            .map(|&d| {
-                if d > ON_EPSILON {
-                    PlaneSide::Front
-                } else if d < -ON_EPSILON {
-                    PlaneSide::Back
-                } else {
-                    PlaneSide::On
-                }
-            })
-            .collect();
+        let sides: Vec<PlaneSide> = dists.iter().map(|&d| PlaneSide::of_distance(d)).collect();
         let has_front = sides.contains(&PlaneSide::Front);
         let has_back = sides.contains(&PlaneSide::Back);
         match (has_front, has_back) {
