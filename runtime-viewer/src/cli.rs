@@ -38,6 +38,10 @@ pub struct Args {
     /// Palette (768 bytes); default: gfx/palette.lmp above the map's folder, else Slipgate's.
     #[arg(long)]
     pub palette: Option<PathBuf>,
+    /// Seconds on the map's clock: light styles step 10 times a second, liquids warp. The
+    /// flythrough advances it 1/60 s per frame, the window follows real time from here.
+    #[arg(long, default_value_t = 0.0)]
+    pub time: f64,
     /// Surface cache budget in MiB.
     #[arg(long, default_value_t = 64)]
     pub cache_mb: usize,
@@ -48,6 +52,11 @@ pub struct Args {
     /// Fly through the map for this many frames and report frame rates (no PNG).
     #[arg(long, value_name = "FRAMES")]
     pub bench: Option<usize>,
+    /// Open an interactive window instead of writing a PNG: W/A/S/D fly, Q/E or Space/Ctrl go
+    /// down/up, Shift is faster, drag with a mouse button or use the arrows to look, Esc quits.
+    /// Needs a build with the cargo feature `window`.
+    #[arg(long, conflicts_with_all = ["bench", "reference"])]
+    pub window: bool,
     /// With --bench: empty the surface cache before every frame.
     #[arg(long)]
     pub no_cache: bool,
@@ -79,7 +88,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         span_step: args.span_step,
         use_cache: !args.no_cache,
         cache_budget: args.cache_mb << 20,
-        ..RenderOptions::default()
+        time: args.time,
     };
     let mut renderer = Renderer::new(&world, options);
     let mut report = serde_json::json!({
@@ -89,7 +98,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         "palette": format!("{:?}", world.palette_source),
     });
 
-    if let Some(frames) = args.bench {
+    if args.window {
+        report["window"] = open_window(&world, &mut renderer, camera, args)?;
+    } else if let Some(frames) = args.bench {
         let bench = run_bench(&world, &mut renderer, &camera, frames.max(1));
         eprintln!(
             "{frames} frames at {}x{}: {:.1} fps, cache hit rate {:.1}%, per frame: visibility {:.2} ms, edges {:.2} ms, spans {:.2} ms, surfaces {:.2} ms, raster {:.2} ms",
@@ -155,10 +166,45 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
+#[cfg(feature = "window")]
+fn open_window(
+    world: &World,
+    renderer: &mut Renderer,
+    camera: Camera,
+    args: &Args,
+) -> anyhow::Result<serde_json::Value> {
+    let name = format!("slipgate-view {}", args.map.display());
+    let summary = crate::window::run_window(world, renderer, camera, &name)?;
+    let [x, y, z] = summary.origin;
+    let [p, yaw, r] = summary.angles;
+    eprintln!(
+        "{} frames in {:.1} s ({:.1} fps); last view: --pos {x:.0} {y:.0} {z:.0} --angles {p:.0} {yaw:.0} {r:.0}",
+        summary.frames,
+        summary.seconds,
+        summary.frames as f64 / summary.seconds.max(1e-9),
+    );
+    Ok(serde_json::to_value(summary)?)
+}
+
+#[cfg(not(feature = "window"))]
+fn open_window(
+    _: &World,
+    _: &mut Renderer,
+    _: Camera,
+    _: &Args,
+) -> anyhow::Result<serde_json::Value> {
+    bail!(
+        "--window needs a viewer built with the `window` feature (cargo build --features slipgate-viewer/window)"
+    )
+}
+
 fn initial_camera(world: &World, args: &Args) -> anyhow::Result<Camera> {
     let numbers = args.pos.iter().chain(&args.angles).flatten();
     if numbers.clone().any(|v| !v.is_finite()) || !(1.0..=179.0).contains(&args.fov) {
         bail!("--pos and --angles must be finite numbers and --fov between 1 and 179 degrees");
+    }
+    if !(args.time.is_finite() && args.time >= 0.0) {
+        bail!("--time must be a number of seconds, 0 or more");
     }
     let start = world.player_start();
     let origin = match (&args.pos, start) {
@@ -183,6 +229,9 @@ fn initial_camera(world: &World, args: &Args) -> anyhow::Result<Camera> {
     })
 }
 
+/// The flythrough's clock runs as if it were shown at 60 frames a second.
+const BENCH_SECONDS_PER_FRAME: f64 = 1.0 / 60.0;
+
 struct BenchResult {
     fps: f64,
     cache: CacheStats,
@@ -205,6 +254,7 @@ fn run_bench(
     if !std::io::IsTerminal::is_terminal(&std::io::stderr()) {
         progress.set_draw_target(indicatif::ProgressDrawTarget::hidden());
     }
+    let start_time = renderer.options.time;
     let mut frame = Frame::new(camera.width, camera.height);
     let mut cache = CacheStats::default();
     let mut sum = FrameStats::default();
@@ -226,6 +276,7 @@ fn run_bench(
             angles: [0.0, spots[a].1 + 360.0 * i as f64 / frames as f64, 0.0],
             ..*camera
         };
+        renderer.options.time = start_time + i as f64 * BENCH_SECONDS_PER_FRAME;
         let s = renderer.render(world, &cam, &mut frame);
         cache.add(&s.cache);
         sum.time_visibility += s.time_visibility;

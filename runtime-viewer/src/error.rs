@@ -17,6 +17,9 @@ pub enum ViewerError {
         path: PathBuf,
         error: png::EncodingError,
     },
+    /// The interactive window could not be opened or updated (no display, for instance).
+    #[error("window: {0}")]
+    Window(String),
 }
 
 impl ViewerError {

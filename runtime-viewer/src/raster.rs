@@ -75,9 +75,40 @@ pub fn draw_spans<F: Fn(i32, i32) -> u32>(
     step: u32,
     fetch: F,
 ) {
+    for_each_segment(spans, map, step, |seg| {
+        let row = seg.y as usize * width;
+        let (mut u, mut v) = (seg.u, seg.v);
+        for px in &mut pixels[row + seg.x as usize..row + (seg.x + seg.len) as usize] {
+            *px = fetch(u >> 16, v >> 16);
+            u += seg.du;
+            v += seg.dv;
+        }
+    });
+}
+
+/// Up to `step` pixels of a span whose texel coordinates (16.16 fixed point) are interpolated
+/// linearly: pixel `x + k` shows `((u + k du) >> 16, (v + k dv) >> 16)`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Segment {
+    pub y: u32,
+    pub x: u32,
+    pub len: u32,
+    pub u: i32,
+    pub v: i32,
+    pub du: i32,
+    pub dv: i32,
+}
+
+/// Cut `spans` into segments of `step` pixels with exact texel coordinates at their ends.
+#[inline]
+pub fn for_each_segment<F: FnMut(Segment)>(
+    spans: &[Span],
+    map: &TexMapping,
+    step: u32,
+    mut visit: F,
+) {
     let step = step.max(1);
     for span in spans {
-        let row = &mut pixels[span.y as usize * width..][..width];
         let mut x = span.x0;
         let (mut u, mut v) = map.exact(x, span.y);
         while x < span.x1 {
@@ -90,13 +121,15 @@ pub fn draw_spans<F: Fn(i32, i32) -> u32>(
             } else {
                 ((u, v), 1)
             };
-            let du = (next.0 - u) / divisor;
-            let dv = (next.1 - v) / divisor;
-            for px in &mut row[x as usize..(x + n) as usize] {
-                *px = fetch(u >> 16, v >> 16);
-                u += du;
-                v += dv;
-            }
+            visit(Segment {
+                y: span.y,
+                x,
+                len: n,
+                u,
+                v,
+                du: (next.0 - u) / divisor,
+                dv: (next.1 - v) / divisor,
+            });
             (u, v) = next;
             x += n;
         }

@@ -9,7 +9,7 @@ use quake_formats::geom::Vec3;
 
 use crate::camera::{Camera, NEAR_CLIP, View};
 use crate::render::Frame;
-use crate::surface_cache::{LightStyles, LitSurface, build_lit_surface, choose_mip};
+use crate::surface_cache::{LightStyles, LitSurface, TRANSPARENT, build_lit_surface, choose_mip};
 use crate::textures::{TextureKind, WarpTable, liquid_color, sky_color};
 use crate::world::{Surface, World};
 
@@ -25,54 +25,97 @@ enum Trace {
 }
 
 /// Draw `camera`'s view by ray casting; lighting with `styles`, liquids warped at `time`.
+/// Fences are seen through where their texels are transparent: the nearest fence texel that is
+/// not, in front of the first opaque face, is what a pixel shows.
 pub fn render_reference(world: &World, camera: &Camera, styles: &LightStyles, time: f64) -> Frame {
     let view = camera.view();
-    let warp = WarpTable::new(time);
+    let mut shader = Shader {
+        world,
+        view: &view,
+        styles,
+        warp: WarpTable::new(time),
+        lit: HashMap::new(),
+    };
     let mut frame = Frame::new(camera.width, camera.height);
-    let mut lit: HashMap<(u32, usize), LitSurface> = HashMap::new();
+    let mut fences = Vec::new();
     for y in 0..camera.height {
         for x in 0..camera.width {
-            let (xc, yc) = (x as f64 + 0.5, y as f64 + 0.5);
-            let dir = view.ray(xc, yc);
-            let Some((face, depth)) = first_hit(world, &view, dir) else {
-                continue;
-            };
-            let Some(surface) = world.surfaces[face as usize].as_ref() else {
-                continue;
-            };
-            let i = y * camera.width + x;
-            frame.faces[i] = face;
-            let tex = &world.textures[surface.texture];
-            let (s, t) = surface.st(view.origin + dir * depth);
-            let ext = surface.extents;
-            frame.pixels[i] = match surface.kind {
-                TextureKind::Sky => sky_color(tex, &world.palette, dir),
-                TextureKind::Liquid => {
-                    let texel = |c: f64, axis: usize| {
-                        let rel = (c - ext.tex_mins[axis] as f64).floor();
-                        rel.clamp(0.0, (ext.extents[axis].max(1) - 1) as f64) as i32
-                            + ext.tex_mins[axis]
-                    };
-                    liquid_color(tex, &world.palette, &warp, texel(s, 0), texel(t, 1))
-                }
-                TextureKind::Lit => {
-                    let mip = choose_mip(&view, surface);
-                    let ls = lit
-                        .entry((face, mip))
-                        .or_insert_with(|| build_lit_surface(world, surface, mip, styles));
-                    let texel = |c: f64, axis: usize, size: usize| {
-                        let rel = ((c - ext.tex_mins[axis] as f64) / (1 << mip) as f64).floor();
-                        rel.clamp(0.0, (size - 1) as f64) as usize
-                    };
-                    ls.texels[texel(t, 1, ls.height) * ls.width + texel(s, 0, ls.width)]
-                }
-            };
+            let dir = view.ray(x as f64 + 0.5, y as f64 + 0.5);
+            let opaque = first_hit(world, &view, dir);
+            fence_hits(world, &view, dir, opaque.map(|(_, d)| d), &mut fences);
+            let shown = fences
+                .iter()
+                .copied()
+                .chain(opaque)
+                .find_map(|(face, depth)| Some((face, shader.color(face, dir, depth)?)));
+            if let Some((face, color)) = shown {
+                let i = y * camera.width + x;
+                frame.faces[i] = face;
+                frame.pixels[i] = color;
+            }
         }
     }
     frame
 }
 
-/// The nearest face along `dir` (depth-scaled: the point is `origin + dir * depth`).
+/// Colours of surface points, with the lit surfaces built so far.
+struct Shader<'a> {
+    world: &'a World,
+    view: &'a View,
+    styles: &'a LightStyles,
+    warp: WarpTable,
+    lit: HashMap<(u32, usize), LitSurface>,
+}
+
+impl Shader<'_> {
+    /// The colour of `face` where the ray along `dir` meets it at `depth`; `None` for a hole
+    /// in a fence.
+    fn color(&mut self, face: u32, dir: Vec3, depth: f64) -> Option<u32> {
+        let world = self.world;
+        let surface = world.surfaces[face as usize].as_ref()?;
+        let tex = &world.textures[surface.texture];
+        let (s, t) = surface.st(self.view.origin + dir * depth);
+        let ext = surface.extents;
+        let color = match surface.kind {
+            TextureKind::Sky => sky_color(tex, &world.palette, dir),
+            TextureKind::Liquid => {
+                let texel = |c: f64, axis: usize| {
+                    let rel = (c - ext.tex_mins[axis] as f64).floor();
+                    rel.clamp(0.0, (ext.extents[axis].max(1) - 1) as f64) as i32
+                        + ext.tex_mins[axis]
+                };
+                liquid_color(tex, &world.palette, &self.warp, texel(s, 0), texel(t, 1))
+            }
+            TextureKind::Lit | TextureKind::Fence => {
+                let mip = choose_mip(self.view, surface);
+                let styles = self.styles;
+                let ls = self
+                    .lit
+                    .entry((face, mip))
+                    .or_insert_with(|| build_lit_surface(world, surface, mip, styles));
+                let texel = |c: f64, axis: usize, size: usize| {
+                    let rel = ((c - ext.tex_mins[axis] as f64) / (1 << mip) as f64).floor();
+                    rel.clamp(0.0, (size - 1) as f64) as usize
+                };
+                ls.texels[texel(t, 1, ls.height) * ls.width + texel(s, 0, ls.width)]
+            }
+        };
+        (color != TRANSPARENT).then_some(color)
+    }
+}
+
+/// Depth at which the ray along `dir` meets the front of `s` inside its polygon.
+fn ray_hit(s: &Surface, view: &View, dir: Vec3) -> Option<f64> {
+    let eye = s.plane.distance(view.origin);
+    let along = s.plane.normal.dot(dir);
+    if eye <= 0.0 || along >= 0.0 {
+        return None;
+    }
+    let depth = -eye / along;
+    (depth >= NEAR_CLIP && inside(s, view.origin + dir * depth)).then_some(depth)
+}
+
+/// The nearest opaque face along `dir` (depth-scaled: the point is `origin + dir * depth`).
 fn first_hit(world: &World, view: &View, dir: Vec3) -> Option<(u32, f64)> {
     let world_hit = match world.root() {
         Some(root) => match trace(world, root, view.origin, dir, NEAR_CLIP, MAX_DEPTH) {
@@ -86,65 +129,123 @@ fn first_hit(world: &World, view: &View, dir: Vec3) -> Option<(u32, f64)> {
         let Some(s) = world.surfaces[f as usize].as_ref() else {
             continue;
         };
-        let eye = s.plane.distance(view.origin);
-        let along = s.plane.normal.dot(dir);
-        if eye <= 0.0 || along >= 0.0 {
+        if s.kind == TextureKind::Fence {
             continue;
         }
-        let depth = -eye / along;
-        if depth < NEAR_CLIP || best.is_some_and(|(_, d)| d <= depth) {
-            continue;
-        }
-        if inside(s, view.origin + dir * depth) {
+        if let Some(depth) = ray_hit(s, view, dir)
+            && best.is_none_or(|(_, d)| depth < d)
+        {
             best = Some((f, depth));
         }
     }
     best
 }
 
-/// Front-to-back along the ray; the tree has no cycles ([`World::new`] checked).
-fn trace(world: &World, child: i32, o: Vec3, dir: Vec3, t0: f64, t1: f64) -> Trace {
-    let bsp = &world.bsp;
-    if child < 0 {
-        return match bsp.leafs.get((-(child + 1)) as usize) {
-            Some(l) if l.contents != contents::SOLID => Trace::Miss,
-            _ => Trace::Blocked,
-        };
-    }
-    let (Some(node), Some(plane)) = (
-        bsp.nodes.get(child as usize),
-        world.node_plane(child as usize),
-    ) else {
-        return Trace::Blocked;
-    };
-    let d0 = plane.distance(o + dir * t0);
-    let d1 = plane.distance(o + dir * t1);
-    if d0 >= 0.0 && d1 >= 0.0 {
-        return trace(world, node.children[0], o, dir, t0, t1);
-    }
-    if d0 < 0.0 && d1 < 0.0 {
-        return trace(world, node.children[1], o, dir, t0, t1);
-    }
-    let near = usize::from(d0 < 0.0);
-    let tm = (t0 + (t1 - t0) * d0 / (d0 - d1)).clamp(t0, t1);
-    match trace(world, node.children[near], o, dir, t0, tm) {
-        Trace::Miss => {}
-        other => return other,
-    }
-    let p = o + dir * tm;
-    let first = node.first_face as usize;
-    for f in first..first + node.num_faces as usize {
-        let Some(face) = bsp.faces.get(f) else { break };
-        if face.side as usize != near {
+/// Fence faces the ray along `dir` meets before depth `limit`, nearest first, into `out`.
+fn fence_hits(
+    world: &World,
+    view: &View,
+    dir: Vec3,
+    limit: Option<f64>,
+    out: &mut Vec<(u32, f64)>,
+) {
+    out.clear();
+    for &f in &world.fence_faces {
+        let Some(s) = world.surfaces[f as usize].as_ref() else {
             continue;
-        }
-        if let Some(s) = world.surfaces[f].as_ref()
-            && inside(s, p)
+        };
+        if let Some(depth) = ray_hit(s, view, dir)
+            && limit.is_none_or(|l| depth < l)
         {
-            return Trace::Hit(f as u32, tm);
+            out.push((f, depth));
         }
     }
-    trace(world, node.children[1 - near], o, dir, tm, t1)
+    out.sort_by(|a, b| a.1.total_cmp(&b.1));
+}
+
+/// Pending work of a ray's walk through the tree.
+enum RayStep {
+    /// The ray's part from depth `t0` to `t1` through `child`.
+    Visit { child: i32, t0: f64, t1: f64 },
+    /// The faces of `node` on its `near` side, where the ray crosses its plane at depth `t`.
+    Faces { node: usize, near: usize, t: f64 },
+}
+
+/// Front-to-back along the ray: the first face hit, or the first solid leaf. An explicit stack
+/// keeps a degenerate, very deep tree from overflowing the thread's stack.
+fn trace(world: &World, root: i32, o: Vec3, dir: Vec3, t0: f64, t1: f64) -> Trace {
+    let bsp = &world.bsp;
+    let mut stack = vec![RayStep::Visit {
+        child: root,
+        t0,
+        t1,
+    }];
+    while let Some(step) = stack.pop() {
+        match step {
+            RayStep::Visit { child, t0, t1 } => {
+                if child < 0 {
+                    match bsp.leafs.get((-(child + 1)) as usize) {
+                        Some(l) if l.contents != contents::SOLID => continue,
+                        _ => return Trace::Blocked,
+                    }
+                }
+                let (Some(node), Some(plane)) = (
+                    bsp.nodes.get(child as usize),
+                    world.node_plane(child as usize),
+                ) else {
+                    return Trace::Blocked;
+                };
+                let d0 = plane.distance(o + dir * t0);
+                let d1 = plane.distance(o + dir * t1);
+                if (d0 >= 0.0) == (d1 >= 0.0) {
+                    let side = usize::from(d0 < 0.0);
+                    stack.push(RayStep::Visit {
+                        child: node.children[side],
+                        t0,
+                        t1,
+                    });
+                    continue;
+                }
+                let near = usize::from(d0 < 0.0);
+                let tm = (t0 + (t1 - t0) * d0 / (d0 - d1)).clamp(t0, t1);
+                // Pushed in reverse: the near part, the faces on the plane, the far part.
+                stack.push(RayStep::Visit {
+                    child: node.children[1 - near],
+                    t0: tm,
+                    t1,
+                });
+                stack.push(RayStep::Faces {
+                    node: child as usize,
+                    near,
+                    t: tm,
+                });
+                stack.push(RayStep::Visit {
+                    child: node.children[near],
+                    t0,
+                    t1: tm,
+                });
+            }
+            RayStep::Faces { node, near, t } => {
+                let node = &bsp.nodes[node];
+                let p = o + dir * t;
+                let first = node.first_face as usize;
+                for f in first..first + node.num_faces as usize {
+                    let Some(face) = bsp.faces.get(f) else { break };
+                    if face.side as usize != near {
+                        continue;
+                    }
+                    // Fences are looked for apart from the tree walk (`fence_hits`).
+                    if let Some(s) = world.surfaces[f].as_ref()
+                        && s.kind != TextureKind::Fence
+                        && inside(s, p)
+                    {
+                        return Trace::Hit(f as u32, t);
+                    }
+                }
+            }
+        }
+    }
+    Trace::Miss
 }
 
 /// Whether `p` (on the surface's plane) lies inside its convex polygon, either winding.

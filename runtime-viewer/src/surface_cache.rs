@@ -12,6 +12,7 @@ use std::time::{Duration, Instant};
 use quake_formats::bsp::limits::MAX_LIGHTMAPS;
 
 use crate::camera::{NEAR_CLIP, View};
+use crate::textures::{FENCE_TRANSPARENT_INDEX, TextureKind};
 use crate::world::{Surface, World};
 
 /// Light value of a face without a lightmap (engines draw those fully lit).
@@ -19,17 +20,58 @@ const UNLIT_LIGHT: u32 = 255;
 /// Style value for normal light ('m').
 pub const NORMAL_STYLE: u32 = 256;
 
-/// Current brightness of the 256 light styles; `NORMAL_STYLE` is unchanged light.
+/// Quake's standard light style patterns, which the game sets when a level starts: one letter
+/// per step, 'a' dark, 'm' normal, 'z' double. Styles past these (the switchable lights from 32
+/// on) stay 'm'.
+pub const STANDARD_STYLES: [&str; 12] = [
+    // 0 normal
+    "m",
+    // 1 flicker
+    "mmnmmommommnonmmonqnmmo",
+    // 2 slow strong pulse
+    "abcdefghijklmnopqrstuvwxyzyxwvutsrqponmlkjihgfedcba",
+    // 3 candle
+    "mmmmmaaaaammmmmaaaaaabcdefgabcdefg",
+    // 4 fast strobe
+    "mamamamamama",
+    // 5 gentle pulse
+    "jklmnopqrstuvwxyzyxwvutsrqponmlkj",
+    // 6 other flicker
+    "nmonqnmomnmomomno",
+    // 7 candle
+    "mmmaaaabcdefgmmmmaaaammmaamm",
+    // 8 candle
+    "mmmaaammmaaammmabcdefaaaammmmabcdefmmmaaaa",
+    // 9 slow strobe
+    "aaaaaaaazzzzzzzz",
+    // 10 fluorescent flicker
+    "mmamammmmammamamaaamammma",
+    // 11 slow pulse, not fading to black
+    "abcdefghijklmnopqrrqponmlkjihgfedcba",
+];
+
+/// Light style steps per second.
+pub const STYLE_STEPS_PER_SECOND: f64 = 10.0;
+
+/// The 256 light styles: each one's pattern and its brightness at the current time
+/// (`NORMAL_STYLE` is unchanged light).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct LightStyles {
+    patterns: Vec<Vec<u8>>,
     pub values: [u32; 256],
 }
 
 impl Default for LightStyles {
+    /// The standard patterns at time 0.
     fn default() -> Self {
-        LightStyles {
+        let mut styles = LightStyles {
+            patterns: vec![b"m".to_vec(); 256],
             values: [NORMAL_STYLE; 256],
+        };
+        for (style, pattern) in STANDARD_STYLES.iter().enumerate() {
+            styles.set_pattern(style as u8, pattern);
         }
+        styles
     }
 }
 
@@ -39,6 +81,27 @@ impl LightStyles {
         (c.clamp(b'a', b'z') - b'a') as u32 * NORMAL_STYLE / 12
     }
 
+    /// Give `style` a new pattern (as the game's `lightstyle` does; an empty one means 'm').
+    /// Its value is that of the pattern's first letter until the next [`LightStyles::animate`].
+    pub fn set_pattern(&mut self, style: u8, pattern: &str) {
+        let letters = if pattern.is_empty() {
+            b"m".to_vec()
+        } else {
+            pattern.as_bytes().to_vec()
+        };
+        self.values[style as usize] = Self::letter_value(letters[0]);
+        self.patterns[style as usize] = letters;
+    }
+
+    /// Set every style's value for `time` seconds: the pattern's letter at step
+    /// `floor(time * 10)`, wrapping around.
+    pub fn animate(&mut self, time: f64) {
+        let step = (time.max(0.0) * STYLE_STEPS_PER_SECOND) as u64;
+        for (value, pattern) in self.values.iter_mut().zip(&self.patterns) {
+            *value = Self::letter_value(pattern[(step % pattern.len() as u64) as usize]);
+        }
+    }
+
     fn of(&self, surface: &Surface) -> [u32; MAX_LIGHTMAPS] {
         std::array::from_fn(|i| match surface.styles[i] {
             crate::world::NO_STYLE => 0,
@@ -46,6 +109,9 @@ impl LightStyles {
         })
     }
 }
+
+/// A lit texel of a fence that shows what lies behind (real colours are 0x00RRGGBB).
+pub const TRANSPARENT: u32 = 0xFF00_0000;
 
 /// Largest cached surface side in texels; bigger surfaces use a coarser mip level.
 pub const MAX_CACHE_EXTENT: i32 = 2048;
@@ -75,8 +141,8 @@ pub fn choose_mip(view: &View, surface: &Surface) -> usize {
     mip
 }
 
-/// A lit surface at one mip level: `width` x `height` texels, 0x00RRGGBB. Texel (u, v) shows
-/// texture coordinates (tex_mins + (u, v) * 2^mip).
+/// A lit surface at one mip level: `width` x `height` texels, 0x00RRGGBB or [`TRANSPARENT`].
+/// Texel (u, v) shows texture coordinates (tex_mins + (u, v) * 2^mip).
 #[derive(Debug, Clone)]
 pub struct LitSurface {
     pub width: usize,
@@ -113,6 +179,7 @@ pub fn build_lit_surface(
         None => block.fill([UNLIT_LIGHT * NORMAL_STYLE; 3]),
     }
     let tex = &world.textures[surface.texture];
+    let holes = surface.kind == TextureKind::Fence;
     let (s0, t0) = (ext.tex_mins[0] >> mip, ext.tex_mins[1] >> mip);
     let mut texels = Vec::with_capacity(width * height);
     for v in 0..height {
@@ -131,7 +198,11 @@ pub fn build_lit_surface(
                 ((top as u64 * (16 - fy) as u64 + bottom as u64 * fy as u64) >> 16) as u32
             });
             let idx = tex.index_at(mip, s0 + u as i32, t0 + v as i32);
-            texels.push(world.palette.shade(idx, light));
+            texels.push(if holes && idx == FENCE_TRANSPARENT_INDEX {
+                TRANSPARENT
+            } else {
+                world.palette.shade(idx, light)
+            });
         }
     }
     LitSurface {
@@ -356,6 +427,28 @@ mod tests {
         assert_eq!(lit.texels[0], expect(0, l0));
         assert_eq!(lit.texels[16], expect(16, l1));
         assert_eq!(lit.texels[8], expect(8, (l0 + l1) / 2));
+    }
+
+    #[test]
+    fn styles_follow_their_patterns_at_ten_steps_a_second() {
+        let mut styles = LightStyles::default();
+        let flicker = STANDARD_STYLES[1].as_bytes();
+        for (time, step) in [(0.0, 0), (0.25, 2), (0.55, 5), (2.35, 0), (2.45, 1)] {
+            styles.animate(time);
+            assert_eq!(
+                styles.values[1],
+                LightStyles::letter_value(flicker[step]),
+                "time {time}"
+            );
+            assert_eq!(styles.values[0], NORMAL_STYLE);
+            assert_eq!(styles.values[32], NORMAL_STYLE, "switchable styles stay on");
+        }
+        styles.animate(0.85);
+        assert_eq!(styles.values[9], LightStyles::letter_value(b'z'));
+        styles.set_pattern(40, "a");
+        styles.set_pattern(41, "");
+        styles.animate(100.0);
+        assert_eq!((styles.values[40], styles.values[41]), (0, NORMAL_STYLE));
     }
 
     #[test]

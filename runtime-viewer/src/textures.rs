@@ -48,7 +48,13 @@ pub enum TextureKind {
     Sky,
     /// Liquids (`*` names): warped, drawn unlit as Quake's software renderer does.
     Liquid,
+    /// Fences (`{` names): lit like [`TextureKind::Lit`], but palette index
+    /// [`FENCE_TRANSPARENT_INDEX`] is a hole.
+    Fence,
 }
+
+/// The palette index that fence textures leave see-through.
+pub const FENCE_TRANSPARENT_INDEX: u8 = 255;
 
 /// One texture's four mip levels of palette indices.
 #[derive(Debug, Clone)]
@@ -108,6 +114,8 @@ impl Texture {
             TextureKind::Sky
         } else if lower.starts_with('*') || special {
             TextureKind::Liquid
+        } else if lower.starts_with('{') {
+            TextureKind::Fence
         } else {
             TextureKind::Lit
         }
@@ -244,6 +252,16 @@ mod tests {
             p.rgb[FIRST_FULLBRIGHT as usize]
         );
         assert_eq!(unpack(pack([1, 2, 3])), [1, 2, 3]);
+    }
+
+    #[test]
+    fn kinds_follow_the_name() {
+        let kind = |name: &str, special| Texture::checker(name.into()).kind(special);
+        assert_eq!(kind("SKY4", false), TextureKind::Sky);
+        assert_eq!(kind("*water1", true), TextureKind::Liquid);
+        assert_eq!(kind("{grate", false), TextureKind::Fence);
+        assert_eq!(kind("brick", true), TextureKind::Liquid);
+        assert_eq!(kind("brick", false), TextureKind::Lit);
     }
 
     #[test]

@@ -41,6 +41,24 @@ pub struct Visibility {
     leaf_mark: Vec<u32>,
     node_mark: Vec<u32>,
     face_mark: Vec<u32>,
+    /// The walk's pending steps, kept to reuse the allocation.
+    stack: Vec<Step>,
+}
+
+/// Pending work of the front-to-back walk.
+#[derive(Debug, Clone, Copy)]
+enum Step {
+    Visit {
+        child: i32,
+        clip_flags: u8,
+    },
+    /// A node's own faces, once its near side is done; `facing_side` is `None` when the eye
+    /// lies (nearly) on its plane and every face there is edge-on.
+    NodeFaces {
+        node: u32,
+        facing_side: Option<u32>,
+        clip_flags: u8,
+    },
 }
 
 struct Walk<'a> {
@@ -58,6 +76,7 @@ impl Visibility {
             leaf_mark: vec![0; world.bsp.leafs.len()],
             node_mark: vec![0; world.bsp.nodes.len()],
             face_mark: vec![0; world.bsp.faces.len()],
+            stack: Vec::new(),
         }
     }
 
@@ -80,7 +99,7 @@ impl Visibility {
             key: 0,
         };
         if let Some(root) = world.root() {
-            self.walk(&mut walk, root, 0b1111);
+            self.walk(&mut walk, root);
         }
         walk.stats.candidates = walk.out.len();
         walk.stats
@@ -124,8 +143,39 @@ impl Visibility {
         count
     }
 
-    /// Recursion depth is bounded by the node count: [`World::new`] checked the tree has no cycles.
-    fn walk(&mut self, w: &mut Walk, child: i32, mut clip_flags: u8) {
+    /// Walk the tree from `root` front to back: the near side of each node, then its faces
+    /// that look towards the eye (all with one key), then the far side. An explicit stack keeps
+    /// a degenerate, very deep tree from overflowing the thread's stack.
+    fn walk(&mut self, w: &mut Walk, root: i32) {
+        let mut stack = std::mem::take(&mut self.stack);
+        stack.clear();
+        stack.push(Step::Visit {
+            child: root,
+            clip_flags: 0b1111,
+        });
+        while let Some(step) = stack.pop() {
+            match step {
+                Step::Visit { child, clip_flags } => {
+                    self.visit(w, child, clip_flags, &mut stack);
+                }
+                Step::NodeFaces {
+                    node,
+                    facing_side,
+                    clip_flags,
+                } => {
+                    if let Some(side) = facing_side {
+                        self.node_faces(w, node as usize, side, clip_flags);
+                    }
+                    w.key += 1;
+                }
+            }
+        }
+        self.stack = stack;
+    }
+
+    /// Cull `child` by the PVS marks and the frustum; a leaf is collected now, a node queues its
+    /// near side, its faces and its far side.
+    fn visit(&mut self, w: &mut Walk, child: i32, mut clip_flags: u8, stack: &mut Vec<Step>) {
         let bsp = &w.world.bsp;
         let (mins, maxs) = if child < 0 {
             let leaf = (-(child + 1)) as usize;
@@ -171,30 +221,43 @@ impl Visibility {
         };
         let d = plane.distance(w.view.origin);
         let near = usize::from(d < 0.0);
-        self.walk(w, node.children[near], clip_flags);
-        if d.abs() > BACKFACE_EPSILON {
-            // Faces on this node that look towards the eye's side.
-            let facing_side = near as u32;
-            let first = node.first_face as usize;
-            for f in first..first + node.num_faces as usize {
-                let Some(face) = bsp.faces.get(f) else { break };
-                if self.face_mark.get(f) != Some(&self.frame) {
-                    continue;
-                }
-                if face.side != facing_side {
-                    w.stats.backfaces += 1;
-                    continue;
-                }
-                w.out.push(Candidate {
-                    face: f as u32,
-                    key: w.key,
-                    fragment: None,
-                    clip_flags,
-                });
+        // Pushed in reverse: near side first, then this node's faces, then the far side.
+        stack.push(Step::Visit {
+            child: node.children[1 - near],
+            clip_flags,
+        });
+        stack.push(Step::NodeFaces {
+            node: child as u32,
+            facing_side: (d.abs() > BACKFACE_EPSILON).then_some(near as u32),
+            clip_flags,
+        });
+        stack.push(Step::Visit {
+            child: node.children[near],
+            clip_flags,
+        });
+    }
+
+    /// The node's faces seen in the PVS that look towards the eye's side.
+    fn node_faces(&mut self, w: &mut Walk, node: usize, facing_side: u32, clip_flags: u8) {
+        let bsp = &w.world.bsp;
+        let node = &bsp.nodes[node];
+        let first = node.first_face as usize;
+        for f in first..first + node.num_faces as usize {
+            let Some(face) = bsp.faces.get(f) else { break };
+            if self.face_mark.get(f) != Some(&self.frame) {
+                continue;
             }
+            if face.side != facing_side {
+                w.stats.backfaces += 1;
+                continue;
+            }
+            w.out.push(Candidate {
+                face: f as u32,
+                key: w.key,
+                fragment: None,
+                clip_flags,
+            });
         }
-        w.key += 1;
-        self.walk(w, node.children[1 - near], clip_flags);
     }
 
     fn visit_leaf(&mut self, w: &mut Walk, leaf: usize, clip_flags: u8) {

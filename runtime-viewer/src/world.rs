@@ -84,6 +84,8 @@ pub struct World {
     pub leaf_fragments: Vec<Vec<Fragment>>,
     /// Faces of the brush models that entities show.
     pub brush_faces: Vec<u32>,
+    /// Fence faces of the world and of the brush models shown.
+    pub fence_faces: Vec<u32>,
     pub entities: Vec<Entity>,
     pub stats: LoadStats,
 }
@@ -191,16 +193,26 @@ impl World {
         let (node_parent, leaf_parent) = parents(&bsp)?;
         let mut leaf_fragments = vec![Vec::new(); bsp.leafs.len()];
         let mut brush_faces = Vec::new();
+        let mut fence_faces = Vec::new();
         for (f, fo) in face_origin.iter().enumerate() {
             let (Some((model, _)), Some(surface)) = (fo, &surfaces[f]) else {
                 continue;
             };
-            if *model == 0
-                || textures[surface.texture]
-                    .name
-                    .eq_ignore_ascii_case("trigger")
+            let is_fence = surface.kind == TextureKind::Fence;
+            if *model == 0 {
+                if is_fence {
+                    fence_faces.push(f as u32);
+                }
+                continue;
+            }
+            if textures[surface.texture]
+                .name
+                .eq_ignore_ascii_case("trigger")
             {
                 continue;
+            }
+            if is_fence {
+                fence_faces.push(f as u32);
             }
             brush_faces.push(f as u32);
             let winding = Winding::new(surface.points.clone());
@@ -220,6 +232,7 @@ impl World {
             leaf_parent,
             leaf_fragments,
             brush_faces,
+            fence_faces,
             entities,
             stats,
         })

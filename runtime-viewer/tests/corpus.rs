@@ -115,6 +115,33 @@ fn fast_renderer_agrees_with_the_reference() {
     assert!(brush_pixels > 0, "no brush model seen");
 }
 
+/// The fence map seen through its `{trigger` fences: the letters (index 255) are holes, and the
+/// fast renderer agrees with the reference about what shows through them.
+#[test]
+fn fences_are_see_through() {
+    let Some(corpus) = corpus() else { return };
+    let world = load(&corpus, "ericw-tools/q1_detail_fence2.bsp");
+    assert!(!world.fence_faces.is_empty());
+    let cam = camera(Vec3::new(64.0, -200.0, 100.0), [10.0, 80.0, 0.0], 320, 200);
+    let options = RenderOptions {
+        span_step: 1,
+        ..RenderOptions::default()
+    };
+    let mut fast = Frame::new(cam.width, cam.height);
+    let stats = Renderer::new(&world, options).render(&world, &cam, &mut fast);
+    assert!(stats.fences > 0, "{stats:?}");
+    let reference = render_reference(&world, &cam, &Default::default(), 0.0);
+    let diff = compare(&fast, &reference);
+    println!("fences: {diff:?}");
+    assert!(diff.face_mismatch < 0.005, "{diff:?}");
+    let fence_pixels = fast
+        .faces
+        .iter()
+        .filter(|f| world.fence_faces.contains(f))
+        .count();
+    assert!(fence_pixels > 1000, "{fence_pixels} fence pixels");
+}
+
 /// Texture error against the reference for span steps 1, 8, 16 and 32 (run with --nocapture to
 /// read the table).
 #[test]
