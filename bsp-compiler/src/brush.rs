@@ -19,6 +19,8 @@ pub struct Side {
     pub texinfo: Option<u32>,
     /// Set once a node plane the side lies on splits the space above it.
     pub used: bool,
+    /// Wholly inside other brushes (see [`crate::csg`]): never a splitter, yet not a node plane.
+    pub buried: bool,
 }
 
 /// A convex volume of one contents type.
@@ -101,6 +103,7 @@ impl Brush {
                 winding: w,
                 texinfo: face.texinfo,
                 used: false,
+                buried: false,
             });
         }
         let brush = Brush::with_sides(sides, contents, source).ok_or(BrushError::NoVolume)?;
@@ -133,6 +136,11 @@ impl Brush {
 
     pub fn outward(&self, side: &Side, planes: &PlaneSet) -> Plane {
         outward_plane(planes, side.plane, side.flipped)
+    }
+
+    /// Whether every side lies on a node plane above: the brush then fills its node's region.
+    pub fn fills_node(&self) -> bool {
+        self.sides.iter().all(|s| s.used)
     }
 
     pub fn volume(&self) -> f64 {
@@ -197,30 +205,16 @@ impl Brush {
             let out = self.outward(s, planes);
             cut = cut.and_then(|w| w.clip_front(&out.flipped(), false));
         }
-        let cut = cut.filter(|w| !w.is_tiny());
-        let Some(cut) = cut else {
-            // The plane only grazes the brush: keep it whole on the side holding more of it.
-            let mut max_front: f64 = 0.0;
-            let mut max_back: f64 = 0.0;
-            for s in &self.sides {
-                for &p in &s.winding.points {
-                    let d = plane.distance(p);
-                    max_front = max_front.max(d);
-                    max_back = max_back.max(-d);
-                }
-            }
-            return if max_front >= max_back {
-                (Some(self), None)
-            } else {
-                (None, Some(self))
-            };
+        let Some(cut) = cut.filter(|w| !w.is_tiny()) else {
+            // The plane grazes an edge or a corner: the cut is too thin to build on.
+            return self.on_both_sides();
         };
         let mut front_sides = Vec::with_capacity(self.sides.len() + 1);
         let mut back_sides = Vec::with_capacity(self.sides.len() + 1);
-        for s in self.sides {
+        for s in &self.sides {
             match s.winding.split(&plane) {
-                Split::Front(_) => front_sides.push(s),
-                Split::Back(_) => back_sides.push(s),
+                Split::Front(_) => front_sides.push(s.clone()),
+                Split::Back(_) => back_sides.push(s.clone()),
                 Split::Both { front, back } => {
                     if !front.is_tiny() {
                         front_sides.push(Side {
@@ -229,7 +223,10 @@ impl Brush {
                         });
                     }
                     if !back.is_tiny() {
-                        back_sides.push(Side { winding: back, ..s });
+                        back_sides.push(Side {
+                            winding: back,
+                            ..s.clone()
+                        });
                     }
                 }
                 Split::On { .. } => {}
@@ -242,6 +239,7 @@ impl Brush {
             winding: cut.reversed(),
             texinfo: None,
             used: true,
+            buried: false,
         });
         back_sides.push(Side {
             plane: id,
@@ -249,11 +247,23 @@ impl Brush {
             winding: cut,
             texinfo: None,
             used: true,
+            buried: false,
         });
-        (
+        match (
             Brush::with_sides(front_sides, self.contents, self.source),
             Brush::with_sides(back_sides, self.contents, self.source),
-        )
+        ) {
+            (Some(front), Some(back)) => (Some(front), Some(back)),
+            _ => self.on_both_sides(),
+        }
+    }
+
+    /// The brush reaches past a plane on both sides but one part is too thin to build: each side
+    /// keeps the whole brush. Dropping the thin part would leave an uncovered sliver (inside a
+    /// wall, a hole the outside flood leaks through); the whole brush is still cut down to its
+    /// own sides further down the tree, so no leaf extends past it.
+    fn on_both_sides(self) -> (Option<Brush>, Option<Brush>) {
+        (Some(self.clone()), Some(self))
     }
 }
 
@@ -319,6 +329,28 @@ pub(crate) mod tests {
             Brush::from_planes(&faces, &mut planes, -2, 0),
             Err(BrushError::NoVolume)
         );
+    }
+
+    /// A plane cutting a 0.02-deep wedge off the edge of a box (the e3m4 leak: the wedge was
+    /// dropped for being too small, leaving an empty sliver inside a wall).
+    #[test]
+    fn split_keeps_thin_parts_covered() {
+        let mut planes = PlaneSet::new();
+        let b = Brush::from_planes(
+            &box_planes(Vec3::ZERO, Vec3::new(64.0, 64.0, 64.0)),
+            &mut planes,
+            -2,
+            0,
+        )
+        .expect("brush");
+        let n = Vec3::new(1.0, 0.0, 1.0).normalized().expect("n");
+        let corner = Vec3::new(64.0, 32.0, 64.0);
+        let (cut, flipped) = planes.insert(&Plane::new(n, n.dot(corner) - 0.02));
+        assert!(!flipped);
+        let (front, back) = b.clone().split(cut, &planes);
+        let front = front.expect("the thin wedge keeps a brush");
+        assert!(back.is_some());
+        assert!(front.bounds.contains(corner));
     }
 
     #[test]

@@ -10,6 +10,7 @@ use crate::map::{MapEntity, MapError, parse_map};
 use crate::outside::{FillOutcome, Leak, Occupant, fill_outside};
 use crate::planes::PlaneSet;
 use crate::portals::{Portals, make_portals};
+use crate::surface_tree::rebuild_from_surfaces;
 use crate::texinfo::TextureRole;
 use crate::tree::{SplitHeuristic, Tree, build_tree};
 use crate::wad_lookup::WadSet;
@@ -141,6 +142,19 @@ struct ModelInput {
     brushes: Vec<Brush>,
     /// Grown brushes of hulls 1 and 2.
     hull_brushes: [Vec<Brush>; 2],
+    /// Bounds of the clip brushes, which only exist grown in the hulls.
+    clip_bounds: Bounds,
+}
+
+impl ModelInput {
+    fn new(entity: usize) -> ModelInput {
+        ModelInput {
+            entity,
+            brushes: Vec::new(),
+            hull_brushes: [Vec::new(), Vec::new()],
+            clip_bounds: Bounds::EMPTY,
+        }
+    }
 }
 
 /// One model's trees and faces.
@@ -233,11 +247,7 @@ pub fn compile(
     let t = Instant::now();
     let mut planes = PlaneSet::new();
     let mut table = TexInfoTable::default();
-    let mut models: Vec<ModelInput> = vec![ModelInput {
-        entity: 0,
-        brushes: Vec::new(),
-        hull_brushes: [Vec::new(), Vec::new()],
-    }];
+    let mut models: Vec<ModelInput> = vec![ModelInput::new(0)];
     let mut entities: Vec<Entity> = Vec::new();
     let mut occupants = Vec::new();
     let mut skipped_illusionary = 0;
@@ -262,11 +272,7 @@ pub fn compile(
         let model = if index == 0 || merges_into_world(class) {
             0
         } else {
-            models.push(ModelInput {
-                entity: index,
-                brushes: Vec::new(),
-                hull_brushes: [Vec::new(), Vec::new()],
-            });
+            models.push(ModelInput::new(index));
             let mut e = ent.entity.clone();
             e.set("model", format!("*{}", models.len() - 1));
             entities.push(e);
@@ -289,7 +295,9 @@ pub fn compile(
                     m.hull_brushes[hull].push(g);
                 }
             }
-            if !clip {
+            if clip {
+                m.clip_bounds = m.clip_bounds.union(&brush.bounds);
+            } else {
                 m.brushes.push(brush);
             }
         }
@@ -497,6 +505,28 @@ fn build_entity_brushes(
     (out, bad, hints)
 }
 
+/// Fill the outside of a clip hull's tree, flooding from the world's point entities, and
+/// rebuild it from what is left.
+fn fill_hull(
+    tree: &mut Tree,
+    planes: &PlaneSet,
+    bounds: &Bounds,
+    occupants: &[Occupant],
+    heuristic: SplitHeuristic,
+) {
+    if bounds.is_empty() {
+        return;
+    }
+    let portals = make_portals(tree, planes, bounds);
+    // Entities near walls are inside the grown brushes; that is expected, not worth a warning.
+    let mut ignored = Vec::new();
+    if let FillOutcome::Sealed { .. } =
+        fill_outside(tree, planes, &portals, occupants, &mut ignored)
+    {
+        *tree = rebuild_from_surfaces(tree, &portals, planes, heuristic);
+    }
+}
+
 fn build_model(
     m: ModelInput,
     planes: &PlaneSet,
@@ -506,8 +536,10 @@ fn build_model(
 ) -> (ModelOutput, Vec<Warning>) {
     let mut warnings = Vec::new();
     let mut timings = [0.0; 6];
-    let mut bounds = Bounds::EMPTY;
-    for b in m.brushes.iter().chain(m.hull_brushes[0].iter()) {
+    // Engines size brush entities from the model bounds (a door's travel, its trigger field),
+    // so they hold the map brushes, not the grown ones.
+    let mut bounds = m.clip_bounds;
+    for b in &m.brushes {
         bounds = bounds.union(&b.bounds);
     }
     if bounds.is_empty() {
@@ -523,8 +555,12 @@ fn build_model(
     for list in [&mut brushes, &mut h1, &mut h2] {
         mark_hidden_sides(list, planes);
     }
+    let hull_bounds = [&h1, &h2].map(|list| {
+        list.iter()
+            .fold(Bounds::EMPTY, |acc, b| acc.union(&b.bounds))
+    });
     timings[5] = t.elapsed().as_secs_f64();
-    let ((mut tree, tree_time), (hulls, hull_time)) = rayon::join(
+    let ((mut tree, tree_time), (mut hulls, hull_time)) = rayon::join(
         || {
             let t = Instant::now();
             let tree = build_tree(brushes, planes, heuristic, true);
@@ -552,6 +588,17 @@ fn build_model(
         is_world.then(|| fill_outside(&mut tree, planes, &portals, occupants, &mut warnings));
     timings[2] = t.elapsed().as_secs_f64();
 
+    // A sealed world's clip hulls are sealed too (grown brushes only close gaps further): fill
+    // their outsides as well, so it collapses into one solid leaf instead of many clip nodes.
+    let t = Instant::now();
+    if matches!(fill, Some(FillOutcome::Sealed { .. })) {
+        let [h1, h2] = &mut hulls;
+        rayon::join(
+            || fill_hull(h1, planes, &hull_bounds[0], occupants, heuristic),
+            || fill_hull(h2, planes, &hull_bounds[1], occupants, heuristic),
+        );
+    }
+    timings[4] += t.elapsed().as_secs_f64();
     let t = Instant::now();
     let mut face_stats = FaceStats::default();
     let raw = faces_from_portals(&tree, &portals, texinfos, &mut face_stats);

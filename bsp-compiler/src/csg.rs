@@ -12,7 +12,8 @@ use crate::tree::contents_priority;
 use quake_formats::geom::{Bounds, ON_EPSILON, Split, Vec3, Winding};
 use rayon::prelude::*;
 
-/// Mark every side of `brushes` that lies wholly inside other brushes as used. Returns how many.
+/// Mark every side of `brushes` that lies wholly inside other brushes as buried. Returns how
+/// many.
 pub fn mark_hidden_sides(brushes: &mut [Brush], planes: &PlaneSet) -> usize {
     let pad = Vec3::new(ON_EPSILON, ON_EPSILON, ON_EPSILON);
     let padded: Vec<Bounds> = brushes
@@ -49,15 +50,15 @@ pub fn mark_hidden_sides(brushes: &mut [Brush], planes: &PlaneSet) -> usize {
             covers.sort_unstable();
             me.sides
                 .iter()
-                .map(|s| s.used || buried(s, me, &covers, brushes, planes))
+                .map(|s| s.buried || buried(s, me, &covers, brushes, planes))
                 .collect()
         })
         .collect();
     let mut count = 0;
     for (b, flags) in brushes.iter_mut().zip(hidden) {
         for (s, h) in b.sides.iter_mut().zip(flags) {
-            count += usize::from(h && !s.used);
-            s.used |= h;
+            count += usize::from(h && !s.buried);
+            s.buried |= h;
         }
     }
     count
@@ -160,7 +161,7 @@ mod tests {
             brushes
                 .iter()
                 .flat_map(|b| &b.sides)
-                .filter(|s| s.used)
+                .filter(|s| s.buried)
                 .count(),
             2
         );
@@ -199,5 +200,46 @@ mod tests {
             ),
         ];
         assert_eq!(mark_hidden_sides(&mut brushes, &planes), 6);
+    }
+
+    proptest::proptest! {
+        /// A side marked buried lies inside the other boxes: points just outside it, all over
+        /// it, are inside some other box.
+        #[test]
+        fn buried_sides_are_covered(
+            boxes in proptest::collection::vec(
+                ((-4i32..4, -4i32..4, -4i32..4), (1i32..5, 1i32..5, 1i32..5)),
+                2..6,
+            ),
+        ) {
+            let mut planes = PlaneSet::new();
+            let boxes: Vec<(Vec3, Vec3)> = boxes
+                .iter()
+                .map(|&((x, y, z), (w, d, h))| {
+                    let lo = Vec3::new(x as f64, y as f64, z as f64) * 16.0;
+                    (lo, lo + Vec3::new(w as f64, d as f64, h as f64) * 16.0)
+                })
+                .collect();
+            let mut brushes: Vec<Brush> = boxes
+                .iter()
+                .map(|&(lo, hi)| cube(&mut planes, lo, hi, contents::SOLID))
+                .collect();
+            mark_hidden_sides(&mut brushes, &planes);
+            for (i, b) in brushes.iter().enumerate() {
+                for s in b.sides.iter().filter(|s| s.buried) {
+                    let out = b.outward(s, &planes).normal;
+                    let pts = &s.winding.points;
+                    let c = s.winding.center();
+                    // Corners pulled a little towards the centre, then pushed out of the side.
+                    for &p in pts.iter().chain(std::iter::once(&c)) {
+                        let probe = p + (c - p) * 0.01 + out * 0.5;
+                        let covered = boxes.iter().enumerate().any(|(j, &(lo, hi))| {
+                            j != i && Bounds { mins: lo, maxs: hi }.contains(probe)
+                        });
+                        proptest::prop_assert!(covered, "box {} side at {:?}", i, probe);
+                    }
+                }
+            }
+        }
     }
 }

@@ -338,4 +338,35 @@ mod tests {
         );
         assert!(out.len() >= 9);
     }
+
+    /// Regression: a piece whose rounded extents overflowed shrank the cut size for every piece
+    /// and face after it, cutting later faces into slivers.
+    #[test]
+    fn shrinking_one_piece_leaves_the_others_alone() {
+        let vecs = [[1.0, 0.0, 0.0, 0.0], [0.0, -1.0, 0.0, 0.0]];
+        let strip = Winding::new(vec![
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(0.0, 16.0, 0.0),
+            Vec3::new(4000.0, 16.0, 0.0),
+            Vec3::new(4000.0, 0.0, 0.0),
+        ]);
+        let alone = |w: &Winding, size: f64| {
+            let mut out = Vec::new();
+            subdivide(w.clone(), &vecs, size, &mut out);
+            out
+        };
+        // 300 texels is more than the engine allows, so every piece takes the shrinking path.
+        let big = alone(&strip, 300.0);
+        assert!(big.len() <= 2 * (4000 / 224 + 1), "{} pieces", big.len());
+        for w in &big {
+            let e = winding_extents(w, &vecs);
+            assert!(e.extents[0] <= MAX_SURFACE_EXTENT && e.extents[1] <= MAX_SURFACE_EXTENT);
+        }
+        // A face cut after it is cut as if alone.
+        let mut out = Vec::new();
+        subdivide(strip.clone(), &vecs, 300.0, &mut out);
+        let before = out.len();
+        subdivide(square(0.0, 0.0, 1000.0), &vecs, 240.0, &mut out);
+        assert_eq!(out[before..], alone(&square(0.0, 0.0, 1000.0), 240.0)[..]);
+    }
 }

@@ -1,10 +1,11 @@
 //! Slipgate: .map to BSP29/BSP2 compiler.
 //!
 //! Stages, each a module with typed input and output: [`map`] (parsing), [`texinfo`] and
-//! [`wad_lookup`] (textures), [`brush`] (brush windings), [`tree`] (the BSP tree, which also does
-//! the CSG), [`portals`], [`outside`] (filling and leaks), [`faces`] (faces from portals, merging,
-//! subdivision), [`hulls`] (clip hulls), [`weld`] (shared vertices, T-junctions) and `emit`.
-//! [`compile()`] runs them all.
+//! [`wad_lookup`] (textures), [`brush`] (brush windings), [`csg`] (hidden sides), [`tree`] (the
+//! BSP tree), [`portals`], [`outside`] (filling and leaks), [`faces`] (faces from portals,
+//! merging, subdivision), [`hulls`] (clip hulls) and [`surface_tree`] (their trees rebuilt after
+//! filling), [`weld`] (shared vertices, T-junctions) and `emit`. [`compile()`] runs them all;
+//! [`trace`] moves a hull's box through a written BSP as engines do.
 
 pub mod brush;
 pub mod cli;
@@ -17,7 +18,9 @@ pub mod map;
 pub mod outside;
 pub mod planes;
 pub mod portals;
+pub mod surface_tree;
 pub mod texinfo;
+pub mod trace;
 pub mod tree;
 pub mod wad_lookup;
 pub mod warnings;

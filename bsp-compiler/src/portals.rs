@@ -262,4 +262,50 @@ mod tests {
             assert!(own.normal.dot(p.plane.normal) > 0.99);
         }
     }
+
+    /// Regression: a node's portal used to be cut only by the portals around the node, not by
+    /// the node planes above it, so it could reach past the node's region.
+    #[test]
+    fn portals_stay_within_their_nodes_regions() {
+        let mut planes = PlaneSet::new();
+        let boxes = [
+            (Vec3::new(0.0, 0.0, 0.0), Vec3::new(64.0, 64.0, 16.0)),
+            (Vec3::new(96.0, -32.0, 0.0), Vec3::new(128.0, 96.0, 128.0)),
+            (Vec3::new(-64.0, 80.0, 32.0), Vec3::new(200.0, 112.0, 48.0)),
+            (Vec3::new(16.0, 16.0, 64.0), Vec3::new(48.0, 48.0, 200.0)),
+        ];
+        let brushes: Vec<Brush> = boxes
+            .iter()
+            .enumerate()
+            .map(|(i, &(lo, hi))| {
+                Brush::from_planes(&box_planes(lo, hi), &mut planes, contents::SOLID, i as u32)
+                    .expect("brush")
+            })
+            .collect();
+        let bounds = brushes
+            .iter()
+            .fold(Bounds::EMPTY, |acc, b| acc.union(&b.bounds));
+        let tree = build_tree(brushes, &planes, SplitHeuristic::FewestSplits, true);
+        let portals = make_portals(&tree, &planes, &bounds);
+        // The half-spaces above each node.
+        let mut above: Vec<Vec<Plane>> = vec![Vec::new(); tree.nodes.len()];
+        for (i, n) in tree.nodes.iter().enumerate() {
+            if let Some(id) = n.plane {
+                let p = *planes.get(id);
+                for (child, side) in n.children.into_iter().zip([p, p.flipped()]) {
+                    let mut list = above[i].clone();
+                    list.push(side);
+                    above[child as usize] = list;
+                }
+            }
+        }
+        for p in &portals.portals {
+            let Some(node) = p.on_node else { continue };
+            for half in &above[node as usize] {
+                for &v in &p.winding.points {
+                    assert!(half.distance(v) > -0.1, "{v:?} is outside node {node}");
+                }
+            }
+        }
+    }
 }

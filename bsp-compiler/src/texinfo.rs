@@ -246,4 +246,31 @@ mod tests {
         assert!(TextureRole::of("*slime0").is_special());
         assert!(!TextureRole::of("skip").is_drawn());
     }
+
+    proptest::proptest! {
+        /// On any plane, a standard projection maps points to texture coordinates one to one,
+        /// so every texel position belongs to exactly one point of the face.
+        #[test]
+        fn standard_projections_invert(
+            n in (-1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0),
+            rotation in -360.0f64..360.0,
+            scale in (0.1f64..4.0, 0.1f64..4.0),
+            negate in (proptest::bool::ANY, proptest::bool::ANY),
+        ) {
+            let Some(normal) = Vec3::new(n.0, n.1, n.2).normalized() else {
+                return Ok(());
+            };
+            let scale = [
+                if negate.0 { -scale.0 } else { scale.0 },
+                if negate.1 { -scale.1 } else { scale.1 },
+            ];
+            let v = standard([3.0, -7.0], rotation, scale).vecs(&plane(normal));
+            let s = Vec3::new(v[0][0], v[0][1], v[0][2]);
+            let t = Vec3::new(v[1][0], v[1][1], v[1][2]);
+            // The area the plane's unit square covers in texture space: zero means two points
+            // share texture coordinates.
+            let covered = s.cross(t).dot(normal).abs();
+            proptest::prop_assert!(covered > 1e-3 / (scale[0] * scale[1]).abs(), "{:?} {:?}", s, t);
+        }
+    }
 }

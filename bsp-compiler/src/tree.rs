@@ -6,7 +6,7 @@
 use crate::brush::Brush;
 use crate::planes::{PlaneId, PlaneSet};
 use quake_formats::bsp::contents;
-use quake_formats::geom::{Bounds, Vec3};
+use quake_formats::geom::{Bounds, Plane, Vec3};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -26,6 +26,39 @@ pub enum SplitHeuristic {
 
 /// Nodes whose brushes span more than this on some axis are cut near their middle.
 pub const MID_SPLIT_SIZE: f64 = 1024.0;
+
+impl SplitHeuristic {
+    /// The ranking of a candidate `plane` that splits `split` things and leaves `front` and
+    /// `back` whole on either side: lower is better.
+    pub fn key(self, plane: &Plane, split: i64, front: i64, back: i64) -> (i64, i64, i64) {
+        let imbalance = (front - back).abs();
+        let non_axial = i64::from(plane.axial().is_none());
+        match self {
+            SplitHeuristic::FewestSplits => (split, imbalance, non_axial),
+            SplitHeuristic::Balanced => (5 * split + imbalance, non_axial, 0),
+        }
+    }
+}
+
+/// For a node whose contents span `bounds`, larger than [`MID_SPLIT_SIZE`]: the axial candidate
+/// closest to the middle of its longest axis.
+pub fn mid_split(bounds: &Bounds, candidates: &[PlaneId], planes: &PlaneSet) -> Option<PlaneId> {
+    let size = bounds.maxs - bounds.mins;
+    let axis = (0..3).max_by(|&a, &b| size[a].total_cmp(&size[b]).then(b.cmp(&a)))?;
+    if size[axis] <= MID_SPLIT_SIZE {
+        return None;
+    }
+    let middle = bounds.center()[axis];
+    candidates
+        .iter()
+        .filter(|&&id| planes.get(id).axial() == Some(axis))
+        .min_by(|&&a, &&b| {
+            let da = (planes.get(a).dist - middle).abs();
+            let db = (planes.get(b).dist - middle).abs();
+            da.total_cmp(&db).then(a.cmp(&b))
+        })
+        .copied()
+}
 
 impl std::str::FromStr for SplitHeuristic {
     type Err = String;
@@ -109,7 +142,8 @@ impl Tree {
     }
 }
 
-enum BuildNode {
+/// A tree under construction; [`flatten`] turns it into a [`Tree`].
+pub(crate) enum BuildNode {
     Split {
         plane: PlaneId,
         children: Box<[BuildNode; 2]>,
@@ -152,7 +186,7 @@ pub fn build_tree(
     }
 }
 
-fn flatten(node: BuildNode, out: &mut Vec<TreeNode>) -> u32 {
+pub(crate) fn flatten(node: BuildNode, out: &mut Vec<TreeNode>) -> u32 {
     let index = out.len() as u32;
     match node {
         BuildNode::Leaf { contents, brushes } => out.push(TreeNode {
@@ -179,7 +213,18 @@ fn flatten(node: BuildNode, out: &mut Vec<TreeNode>) -> u32 {
 
 impl Builder<'_> {
     fn build(&self, brushes: Vec<Brush>) -> BuildNode {
-        let Some(plane) = self.choose_splitter(&brushes) else {
+        // A fragment of the strongest contents filling the region decides it whatever lies
+        // inside: splitting further would only cut up space of one contents.
+        let strongest = brushes.iter().map(|b| contents_priority(b.contents)).max();
+        let filled = brushes
+            .iter()
+            .any(|b| Some(contents_priority(b.contents)) == strongest && b.fills_node());
+        let splitter = if filled {
+            None
+        } else {
+            self.choose_splitter(&brushes)
+        };
+        let Some(plane) = splitter else {
             let contents = brushes
                 .iter()
                 .map(|b| b.contents)
@@ -223,40 +268,26 @@ impl Builder<'_> {
         }
     }
 
-    /// For a big node: the axial candidate closest to the middle of its longest axis.
-    fn mid_split(&self, brushes: &[Brush], candidates: &[PlaneId]) -> Option<PlaneId> {
-        let bounds = brushes
-            .iter()
-            .fold(Bounds::EMPTY, |acc, b| acc.union(&b.bounds));
-        let size = bounds.maxs - bounds.mins;
-        let axis = (0..3).max_by(|&a, &b| size[a].total_cmp(&size[b]).then(b.cmp(&a)))?;
-        if size[axis] <= MID_SPLIT_SIZE {
-            return None;
-        }
-        let middle = bounds.center()[axis];
-        candidates
-            .iter()
-            .filter(|&&id| self.planes.get(id).axial() == Some(axis))
-            .min_by(|&&a, &&b| {
-                let da = (self.planes.get(a).dist - middle).abs();
-                let db = (self.planes.get(b).dist - middle).abs();
-                da.total_cmp(&db).then(a.cmp(&b))
-            })
-            .copied()
-    }
-
     /// The best unused side plane, or `None` when every side has been used (a leaf).
     fn choose_splitter(&self, brushes: &[Brush]) -> Option<PlaneId> {
         let mut candidates: Vec<PlaneId> = brushes
             .iter()
-            .flat_map(|b| b.sides.iter().filter(|s| !s.used).map(|s| s.plane))
+            .flat_map(|b| {
+                b.sides
+                    .iter()
+                    .filter(|s| !s.used && !s.buried)
+                    .map(|s| s.plane)
+            })
             .collect();
         if candidates.is_empty() {
             return None;
         }
         candidates.sort_unstable();
         candidates.dedup();
-        if let Some(mid) = self.mid_split(brushes, &candidates) {
+        let bounds = brushes
+            .iter()
+            .fold(Bounds::EMPTY, |acc, b| acc.union(&b.bounds));
+        if let Some(mid) = mid_split(&bounds, &candidates, self.planes) {
             return Some(mid);
         }
         let score = |&id: &PlaneId| {
@@ -270,13 +301,7 @@ impl Builder<'_> {
                     (false, false) => {}
                 }
             }
-            let imbalance = (front - back).abs();
-            let non_axial = i64::from(plane.axial().is_none());
-            let key = match self.heuristic {
-                SplitHeuristic::FewestSplits => (split, imbalance, non_axial),
-                SplitHeuristic::Balanced => (5 * split + imbalance, non_axial, 0),
-            };
-            (key, id)
+            (self.heuristic.key(plane, split, front, back), id)
         };
         let work = candidates.len() * brushes.len();
         if work > 20_000 {
@@ -337,5 +362,46 @@ mod tests {
         assert_eq!(find(Vec3::new(48.0, 32.0, 32.0)), contents::SOLID);
         assert_eq!(find(Vec3::new(80.0, 32.0, 32.0)), contents::WATER);
         assert_eq!(find(Vec3::new(200.0, 32.0, 32.0)), contents::EMPTY);
+    }
+
+    proptest::proptest! {
+        /// Overlapping boxes: every point well inside one lands in a solid leaf, every point
+        /// well outside all of them in an empty one.
+        #[test]
+        fn boxes_give_solid_leaves_exactly_inside(
+            boxes in proptest::collection::vec(
+                ((-8i32..8, -8i32..8, -8i32..8), (1i32..6, 1i32..6, 1i32..6)),
+                1..6,
+            ),
+            probes in proptest::collection::vec((-80i32..120, -80i32..120, -80i32..120), 40),
+        ) {
+            let mut planes = PlaneSet::new();
+            let boxes: Vec<(Vec3, Vec3)> = boxes
+                .iter()
+                .map(|&((x, y, z), (w, d, h))| {
+                    let lo = Vec3::new(x as f64, y as f64, z as f64) * 8.0;
+                    (lo, lo + Vec3::new(w as f64, d as f64, h as f64) * 8.0)
+                })
+                .collect();
+            let brushes: Vec<Brush> = boxes
+                .iter()
+                .enumerate()
+                .map(|(i, &(lo, hi))| {
+                    Brush::from_planes(&box_planes(lo, hi), &mut planes, contents::SOLID, i as u32)
+                        .expect("box")
+                })
+                .collect();
+            let mut brushes = brushes;
+            crate::csg::mark_hidden_sides(&mut brushes, &planes);
+            let tree = build_tree(brushes, &planes, SplitHeuristic::FewestSplits, true);
+            for &(x, y, z) in &probes {
+                // Odd coordinates are never on a box plane (those are multiples of 8).
+                let p = Vec3::new(x as f64 + 0.5, y as f64 + 0.5, z as f64 + 0.5);
+                let inside = boxes.iter().any(|&(lo, hi)| Bounds { mins: lo, maxs: hi }.contains(p));
+                let leaf = tree.leaf_at(&planes, p) as usize;
+                let expected = if inside { contents::SOLID } else { contents::EMPTY };
+                proptest::prop_assert_eq!(tree.nodes[leaf].contents, expected, "{:?}", p);
+            }
+        }
     }
 }

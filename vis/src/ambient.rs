@@ -1,0 +1,146 @@
+//! Ambient sound levels: each leaf hears the water, sky, slime and lava surfaces it can see,
+//! loudest when one is near. Engines read `Leaf::ambient` to fade the ambient loops in and out.
+
+use crate::VisError;
+use crate::pvs::Pvs;
+use quake_formats::Bsp;
+use quake_formats::geom::{Bounds, Vec3};
+use rayon::prelude::*;
+
+/// Ambient channels in `Leaf::ambient` order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Ambient {
+    Water = 0,
+    Sky = 1,
+    Slime = 2,
+    Lava = 3,
+}
+
+/// Full volume up to this distance (map units) from the leaf's box.
+const FULL_VOLUME_DISTANCE: f64 = 100.0;
+/// Volume lost per map unit beyond that (silent from 500 units on).
+const FALLOFF_PER_UNIT: f64 = 0.002;
+
+/// The ambient a texture makes, by its name (case-insensitive): liquids start with `*`.
+pub fn ambient_of_texture(name: &str) -> Option<Ambient> {
+    let name = name.to_ascii_lowercase();
+    if name.starts_with("sky") {
+        return Some(Ambient::Sky);
+    }
+    let liquid = name.strip_prefix('*')?;
+    if liquid.contains("slime") {
+        Some(Ambient::Slime)
+    } else if liquid.contains("lava") {
+        Some(Ambient::Lava)
+    } else if liquid.contains("water") {
+        Some(Ambient::Water)
+    } else {
+        None
+    }
+}
+
+/// Volume (0..=255) of a surface `distance` units from the listener's box.
+pub fn level_at(distance: f64) -> u8 {
+    let volume = if distance < FULL_VOLUME_DISTANCE {
+        1.0
+    } else {
+        (1.0 - distance * FALLOFF_PER_UNIT).max(0.0)
+    };
+    (volume * 255.0) as u8
+}
+
+/// The largest per-axis gap between two boxes (0 when they overlap).
+fn box_distance(a: &Bounds, b: &Bounds) -> f64 {
+    (0..3)
+        .map(|i| (b.mins[i] - a.maxs[i]).max(a.mins[i] - b.maxs[i]).max(0.0))
+        .fold(0.0, f64::max)
+}
+
+fn leaf_bounds(mins: [f32; 3], maxs: [f32; 3]) -> Bounds {
+    let mut b = Bounds::EMPTY;
+    b.add_point(Vec3::from_f32(mins));
+    b.add_point(Vec3::from_f32(maxs));
+    b
+}
+
+/// Fill `Leaf::ambient` of every vis leaf from the sound surfaces of the leaves it sees. Returns
+/// how many leaves hear anything.
+pub fn ambient_levels(bsp: &mut Bsp, pvs: &Pvs) -> Result<usize, VisError> {
+    crate::lump::check_portals_match(bsp, pvs.num_leafs())?;
+    // Each vis leaf's sound surfaces: channel and bounds.
+    let sources: Vec<Vec<(Ambient, Bounds)>> = (1..=pvs.num_leafs())
+        .map(|l| {
+            let leaf = &bsp.leafs[l];
+            let first = leaf.first_marksurface as usize;
+            let marks = bsp
+                .marksurfaces
+                .get(first..first + leaf.num_marksurfaces as usize)
+                .unwrap_or(&[]);
+            marks
+                .iter()
+                .filter_map(|&f| {
+                    let face = bsp.faces.get(f as usize)?;
+                    let texinfo = bsp.texinfo.get(face.texinfo as usize)?;
+                    let tex = bsp
+                        .textures
+                        .textures
+                        .get(texinfo.miptex as usize)?
+                        .as_ref()?;
+                    let kind = ambient_of_texture(&tex.name())?;
+                    let mut b = Bounds::EMPTY;
+                    for v in bsp.face_vertices(face)? {
+                        b.add_point(Vec3::from_f32(v));
+                    }
+                    Some((kind, b))
+                })
+                .collect()
+        })
+        .collect();
+    let levels: Vec<[u8; 4]> = (0..pvs.num_leafs())
+        .into_par_iter()
+        .map(|i| {
+            let leaf = &bsp.leafs[i + 1];
+            let here = leaf_bounds(leaf.mins, leaf.maxs);
+            let mut nearest = [f64::INFINITY; 4];
+            for seen in pvs.row(i).iter() {
+                for (kind, b) in &sources[seen] {
+                    let d = box_distance(&here, b);
+                    let slot = &mut nearest[*kind as usize];
+                    *slot = slot.min(d);
+                }
+            }
+            nearest.map(level_at)
+        })
+        .collect();
+    let mut hearing = 0;
+    for (i, level) in levels.into_iter().enumerate() {
+        hearing += usize::from(level.iter().any(|&l| l > 0));
+        bsp.leafs[i + 1].ambient = level;
+    }
+    Ok(hearing)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn texture_names_map_to_channels() {
+        assert_eq!(ambient_of_texture("*water1"), Some(Ambient::Water));
+        assert_eq!(ambient_of_texture("*04WATER2"), Some(Ambient::Water));
+        assert_eq!(ambient_of_texture("SKY4"), Some(Ambient::Sky));
+        assert_eq!(ambient_of_texture("*slime0"), Some(Ambient::Slime));
+        assert_eq!(ambient_of_texture("*lava1"), Some(Ambient::Lava));
+        assert_eq!(ambient_of_texture("*teleport"), None);
+        assert_eq!(ambient_of_texture("city4_6"), None);
+    }
+
+    #[test]
+    fn level_falls_off_with_distance() {
+        assert_eq!(level_at(0.0), 255);
+        assert_eq!(level_at(99.0), 255);
+        assert_eq!(level_at(250.0), 127);
+        assert_eq!(level_at(500.0), 0);
+        assert_eq!(level_at(f64::INFINITY), 0);
+    }
+}

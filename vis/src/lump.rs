@@ -1,0 +1,112 @@
+//! The BSP's visibility lump: compressed rows, shared when identical, and each leaf's offset.
+
+use crate::VisError;
+use crate::bitset::BitSet;
+use crate::pvs::Pvs;
+use quake_formats::Bsp;
+use quake_formats::visrle::{compress_row, decompress_row};
+use std::collections::HashMap;
+
+/// What writing the lump produced.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
+pub struct LumpStats {
+    pub vis_leafs: usize,
+    /// Distinct compressed rows (identical rows are stored once).
+    pub unique_rows: usize,
+    pub compressed_bytes: usize,
+    /// What the rows would take uncompressed and unshared.
+    pub uncompressed_bytes: usize,
+    pub average_visible: f64,
+    pub max_visible: usize,
+}
+
+/// The world model's vis leaf count (BSP leaves 1..=N have PVS rows).
+pub fn world_vis_leafs(bsp: &Bsp) -> Result<usize, VisError> {
+    let world = bsp.models.first().ok_or(VisError::NoWorldModel)?;
+    let n = usize::try_from(world.vis_leafs).map_err(|_| VisError::BadVisLeafs {
+        vis_leafs: world.vis_leafs as i64,
+        leafs: bsp.leafs.len(),
+    })?;
+    if n + 1 > bsp.leafs.len() {
+        return Err(VisError::BadVisLeafs {
+            vis_leafs: n as i64,
+            leafs: bsp.leafs.len(),
+        });
+    }
+    Ok(n)
+}
+
+/// Refuse a portal file made for another BSP (or another compile of it).
+pub fn check_portals_match(bsp: &Bsp, prt_leafs: usize) -> Result<(), VisError> {
+    let vis_leafs = world_vis_leafs(bsp)?;
+    if vis_leafs != prt_leafs {
+        return Err(VisError::LeafCountMismatch {
+            prt_leafs,
+            vis_leafs,
+        });
+    }
+    Ok(())
+}
+
+/// Store `pvs` in `bsp`: the visibility lump and the vis offset of every leaf. Leaf 0 and the
+/// leaves of brush models get -1 (no row), as engines expect.
+pub fn write_vis(bsp: &mut Bsp, pvs: &Pvs) -> Result<LumpStats, VisError> {
+    check_portals_match(bsp, pvs.num_leafs())?;
+    let mut lump = Vec::new();
+    let mut offsets: HashMap<Vec<u8>, i32> = HashMap::new();
+    let mut uncompressed = 0;
+    for leaf in bsp.leafs.iter_mut() {
+        leaf.vis_offset = -1;
+    }
+    for (i, row) in pvs.rows().iter().enumerate() {
+        let bytes = row.to_row_bytes();
+        uncompressed += bytes.len();
+        let packed = compress_row(&bytes);
+        let offset = match offsets.get(&packed) {
+            Some(&offset) => offset,
+            None => {
+                let offset = i32::try_from(lump.len()).map_err(|_| VisError::LumpTooLarge)?;
+                lump.extend_from_slice(&packed);
+                offsets.insert(packed, offset);
+                offset
+            }
+        };
+        bsp.leafs[i + 1].vis_offset = offset;
+    }
+    bsp.visibility = lump;
+    Ok(LumpStats {
+        vis_leafs: pvs.num_leafs(),
+        unique_rows: offsets.len(),
+        compressed_bytes: bsp.visibility.len(),
+        uncompressed_bytes: uncompressed,
+        average_visible: pvs.average_visible(),
+        max_visible: pvs.max_visible(),
+    })
+}
+
+/// The PVS stored in `bsp`, as engines read it. A leaf without a row (offset -1, or no
+/// visibility data at all) sees everything, which is what engines do with it.
+pub fn read_pvs(bsp: &Bsp) -> Result<Pvs, VisError> {
+    let n = world_vis_leafs(bsp)?;
+    let row_len = n.div_ceil(8);
+    let rows = (1..=n)
+        .map(|leaf| {
+            let offset = bsp.leafs[leaf].vis_offset;
+            if offset < 0 || bsp.visibility.is_empty() {
+                return Ok(BitSet::full(n));
+            }
+            let data = bsp
+                .visibility
+                .get(offset as usize..)
+                .filter(|d| !d.is_empty())
+                .ok_or(VisError::BadVisOffset {
+                    leaf,
+                    offset,
+                    lump_len: bsp.visibility.len(),
+                })?;
+            let (bytes, _complete) = decompress_row(data, row_len);
+            Ok(BitSet::from_row_bytes(&bytes, n))
+        })
+        .collect::<Result<Vec<_>, VisError>>()?;
+    Ok(Pvs::new(rows))
+}

@@ -1,0 +1,21 @@
+use clap::Parser;
+use std::process::ExitCode;
+use vis::cli::{Args, run};
+
+/// Compute the potentially visible sets of a compiled Quake map.
+#[derive(Parser)]
+#[command(name = "slipgate-vis", version)]
+struct Cli {
+    #[command(flatten)]
+    args: Args,
+}
+
+fn main() -> ExitCode {
+    match run(&Cli::parse().args) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
