@@ -17,6 +17,9 @@ pub struct BuildArgs {
     /// Extra folders to search for the WADs the map names
     #[arg(long = "wad-dir", value_name = "DIR")]
     wad_dirs: Vec<PathBuf>,
+    /// Base vis only (conservative, coarser, much faster)
+    #[arg(long)]
+    fast: bool,
     /// Light with 2x2 samples per luxel
     #[arg(long)]
     extra: bool,
@@ -56,6 +59,13 @@ pub fn build(args: &BuildArgs) -> Result<()> {
     }
     eprintln!("== bsp");
     bsp_compiler::cli::run(&stage_args("bsp", argv)?)?;
+
+    let mut argv: Vec<OsString> = vec![bsp.clone().into()];
+    if args.fast {
+        argv.push("--fast".into());
+    }
+    eprintln!("== vis");
+    vis::cli::run(&stage_args("vis", argv)?)?;
 
     let mut argv: Vec<OsString> = vec![bsp.clone().into()];
     for (on, flag) in [

@@ -27,6 +27,8 @@ enum Command {
     Build(build::BuildArgs),
     /// Compile a .map to BSP29 (or BSP2), writing the .prt portal file and a .pts pointfile on a leak
     Bsp(bsp_compiler::cli::Args),
+    /// Compute the potentially visible set of every leaf from the .prt portals (--fast: base vis only)
+    Vis(vis::cli::Args),
     /// Compute lightmaps with Embree-traced shadow rays (writes the BSP, and .lit for coloured light)
     Light(light::cli::Args),
     /// Render a compiled map to PNG with the software renderer (or fly through it with --bench)
@@ -70,6 +72,7 @@ fn run(command: Command) -> Result<ExitCode> {
     match command {
         Command::Build(args) => build::build(&args).map(|()| ExitCode::SUCCESS),
         Command::Bsp(args) => bsp_compiler::cli::run(&args).map(|()| ExitCode::SUCCESS),
+        Command::Vis(args) => vis::cli::run(&args).map(|()| ExitCode::SUCCESS),
         Command::Light(args) => light::cli::run(&args).map(|()| ExitCode::SUCCESS),
         Command::View(args) => runtime_viewer::cli::run(&args).map(|()| ExitCode::SUCCESS),
         Command::Info(args) => inspect::info(&args),

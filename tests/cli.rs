@@ -153,3 +153,50 @@ fn build_runs_the_whole_pipeline_on_the_demo_map() {
         .expect("lighting line");
     assert!(lighting > 0, "the build left the map unlit");
 }
+
+/// Sight lines between random points must never find a leaf missing from the other's PVS; this
+/// failed on every waterline before the compiler wrote portals through liquid surfaces.
+#[test]
+fn vis_of_the_demo_map_is_never_too_small() {
+    let maps = Path::new(env!("CARGO_MANIFEST_DIR")).join("maps");
+    let dir = scratch("vis");
+    std::fs::create_dir_all(&dir).expect("dir");
+    for f in ["demo.map", "slipgate.wad"] {
+        std::fs::copy(maps.join(f), dir.join(f)).expect("copy");
+    }
+    let map = dir.join("demo.map");
+    let bsp = map.with_extension("bsp");
+    assert!(
+        slipgate(&["bsp", map.to_str().expect("utf8")])
+            .status
+            .success()
+    );
+    let mut in_pvs = Vec::new();
+    for mode in [&["-fast"][..], &[][..]] {
+        let mut args = vec!["vis", "--sample-pairs", "100000"];
+        args.extend_from_slice(mode);
+        args.push(bsp.to_str().expect("utf8"));
+        let out = slipgate(&args);
+        let text = String::from_utf8_lossy(&out.stdout).to_string()
+            + &String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{text}");
+        let line = text
+            .lines()
+            .find(|l| l.contains("sampling:"))
+            .expect("sampling line");
+        assert!(line.ends_with("0 too small"), "{line}");
+        let share: f64 = line
+            .split(" vs ")
+            .nth(1)
+            .and_then(|s| s.split('%').next())
+            .and_then(|s| s.parse().ok())
+            .expect("PVS share");
+        in_pvs.push(share);
+    }
+    assert!(
+        in_pvs[1] <= in_pvs[0],
+        "full vis {} is larger than fast {}",
+        in_pvs[1],
+        in_pvs[0]
+    );
+}

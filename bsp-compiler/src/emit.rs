@@ -383,7 +383,17 @@ impl TreeWriter<'_, '_> {
     }
 }
 
-/// The PRT1 file: portals between world leaves of the same contents, numbered from BSP leaf 1.
+/// Whether sight passes through leaves of these contents. Liquids count: modern engines draw
+/// water translucent, so (like ericw-tools' default "transwater") vis sees through liquid
+/// surfaces instead of cutting the world in two at every waterline.
+fn see_through(contents: i32) -> bool {
+    matches!(
+        contents,
+        contents::EMPTY | contents::WATER | contents::SLIME | contents::LAVA
+    )
+}
+
+/// The PRT1 file: portals between see-through world leaves, numbered from BSP leaf 1.
 fn world_portal_file(
     world: &ModelOutput,
     leaf_index: &HashMap<u32, u32>,
@@ -396,7 +406,9 @@ fn world_portal_file(
             continue;
         };
         let tree = &world.tree.nodes;
-        if tree[p.nodes[0] as usize].contents != tree[p.nodes[1] as usize].contents {
+        if !see_through(tree[p.nodes[0] as usize].contents)
+            || !see_through(tree[p.nodes[1] as usize].contents)
+        {
             continue;
         }
         portals.push(PrtPortal {
