@@ -419,5 +419,6 @@ fn world_portal_file(
     PortalFile {
         num_leafs: vis_leafs.max(0) as u32,
         portals,
+        clusters: None,
     }
 }

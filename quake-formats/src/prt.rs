@@ -7,6 +7,19 @@
 //! <points> <leaf a> <leaf b> (x y z ) (x y z ) ...
 //! ```
 //! Leaf numbers here count from BSP leaf 1.
+//!
+//! PRT2 (tyrutils/ericw-tools, for maps whose detail leaves are grouped into clusters) adds the
+//! cluster count to the header, numbers portal ends by cluster, and ends with one line per
+//! cluster listing its leaves, each list closed by `-1`:
+//!
+//! ```text
+//! PRT2
+//! <leaf count>
+//! <cluster count>
+//! <portal count>
+//! <points> <cluster a> <cluster b> (x y z ) ...
+//! <leaf> <leaf> ... -1          (one line per cluster)
+//! ```
 
 use crate::error::{FormatError, Result};
 use crate::geom::{Vec3, Winding};
@@ -21,8 +34,12 @@ pub struct PrtPortal {
 /// A whole portal file.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct PortalFile {
+    /// Vis leaves (BSP leaves 1..=num_leafs).
     pub num_leafs: u32,
+    /// Portals; their `leafs` are cluster numbers when `clusters` is set.
     pub portals: Vec<PrtPortal>,
+    /// PRT2 only: the leaves of each cluster.
+    pub clusters: Option<Vec<Vec<u32>>>,
 }
 
 impl PortalFile {
@@ -37,13 +54,17 @@ impl PortalFile {
                     detail: format!("portal file ends before {what}"),
                 })
         };
-        let (line, magic) = next("the PRT1 header")?;
-        if magic != "PRT1" {
-            return Err(FormatError::Syntax {
-                line,
-                detail: format!("expected PRT1, found {magic:?}"),
-            });
-        }
+        let (line, magic) = next("the PRT1 or PRT2 header")?;
+        let prt2 = match magic {
+            "PRT1" => false,
+            "PRT2" => true,
+            _ => {
+                return Err(FormatError::Syntax {
+                    line,
+                    detail: format!("expected PRT1 or PRT2, found {magic:?}"),
+                });
+            }
+        };
         let num = |(line, s): (usize, &str), what: &str| -> Result<u32> {
             s.parse().map_err(|_| FormatError::Syntax {
                 line,
@@ -51,17 +72,44 @@ impl PortalFile {
             })
         };
         let num_leafs = num(next("the leaf count")?, "leaf count")?;
+        let num_clusters = if prt2 {
+            num(next("the cluster count")?, "cluster count")?
+        } else {
+            num_leafs
+        };
         let num_portals = num(next("the portal count")?, "portal count")?;
-        let mut portals = Vec::with_capacity(num_portals as usize);
+        let mut portals = Vec::with_capacity(num_portals.min(1 << 20) as usize);
         for _ in 0..num_portals {
             let (line, text) = next("all portals")?;
-            portals.push(parse_portal(line, text, num_leafs)?);
+            portals.push(parse_portal(line, text, num_clusters)?);
         }
-        Ok(PortalFile { num_leafs, portals })
+        let clusters = if prt2 {
+            let mut clusters = Vec::with_capacity(num_clusters.min(1 << 20) as usize);
+            for _ in 0..num_clusters {
+                let (line, text) = next("every cluster's leaf list")?;
+                clusters.push(parse_cluster(line, text, num_leafs)?);
+            }
+            Some(clusters)
+        } else {
+            None
+        };
+        Ok(PortalFile {
+            num_leafs,
+            portals,
+            clusters,
+        })
     }
 
     pub fn write(&self) -> String {
-        let mut out = format!("PRT1\n{}\n{}\n", self.num_leafs, self.portals.len());
+        let mut out = match &self.clusters {
+            None => format!("PRT1\n{}\n{}\n", self.num_leafs, self.portals.len()),
+            Some(c) => format!(
+                "PRT2\n{}\n{}\n{}\n",
+                self.num_leafs,
+                c.len(),
+                self.portals.len()
+            ),
+        };
         for p in &self.portals {
             out.push_str(&format!(
                 "{} {} {}",
@@ -79,8 +127,34 @@ impl PortalFile {
             }
             out.push('\n');
         }
+        for leafs in self.clusters.iter().flatten() {
+            for leaf in leafs {
+                out.push_str(&format!("{leaf} "));
+            }
+            out.push_str("-1\n");
+        }
         out
     }
+}
+
+fn parse_cluster(line: usize, text: &str, num_leafs: u32) -> Result<Vec<u32>> {
+    let err = |detail: String| FormatError::Syntax { line, detail };
+    let mut leafs = Vec::new();
+    for f in text.split_whitespace() {
+        let v: i64 = f
+            .parse()
+            .map_err(|_| err(format!("cluster leaf {f:?} is not a number")))?;
+        if v == -1 {
+            return Ok(leafs);
+        }
+        if v < 0 || v >= num_leafs as i64 {
+            return Err(err(format!(
+                "leaf {v} is not below the leaf count {num_leafs}"
+            )));
+        }
+        leafs.push(v as u32);
+    }
+    Err(err("cluster leaf list does not end with -1".to_string()))
 }
 
 /// Coordinates as the shortest text that reads back to the same `f32` (what vis gets anyway).
@@ -88,7 +162,7 @@ fn fmt_coord(v: f64) -> String {
     format!("{}", v as f32)
 }
 
-fn parse_portal(line: usize, text: &str, num_leafs: u32) -> Result<PrtPortal> {
+fn parse_portal(line: usize, text: &str, num_ends: u32) -> Result<PrtPortal> {
     let err = |detail: String| FormatError::Syntax { line, detail };
     let cleaned = text.replace(['(', ')'], " ");
     let mut fields = cleaned.split_whitespace();
@@ -102,9 +176,9 @@ fn parse_portal(line: usize, text: &str, num_leafs: u32) -> Result<PrtPortal> {
     let count = int("point count")?;
     let a = int("first leaf")?;
     let b = int("second leaf")?;
-    if a >= num_leafs || b >= num_leafs {
+    if a >= num_ends || b >= num_ends {
         return Err(err(format!(
-            "leaf {a} or {b} is not below the leaf count {num_leafs}"
+            "portal end {a} or {b} is not below the leaf (or cluster) count {num_ends}"
         )));
     }
     if !(3..=1024).contains(&count) {
@@ -153,6 +227,7 @@ mod tests {
                     Vec3::new(-1e-3, 64.0, 128.0),
                 ]),
             }],
+            clusters: None,
         };
         let text = file.write();
         assert!(text.starts_with("PRT1\n3\n1\n3 0 2 ("));
@@ -166,6 +241,15 @@ mod tests {
         {
             assert!(a.near(*b, 1e-6));
         }
+    }
+
+    #[test]
+    fn prt2_round_trip() {
+        let text = "PRT2\n3\n2\n1\n3 0 1 (0 0 0 ) (0 64 0 ) (0 0 64 )\n0 1 -1\n2 -1\n";
+        let file = PortalFile::parse(text).expect("parse");
+        assert_eq!(file.clusters, Some(vec![vec![0, 1], vec![2]]));
+        assert_eq!(PortalFile::parse(&file.write()).expect("reparse"), file);
+        assert!(PortalFile::parse("PRT2\n3\n2\n0\n0 1\n2 -1\n").is_err());
     }
 
     #[test]

@@ -153,6 +153,7 @@ impl VoxelWorld {
         PortalFile {
             num_leafs: cells.len() as u32,
             portals,
+            clusters: None,
         }
     }
 

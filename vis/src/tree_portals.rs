@@ -47,6 +47,7 @@ pub fn portals_from_bsp(bsp: &Bsp) -> Result<PortalFile, VisError> {
     Ok(PortalFile {
         num_leafs: vis_leafs as u32,
         portals,
+        clusters: None,
     })
 }
 
