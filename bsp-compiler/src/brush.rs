@@ -23,6 +23,18 @@ pub struct Side {
     pub buried: bool,
 }
 
+/// What a brush does to the tree's structure.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum BrushKind {
+    /// Splits the structural tree, whose leaves are vis clusters, and seals the map.
+    #[default]
+    Structural,
+    /// Split in below the structural leaves only: neither a vis boundary nor a seal.
+    Detail,
+    /// Empty; its hint sides split the structural tree before any other plane.
+    Hint,
+}
+
 /// A convex volume of one contents type.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Brush {
@@ -31,6 +43,7 @@ pub struct Brush {
     pub contents: i32,
     /// Index of the map brush this came from, within its model.
     pub source: u32,
+    pub kind: BrushKind,
 }
 
 /// A plane of a brush being built, with the texinfo of its map face.
@@ -63,8 +76,8 @@ fn outward_plane(planes: &PlaneSet, plane: PlaneId, flipped: bool) -> Plane {
 }
 
 impl Brush {
-    /// The brush bounded by `faces` (outward planes). Planes that do not touch the brush are
-    /// dropped.
+    /// The structural brush bounded by `faces` (outward planes). Planes that do not touch the
+    /// brush are dropped.
     pub fn from_planes(
         faces: &[BrushPlane],
         planes: &mut PlaneSet,
@@ -106,7 +119,8 @@ impl Brush {
                 buried: false,
             });
         }
-        let brush = Brush::with_sides(sides, contents, source).ok_or(BrushError::NoVolume)?;
+        let brush = Brush::with_sides(sides, contents, source, BrushKind::Structural)
+            .ok_or(BrushError::NoVolume)?;
         let limit = MAX_WORLD_COORD * 0.5;
         if (0..3).any(|i| brush.bounds.mins[i] < -limit || brush.bounds.maxs[i] > limit) {
             return Err(BrushError::TooLarge);
@@ -115,7 +129,7 @@ impl Brush {
     }
 
     /// A brush from finished sides, or `None` when it is too small to keep.
-    fn with_sides(sides: Vec<Side>, contents: i32, source: u32) -> Option<Brush> {
+    fn with_sides(sides: Vec<Side>, contents: i32, source: u32, kind: BrushKind) -> Option<Brush> {
         if sides.len() < 4 {
             return None;
         }
@@ -130,8 +144,13 @@ impl Brush {
             bounds,
             contents,
             source,
+            kind,
         };
         (brush.volume() >= MIN_VOLUME).then_some(brush)
+    }
+
+    pub fn is_detail(&self) -> bool {
+        self.kind == BrushKind::Detail
     }
 
     pub fn outward(&self, side: &Side, planes: &PlaneSet) -> Plane {
@@ -250,8 +269,8 @@ impl Brush {
             buried: false,
         });
         match (
-            Brush::with_sides(front_sides, self.contents, self.source),
-            Brush::with_sides(back_sides, self.contents, self.source),
+            Brush::with_sides(front_sides, self.contents, self.source, self.kind),
+            Brush::with_sides(back_sides, self.contents, self.source, self.kind),
         ) {
             (Some(front), Some(back)) => (Some(front), Some(back)),
             _ => self.on_both_sides(),

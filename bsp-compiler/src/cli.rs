@@ -1,10 +1,13 @@
 //! The command line: `slipgate-bsp [--bsp2] [--wad-dir DIR]... IN.map [OUT.bsp]`.
 
-use crate::{CompileOptions, MapSource, SplitHeuristic, compile};
+use crate::{CompileOptions, MapSource, Progress, ProgressEvent, SplitHeuristic, compile};
 use anyhow::{Context, Result};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use quake_formats::fsutil::write_atomic;
 use quake_formats::pts::write_pointfile;
+use std::io::IsTerminal;
 use std::path::PathBuf;
+use std::sync::Mutex;
 
 #[derive(clap::Args, Debug, Clone)]
 pub struct Args {
@@ -30,6 +33,41 @@ pub struct Args {
     pub stats: Option<PathBuf>,
 }
 
+/// A progress bar on stderr for each long phase, when stderr is a terminal.
+fn progress_bar() -> Progress {
+    if !std::io::stderr().is_terminal() {
+        return Progress::default();
+    }
+    let current: Mutex<Option<ProgressBar>> = Mutex::new(None);
+    Progress::new(move |event| {
+        let Ok(mut current) = current.lock() else {
+            return;
+        };
+        match event {
+            ProgressEvent::Start { phase, total } => {
+                let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
+                if let Ok(style) =
+                    ProgressStyle::with_template("{msg:>8} {bar:40} {pos}/{len} {elapsed}")
+                {
+                    bar.set_style(style);
+                }
+                bar.set_message(phase);
+                *current = Some(bar);
+            }
+            ProgressEvent::Advance(n) => {
+                if let Some(bar) = current.as_ref() {
+                    bar.inc(n);
+                }
+            }
+            ProgressEvent::Finish => {
+                if let Some(bar) = current.take() {
+                    bar.finish_and_clear();
+                }
+            }
+        }
+    })
+}
+
 pub fn run(args: &Args) -> Result<()> {
     let source = MapSource::read(&args.input)?;
     let options = CompileOptions {
@@ -37,6 +75,7 @@ pub fn run(args: &Args) -> Result<()> {
         wad_dirs: args.wad_dirs.clone(),
         heuristic: args.heuristic,
         subdivide: args.subdivide,
+        progress: progress_bar(),
     };
     let out = compile(&source, &options)?;
     let bsp_path = args
@@ -85,8 +124,8 @@ pub fn run(args: &Args) -> Result<()> {
         s.planes, s.nodes, s.leaves, s.faces, s.splits, s.clipnodes, s.vertices, s.edges
     );
     println!(
-        "  {} portals ({} for vis), {} textures, {} texinfo, {} T-junction vertices added",
-        s.portals, s.vis_portals, s.textures, s.texinfo, s.tjunction_vertices
+        "  {} portals ({} for vis between {} clusters), {} textures, {} texinfo, {} T-junction vertices added",
+        s.portals, s.vis_portals, s.clusters, s.textures, s.texinfo, s.tjunction_vertices
     );
     for (phase, secs) in &s.timings {
         println!("  {phase:<28} {secs:8.3} s");

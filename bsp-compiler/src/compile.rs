@@ -1,18 +1,21 @@
 //! The whole compile: parse, build brushes, build each model's trees (in parallel), fill the
 //! outside, make faces, and emit the BSP and portal file.
 
-use crate::brush::{Brush, BrushPlane};
+use crate::brush::{Brush, BrushKind, BrushPlane};
 use crate::csg::mark_hidden_sides;
 use crate::emit::{EmitInput, emit};
 use crate::faces::{FaceStats, FaceTexInfo, ModelFace, faces_from_portals, merge_faces, subdivide};
 use crate::hulls::{HULL_BOXES, expand_brush};
-use crate::map::{MapEntity, MapError, parse_map};
+use crate::map::{MapBrush, MapEntity, MapError, parse_map};
 use crate::outside::{FillOutcome, Leak, Occupant, fill_outside};
 use crate::planes::PlaneSet;
-use crate::portals::{Portals, make_portals};
+use crate::portals::{Portals, make_cluster_portals, make_portals};
+use crate::progress::Progress;
 use crate::surface_tree::rebuild_from_surfaces;
 use crate::texinfo::TextureRole;
-use crate::tree::{SplitHeuristic, Tree, build_tree};
+use crate::tree::{
+    DETAIL_WALL, FENCE, ILLUSIONARY, SplitHeuristic, Tree, build_tree, engine_contents,
+};
 use crate::wad_lookup::WadSet;
 use crate::warnings::Warning;
 use quake_formats::bsp::contents;
@@ -59,6 +62,8 @@ pub struct CompileOptions {
     pub heuristic: SplitHeuristic,
     /// Largest span of a lit face in texels before it is cut.
     pub subdivide: f64,
+    /// Where the long phases report their progress.
+    pub progress: Progress,
 }
 
 impl Default for CompileOptions {
@@ -68,6 +73,7 @@ impl Default for CompileOptions {
             wad_dirs: Vec::new(),
             heuristic: SplitHeuristic::default(),
             subdivide: 240.0,
+            progress: Progress::default(),
         }
     }
 }
@@ -105,6 +111,8 @@ pub struct CompileStats {
     pub clipnodes: usize,
     pub portals: usize,
     pub vis_portals: usize,
+    /// Vis clusters (PRT2), or vis leaves when the world has no detail (PRT1).
+    pub clusters: usize,
     pub vertices: usize,
     pub edges: usize,
     pub texinfo: usize,
@@ -146,7 +154,16 @@ struct ModelInput {
     clip_bounds: Bounds,
 }
 
+/// Progress units [`build_model`] reports per brush of [`ModelInput::work`]: one for its CSG,
+/// one for its tree, one for filling and faces.
+const MODEL_WORK_PER_BRUSH: usize = 3;
+
 impl ModelInput {
+    /// Brushes of all three trees: the unit of model building progress.
+    fn work(&self) -> usize {
+        self.brushes.len() + self.hull_brushes[0].len() + self.hull_brushes[1].len()
+    }
+
     fn new(entity: usize) -> ModelInput {
         ModelInput {
             entity,
@@ -161,6 +178,8 @@ impl ModelInput {
 pub(crate) struct ModelOutput {
     pub tree: Tree,
     pub portals: Portals,
+    /// Portals between the structural leaves, when detail split some of them.
+    pub cluster_portals: Option<Portals>,
     pub faces: Vec<ModelFace>,
     pub hulls: [Tree; 2],
     pub bounds: Bounds,
@@ -171,12 +190,42 @@ pub(crate) struct ModelOutput {
 
 const MODEL_PHASES: [&str; 6] = ["tree", "portals", "outside", "faces", "hulls", "csg"];
 
-/// Entities whose brushes belong to the world.
-fn merges_into_world(classname: &str) -> bool {
-    matches!(
-        classname,
-        "func_group" | "func_detail" | "func_detail_wall" | "func_detail_fence"
-    )
+/// How an entity's brushes enter the compile.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum EntityBrushes {
+    /// Worldspawn and `func_group`.
+    World,
+    /// `func_detail`: world brushes that do not split the vis structure.
+    Detail,
+    /// `func_detail_wall`: detail that leaves the faces it touches whole.
+    DetailWall,
+    /// `func_detail_fence`: detail with see-through (fence) textures.
+    Fence,
+    /// `func_detail_illusionary`: drawn detail without collision.
+    Illusionary,
+    /// A brush entity of its own.
+    Submodel,
+}
+
+impl EntityBrushes {
+    fn of(index: usize, classname: &str) -> EntityBrushes {
+        match classname {
+            _ if index == 0 => EntityBrushes::World,
+            "func_group" => EntityBrushes::World,
+            "func_detail" => EntityBrushes::Detail,
+            "func_detail_wall" => EntityBrushes::DetailWall,
+            "func_detail_fence" => EntityBrushes::Fence,
+            "func_detail_illusionary" => EntityBrushes::Illusionary,
+            _ => EntityBrushes::Submodel,
+        }
+    }
+
+    fn kind(self) -> BrushKind {
+        match self {
+            EntityBrushes::World | EntityBrushes::Submodel => BrushKind::Structural,
+            _ => BrushKind::Detail,
+        }
+    }
 }
 
 /// Texture names and texinfos, interned in first-use order.
@@ -250,9 +299,11 @@ pub fn compile(
     let mut models: Vec<ModelInput> = vec![ModelInput::new(0)];
     let mut entities: Vec<Entity> = Vec::new();
     let mut occupants = Vec::new();
-    let mut skipped_illusionary = 0;
     let mut skipped_hint = 0;
+    let progress = &options.progress;
+    progress.start("brushes", map.entities.len());
     for (index, ent) in map.entities.iter().enumerate() {
+        progress.advance(1);
         let class = ent.entity.classname();
         if index > 0 && ent.brushes.is_empty() {
             if let Some([x, y, z]) = ent.entity.get_floats::<3>("origin") {
@@ -265,33 +316,50 @@ pub fn compile(
             entities.push(ent.entity.clone());
             continue;
         }
-        if class == "func_detail_illusionary" {
-            skipped_illusionary += ent.brushes.len();
-            continue;
-        }
-        let model = if index == 0 || merges_into_world(class) {
-            0
-        } else {
+        let brush_class = EntityBrushes::of(index, class);
+        // A submodel with an origin brush is built around that brush's centre, which becomes its
+        // "origin" (what rotating entities turn about).
+        let origin = match brush_class {
+            EntityBrushes::Submodel => origin_brush_centre(ent, &mut planes),
+            _ => None,
+        };
+        let model = if brush_class == EntityBrushes::Submodel {
             models.push(ModelInput::new(index));
             let mut e = ent.entity.clone();
             e.set("model", format!("*{}", models.len() - 1));
+            if let Some(o) = origin {
+                e.set("origin", format!("{} {} {}", o.x, o.y, o.z));
+            }
             entities.push(e);
             models.len() - 1
+        } else {
+            0
         };
         if index == 0 {
             entities.push(ent.entity.clone());
         }
-        let is_world = model == 0;
-        let (built, bad, hints) =
-            build_entity_brushes(ent, index, is_world, &mut planes, &mut table, &mut warnings);
+        let (built, bad, hints) = build_entity_brushes(
+            ent,
+            index,
+            brush_class,
+            origin.unwrap_or(Vec3::ZERO),
+            &mut planes,
+            &mut table,
+            &mut warnings,
+        );
         stats.brushes += ent.brushes.len();
         stats.bad_brushes += bad;
         skipped_hint += hints;
         let m = &mut models[model];
         for (brush, clip) in built {
+            let collides = matches!(
+                engine_contents(brush.contents),
+                contents::SOLID | contents::SKY
+            );
             for (hull, (mins, maxs)) in HULL_BOXES.iter().enumerate() {
-                let in_hulls = matches!(brush.contents, contents::SOLID | contents::SKY) || clip;
-                if in_hulls && let Some(g) = expand_brush(&brush, &mut planes, *mins, *maxs) {
+                if (collides || clip)
+                    && let Some(g) = expand_brush(&brush, &mut planes, *mins, *maxs)
+                {
                     m.hull_brushes[hull].push(g);
                 }
             }
@@ -302,14 +370,10 @@ pub fn compile(
             }
         }
     }
-    if skipped_illusionary > 0 {
-        warnings.push(Warning::Unsupported {
-            what: format!("{skipped_illusionary} func_detail_illusionary brushes are left out"),
-        });
-    }
+    progress.finish();
     if skipped_hint > 0 {
         warnings.push(Warning::Unsupported {
-            what: format!("{skipped_hint} hint brushes are ignored"),
+            what: format!("{skipped_hint} hint brushes in brush entities are ignored"),
         });
     }
     for m in &models[1..] {
@@ -331,6 +395,10 @@ pub fn compile(
             role: i.role,
         })
         .collect();
+    progress.start(
+        "models",
+        models.iter().map(ModelInput::work).sum::<usize>() * MODEL_WORK_PER_BRUSH,
+    );
     let results: Vec<(ModelOutput, Vec<Warning>)> = models
         .into_par_iter()
         .enumerate()
@@ -339,6 +407,7 @@ pub fn compile(
             build_model(m, &planes, &face_texinfos, options, occ)
         })
         .collect();
+    progress.finish();
     timings.push(("models (wall)".to_string(), t.elapsed().as_secs_f64()));
     let mut outputs = Vec::with_capacity(results.len());
     let mut phase_sums = [0.0; 6];
@@ -428,6 +497,11 @@ pub fn compile(
     stats.texinfo = bsp.texinfo.len();
     stats.textures = bsp.textures.textures.len();
     stats.vis_portals = emitted.portals.portals.len();
+    stats.clusters = emitted
+        .portals
+        .clusters
+        .as_ref()
+        .map_or(emitted.portals.num_leafs as usize, Vec::len);
     stats.tjunction_vertices = emitted.tjunction_vertices;
     stats.timings = timings;
     Ok(CompileOutput {
@@ -439,12 +513,42 @@ pub fn compile(
     })
 }
 
-/// Build one entity's brushes: each with whether it is a clip brush. Returns the brushes, the
-/// number of bad brushes and the number of hint brushes skipped.
+fn is_origin_brush(mb: &MapBrush) -> bool {
+    mb.faces
+        .iter()
+        .any(|f| TextureRole::of(&f.texture) == TextureRole::Origin)
+}
+
+/// The centre of the bounds of an entity's origin brushes, if it has any that can be built.
+fn origin_brush_centre(ent: &MapEntity, planes: &mut PlaneSet) -> Option<Vec3> {
+    let mut bounds = Bounds::EMPTY;
+    for mb in ent.brushes.iter().filter(|mb| is_origin_brush(mb)) {
+        let faces: Option<Vec<BrushPlane>> = mb
+            .faces
+            .iter()
+            .map(|f| {
+                Some(BrushPlane {
+                    plane: f.plane(Vec3::ZERO)?,
+                    texinfo: None,
+                })
+            })
+            .collect();
+        if let Some(b) = faces.and_then(|f| Brush::from_planes(&f, planes, contents::SOLID, 0).ok())
+        {
+            bounds = bounds.union(&b.bounds);
+        }
+    }
+    (!bounds.is_empty()).then(|| bounds.center())
+}
+
+/// Build one entity's brushes, in coordinates relative to `origin`, each with whether it is a
+/// clip brush; origin brushes are left out. Returns the brushes, the number of bad brushes and
+/// the number of hint brushes skipped (outside the world).
 fn build_entity_brushes(
     ent: &MapEntity,
     entity: usize,
-    is_world: bool,
+    class: EntityBrushes,
+    origin: Vec3,
     planes: &mut PlaneSet,
     table: &mut TexInfoTable,
     warnings: &mut Vec<Warning>,
@@ -452,37 +556,55 @@ fn build_entity_brushes(
     let mut out = Vec::new();
     let (mut bad, mut hints) = (0, 0);
     for (bi, mb) in ent.brushes.iter().enumerate() {
+        if is_origin_brush(mb) {
+            continue;
+        }
         let mut faces = Vec::with_capacity(mb.faces.len());
         let mut roles = Vec::with_capacity(mb.faces.len());
         let mut failure = None;
         for (fi, f) in mb.faces.iter().enumerate() {
-            let Some(plane) = f.plane() else {
+            let Some(plane) = f.plane(origin) else {
                 failure = Some(crate::brush::BrushError::NoPlane(fi).to_string());
                 break;
             };
-            let texinfo = table.intern(&f.texture, f.projection.vecs(&plane));
+            // Engines draw the model moved by its origin: shift the texture to match.
+            let mut vecs = f.projection.vecs(&plane);
+            for row in &mut vecs {
+                row[3] += Vec3::new(row[0], row[1], row[2]).dot(origin);
+            }
+            let texinfo = table.intern(&f.texture, vecs);
             roles.push(TextureRole::of(&f.texture));
             faces.push(BrushPlane {
                 plane,
                 texinfo: Some(texinfo),
             });
         }
-        if roles.contains(&TextureRole::Hint) {
+        let hint = roles
+            .iter()
+            .any(|r| matches!(r, TextureRole::Hint | TextureRole::HintSkip));
+        if hint && class == EntityBrushes::Submodel {
             hints += 1;
             continue;
         }
         let clip = roles.contains(&TextureRole::Clip);
-        let brush_contents = if !is_world {
-            contents::SOLID
-        } else if roles.contains(&TextureRole::Sky) {
-            contents::SKY
-        } else if let Some(c) = roles.iter().find_map(|r| match r {
-            TextureRole::Liquid(c) => Some(*c),
-            _ => None,
-        }) {
-            c
-        } else {
-            contents::SOLID
+        let brush_contents = match class {
+            _ if hint => contents::EMPTY,
+            EntityBrushes::Submodel => contents::SOLID,
+            EntityBrushes::Fence => FENCE,
+            EntityBrushes::DetailWall => DETAIL_WALL,
+            EntityBrushes::Illusionary => ILLUSIONARY,
+            EntityBrushes::World | EntityBrushes::Detail => {
+                if roles.contains(&TextureRole::Sky) {
+                    contents::SKY
+                } else if let Some(c) = roles.iter().find_map(|r| match r {
+                    TextureRole::Liquid(c) => Some(*c),
+                    _ => None,
+                }) {
+                    c
+                } else {
+                    contents::SOLID
+                }
+            }
         };
         let built = match failure {
             Some(reason) => Err(reason),
@@ -490,7 +612,19 @@ fn build_entity_brushes(
                 .map_err(|e| e.to_string()),
         };
         match built {
-            Ok(b) => out.push((b, clip)),
+            Ok(mut b) => {
+                if hint {
+                    b.kind = BrushKind::Hint;
+                    // Only the hint faces split; the others (skip, hintskip) are ignored.
+                    for s in &mut b.sides {
+                        let role = s.texinfo.map(|t| table.infos[t as usize].role);
+                        s.buried |= role != Some(TextureRole::Hint);
+                    }
+                } else {
+                    b.kind = class.kind();
+                }
+                out.push((b, clip));
+            }
             Err(reason) => {
                 bad += 1;
                 warnings.push(Warning::BadBrush {
@@ -549,11 +683,14 @@ fn build_model(
         };
     }
     let heuristic = options.heuristic;
+    let progress = &options.progress;
     let t = Instant::now();
     let mut brushes = m.brushes;
     let [mut h1, mut h2] = m.hull_brushes;
+    let counts = [brushes.len(), h1.len(), h2.len()];
     for list in [&mut brushes, &mut h1, &mut h2] {
         mark_hidden_sides(list, planes);
+        progress.advance(list.len());
     }
     let hull_bounds = [&h1, &h2].map(|list| {
         list.iter()
@@ -564,13 +701,22 @@ fn build_model(
         || {
             let t = Instant::now();
             let tree = build_tree(brushes, planes, heuristic, true);
+            progress.advance(counts[0]);
             (tree, t.elapsed().as_secs_f64())
         },
         || {
             let t = Instant::now();
             let (a, b) = rayon::join(
-                || build_tree(h1, planes, heuristic, false),
-                || build_tree(h2, planes, heuristic, false),
+                || {
+                    let tree = build_tree(h1, planes, heuristic, false);
+                    progress.advance(counts[1]);
+                    tree
+                },
+                || {
+                    let tree = build_tree(h2, planes, heuristic, false);
+                    progress.advance(counts[2]);
+                    tree
+                },
             );
             ([a, b], t.elapsed().as_secs_f64())
         },
@@ -580,12 +726,19 @@ fn build_model(
 
     let t = Instant::now();
     let portals = make_portals(&tree, planes, &bounds);
+    let cluster_portals = tree
+        .nodes
+        .iter()
+        .any(|n| n.cluster.is_some() && !n.is_leaf())
+        .then(|| make_cluster_portals(&tree, planes, &bounds));
     timings[1] = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
     let is_world = m.entity == 0;
-    let fill =
-        is_world.then(|| fill_outside(&mut tree, planes, &portals, occupants, &mut warnings));
+    let fill = is_world.then(|| {
+        let flood = cluster_portals.as_ref().unwrap_or(&portals);
+        fill_outside(&mut tree, planes, flood, occupants, &mut warnings)
+    });
     timings[2] = t.elapsed().as_secs_f64();
 
     // A sealed world's clip hulls are sealed too (grown brushes only close gaps further): fill
@@ -598,6 +751,7 @@ fn build_model(
             || fill_hull(h2, planes, &hull_bounds[1], occupants, heuristic),
         );
     }
+    progress.advance(counts[1] + counts[2]);
     timings[4] += t.elapsed().as_secs_f64();
     let t = Instant::now();
     let mut face_stats = FaceStats::default();
@@ -625,11 +779,13 @@ fn build_model(
     }
     face_stats.after_subdivide = faces.len();
     timings[3] = t.elapsed().as_secs_f64();
+    progress.advance(counts[0]);
 
     (
         ModelOutput {
             tree,
             portals,
+            cluster_portals,
             faces,
             hulls,
             bounds,

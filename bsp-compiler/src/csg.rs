@@ -1,5 +1,6 @@
 //! CSG between brushes: a side buried inside other brushes of at least its contents strength
-//! (solid > sky > lava > slime > water) can never be seen, so it never splits the tree. Faces
+//! (solid > detail wall > fence > sky > lava > slime > water > illusionary) can never be seen, so it never
+//! splits the tree. Detail brushes only hide the sides of other detail brushes. Faces
 //! between touching or overlapping brushes disappear that way, and trees (above all the clip
 //! hulls, whose grown brushes overlap a lot) get far fewer splits.
 //!
@@ -42,9 +43,11 @@ pub fn mark_hidden_sides(brushes: &mut [Brush], planes: &PlaneSet) -> usize {
                 .iter()
                 .copied()
                 .filter(|&j| {
+                    // Structure must not depend on detail: only detail is hidden by detail.
                     j != i
                         && padded[j].intersects(&padded[i])
                         && contents_priority(brushes[j].contents) >= prio
+                        && (me.is_detail() || !brushes[j].is_detail())
                 })
                 .collect();
             covers.sort_unstable();

@@ -1,12 +1,12 @@
 //! Writing the compiled models into a [`Bsp`]: planes, textures, shared vertices and edges,
 //! faces, nodes, leaves (leaf 0 is the shared solid leaf), clip nodes and models; and the
-//! world's portals into a PRT1 file.
+//! world's portals into a PRT1 file (PRT2 when it has detail).
 
 use crate::compile::{MapTexInfo, ModelOutput};
 use crate::faces::ModelFace;
 use crate::hulls::emit_clipnodes;
 use crate::planes::{PlaneId, PlaneSet};
-use crate::tree::Tree;
+use crate::tree::{Tree, engine_contents, is_see_through};
 use crate::wad_lookup::WadSet;
 use crate::warnings::Warning;
 use crate::weld::{VertexWelder, fix_tjunctions};
@@ -347,7 +347,7 @@ impl TreeWriter<'_, '_> {
             self.bsp.marksurfaces.extend(marks.into_iter().flatten());
             let index = self.bsp.leafs.len() as u32;
             self.bsp.leafs.push(Leaf {
-                contents: node.contents,
+                contents: engine_contents(node.contents),
                 vis_offset: -1,
                 mins: bounds.mins.to_f32(),
                 maxs: bounds.maxs.to_f32(),
@@ -383,42 +383,80 @@ impl TreeWriter<'_, '_> {
     }
 }
 
-/// Whether sight passes through leaves of these contents. Liquids count: modern engines draw
-/// water translucent, so (like ericw-tools' default "transwater") vis sees through liquid
-/// surfaces instead of cutting the world in two at every waterline.
-fn see_through(contents: i32) -> bool {
-    matches!(
-        contents,
-        contents::EMPTY | contents::WATER | contents::SLIME | contents::LAVA
-    )
-}
-
-/// The PRT1 file: portals between see-through world leaves, numbered from BSP leaf 1.
+/// The world's portal file: PRT1 between see-through leaves, numbered from BSP leaf 1; or, when
+/// the world has detail, PRT2 between its clusters (structural leaves).
 fn world_portal_file(
     world: &ModelOutput,
     leaf_index: &HashMap<u32, u32>,
     vis_leafs: i32,
 ) -> PortalFile {
-    let mut portals = Vec::new();
-    for p in &world.portals.portals {
-        let (Some(&a), Some(&b)) = (leaf_index.get(&p.nodes[0]), leaf_index.get(&p.nodes[1]))
-        else {
-            continue;
+    let tree = &world.tree.nodes;
+    let num_leafs = vis_leafs.max(0) as u32;
+    let Some(cluster_portals) = &world.cluster_portals else {
+        let mut portals = Vec::new();
+        for p in &world.portals.portals {
+            let (Some(&a), Some(&b)) = (leaf_index.get(&p.nodes[0]), leaf_index.get(&p.nodes[1]))
+            else {
+                continue;
+            };
+            if p.nodes
+                .iter()
+                .all(|&n| is_see_through(tree[n as usize].contents))
+            {
+                portals.push(PrtPortal {
+                    leafs: [a - 1, b - 1],
+                    winding: p.winding.clone(),
+                });
+            }
+        }
+        return PortalFile {
+            num_leafs,
+            portals,
+            clusters: None,
         };
-        let tree = &world.tree.nodes;
-        if !see_through(tree[p.nodes[0] as usize].contents)
-            || !see_through(tree[p.nodes[1] as usize].contents)
-        {
+    };
+    // Clusters in tree order, each with the vis leaves below it; a cluster is open to sight when
+    // one of its leaves is.
+    let mut clusters = Vec::new();
+    let mut cluster_of: HashMap<u32, (u32, bool)> = HashMap::new();
+    let mut stack = vec![0u32];
+    while let Some(n) = stack.pop() {
+        let node = &tree[n as usize];
+        if node.cluster.is_none() {
+            if !node.is_leaf() {
+                stack.push(node.children[1]);
+                stack.push(node.children[0]);
+            }
             continue;
         }
-        portals.push(PrtPortal {
-            leafs: [a - 1, b - 1],
-            winding: p.winding.clone(),
-        });
+        let leaves = world.tree.leaves_below(n);
+        let vis: Vec<u32> = leaves
+            .iter()
+            .filter_map(|l| leaf_index.get(l).map(|&i| i - 1))
+            .collect();
+        if vis.is_empty() {
+            continue;
+        }
+        let open = leaves
+            .iter()
+            .any(|&l| is_see_through(tree[l as usize].contents));
+        cluster_of.insert(n, (clusters.len() as u32, open));
+        clusters.push(vis);
+    }
+    let mut portals = Vec::new();
+    for p in &cluster_portals.portals {
+        if let (Some(&(a, true)), Some(&(b, true))) =
+            (cluster_of.get(&p.nodes[0]), cluster_of.get(&p.nodes[1]))
+        {
+            portals.push(PrtPortal {
+                leafs: [a, b],
+                winding: p.winding.clone(),
+            });
+        }
     }
     PortalFile {
-        num_leafs: vis_leafs.max(0) as u32,
+        num_leafs,
         portals,
-        clusters: None,
+        clusters: Some(clusters),
     }
 }

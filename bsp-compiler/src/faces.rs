@@ -1,10 +1,13 @@
 //! Faces: made from the portals where leaf contents change, textured from the brush side lying
 //! on the portal, then merged (coplanar, same texinfo) and subdivided for lightmaps.
 
+use crate::brush::{Brush, BrushKind};
 use crate::planes::PlaneId;
 use crate::portals::Portals;
 use crate::texinfo::TextureRole;
-use crate::tree::{Tree, TreeNode, contents_priority};
+use crate::tree::{
+    Tree, TreeNode, contents_priority, engine_contents, is_see_through, shows_faces_behind,
+};
 use quake_formats::bsp::contents;
 use quake_formats::bsp::limits::MAX_SURFACE_EXTENT;
 use quake_formats::extents::LightmapExtents;
@@ -43,17 +46,33 @@ pub struct FaceStats {
     pub after_subdivide: usize,
 }
 
-fn can_look_out(c: i32) -> bool {
-    matches!(
-        c,
-        contents::EMPTY | contents::WATER | contents::SLIME | contents::LAVA
-    )
+/// Whether a face on the boundary of a leaf of contents `owner` is seen from the leaf on its
+/// other side (`own_side` false) or from inside the owner: only liquid surfaces are seen from
+/// within (illusionary and fence brushes show their outsides only).
+fn seen_from(owner: i32, viewer: i32, own_side: bool) -> bool {
+    if own_side {
+        matches!(owner, contents::WATER | contents::SLIME | contents::LAVA)
+    } else {
+        shows_faces_behind(viewer)
+    }
 }
 
 /// The texinfo of the side of `leaf`'s brushes on `plane` facing out of it (`flipped` as in
-/// [`crate::brush::Side`]).
+/// [`crate::brush::Side`]). Brushes of the leaf's own contents come first.
 fn side_texinfo(leaf: &TreeNode, plane: PlaneId, flipped: bool) -> Option<u32> {
-    let sides = || leaf.brushes.iter().flat_map(|b| b.sides.iter());
+    let mut brushes: Vec<&Brush> = leaf
+        .brushes
+        .iter()
+        .filter(|b| b.contents == leaf.contents)
+        .collect();
+    if brushes.is_empty() {
+        brushes = leaf
+            .brushes
+            .iter()
+            .filter(|b| b.kind != BrushKind::Hint)
+            .collect();
+    }
+    let sides = || brushes.iter().flat_map(|b| b.sides.iter());
     sides()
         .find(|s| s.plane == plane && s.flipped == flipped && s.texinfo.is_some())
         .or_else(|| sides().find(|s| s.plane == plane && s.texinfo.is_some()))
@@ -61,8 +80,29 @@ fn side_texinfo(leaf: &TreeNode, plane: PlaneId, flipped: bool) -> Option<u32> {
         .and_then(|s| s.texinfo)
 }
 
-/// Faces on every portal between leaves of different contents, seen from each side that is not
-/// solid, textured by the stronger side's brushes.
+/// The leaves a face seen from `viewer` is listed in. A face behind a fence or a detail wall
+/// (solid leaves engines never draw from) is listed in the open leaves around them too.
+fn viewing_leaves(tree: &Tree, portals: &Portals, viewer: u32) -> Vec<u32> {
+    let mut leaves = vec![viewer];
+    let solid_viewer = |c: i32| engine_contents(c) == contents::SOLID;
+    if solid_viewer(tree.nodes[viewer as usize].contents) {
+        for &p in &portals.leaf_portals[viewer as usize] {
+            let other = portals.other(p, viewer);
+            if other != portals.outside
+                && is_see_through(tree.nodes[other as usize].contents)
+                && !solid_viewer(tree.nodes[other as usize].contents)
+            {
+                leaves.push(other);
+            }
+        }
+        leaves.sort_unstable();
+        leaves.dedup();
+    }
+    leaves
+}
+
+/// Faces on every portal between leaves of different contents, seen from each side that can see
+/// them, textured by the stronger side's brushes.
 pub fn faces_from_portals(
     tree: &Tree,
     portals: &Portals,
@@ -101,7 +141,8 @@ pub fn faces_from_portals(
             continue;
         }
         for (viewer, front) in [(a, true), (b, false)] {
-            if !can_look_out(tree.nodes[viewer as usize].contents) {
+            let viewer_contents = tree.nodes[viewer as usize].contents;
+            if !seen_from(owner_node.contents, viewer_contents, viewer == owner) {
                 continue;
             }
             stats.from_portals += 1;
@@ -116,7 +157,7 @@ pub fn faces_from_portals(
                 } else {
                     p.winding.reversed()
                 },
-                leaves: vec![viewer],
+                leaves: viewing_leaves(tree, portals, viewer),
             });
         }
     }

@@ -2,7 +2,8 @@
 //!
 //! Stages, each a module with typed input and output: [`map`] (parsing), [`texinfo`] and
 //! [`wad_lookup`] (textures), [`brush`] (brush windings), [`csg`] (hidden sides), [`tree`] (the
-//! BSP tree), [`portals`], [`outside`] (filling and leaks), [`faces`] (faces from portals,
+//! BSP tree: structural brushes first, its leaves the vis clusters, then detail below them),
+//! [`portals`], [`outside`] (filling and leaks), [`faces`] (faces from portals,
 //! merging, subdivision), [`hulls`] (clip hulls) and [`surface_tree`] (their trees rebuilt after
 //! filling), [`weld`] (shared vertices, T-junctions) and `emit`. [`compile()`] runs them all;
 //! [`trace`] moves a hull's box through a written BSP as engines do.
@@ -18,6 +19,7 @@ pub mod map;
 pub mod outside;
 pub mod planes;
 pub mod portals;
+pub mod progress;
 pub mod surface_tree;
 pub mod texinfo;
 pub mod trace;
@@ -30,5 +32,6 @@ pub use compile::{
     CompileError, CompileOptions, CompileOutput, CompileStats, MapSource, MapTexInfo, compile,
 };
 pub use outside::Leak;
+pub use progress::{Progress, ProgressEvent};
 pub use tree::SplitHeuristic;
 pub use warnings::Warning;

@@ -30,9 +30,10 @@ pub struct MapFace {
 }
 
 impl MapFace {
-    /// The face's plane (outward facing), snapped; `None` when the points are collinear.
-    pub fn plane(&self) -> Option<Plane> {
-        let [a, b, c] = self.points;
+    /// The face's plane (outward facing) in coordinates relative to `origin`, snapped; `None`
+    /// when the points are collinear.
+    pub fn plane(&self, origin: Vec3) -> Option<Plane> {
+        let [a, b, c] = self.points.map(|p| p - origin);
         Plane::from_points(a, b, c).map(|p| p.snapped())
     }
 }

@@ -1,9 +1,12 @@
 //! Outside filling: flood from the void through open portals; if that reaches a point entity the
 //! map leaks (report it with a path to the void), otherwise every flooded leaf becomes solid.
+//!
+//! The flood runs over the structural leaves (vis clusters) with their structural contents:
+//! detail brushes never seal a map, as in ericw-tools.
 
 use crate::planes::PlaneSet;
 use crate::portals::Portals;
-use crate::tree::{Tree, is_opaque};
+use crate::tree::{Tree, TreeNode, engine_contents, is_opaque};
 use crate::warnings::Warning;
 use quake_formats::bsp::contents;
 use quake_formats::geom::Vec3;
@@ -39,7 +42,8 @@ pub enum FillOutcome {
     NoOccupants,
 }
 
-/// Flood `tree` from the outside and fill it unless an occupant is reached.
+/// Flood `tree` from the outside and fill it unless an occupant is reached. `portals` are its
+/// cluster portals ([`crate::portals::make_cluster_portals`]).
 pub fn fill_outside(
     tree: &mut Tree,
     planes: &PlaneSet,
@@ -49,26 +53,30 @@ pub fn fill_outside(
 ) -> FillOutcome {
     let leaf_count = portals.leaf_portals.len();
     let mut occupant_of: Vec<Option<usize>> = vec![None; leaf_count];
+    let cluster_contents = |node: &TreeNode| node.cluster.unwrap_or(node.contents);
     for (i, o) in occupants.iter().enumerate() {
-        let leaf = tree.leaf_at(planes, o.origin) as usize;
-        if is_opaque(tree.nodes[leaf].contents) {
+        let cluster = tree.cluster_at(planes, o.origin) as usize;
+        let leaf = &tree.nodes[tree.leaf_at(planes, o.origin) as usize];
+        let sealed_in = is_opaque(cluster_contents(&tree.nodes[cluster]));
+        if sealed_in || engine_contents(leaf.contents) == contents::SOLID {
             warnings.push(Warning::EntityInSolid {
                 entity: o.entity,
                 classname: o.classname.clone(),
                 origin: o.origin,
             });
-        } else if occupant_of[leaf].is_none() {
-            occupant_of[leaf] = Some(i);
+        }
+        if !sealed_in && occupant_of[cluster].is_none() {
+            occupant_of[cluster] = Some(i);
         }
     }
     if occupant_of.iter().all(Option::is_none) {
         return FillOutcome::NoOccupants;
     }
-    let contents_of = |leaf: u32| {
-        if leaf == portals.outside {
+    let contents_of = |cluster: u32| {
+        if cluster == portals.outside {
             contents::EMPTY
         } else {
-            tree.nodes[leaf as usize].contents
+            cluster_contents(&tree.nodes[cluster as usize])
         }
     };
     let mut reached = vec![false; leaf_count];
@@ -99,10 +107,13 @@ pub fn fill_outside(
         });
     }
     let mut filled = 0;
-    for (leaf, &r) in reached.iter().enumerate().take(tree.nodes.len()) {
-        if r && tree.nodes[leaf].plane.is_none() {
-            tree.nodes[leaf].contents = contents::SOLID;
-            filled += 1;
+    for (cluster, &r) in reached.iter().enumerate().take(tree.nodes.len()) {
+        if r && tree.nodes[cluster].cluster.is_some() {
+            tree.nodes[cluster].cluster = Some(contents::SOLID);
+            for leaf in tree.leaves_below(cluster as u32) {
+                tree.nodes[leaf as usize].contents = contents::SOLID;
+                filled += 1;
+            }
         }
     }
     FillOutcome::Sealed { filled }

@@ -3,7 +3,7 @@
 //! A box of six portals around the whole tree joins it to an "outside" leaf.
 
 use crate::planes::{PlaneId, PlaneSet};
-use crate::tree::Tree;
+use crate::tree::{Tree, TreeNode};
 use quake_formats::geom::{Bounds, Plane, Split, Vec3, Winding};
 
 /// Space left between the map and the outside box.
@@ -26,7 +26,8 @@ pub struct Portal {
 pub struct Portals {
     /// Live portals only (every portal separates two leaves).
     pub portals: Vec<Portal>,
-    /// Portal indices touching each tree node (leaves only), plus the outside leaf last.
+    /// Portal indices touching each tree node (the leaves of the portalisation only), plus the
+    /// outside leaf last.
     pub leaf_portals: Vec<Vec<u32>>,
     /// Index of the outside leaf (one past the tree's nodes).
     pub outside: u32,
@@ -49,8 +50,23 @@ impl Portals {
     }
 }
 
-/// Portalize `tree`, whose contents lie within `bounds`.
+/// Portalize `tree`, whose contents lie within `bounds`: portals between its leaves.
 pub fn make_portals(tree: &Tree, planes: &PlaneSet, bounds: &Bounds) -> Portals {
+    portalize(tree, planes, bounds, TreeNode::is_leaf)
+}
+
+/// Portals between the structural leaves (vis clusters) of `tree`, ignoring the detail below.
+pub fn make_cluster_portals(tree: &Tree, planes: &PlaneSet, bounds: &Bounds) -> Portals {
+    portalize(tree, planes, bounds, |n| n.cluster.is_some() || n.is_leaf())
+}
+
+/// Portals between the nodes where `stop` holds, as if they were leaves.
+fn portalize(
+    tree: &Tree,
+    planes: &PlaneSet,
+    bounds: &Bounds,
+    stop: impl Fn(&TreeNode) -> bool,
+) -> Portals {
     let outside = tree.nodes.len() as u32;
     let mut b = Builder {
         portals: Vec::new(),
@@ -63,6 +79,9 @@ pub fn make_portals(tree: &Tree, planes: &PlaneSet, bounds: &Bounds) -> Portals 
     let mut stack = vec![0u32];
     while let Some(node) = stack.pop() {
         let n = &tree.nodes[node as usize];
+        if stop(n) {
+            continue;
+        }
         let Some(plane_id) = n.plane else { continue };
         let plane = *planes.get(plane_id);
         let above = std::mem::take(&mut bounding[node as usize]);

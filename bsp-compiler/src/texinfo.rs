@@ -128,6 +128,10 @@ pub enum TextureRole {
     Trigger,
     /// `hint`: a splitter only; the brush is neither drawn nor solid.
     Hint,
+    /// `hintskip`: a face of a hint brush that does not split.
+    HintSkip,
+    /// `origin`: the brush marks a brush entity's origin (its centre), and is not built.
+    Origin,
 }
 
 impl TextureRole {
@@ -148,7 +152,9 @@ impl TextureRole {
                 "clip" => TextureRole::Clip,
                 "skip" => TextureRole::Skip,
                 "trigger" => TextureRole::Trigger,
-                "hint" | "hintskip" => TextureRole::Hint,
+                "origin" => TextureRole::Origin,
+                "hint" => TextureRole::Hint,
+                "hintskip" => TextureRole::HintSkip,
                 _ => TextureRole::Normal,
             }
         }
@@ -163,7 +169,12 @@ impl TextureRole {
     pub fn is_drawn(self) -> bool {
         !matches!(
             self,
-            TextureRole::Clip | TextureRole::Skip | TextureRole::Trigger | TextureRole::Hint
+            TextureRole::Clip
+                | TextureRole::Skip
+                | TextureRole::Trigger
+                | TextureRole::Hint
+                | TextureRole::HintSkip
+                | TextureRole::Origin
         )
     }
 }

@@ -3,7 +3,7 @@
 //! This does the CSG implicitly: hidden faces between touching or overlapping brushes never
 //! become faces, because faces are only made where leaf contents change (see [`crate::faces`]).
 
-use crate::brush::Brush;
+use crate::brush::{Brush, BrushKind};
 use crate::planes::{PlaneId, PlaneSet};
 use quake_formats::bsp::contents;
 use quake_formats::geom::{Bounds, Plane, Vec3};
@@ -73,14 +73,36 @@ impl std::str::FromStr for SplitHeuristic {
     }
 }
 
+/// Compiler-only contents of `func_detail_fence` brushes: solid, yet faces behind them stay
+/// (fence textures have holes), and vis and face marking look through them. Written as solid.
+pub const FENCE: i32 = -100;
+/// Compiler-only contents of `func_detail_wall` brushes: solid, yet faces behind them stay whole
+/// instead of being cut where the brush touches them (as in ericw-tools). Written as solid.
+pub const DETAIL_WALL: i32 = -102;
+/// Compiler-only contents of `func_detail_illusionary` brushes: drawn from outside, written as
+/// empty.
+pub const ILLUSIONARY: i32 = -101;
+
+/// The contents engines see for a leaf of compiler contents `c`.
+pub fn engine_contents(c: i32) -> i32 {
+    match c {
+        FENCE | DETAIL_WALL => contents::SOLID,
+        ILLUSIONARY => contents::EMPTY,
+        c => c,
+    }
+}
+
 /// Ranking of contents: a region holding several brushes takes the strongest.
 pub fn contents_priority(c: i32) -> u8 {
     match c {
-        contents::SOLID => 5,
-        contents::SKY => 4,
-        contents::LAVA => 3,
-        contents::SLIME => 2,
-        contents::WATER => 1,
+        contents::SOLID => 8,
+        DETAIL_WALL => 7,
+        FENCE => 6,
+        contents::SKY => 5,
+        contents::LAVA => 4,
+        contents::SLIME => 3,
+        contents::WATER => 2,
+        ILLUSIONARY => 1,
         _ => 0,
     }
 }
@@ -88,6 +110,22 @@ pub fn contents_priority(c: i32) -> u8 {
 /// Contents that block flooding and are never looked out of.
 pub fn is_opaque(c: i32) -> bool {
     c == contents::SOLID || c == contents::SKY
+}
+
+/// Whether faces behind leaves of these contents are kept whole: sight passes through them, or
+/// (detail walls) they are told not to cut the faces they touch.
+pub fn shows_faces_behind(c: i32) -> bool {
+    is_see_through(c) || c == DETAIL_WALL
+}
+
+/// Whether sight passes through leaves of these contents. Liquids count: modern engines draw
+/// water translucent, so (like ericw-tools' default "transwater") vis sees through liquid
+/// surfaces instead of cutting the world in two at every waterline. Fences have holes.
+pub fn is_see_through(c: i32) -> bool {
+    matches!(
+        c,
+        contents::EMPTY | contents::WATER | contents::SLIME | contents::LAVA | FENCE | ILLUSIONARY
+    )
 }
 
 /// A node of the flattened tree; a leaf has no plane.
@@ -100,6 +138,9 @@ pub struct TreeNode {
     pub contents: i32,
     /// The brush fragments filling a leaf (kept for hull 0, for face textures).
     pub brushes: Vec<Brush>,
+    /// Set on the nodes where the structural tree ends (its leaves, the vis clusters): the
+    /// contents of the structural brushes there. Detail brushes split the space further below.
+    pub cluster: Option<i32>,
 }
 
 impl TreeNode {
@@ -119,22 +160,51 @@ pub struct Tree {
 impl Tree {
     /// The leaf holding `p` (points on a plane go to the front, as in engines).
     pub fn leaf_at(&self, planes: &PlaneSet, p: Vec3) -> u32 {
+        self.descend(planes, p, TreeNode::is_leaf)
+    }
+
+    /// The structural leaf (vis cluster) holding `p`.
+    pub fn cluster_at(&self, planes: &PlaneSet, p: Vec3) -> u32 {
+        self.descend(planes, p, |n| n.cluster.is_some())
+    }
+
+    fn descend(&self, planes: &PlaneSet, p: Vec3, stop: impl Fn(&TreeNode) -> bool) -> u32 {
         let mut n = 0u32;
-        while let Some(id) = self.nodes[n as usize].plane {
+        while !stop(&self.nodes[n as usize]) {
+            let Some(id) = self.nodes[n as usize].plane else {
+                break;
+            };
             let d = planes.get(id).distance(p);
             n = self.nodes[n as usize].children[usize::from(d < 0.0)];
         }
         n
     }
 
-    /// For each node, whether everything below it is solid (such subtrees become one leaf).
+    /// The leaves at or below node `n`, in pre-order.
+    pub fn leaves_below(&self, n: u32) -> Vec<u32> {
+        let mut out = Vec::new();
+        let mut stack = vec![n];
+        while let Some(n) = stack.pop() {
+            let node = &self.nodes[n as usize];
+            if node.is_leaf() {
+                out.push(n);
+            } else {
+                stack.push(node.children[1]);
+                stack.push(node.children[0]);
+            }
+        }
+        out
+    }
+
+    /// For each node, whether everything below it is solid and never looked through (such
+    /// subtrees become one leaf).
     pub fn all_solid(&self) -> Vec<bool> {
         let mut solid = vec![false; self.nodes.len()];
         // Children always come after their parent in the flattened order.
         for i in (0..self.nodes.len()).rev() {
             let n = &self.nodes[i];
             solid[i] = match n.plane {
-                None => n.contents == contents::SOLID,
+                None => matches!(n.contents, contents::SOLID | DETAIL_WALL),
                 Some(_) => solid[n.children[0] as usize] && solid[n.children[1] as usize],
             };
         }
@@ -152,6 +222,11 @@ pub(crate) enum BuildNode {
         contents: i32,
         brushes: Vec<Brush>,
     },
+    /// A structural leaf whose detail brushes split it further.
+    Cluster {
+        structural_contents: i32,
+        detail: Box<BuildNode>,
+    },
 }
 
 /// Subtrees with at least this many brushes are built in parallel.
@@ -165,6 +240,9 @@ struct Builder<'a> {
 }
 
 /// Build the tree of `brushes`. `keep_brushes` keeps each leaf's fragments in the result.
+///
+/// Structural (and hint) brush sides split first; where none is left, the node is a structural
+/// leaf, and the detail brushes in it are split in below.
 pub fn build_tree(
     brushes: Vec<Brush>,
     planes: &PlaneSet,
@@ -177,7 +255,7 @@ pub fn build_tree(
         keep_brushes,
         splits: AtomicUsize::new(0),
     };
-    let root = builder.build(brushes);
+    let root = builder.build(brushes, Phase::Structural);
     let mut nodes = Vec::new();
     flatten(root, &mut nodes);
     Tree {
@@ -187,6 +265,11 @@ pub fn build_tree(
 }
 
 pub(crate) fn flatten(node: BuildNode, out: &mut Vec<TreeNode>) -> u32 {
+    flatten_in(node, out, false)
+}
+
+/// `in_cluster`: the node lies below a structural leaf.
+fn flatten_in(node: BuildNode, out: &mut Vec<TreeNode>, in_cluster: bool) -> u32 {
     let index = out.len() as u32;
     match node {
         BuildNode::Leaf { contents, brushes } => out.push(TreeNode {
@@ -194,6 +277,7 @@ pub(crate) fn flatten(node: BuildNode, out: &mut Vec<TreeNode>) -> u32 {
             children: [0, 0],
             contents,
             brushes,
+            cluster: (!in_cluster).then_some(contents),
         }),
         BuildNode::Split { plane, children } => {
             out.push(TreeNode {
@@ -201,37 +285,67 @@ pub(crate) fn flatten(node: BuildNode, out: &mut Vec<TreeNode>) -> u32 {
                 children: [0, 0],
                 contents: 0,
                 brushes: Vec::new(),
+                cluster: None,
             });
             let [front, back] = *children;
-            let f = flatten(front, out);
-            let b = flatten(back, out);
+            let f = flatten_in(front, out, in_cluster);
+            let b = flatten_in(back, out, in_cluster);
             out[index as usize].children = [f, b];
+        }
+        BuildNode::Cluster {
+            structural_contents,
+            detail,
+        } => {
+            debug_assert!(!in_cluster, "clusters do not nest");
+            flatten_in(*detail, out, true);
+            out[index as usize].cluster = Some(structural_contents);
         }
     }
     index
 }
 
+/// Which brush sides may split a node.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Phase {
+    /// Above the structural leaves: structural and hint sides.
+    Structural,
+    /// Below a structural leaf: every side.
+    Detail,
+}
+
+impl Phase {
+    fn splits_with(self, b: &Brush) -> bool {
+        self == Phase::Detail || !b.is_detail()
+    }
+}
+
 impl Builder<'_> {
-    fn build(&self, brushes: Vec<Brush>) -> BuildNode {
+    fn build(&self, brushes: Vec<Brush>, phase: Phase) -> BuildNode {
         // A fragment of the strongest contents filling the region decides it whatever lies
-        // inside: splitting further would only cut up space of one contents.
+        // inside: splitting further would only cut up space of one contents. Above the
+        // structural leaves only a structural fragment may end the structure.
         let strongest = brushes.iter().map(|b| contents_priority(b.contents)).max();
-        let filled = brushes
-            .iter()
-            .any(|b| Some(contents_priority(b.contents)) == strongest && b.fills_node());
+        let filled = brushes.iter().any(|b| {
+            Some(contents_priority(b.contents)) == strongest
+                && b.fills_node()
+                && phase.splits_with(b)
+        });
         let splitter = if filled {
             None
         } else {
-            self.choose_splitter(&brushes)
+            self.choose_splitter(&brushes, phase)
         };
         let Some(plane) = splitter else {
-            let contents = brushes
-                .iter()
-                .map(|b| b.contents)
-                .max_by_key(|&c| contents_priority(c))
-                .unwrap_or(contents::EMPTY);
+            if phase == Phase::Structural && !filled && brushes.iter().any(Brush::is_detail) {
+                let structural_contents =
+                    strongest_contents(brushes.iter().filter(|b| !b.is_detail()));
+                return BuildNode::Cluster {
+                    structural_contents,
+                    detail: Box::new(self.build(brushes, Phase::Detail)),
+                };
+            }
             return BuildNode::Leaf {
-                contents,
+                contents: strongest_contents(brushes.iter()),
                 brushes: if self.keep_brushes {
                     brushes
                 } else {
@@ -258,9 +372,9 @@ impl Builder<'_> {
             }
         }
         let (f, b) = if parallel {
-            rayon::join(|| self.build(front), || self.build(back))
+            rayon::join(|| self.build(front, phase), || self.build(back, phase))
         } else {
-            (self.build(front), self.build(back))
+            (self.build(front, phase), self.build(back, phase))
         };
         BuildNode::Split {
             plane,
@@ -268,28 +382,36 @@ impl Builder<'_> {
         }
     }
 
-    /// The best unused side plane, or `None` when every side has been used (a leaf).
-    fn choose_splitter(&self, brushes: &[Brush]) -> Option<PlaneId> {
-        let mut candidates: Vec<PlaneId> = brushes
-            .iter()
-            .flat_map(|b| {
-                b.sides
-                    .iter()
-                    .filter(|s| !s.used && !s.buried)
-                    .map(|s| s.plane)
-            })
-            .collect();
+    /// The best unused side plane, or `None` when every side has been used (a leaf). Big nodes
+    /// are cut near their middle first, then hint sides win, then the heuristic decides.
+    fn choose_splitter(&self, brushes: &[Brush], phase: Phase) -> Option<PlaneId> {
+        let unused = |kind: Option<BrushKind>| {
+            let mut list: Vec<PlaneId> = brushes
+                .iter()
+                .filter(|b| phase.splits_with(b) && kind.is_none_or(|k| b.kind == k))
+                .flat_map(|b| {
+                    b.sides
+                        .iter()
+                        .filter(|s| !s.used && !s.buried)
+                        .map(|s| s.plane)
+                })
+                .collect();
+            list.sort_unstable();
+            list.dedup();
+            list
+        };
+        let candidates = unused(None);
         if candidates.is_empty() {
             return None;
         }
-        candidates.sort_unstable();
-        candidates.dedup();
         let bounds = brushes
             .iter()
             .fold(Bounds::EMPTY, |acc, b| acc.union(&b.bounds));
         if let Some(mid) = mid_split(&bounds, &candidates, self.planes) {
             return Some(mid);
         }
+        let hints = unused(Some(BrushKind::Hint));
+        let candidates = if hints.is_empty() { candidates } else { hints };
         let score = |&id: &PlaneId| {
             let plane = self.planes.get(id);
             let (mut front, mut back, mut split) = (0i64, 0i64, 0i64);
@@ -310,6 +432,14 @@ impl Builder<'_> {
             candidates.iter().map(score).min().map(|(_, id)| id)
         }
     }
+}
+
+/// The strongest contents among `brushes`, empty when there are none.
+fn strongest_contents<'a>(brushes: impl Iterator<Item = &'a Brush>) -> i32 {
+    brushes
+        .map(|b| b.contents)
+        .max_by_key(|&c| contents_priority(c))
+        .unwrap_or(contents::EMPTY)
 }
 
 #[cfg(test)]
@@ -362,6 +492,87 @@ mod tests {
         assert_eq!(find(Vec3::new(48.0, 32.0, 32.0)), contents::SOLID);
         assert_eq!(find(Vec3::new(80.0, 32.0, 32.0)), contents::WATER);
         assert_eq!(find(Vec3::new(200.0, 32.0, 32.0)), contents::EMPTY);
+    }
+
+    fn solid_box(planes: &mut PlaneSet, lo: Vec3, hi: Vec3) -> Brush {
+        Brush::from_planes(&box_planes(lo, hi), planes, contents::SOLID, 0).expect("box")
+    }
+
+    #[test]
+    fn hint_sides_split_first() {
+        let mut planes = PlaneSet::new();
+        let mut brushes = vec![
+            solid_box(&mut planes, Vec3::ZERO, Vec3::new(64.0, 64.0, 64.0)),
+            solid_box(
+                &mut planes,
+                Vec3::new(128.0, 0.0, 0.0),
+                Vec3::new(192.0, 64.0, 64.0),
+            ),
+        ];
+        let without = build_tree(
+            brushes.clone(),
+            &planes,
+            SplitHeuristic::FewestSplits,
+            false,
+        );
+        let (hint_plane, _) = planes.insert(&Plane::new(Vec3::new(1.0, 0.0, 0.0), 100.0));
+        assert_ne!(without.nodes[0].plane, Some(hint_plane));
+        let mut hint = Brush::from_planes(
+            &box_planes(Vec3::new(90.0, -8.0, -8.0), Vec3::new(100.0, 72.0, 72.0)),
+            &mut planes,
+            contents::EMPTY,
+            2,
+        )
+        .expect("hint");
+        hint.kind = BrushKind::Hint;
+        // One hint face; the others are skip.
+        for s in &mut hint.sides {
+            s.buried = s.plane != hint_plane;
+        }
+        brushes.push(hint);
+        let tree = build_tree(brushes, &planes, SplitHeuristic::FewestSplits, false);
+        assert_eq!(tree.nodes[0].plane, Some(hint_plane));
+        // The hint brush is empty space: neither solid nor a plane of its skip faces.
+        let find = |p: Vec3| tree.nodes[tree.leaf_at(&planes, p) as usize].contents;
+        assert_eq!(find(Vec3::new(95.0, 32.0, 32.0)), contents::EMPTY);
+        let (skip_plane, _) = planes.insert(&Plane::new(Vec3::new(1.0, 0.0, 0.0), 90.0));
+        assert!(tree.nodes.iter().all(|n| n.plane != Some(skip_plane)));
+    }
+
+    #[test]
+    fn detail_splits_below_the_structural_leaves() {
+        let mut planes = PlaneSet::new();
+        let wall = solid_box(&mut planes, Vec3::ZERO, Vec3::new(16.0, 256.0, 256.0));
+        let mut pillar = solid_box(
+            &mut planes,
+            Vec3::new(100.0, 100.0, 0.0),
+            Vec3::new(132.0, 132.0, 256.0),
+        );
+        pillar.kind = BrushKind::Detail;
+        let tree = build_tree(
+            vec![wall, pillar],
+            &planes,
+            SplitHeuristic::FewestSplits,
+            true,
+        );
+        // The wall's six planes come first: seven structural leaves, one of them split further.
+        let clusters: Vec<usize> = (0..tree.nodes.len())
+            .filter(|&i| tree.nodes[i].cluster.is_some())
+            .collect();
+        assert_eq!(clusters.len(), 7);
+        let split = clusters
+            .iter()
+            .filter(|&&i| !tree.nodes[i].is_leaf())
+            .count();
+        assert_eq!(split, 1);
+        let pillar_cluster = tree.cluster_at(&planes, Vec3::new(116.0, 116.0, 128.0));
+        assert_eq!(
+            tree.nodes[pillar_cluster as usize].cluster,
+            Some(contents::EMPTY)
+        );
+        let leaf = tree.leaf_at(&planes, Vec3::new(116.0, 116.0, 128.0));
+        assert_eq!(tree.nodes[leaf as usize].contents, contents::SOLID);
+        assert!(tree.leaves_below(pillar_cluster).contains(&leaf));
     }
 
     proptest::proptest! {

@@ -57,10 +57,19 @@ fn room(lo: f64, hi: f64, t: f64, hole: bool) -> String {
 }
 
 fn room_map(hole: bool, extra: &str) -> String {
+    room_map_with(hole, extra, "")
+}
+
+/// The room, with `extra` brushes in worldspawn and the entity blocks `entities` after it.
+fn room_map_with(hole: bool, extra: &str, entities: &str) -> String {
     format!(
-        "{{\n\"classname\" \"worldspawn\"\n\"wad\" \"none.wad\"\n{}{extra}}}\n{{\n\"classname\" \"info_player_start\"\n\"origin\" \"-32 -32 -100\"\n}}\n",
+        "{{\n\"classname\" \"worldspawn\"\n\"wad\" \"none.wad\"\n{}{extra}}}\n{entities}{{\n\"classname\" \"info_player_start\"\n\"origin\" \"-32 -32 -100\"\n}}\n",
         room(-128.0, 128.0, 16.0, hole)
     )
+}
+
+fn brush_entity(classname: &str, brushes: &str) -> String {
+    format!("{{\n\"classname\" \"{classname}\"\n{brushes}}}\n")
 }
 
 fn compile_text(text: &str) -> CompileOutput {
@@ -226,6 +235,273 @@ fn leaking_room_writes_a_pointfile_to_the_void() {
     assert!(out.bsp.faces.len() > 6);
 }
 
+/// The leaf numbers each PRT2 cluster lists, checked to cover every vis leaf exactly once.
+fn checked_clusters(prt: &PortalFile) -> Vec<Vec<u32>> {
+    let clusters = prt.clusters.clone().expect("a PRT2 file");
+    let mut seen = vec![0; prt.num_leafs as usize];
+    for &leaf in clusters.iter().flatten() {
+        seen[leaf as usize] += 1;
+    }
+    assert!(seen.iter().all(|&n| n == 1), "leaf cover counts {seen:?}");
+    clusters
+}
+
+#[test]
+fn detail_splits_below_the_clusters() {
+    let pillar = box_brush([-16.0, -16.0, -128.0], [16.0, 16.0, 128.0], "pillar");
+    let structural = compile_text(&room_map(false, &pillar));
+    let out = compile_text(&room_map_with(
+        false,
+        "",
+        &brush_entity("func_detail", &pillar),
+    ));
+    let bsp = &out.bsp;
+    assert!(out.leak.is_none(), "{:?}", out.warnings);
+    assert_eq!(errors(bsp), Vec::<String>::new());
+    check_round_trip(bsp);
+    // Solid where the pillar is, drawn like the structural pillar.
+    assert_eq!(leaf_contents(bsp, [0.0, 0.0, 0.0]), contents::SOLID);
+    assert_eq!(leaf_contents(bsp, [64.0, 0.0, 0.0]), contents::EMPTY);
+    assert_eq!(
+        out.stats.face_stats.after_merge,
+        structural.stats.face_stats.after_merge
+    );
+    let prt = PortalFile::parse(&out.portals.write()).expect("prt");
+    assert_eq!(prt.num_leafs as i32, bsp.models[0].vis_leafs);
+    let clusters = checked_clusters(&prt);
+    // The room is one cluster: the pillar does not cut it up for vis.
+    assert!(
+        clusters.len() < prt.num_leafs as usize,
+        "{} clusters, {} leaves",
+        clusters.len(),
+        prt.num_leafs
+    );
+    assert_eq!(clusters.len(), 1);
+    assert_eq!(out.stats.clusters, 1);
+    // The structural pillar gives a leaf per side of it.
+    let prt1 = PortalFile::parse(&structural.portals.write()).expect("prt1");
+    assert!(prt1.clusters.is_none());
+    assert!(prt1.num_leafs >= 4 && !prt1.portals.is_empty());
+}
+
+/// Two rooms joined by a doorway with a detail pillar in each: PRT2 portals join the clusters,
+/// each facing its first cluster.
+#[test]
+fn cluster_portals_face_their_first_cluster() {
+    let mut world = String::new();
+    // The wall between two 256-unit rooms along x, with a doorway at y in -32..32.
+    world += &box_brush([-144.0, -144.0, -144.0], [400.0, 144.0, -128.0], "floor");
+    world += &box_brush([-144.0, -144.0, 128.0], [400.0, 144.0, 144.0], "ceiling");
+    world += &box_brush([-144.0, -144.0, -128.0], [-128.0, 144.0, 128.0], "wall");
+    world += &box_brush([384.0, -144.0, -128.0], [400.0, 144.0, 128.0], "wall");
+    world += &box_brush([-128.0, -144.0, -128.0], [384.0, -128.0, 128.0], "wall");
+    world += &box_brush([-128.0, 128.0, -128.0], [384.0, 144.0, 128.0], "wall");
+    world += &box_brush([128.0, -128.0, -128.0], [144.0, -32.0, 128.0], "wall");
+    world += &box_brush([128.0, 32.0, -128.0], [144.0, 128.0, 128.0], "wall");
+    let pillars = box_brush([-16.0, -16.0, -128.0], [16.0, 16.0, 0.0], "pillar")
+        + &box_brush([240.0, 40.0, -128.0], [300.0, 60.0, 128.0], "pillar");
+    let text = format!(
+        "{{\n\"classname\" \"worldspawn\"\n{world}}}\n{}{{\n\"classname\" \"info_player_start\"\n\"origin\" \"-32 -32 -100\"\n}}\n",
+        brush_entity("func_detail", &pillars)
+    );
+    let out = compile_text(&text);
+    assert!(out.leak.is_none(), "{:?}", out.warnings);
+    let bsp = &out.bsp;
+    let prt = PortalFile::parse(&out.portals.write()).expect("prt");
+    let clusters = checked_clusters(&prt);
+    assert!(clusters.len() >= 2 && !prt.portals.is_empty());
+    let cluster_of_leaf = |leaf: usize| {
+        clusters
+            .iter()
+            .position(|c| c.contains(&(leaf as u32 - 1)))
+            .expect("leaf in a cluster")
+    };
+    for p in &prt.portals {
+        assert_ne!(p.leafs[0], p.leafs[1]);
+        let plane = p.winding.plane().expect("plane");
+        let c = p.winding.center();
+        for (side, cluster) in [(1.0, p.leafs[0]), (-1.0, p.leafs[1])] {
+            let probe = c + plane.normal * side;
+            let leaf = bsp.leaf_at(probe.to_f32()).expect("leaf");
+            assert_eq!(cluster_of_leaf(leaf), cluster as usize, "{probe:?}");
+        }
+    }
+}
+
+#[test]
+fn detail_does_not_seal() {
+    // The gap in the +x wall, filled by a detail brush, then by a structural one.
+    let plug = box_brush([128.0, 0.0, -128.0], [144.0, 32.0, 128.0], "wall");
+    let out = compile_text(&room_map_with(
+        true,
+        "",
+        &brush_entity("func_detail", &plug),
+    ));
+    let leak = out.leak.expect("a detail-sealed map leaks");
+    assert_eq!(leak.classname, "info_player_start");
+    let out = compile_text(&room_map(true, &plug));
+    assert!(out.leak.is_none(), "{:?}", out.warnings);
+}
+
+#[test]
+fn illusionary_detail_is_drawn_and_not_solid() {
+    let block = box_brush([-64.0, -64.0, -128.0], [0.0, 0.0, -64.0], "block");
+    let out = compile_text(&room_map_with(
+        false,
+        "",
+        &brush_entity("func_detail_illusionary", &block),
+    ));
+    let bsp = &out.bsp;
+    assert!(out.leak.is_none(), "{:?}", out.warnings);
+    assert_eq!(errors(bsp), Vec::<String>::new());
+    assert!(
+        !out.warnings
+            .iter()
+            .any(|w| matches!(w, Warning::Unsupported { .. }))
+    );
+    assert_eq!(bsp.models.len(), 1);
+    // Empty inside, for hull 0 and the player's hull.
+    assert_eq!(leaf_contents(bsp, [-32.0, -32.0, -96.0]), contents::EMPTY);
+    assert_eq!(
+        hull_contents(bsp, 1, [-32.0, -32.0, -100.0]),
+        contents::EMPTY
+    );
+    // Its five open sides are drawn from outside (the bottom lies on the floor), and the floor
+    // under it is kept.
+    let block_faces: Vec<_> = bsp
+        .faces
+        .iter()
+        .filter(|f| {
+            let info = &bsp.texinfo[f.texinfo as usize];
+            bsp.textures.textures[info.miptex as usize]
+                .as_ref()
+                .is_some_and(|t| t.name().eq_ignore_ascii_case("block"))
+        })
+        .collect();
+    assert_eq!(block_faces.len(), 5);
+    for f in &block_faces {
+        let verts = bsp.face_vertices(f).expect("vertices");
+        let n = face_normal(bsp, f);
+        let c = verts.iter().fold([0.0f32; 3], |acc, v| {
+            [acc[0] + v[0], acc[1] + v[1], acc[2] + v[2]]
+        });
+        let c = c.map(|x| x / verts.len() as f32);
+        // Facing out of the block.
+        assert!(
+            c[0] + n[0] > 0.0
+                || c[0] + n[0] < -64.0
+                || c[1] + n[1] > 0.0
+                || c[1] + n[1] < -64.0
+                || c[2] + n[2] > -64.0,
+            "{c:?} {n:?}"
+        );
+    }
+    let floor_area: f64 = face_area_with_texture(bsp, "floor");
+    assert!((floor_area - 256.0 * 256.0).abs() < 1.0, "{floor_area}");
+}
+
+fn face_area_with_texture(bsp: &Bsp, name: &str) -> f64 {
+    let mut area = 0.0;
+    for f in &bsp.faces {
+        let info = &bsp.texinfo[f.texinfo as usize];
+        let named = bsp.textures.textures[info.miptex as usize]
+            .as_ref()
+            .is_some_and(|t| t.name().eq_ignore_ascii_case(name));
+        if !named {
+            continue;
+        }
+        let v: Vec<Vec3> = bsp
+            .face_vertices(f)
+            .expect("vertices")
+            .iter()
+            .map(|&p| Vec3::from_f32(p))
+            .collect();
+        area += quake_formats::geom::Winding::new(v).area();
+    }
+    area
+}
+
+#[test]
+fn fence_detail_keeps_the_faces_behind_it() {
+    // A fence slab standing on the floor against the -x wall.
+    let fence = box_brush([-128.0, -64.0, -128.0], [-120.0, 64.0, 0.0], "{fence");
+    let out = compile_text(&room_map_with(
+        false,
+        "",
+        &brush_entity("func_detail_fence", &fence),
+    ));
+    let bsp = &out.bsp;
+    assert!(out.leak.is_none(), "{:?}", out.warnings);
+    assert_eq!(errors(bsp), Vec::<String>::new());
+    // Solid for engines and the player, yet a leaf of its own that vis looks through.
+    assert_eq!(leaf_contents(bsp, [-124.0, 0.0, -64.0]), contents::SOLID);
+    assert_ne!(bsp.leaf_at([-124.0, 0.0, -64.0]), Some(0));
+    assert_eq!(hull_contents(bsp, 1, [-110.0, 0.0, -64.0]), contents::SOLID);
+    // The wall and floor behind the fence are whole.
+    let wall_and_floor = face_area_with_texture(bsp, "wall") + face_area_with_texture(bsp, "floor");
+    let plain = compile_text(&room_map(false, ""));
+    let plain_area =
+        face_area_with_texture(&plain.bsp, "wall") + face_area_with_texture(&plain.bsp, "floor");
+    assert!(
+        (wall_and_floor - plain_area).abs() < 1.0,
+        "{wall_and_floor} vs {plain_area}"
+    );
+    // Every face is listed in an open leaf, so engines draw the wall seen through the fence.
+    let mut listed = vec![false; bsp.faces.len()];
+    for leaf in &bsp.leafs[1..] {
+        if leaf.contents == contents::SOLID {
+            continue;
+        }
+        let first = leaf.first_marksurface as usize;
+        for &m in &bsp.marksurfaces[first..first + leaf.num_marksurfaces as usize] {
+            listed[m as usize] = true;
+        }
+    }
+    assert!(listed.iter().all(|&l| l), "{listed:?}");
+    let prt = PortalFile::parse(&out.portals.write()).expect("prt");
+    checked_clusters(&prt);
+}
+
+fn faces_with_texture(bsp: &Bsp, name: &str) -> usize {
+    bsp.faces
+        .iter()
+        .filter(|f| {
+            let info = &bsp.texinfo[f.texinfo as usize];
+            bsp.textures.textures[info.miptex as usize]
+                .as_ref()
+                .is_some_and(|t| t.name().eq_ignore_ascii_case(name))
+        })
+        .count()
+}
+
+#[test]
+fn detail_walls_do_not_cut_the_faces_they_touch() {
+    // A slab standing against the middle of the -x wall.
+    let slab = box_brush([-128.0, -40.0, -100.0], [-112.0, 24.0, 60.0], "slab");
+    let plain = compile_text(&room_map(false, ""));
+    let detail = compile_text(&room_map_with(
+        false,
+        "",
+        &brush_entity("func_detail", &slab),
+    ));
+    let wall = compile_text(&room_map_with(
+        false,
+        "",
+        &brush_entity("func_detail_wall", &slab),
+    ));
+    assert!(wall.leak.is_none(), "{:?}", wall.warnings);
+    assert_eq!(errors(&wall.bsp), Vec::<String>::new());
+    assert_eq!(
+        leaf_contents(&wall.bsp, [-120.0, 0.0, 0.0]),
+        contents::SOLID
+    );
+    // func_detail cuts the wall around the slab; func_detail_wall leaves it as it was.
+    let walls = |out: &CompileOutput| faces_with_texture(&out.bsp, "wall");
+    assert!(walls(&detail) > walls(&plain));
+    assert_eq!(walls(&wall), walls(&plain));
+    assert_eq!(faces_with_texture(&wall.bsp, "slab"), 5);
+}
+
 #[test]
 fn brush_entities_become_submodels() {
     let door = format!(
@@ -243,6 +519,53 @@ fn brush_entities_become_submodels() {
     assert_eq!(bsp.models[1].maxs, [32.0, 8.0, 0.0]);
     assert!(bsp.entity_text().contains("\"model\" \"*1\""));
     check_round_trip(bsp);
+}
+
+/// Each vertex of model `m`'s faces moved by `origin`, with its texture coordinates.
+fn model_texels(bsp: &Bsp, m: usize, origin: [f32; 3]) -> Vec<[i64; 5]> {
+    let model = &bsp.models[m];
+    let mut out = Vec::new();
+    for f in &bsp.faces[model.first_face as usize..(model.first_face + model.num_faces) as usize] {
+        let info = &bsp.texinfo[f.texinfo as usize];
+        for v in bsp.face_vertices(f).expect("vertices") {
+            let p = [v[0] + origin[0], v[1] + origin[1], v[2] + origin[2]];
+            let st = info
+                .vecs
+                .map(|r| r[0] * v[0] + r[1] * v[1] + r[2] * v[2] + r[3]);
+            let q = |x: f32| (x * 64.0).round() as i64;
+            out.push([q(p[0]), q(p[1]), q(p[2]), q(st[0]), q(st[1])]);
+        }
+    }
+    out.sort_unstable();
+    out
+}
+
+#[test]
+fn origin_brushes_set_the_origin_of_their_model() {
+    let door = box_brush([32.0, -8.0, -128.0], [96.0, 8.0, 0.0], "door");
+    let origin = box_brush([56.0, -8.0, -72.0], [72.0, 8.0, -56.0], "origin");
+    let plain = compile_text(&room_map_with(
+        false,
+        "",
+        &brush_entity("func_rotate_door", &door),
+    ));
+    let out = compile_text(&room_map_with(
+        false,
+        "",
+        &brush_entity("func_rotate_door", &(door + &origin)),
+    ));
+    let bsp = &out.bsp;
+    assert_eq!(errors(bsp), Vec::<String>::new());
+    assert!(bsp.entity_text().contains("\"origin\" \"64 0 -64\""));
+    // Built around the origin: the engine moves it back into place.
+    assert_eq!(bsp.models[1].mins, [-32.0, -8.0, -64.0]);
+    assert_eq!(bsp.models[1].maxs, [32.0, 8.0, 64.0]);
+    // The origin brush is neither drawn nor solid, and the textures stay where they were.
+    assert_eq!(bsp.models[1].num_faces, plain.bsp.models[1].num_faces);
+    assert_eq!(
+        model_texels(bsp, 1, [64.0, 0.0, -64.0]),
+        model_texels(&plain.bsp, 1, [0.0; 3])
+    );
 }
 
 #[test]
@@ -317,6 +640,11 @@ fn compile_corpus_map(rel: &str) -> Option<CompileOutput> {
     assert_eq!(errors(&out.bsp), Vec::<String>::new(), "{rel}");
     assert_finite_bounds(&out.bsp, rel);
     check_round_trip(&out.bsp);
+    let prt = PortalFile::parse(&out.portals.write()).expect("prt");
+    assert_eq!(prt.num_leafs as i32, out.bsp.models[0].vis_leafs, "{rel}");
+    if prt.clusters.is_some() {
+        checked_clusters(&prt);
+    }
     Some(out)
 }
 

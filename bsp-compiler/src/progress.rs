@@ -1,0 +1,58 @@
+//! Progress of the long phases, reported to whoever shows it (the CLI draws a bar).
+
+use std::sync::Arc;
+
+/// One progress report.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ProgressEvent {
+    /// A phase starts with `total` units of work.
+    Start { phase: &'static str, total: u64 },
+    /// `n` more units of the current phase are done.
+    Advance(u64),
+    /// The current phase is over.
+    Finish,
+}
+
+/// Where progress reports go; nowhere by default.
+#[derive(Clone, Default)]
+pub struct Progress(Option<Arc<dyn Fn(ProgressEvent) + Send + Sync>>);
+
+impl std::fmt::Debug for Progress {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(if self.0.is_some() {
+            "Progress(reported)"
+        } else {
+            "Progress(none)"
+        })
+    }
+}
+
+impl Progress {
+    /// Reports go to `sink`, from any thread.
+    pub fn new(sink: impl Fn(ProgressEvent) + Send + Sync + 'static) -> Progress {
+        Progress(Some(Arc::new(sink)))
+    }
+
+    fn send(&self, event: ProgressEvent) {
+        if let Some(sink) = &self.0 {
+            sink(event);
+        }
+    }
+
+    pub(crate) fn start(&self, phase: &'static str, total: usize) {
+        self.send(ProgressEvent::Start {
+            phase,
+            total: total as u64,
+        });
+    }
+
+    pub(crate) fn advance(&self, n: usize) {
+        if n > 0 {
+            self.send(ProgressEvent::Advance(n as u64));
+        }
+    }
+
+    pub(crate) fn finish(&self) {
+        self.send(ProgressEvent::Finish);
+    }
+}
