@@ -7,7 +7,9 @@ use quake_formats::Bsp;
 use quake_formats::fsutil::{read_file, write_atomic};
 
 use crate::lights::GlobalOverrides;
-use crate::{ErrorStats, Options, Quality, compare, compute_lighting};
+use crate::{
+    ErrorStats, Options, Quality, compare, compute_lighting, finish_lighting, trace_lighting,
+};
 
 /// Light a BSP: compute lightmaps from its light entities.
 #[derive(clap::Args, Debug, Clone)]
@@ -47,6 +49,25 @@ pub struct Args {
     /// Directions per sun penumbra and per sky dome.
     #[arg(long, default_value_t = 100)]
     pub sunsamples: usize,
+    /// Dirt (ambient occlusion) on every light, whatever worldspawn `_dirt` says
+    /// (lights with `_dirt -1` still opt out).
+    #[arg(long)]
+    pub dirt: bool,
+    /// Dirt ray pattern: 0 ordered, 1 random (overrides worldspawn `_dirtmode`).
+    #[arg(long, value_name = "N")]
+    pub dirtmode: Option<f64>,
+    /// Dirt ray length (overrides worldspawn `_dirtdepth`, default 128).
+    #[arg(long, value_name = "UNITS")]
+    pub dirtdepth: Option<f64>,
+    /// Dirt strength (overrides worldspawn `_dirtscale`, default 1).
+    #[arg(long, value_name = "N")]
+    pub dirtscale: Option<f64>,
+    /// Dirt exponent (overrides worldspawn `_dirtgain`, default 1).
+    #[arg(long, value_name = "N")]
+    pub dirtgain: Option<f64>,
+    /// Dirt cone angle from the normal in degrees, 1-90 (overrides `_dirtangle`, default 88).
+    #[arg(long, value_name = "DEGREES")]
+    pub dirtangle: Option<f64>,
     /// Consider every light for every face (no range, plane-side or PVS culling).
     #[arg(long)]
     pub no_cull: bool,
@@ -74,6 +95,12 @@ impl Args {
                 dist: self.dist,
                 range: self.range,
                 sunsamples: self.sunsamples,
+                dirt: self.dirt,
+                dirt_mode: self.dirtmode,
+                dirt_depth: self.dirtdepth,
+                dirt_scale: self.dirtscale,
+                dirt_gain: self.dirtgain,
+                dirt_angle: self.dirtangle,
             },
             only_faces: None,
             no_cull: self.no_cull,
@@ -110,7 +137,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let lighting =
         compute_lighting(&bsp, &options).with_context(|| format!("lighting {}", path.display()))?;
     let s = &lighting.stats;
-    let rays = s.shadow_rays + s.sun_rays + s.placement_rays;
+    let rays = s.shadow_rays + s.sun_rays + s.dirt_rays + s.placement_rays;
     eprintln!(
         "light: {} of {} faces, {} luxels ({} samples), {} point + {} surface lights, {} sun directions",
         s.faces_lit,
@@ -122,9 +149,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         s.sun_directions
     );
     eprintln!(
-        "light: {rays} rays ({} shadow, {} sun, {} placement) in {:.2} s trace + {:.2} s setup: {:.2} Mrays/s",
+        "light: {rays} rays ({} shadow, {} sun, {} dirt, {} placement) in {:.2} s trace + {:.2} s setup: {:.2} Mrays/s",
         s.shadow_rays,
         s.sun_rays,
+        s.dirt_rays,
         s.placement_rays,
         s.seconds_trace,
         s.seconds_setup,
@@ -141,22 +169,35 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if args.compare_reference {
         let mut reference = options.clone();
         reference.quality = Quality::Reference;
-        reference.soft_radius = 0;
-        let exact = compute_lighting(&bsp, &reference)?;
-        let e: ErrorStats = compare(&lighting, &exact);
+        let raw = trace_lighting(&bsp, &reference)?;
+        let exact = finish_lighting(&raw, 0);
+        let report = |what: &str, e: &ErrorStats| {
+            eprintln!(
+                "light: against {what}: RMSE {:.3}, max {} levels over {} luxels ({} differ by more than 8)",
+                e.rmse, e.max, e.luxels, e.over_8
+            );
+        };
+        let r = &exact.stats;
         eprintln!(
-            "light: against --reference ({:.2} s, {} rays): RMSE {:.3}, max {} levels over {} luxels ({} differ by more than 8)",
-            exact.stats.seconds_total,
-            exact.stats.shadow_rays + exact.stats.sun_rays + exact.stats.placement_rays,
-            e.rmse,
-            e.max,
-            e.luxels,
-            e.over_8
+            "light: --reference took {:.2} s, {} rays",
+            r.seconds_total,
+            r.shadow_rays + r.sun_rays + r.dirt_rays + r.placement_rays
         );
+        let e: ErrorStats = compare(&lighting, &exact);
+        report("--reference", &e);
         extra.insert("error_vs_reference".into(), serde_json::to_value(e)?);
+        if options.soft_radius > 0 {
+            // The filter blurs on purpose: also measure against the reference blurred the same way.
+            let e = compare(&lighting, &finish_lighting(&raw, options.soft_radius));
+            report("--reference with the same --soft filter", &e);
+            extra.insert(
+                "error_vs_filtered_reference".into(),
+                serde_json::to_value(e)?,
+            );
+        }
         extra.insert(
             "reference_seconds".into(),
-            serde_json::to_value(exact.stats.seconds_total)?,
+            serde_json::to_value(r.seconds_total)?,
         );
     }
     if let Some(max_rays) = args.bench_occlusion {

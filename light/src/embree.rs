@@ -720,7 +720,8 @@ impl Scene {
                 &raw mut rayhit,
             );
         }
-        packet.rays = rayhit.ray;
+        // Only tfar changes (it becomes the hit distance); copy just that back.
+        packet.rays.tfar = rayhit.ray.tfar;
         for (i, id) in ids.iter_mut().enumerate() {
             if packet.valid.0[i] != 0 {
                 *id = rayhit.hit.geomID[i];
@@ -781,6 +782,13 @@ impl RayPacket16 {
         r.tnear[lane] = tnear;
         r.tfar[lane] = tfar;
         self.valid.0[lane] = if ray_ok(org, dir, tnear, tfar) { -1 } else { 0 };
+    }
+
+    /// The far end of `lane`'s segment: after [`Scene::first_hit_geom16`],
+    /// the distance of the lane's hit (if it hit).
+    #[must_use]
+    pub fn tfar(&self, lane: usize) -> f32 {
+        self.rays.tfar[lane]
     }
 
     /// Deactivates every lane.

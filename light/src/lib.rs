@@ -10,19 +10,23 @@
 //!    styles; [`surface`] expands `_surface` templates.
 //! 4. [`samples`]: sample points per luxel (supersampled with `--extra`),
 //!    pulled out of solid. Kept as a structure for a later bounce pass.
+//!    [`phong`] gives them smoothed normals where `_phong` asks for it.
 //! 5. [`trace`]: each face against the lights that can reach it (range,
-//!    plane side and PVS culling from [`visibility`]), 16-ray packets.
-//! 6. [`output`]: minlight, `--soft`, scale, clamp, lump and `.lit` bytes.
+//!    plane side and PVS culling from [`visibility`]), 16-ray packets, close
+//!    lights supersampled; [`dirt`] occlusion; minlight per sample.
+//! 6. [`output`]: `--soft`, scale, clamp, lump and `.lit` bytes.
 //!
 //! Sky faces block point lights (the sky brush is solid) and are what sun
 //! rays look for; liquids (`*` textures) let light through, as in id's tool.
 
 pub mod bench;
 pub mod cli;
+pub mod dirt;
 pub mod embree;
 pub mod faces;
 pub mod lights;
 pub mod output;
+pub mod phong;
 pub mod samples;
 pub mod scene;
 pub mod surface;
@@ -30,7 +34,6 @@ pub mod trace;
 pub mod visibility;
 
 use std::collections::HashMap;
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 use quake_formats::Bsp;
@@ -44,7 +47,7 @@ use crate::lights::{GlobalOverrides, parse_lights};
 use crate::output::{FaceLightmap, Finish, finish_face};
 use crate::samples::{PlacementCounts, face_samples};
 use crate::scene::TraceScene;
-use crate::trace::{TraceCounts, TraceSetup, light_face};
+use crate::trace::{FaceLight, FaceRules, TraceCounts, TraceSetup, light_face};
 use crate::visibility::Visibility;
 
 /// Everything that can stop lighting a map.
@@ -135,7 +138,11 @@ pub struct Stats {
     pub coloured: bool,
     pub shadow_rays: u64,
     pub sun_rays: u64,
+    /// Ambient-occlusion rays (`_dirt`).
+    pub dirt_rays: u64,
     pub placement_rays: u64,
+    /// Points outside their face moved onto it (inset from its edges).
+    pub points_clamped_to_face: u64,
     pub points_pulled_back: u64,
     pub points_moved_to_centre: u64,
     pub face_light_pairs: u64,
@@ -170,6 +177,8 @@ pub struct Prepared {
     pub sun_distance: f32,
     pub surface_lights: usize,
     pub entity_text: Option<String>,
+    /// Per face: `_phong` corner normals, for faces of smoothed models.
+    pub phong: Vec<Option<Vec<Vec3>>>,
 }
 
 /// Reads faces, entities and visibility and builds the Embree scene.
@@ -192,6 +201,7 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
     let device = Device::new(rayon::current_num_threads())?;
     let scene = TraceScene::build(&device, &faces, &map_lights.shadow_models)?;
     let vis = Visibility::new(bsp, &faces);
+    let phong = phong::corner_normals(&faces, &map_lights.phong);
     let surface =
         surface::expand_templates(&map_lights.templates, &faces, surface::DEFAULT_SPACING);
     let surface_lights = surface.len();
@@ -220,6 +230,7 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
         sun_distance: (diagonal * 2.0 + 1024.0) as f32,
         surface_lights,
         entity_text,
+        phong,
     })
 }
 
@@ -239,11 +250,43 @@ fn progress_bar(len: usize, show: bool) -> indicatif::ProgressBar {
     bar
 }
 
-/// Lights every lit face of `bsp` (or `options.only_faces`).
+/// Lightmaps in light units, before the `--soft` filter and the conversion
+/// to bytes (so one tracing run can be finished more than one way).
+#[derive(Debug, Clone)]
+pub struct RawLighting {
+    pub faces: Vec<FaceLight>,
+    pub entity_text: Option<String>,
+    pub coloured: bool,
+    pub rangescale: f64,
+    pub gamma: f64,
+    pub stats: Stats,
+}
+
+/// The rules of the faces of brush model `model` (0 = world).
+fn face_rules<'a>(lights: &'a lights::MapLights, geom: &faces::FaceGeom) -> FaceRules<'a> {
+    // A brush model's own `_minlight` wins; otherwise worldspawn's applies.
+    let minlight = lights
+        .minlight
+        .get(&geom.model)
+        .or_else(|| lights.minlight.get(&0))
+        .filter(|m| {
+            m.exclude_texture
+                .as_ref()
+                .is_none_or(|t| !t.eq_ignore_ascii_case(&geom.texture))
+        });
+    FaceRules {
+        minlight,
+        dirt: !lights.no_dirt_models.contains(&geom.model),
+        minlight_only: lights.lightignore_models.contains(&geom.model),
+    }
+}
+
+/// Traces every lit face of `bsp` (or `options.only_faces`): light units per
+/// luxel and style, minlight included.
 ///
 /// # Errors
 /// Bad entities or faces, or an Embree failure.
-pub fn compute_lighting(bsp: &Bsp, options: &Options) -> Result<Lighting, LightError> {
+pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, LightError> {
     let start = Instant::now();
     let prep = prepare(bsp, options)?;
     let setup_done = Instant::now();
@@ -258,11 +301,7 @@ pub fn compute_lighting(bsp: &Bsp, options: &Options) -> Result<Lighting, LightE
         cull: !options.no_cull && options.quality != Quality::Reference,
         gate: options.gate,
         sun_distance: prep.sun_distance,
-    };
-    let finish = Finish {
-        rangescale: prep.lights.rangescale,
-        gamma: prep.lights.gamma,
-        soft_radius: options.soft_radius,
+        dirt: prep.lights.uses_dirt().then_some(prep.lights.dirt),
     };
     let wanted: Vec<usize> = match &options.only_faces {
         Some(list) => list.clone(),
@@ -274,26 +313,22 @@ pub fn compute_lighting(bsp: &Bsp, options: &Options) -> Result<Lighting, LightE
         .collect();
     let per_axis = options.quality.samples_per_axis();
     let bar = progress_bar(lit_faces.len(), options.progress);
-    let dropped = AtomicU64::new(0);
-    let results: Vec<(FaceLightmap, PlacementCounts, TraceCounts, u64)> = lit_faces
+    let results: Vec<(FaceLight, PlacementCounts, TraceCounts, u64)> = lit_faces
         .par_iter()
         .map(|&f| {
             let geom = &prep.faces[f];
-            let (samples, placement) = face_samples(geom, per_axis, &prep.scene, bsp);
-            let (light, counts) = light_face(&setup, &samples);
-            // A brush model's own `_minlight` wins; otherwise worldspawn's applies.
-            let minlight = prep
-                .lights
-                .minlight
-                .get(&geom.model)
-                .or_else(|| prep.lights.minlight.get(&0))
-                .copied();
-            let (map, d) = finish_face(light, minlight, &finish);
-            if d > 0 {
-                dropped.fetch_add(1, Ordering::Relaxed);
+            let (mut samples, placement) = face_samples(geom, per_axis, &prep.scene, bsp);
+            if let Some(corners) = &prep.phong[f] {
+                samples.normals = samples
+                    .points
+                    .iter()
+                    .map(|&p| phong::interpolate(geom, corners, Vec3::from_f32(p)).to_f32())
+                    .collect();
             }
+            let rules = face_rules(&prep.lights, geom);
+            let (light, counts) = light_face(&setup, &samples, &rules);
             bar.inc(1);
-            (map, placement, counts, samples.points.len() as u64)
+            (light, placement, counts, samples.points.len() as u64)
         })
         .collect();
     bar.finish_and_clear();
@@ -310,20 +345,21 @@ pub fn compute_lighting(bsp: &Bsp, options: &Options) -> Result<Lighting, LightE
         sun_directions: prep.lights.suns.len(),
         switchable_styles: prep.lights.switchable_styles.len(),
         coloured: prep.lights.is_coloured(),
-        faces_with_dropped_styles: dropped.load(Ordering::Relaxed),
         ..Stats::default()
     };
-    let mut lightmaps = Vec::with_capacity(results.len());
-    for (map, p, c, samples) in results {
+    let mut faces = Vec::with_capacity(results.len());
+    for (light, p, c, samples) in results {
         placement.add(&p);
         counts.add(&c);
-        stats.luxels += (map.width * map.height) as u64;
+        stats.luxels += (light.width * light.height) as u64;
         stats.samples += samples;
-        lightmaps.push(map);
+        faces.push(light);
     }
     stats.shadow_rays = counts.shadow_rays;
     stats.sun_rays = counts.sun_rays;
+    stats.dirt_rays = counts.dirt_rays;
     stats.placement_rays = placement.rays;
+    stats.points_clamped_to_face = placement.clamped;
     stats.points_pulled_back = placement.pulled_back;
     stats.points_moved_to_centre = placement.to_centre;
     stats.face_light_pairs = counts.pairs;
@@ -332,12 +368,51 @@ pub fn compute_lighting(bsp: &Bsp, options: &Options) -> Result<Lighting, LightE
     stats.seconds_trace = (trace_done - setup_done).as_secs_f64();
     stats.seconds_total = start.elapsed().as_secs_f64();
     stats.rays_per_second = (counts.rays() + placement.rays) as f64 / stats.seconds_trace.max(1e-9);
-    Ok(Lighting {
-        lightmaps,
+    Ok(RawLighting {
+        faces,
         entity_text: prep.entity_text,
         coloured: stats.coloured,
+        rangescale: prep.lights.rangescale,
+        gamma: prep.lights.gamma,
         stats,
     })
+}
+
+/// Filters (`soft_radius`, the `--soft` box radius) and converts `raw` to
+/// lightmap bytes.
+pub fn finish_lighting(raw: &RawLighting, soft_radius: usize) -> Lighting {
+    let start = Instant::now();
+    let finish = Finish {
+        rangescale: raw.rangescale,
+        gamma: raw.gamma,
+        soft_radius,
+    };
+    let mut stats = raw.stats.clone();
+    let lightmaps = raw
+        .faces
+        .iter()
+        .map(|light| {
+            let (map, dropped) = finish_face(light, &finish);
+            stats.faces_with_dropped_styles += u64::from(dropped > 0);
+            map
+        })
+        .collect();
+    stats.seconds_total += start.elapsed().as_secs_f64();
+    Lighting {
+        lightmaps,
+        entity_text: raw.entity_text.clone(),
+        coloured: raw.coloured,
+        stats,
+    }
+}
+
+/// Lights every lit face of `bsp` (or `options.only_faces`).
+///
+/// # Errors
+/// Bad entities or faces, or an Embree failure.
+pub fn compute_lighting(bsp: &Bsp, options: &Options) -> Result<Lighting, LightError> {
+    let raw = trace_lighting(bsp, options)?;
+    Ok(finish_lighting(&raw, options.soft_radius))
 }
 
 /// Writes `lighting` into `bsp` (lighting lump, face styles and offsets,

@@ -25,6 +25,14 @@ pub const DEFAULT_RANGESCALE: f64 = 0.5;
 /// First style given to switchable lights (styles below are the engine's
 /// animated presets).
 pub const FIRST_SWITCHABLE_STYLE: u8 = 32;
+/// Dirt ray length when `_dirtdepth` is absent.
+pub const DEFAULT_DIRT_DEPTH: f64 = 128.0;
+/// Dirt cone (degrees from the normal) when `_dirtangle` is absent.
+pub const DEFAULT_DIRT_ANGLE: f64 = 88.0;
+/// Phong smoothing angle (degrees) when `_phong 1` gives none.
+pub const DEFAULT_PHONG_ANGLE: f64 = 89.0;
+/// Lights a `_deviance` light is split into when `_samples` is absent.
+pub const DEFAULT_DEVIANCE_SAMPLES: usize = 16;
 /// Distance (map units) at which the 1/x and 1/x² formulas give `light`.
 const FALLOFF_SCALE: f64 = 128.0;
 
@@ -118,6 +126,56 @@ pub fn angle_factor(cos_incidence: f64, anglescale: f64) -> f64 {
     }
 }
 
+/// How dirt (ambient occlusion) darkens one light: ericw-tools' `_dirtscale`
+/// and `_dirtgain`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DirtResponse {
+    pub scale: f64,
+    pub gain: f64,
+}
+
+impl DirtResponse {
+    /// Multiplier for light reaching a point with `occlusion` (0 = open,
+    /// 1 = every dirt ray hit something right away): `1 - min(1, scale *
+    /// min(1, occlusion^gain))`.
+    pub fn factor(&self, occlusion: f64) -> f64 {
+        if occlusion <= 0.0 {
+            return 1.0;
+        }
+        let dirt = (occlusion.powf(self.gain).min(1.0) * self.scale).min(1.0);
+        1.0 - dirt
+    }
+}
+
+/// How dirt rays are spread over the cone around a sample's normal (`_dirtmode`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DirtMode {
+    /// 0: the same evenly spaced directions for every sample.
+    Ordered,
+    /// 1: different pseudo-random directions per sample (deterministic).
+    Random,
+}
+
+/// How occlusion is measured: worldspawn `_dirtmode`, `_dirtdepth`, `_dirtangle`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DirtSampling {
+    pub mode: DirtMode,
+    /// Rays longer than this see no occluder.
+    pub depth: f64,
+    /// Angle from the normal of the outermost rays, in degrees (1..=90).
+    pub cone_degrees: f64,
+}
+
+impl Default for DirtSampling {
+    fn default() -> Self {
+        DirtSampling {
+            mode: DirtMode::Ordered,
+            depth: DEFAULT_DIRT_DEPTH,
+            cone_degrees: DEFAULT_DIRT_ANGLE,
+        }
+    }
+}
+
 /// A light at a point (an entity, or one copy of a `_surface` template).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PointLight {
@@ -132,6 +190,8 @@ pub struct PointLight {
     pub style: u8,
     pub spot: Option<Spot>,
     pub anglescale: f64,
+    /// How dirt darkens this light (`None`: it ignores dirt).
+    pub dirt: Option<DirtResponse>,
     /// Entity index it came from (for messages).
     pub entity: usize,
 }
@@ -202,13 +262,18 @@ pub struct SunLight {
     pub color: Vec3,
     pub style: u8,
     pub anglescale: f64,
+    pub dirt: Option<DirtResponse>,
 }
 
-/// A minimum light level: no luxel of style 0 ends up darker than this.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// A minimum light level: no luxel of style 0 ends up darker than this
+/// (times the dirt factor when minlight takes dirt).
+#[derive(Debug, Clone, PartialEq)]
 pub struct Minlight {
     pub level: f64,
     pub color: Vec3,
+    pub dirt: Option<DirtResponse>,
+    /// Faces with this texture get no minlight (`_minlight_exclude`).
+    pub exclude_texture: Option<String>,
 }
 
 /// A `_surface` light: copied over every face whose texture is `texture`.
@@ -233,6 +298,15 @@ pub struct GlobalOverrides {
     pub range: Option<f64>,
     /// `--sunsamples`: directions for a sun penumbra and for each sky dome.
     pub sunsamples: usize,
+    /// `--dirt`: dirt on for every light, whatever worldspawn `_dirt` says.
+    pub dirt: bool,
+    /// `--dirtmode`, `--dirtdepth`, `--dirtscale`, `--dirtgain`, `--dirtangle`:
+    /// override the worldspawn keys of the same names.
+    pub dirt_mode: Option<f64>,
+    pub dirt_depth: Option<f64>,
+    pub dirt_scale: Option<f64>,
+    pub dirt_gain: Option<f64>,
+    pub dirt_angle: Option<f64>,
 }
 
 impl Default for GlobalOverrides {
@@ -241,6 +315,12 @@ impl Default for GlobalOverrides {
             dist: None,
             range: None,
             sunsamples: 100,
+            dirt: false,
+            dirt_mode: None,
+            dirt_depth: None,
+            dirt_scale: None,
+            dirt_gain: None,
+            dirt_angle: None,
         }
     }
 }
@@ -255,6 +335,14 @@ pub struct MapLights {
     pub minlight: HashMap<usize, Minlight>,
     /// Brush models that cast shadows (`_shadow 1`).
     pub shadow_models: Vec<usize>,
+    /// Brush models whose faces never take dirt (`_dirt -1`).
+    pub no_dirt_models: Vec<usize>,
+    /// Brush models whose faces get minlight only (`_lightignore 1`).
+    pub lightignore_models: Vec<usize>,
+    /// How dirt occlusion is measured (used only when something takes dirt).
+    pub dirt: DirtSampling,
+    /// Brush models (0 = world) with `_phong` smoothing, and their angle in degrees.
+    pub phong: HashMap<usize, f64>,
     /// Offset of each brush model with an `origin` key (rotating entities).
     pub model_origins: HashMap<usize, Vec3>,
     /// Lightmap bytes per light unit.
@@ -266,6 +354,14 @@ pub struct MapLights {
 }
 
 impl MapLights {
+    /// True if any light, sun or minlight is darkened by dirt.
+    pub fn uses_dirt(&self) -> bool {
+        self.points.iter().any(|l| l.dirt.is_some())
+            || self.suns.iter().any(|s| s.dirt.is_some())
+            || self.templates.iter().any(|t| t.light.dirt.is_some())
+            || self.minlight.values().any(|m| m.dirt.is_some())
+    }
+
     /// True if any light, sun or minlight is not white (a `.lit` is needed).
     pub fn is_coloured(&self) -> bool {
         let grey = |c: &Vec3| c.x != c.y || c.y != c.z;
@@ -365,6 +461,17 @@ pub fn mangle_to_vec(yaw: f64, pitch: f64) -> Vec3 {
     Vec3::new(y.cos() * p.cos(), y.sin() * p.cos(), p.sin())
 }
 
+/// Two unit vectors that make a right-handed orthonormal basis with unit `n`.
+pub fn tangent_basis(n: Vec3) -> [Vec3; 2] {
+    let helper = if n.z.abs() < 0.9 {
+        Vec3::new(0.0, 0.0, 1.0)
+    } else {
+        Vec3::new(1.0, 0.0, 0.0)
+    };
+    let u = helper.cross(n).normalized().unwrap_or(helper);
+    [u, n.cross(u)]
+}
+
 /// `n` unit directions spread evenly (a Fibonacci spiral) over the cap of
 /// half-angle `half_angle_deg` around unit `center`; `[center]` for `n <= 1`
 /// or a zero cap. Deterministic.
@@ -372,13 +479,7 @@ pub fn cap_directions(center: Vec3, half_angle_deg: f64, n: usize) -> Vec<Vec3> 
     if n <= 1 || half_angle_deg <= 0.0 {
         return vec![center];
     }
-    let helper = if center.z.abs() < 0.9 {
-        Vec3::new(0.0, 0.0, 1.0)
-    } else {
-        Vec3::new(1.0, 0.0, 0.0)
-    };
-    let u = helper.cross(center).normalized().unwrap_or(helper);
-    let v = center.cross(u);
+    let [u, v] = tangent_basis(center);
     let cos_cap = half_angle_deg.min(180.0).to_radians().cos();
     let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
     (0..n)
@@ -392,22 +493,40 @@ pub fn cap_directions(center: Vec3, half_angle_deg: f64, n: usize) -> Vec<Vec3> 
         .collect()
 }
 
-/// Splits `light` evenly over `dirs`.
-fn suns_over(
-    dirs: Vec<Vec3>,
-    light: f64,
-    color: Vec3,
-    style: u8,
-    anglescale: f64,
-) -> Vec<SunLight> {
-    let each = light / dirs.len().max(1) as f64;
+/// Splits the light of `sun` evenly over `dirs` (its `to_sun` is replaced).
+fn suns_over(dirs: Vec<Vec3>, sun: &SunLight) -> Vec<SunLight> {
+    let each = sun.light / dirs.len().max(1) as f64;
     dirs.into_iter()
         .map(|to_sun| SunLight {
             to_sun,
             light: each,
-            color,
-            style,
-            anglescale,
+            ..sun.clone()
+        })
+        .collect()
+}
+
+/// Whether something takes dirt: its own switch (1 on, -1 off), else the
+/// global setting.
+fn dirt_if(switch: Option<f64>, global_on: bool, response: DirtResponse) -> Option<DirtResponse> {
+    let on = match switch {
+        Some(1.0) => true,
+        Some(-1.0) => false,
+        _ => global_on,
+    };
+    on.then_some(response)
+}
+
+/// `count` points spread evenly through the ball of `radius` around
+/// `center` (deterministic: a Fibonacci spiral over shells of equal volume).
+pub fn ball_points(center: Vec3, radius: f64, count: usize) -> Vec<Vec3> {
+    let dirs = cap_directions(Vec3::new(0.0, 0.0, 1.0), 180.0, count);
+    dirs.into_iter()
+        .enumerate()
+        .map(|(i, d)| {
+            // Radius by the cube root of an evenly spaced volume fraction,
+            // scrambled by the golden ratio so shells do not line up with the spiral.
+            let fraction = ((i as f64 + 0.5) * 0.618_033_988_749_895).fract();
+            center + d * (radius * fraction.cbrt())
         })
         .collect()
 }
@@ -446,6 +565,50 @@ pub fn parse_lights(
         .unwrap_or(DEFAULT_ANGLESCALE)
         .clamp(0.0, 1.0);
     let sunsamples = overrides.sunsamples.max(1);
+    let global_dirt = overrides.dirt || wk.float("_dirt")? == Some(1.0);
+    let global_response = DirtResponse {
+        scale: overrides
+            .dirt_scale
+            .or(wk.float("_dirtscale")?)
+            .filter(|s| *s >= 0.0)
+            .unwrap_or(1.0),
+        gain: overrides
+            .dirt_gain
+            .or(wk.float("_dirtgain")?)
+            .filter(|g| *g > 0.0)
+            .unwrap_or(1.0),
+    };
+    let dirt = DirtSampling {
+        mode: if overrides.dirt_mode.or(wk.float("_dirtmode")?) == Some(1.0) {
+            DirtMode::Random
+        } else {
+            DirtMode::Ordered
+        },
+        depth: overrides
+            .dirt_depth
+            .or(wk.float("_dirtdepth")?)
+            .filter(|d| *d > 0.0)
+            .unwrap_or(DEFAULT_DIRT_DEPTH),
+        cone_degrees: overrides
+            .dirt_angle
+            .or(wk.float("_dirtangle")?)
+            .unwrap_or(DEFAULT_DIRT_ANGLE)
+            .clamp(1.0, 90.0),
+    };
+    // A light's own `_dirtscale` / `_dirtgain` (non-zero) win over the global ones.
+    let response_of = |k: &Keys| -> Result<DirtResponse, LightError> {
+        Ok(DirtResponse {
+            scale: k
+                .float("_dirtscale")?
+                .filter(|s| *s > 0.0)
+                .unwrap_or(global_response.scale),
+            gain: k
+                .float("_dirtgain")?
+                .filter(|g| *g > 0.0)
+                .unwrap_or(global_response.gain),
+        })
+    };
+    let minlight_dirt = dirt_if(wk.float("_minlight_dirt")?, global_dirt, global_response);
 
     let mut out = MapLights {
         points: Vec::new(),
@@ -453,6 +616,10 @@ pub fn parse_lights(
         templates: Vec::new(),
         minlight: HashMap::new(),
         shadow_models: Vec::new(),
+        no_dirt_models: Vec::new(),
+        lightignore_models: Vec::new(),
+        dirt,
+        phong: HashMap::new(),
         model_origins: HashMap::new(),
         rangescale,
         gamma,
@@ -468,6 +635,8 @@ pub fn parse_lights(
             Minlight {
                 level: world_min,
                 color,
+                dirt: minlight_dirt,
+                exclude_texture: wk.entity.get("_minlight_exclude").map(str::to_string),
             },
         );
     }
@@ -477,20 +646,51 @@ pub fn parse_lights(
             .or(wk.vec3("_sunlight_mangle")?)
             .unwrap_or(Vec3::new(0.0, -90.0, 0.0));
         let penumbra = wk.float("_sunlight_penumbra")?.unwrap_or(0.0);
-        let color = wk.color_any(&["_sunlight_color"])?;
-        let dirs = cap_directions(-mangle_to_vec(mangle.x, mangle.y), penumbra, sunsamples);
-        out.suns
-            .extend(suns_over(dirs, sun, color, 0, global_anglescale));
+        let to_sun = -mangle_to_vec(mangle.x, mangle.y);
+        let template = SunLight {
+            to_sun,
+            light: sun,
+            color: wk.color_any(&["_sunlight_color"])?,
+            style: 0,
+            anglescale: global_anglescale,
+            dirt: dirt_if(wk.float("_sunlight_dirt")?, global_dirt, global_response),
+        };
+        let dirs = cap_directions(to_sun, penumbra, sunsamples);
+        out.suns.extend(suns_over(dirs, &template));
     }
+    let dome_dirt = dirt_if(wk.float("_sunlight2_dirt")?, global_dirt, global_response);
     for (key, colors, up) in [
         ("_sunlight2", ["_sunlight2_color", "_sunlight_color2"], 1.0),
         ("_sunlight3", ["_sunlight3_color", "_sunlight_color3"], -1.0),
     ] {
         if let Some(dome) = wk.float(key)?.filter(|s| *s != 0.0) {
-            let color = wk.color_any(&colors)?;
-            let dirs = cap_directions(Vec3::new(0.0, 0.0, up), 90.0, sunsamples);
+            let up = Vec3::new(0.0, 0.0, up);
+            let template = SunLight {
+                to_sun: up,
+                light: dome,
+                color: wk.color_any(&colors)?,
+                style: 0,
+                anglescale: global_anglescale,
+                dirt: dome_dirt,
+            };
             out.suns
-                .extend(suns_over(dirs, dome, color, 0, global_anglescale));
+                .extend(suns_over(cap_directions(up, 90.0, sunsamples), &template));
+        }
+    }
+
+    for (index, e) in entities.iter().enumerate() {
+        let model = if index == world {
+            Some(0)
+        } else {
+            model_index(e).filter(|&m| m > 0)
+        };
+        if let Some(model) = model {
+            let k = Keys { entity: e, index };
+            let angle = k.float("_phong_angle")?.filter(|a| *a > 0.0);
+            if k.float("_phong")? == Some(1.0) || angle.is_some() {
+                out.phong
+                    .insert(model, angle.unwrap_or(DEFAULT_PHONG_ANGLE).min(180.0));
+            }
         }
     }
 
@@ -511,9 +711,23 @@ pub fn parse_lights(
             if let Some(o) = k.vec3("origin")? {
                 out.model_origins.insert(model, o);
             }
+            if k.float("_dirt")? == Some(-1.0) {
+                out.no_dirt_models.push(model);
+            }
+            if k.float("_lightignore")? == Some(1.0) {
+                out.lightignore_models.push(model);
+            }
             if let Some(level) = k.float("_minlight")?.filter(|m| *m != 0.0) {
                 let color = k.color_any(&["_minlight_color", "_mincolor"])?;
-                out.minlight.insert(model, Minlight { level, color });
+                out.minlight.insert(
+                    model,
+                    Minlight {
+                        level,
+                        color,
+                        dirt: minlight_dirt,
+                        exclude_texture: e.get("_minlight_exclude").map(str::to_string),
+                    },
+                );
             }
             continue;
         }
@@ -538,20 +752,36 @@ pub fn parse_lights(
             (None, Some(t)) => origins.get(t).and_then(|&to| (to - origin).normalized()),
             (None, None) => None,
         };
+        let dirt = dirt_if(k.float("_dirt")?, global_dirt, response_of(&k)?);
+        let deviance = k.float("_deviance")?.unwrap_or(0.0).max(0.0);
         if k.float("_sun")? == Some(1.0) {
             let to_sun = -aim.unwrap_or(Vec3::new(0.0, 0.0, -1.0));
-            let deviance = k.float("_deviance")?.unwrap_or(0.0);
+            let template = SunLight {
+                to_sun,
+                light,
+                color,
+                style,
+                anglescale,
+                dirt,
+            };
             let dirs = cap_directions(to_sun, deviance, sunsamples);
-            out.suns
-                .extend(suns_over(dirs, light, color, style, anglescale));
+            out.suns.extend(suns_over(dirs, &template));
             continue;
         }
         let mut dome = false;
         for (key, up) in [("_sunlight2", 1.0), ("_sunlight3", -1.0)] {
             if k.float(key)? == Some(1.0) {
-                let dirs = cap_directions(Vec3::new(0.0, 0.0, up), 90.0, sunsamples);
+                let up = Vec3::new(0.0, 0.0, up);
+                let template = SunLight {
+                    to_sun: up,
+                    light,
+                    color,
+                    style,
+                    anglescale,
+                    dirt,
+                };
                 out.suns
-                    .extend(suns_over(dirs, light, color, style, anglescale));
+                    .extend(suns_over(cap_directions(up, 90.0, sunsamples), &template));
                 dome = true;
             }
         }
@@ -563,17 +793,23 @@ pub fn parse_lights(
             .filter(|_| delay.fract() == 0.0)
             .ok_or_else(|| k.bad("delay", "0, 1, 2, 3, 4 or 5"))?;
         let wait = k.float("wait")?.filter(|w| *w > 0.0).unwrap_or(1.0);
+        // `_falloff` (linear only): reaches zero exactly that many units out.
+        let atten = match k.float("_falloff")?.filter(|f| *f > 0.0) {
+            Some(reach) if falloff == Falloff::Linear => light.abs() / reach,
+            _ => wait * scaledist,
+        };
         let angle = k.float("angle")?.unwrap_or(DEFAULT_SPOT_ANGLE);
         let softangle = k.float("_softangle")?.unwrap_or(0.0);
         let point = PointLight {
             origin,
             light,
-            atten: wait * scaledist,
+            atten,
             falloff,
             color,
             style,
             spot: aim.map(|dir| Spot::new(dir, angle, softangle)),
             anglescale,
+            dirt,
             entity: index,
         };
         match e.get("_surface").filter(|t| !t.is_empty()) {
@@ -587,10 +823,41 @@ pub fn parse_lights(
                 spotlight: k.float("_surface_spotlight")? == Some(1.0),
                 spot_angle: angle,
             }),
+            None if deviance > 0.0 => {
+                let count = k
+                    .float("_samples")?
+                    .filter(|n| *n >= 1.0)
+                    .map_or(DEFAULT_DEVIANCE_SAMPLES, |n| n as usize);
+                out.points.extend(split_light(&point, deviance, count));
+            }
             None => out.points.push(point),
         }
     }
     Ok(out)
+}
+
+/// `_deviance`: `light` as `count` lights spread through a ball of `radius`,
+/// together as bright as the one light. Linear lights also divide their
+/// fade rate, so each copy still reaches as far as the original; local
+/// minlight raises to a level rather than adding, so its copies keep it.
+pub fn split_light(light: &PointLight, radius: f64, count: usize) -> Vec<PointLight> {
+    let n = count.max(1) as f64;
+    ball_points(light.origin, radius, count.max(1))
+        .into_iter()
+        .map(|origin| {
+            let mut copy = light.clone();
+            copy.origin = origin;
+            match light.falloff {
+                Falloff::LocalMin => {}
+                Falloff::Linear => {
+                    copy.light /= n;
+                    copy.atten /= n;
+                }
+                _ => copy.light /= n,
+            }
+            copy
+        })
+        .collect()
 }
 
 /// Gives each `targetname` of a light entity without an explicit `style` its
@@ -641,6 +908,7 @@ mod tests {
             style: 0,
             spot: None,
             anglescale: 0.5,
+            dirt: None,
             entity: 0,
         }
     }
@@ -815,5 +1083,62 @@ mod tests {
         let mut ents =
             parse_entities("{ \"classname\" \"light\" \"delay\" \"7\" }").expect("parse");
         assert!(parse_lights(&mut ents, &GlobalOverrides::default()).is_err());
+    }
+
+    #[test]
+    fn dirt_keys_resolve_per_light() {
+        let text = r#"
+{ "classname" "worldspawn" "_dirt" "1" "_dirtscale" "1.5" "_dirtgain" "0.5" "_dirtdepth" "64" "_dirtangle" "120" "_dirtmode" "1" "_sunlight" "100" "_sunlight_dirt" "-1" }
+{ "classname" "light" "origin" "0 0 0" }
+{ "classname" "light" "origin" "0 0 0" "_dirt" "-1" }
+{ "classname" "light" "origin" "0 0 0" "_dirtscale" "3" }
+{ "classname" "func_wall" "model" "*1" "_dirt" "-1" "_lightignore" "1" "_minlight" "5" "_minlight_exclude" "sky1" }
+"#;
+        let mut ents = parse_entities(text).expect("parse");
+        let lights = parse_lights(&mut ents, &GlobalOverrides::default()).expect("lights");
+        let global = DirtResponse {
+            scale: 1.5,
+            gain: 0.5,
+        };
+        assert_eq!(lights.points[0].dirt, Some(global));
+        assert_eq!(lights.points[1].dirt, None);
+        assert_eq!(lights.points[2].dirt.map(|d| d.scale), Some(3.0));
+        assert_eq!(lights.suns[0].dirt, None, "_sunlight_dirt -1");
+        assert_eq!(lights.dirt.mode, DirtMode::Random);
+        assert_eq!(lights.dirt.depth, 64.0);
+        assert_eq!(lights.dirt.cone_degrees, 90.0, "clamped to 90");
+        assert_eq!(lights.no_dirt_models, vec![1]);
+        assert_eq!(lights.lightignore_models, vec![1]);
+        assert_eq!(lights.minlight[&1].exclude_texture.as_deref(), Some("sky1"));
+        assert!(lights.uses_dirt());
+        // Factor: 1 - min(1, scale * occlusion^gain).
+        assert!(close(global.factor(0.25), 1.0 - 1.5 * 0.5));
+        assert_eq!(global.factor(0.0), 1.0);
+        assert_eq!(global.factor(1.0), 0.0);
+    }
+
+    #[test]
+    fn falloff_key_and_deviance_split() {
+        let text = r#"
+{ "classname" "light" "origin" "0 0 0" "light" "200" "_falloff" "400" }
+{ "classname" "light" "origin" "0 0 0" "light" "160" "delay" "2" "_deviance" "8" "_samples" "4" }
+"#;
+        let mut ents = parse_entities(text).expect("parse");
+        let lights = parse_lights(&mut ents, &GlobalOverrides::default()).expect("lights");
+        assert_eq!(lights.points.len(), 5);
+        let linear = &lights.points[0];
+        assert!(close(linear.value_at(200.0), 100.0), "half way to 400");
+        assert_eq!(linear.value_at(400.0), 0.0);
+        let total: f64 = lights.points[1..].iter().map(|l| l.light).sum();
+        assert!(close(total, 160.0), "copies share the light");
+        for l in &lights.points[1..] {
+            assert!(l.origin.length() <= 8.0 + 1e-9);
+        }
+        // Linear copies divide the fade rate too: together as bright, as far-reaching.
+        let one = light(Falloff::Linear, 300.0, 1.0);
+        let split = split_light(&one, 4.0, 3);
+        let sum: f64 = split.iter().map(|l| l.value_at(100.0)).sum();
+        assert!(close(sum, one.value_at(100.0)));
+        assert!(close(split[0].range(0.001), one.range(0.001)));
     }
 }

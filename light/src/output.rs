@@ -1,11 +1,9 @@
-//! From light units to the bytes engines read: minlight, the `--soft`
-//! filter, range scale, gamma, clamping, and the lighting lump (plus the
+//! From light units to the bytes engines read: the `--soft` filter, range scale, gamma, clamping, and the lighting lump (plus the
 //! `.lit` colour data) with each face's `styles` and `light_offset`.
 
 use quake_formats::Bsp;
 use quake_formats::bsp::limits::MAX_LIGHTMAPS;
 
-use crate::lights::Minlight;
 use crate::trace::FaceLight;
 
 /// Style slot value for "unused".
@@ -80,25 +78,12 @@ pub fn to_bytes(c: [f32; 3], finish: &Finish) -> [u8; 3] {
 
 /// Finishes one face. Returns the lightmap and how many styles were dropped
 /// for exceeding four.
-pub fn finish_face(
-    light: FaceLight,
-    minlight: Option<Minlight>,
-    finish: &Finish,
-) -> (FaceLightmap, usize) {
+pub fn finish_face(light: &FaceLight, finish: &Finish) -> (FaceLightmap, usize) {
     let (w, h) = (light.width, light.height);
     let mut maps: Vec<(u8, Vec<[u8; 3]>, u64)> = Vec::new();
-    for (style, mut luxels) in light.styles {
-        if style == 0
-            && let Some(m) = minlight
-        {
-            let floor = [0, 1, 2].map(|c| (m.level * m.color[c]) as f32);
-            for l in &mut luxels {
-                for (v, f) in l.iter_mut().zip(floor) {
-                    *v = v.max(f);
-                }
-            }
-        }
-        let filtered = soft_filter(&luxels, w, h, finish.soft_radius);
+    for (style, luxels) in &light.styles {
+        let style = *style;
+        let filtered = soft_filter(luxels, w, h, finish.soft_radius);
         let rgb: Vec<[u8; 3]> = filtered.iter().map(|&c| to_bytes(c, finish)).collect();
         let energy: u64 = rgb.iter().flatten().map(|&b| u64::from(b)).sum();
         // Style 0 is always written (a face without a lightmap renders fullbright).
@@ -196,7 +181,7 @@ mod tests {
             height: 1,
             styles,
         };
-        let (m, dropped) = finish_face(light, None, &PLAIN);
+        let (m, dropped) = finish_face(&light, &PLAIN);
         assert_eq!(m.styles, vec![0, 36, 35, 34]);
         assert_eq!(
             dropped, 2,
@@ -206,18 +191,14 @@ mod tests {
     }
 
     #[test]
-    fn minlight_raises_style_zero() {
+    fn grey_is_the_rounded_channel_mean() {
         let light = FaceLight {
             face: 0,
             width: 1,
             height: 1,
-            styles: vec![(0, vec![[10.0; 3]])],
+            styles: vec![(0, vec![[40.0, 20.0, 20.0]])],
         };
-        let m = Minlight {
-            level: 40.0,
-            color: quake_formats::geom::Vec3::new(1.0, 0.5, 0.5),
-        };
-        let (out, _) = finish_face(light, Some(m), &PLAIN);
+        let (out, _) = finish_face(&light, &PLAIN);
         assert_eq!(out.rgb[0], vec![[20, 10, 10]]);
         assert_eq!(out.grey[0], vec![13]);
     }

@@ -1,11 +1,14 @@
 //! Sample points: where on (just in front of) each face light is measured.
 //!
 //! One point per luxel (16 texels), or `n x n` per luxel when supersampling,
-//! found by inverting the face's texture projection onto its plane. Points
-//! are pushed [`SURFACE_OFFSET`] units off the surface; a point that ends up
-//! behind a wall (luxels past the face's edge, e.g. under a wall standing on
-//! a floor) is pulled back towards the face centre until it is in the open,
-//! so light from the far side of the wall does not bleed under it.
+//! found by inverting the face's texture projection onto its plane. A point
+//! that falls outside the face (luxels past its edge, e.g. under a wall
+//! standing on a floor) moves to the nearest point of the face, kept
+//! [`FACE_INSET`] inside its edges, so light from the far side of the wall
+//! does not bleed under it and the point stays over the part of the face it
+//! stands for. Points are then pushed [`SURFACE_OFFSET`] units off the
+//! surface; one that something still hides from the face centre (an object
+//! resting on the face) is pulled back towards the centre into the open.
 //!
 //! [`FaceSamples`] is kept as its own structure so later passes (bounce
 //! lighting) can reuse the same points.
@@ -13,7 +16,8 @@
 use quake_formats::Bsp;
 use quake_formats::bsp::contents;
 use quake_formats::bsp::limits::LIGHTMAP_SCALE;
-use quake_formats::geom::Vec3;
+use quake_formats::extents::LightmapExtents;
+use quake_formats::geom::{Plane, Vec3, Winding};
 
 use crate::faces::FaceGeom;
 use crate::scene::TraceScene;
@@ -22,6 +26,9 @@ use crate::scene::TraceScene;
 pub const SURFACE_OFFSET: f64 = 1.0;
 /// Clearance kept between a pulled-back point and the wall that blocked it.
 const WALL_CLEARANCE: f32 = 1.0;
+/// How far inside the face's edges points moved onto the face stay (less
+/// on faces too narrow for it).
+pub const FACE_INSET: f64 = 0.5;
 
 /// The sample points of one face.
 #[derive(Debug, Clone)]
@@ -36,6 +43,10 @@ pub struct FaceSamples {
     pub normal: Vec3,
     /// Sample positions, luxel by luxel (row-major), `per_axis²` per luxel.
     pub points: Vec<[f32; 3]>,
+    /// Per-sample shading normals (`_phong`), or empty: the face normal everywhere.
+    pub normals: Vec<[f32; 3]>,
+    /// Where the samples' texture coordinates land on the face.
+    pub map: SurfaceMap,
 }
 
 impl FaceSamples {
@@ -46,6 +57,13 @@ impl FaceSamples {
     pub fn per_luxel(&self) -> usize {
         self.per_axis * self.per_axis
     }
+
+    /// The normal the angle-of-incidence term uses at sample `i`.
+    pub fn normal_at(&self, i: usize) -> Vec3 {
+        self.normals
+            .get(i)
+            .map_or(self.normal, |&n| Vec3::from_f32(n))
+    }
 }
 
 /// Counts from placing sample points.
@@ -53,6 +71,8 @@ impl FaceSamples {
 pub struct PlacementCounts {
     /// Rays cast from the face centre to check points are in the open.
     pub rays: u64,
+    /// Points outside the face moved onto it.
+    pub clamped: u64,
     /// Points pulled back because something stood between them and the centre.
     pub pulled_back: u64,
     /// Points still in solid afterwards, moved onto the face centre.
@@ -62,6 +82,7 @@ pub struct PlacementCounts {
 impl PlacementCounts {
     pub fn add(&mut self, o: &PlacementCounts) {
         self.rays += o.rays;
+        self.clamped += o.clamped;
         self.pulled_back += o.pulled_back;
         self.to_centre += o.to_centre;
     }
@@ -69,6 +90,7 @@ impl PlacementCounts {
 
 /// Solves `[s_axis; t_axis; normal] p = rhs` for model-space `p`: the point
 /// on the face plane with texture coordinates (s, t).
+#[derive(Debug, Clone)]
 struct TextureToWorld {
     inverse: [Vec3; 3],
     s_offset: f64,
@@ -102,6 +124,174 @@ impl TextureToWorld {
     }
 }
 
+/// A convex face polygon as half-planes: a point is inside when it is in
+/// front of every edge's inward plane.
+#[derive(Debug, Clone)]
+pub struct FaceRegion {
+    points: Vec<Vec3>,
+    /// Per edge (from `points[i]` to the next): unit in-plane normal pointing inside.
+    inward: Vec<Vec3>,
+}
+
+impl FaceRegion {
+    fn from_points(points: Vec<Vec3>, normal: Vec3) -> FaceRegion {
+        let centre = points.iter().fold(Vec3::ZERO, |a, &p| a + p) / points.len().max(1) as f64;
+        let inward = (0..points.len())
+            .map(|i| {
+                let a = points[i];
+                let b = points[(i + 1) % points.len()];
+                let m = normal.cross(b - a).normalized().unwrap_or(Vec3::ZERO);
+                if m.dot(centre - a) < 0.0 { -m } else { m }
+            })
+            .collect();
+        FaceRegion { points, inward }
+    }
+
+    /// The face's polygon shrunk by [`FACE_INSET`] (halved until the face
+    /// has room for it; the polygon itself if it never has).
+    pub fn inset(face: &FaceGeom) -> FaceRegion {
+        let normal = face.plane.normal;
+        let outline = FaceRegion::from_points(face.points.clone(), normal);
+        let mut inset = FACE_INSET;
+        while inset >= 1.0 / 64.0 {
+            let mut w = Some(Winding::new(face.points.clone()));
+            for (i, m) in outline.inward.iter().enumerate() {
+                let plane = Plane::new(*m, m.dot(outline.points[i]) + inset);
+                w = w.and_then(|w| w.clip_front(&plane, false));
+            }
+            if let Some(w) = w.filter(|w| !w.is_tiny()) {
+                return FaceRegion::from_points(w.points, normal);
+            }
+            inset /= 2.0;
+        }
+        outline
+    }
+
+    /// Mean of the corners (inside: the region is convex).
+    pub fn centre(&self) -> Vec3 {
+        self.points.iter().fold(Vec3::ZERO, |a, &p| a + p) / self.points.len().max(1) as f64
+    }
+
+    /// `p` (a point on the face's plane) if it is inside, else the nearest
+    /// point of the region's outline.
+    pub fn nearest(&self, p: Vec3) -> Vec3 {
+        let outside = (0..self.points.len()).any(|i| self.inward[i].dot(p - self.points[i]) < 0.0);
+        if !outside || self.points.is_empty() {
+            return p;
+        }
+        let mut best = self.points[0];
+        let mut best_d2 = f64::INFINITY;
+        for i in 0..self.points.len() {
+            let a = self.points[i];
+            let ab = self.points[(i + 1) % self.points.len()] - a;
+            let len2 = ab.dot(ab);
+            let t = if len2 > 0.0 {
+                ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let q = a + ab * t;
+            let d = p - q;
+            if d.dot(d) < best_d2 {
+                best_d2 = d.dot(d);
+                best = q;
+            }
+        }
+        best
+    }
+}
+
+/// Where a face's texture coordinates land: the point of the face's plane
+/// with those (s, t), moved onto the face (inside its inset outline) and
+/// lifted [`SURFACE_OFFSET`] off it. Also knows the square of texture space
+/// each sample stands for, so later passes can spread points over it.
+#[derive(Debug, Clone)]
+pub struct SurfaceMap {
+    to_world: Option<TextureToWorld>,
+    region: FaceRegion,
+    origin: Vec3,
+    lift: Vec3,
+    extents: LightmapExtents,
+    per_axis: usize,
+    /// Half-diagonal of one sample's square, in world units.
+    footprint_radius: f64,
+}
+
+impl SurfaceMap {
+    pub fn new(face: &FaceGeom, per_axis: usize) -> SurfaceMap {
+        let to_world = TextureToWorld::new(face);
+        let step = f64::from(LIGHTMAP_SCALE) / per_axis as f64;
+        let footprint_radius = to_world.as_ref().map_or(0.0, |m| {
+            (m.inverse[0].length() + m.inverse[1].length()) * step / 2.0
+        });
+        SurfaceMap {
+            to_world,
+            region: FaceRegion::inset(face),
+            origin: face.origin,
+            lift: face.plane.normal * SURFACE_OFFSET,
+            extents: face.extents,
+            per_axis,
+            footprint_radius,
+        }
+    }
+
+    /// The lifted centre of the face (inside it).
+    pub fn centre(&self) -> Vec3 {
+        self.region.centre() + self.lift
+    }
+
+    /// The lifted point for texture coordinates (s, t), and whether it had
+    /// to move onto the face. Without a usable projection: the centre.
+    pub fn point(&self, s: f64, t: f64) -> (Vec3, bool) {
+        let Some(m) = &self.to_world else {
+            return (self.centre(), false);
+        };
+        let on_plane = m.point(s, t) + self.origin;
+        let on_face = self.region.nearest(on_plane);
+        (on_face + self.lift, on_face != on_plane)
+    }
+
+    /// Texels along each axis one sample stands for.
+    pub fn sample_step(&self) -> f64 {
+        f64::from(LIGHTMAP_SCALE) / self.per_axis as f64
+    }
+
+    /// Half-diagonal of one sample's square, in world units.
+    pub fn footprint_radius(&self) -> f64 {
+        self.footprint_radius
+    }
+
+    /// Texture coordinates of sample `i` (in [`FaceSamples::points`] order):
+    /// the middle of its square.
+    pub fn sample_st(&self, i: usize) -> [f64; 2] {
+        let per_luxel = self.per_axis * self.per_axis;
+        let width = self.extents.luxel_size()[0];
+        let (luxel, sub) = (i / per_luxel, i % per_luxel);
+        let [s0, t0] = self.extents.luxel_st(luxel % width, luxel / width);
+        if self.per_axis == 1 {
+            return [s0, t0];
+        }
+        let step = self.sample_step();
+        let first = -f64::from(LIGHTMAP_SCALE) / 2.0 + step / 2.0;
+        [
+            s0 + first + step * (sub % self.per_axis) as f64,
+            t0 + first + step * (sub / self.per_axis) as f64,
+        ]
+    }
+
+    /// `n x n` points spread evenly over sample `i`'s square, each placed as
+    /// a sample point would be (onto the face, lifted; not pulled back).
+    pub fn footprint_points(&self, i: usize, n: usize) -> impl Iterator<Item = Vec3> + '_ {
+        let [s, t] = self.sample_st(i);
+        let sub = self.sample_step() / n as f64;
+        let first = -self.sample_step() / 2.0 + sub / 2.0;
+        (0..n * n).map(move |k| {
+            let (ks, kt) = ((k % n) as f64, (k / n) as f64);
+            self.point(s + first + sub * ks, t + first + sub * kt).0
+        })
+    }
+}
+
 /// Places the sample points of `face`: `per_axis²` per luxel, spread evenly
 /// over the luxel's 16x16-texel square. `bsp` is consulted for world faces to
 /// catch points that are still inside solid after the pull-back.
@@ -112,48 +302,28 @@ pub fn face_samples(
     bsp: &Bsp,
 ) -> (FaceSamples, PlacementCounts) {
     let [width, height] = face.extents.luxel_size();
-    let normal = face.plane.normal;
-    let lift = normal * SURFACE_OFFSET;
-    let centre = face.centroid() + lift;
-    let to_world = TextureToWorld::new(face);
+    let map = SurfaceMap::new(face, per_axis);
+    let centre = map.centre();
     let mut counts = PlacementCounts::default();
-    let mut points = Vec::with_capacity(width * height * per_axis * per_axis);
-    let step = f64::from(LIGHTMAP_SCALE) / per_axis as f64;
-    let first = -f64::from(LIGHTMAP_SCALE) / 2.0 + step / 2.0;
-    for y in 0..height {
-        for x in 0..width {
-            let [s0, t0] = face.extents.luxel_st(x, y);
-            for sy in 0..per_axis {
-                for sx in 0..per_axis {
-                    let (s, t) = if per_axis == 1 {
-                        (s0, t0)
-                    } else {
-                        (s0 + first + step * sx as f64, t0 + first + step * sy as f64)
-                    };
-                    let p = match &to_world {
-                        Some(m) => m.point(s, t) + face.origin + lift,
-                        None => centre,
-                    };
-                    points.push(into_open(
-                        p,
-                        centre,
-                        face.model == 0,
-                        scene,
-                        bsp,
-                        &mut counts,
-                    ));
-                }
-            }
-        }
-    }
+    let count = width * height * per_axis * per_axis;
+    let points = (0..count)
+        .map(|i| {
+            let [s, t] = map.sample_st(i);
+            let (p, clamped) = map.point(s, t);
+            counts.clamped += u64::from(clamped);
+            into_open(p, centre, face.model == 0, scene, bsp, &mut counts)
+        })
+        .collect();
     (
         FaceSamples {
             face: face.index,
             width,
             height,
             per_axis,
-            normal,
+            normal: face.plane.normal,
             points,
+            normals: Vec::new(),
+            map,
         },
         counts,
     )

@@ -75,6 +75,19 @@ impl TraceScene {
             .fold(0, |m, i| m | (1 << i))
     }
 
+    /// For each active lane of `packet`, the distance to the first surface
+    /// if that is an opaque one (not sky).
+    pub fn opaque_hits16(&self, packet: &mut RayPacket16) -> [Option<f32>; 16] {
+        let ids = self.scene.first_hit_geom16(packet, true);
+        let mut out = [None; 16];
+        for (lane, id) in ids.iter().enumerate() {
+            if *id != self.sky_geom && *id != sys::RTC_INVALID_GEOMETRY_ID {
+                out[lane] = Some(packet.tfar(lane));
+            }
+        }
+        out
+    }
+
     /// Distance along unit `dir` from `org` to the first surface, if any within `max`.
     pub fn hit_distance(&self, org: [f32; 3], dir: [f32; 3], max: f32) -> Option<f32> {
         self.scene.intersect(org, dir, 0.0, max).map(|h| h.t)

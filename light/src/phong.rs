@@ -1,0 +1,198 @@
+//! `_phong` smoothing: shading normals that turn smoothly across the faces
+//! of one brush entity (worldspawn for the world), so a column made of flat
+//! faces is lit like a round one. Each face corner gets the mean of the
+//! normals of the entity's faces that meet there and lie within the phong
+//! angle of the face, weighted by the angle each face spans at that corner.
+//! Inside a face the corner normals are blended with mean value
+//! coordinates. Only the angle-of-incidence term uses them; shadows and
+//! culling keep the flat face.
+
+use std::collections::HashMap;
+
+use quake_formats::geom::{Bounds, Vec3};
+
+use crate::faces::{FaceGeom, FaceKind};
+
+/// A point this close to a face (plane and outline) touches it.
+const TOUCH_EPSILON: f64 = 0.05;
+/// Grid cell size of the lookup of faces near a point.
+const CELL: f64 = 64.0;
+
+fn cell_of(p: Vec3) -> [i64; 3] {
+    [p.x, p.y, p.z].map(|c| (c / CELL).floor() as i64)
+}
+
+/// The angle the polygon `points` spans at `p` if `p` is one of its corners,
+/// π if `p` lies on one of its edges, and 2π inside it; `None` if `p` is
+/// not on the polygon.
+fn angle_at(points: &[Vec3], normal: Vec3, plane_dist: f64, p: Vec3) -> Option<f64> {
+    if (normal.dot(p) - plane_dist).abs() > TOUCH_EPSILON {
+        return None;
+    }
+    let n = points.len();
+    let mut inside = true;
+    for i in 0..n {
+        let a = points[i];
+        let b = points[(i + 1) % n];
+        if (p - a).length() <= TOUCH_EPSILON {
+            let prev = points[(i + n - 1) % n];
+            let (u, v) = ((prev - a).normalized()?, (b - a).normalized()?);
+            return Some(u.dot(v).clamp(-1.0, 1.0).acos());
+        }
+        let edge = b - a;
+        let len = edge.length();
+        let along = (p - a).dot(edge) / len.max(1e-12);
+        let off = (p - a - edge * (along / len.max(1e-12))).length();
+        if off <= TOUCH_EPSILON && along > 0.0 && along < len {
+            return Some(std::f64::consts::PI);
+        }
+        // Faces are clockwise seen from the front.
+        if normal.dot((p - a).cross(edge)) < 0.0 {
+            inside = false;
+        }
+    }
+    inside.then_some(std::f64::consts::TAU)
+}
+
+/// Corner normals of every lit face whose brush model appears in `angles`
+/// (model index -> phong angle in degrees); `None` for the other faces.
+pub fn corner_normals(faces: &[FaceGeom], angles: &HashMap<usize, f64>) -> Vec<Option<Vec<Vec3>>> {
+    let mut out: Vec<Option<Vec<Vec3>>> = vec![None; faces.len()];
+    for (&model, &angle) in angles {
+        let members: Vec<&FaceGeom> = faces
+            .iter()
+            .filter(|f| f.model == model && f.kind == FaceKind::Lit && f.points.len() >= 3)
+            .collect();
+        let mut grid: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
+        for (m, f) in members.iter().enumerate() {
+            let mut bounds = Bounds::EMPTY;
+            for &p in &f.points {
+                bounds.add_point(p);
+            }
+            let margin = Vec3::new(1.0, 1.0, 1.0) * TOUCH_EPSILON;
+            let (lo, hi) = (cell_of(bounds.mins - margin), cell_of(bounds.maxs + margin));
+            for x in lo[0]..=hi[0] {
+                for y in lo[1]..=hi[1] {
+                    for z in lo[2]..=hi[2] {
+                        grid.entry([x, y, z]).or_default().push(m);
+                    }
+                }
+            }
+        }
+        let cos_limit = angle.to_radians().cos();
+        for f in &members {
+            let normal = f.plane.normal;
+            let corners = f
+                .points
+                .iter()
+                .map(|&p| {
+                    let mut sum = Vec3::ZERO;
+                    for &m in grid.get(&cell_of(p)).into_iter().flatten() {
+                        let g = members[m];
+                        if g.plane.normal.dot(normal) < cos_limit - 1e-9 {
+                            continue;
+                        }
+                        if let Some(w) = angle_at(&g.points, g.plane.normal, g.plane.dist, p) {
+                            sum += g.plane.normal * w;
+                        }
+                    }
+                    sum.normalized().unwrap_or(normal)
+                })
+                .collect();
+            out[f.index] = Some(corners);
+        }
+    }
+    out
+}
+
+/// The smooth normal at `p` (on or just off the face) from the face's
+/// `corners` normals, by mean value coordinates of `p` projected onto the
+/// face's plane (a point outside the face takes the nearest edge's blend).
+pub fn interpolate(face: &FaceGeom, corners: &[Vec3], p: Vec3) -> Vec3 {
+    let n = face.plane.normal;
+    let q = p - n * face.plane.distance(p);
+    let pts = &face.points;
+    let count = pts.len();
+    let spokes: Vec<Vec3> = pts.iter().map(|&v| v - q).collect();
+    let lengths: Vec<f64> = spokes.iter().map(|s| s.length()).collect();
+    if let Some(i) = lengths.iter().position(|&r| r < 1e-6) {
+        return corners[i];
+    }
+    // tan(half the angle between spokes i and i+1), signed so points
+    // outside the face get negative weights on the edges they are beyond.
+    let mut half_tan = Vec::with_capacity(count);
+    for i in 0..count {
+        let j = (i + 1) % count;
+        let cross = spokes[j].cross(spokes[i]).dot(n);
+        let dot = spokes[i].dot(spokes[j]);
+        let denom = lengths[i] * lengths[j] + dot;
+        if denom.abs() < 1e-9 || (cross.abs() < 1e-9 && dot < 0.0) {
+            // On the edge i..j: blend its two corners.
+            let t = lengths[i] / (lengths[i] + lengths[j]);
+            return (corners[i] * (1.0 - t) + corners[j] * t)
+                .normalized()
+                .unwrap_or(n);
+        }
+        half_tan.push(cross / denom);
+    }
+    let mut sum = Vec3::ZERO;
+    for i in 0..count {
+        let w = (half_tan[(i + count - 1) % count] + half_tan[i]) / lengths[i];
+        sum += corners[i] * w;
+    }
+    match sum.normalized() {
+        Some(s) if s.dot(n) > 0.0 => s,
+        _ => n,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use quake_formats::extents::LightmapExtents;
+    use quake_formats::geom::Plane;
+
+    fn square() -> FaceGeom {
+        FaceGeom {
+            index: 0,
+            model: 0,
+            kind: FaceKind::Lit,
+            texture: String::new(),
+            // Clockwise seen from above (+z).
+            points: vec![
+                Vec3::new(0.0, 0.0, 0.0),
+                Vec3::new(0.0, 10.0, 0.0),
+                Vec3::new(10.0, 10.0, 0.0),
+                Vec3::new(10.0, 0.0, 0.0),
+            ],
+            plane: Plane::new(Vec3::new(0.0, 0.0, 1.0), 0.0),
+            vecs: [[0.0; 4]; 2],
+            origin: Vec3::ZERO,
+            extents: LightmapExtents::from_points(&[], &[[0.0; 4]; 2]),
+        }
+    }
+
+    #[test]
+    fn interpolation_hits_corners_edges_and_blends_inside() {
+        let f = square();
+        let tilt = |x: f64| Vec3::new(x, 0.0, 1.0).normalized().expect("unit");
+        // Normals lean -x on the x = 0 side and +x on the x = 10 side.
+        let corners = [tilt(-0.5), tilt(-0.5), tilt(0.5), tilt(0.5)];
+        assert!(interpolate(&f, &corners, Vec3::new(0.0, 0.0, 1.0)).near(corners[0], 1e-12));
+        let edge = interpolate(&f, &corners, Vec3::new(5.0, 10.0, 1.0));
+        assert!(edge.near(Vec3::new(0.0, 0.0, 1.0), 1e-9), "{edge:?}");
+        let mid = interpolate(&f, &corners, Vec3::new(5.0, 3.0, 0.0));
+        assert!(mid.near(Vec3::new(0.0, 0.0, 1.0), 1e-9), "{mid:?}");
+        let left = interpolate(&f, &corners, Vec3::new(2.0, 5.0, 0.0));
+        assert!(left.x < 0.0 && left.x > tilt(-0.5).x, "{left:?}");
+    }
+
+    #[test]
+    fn corners_of_a_lone_face_keep_its_normal() {
+        let f = square();
+        let angles = HashMap::from([(0, 89.0)]);
+        let normals = corner_normals(std::slice::from_ref(&f), &angles);
+        let c = normals[0].as_ref().expect("phong face");
+        assert!(c.iter().all(|n| n.near(f.plane.normal, 1e-12)));
+    }
+}
