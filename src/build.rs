@@ -29,6 +29,9 @@ pub struct BuildArgs {
     /// Filter lightmaps so shadow edges do not stair-step
     #[arg(long)]
     soft: bool,
+    /// Ambient occlusion ("dirt") on every light
+    #[arg(long)]
+    dirt: bool,
     /// Preview size, WIDTHxHEIGHT
     #[arg(long, default_value = "640x480")]
     size: String,
@@ -72,6 +75,7 @@ pub fn build(args: &BuildArgs) -> Result<()> {
         (args.extra, "--extra"),
         (args.extra4, "--extra4"),
         (args.soft, "--soft"),
+        (args.dirt, "--dirt"),
     ] {
         if on {
             argv.push(flag.into());
