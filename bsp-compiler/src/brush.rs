@@ -309,6 +309,11 @@ pub(crate) mod tests {
         out
     }
 
+    /// An axial box brush of `contents` in entity 0.
+    pub(crate) fn box_brush(planes: &mut PlaneSet, mins: Vec3, maxs: Vec3, contents: i32) -> Brush {
+        Brush::from_planes(&box_planes(mins, maxs), planes, contents, 0).expect("box brush")
+    }
+
     #[test]
     fn box_brush_has_six_sides_and_volume() {
         let mut planes = PlaneSet::new();

@@ -122,18 +122,17 @@ pub fn emit_clipnodes(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::brush::tests::box_planes;
+    use crate::brush::tests::{box_brush, box_planes};
 
     #[test]
     fn box_grows_by_the_hull_size() {
         let mut planes = PlaneSet::new();
-        let b = Brush::from_planes(
-            &box_planes(Vec3::ZERO, Vec3::new(64.0, 64.0, 64.0)),
+        let b = box_brush(
             &mut planes,
+            Vec3::ZERO,
+            Vec3::new(64.0, 64.0, 64.0),
             contents::SOLID,
-            0,
-        )
-        .expect("brush");
+        );
         let (mins, maxs) = HULL_BOXES[0];
         let g = expand_brush(&b, &mut planes, mins, maxs).expect("grown");
         assert_eq!(g.bounds.mins, Vec3::new(-16.0, -16.0, -32.0));

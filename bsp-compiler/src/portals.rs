@@ -244,20 +244,19 @@ impl Builder {
 mod tests {
     use super::*;
     use crate::brush::Brush;
-    use crate::brush::tests::box_planes;
+    use crate::brush::tests::{box_brush, box_planes};
     use crate::tree::{SplitHeuristic, build_tree};
     use quake_formats::bsp::contents;
 
     #[test]
     fn portals_of_a_single_box_close_every_leaf() {
         let mut planes = PlaneSet::new();
-        let b = Brush::from_planes(
-            &box_planes(Vec3::ZERO, Vec3::new(64.0, 64.0, 64.0)),
+        let b = box_brush(
             &mut planes,
+            Vec3::ZERO,
+            Vec3::new(64.0, 64.0, 64.0),
             contents::SOLID,
-            0,
-        )
-        .expect("brush");
+        );
         let bounds = b.bounds;
         let tree = build_tree(vec![b], &planes, SplitHeuristic::FewestSplits, true);
         let portals = make_portals(&tree, &planes, &bounds);

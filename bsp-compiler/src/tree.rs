@@ -445,18 +445,17 @@ fn strongest_contents<'a>(brushes: impl Iterator<Item = &'a Brush>) -> i32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::brush::tests::box_planes;
+    use crate::brush::tests::{box_brush, box_planes};
 
     #[test]
     fn single_box_gives_one_solid_leaf_and_empty_around() {
         let mut planes = PlaneSet::new();
-        let b = Brush::from_planes(
-            &box_planes(Vec3::ZERO, Vec3::new(64.0, 64.0, 64.0)),
+        let b = box_brush(
             &mut planes,
+            Vec3::ZERO,
+            Vec3::new(64.0, 64.0, 64.0),
             contents::SOLID,
-            0,
-        )
-        .expect("brush");
+        );
         let tree = build_tree(vec![b], &planes, SplitHeuristic::FewestSplits, true);
         let leaves: Vec<_> = tree.nodes.iter().filter(|n| n.is_leaf()).collect();
         assert_eq!(leaves.len(), 7);
@@ -473,13 +472,12 @@ mod tests {
     #[test]
     fn overlapping_water_and_solid_take_solid() {
         let mut planes = PlaneSet::new();
-        let solid = Brush::from_planes(
-            &box_planes(Vec3::ZERO, Vec3::new(64.0, 64.0, 64.0)),
+        let solid = box_brush(
             &mut planes,
+            Vec3::ZERO,
+            Vec3::new(64.0, 64.0, 64.0),
             contents::SOLID,
-            0,
-        )
-        .expect("solid");
+        );
         let water = Brush::from_planes(
             &box_planes(Vec3::new(32.0, 0.0, 0.0), Vec3::new(96.0, 64.0, 64.0)),
             &mut planes,
