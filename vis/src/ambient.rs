@@ -4,6 +4,7 @@
 use crate::VisError;
 use crate::pvs::Pvs;
 use quake_formats::Bsp;
+use quake_formats::bsp::contents;
 use quake_formats::geom::{Bounds, Vec3};
 use rayon::prelude::*;
 
@@ -39,6 +40,17 @@ pub fn ambient_of_texture(name: &str) -> Option<Ambient> {
     }
 }
 
+/// The ambient a leaf of these contents makes as a whole.
+pub fn ambient_of_contents(leaf_contents: i32) -> Option<Ambient> {
+    match leaf_contents {
+        contents::WATER => Some(Ambient::Water),
+        contents::SLIME => Some(Ambient::Slime),
+        contents::LAVA => Some(Ambient::Lava),
+        contents::SKY => Some(Ambient::Sky),
+        _ => None,
+    }
+}
+
 /// Volume (0..=255) of a surface `distance` units from the listener's box.
 pub fn level_at(distance: f64) -> u8 {
     let volume = if distance < FULL_VOLUME_DISTANCE {
@@ -67,7 +79,9 @@ fn leaf_bounds(mins: [f32; 3], maxs: [f32; 3]) -> Bounds {
 /// how many leaves hear anything.
 pub fn ambient_levels(bsp: &mut Bsp, pvs: &Pvs) -> Result<usize, VisError> {
     crate::lump::check_portals_match(bsp, pvs.num_leafs())?;
-    // Each vis leaf's sound surfaces: channel and bounds.
+    // Each vis leaf's sound sources: channel and bounds. A liquid or sky leaf sounds as a
+    // whole (its surfaces may be named unlike liquids and skies, or be missing), and so does
+    // every face of it with a liquid or sky texture.
     let sources: Vec<Vec<(Ambient, Bounds)>> = (1..=pvs.num_leafs())
         .map(|l| {
             let leaf = &bsp.leafs[l];
@@ -76,9 +90,11 @@ pub fn ambient_levels(bsp: &mut Bsp, pvs: &Pvs) -> Result<usize, VisError> {
                 .marksurfaces
                 .get(first..first + leaf.num_marksurfaces as usize)
                 .unwrap_or(&[]);
-            marks
-                .iter()
-                .filter_map(|&f| {
+            let volume = ambient_of_contents(leaf.contents)
+                .map(|kind| (kind, leaf_bounds(leaf.mins, leaf.maxs)));
+            volume
+                .into_iter()
+                .chain(marks.iter().filter_map(|&f| {
                     let face = bsp.faces.get(f as usize)?;
                     let texinfo = bsp.texinfo.get(face.texinfo as usize)?;
                     let tex = bsp
@@ -92,7 +108,7 @@ pub fn ambient_levels(bsp: &mut Bsp, pvs: &Pvs) -> Result<usize, VisError> {
                         b.add_point(Vec3::from_f32(v));
                     }
                     Some((kind, b))
-                })
+                }))
                 .collect()
         })
         .collect();
@@ -133,6 +149,16 @@ mod tests {
         assert_eq!(ambient_of_texture("*lava1"), Some(Ambient::Lava));
         assert_eq!(ambient_of_texture("*teleport"), None);
         assert_eq!(ambient_of_texture("city4_6"), None);
+    }
+
+    #[test]
+    fn liquid_and_sky_contents_map_to_channels() {
+        assert_eq!(ambient_of_contents(contents::WATER), Some(Ambient::Water));
+        assert_eq!(ambient_of_contents(contents::SLIME), Some(Ambient::Slime));
+        assert_eq!(ambient_of_contents(contents::LAVA), Some(Ambient::Lava));
+        assert_eq!(ambient_of_contents(contents::SKY), Some(Ambient::Sky));
+        assert_eq!(ambient_of_contents(contents::EMPTY), None);
+        assert_eq!(ambient_of_contents(contents::SOLID), None);
     }
 
     #[test]

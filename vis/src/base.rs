@@ -22,19 +22,19 @@ pub fn may_see_through(p: &OneWayPortal, q: &OneWayPortal) -> bool {
 pub fn mightsee(graph: &PortalGraph, source: usize) -> BitSet {
     let p = &graph.portals[source];
     let mut seen = BitSet::new(graph.portals.len());
-    let mut flooded = BitSet::new(graph.num_leafs);
-    let mut stack = vec![p.to_leaf];
-    flooded.insert(p.to_leaf as usize);
+    let mut flooded = BitSet::new(graph.num_clusters);
+    let mut stack = vec![p.to_cluster];
+    flooded.insert(p.to_cluster as usize);
     while let Some(leaf) = stack.pop() {
-        for &q in &graph.leaf_portals[leaf as usize] {
+        for &q in &graph.cluster_portals[leaf as usize] {
             let portal = &graph.portals[q as usize];
             if q as usize == source || !may_see_through(p, portal) {
                 continue;
             }
             seen.insert(q as usize);
-            if !flooded.contains(portal.to_leaf as usize) {
-                flooded.insert(portal.to_leaf as usize);
-                stack.push(portal.to_leaf);
+            if !flooded.contains(portal.to_cluster as usize) {
+                flooded.insert(portal.to_cluster as usize);
+                stack.push(portal.to_cluster);
             }
         }
     }

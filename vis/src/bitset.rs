@@ -61,24 +61,6 @@ impl BitSet {
         }
     }
 
-    /// `self = a & b`; returns whether the result holds any index not in `known`.
-    #[inline]
-    pub fn assign_and(&mut self, a: &BitSet, b: &BitSet, known: &BitSet) -> bool {
-        debug_assert!(self.len == a.len && a.len == b.len && b.len == known.len);
-        let mut new = 0;
-        for (((out, &x), &y), &k) in self
-            .words
-            .iter_mut()
-            .zip(&a.words)
-            .zip(&b.words)
-            .zip(&known.words)
-        {
-            *out = x & y;
-            new |= *out & !k;
-        }
-        new != 0
-    }
-
     pub fn is_subset(&self, other: &BitSet) -> bool {
         self.words
             .iter()
@@ -122,6 +104,139 @@ impl BitSet {
     }
 }
 
+/// A set of indices `0..len` whose members all lie in a window of words, kept as narrow as
+/// the members allow: operations touch only the window. A portal flow's "might see" sets
+/// shrink to a few nearby portals after the first steps (portals are numbered in tree order,
+/// so nearby ones have nearby numbers), which makes this much cheaper than a whole set.
+#[derive(Debug, Clone, Default)]
+pub struct WindowBits {
+    /// Only `words[lo..hi]` are meaningful; the others are stale.
+    words: Vec<u64>,
+    lo: usize,
+    hi: usize,
+}
+
+impl WindowBits {
+    /// Copy `set`, removing the members for which `drop` holds.
+    pub fn assign_filtered(&mut self, set: &BitSet, mut drop: impl FnMut(usize) -> bool) {
+        self.words.clone_from(&set.words);
+        self.lo = 0;
+        self.hi = self.words.len();
+        for (wi, w) in self.words.iter_mut().enumerate() {
+            let mut bits = *w;
+            while bits != 0 {
+                let b = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                if drop(wi * 64 + b) {
+                    *w &= !(1 << b);
+                }
+            }
+        }
+        self.trim();
+    }
+
+    #[inline]
+    pub fn contains(&self, i: usize) -> bool {
+        let w = i / 64;
+        (self.lo..self.hi).contains(&w) && self.words[w] & (1 << (i % 64)) != 0
+    }
+
+    pub fn count(&self) -> usize {
+        self.window().iter().map(|w| w.count_ones() as usize).sum()
+    }
+
+    fn window(&self) -> &[u64] {
+        &self.words[self.lo..self.hi]
+    }
+
+    /// Narrow the window to the words holding members.
+    fn trim(&mut self) {
+        while self.lo < self.hi && self.words[self.lo] == 0 {
+            self.lo += 1;
+        }
+        while self.hi > self.lo && self.words[self.hi - 1] == 0 {
+            self.hi -= 1;
+        }
+    }
+
+    /// `self = a & b`; returns whether the result holds any index not in `known`.
+    #[inline]
+    pub fn assign_and(&mut self, a: &WindowBits, b: &BitSet, known: &BitSet) -> bool {
+        debug_assert!(a.words.len() == b.words.len() && b.words.len() == known.words.len());
+        self.words.resize(a.words.len(), 0);
+        let (lo, hi) = (a.lo, a.hi);
+        let mut new = 0;
+        for (((out, &x), &y), &k) in self.words[lo..hi]
+            .iter_mut()
+            .zip(&a.words[lo..hi])
+            .zip(&b.words[lo..hi])
+            .zip(&known.words[lo..hi])
+        {
+            *out = x & y;
+            new |= *out & !k;
+        }
+        self.lo = lo;
+        self.hi = hi;
+        self.trim();
+        new != 0
+    }
+
+    /// Remove each member not in `known` for which `drop` holds; returns whether any member
+    /// outside `known` is left.
+    #[inline]
+    pub fn prune_unknown(&mut self, known: &BitSet, mut drop: impl FnMut(usize) -> bool) -> bool {
+        let mut left = false;
+        for wi in self.lo..self.hi {
+            let w = &mut self.words[wi];
+            let mut bits = *w & !known.words[wi];
+            while bits != 0 {
+                let b = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                if drop(wi * 64 + b) {
+                    *w &= !(1 << b);
+                } else {
+                    left = true;
+                }
+            }
+        }
+        self.trim();
+        left
+    }
+
+    pub fn is_subset(&self, other: &WindowBits) -> bool {
+        (self.lo..self.hi).all(|wi| {
+            let theirs = if (other.lo..other.hi).contains(&wi) {
+                other.words[wi]
+            } else {
+                0
+            };
+            self.words[wi] & !theirs == 0
+        })
+    }
+
+    /// Make `self` a copy of `other`, copying only its window.
+    pub fn assign(&mut self, other: &WindowBits) {
+        self.words.resize(other.words.len(), 0);
+        self.words[other.lo..other.hi].copy_from_slice(other.window());
+        self.lo = other.lo;
+        self.hi = other.hi;
+    }
+
+    pub fn iter(&self) -> impl Iterator<Item = usize> + '_ {
+        (self.lo..self.hi).flat_map(move |wi| {
+            let mut bits = self.words[wi];
+            std::iter::from_fn(move || {
+                if bits == 0 {
+                    return None;
+                }
+                let b = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                Some(wi * 64 + b)
+            })
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -143,18 +258,45 @@ mod tests {
         }
     }
 
-    #[test]
-    fn assign_and_reports_new_bits() {
-        let mut a = BitSet::new(70);
-        let mut b = BitSet::new(70);
-        let mut known = BitSet::new(70);
-        a.insert(65);
-        b.insert(65);
-        let mut out = BitSet::new(70);
-        assert!(out.assign_and(&a, &b, &known));
-        known.insert(65);
-        assert!(!out.assign_and(&a, &b, &known));
-        assert!(out.contains(65));
+    fn set_of(len: usize, members: &[usize]) -> BitSet {
+        let mut set = BitSet::new(len);
+        for &i in members {
+            set.insert(i);
+        }
+        set
+    }
+
+    proptest! {
+        #[test]
+        fn window_bits_agree_with_whole_sets(
+            a in proptest::collection::vec(0usize..300, 0..30),
+            b in proptest::collection::vec(0usize..300, 0..60),
+            known in proptest::collection::vec(0usize..300, 0..60),
+            dropped in proptest::collection::vec(0usize..300, 0..60),
+        ) {
+            let (a, b, known) = (set_of(300, &a), set_of(300, &b), set_of(300, &known));
+            let mut wa = WindowBits::default();
+            wa.assign_filtered(&a, |i| dropped.contains(&i));
+            let expected: Vec<usize> = a.iter().filter(|i| !dropped.contains(i)).collect();
+            prop_assert_eq!(wa.iter().collect::<Vec<_>>(), expected.clone());
+            prop_assert_eq!(wa.count(), expected.len());
+            let mut and = WindowBits::default();
+            let new = and.assign_and(&wa, &b, &known);
+            let both: Vec<usize> = expected.iter().copied().filter(|&i| b.contains(i)).collect();
+            prop_assert_eq!(and.iter().collect::<Vec<_>>(), both.clone());
+            prop_assert_eq!(new, both.iter().any(|&i| !known.contains(i)));
+            prop_assert!(and.is_subset(&wa));
+            prop_assert_eq!(wa.is_subset(&and), both.len() == expected.len());
+            for i in 0..300 {
+                prop_assert_eq!(and.contains(i), both.contains(&i));
+            }
+            let mut copy = WindowBits::default();
+            copy.assign(&and);
+            let left = copy.prune_unknown(&known, |i| i % 2 == 0);
+            let kept: Vec<usize> = both.iter().copied().filter(|&i| known.contains(i) || i % 2 == 1).collect();
+            prop_assert_eq!(copy.iter().collect::<Vec<_>>(), kept);
+            prop_assert_eq!(left, both.iter().any(|&i| !known.contains(i) && i % 2 == 1));
+        }
     }
 
     #[test]

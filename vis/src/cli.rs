@@ -1,7 +1,7 @@
 //! `slipgate-vis`: compute the PVS of a compiled map from the `.prt` file beside it.
 
 use crate::{VisMode, VisOptions};
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use quake_formats::Bsp;
 use quake_formats::fsutil::{read_file, write_atomic};
 use quake_formats::prt::PortalFile;
@@ -85,13 +85,14 @@ pub fn run(args: &Args) -> Result<()> {
 
     let n = c.leafs.max(1) as f64;
     eprintln!(
-        "vis ({}): {} leaves, {} one-way portals ({} degenerate dropped)",
+        "vis ({}): {} leaves in {} clusters, {} one-way portals ({} degenerate dropped)",
         if args.fast {
             "fast".to_string()
         } else {
             format!("full, level {}", args.level)
         },
         c.leafs,
+        c.clusters,
         c.portals,
         c.degenerate_portals
     );
@@ -140,12 +141,6 @@ pub fn run(args: &Args) -> Result<()> {
 fn read_portals(path: &Path) -> Result<PortalFile> {
     let bytes =
         read_file(path).context("vis needs the portal file the compiler writes beside the BSP")?;
-    let text = String::from_utf8_lossy(&bytes);
-    if text.trim_start().starts_with("PRT2") {
-        bail!(
-            "{}: PRT2 (detail clusters) portal files are not supported yet",
-            path.display()
-        );
-    }
-    PortalFile::parse(&text).with_context(|| format!("{}", path.display()))
+    PortalFile::parse(&String::from_utf8_lossy(&bytes))
+        .with_context(|| format!("{}", path.display()))
 }

@@ -9,6 +9,8 @@ pub mod ambient;
 pub mod base;
 pub mod bitset;
 pub mod cli;
+pub mod clusters;
+pub mod explored;
 pub mod flow;
 pub mod lump;
 pub mod portals;
@@ -18,6 +20,7 @@ pub mod synthetic;
 pub mod tree_portals;
 
 pub use bitset::BitSet;
+pub use clusters::Clusters;
 pub use lump::{LumpStats, check_portals_match, read_pvs, write_vis};
 pub use portals::PortalGraph;
 pub use pvs::Pvs;
@@ -26,8 +29,8 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use quake_formats::prt::PortalFile;
 use rayon::prelude::*;
 use std::io::IsTerminal;
-use std::sync::OnceLock;
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Mutex, OnceLock};
 use std::time::Instant;
 
 /// Everything vis can refuse.
@@ -42,12 +45,23 @@ pub enum VisError {
     NoWorldModel,
     #[error("the world model claims {vis_leafs} vis leaves but the BSP has {leafs} leaves")]
     BadVisLeafs { vis_leafs: i64, leafs: usize },
-    #[error("portal {index} joins leaves {leafs:?}, not both below the leaf count {num_leafs}")]
-    PortalLeaf {
+    #[error(
+        "portal {index} joins clusters {clusters:?}, not both below the cluster count \
+         {num_clusters} (in a PRT1 file, the leaf count)"
+    )]
+    PortalCluster {
         index: usize,
-        leafs: [u32; 2],
+        clusters: [u32; 2],
+        num_clusters: usize,
+    },
+    #[error("cluster {cluster} lists leaf {leaf}, not below the leaf count {num_leafs}")]
+    ClusterLeaf {
+        cluster: usize,
+        leaf: u32,
         num_leafs: usize,
     },
+    #[error("leaf {leaf} is listed in two clusters, {clusters:?}")]
+    LeafInTwoClusters { leaf: u32, clusters: [usize; 2] },
     #[error("portal {index} has a coordinate that is not a finite number")]
     PortalNotFinite { index: usize },
     #[error("leaf {leaf}: vis offset {offset} is outside the {lump_len}-byte visibility lump")]
@@ -96,10 +110,13 @@ impl Default for VisOptions {
 #[derive(Debug, Clone, Default, serde::Serialize)]
 pub struct ComputeStats {
     pub leafs: usize,
+    /// Clusters visibility was computed between (the leaf count for a PRT1 file).
+    pub clusters: usize,
     pub portals: usize,
     pub degenerate_portals: usize,
     /// One-way portals whose leaf has another portal in front of them (see
-    /// [`PortalGraph::misoriented_portals`]); non-zero means a suspicious portal file.
+    /// [`PortalGraph::misoriented_portals`]); non-zero means a suspicious portal file. Only
+    /// counted for PRT1 files (clusters need not be convex).
     pub misoriented_portals: usize,
     pub average_mightsee: f64,
     pub average_portal_vis: f64,
@@ -107,6 +124,8 @@ pub struct ComputeStats {
     pub flow_seconds: f64,
     pub average_visible: f64,
     pub max_visible: usize,
+    /// One-way cluster pairs dropped because the other side does not see back (see
+    /// [`Pvs::intersect_with_transpose`]).
     pub asymmetric_pairs: usize,
 }
 
@@ -120,6 +139,7 @@ pub struct VisResult {
 /// Compute every leaf's potentially visible set from a portal file.
 pub fn compute_vis(prt: &PortalFile, options: &VisOptions) -> Result<VisResult, VisError> {
     let graph = PortalGraph::from_prt(prt)?;
+    let clusters = Clusters::from_prt(prt)?;
     let mut builder = rayon::ThreadPoolBuilder::new().stack_size(64 << 20);
     if let Some(threads) = options.threads {
         builder = builder.num_threads(threads);
@@ -127,10 +147,14 @@ pub fn compute_vis(prt: &PortalFile, options: &VisOptions) -> Result<VisResult, 
     let pool = builder
         .build()
         .map_err(|e| VisError::Threads(e.to_string()))?;
-    Ok(pool.install(|| compute_on_graph(&graph, options)))
+    Ok(pool.install(|| compute_on_graph(&graph, clusters.as_ref(), options)))
 }
 
-fn compute_on_graph(graph: &PortalGraph, options: &VisOptions) -> VisResult {
+fn compute_on_graph(
+    graph: &PortalGraph,
+    clusters: Option<&Clusters>,
+    options: &VisOptions,
+) -> VisResult {
     let n = graph.portals.len();
     let start = Instant::now();
     let mightsee: Vec<BitSet> = (0..n)
@@ -142,86 +166,92 @@ fn compute_on_graph(graph: &PortalGraph, options: &VisOptions) -> VisResult {
         |sets: &[BitSet]| sets.iter().map(BitSet::count).sum::<usize>() as f64 / n.max(1) as f64;
 
     let start = Instant::now();
-    let (portal_vis, portal_leafs) = match options.mode {
-        VisMode::Fast => {
-            let leafs = (0..n)
-                .into_par_iter()
-                .map(|p| Pvs::leafs_behind(graph, p, &mightsee[p]))
-                .collect();
-            (mightsee.clone(), leafs)
-        }
+    let portal_vis = match options.mode {
+        VisMode::Fast => mightsee.clone(),
         VisMode::Full { level } => full_flow(graph, &mightsee, level, options.progress),
     };
     let flow_seconds = start.elapsed().as_secs_f64();
-    let pvs = Pvs::from_portal_leafs(graph, &portal_leafs);
+    let seen_through: Vec<BitSet> = (0..n)
+        .into_par_iter()
+        .map(|p| Pvs::clusters_behind(graph, p, &portal_vis[p]))
+        .collect();
+    let mut rows = Pvs::cluster_rows(graph, &seen_through);
+    let asymmetric_pairs = Pvs::intersect_with_transpose(&mut rows);
+    let pvs = match clusters {
+        Some(clusters) => clusters.expand(&rows),
+        None => Pvs::new(rows),
+    };
     let stats = ComputeStats {
-        leafs: graph.num_leafs,
+        leafs: pvs.num_leafs(),
+        clusters: graph.num_clusters,
         portals: n,
         degenerate_portals: graph.degenerate,
-        misoriented_portals: graph.misoriented_portals(),
+        misoriented_portals: if clusters.is_some() {
+            0
+        } else {
+            graph.misoriented_portals()
+        },
         average_mightsee: average(&mightsee),
         average_portal_vis: average(&portal_vis),
         base_seconds,
         flow_seconds,
         average_visible: pvs.average_visible(),
         max_visible: pvs.max_visible(),
-        asymmetric_pairs: pvs.asymmetric_pairs(),
+        asymmetric_pairs,
     };
     VisResult { pvs, stats }
 }
 
-/// Run the portal flow for every portal on every worker thread. Portals with the smallest
-/// mightsee go first: they finish fast, and their exact sets then bound the bigger ones' flow
-/// more tightly than mightsee does.
-fn full_flow(
-    graph: &PortalGraph,
-    mightsee: &[BitSet],
-    level: u8,
-    progress: bool,
-) -> (Vec<BitSet>, Vec<BitSet>) {
+/// Portal flows run in this many waves (fewer when there are few portals): each wave's flows
+/// run in parallel, bounded by the results of the waves before. Fixing the waves by the portal
+/// count alone makes the result the same whatever the thread count and timing.
+const FLOW_WAVES: usize = 200;
+const MIN_WAVE_PORTALS: usize = 16;
+
+/// Run the portal flow for every portal on every worker thread; returns the portals seen
+/// through each. Portals with the smallest mightsee go first: they finish fast, and their
+/// results then bound the bigger ones' flows more tightly than mightsee does.
+fn full_flow(graph: &PortalGraph, mightsee: &[BitSet], level: u8, progress: bool) -> Vec<BitSet> {
     let n = graph.portals.len();
     let mut order: Vec<usize> = (0..n).collect();
-    order.sort_by_key(|&p| mightsee[p].count());
-    let done: Vec<OnceLock<BitSet>> = (0..n).map(|_| OnceLock::new()).collect();
-    let leafs: Vec<OnceLock<BitSet>> = (0..n).map(|_| OnceLock::new()).collect();
-    let ctx = flow::FlowContext {
-        graph,
-        mightsee,
-        done: &done,
-        level,
-    };
-    let bar = progress_bar(
-        mightsee.iter().map(|m| m.count() as u64 + 1).sum(),
-        progress,
-    );
-    let next = AtomicUsize::new(0);
-    rayon::broadcast(|_| {
-        let mut ws = flow::Workspace::default();
-        loop {
-            let i = next.fetch_add(1, Ordering::Relaxed);
-            let Some(&p) = order.get(i) else { break };
-            let seen = flow::portal_flow(&ctx, p, &mut ws);
-            let _ = done[p].set(flow::done_bound(graph, &mightsee[p], &seen));
-            let _ = leafs[p].set(seen);
-            bar.inc(mightsee[p].count() as u64 + 1);
+    order.sort_by_key(|&p| (mightsee[p].count(), p));
+    let mut done: Vec<Option<BitSet>> = vec![None; n];
+    let bar = progress_bar(n as u64, progress);
+    let workspaces: Vec<Mutex<flow::Workspace>> = (0..rayon::current_num_threads())
+        .map(|_| Mutex::default())
+        .collect();
+    let wave_len = n.div_ceil(FLOW_WAVES).max(MIN_WAVE_PORTALS);
+    for wave in order.chunks(wave_len) {
+        let results: Vec<OnceLock<BitSet>> = wave.iter().map(|_| OnceLock::new()).collect();
+        let ctx = flow::FlowContext {
+            graph,
+            mightsee,
+            done: &done,
+            level,
+        };
+        let next = AtomicUsize::new(0);
+        rayon::broadcast(|thread| {
+            // A worker that panicked poisons only its own workspace; the portals it would have
+            // taken fall back to their mightsee below.
+            let Ok(mut ws) = workspaces[thread.index()].lock() else {
+                return;
+            };
+            loop {
+                let i = next.fetch_add(1, Ordering::Relaxed);
+                let Some(&p) = wave.get(i) else { break };
+                let _ = results[i].set(flow::portal_flow(&ctx, p, &mut ws));
+                bar.inc(1);
+            }
+        });
+        for (&p, result) in wave.iter().zip(results) {
+            done[p] = result.into_inner();
         }
-    });
+    }
     bar.finish_and_clear();
-    // Every portal was taken by some worker; the fallbacks only keep this panic-free.
-    let portals = done
-        .into_iter()
+    done.into_iter()
         .zip(mightsee)
-        .map(|(d, m)| d.into_inner().unwrap_or_else(|| m.clone()))
-        .collect();
-    let leafs = leafs
-        .into_iter()
-        .enumerate()
-        .map(|(p, l)| {
-            l.into_inner()
-                .unwrap_or_else(|| Pvs::leafs_behind(graph, p, &mightsee[p]))
-        })
-        .collect();
-    (portals, leafs)
+        .map(|(d, m)| d.unwrap_or_else(|| m.clone()))
+        .collect()
 }
 
 /// A bar with a time estimate on stderr, or a hidden one when stderr is not a terminal.

@@ -1,6 +1,9 @@
-//! The portal graph vis works on: every PRT1 portal as two one-way portals.
+//! The portal graph vis works on: every portal of a `.prt` file as two one-way portals between
+//! clusters. In a PRT1 file each vis leaf is its own cluster; a PRT2 file groups leaves (detail
+//! leaves merged with the leaf around them) into clusters and joins clusters by its portals.
+//! Clusters need not be convex, so a sight line may enter one more than once.
 //!
-//! PRT1 convention (the one id's and ericw-tools' qbsp write): the plane of a portal's winding
+//! PRT1 convention (PRT2 too) (the one id's and ericw-tools' qbsp write): the plane of a portal's winding
 //! (clockwise seen from the front) faces its first leaf. The one-way portal from the first leaf
 //! into the second therefore uses the flipped plane, so that every one-way portal's plane faces
 //! into the leaf it leads to: whatever is seen through it lies in front of it.
@@ -9,21 +12,21 @@ use crate::VisError;
 use quake_formats::geom::{ON_EPSILON, Plane, Vec3};
 use quake_formats::prt::PortalFile;
 
-/// A portal seen from one side: looking from `from_leaf` through `winding` into `to_leaf`.
+/// A portal seen from one side: looking from `from_cluster` through `winding` into `to_cluster`.
 #[derive(Debug, Clone)]
 pub struct OneWayPortal {
     pub winding: Vec<Vec3>,
-    /// Faces into `to_leaf`.
+    /// Faces into `to_cluster`.
     pub plane: Plane,
-    pub from_leaf: u32,
-    pub to_leaf: u32,
+    pub from_cluster: u32,
+    pub to_cluster: u32,
     /// A sphere holding the winding, for quick plane tests.
     pub center: Vec3,
     pub radius: f64,
 }
 
 impl OneWayPortal {
-    fn new(winding: Vec<Vec3>, plane: Plane, from_leaf: u32, to_leaf: u32) -> OneWayPortal {
+    fn new(winding: Vec<Vec3>, plane: Plane, from_cluster: u32, to_cluster: u32) -> OneWayPortal {
         let center = winding.iter().fold(Vec3::ZERO, |a, &v| a + v) / winding.len().max(1) as f64;
         let radius = winding
             .iter()
@@ -32,43 +35,60 @@ impl OneWayPortal {
         OneWayPortal {
             winding,
             plane,
-            from_leaf,
-            to_leaf,
+            from_cluster,
+            to_cluster,
             center,
             radius,
         }
     }
 
-    /// True when the whole winding lies behind `plane` (by more than [`ON_EPSILON`]).
+    /// True when the bounding sphere lies behind `plane` (by more than [`ON_EPSILON`]): a
+    /// quick test that the whole winding does.
     #[inline]
     pub fn behind(&self, plane: &Plane) -> bool {
         plane.distance(self.center) < -self.radius - ON_EPSILON
     }
+
+    /// True when every point of the winding lies behind `plane` (by more than [`ON_EPSILON`]).
+    #[inline]
+    pub fn wholly_behind(&self, plane: &Plane) -> bool {
+        let d = plane.distance(self.center);
+        d < -self.radius - ON_EPSILON
+            || (d < self.radius
+                && self
+                    .winding
+                    .iter()
+                    .all(|&v| plane.distance(v) < -ON_EPSILON))
+    }
 }
 
-/// Leaves (numbered from 0 = BSP leaf 1) and the one-way portals leading out of each.
+/// Clusters (in a PRT1 file, leaves numbered from 0 = BSP leaf 1) and the one-way portals
+/// leading out of each.
 #[derive(Debug, Clone)]
 pub struct PortalGraph {
-    pub num_leafs: usize,
+    pub num_clusters: usize,
     pub portals: Vec<OneWayPortal>,
-    /// For each leaf, the one-way portals whose `from_leaf` it is.
-    pub leaf_portals: Vec<Vec<u32>>,
+    /// For each cluster, the one-way portals whose `from_cluster` it is.
+    pub cluster_portals: Vec<Vec<u32>>,
     /// PRT portals dropped because their winding has no plane (degenerate, zero area).
     pub degenerate: usize,
 }
 
 impl PortalGraph {
     pub fn from_prt(prt: &PortalFile) -> Result<PortalGraph, VisError> {
-        let num_leafs = prt.num_leafs as usize;
+        let num_clusters = prt
+            .clusters
+            .as_ref()
+            .map_or(prt.num_leafs as usize, Vec::len);
         let mut portals = Vec::with_capacity(prt.portals.len() * 2);
         let mut degenerate = 0;
         for (index, p) in prt.portals.iter().enumerate() {
             let [a, b] = p.leafs;
-            if a as usize >= num_leafs || b as usize >= num_leafs {
-                return Err(VisError::PortalLeaf {
+            if a as usize >= num_clusters || b as usize >= num_clusters {
+                return Err(VisError::PortalCluster {
                     index,
-                    leafs: p.leafs,
-                    num_leafs,
+                    clusters: p.leafs,
+                    num_clusters,
                 });
             }
             if !p.winding.is_finite() {
@@ -89,14 +109,14 @@ impl PortalGraph {
             ));
             portals.push(OneWayPortal::new(p.winding.reversed().points, plane, b, a));
         }
-        let mut leaf_portals = vec![Vec::new(); num_leafs];
+        let mut cluster_portals = vec![Vec::new(); num_clusters];
         for (i, p) in portals.iter().enumerate() {
-            leaf_portals[p.from_leaf as usize].push(i as u32);
+            cluster_portals[p.from_cluster as usize].push(i as u32);
         }
         Ok(PortalGraph {
-            num_leafs,
+            num_clusters,
             portals,
-            leaf_portals,
+            cluster_portals,
             degenerate,
         })
     }
@@ -106,16 +126,17 @@ impl PortalGraph {
         portal ^ 1
     }
 
-    /// How many one-way portals of each leaf face out of it the wrong way: another portal of the
-    /// same leaf lies in front of the portal's plane (inside the neighbour). A correct portal
-    /// file (convex leaves, PRT1 orientation as documented above) gives zero; a file written with
-    /// the opposite orientation gives nearly every portal of every leaf with two or more.
+    /// How many one-way portals of each cluster face out of it the wrong way: another portal of
+    /// the same cluster lies in front of the portal's plane (inside the neighbour). A correct
+    /// PRT1 file (convex leaves, orientation as documented above) gives zero; a file written with
+    /// the opposite orientation gives nearly every portal of every leaf with two or more. Only
+    /// meaningful for convex clusters (PRT1 leaves).
     pub fn misoriented_portals(&self) -> usize {
         let mut bad = 0;
-        for leaf in &self.leaf_portals {
-            for &p in leaf {
+        for outs in &self.cluster_portals {
+            for &p in outs {
                 let plane = &self.portals[p as usize].plane;
-                let wrong = leaf.iter().filter(|&&q| q != p).any(|&q| {
+                let wrong = outs.iter().filter(|&&q| q != p).any(|&q| {
                     self.portals[q as usize]
                         .winding
                         .iter()

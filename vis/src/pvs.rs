@@ -17,30 +17,44 @@ impl Pvs {
         Pvs { rows }
     }
 
-    /// A leaf's set is itself plus the leaves seen through each portal out of it.
-    pub fn from_portal_leafs(graph: &PortalGraph, portal_leafs: &[BitSet]) -> Pvs {
-        let n = graph.num_leafs;
-        let rows = (0..n)
-            .map(|leaf| {
+    /// Each cluster's set: itself plus the clusters seen through each portal out of it.
+    pub fn cluster_rows(graph: &PortalGraph, seen_through: &[BitSet]) -> Vec<BitSet> {
+        let n = graph.num_clusters;
+        (0..n)
+            .map(|cluster| {
                 let mut row = BitSet::new(n);
-                row.insert(leaf);
-                for &p in &graph.leaf_portals[leaf] {
-                    row.union_with(&portal_leafs[p as usize]);
+                row.insert(cluster);
+                for &p in &graph.cluster_portals[cluster] {
+                    row.union_with(&seen_through[p as usize]);
                 }
                 row
             })
-            .collect();
-        Pvs { rows }
+            .collect()
     }
 
-    /// The leaves behind a portal and behind every portal in `portals` (what base vis gives).
-    pub fn leafs_behind(graph: &PortalGraph, portal: usize, portals: &BitSet) -> BitSet {
-        let mut leafs = BitSet::new(graph.num_leafs);
-        leafs.insert(graph.portals[portal].to_leaf as usize);
+    /// The clusters behind a portal and behind every portal in `portals` (what base vis gives).
+    pub fn clusters_behind(graph: &PortalGraph, portal: usize, portals: &BitSet) -> BitSet {
+        let mut clusters = BitSet::new(graph.num_clusters);
+        clusters.insert(graph.portals[portal].to_cluster as usize);
         for q in portals.iter() {
-            leafs.insert(graph.portals[q].to_leaf as usize);
+            clusters.insert(graph.portals[q].to_cluster as usize);
         }
-        leafs
+        clusters
+    }
+
+    /// Keep only the pairs seen both ways; returns how many one-way pairs were dropped. Sight is
+    /// symmetric and both rows are conservative, so when one side does not see the other,
+    /// neither truly does.
+    pub fn intersect_with_transpose(rows: &mut [BitSet]) -> usize {
+        let mut dropped = 0;
+        for a in 0..rows.len() {
+            let lonely: Vec<usize> = rows[a].iter().filter(|&b| !rows[b].contains(a)).collect();
+            dropped += lonely.len();
+            for b in lonely {
+                rows[a].remove(b);
+            }
+        }
+        dropped
     }
 
     pub fn num_leafs(&self) -> usize {
@@ -67,16 +81,6 @@ impl Pvs {
 
     pub fn max_visible(&self) -> usize {
         self.rows.iter().map(BitSet::count).max().unwrap_or(0)
-    }
-
-    /// Ordered pairs `(a, b)` where `a` sees `b` but not the other way round. Sight is
-    /// symmetric, so these show where the flow's clipping differs by direction.
-    pub fn asymmetric_pairs(&self) -> usize {
-        self.rows
-            .iter()
-            .enumerate()
-            .map(|(a, row)| row.iter().filter(|&b| !self.rows[b].contains(a)).count())
-            .sum()
     }
 
     /// True when every leaf's set holds this one's (for checking one mode against another).

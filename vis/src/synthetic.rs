@@ -157,6 +157,46 @@ impl VoxelWorld {
         }
     }
 
+    /// PRT2 portals with open cells grouped in pairs along x (cells `2k` and `2k + 1` of a row
+    /// when both are open; otherwise a cell is a cluster alone). Portals inside a pair are left
+    /// out; the others join clusters.
+    pub fn paired_portal_file(&self) -> PortalFile {
+        let cells = self.open_cells();
+        let mut cluster_of = Vec::with_capacity(cells.len());
+        let mut clusters: Vec<Vec<u32>> = Vec::new();
+        for (leaf, &c) in cells.iter().enumerate() {
+            let mut partner = c;
+            partner[0] ^= 1;
+            let paired = partner[0] < self.size[0] && self.is_open(partner);
+            if paired && partner[0] < c[0] {
+                // The second of a pair joins the first one's cluster.
+                let cluster = cluster_of[leaf - 1];
+                clusters[cluster as usize].push(leaf as u32);
+                cluster_of.push(cluster);
+            } else {
+                cluster_of.push(clusters.len() as u32);
+                clusters.push(vec![leaf as u32]);
+            }
+        }
+        let leafs = self.portal_file();
+        let portals = leafs
+            .portals
+            .into_iter()
+            .filter_map(|p| {
+                let ends = p.leafs.map(|l| cluster_of[l as usize]);
+                (ends[0] != ends[1]).then_some(PrtPortal {
+                    leafs: ends,
+                    winding: p.winding,
+                })
+            })
+            .collect();
+        PortalFile {
+            num_leafs: leafs.num_leafs,
+            portals,
+            clusters: Some(clusters),
+        }
+    }
+
     /// A BSP with an axis-aligned hull 0 tree: open cells are leaves 1..=N (empty), everything
     /// else is the solid leaf 0. No faces; enough for vis lumps and tracing.
     pub fn bsp(&self) -> Bsp {

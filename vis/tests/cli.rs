@@ -45,6 +45,30 @@ fn vis_writes_the_pvs_into_the_bsp_and_stats_json() {
 }
 
 #[test]
+fn vis_reads_a_prt2_file_with_clusters() {
+    let dir = temp_dir("prt2");
+    let world = VoxelWorld::random_caves([8, 8, 2], 50, 2);
+    let bsp_path = dir.join("map.bsp");
+    std::fs::write(&bsp_path, world.bsp().write().expect("bsp")).expect("write bsp");
+    let prt = world.paired_portal_file();
+    assert!(prt.write().starts_with("PRT2"));
+    std::fs::write(dir.join("map.prt"), prt.write()).expect("write prt");
+    let mut a = args(bsp_path.clone());
+    a.stats = Some(dir.join("stats.json"));
+    run(&a).expect("vis");
+    let stats: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("stats.json")).expect("stats"))
+            .expect("json");
+    assert_eq!(stats["sampling"]["violations"], 0);
+    assert_eq!(stats["compute"]["leafs"], 50);
+    assert_eq!(
+        stats["compute"]["clusters"],
+        prt.clusters.expect("PRT2").len()
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
 fn a_mismatched_portal_file_is_refused_naming_both_files() {
     let dir = temp_dir("mismatch");
     let world = VoxelWorld::random_caves([8, 8, 2], 50, 2);

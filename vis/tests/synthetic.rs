@@ -61,7 +61,11 @@ fn rooms_around_a_corner_do_not_see_each_other() {
     // Base vis cannot tell; it sees round the corner.
     assert!(fast.sees(start, leaf(&w, 5, 5, 0)));
     assert!(full.is_subset_of(&fast));
-    assert_eq!(full.asymmetric_pairs(), 0);
+    for a in 0..full.num_leafs() {
+        for b in 0..full.num_leafs() {
+            assert_eq!(full.sees(a, b), full.sees(b, a), "{a} and {b}");
+        }
+    }
 }
 
 #[test]
@@ -92,6 +96,35 @@ fn full_vis_is_never_too_small_and_fast_is_a_superset() {
             full.average_visible() < fast.average_visible(),
             "seed {seed}"
         );
+    }
+}
+
+#[test]
+fn clustered_portals_give_every_leaf_its_clusters_leaves_and_are_never_too_small() {
+    for seed in 1..=3 {
+        let w = VoxelWorld::random_caves([14, 14, 4], 220, seed);
+        let prt = w.paired_portal_file();
+        let clusters = prt.clusters.clone().expect("PRT2");
+        assert!(
+            clusters.len() < prt.num_leafs as usize,
+            "seed {seed}: some pairs"
+        );
+        // Through the text format, as vis reads it.
+        let prt = PortalFile::parse(&prt.write()).expect("parse");
+        let fast = run(&prt, VisMode::Fast);
+        for pvs in [run(&prt, FULL), fast.clone()] {
+            assert!(pvs.is_subset_of(&fast), "seed {seed}");
+            assert_eq!(pvs.num_leafs(), prt.num_leafs as usize);
+            for members in &clusters {
+                let first = members[0] as usize;
+                for &leaf in members {
+                    assert_eq!(pvs.row(leaf as usize), pvs.row(first), "seed {seed}");
+                    assert!(pvs.sees(first, leaf as usize), "seed {seed}");
+                }
+            }
+            let report = sample_visibility(&w.bsp(), &pvs, 20_000, seed).expect("sample");
+            assert_eq!(report.violations, 0, "seed {seed}: {:?}", report.examples);
+        }
     }
 }
 
@@ -249,4 +282,36 @@ fn leaves_that_see_water_hear_it_fading_with_distance() {
     assert_eq!(water[11], 0, "640 units away");
     assert_eq!(hearing, water.iter().filter(|&&l| l > 0).count());
     assert!(bsp.leafs.iter().all(|l| l.ambient[1..] == [0, 0, 0]));
+}
+
+#[test]
+fn leaves_that_see_a_slime_leaf_hear_it_without_any_slime_texture() {
+    // A corridor of 12 cells; the first cell is a slime volume with no faces at all.
+    let mut w = VoxelWorld::new([12, 1, 1], 64.0);
+    w.open_box([0, 0, 0], [11, 0, 0]);
+    let pvs = run(&w.portal_file(), FULL);
+    let mut bsp = w.bsp();
+    bsp.leafs[1].contents = quake_formats::bsp::contents::SLIME;
+    vis::ambient::ambient_levels(&mut bsp, &pvs).expect("ambient");
+    let slime: Vec<u8> = bsp.leafs[1..].iter().map(|l| l.ambient[2]).collect();
+    assert_eq!(slime[0], 255);
+    assert_eq!(slime[1], 255, "touching the slime leaf");
+    assert!(slime.windows(2).all(|p| p[0] >= p[1]), "{slime:?}");
+    assert_eq!(slime[11], 0, "640 units away");
+    assert!(bsp.leafs[1..].iter().all(|l| l.ambient[0] == 0));
+}
+
+#[test]
+fn the_pvs_does_not_depend_on_the_thread_count() {
+    let w = VoxelWorld::random_caves([16, 16, 4], 400, 5);
+    let prt = w.portal_file();
+    let with = |threads| {
+        let options = VisOptions {
+            mode: FULL,
+            threads: Some(threads),
+            progress: false,
+        };
+        compute_vis(&prt, &options).expect("vis").pvs
+    };
+    assert_eq!(with(1), with(3));
 }

@@ -1,0 +1,166 @@
+//! The states a portal flow has already walked on from, to skip paths that cannot see more.
+//!
+//! After passing a portal, everything the flow does next depends only on the state it reached:
+//! the part of the base portal sight lines can still start from (`source`), the part of the
+//! passed portal they can still go through (`pass`), and the bound of what might still be seen
+//! (`might`). Clipping is monotone in the windings: a smaller source and a smaller pass let
+//! fewer lines through, so they show no more. A second path reaching the same portal with
+//! windings inside those of a path already walked on, and a bound inside that path's bound, can
+//! see nothing that walk did not see (everything it skipped was already seen). In open areas,
+//! where many leaf orders lead to the same portal unclipped, this cuts the walk from a number
+//! of paths exponential in the depth down to a few per portal.
+
+use crate::bitset::WindowBits;
+use quake_formats::geom::Vec3;
+
+/// How far (map units) a winding may stick out of another and still count as inside: clipped
+/// copies of the same portal differ by rounding only.
+const INSIDE_EPSILON: f64 = 1e-3;
+
+/// At most this many states are kept per portal; later ones are walked without being kept.
+const STATES_PER_PORTAL: usize = 4;
+
+struct State {
+    source: Vec<Vec3>,
+    pass: Vec<Vec3>,
+    might: WindowBits,
+}
+
+/// The states walked on from, per portal, during one base portal's flow.
+#[derive(Default)]
+pub struct Explored {
+    states: Vec<Vec<State>>,
+    touched: Vec<u32>,
+    spare: Vec<State>,
+}
+
+impl Explored {
+    /// Forget every state (the start of another base portal's flow over `portals` portals).
+    pub fn reset(&mut self, portals: usize) {
+        for &p in &self.touched {
+            self.spare.append(&mut self.states[p as usize]);
+        }
+        self.touched.clear();
+        self.states.resize_with(portals, Vec::new);
+    }
+
+    /// Whether a state already walked on from `portal` lets through everything this one does.
+    /// `source_normal` and `pass_normal` are the normals of the windings' planes.
+    pub fn covers(
+        &self,
+        portal: usize,
+        source: &[Vec3],
+        pass: &[Vec3],
+        might: &WindowBits,
+        source_normal: Vec3,
+        pass_normal: Vec3,
+    ) -> bool {
+        self.states[portal].iter().any(|s| {
+            convex_contains(&s.pass, pass, pass_normal)
+                && convex_contains(&s.source, source, source_normal)
+                && might.is_subset(&s.might)
+        })
+    }
+
+    /// Remember a state about to be walked on from `portal`.
+    pub fn record(&mut self, portal: usize, source: &[Vec3], pass: &[Vec3], might: &WindowBits) {
+        let kept = &mut self.states[portal];
+        if kept.len() >= STATES_PER_PORTAL {
+            return;
+        }
+        if kept.is_empty() {
+            self.touched.push(portal as u32);
+        }
+        let mut state = self.spare.pop().unwrap_or_else(|| State {
+            source: Vec::new(),
+            pass: Vec::new(),
+            might: WindowBits::default(),
+        });
+        state.source.clear();
+        state.source.extend_from_slice(source);
+        state.pass.clear();
+        state.pass.extend_from_slice(pass);
+        state.might.assign(might);
+        kept.push(state);
+    }
+}
+
+/// Whether the convex winding `inner` lies inside the convex winding `outer` (both in one plane
+/// with normal `normal`), allowing [`INSIDE_EPSILON`].
+pub fn convex_contains(outer: &[Vec3], inner: &[Vec3], normal: Vec3) -> bool {
+    let n = outer.len();
+    if n < 3 {
+        return false;
+    }
+    let center = outer.iter().fold(Vec3::ZERO, |a, &v| a + v) / n as f64;
+    (0..n).all(|i| {
+        let a = outer[i];
+        let Some(mut inward) = (outer[(i + 1) % n] - a).cross(normal).normalized() else {
+            return true; // a repeated point: no edge
+        };
+        if inward.dot(center - a) < 0.0 {
+            inward = -inward;
+        }
+        inner.iter().all(|&v| inward.dot(v - a) >= -INSIDE_EPSILON)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bitset::BitSet;
+
+    fn square(size: f64, offset: f64) -> Vec<Vec3> {
+        [(0.0, 0.0), (0.0, 1.0), (1.0, 1.0), (1.0, 0.0)]
+            .iter()
+            .map(|&(x, y)| Vec3::new(offset + x * size, offset + y * size, 5.0))
+            .collect()
+    }
+
+    #[test]
+    fn containment_of_squares() {
+        let up = Vec3::new(0.0, 0.0, 1.0);
+        assert!(convex_contains(&square(64.0, 0.0), &square(32.0, 16.0), up));
+        assert!(convex_contains(&square(64.0, 0.0), &square(64.0, 0.0), up));
+        assert!(!convex_contains(
+            &square(32.0, 16.0),
+            &square(64.0, 0.0),
+            up
+        ));
+        assert!(!convex_contains(&square(64.0, 0.0), &square(64.0, 1.0), up));
+        // Either winding order.
+        let mut reversed = square(64.0, 0.0);
+        reversed.reverse();
+        assert!(convex_contains(&reversed, &square(32.0, 16.0), up));
+    }
+
+    #[test]
+    fn a_state_covers_smaller_ones_with_a_smaller_bound() {
+        let up = Vec3::new(0.0, 0.0, 1.0);
+        let mut explored = Explored::default();
+        explored.reset(3);
+        let might = |members: &[usize]| {
+            let mut set = BitSet::new(100);
+            for &i in members {
+                set.insert(i);
+            }
+            let mut bits = WindowBits::default();
+            bits.assign_filtered(&set, |_| false);
+            bits
+        };
+        explored.record(
+            1,
+            &square(64.0, 0.0),
+            &square(64.0, 0.0),
+            &might(&[2, 5, 90]),
+        );
+        let small = square(32.0, 8.0);
+        assert!(explored.covers(1, &small, &small, &might(&[5]), up, up));
+        assert!(explored.covers(1, &small, &small, &might(&[]), up, up));
+        assert!(!explored.covers(2, &small, &small, &might(&[5]), up, up));
+        assert!(!explored.covers(1, &small, &small, &might(&[5, 7]), up, up));
+        assert!(!explored.covers(1, &small, &square(64.0, 1.0), &might(&[5]), up, up));
+        explored.reset(3);
+        assert!(!explored.covers(1, &small, &small, &might(&[]), up, up));
+    }
+}
