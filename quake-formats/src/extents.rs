@@ -45,7 +45,8 @@ impl LightmapExtents {
             let lo = (mins[axis] / scale).floor().clamp(-GRID_CLAMP, GRID_CLAMP) as i32;
             let hi = (maxs[axis] / scale).ceil().clamp(-GRID_CLAMP, GRID_CLAMP) as i32;
             tex_mins[axis] = lo * LIGHTMAP_SCALE;
-            extents[axis] = (hi - lo) * LIGHTMAP_SCALE;
+            // All-NaN coordinates leave lo above hi.
+            extents[axis] = (hi - lo).max(0) * LIGHTMAP_SCALE;
         }
         LightmapExtents { tex_mins, extents }
     }
@@ -75,6 +76,14 @@ impl LightmapExtents {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn nan_coordinates_give_an_empty_extent() {
+        let pts = [[f32::NAN; 3], [f32::NAN; 3]];
+        let e = LightmapExtents::from_points(&pts, &AXIAL);
+        assert_eq!(e.extents, [0, 0]);
+        assert_eq!(e.luxel_count(), 1);
+    }
 
     #[test]
     fn absurd_coordinates_do_not_overflow() {
