@@ -5,9 +5,9 @@
 //! light in solid, a brush-model face) is treated as visible.
 
 use quake_formats::Bsp;
+use quake_formats::PvsRow;
 use quake_formats::bsp::contents;
 use quake_formats::geom::Vec3;
-use quake_formats::visrle::decompress_row;
 
 use crate::faces::{FaceGeom, FaceKind};
 
@@ -32,19 +32,14 @@ fn bit(row: &[u8], leaf: u32) -> bool {
 
 impl Visibility {
     pub fn new(bsp: &Bsp, faces: &[FaceGeom]) -> Visibility {
-        let vis_leafs = bsp
-            .models
-            .first()
-            .map_or(0, |m| m.vis_leafs.max(0) as usize);
-        let row_len = vis_leafs.div_ceil(8);
-        let rows: Vec<Option<Vec<u8>>> = bsp
-            .leafs
-            .iter()
-            .map(|leaf| {
-                let ofs = usize::try_from(leaf.vis_offset).ok()?;
-                let data = bsp.visibility.get(ofs..)?;
-                let (row, complete) = decompress_row(data, row_len);
-                complete.then_some(row)
+        // Damaged or truncated rows count as seeing everything: culling must stay conservative.
+        let rows: Vec<Option<Vec<u8>>> = (0..bsp.leafs.len())
+            .map(|leaf| match bsp.pvs_row(leaf) {
+                Ok(PvsRow::Row {
+                    bits,
+                    complete: true,
+                }) => Some(bits),
+                _ => None,
             })
             .collect();
         let mut face_leafs = vec![Vec::new(); faces.len()];

@@ -214,3 +214,21 @@ fn random_byte_flips_on_a_corpus_bsp_never_panic() {
         )
         .expect("no panics");
 }
+
+#[test]
+fn pvs_rows_read_as_engines_read_them() {
+    use quake_formats::PvsRow;
+    let mut bsp = tiny_bsp(BspVersion::Bsp29);
+    assert_eq!(bsp.pvs_row(1).expect("no vis data"), PvsRow::All);
+    bsp.visibility = quake_formats::visrle::compress_row(&[0b1]);
+    bsp.leafs[1].vis_offset = 0;
+    let row = PvsRow::Row {
+        bits: vec![0b1],
+        complete: true,
+    };
+    assert_eq!(bsp.pvs_row(1).expect("row"), row);
+    assert_eq!(bsp.pvs_row(0).expect("leaf 0"), PvsRow::All);
+    bsp.leafs[1].vis_offset = 99;
+    let err = bsp.pvs_row(1).expect_err("offset past the lump");
+    assert!(err.to_string().contains("leaf 1"), "{err}");
+}

@@ -2,9 +2,9 @@
 //! nodes culled by the frustum, faces culled by facing, and a sort key per face from the order
 //! of the BSP walk (smaller keys are nearer).
 
+use quake_formats::PvsRow;
 use quake_formats::bsp::contents;
 use quake_formats::geom::Vec3;
-use quake_formats::visrle::decompress_row;
 
 use crate::camera::View;
 use crate::world::World;
@@ -108,18 +108,9 @@ impl Visibility {
     /// Mark the leaves in the camera leaf's PVS row and every node above them.
     fn mark_leaves(&mut self, world: &World, camera_leaf: usize) -> usize {
         let bsp = &world.bsp;
-        let vis_leafs = bsp
-            .models
-            .first()
-            .map_or(0, |m| m.vis_leafs.max(0) as usize);
-        let vis_offset = bsp.leafs.get(camera_leaf).map_or(-1, |l| l.vis_offset);
-        let row = match usize::try_from(vis_offset) {
-            Ok(ofs)
-                if camera_leaf != 0 && !bsp.visibility.is_empty() && ofs < bsp.visibility.len() =>
-            {
-                Some(decompress_row(&bsp.visibility[ofs..], vis_leafs.div_ceil(8)).0)
-            }
-            // Outside the map, or no vis data: everything is visible, as in engines.
+        // Outside the map, no vis data or a damaged offset: everything is visible, as in engines.
+        let row = match bsp.pvs_row(camera_leaf) {
+            Ok(PvsRow::Row { bits, .. }) => Some(bits),
             _ => None,
         };
         let mut count = 0;

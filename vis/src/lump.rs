@@ -4,7 +4,8 @@ use crate::VisError;
 use crate::bitset::BitSet;
 use crate::pvs::Pvs;
 use quake_formats::Bsp;
-use quake_formats::visrle::{compress_row, decompress_row};
+use quake_formats::PvsRow;
+use quake_formats::visrle::compress_row;
 use std::collections::HashMap;
 
 /// What writing the lump produced.
@@ -88,24 +89,15 @@ pub fn write_vis(bsp: &mut Bsp, pvs: &Pvs) -> Result<LumpStats, VisError> {
 /// visibility data at all) sees everything, which is what engines do with it.
 pub fn read_pvs(bsp: &Bsp) -> Result<Pvs, VisError> {
     let n = world_vis_leafs(bsp)?;
-    let row_len = n.div_ceil(8);
     let rows = (1..=n)
-        .map(|leaf| {
-            let offset = bsp.leafs[leaf].vis_offset;
-            if offset < 0 || bsp.visibility.is_empty() {
-                return Ok(BitSet::full(n));
-            }
-            let data = bsp
-                .visibility
-                .get(offset as usize..)
-                .filter(|d| !d.is_empty())
-                .ok_or(VisError::BadVisOffset {
-                    leaf,
-                    offset,
-                    lump_len: bsp.visibility.len(),
-                })?;
-            let (bytes, _complete) = decompress_row(data, row_len);
-            Ok(BitSet::from_row_bytes(&bytes, n))
+        .map(|leaf| match bsp.pvs_row(leaf) {
+            Ok(PvsRow::All) => Ok(BitSet::full(n)),
+            Ok(PvsRow::Row { bits, .. }) => Ok(BitSet::from_row_bytes(&bits, n)),
+            Err(_) => Err(VisError::BadVisOffset {
+                leaf,
+                offset: bsp.leafs[leaf].vis_offset,
+                lump_len: bsp.visibility.len(),
+            }),
         })
         .collect::<Result<Vec<_>, VisError>>()?;
     Ok(Pvs::new(rows))

@@ -66,6 +66,15 @@ pub const LUMP_NAMES: [&str; 15] = [
 /// The order lumps are laid out in a freshly written file (the order common compilers use).
 const FILE_ORDER: [usize; 15] = [1, 10, 3, 5, 6, 7, 9, 11, 13, 12, 14, 8, 4, 0, 2];
 
+/// A leaf's potentially visible set as stored in a BSP.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PvsRow {
+    /// No row: the leaf sees every leaf.
+    All,
+    /// The decompressed row; `complete` is false when the data ended early (zero-padded).
+    Row { bits: Vec<u8>, complete: bool },
+}
+
 /// An extension lump stored after the standard ones (BSPX), kept verbatim.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BspxLump {
@@ -365,6 +374,33 @@ impl Bsp {
                 self.vertices.get(v as usize).copied()
             })
             .collect()
+    }
+
+    /// Leaf `leaf`'s stored PVS row (bit `i` stands for leaf `i + 1`), read as engines read it:
+    /// leaf 0, a vis offset of -1 or a map without visibility data sees everything
+    /// ([`PvsRow::All`]). An offset outside the visibility lump is an error.
+    pub fn pvs_row(&self, leaf: usize) -> Result<PvsRow> {
+        let offset = self.leafs.get(leaf).map_or(-1, |l| l.vis_offset);
+        if leaf == 0 || offset < 0 || self.visibility.is_empty() {
+            return Ok(PvsRow::All);
+        }
+        let data = self
+            .visibility
+            .get(offset as usize..)
+            .filter(|d| !d.is_empty())
+            .ok_or_else(|| FormatError::BadLump {
+                lump: "visibility",
+                detail: format!(
+                    "leaf {leaf}'s row at offset {offset} is outside the {}-byte lump",
+                    self.visibility.len()
+                ),
+            })?;
+        let vis_leafs = self
+            .models
+            .first()
+            .map_or(0, |m| m.vis_leafs.max(0) as usize);
+        let (bits, complete) = crate::visrle::decompress_row(data, vis_leafs.div_ceil(8));
+        Ok(PvsRow::Row { bits, complete })
     }
 
     /// The leaf containing `point`, walking the world model's hull 0 tree.
