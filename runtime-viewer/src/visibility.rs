@@ -4,13 +4,10 @@
 
 use quake_formats::PvsRow;
 use quake_formats::bsp::contents;
-use quake_formats::geom::Vec3;
+use quake_formats::geom::{ON_EPSILON, Vec3};
 
 use crate::camera::View;
 use crate::world::World;
-
-/// Faces this close to the eye's plane are edge-on and skipped.
-const BACKFACE_EPSILON: f64 = 0.01;
 
 /// A surface to draw: a world face, or a brush model fragment (`leaf`, index in that leaf).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -219,7 +216,7 @@ impl Visibility {
         });
         stack.push(Step::NodeFaces {
             node: child as u32,
-            facing_side: (d.abs() > BACKFACE_EPSILON).then_some(near as u32),
+            facing_side: (d.abs() > ON_EPSILON).then_some(near as u32),
             clip_flags,
         });
         stack.push(Step::Visit {
@@ -270,7 +267,7 @@ impl Visibility {
             let Some(s) = &w.world.surfaces[frag.face as usize] else {
                 continue;
             };
-            if s.plane.distance(w.view.origin) <= BACKFACE_EPSILON {
+            if s.plane.distance(w.view.origin) <= ON_EPSILON {
                 w.stats.backfaces += 1;
                 continue;
             }

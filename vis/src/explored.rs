@@ -11,11 +11,7 @@
 //! of paths exponential in the depth down to a few per portal.
 
 use crate::bitset::WindowBits;
-use quake_formats::geom::Vec3;
-
-/// How far (map units) a winding may stick out of another and still count as inside: clipped
-/// copies of the same portal differ by rounding only.
-const INSIDE_EPSILON: f64 = 1e-3;
+use quake_formats::geom::{POINT_EPSILON, Vec3};
 
 /// At most this many states are kept per portal; later ones are walked without being kept.
 const STATES_PER_PORTAL: usize = 4;
@@ -86,7 +82,7 @@ impl Explored {
 }
 
 /// Whether the convex winding `inner` lies inside the convex winding `outer` (both in one plane
-/// with normal `normal`), allowing [`INSIDE_EPSILON`].
+/// with normal `normal`), allowing [`POINT_EPSILON`].
 pub fn convex_contains(outer: &[Vec3], inner: &[Vec3], normal: Vec3) -> bool {
     let n = outer.len();
     if n < 3 {
@@ -101,7 +97,7 @@ pub fn convex_contains(outer: &[Vec3], inner: &[Vec3], normal: Vec3) -> bool {
         if inward.dot(center - a) < 0.0 {
             inward = -inward;
         }
-        inner.iter().all(|&v| inward.dot(v - a) >= -INSIDE_EPSILON)
+        inner.iter().all(|&v| inward.dot(v - a) >= -POINT_EPSILON)
     })
 }
 
