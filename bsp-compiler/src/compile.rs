@@ -19,6 +19,7 @@ use crate::tree::{
 use crate::wad_lookup::WadSet;
 use crate::warnings::Warning;
 use quake_formats::bsp::contents;
+use quake_formats::bsp::phong::{self, FacePhong};
 use quake_formats::entities::Entity;
 use quake_formats::geom::{Bounds, Vec3};
 use quake_formats::prt::PortalFile;
@@ -142,6 +143,8 @@ pub struct MapTexInfo {
     /// Index into the texture name list.
     pub texture: u32,
     pub role: TextureRole,
+    /// The `_phong` group of the world-merged entity the face came from.
+    pub phong: FacePhong,
 }
 
 /// One model's brushes before tree building.
@@ -234,11 +237,13 @@ struct TexInfoTable {
     names: Vec<String>,
     name_index: HashMap<String, u32>,
     infos: Vec<MapTexInfo>,
-    info_index: HashMap<([u64; 8], u32), u32>,
+    info_index: HashMap<([u64; 8], u32, u32), u32>,
 }
 
 impl TexInfoTable {
-    fn intern(&mut self, name: &str, vecs: [[f64; 4]; 2]) -> u32 {
+    /// The texinfo of `name` projected by `vecs` on a face of `phong`'s group
+    /// (faces of different groups never share one, so they never merge).
+    fn intern(&mut self, name: &str, vecs: [[f64; 4]; 2], phong: FacePhong) -> u32 {
         let key = name.to_ascii_lowercase();
         let texture = match self.name_index.get(&key) {
             Some(&i) => i,
@@ -250,7 +255,7 @@ impl TexInfoTable {
             }
         };
         let bits: [u64; 8] = std::array::from_fn(|i| (vecs[i / 4][i % 4] as f32).to_bits() as u64);
-        if let Some(&i) = self.info_index.get(&(bits, texture)) {
+        if let Some(&i) = self.info_index.get(&(bits, texture, phong.group)) {
             return i;
         }
         let i = self.infos.len() as u32;
@@ -258,8 +263,9 @@ impl TexInfoTable {
             vecs,
             texture,
             role: TextureRole::of(name),
+            phong,
         });
-        self.info_index.insert((bits, texture), i);
+        self.info_index.insert((bits, texture, phong.group), i);
         i
     }
 }
@@ -541,6 +547,25 @@ fn origin_brush_centre(ent: &MapEntity, planes: &mut PlaneSet) -> Option<Vec3> {
     (!bounds.is_empty()).then(|| bounds.center())
 }
 
+/// The `_phong` group of entity `index` if it is merged into the world (its
+/// faces could not be told apart from the world's otherwise): its entity
+/// index as group id. Worldspawn and brush models get none here; light reads
+/// their own keys.
+fn merged_phong(ent: &MapEntity, index: usize, class: EntityBrushes) -> FacePhong {
+    let merged = index != 0 && class != EntityBrushes::Submodel;
+    let angle = phong::angle_from_keys(
+        ent.entity.get_float("_phong"),
+        ent.entity.get_float("_phong_angle"),
+    );
+    match angle.filter(|_| merged) {
+        Some(angle) => FacePhong {
+            group: index as u32,
+            angle: angle as f32,
+        },
+        None => FacePhong::default(),
+    }
+}
+
 /// Build one entity's brushes, in coordinates relative to `origin`, each with whether it is a
 /// clip brush; origin brushes are left out. Returns the brushes, the number of bad brushes and
 /// the number of hint brushes skipped (outside the world).
@@ -555,6 +580,7 @@ fn build_entity_brushes(
 ) -> (Vec<(Brush, bool)>, usize, usize) {
     let mut out = Vec::new();
     let (mut bad, mut hints) = (0, 0);
+    let phong = merged_phong(ent, entity, class);
     for (bi, mb) in ent.brushes.iter().enumerate() {
         if is_origin_brush(mb) {
             continue;
@@ -572,7 +598,7 @@ fn build_entity_brushes(
             for row in &mut vecs {
                 row[3] += Vec3::new(row[0], row[1], row[2]).dot(origin);
             }
-            let texinfo = table.intern(&f.texture, vecs);
+            let texinfo = table.intern(&f.texture, vecs, phong);
             roles.push(TextureRole::of(&f.texture));
             faces.push(BrushPlane {
                 plane,
@@ -795,4 +821,45 @@ fn build_model(
         },
         warnings,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn phong_groups_only_for_entities_merged_into_the_world() {
+        let text = "{ \"classname\" \"worldspawn\" \"_phong\" \"1\" }\n\
+                    { \"classname\" \"func_detail\" \"_phong\" \"1\" }\n\
+                    { \"classname\" \"func_group\" \"_phong_angle\" \"30\" }\n\
+                    { \"classname\" \"func_wall\" \"_phong\" \"1\" }\n\
+                    { \"classname\" \"func_detail_wall\" }\n";
+        let map = parse_map(Path::new("phong.map"), text).expect("parse");
+        let got: Vec<FacePhong> = map
+            .entities
+            .iter()
+            .enumerate()
+            .map(|(i, e)| merged_phong(e, i, EntityBrushes::of(i, e.entity.classname())))
+            .collect();
+        let group = |group, angle| FacePhong { group, angle };
+        let none = FacePhong::default();
+        // Worldspawn and brush models keep their keys for light to read.
+        assert_eq!(got, vec![none, group(1, 89.0), group(2, 30.0), none, none]);
+    }
+
+    #[test]
+    fn faces_of_different_phong_groups_get_different_texinfos() {
+        let mut table = TexInfoTable::default();
+        let vecs = [[1.0, 0.0, 0.0, 0.0], [0.0, -1.0, 0.0, 0.0]];
+        let grouped = FacePhong {
+            group: 3,
+            angle: 89.0,
+        };
+        let plain = table.intern("wall", vecs, FacePhong::default());
+        let a = table.intern("wall", vecs, grouped);
+        assert_ne!(plain, a);
+        assert_eq!(table.intern("wall", vecs, grouped), a);
+        assert_eq!(table.infos[a as usize].phong, grouped);
+        assert_eq!(table.names.len(), 1, "one texture either way");
+    }
 }

@@ -175,6 +175,7 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
     let mut node_faces: HashMap<(usize, u32), (u32, u32)> = HashMap::new();
     let mut leaf_faces: HashMap<(usize, u32), Vec<u32>> = HashMap::new();
     let mut model_faces: Vec<(u32, u32)> = vec![(0, 0); input.models.len()];
+    let mut phong = Vec::with_capacity(pending.len());
     for (pf, mut poly) in pending.iter().zip(polygons) {
         poly.dedup();
         while poly.len() > 1 && poly.first() == poly.last() {
@@ -215,6 +216,7 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
             },
             light_offset: -1,
         });
+        phong.push(input.texinfos[f.texinfo as usize].phong);
         let range = node_faces
             .entry((pf.model, f.node))
             .or_insert((face_index, 0));
@@ -303,6 +305,7 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
     }
     bsp.textures.textures = used;
     bsp.texinfo = textures.out_infos;
+    bsp.set_phong_faces(&phong);
     bsp.planes = planes.planes;
     bsp.set_entity_text(&write_entities(input.entities));
 

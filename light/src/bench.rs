@@ -55,7 +55,7 @@ pub fn bare_occlusion(bsp: &Bsp, prep: &Prepared, gate: f64, max_rays: usize) ->
             for (lane, &(o, d, t)) in chunk.iter().enumerate() {
                 packet.set(lane, o, d, 0.0, t);
             }
-            u64::from(prep.scene.occluded16(&mut packet).count_ones())
+            u64::from(prep.scene.occluded16(&mut packet, 0).count_ones())
         })
         .sum();
     let seconds = start.elapsed().as_secs_f64();

@@ -68,6 +68,9 @@ pub struct Args {
     /// Dirt cone angle from the normal in degrees, 1-90 (overrides `_dirtangle`, default 88).
     #[arg(long, value_name = "DEGREES")]
     pub dirtangle: Option<f64>,
+    /// Add minlight to every luxel's light instead of raising dark luxels to it.
+    #[arg(long)]
+    pub addmin: bool,
     /// Consider every light for every face (no range, plane-side or PVS culling).
     #[arg(long)]
     pub no_cull: bool,
@@ -101,6 +104,7 @@ impl Args {
                 dirt_scale: self.dirtscale,
                 dirt_gain: self.dirtgain,
                 dirt_angle: self.dirtangle,
+                addmin: self.addmin,
             },
             only_faces: None,
             no_cull: self.no_cull,

@@ -7,6 +7,7 @@ use quake_formats::geom::Vec3;
 
 use crate::embree::RayPacket16;
 use crate::lights::{DirtMode, DirtSampling, tangent_basis};
+use crate::samples::FaceSamples;
 use crate::scene::TraceScene;
 
 /// Directions around the cone's axis (ordered mode).
@@ -61,44 +62,83 @@ fn random_directions(basis: [Vec3; 3], cone: f64, face: usize, sample: usize) ->
         .collect()
 }
 
-/// Occlusion of each of `points` (in front of a face with unit `normal`):
-/// the mean over the dirt rays of `1 - hit distance / depth` (0 for a ray
-/// that reaches no opaque surface within `depth`; sky does not occlude).
-/// Returns the values and the number of rays cast.
+/// `d` if it points in front of a face with unit normal `face_normal`,
+/// else its mirror image in the face's plane. A `_phong` normal tilts the
+/// dirt cone, and rays it would send behind the flat face (into the face's
+/// own polygon, a facet the smooth surface does not have) go back out.
+fn in_front(d: [f32; 3], face_normal: Vec3) -> [f32; 3] {
+    let v = Vec3::from_f32(d);
+    let below = v.dot(face_normal);
+    if below < 0.0 {
+        (v - face_normal * (2.0 * below)).to_f32()
+    } else {
+        d
+    }
+}
+
+/// Occlusion of each sample point of `samples` (a face of brush model
+/// `model`): the mean over the dirt rays, cast in a cone around the
+/// sample's shading normal (the `_phong` one where the face has them), of
+/// `1 - hit distance / depth` (0 for a ray that reaches no opaque surface
+/// within `depth`; sky does not occlude). Returns the values and the number
+/// of rays cast.
 pub fn occlusion(
-    points: &[[f32; 3]],
-    normal: Vec3,
-    face: usize,
+    samples: &FaceSamples,
+    model: usize,
     sampling: &DirtSampling,
     scene: &TraceScene,
 ) -> (Vec<f32>, u64) {
-    let [u, v] = tangent_basis(normal);
-    let basis = [u, v, normal];
+    let all: Vec<usize> = (0..samples.points.len()).collect();
+    occlusion_at(samples, &all, model, sampling, scene)
+}
+
+/// [`occlusion`] of the samples `indices` only (values in that order).
+pub fn occlusion_at(
+    samples: &FaceSamples,
+    indices: &[usize],
+    model: usize,
+    sampling: &DirtSampling,
+    scene: &TraceScene,
+) -> (Vec<f32>, u64) {
     let cone = sampling.cone_degrees.to_radians();
-    let ordered = ordered_directions(basis, cone);
+    let basis_of = |n: Vec3| {
+        let [u, v] = tangent_basis(n);
+        [u, v, n]
+    };
+    // Without per-sample normals every sample shares one ordered pattern.
+    let flat_ordered = ordered_directions(basis_of(samples.normal), cone);
     let depth = sampling.depth as f32;
     let mut packet = RayPacket16::new();
     let mut rays = 0u64;
-    let values = points
+    let values = indices
         .iter()
-        .enumerate()
-        .map(|(i, &p)| {
-            let random;
+        .map(|&i| {
+            let axis = samples.normal_at(i);
+            let own;
             let dirs = match sampling.mode {
-                DirtMode::Ordered => &ordered,
+                DirtMode::Ordered if samples.normals.is_empty() => &flat_ordered,
+                DirtMode::Ordered => {
+                    own = ordered_directions(basis_of(axis), cone);
+                    &own
+                }
                 DirtMode::Random => {
-                    random = random_directions(basis, cone, face, i);
-                    &random
+                    own = random_directions(basis_of(axis), cone, samples.face, i);
+                    &own
                 }
             };
+            let p = samples.points[i];
             let mut gathered = 0.0f32;
             for chunk in dirs.chunks(16) {
                 packet.clear();
                 for (lane, &d) in chunk.iter().enumerate() {
-                    packet.set(lane, p, d, 0.0, depth);
+                    packet.set(lane, p, in_front(d, samples.normal), 0.0, depth);
                 }
                 rays += chunk.len() as u64;
-                for t in scene.opaque_hits16(&mut packet).into_iter().flatten() {
+                for t in scene
+                    .opaque_hits16(&mut packet, model)
+                    .into_iter()
+                    .flatten()
+                {
                     gathered += 1.0 - (t / depth).min(1.0);
                 }
             }

@@ -5,7 +5,8 @@
 //! 1. [`faces`]: every face as world-space geometry with its lightmap extents
 //!    (from the shared `quake_formats::extents`).
 //! 2. [`scene`]: one Embree scene of the opaque world (and `_shadow 1` brush
-//!    models), sky faces as their own geometry.
+//!    models), sky faces as their own geometry; a small scene per
+//!    `_shadowself` model for its own faces' rays.
 //! 3. [`lights`]: light entities, suns and sky domes, minlight, switchable
 //!    styles; [`surface`] expands `_surface` templates.
 //! 4. [`samples`]: sample points per luxel (supersampled with `--extra`),
@@ -67,6 +68,9 @@ pub enum LightError {
     TooManySwitchableLights,
     #[error("{0}")]
     Embree(#[from] EmbreeError),
+    /// A damaged `SLIPGATE_PHONG` lump (the message names it).
+    #[error("{0}")]
+    PhongLump(quake_formats::FormatError),
 }
 
 /// How much work to spend per luxel.
@@ -199,9 +203,16 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
     let faces = face_geometry(bsp, origin_of)?;
     // Embree's own threads only build the BVH; rayon does the tracing.
     let device = Device::new(rayon::current_num_threads())?;
-    let scene = TraceScene::build(&device, &faces, &map_lights.shadow_models)?;
+    let scene = TraceScene::build(
+        &device,
+        &faces,
+        &map_lights.shadow_models,
+        &map_lights.self_shadow_models,
+    )?;
     let vis = Visibility::new(bsp, &faces);
-    let phong = phong::corner_normals(&faces, &map_lights.phong);
+    let lump = bsp.phong_faces().map_err(LightError::PhongLump)?;
+    let groups = phong::groups(&faces, &map_lights.phong, lump.as_deref());
+    let phong = phong::corner_normals(&faces, &groups);
     let surface =
         surface::expand_templates(&map_lights.templates, &faces, surface::DEFAULT_SPACING);
     let surface_lights = surface.len();
@@ -302,6 +313,7 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
         gate: options.gate,
         sun_distance: prep.sun_distance,
         dirt: prep.lights.uses_dirt().then_some(prep.lights.dirt),
+        adaptive: options.quality != Quality::Reference && std::env::var_os("NOADAPT").is_none(),
     };
     let wanted: Vec<usize> = match &options.only_faces {
         Some(list) => list.clone(),

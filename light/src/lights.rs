@@ -8,6 +8,7 @@
 
 use std::collections::HashMap;
 
+use quake_formats::bsp::phong;
 use quake_formats::entities::Entity;
 use quake_formats::geom::Vec3;
 
@@ -29,8 +30,6 @@ pub const FIRST_SWITCHABLE_STYLE: u8 = 32;
 pub const DEFAULT_DIRT_DEPTH: f64 = 128.0;
 /// Dirt cone (degrees from the normal) when `_dirtangle` is absent.
 pub const DEFAULT_DIRT_ANGLE: f64 = 88.0;
-/// Phong smoothing angle (degrees) when `_phong 1` gives none.
-pub const DEFAULT_PHONG_ANGLE: f64 = 89.0;
 /// Lights a `_deviance` light is split into when `_samples` is absent.
 pub const DEFAULT_DEVIANCE_SAMPLES: usize = 16;
 /// Distance (map units) at which the 1/x and 1/x² formulas give `light`.
@@ -270,6 +269,8 @@ pub struct SunLight {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Minlight {
     pub level: f64,
+    /// `--addmin`: the level is added to style 0 instead of being a floor.
+    pub add: bool,
     pub color: Vec3,
     pub dirt: Option<DirtResponse>,
     /// Faces with this texture get no minlight (`_minlight_exclude`).
@@ -307,6 +308,8 @@ pub struct GlobalOverrides {
     pub dirt_scale: Option<f64>,
     pub dirt_gain: Option<f64>,
     pub dirt_angle: Option<f64>,
+    /// `--addmin`: minlight is added to style 0 instead of raising it to a floor.
+    pub addmin: bool,
 }
 
 impl Default for GlobalOverrides {
@@ -321,6 +324,7 @@ impl Default for GlobalOverrides {
             dirt_scale: None,
             dirt_gain: None,
             dirt_angle: None,
+            addmin: false,
         }
     }
 }
@@ -335,6 +339,8 @@ pub struct MapLights {
     pub minlight: HashMap<usize, Minlight>,
     /// Brush models that cast shadows (`_shadow 1`).
     pub shadow_models: Vec<usize>,
+    /// Brush models that shadow only their own faces (`_shadowself 1`).
+    pub self_shadow_models: Vec<usize>,
     /// Brush models whose faces never take dirt (`_dirt -1`).
     pub no_dirt_models: Vec<usize>,
     /// Brush models whose faces get minlight only (`_lightignore 1`).
@@ -616,6 +622,7 @@ pub fn parse_lights(
         templates: Vec::new(),
         minlight: HashMap::new(),
         shadow_models: Vec::new(),
+        self_shadow_models: Vec::new(),
         no_dirt_models: Vec::new(),
         lightignore_models: Vec::new(),
         dirt,
@@ -634,6 +641,7 @@ pub fn parse_lights(
             0,
             Minlight {
                 level: world_min,
+                add: overrides.addmin,
                 color,
                 dirt: minlight_dirt,
                 exclude_texture: wk.entity.get("_minlight_exclude").map(str::to_string),
@@ -686,10 +694,9 @@ pub fn parse_lights(
         };
         if let Some(model) = model {
             let k = Keys { entity: e, index };
-            let angle = k.float("_phong_angle")?.filter(|a| *a > 0.0);
-            if k.float("_phong")? == Some(1.0) || angle.is_some() {
-                out.phong
-                    .insert(model, angle.unwrap_or(DEFAULT_PHONG_ANGLE).min(180.0));
+            let keys = (k.float("_phong")?, k.float("_phong_angle")?);
+            if let Some(angle) = phong::angle_from_keys(keys.0, keys.1) {
+                out.phong.insert(model, angle);
             }
         }
     }
@@ -708,6 +715,9 @@ pub fn parse_lights(
             if k.float("_shadow")?.unwrap_or(0.0) == 1.0 {
                 out.shadow_models.push(model);
             }
+            if k.float_any(&["_shadowself", "_selfshadow"])? == Some(1.0) {
+                out.self_shadow_models.push(model);
+            }
             if let Some(o) = k.vec3("origin")? {
                 out.model_origins.insert(model, o);
             }
@@ -723,6 +733,7 @@ pub fn parse_lights(
                     model,
                     Minlight {
                         level,
+                        add: overrides.addmin,
                         color,
                         dirt: minlight_dirt,
                         exclude_texture: e.get("_minlight_exclude").map(str::to_string),

@@ -1,6 +1,7 @@
 //! `_phong` smoothing: shading normals that turn smoothly across the faces
-//! of one brush entity (worldspawn for the world), so a column made of flat
-//! faces is lit like a round one. Each face corner gets the mean of the
+//! of one brush entity (worldspawn for the world, or a `func_detail` /
+//! `func_group` the compiler recorded in the `SLIPGATE_PHONG` lump), so a
+//! column made of flat faces is lit like a round one. Each face corner gets the mean of the
 //! normals of the entity's faces that meet there and lie within the phong
 //! angle of the face, weighted by the angle each face spans at that corner.
 //! Inside a face the corner normals are blended with mean value
@@ -9,6 +10,7 @@
 
 use std::collections::HashMap;
 
+use quake_formats::bsp::phong::FacePhong;
 use quake_formats::geom::{Bounds, Vec3};
 
 use crate::faces::{FaceGeom, FaceKind};
@@ -54,15 +56,72 @@ fn angle_at(points: &[Vec3], normal: Vec3, plane_dist: f64, p: Vec3) -> Option<f
     inside.then_some(std::f64::consts::TAU)
 }
 
-/// Corner normals of every lit face whose brush model appears in `angles`
-/// (model index -> phong angle in degrees); `None` for the other faces.
-pub fn corner_normals(faces: &[FaceGeom], angles: &HashMap<usize, f64>) -> Vec<Option<Vec<Vec3>>> {
+/// Which faces smooth together.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PhongGroups {
+    /// Per face: its group (an index into `angles`), or `None`.
+    pub of_face: Vec<Option<usize>>,
+    /// Per group: its phong angle in degrees.
+    pub angles: Vec<f64>,
+}
+
+/// Where a group comes from: a brush model's (or worldspawn's) own keys, or
+/// a group the compiler recorded in the `SLIPGATE_PHONG` lump.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+enum GroupKey {
+    Model(usize),
+    Lump(u32),
+}
+
+/// The phong groups of the lit faces: a face the `lump` (one record per
+/// face, from the compiler) puts in a group smooths with that group;
+/// otherwise a face of a brush model in `model_angles` (model index ->
+/// angle in degrees; 0 = worldspawn) smooths with its model's faces.
+pub fn groups(
+    faces: &[FaceGeom],
+    model_angles: &HashMap<usize, f64>,
+    lump: Option<&[FacePhong]>,
+) -> PhongGroups {
+    let mut ids: HashMap<GroupKey, usize> = HashMap::new();
+    let mut out = PhongGroups {
+        of_face: vec![None; faces.len()],
+        angles: Vec::new(),
+    };
+    for f in faces {
+        if f.kind != FaceKind::Lit || f.points.len() < 3 {
+            continue;
+        }
+        let recorded = lump
+            .and_then(|l| l.get(f.index))
+            .filter(|r| r.group != 0)
+            .map(|r| (GroupKey::Lump(r.group), f64::from(r.angle)));
+        let own = || {
+            model_angles
+                .get(&f.model)
+                .map(|&a| (GroupKey::Model(f.model), a))
+        };
+        let Some((key, angle)) = recorded.or_else(own) else {
+            continue;
+        };
+        let id = *ids.entry(key).or_insert_with(|| {
+            out.angles.push(angle);
+            out.angles.len() - 1
+        });
+        out.of_face[f.index] = Some(id);
+    }
+    out
+}
+
+/// Corner normals of every face in a phong group; `None` for the others.
+pub fn corner_normals(faces: &[FaceGeom], groups: &PhongGroups) -> Vec<Option<Vec<Vec3>>> {
     let mut out: Vec<Option<Vec<Vec3>>> = vec![None; faces.len()];
-    for (&model, &angle) in angles {
-        let members: Vec<&FaceGeom> = faces
-            .iter()
-            .filter(|f| f.model == model && f.kind == FaceKind::Lit && f.points.len() >= 3)
-            .collect();
+    let mut members: Vec<Vec<&FaceGeom>> = vec![Vec::new(); groups.angles.len()];
+    for f in faces {
+        if let Some(Some(g)) = groups.of_face.get(f.index) {
+            members[*g].push(f);
+        }
+    }
+    for (members, &angle) in members.iter().zip(&groups.angles) {
         let mut grid: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
         for (m, f) in members.iter().enumerate() {
             let mut bounds = Bounds::EMPTY;
@@ -80,7 +139,7 @@ pub fn corner_normals(faces: &[FaceGeom], angles: &HashMap<usize, f64>) -> Vec<O
             }
         }
         let cos_limit = angle.to_radians().cos();
-        for f in &members {
+        for f in members {
             let normal = f.plane.normal;
             let corners = f
                 .points
@@ -188,10 +247,39 @@ mod tests {
     }
 
     #[test]
+    fn lump_groups_take_precedence_over_model_keys() {
+        let faces: Vec<FaceGeom> = (0..4)
+            .map(|index| FaceGeom {
+                index,
+                model: usize::from(index == 3),
+                ..square()
+            })
+            .collect();
+        let group = |g: u32, angle: f32| FacePhong { group: g, angle };
+        // Face 1 is in a compiler group; faces 0 and 2 follow worldspawn's
+        // `_phong`; face 3 belongs to model 1, which has no key.
+        let lump = [group(0, 0.0), group(7, 45.0), group(0, 0.0), group(0, 0.0)];
+        let world = HashMap::from([(0, 60.0)]);
+        let g = groups(&faces, &world, Some(&lump));
+        assert_eq!(g.of_face, vec![Some(0), Some(1), Some(0), None]);
+        assert_eq!(g.angles, vec![60.0, 45.0]);
+        let g = groups(&faces, &HashMap::new(), Some(&lump));
+        assert_eq!(g.of_face, vec![None, Some(0), None, None]);
+        assert_eq!(
+            groups(&faces, &HashMap::new(), None),
+            PhongGroups {
+                of_face: vec![None; 4],
+                angles: Vec::new(),
+            }
+        );
+    }
+
+    #[test]
     fn corners_of_a_lone_face_keep_its_normal() {
         let f = square();
         let angles = HashMap::from([(0, 89.0)]);
-        let normals = corner_normals(std::slice::from_ref(&f), &angles);
+        let groups = groups(std::slice::from_ref(&f), &angles, None);
+        let normals = corner_normals(std::slice::from_ref(&f), &groups);
         let c = normals[0].as_ref().expect("phong face");
         assert!(c.iter().all(|n| n.near(f.plane.normal, 1e-12)));
     }

@@ -19,6 +19,7 @@ use quake_formats::bsp::limits::LIGHTMAP_SCALE;
 use quake_formats::extents::LightmapExtents;
 use quake_formats::geom::{Plane, Vec3, Winding};
 
+use crate::embree::{RayPacket16, sys};
 use crate::faces::FaceGeom;
 use crate::scene::TraceScene;
 
@@ -45,6 +46,9 @@ pub struct FaceSamples {
     pub points: Vec<[f32; 3]>,
     /// Per-sample shading normals (`_phong`), or empty: the face normal everywhere.
     pub normals: Vec<[f32; 3]>,
+    /// Per sample: it is not where the texture grid puts it (moved onto the
+    /// face, pulled back into the open or onto the centre).
+    pub moved: Vec<bool>,
     /// Where the samples' texture coordinates land on the face.
     pub map: SurfaceMap,
 }
@@ -56,6 +60,25 @@ impl FaceSamples {
 
     pub fn per_luxel(&self) -> usize {
         self.per_axis * self.per_axis
+    }
+
+    /// Per sample, the first sample at exactly the same point (itself when
+    /// there is none): points moved onto the face often land together, on
+    /// an edge or a corner, and need their rays traced only once.
+    pub fn first_at_same_point(&self) -> Vec<usize> {
+        let mut first: Vec<usize> = (0..self.points.len()).collect();
+        // Points on the texture grid are all distinct: only moved ones can meet.
+        let mut moved: Vec<([u32; 3], usize)> = (0..self.points.len())
+            .filter(|&i| self.moved.get(i).copied().unwrap_or(true))
+            .map(|i| (self.points[i].map(f32::to_bits), i))
+            .collect();
+        moved.sort_unstable();
+        for pair in moved.windows(2) {
+            if pair[0].0 == pair[1].0 {
+                first[pair[1].1] = first[pair[0].1];
+            }
+        }
+        first
     }
 
     /// The normal the angle-of-incidence term uses at sample `i`.
@@ -306,14 +329,15 @@ pub fn face_samples(
     let centre = map.centre();
     let mut counts = PlacementCounts::default();
     let count = width * height * per_axis * per_axis;
-    let points = (0..count)
+    let (on_face, clamped): (Vec<Vec3>, Vec<bool>) = (0..count)
         .map(|i| {
             let [s, t] = map.sample_st(i);
-            let (p, clamped) = map.point(s, t);
-            counts.clamped += u64::from(clamped);
-            into_open(p, centre, face.model == 0, scene, bsp, &mut counts)
+            map.point(s, t)
         })
-        .collect();
+        .unzip();
+    counts.clamped += clamped.iter().filter(|&&c| c).count() as u64;
+    let (points, pulled) = into_open(&on_face, centre, face.model == 0, scene, bsp, &mut counts);
+    let moved = clamped.iter().zip(&pulled).map(|(&c, &p)| c || p).collect();
     (
         FaceSamples {
             face: face.index,
@@ -323,49 +347,72 @@ pub fn face_samples(
             normal: face.plane.normal,
             points,
             normals: Vec::new(),
+            moved,
             map,
         },
         counts,
     )
 }
 
-/// `p` if nothing stands between it and `centre`, else pulled back along
-/// that line to [`WALL_CLEARANCE`] in front of the obstacle; onto `centre`
-/// if it is still in a solid world leaf.
+/// Each of `points` if nothing stands between it and `centre`, else pulled
+/// back along that line to [`WALL_CLEARANCE`] in front of the obstacle;
+/// onto `centre` if it is still in a solid world leaf. Also says which
+/// moved. The rays all leave the centre, so they go 16 to a coherent packet.
 fn into_open(
-    p: Vec3,
+    points: &[Vec3],
     centre: Vec3,
     check_leaf: bool,
     scene: &TraceScene,
     bsp: &Bsp,
     counts: &mut PlacementCounts,
-) -> [f32; 3] {
+) -> (Vec<[f32; 3]>, Vec<bool>) {
     let c = centre.to_f32();
-    let d = p - centre;
-    let len = d.length();
-    let mut out = p.to_f32();
-    if len > 1e-3 {
-        let dir = (d / len).to_f32();
-        counts.rays += 1;
-        let reach = len as f32 + WALL_CLEARANCE;
-        if let Some(t) = scene.hit_distance(c, dir, reach) {
-            let keep = (t - WALL_CLEARANCE).clamp(0.0, len as f32);
-            out = [
+    let mut out: Vec<[f32; 3]> = points.iter().map(|p| p.to_f32()).collect();
+    let mut moved = vec![false; points.len()];
+    let away: Vec<usize> = (0..points.len())
+        .filter(|&i| (points[i] - centre).length() > 1e-3)
+        .collect();
+    let mut packet = RayPacket16::new();
+    for chunk in away.chunks(16) {
+        packet.clear();
+        let mut lens = [0.0f32; 16];
+        let mut dirs = [[0.0f32; 3]; 16];
+        for (lane, &i) in chunk.iter().enumerate() {
+            let d = points[i] - centre;
+            let len = d.length();
+            lens[lane] = len as f32;
+            dirs[lane] = (d / len).to_f32();
+            packet.set(lane, c, dirs[lane], 0.0, len as f32 + WALL_CLEARANCE);
+        }
+        counts.rays += u64::from(packet.active_mask().count_ones());
+        let ids = scene.scene.first_hit_geom16(&mut packet, true);
+        for (lane, &i) in chunk.iter().enumerate() {
+            if ids[lane] == sys::RTC_INVALID_GEOMETRY_ID {
+                continue;
+            }
+            let keep = (packet.tfar(lane) - WALL_CLEARANCE).clamp(0.0, lens[lane]);
+            let dir = dirs[lane];
+            out[i] = [
                 c[0] + dir[0] * keep,
                 c[1] + dir[1] * keep,
                 c[2] + dir[2] * keep,
             ];
+            moved[i] = true;
             counts.pulled_back += 1;
         }
     }
-    if check_leaf
-        && bsp
-            .leaf_at(out)
-            .and_then(|l| bsp.leafs.get(l))
-            .is_some_and(|l| l.contents == contents::SOLID)
-    {
-        counts.to_centre += 1;
-        return c;
+    if check_leaf {
+        for (p, m) in out.iter_mut().zip(&mut moved) {
+            let solid = bsp
+                .leaf_at(*p)
+                .and_then(|l| bsp.leafs.get(l))
+                .is_some_and(|l| l.contents == contents::SOLID);
+            if solid {
+                counts.to_centre += 1;
+                *p = c;
+                *m = true;
+            }
+        }
     }
-    out
+    (out, moved)
 }

@@ -1,6 +1,10 @@
 //! The Embree scene rays are traced against: every opaque face of the world
 //! and of shadow-casting brush models, plus the sky faces as a separate
 //! geometry so a ray can tell "reached the sky" from "hit a wall".
+//! A `_shadowself` model gets a small scene of its own, which only rays
+//! from that model's faces are tested against.
+
+use std::collections::HashMap;
 
 use crate::LightError;
 use crate::embree::{Device, RayPacket16, Scene, SceneBuilder, sys};
@@ -10,7 +14,9 @@ use crate::faces::{FaceGeom, FaceKind};
 pub struct TraceScene {
     pub scene: Scene,
     sky_geom: u32,
-    /// Triangles in the scene (opaque + sky).
+    /// Per `_shadowself` model (not already in `scene`): its own faces.
+    own: HashMap<usize, Scene>,
+    /// Triangles in the scene (opaque + sky) and the `_shadowself` scenes.
     pub triangles: usize,
 }
 
@@ -33,7 +39,9 @@ impl Mesh {
 
 impl TraceScene {
     /// Builds the scene from `faces`: world faces, and faces of the brush
-    /// models in `shadow_models`. Liquids are left out (they let light through).
+    /// models in `shadow_models`; each model in `self_shadow_models` that is
+    /// not also in `shadow_models` gets a scene of its own faces. Liquids are
+    /// left out (they let light through).
     ///
     /// # Errors
     /// The Embree error if building fails.
@@ -41,16 +49,29 @@ impl TraceScene {
         device: &Device,
         faces: &[FaceGeom],
         shadow_models: &[usize],
+        self_shadow_models: &[usize],
     ) -> Result<TraceScene, LightError> {
         let mut opaque = Mesh::default();
         let mut sky = Mesh::default();
+        let mut own_meshes: HashMap<usize, Mesh> = HashMap::new();
         for f in faces {
             let casts = f.model == 0 || shadow_models.contains(&f.model);
             match f.kind {
                 FaceKind::Lit if casts => opaque.add(f),
+                FaceKind::Lit if self_shadow_models.contains(&f.model) => {
+                    own_meshes.entry(f.model).or_default().add(f);
+                }
                 FaceKind::Sky if f.model == 0 => sky.add(f),
                 _ => {}
             }
+        }
+        let mut triangles = opaque.triangles.len() + sky.triangles.len();
+        let mut own = HashMap::with_capacity(own_meshes.len());
+        for (model, mesh) in own_meshes {
+            let mut builder = SceneBuilder::new(device)?;
+            builder.add_triangle_mesh(&mesh.vertices, &mesh.triangles)?;
+            triangles += mesh.triangles.len();
+            own.insert(model, builder.commit()?);
         }
         let mut builder = SceneBuilder::new(device)?;
         builder.add_triangle_mesh(&opaque.vertices, &opaque.triangles)?;
@@ -58,31 +79,56 @@ impl TraceScene {
         Ok(TraceScene {
             scene: builder.commit()?,
             sky_geom,
-            triangles: opaque.triangles.len() + sky.triangles.len(),
+            own,
+            triangles,
         })
     }
 
-    /// Bit `i` set if lane `i` of `packet` is blocked (sky blocks too).
-    pub fn occluded16(&self, packet: &mut RayPacket16) -> u16 {
-        self.scene.occluded16(packet, true)
+    /// Bit `i` set if lane `i` of `packet`, cast from a face of brush model
+    /// `model`, is blocked (sky blocks too).
+    pub fn occluded16(&self, packet: &mut RayPacket16, model: usize) -> u16 {
+        let blocked = self.scene.occluded16(packet, true);
+        // Embree sets tfar of blocked lanes to -inf, so the second query skips them.
+        blocked | self.own_occluded16(packet, model)
     }
 
-    /// Bit `i` set if lane `i` of `packet` reaches a sky face before anything else.
-    pub fn sees_sky16(&self, packet: &mut RayPacket16) -> u16 {
+    /// Lanes of `packet` (each up to its current `tfar`) that `model`'s own
+    /// scene blocks; 0 for a model without one.
+    fn own_occluded16(&self, packet: &mut RayPacket16, model: usize) -> u16 {
+        self.own
+            .get(&model)
+            .map_or(0, |own| own.occluded16(packet, true))
+    }
+
+    /// Bit `i` set if lane `i` of `packet`, cast from a face of `model`,
+    /// reaches a sky face before anything else.
+    pub fn sees_sky16(&self, packet: &mut RayPacket16, model: usize) -> u16 {
         let ids = self.scene.first_hit_geom16(packet, true);
-        (0..16)
+        let sky = (0..16)
             .filter(|&i| ids[i] == self.sky_geom && ids[i] != sys::RTC_INVALID_GEOMETRY_ID)
-            .fold(0, |m, i| m | (1 << i))
+            .fold(0, |m, i| m | (1 << i));
+        // tfar now ends at each lane's first hit: the model blocks the sky
+        // only if it lies nearer.
+        sky & !self.own_occluded16(packet, model)
     }
 
-    /// For each active lane of `packet`, the distance to the first surface
-    /// if that is an opaque one (not sky).
-    pub fn opaque_hits16(&self, packet: &mut RayPacket16) -> [Option<f32>; 16] {
+    /// For each active lane of `packet`, cast from a face of `model`, the
+    /// distance to the first surface if that is an opaque one (not sky).
+    pub fn opaque_hits16(&self, packet: &mut RayPacket16, model: usize) -> [Option<f32>; 16] {
         let ids = self.scene.first_hit_geom16(packet, true);
         let mut out = [None; 16];
         for (lane, id) in ids.iter().enumerate() {
             if *id != self.sky_geom && *id != sys::RTC_INVALID_GEOMETRY_ID {
                 out[lane] = Some(packet.tfar(lane));
+            }
+        }
+        if let Some(own) = self.own.get(&model) {
+            // tfar ends at the world hit, so any hit here is nearer.
+            let own_ids = own.first_hit_geom16(packet, true);
+            for (lane, id) in own_ids.iter().enumerate() {
+                if *id != sys::RTC_INVALID_GEOMETRY_ID {
+                    out[lane] = Some(packet.tfar(lane));
+                }
             }
         }
         out

@@ -101,54 +101,68 @@ fn mip(name: &str) -> MipTex {
 /// A BSP whose world model is `polys` (no nodes, leaves or vis: everything
 /// is in the open and visible) and whose entity lump is `entities`.
 fn synthetic_bsp(polys: &[Poly], entities: &str) -> Bsp {
+    synthetic_bsp_models(&[polys], entities)
+}
+
+/// Like [`synthetic_bsp`], with brush model `m` made of `models[m]`
+/// (model 0 is the world).
+fn synthetic_bsp_models(models: &[&[Poly]], entities: &str) -> Bsp {
     let mut bsp = Bsp::default();
     bsp.set_entity_text(entities);
     bsp.textures = TextureLump {
         textures: vec![Some(mip("wall")), Some(mip("sky1"))],
     };
     bsp.edges.push([0, 0]);
-    for p in polys {
-        let n = p.normal;
-        let dist = n[0] * p.points[0][0] + n[1] * p.points[0][1] + n[2] * p.points[0][2];
-        bsp.planes.push(BspPlane {
-            normal: n,
-            dist,
-            kind: 5,
-        });
-        bsp.texinfo.push(TexInfo {
-            vecs: axial_vecs(n),
-            miptex: u32::from(p.sky),
-            flags: if p.sky { texinfo_flags::SPECIAL } else { 0 },
-        });
-        let first_vertex = bsp.vertices.len() as u32;
-        let first_edge = bsp.surfedges.len() as u32;
-        bsp.vertices.extend(&p.points);
-        let count = p.points.len() as u32;
-        for i in 0..count {
-            bsp.surfedges.push(bsp.edges.len() as i32);
-            bsp.edges
-                .push([first_vertex + i, first_vertex + (i + 1) % count]);
+    for polys in models {
+        let first_face = bsp.faces.len() as u32;
+        for p in *polys {
+            add_poly(&mut bsp, p);
         }
-        bsp.faces.push(Face {
-            plane: bsp.planes.len() as u32 - 1,
-            side: 0,
-            first_edge,
-            num_edges: count,
-            texinfo: bsp.texinfo.len() as u32 - 1,
-            styles: [255; 4],
-            light_offset: -1,
+        bsp.models.push(Model {
+            mins: [-1e4; 3],
+            maxs: [1e4; 3],
+            origin: [0.0; 3],
+            head_nodes: [0; 4],
+            vis_leafs: 0,
+            first_face,
+            num_faces: bsp.faces.len() as u32 - first_face,
         });
     }
-    bsp.models.push(Model {
-        mins: [-1e4; 3],
-        maxs: [1e4; 3],
-        origin: [0.0; 3],
-        head_nodes: [0; 4],
-        vis_leafs: 0,
-        first_face: 0,
-        num_faces: bsp.faces.len() as u32,
-    });
     bsp
+}
+
+/// Appends `p` as a face with its own plane and axial texinfo.
+fn add_poly(bsp: &mut Bsp, p: &Poly) {
+    let n = p.normal;
+    let dist = n[0] * p.points[0][0] + n[1] * p.points[0][1] + n[2] * p.points[0][2];
+    bsp.planes.push(BspPlane {
+        normal: n,
+        dist,
+        kind: 5,
+    });
+    bsp.texinfo.push(TexInfo {
+        vecs: axial_vecs(n),
+        miptex: u32::from(p.sky),
+        flags: if p.sky { texinfo_flags::SPECIAL } else { 0 },
+    });
+    let first_vertex = bsp.vertices.len() as u32;
+    let first_edge = bsp.surfedges.len() as u32;
+    bsp.vertices.extend(&p.points);
+    let count = p.points.len() as u32;
+    for i in 0..count {
+        bsp.surfedges.push(bsp.edges.len() as i32);
+        bsp.edges
+            .push([first_vertex + i, first_vertex + (i + 1) % count]);
+    }
+    bsp.faces.push(Face {
+        plane: bsp.planes.len() as u32 - 1,
+        side: 0,
+        first_edge,
+        num_edges: count,
+        texinfo: bsp.texinfo.len() as u32 - 1,
+        styles: [255; 4],
+        light_offset: -1,
+    });
 }
 
 fn floor(size: f32) -> Poly {
@@ -224,7 +238,7 @@ fn samples_behind_a_wall_are_pulled_back_and_do_not_bleed() {
     let bsp = synthetic_bsp(&polys, ents);
     let faces = face_geometry(&bsp, |_| Vec3::ZERO).expect("faces");
     let device = crate::embree::Device::new(1).expect("device");
-    let scene = TraceScene::build(&device, &faces, &[]).expect("scene");
+    let scene = TraceScene::build(&device, &faces, &[], &[]).expect("scene");
     let (samples, counts) = face_samples(&faces[0], 1, &scene, &bsp);
     assert_eq!(samples.width, 8, "grid 0..112 has 8 luxels across");
     assert!(counts.clamped >= 8, "{counts:?}");
@@ -268,7 +282,7 @@ fn sample_points_invert_an_angled_projection() {
     bsp.texinfo[0].vecs = [[0.9, 0.1, 0.0, 5.5], [0.05, -0.7, -0.3, -3.25]];
     let faces = face_geometry(&bsp, |_| Vec3::ZERO).expect("faces");
     let device = crate::embree::Device::new(1).expect("device");
-    let scene = TraceScene::build(&device, &faces, &[]).expect("scene");
+    let scene = TraceScene::build(&device, &faces, &[], &[]).expect("scene");
     let (samples, _) = face_samples(&faces[0], 1, &scene, &bsp);
     let ext = faces[0].extents;
     assert_eq!([samples.width, samples.height], ext.luxel_size());
@@ -594,6 +608,7 @@ fn edge_jumps(world_keys: &str) -> Vec<f64> {
         gate: 0.001,
         sun_distance: prep.sun_distance,
         dirt: None,
+        adaptive: true,
     };
     // Value and position of every sample at mid height of each column face.
     let rows: Vec<Vec<(Vec3, f64)>> = (1..=8)
@@ -648,4 +663,282 @@ fn phong_smooths_a_column_without_facet_bands() {
     assert!(flat.iter().all(|&j| j > 30.0), "{flat:?}");
     // Smoothed: both sides of an edge use (nearly) the same normal there.
     assert!(smooth.iter().all(|&j| j < 8.0), "{smooth:?}");
+}
+
+/// Floor 0..256 (world) and brush model *1: a pedestal (x, y 96..160, up to
+/// z 64) under a wider slab (32..224, z 64..80), keyed `model_keys`. Light
+/// comes from high up on the +x side, from a constant light or (`sun`) a sun
+/// under a sky ceiling: the slab hides the pedestal's +x face (face 3) and
+/// the floor strip just beyond it.
+fn overhang_scene(model_keys: &str, sun: bool) -> Bsp {
+    let mut world = vec![floor(256.0)];
+    let mut model = box_faces([96.0, 96.0, 0.0], [160.0, 160.0, 64.0]);
+    model.extend(box_faces([32.0, 32.0, 64.0], [224.0, 224.0, 80.0]));
+    let (world_keys, light) = if sun {
+        let mut sky = quad(
+            [-512.0, -512.0, 512.0],
+            [768.0, -512.0, 512.0],
+            [768.0, 768.0, 512.0],
+            [-512.0, 768.0, 512.0],
+            [0.0, 0.0, -1.0],
+        );
+        sky.sky = true;
+        world.push(sky);
+        let keys = "\"_sunlight\" \"200\" \"_sun_mangle\" \"180 -57 0\" \"_anglescale\" \"0\"";
+        (keys, String::new())
+    } else {
+        let light = "{ \"classname\" \"light\" \"origin\" \"400 128 400\" \"light\" \"200\" \"delay\" \"3\" \"_anglescale\" \"0\" }\n";
+        ("", light.to_string())
+    };
+    let ents = format!(
+        "{{ \"classname\" \"worldspawn\" {world_keys} }}\n\
+         {{ \"classname\" \"func_wall\" \"model\" \"*1\" {model_keys} }}\n{light}"
+    );
+    synthetic_bsp_models(&[&world, &model], &ents)
+}
+
+/// The grey style-0 value of the luxel of `face` at texture coordinates
+/// `(s, t)` (the luxel whose centre grid point is nearest).
+fn luxel_at(bsp: &Bsp, lighting: &crate::Lighting, face: usize, s: f64, t: f64) -> u8 {
+    let faces = face_geometry(bsp, |_| Vec3::ZERO).expect("faces");
+    let mins = faces[face].extents.tex_mins;
+    let m = lighting
+        .lightmaps
+        .iter()
+        .find(|m| m.face == face)
+        .expect("lit face");
+    let col = ((s - f64::from(mins[0])) / 16.0).round() as usize;
+    let row = ((t - f64::from(mins[1])) / 16.0).round() as usize;
+    m.grey[0][row.min(m.height - 1) * m.width + col.min(m.width - 1)]
+}
+
+#[test]
+fn shadowself_shadows_the_model_but_not_the_floor() {
+    for sun in [false, true] {
+        let run = |keys: &str| {
+            let bsp = overhang_scene(keys, sun);
+            let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
+            // Floor at x 176, y 128 (s = x, t = -y); the pedestal's +x
+            // face (s = y, t = -z) at its middle.
+            let pedestal = bsp.models[1].first_face as usize + 2;
+            (
+                luxel_at(&bsp, &lighting, 0, 176.0, -128.0),
+                luxel_at(&bsp, &lighting, pedestal, 128.0, -32.0),
+            )
+        };
+        let (floor, pedestal) = run("");
+        assert_eq!(
+            (floor, pedestal),
+            (100, 100),
+            "sun {sun}: no shadows from the model"
+        );
+        let (floor, pedestal) = run("\"_shadow\" \"1\"");
+        assert_eq!(
+            (floor, pedestal),
+            (0, 0),
+            "sun {sun}: the model shadows everything"
+        );
+        for key in ["_shadowself", "_selfshadow"] {
+            let (floor, pedestal) = run(&format!("\"{key}\" \"1\""));
+            assert_eq!(
+                (floor, pedestal),
+                (100, 0),
+                "sun {sun}, {key}: only its own faces"
+            );
+        }
+    }
+}
+
+#[test]
+fn addmin_adds_minlight_instead_of_raising_to_it() {
+    // Worldspawn minlight 40 (20 in bytes) under a light that gives 100.
+    let bsp = corner_scene("\"light\" \"40\"", "");
+    let floor = floor_row(&bsp, &options(Quality::Default), 8);
+    assert!(floor.iter().all(|&v| v == 100), "floor: {floor:?}");
+    let mut add = options(Quality::Default);
+    add.overrides.addmin = true;
+    let added = floor_row(&bsp, &add, 8);
+    assert!(added.iter().all(|&v| v == 120), "added: {added:?}");
+    // Where no light reaches, both give the minlight itself.
+    let dark = corner_scene("\"light\" \"40\"", "\"_nostaticlight\" \"1\"");
+    assert_eq!(
+        floor_row(&dark, &add, 8),
+        floor_row(&dark, &options(Quality::Default), 8)
+    );
+    assert!(floor_row(&dark, &add, 8).iter().all(|&v| v == 20));
+}
+
+#[test]
+fn dirt_cone_follows_the_phong_normal() {
+    // The floor of the corner scene: the wall stands at x = 192.
+    let bsp = corner_scene("", "");
+    let prep = crate::prepare(&bsp, &Options::default()).expect("prepare");
+    let (mut samples, _) = face_samples(&prep.faces[0], 1, &prep.scene, &bsp);
+    let sampling = crate::lights::DirtSampling::default();
+    let occlusion = |samples: &crate::samples::FaceSamples| {
+        crate::dirt::occlusion(samples, 0, &sampling, &prep.scene).0
+    };
+    let flat = occlusion(&samples);
+    let tilted = |x: f64| Vec3::new(x, 0.0, 1.0).normalized().expect("unit").to_f32();
+    // Normals leaning 45 degrees toward the wall, then away from it.
+    samples.normals = vec![tilted(1.0); samples.points.len()];
+    let toward = occlusion(&samples);
+    samples.normals = vec![tilted(-1.0); samples.points.len()];
+    let away = occlusion(&samples);
+    let near_wall = |values: &[f32]| {
+        let (i, _) = samples
+            .points
+            .iter()
+            .enumerate()
+            .find(|(_, p)| (p[1] - 128.0).abs() < 8.0 && (p[0] - 160.0).abs() < 8.0)
+            .expect("a sample near the wall");
+        values[i]
+    };
+    assert!(
+        near_wall(&toward) > near_wall(&flat) + 0.05 && near_wall(&flat) > near_wall(&away) + 0.05,
+        "toward {} flat {} away {}",
+        near_wall(&toward),
+        near_wall(&flat),
+        near_wall(&away)
+    );
+    // Far from the wall nothing occludes, even for cones that lean into
+    // the floor (those rays are folded back above it).
+    for values in [&flat, &toward, &away] {
+        for (p, v) in samples.points.iter().zip(values.iter()) {
+            if p[0] < 48.0 && (16.0..240.0).contains(&p[1]) {
+                assert_eq!(*v, 0.0, "at {p:?}");
+            }
+        }
+    }
+}
+
+/// A `.map` brush from planes given as three points each (Quake's order:
+/// the normal is `(a - b) × (c - b)`, pointing out of the brush).
+fn map_brush(planes: &[[[f64; 3]; 3]]) -> String {
+    let mut s = String::from("{\n");
+    for plane in planes {
+        for p in plane {
+            s += &format!("( {} {} {} ) ", p[0], p[1], p[2]);
+        }
+        s += "wall 0 0 0 1 1\n";
+    }
+    s + "}\n"
+}
+
+/// The axis-aligned box `lo..hi` as a `.map` brush.
+fn map_box(lo: [f64; 3], hi: [f64; 3]) -> String {
+    let ([x0, y0, z0], [x1, y1, z1]) = (lo, hi);
+    map_brush(&[
+        [[x1, y0, z0], [x1, y0, z1], [x1, y1, z0]],
+        [[x0, y0, z0], [x0, y1, z0], [x0, y0, z1]],
+        [[x0, y1, z0], [x1, y1, z0], [x0, y1, z1]],
+        [[x0, y0, z0], [x0, y0, z1], [x1, y0, z0]],
+        [[x0, y0, z1], [x0, y1, z1], [x1, y0, z1]],
+        [[x0, y0, z0], [x1, y0, z0], [x0, y1, z0]],
+    ])
+}
+
+/// A sealed room (inside -128..128) with an octagonal `func_detail` column
+/// (about 48 units in radius, from the floor up to z 0) keyed `detail_keys`,
+/// compiled by the bsp compiler.
+fn detail_column_bsp(detail_keys: &str) -> Bsp {
+    let (lo, hi, t) = (-128.0, 128.0, 16.0);
+    let (a, b) = (lo - t, hi + t);
+    let mut world = String::new();
+    for (l, h) in [
+        ([a, a, a], [b, b, lo]),
+        ([a, a, hi], [b, b, b]),
+        ([a, a, lo], [lo, b, hi]),
+        ([hi, a, lo], [b, b, hi]),
+        ([lo, a, lo], [hi, lo, hi]),
+        ([lo, hi, lo], [hi, b, hi]),
+    ] {
+        world += &map_box(l, h);
+    }
+    // Counter-clockwise seen from above.
+    let ring = [
+        [48.0, -20.0],
+        [48.0, 20.0],
+        [20.0, 48.0],
+        [-20.0, 48.0],
+        [-48.0, 20.0],
+        [-48.0, -20.0],
+        [-20.0, -48.0],
+        [20.0, -48.0],
+    ];
+    let mut planes: Vec<[[f64; 3]; 3]> = (0..8)
+        .map(|k| {
+            let ([px, py], [qx, qy]) = (ring[k], ring[(k + 1) % 8]);
+            [[qx, qy, lo], [px, py, lo], [px, py, 0.0]]
+        })
+        .collect();
+    planes.push([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]);
+    planes.push([[0.0, 0.0, lo], [1.0, 0.0, lo], [0.0, 1.0, lo]]);
+    let text = format!(
+        "{{\n\"classname\" \"worldspawn\"\n{world}}}\n\
+         {{\n\"classname\" \"func_detail\"\n{detail_keys}\n{}}}\n\
+         {{\n\"classname\" \"light\"\n\"origin\" \"100 20 -40\"\n}}\n\
+         {{\n\"classname\" \"info_player_start\"\n\"origin\" \"-90 -90 -100\"\n}}\n",
+        map_brush(&planes)
+    );
+    let source = bsp_compiler::MapSource {
+        path: std::path::PathBuf::from("detail_column.map"),
+        text,
+    };
+    let out =
+        bsp_compiler::compile(&source, &bsp_compiler::CompileOptions::default()).expect("compile");
+    assert!(out.leak.is_none(), "the room leaks");
+    out.bsp
+}
+
+#[test]
+fn phong_on_func_detail_reaches_light_through_the_bsp() {
+    // The column's side faces: vertical, near the axis (the room's walls are 128 out).
+    let column_sides = |prep: &crate::Prepared| -> Vec<usize> {
+        prep.faces
+            .iter()
+            .filter(|f| f.plane.normal.z.abs() < 0.1)
+            .filter(|f| (f.centroid() - Vec3::new(0.0, 0.0, f.centroid().z)).length() < 60.0)
+            .map(|f| f.index)
+            .collect()
+    };
+
+    let plain = detail_column_bsp("");
+    assert_eq!(plain.phong_faces().expect("lump"), None);
+    let prep = crate::prepare(&plain, &Options::default()).expect("prepare");
+    assert_eq!(column_sides(&prep).len(), 8);
+    assert!(
+        prep.phong.iter().all(Option::is_none),
+        "no key, no smoothing"
+    );
+
+    let smooth = detail_column_bsp("\"_phong\" \"1\"");
+    let lump = smooth
+        .phong_faces()
+        .expect("lump")
+        .expect("phong lump written");
+    let prep = crate::prepare(&smooth, &Options::default()).expect("prepare");
+    let sides = column_sides(&prep);
+    assert_eq!(sides.len(), 8);
+    let group = lump[sides[0]].group;
+    for &f in &sides {
+        assert_eq!(lump[f].group, group, "one group for the whole column");
+        assert_eq!(lump[f].angle, 89.0);
+        let corners = prep.phong[f].as_ref().expect("smoothed");
+        let normal = prep.faces[f].plane.normal;
+        // At each vertical edge the normal is halfway to the neighbour's,
+        // 45 / 2 degrees off this face's.
+        let tilted = corners
+            .iter()
+            .filter(|c| (c.dot(normal) - 22.5f64.to_radians().cos()).abs() < 1e-3)
+            .count();
+        assert!(tilted >= 4, "face {f}: {corners:?}");
+    }
+    // The world's faces are in no group; the column's top is in the column's.
+    for f in prep.faces.iter().filter(|f| !sides.contains(&f.index)) {
+        let column_top = f.plane.normal.z > 0.9 && f.centroid().z.abs() < 1.0;
+        let want = if column_top { group } else { 0 };
+        assert_eq!(lump[f.index].group, want, "face {}", f.index);
+    }
+    compute_lighting(&smooth, &options(Quality::Default)).expect("light");
 }

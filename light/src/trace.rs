@@ -9,7 +9,7 @@ use crate::dirt;
 use crate::embree::RayPacket16;
 use crate::faces::FaceGeom;
 use crate::lights::{
-    DirtResponse, DirtSampling, Falloff, Minlight, PointLight, SunLight, angle_factor,
+    DirtMode, DirtResponse, DirtSampling, Falloff, Minlight, PointLight, SunLight, angle_factor,
 };
 use crate::samples::FaceSamples;
 use crate::scene::TraceScene;
@@ -65,6 +65,7 @@ fn footprint_light(
     counts: &mut TraceCounts,
 ) -> f64 {
     let normal = samples.normal_at(i);
+    let model = setup.faces[samples.face].model;
     let in_solid = |q: Vec3| {
         setup
             .bsp
@@ -92,7 +93,7 @@ fn footprint_light(
         }
         let active = packet.active_mask();
         counts.shadow_rays += u64::from(active.count_ones());
-        let lit = active & !setup.scene.occluded16(packet);
+        let lit = active & !setup.scene.occluded16(packet, model);
         sum += (0..16)
             .filter(|l| lit & (1 << l) != 0)
             .map(|l| lane_value[l])
@@ -120,6 +121,9 @@ pub struct TraceSetup<'a> {
     pub sun_distance: f32,
     /// How to measure dirt; `None` when no light, sun or minlight takes dirt.
     pub dirt: Option<DirtSampling>,
+    /// Supersampled faces trace sub-samples only where luxels disagree
+    /// (see [`VisibilityScratch::trace`]); off for the reference.
+    pub adaptive: bool,
 }
 
 /// What one face takes from the lights (set per brush model).
@@ -210,11 +214,290 @@ fn box_distance(b: &Bounds, p: Vec3) -> f64 {
     d2.sqrt()
 }
 
-/// The dirt factor of `response` at sample `i` (1 without occlusion data).
-fn dirt_factor(response: Option<DirtResponse>, occlusion: &[f32], i: usize) -> f64 {
-    match (response, occlusion.get(i)) {
-        (Some(r), Some(&occ)) => r.factor(f64::from(occ)),
-        _ => 1.0,
+/// Occlusion may be interpolated between grid points that differ by at
+/// most this much (a light's dirt factor then moves by about as much).
+const DIRT_SMOOTH: f32 = 0.05;
+
+/// Dirt occlusion of every sample of a face (see [`dirt::occlusion`]) and
+/// the rays cast. With `adaptive`, it is measured on a coarse grid (every
+/// `stride`-th sample along each axis of the face's sample grid: one per
+/// luxel when supersampling, every other luxel otherwise) and at every moved
+/// sample; a sample between four grid points that differ by at most
+/// [`DIRT_SMOOTH`] (none of them moved) takes their bilinear mean, the
+/// others (corners, edges of objects) are measured.
+fn face_occlusion(
+    setup: &TraceSetup,
+    samples: &FaceSamples,
+    model: usize,
+    sampling: &DirtSampling,
+    adaptive: bool,
+    first_at: &[usize],
+) -> (Vec<f32>, u64) {
+    let n = samples.points.len();
+    // Ordered dirt rays depend only on the point: samples at one point share them.
+    let same_rays = sampling.mode == DirtMode::Ordered;
+    let measure = |indices: &[usize]| {
+        if !same_rays {
+            return dirt::occlusion_at(samples, indices, model, sampling, setup.scene);
+        }
+        let mut unique: Vec<usize> = indices.iter().map(|&i| first_at[i]).collect();
+        unique.sort_unstable();
+        unique.dedup();
+        let (values, rays) = dirt::occlusion_at(samples, &unique, model, sampling, setup.scene);
+        let value_of = |i: usize| unique.binary_search(&first_at[i]).map_or(0.0, |k| values[k]);
+        (indices.iter().map(|&i| value_of(i)).collect(), rays)
+    };
+    if !adaptive {
+        return measure(&(0..n).collect::<Vec<_>>());
+    }
+    let axis = samples.per_axis;
+    let stride = axis.max(2);
+    let (gw, gh) = (samples.width * axis, samples.height * axis);
+    // Sample index of grid position (gx, gy).
+    let index = |gx: usize, gy: usize| {
+        ((gy / axis) * samples.width + gx / axis) * axis * axis + (gy % axis) * axis + gx % axis
+    };
+    let mut known: Vec<Option<f32>> = vec![None; n];
+    let mut first: Vec<usize> = (0..gh)
+        .flat_map(|gy| (0..gw).map(move |gx| (gx, gy)))
+        .filter(|&(gx, gy)| gx % stride == 0 && gy % stride == 0)
+        .map(|(gx, gy)| index(gx, gy))
+        .collect();
+    first.extend((0..n).filter(|&i| samples.moved[i]));
+    first.sort_unstable();
+    first.dedup();
+    let (values, mut rays) = measure(&first);
+    for (&i, v) in first.iter().zip(values) {
+        known[i] = Some(v);
+    }
+    let mut rest = Vec::new();
+    for gy in 0..gh {
+        for gx in 0..gw {
+            let i = index(gx, gy);
+            if known[i].is_some() {
+                continue;
+            }
+            let (x0, y0) = (gx / stride * stride, gy / stride * stride);
+            let (x1, y1) = (x0 + stride, y0 + stride);
+            let corners = (x1 < gw && y1 < gh).then(|| {
+                [(x0, y0), (x1, y0), (x0, y1), (x1, y1)].map(|(x, y)| {
+                    let c = index(x, y);
+                    known[c].filter(|_| !samples.moved[c])
+                })
+            });
+            let Some([Some(a), Some(b), Some(c), Some(d)]) = corners else {
+                rest.push(i);
+                continue;
+            };
+            let (lo, hi) = (a.min(b).min(c).min(d), a.max(b).max(c).max(d));
+            if hi - lo > DIRT_SMOOTH {
+                rest.push(i);
+                continue;
+            }
+            let fx = (gx - x0) as f32 / stride as f32;
+            let fy = (gy - y0) as f32 / stride as f32;
+            let top = a + (b - a) * fx;
+            let bottom = c + (d - c) * fx;
+            known[i] = Some(top + (bottom - top) * fy);
+        }
+    }
+    let (values, more) = measure(&rest);
+    rays += more;
+    for (&i, v) in rest.iter().zip(values) {
+        known[i] = Some(v);
+    }
+    (known.into_iter().map(|v| v.unwrap_or(0.0)).collect(), rays)
+}
+
+/// Dirt factors per sample, computed once per distinct [`DirtResponse`]
+/// (a face sees few of them; `powf` per sample and light is not cheap).
+struct DirtFactors<'a> {
+    occlusion: &'a [f32],
+    computed: Vec<(DirtResponse, Vec<f32>)>,
+}
+
+impl<'a> DirtFactors<'a> {
+    /// `occlusion` per sample, or empty when the face takes no dirt.
+    fn new(occlusion: &'a [f32], samples: usize) -> DirtFactors<'a> {
+        let occlusion = if occlusion.len() == samples {
+            occlusion
+        } else {
+            &[]
+        };
+        DirtFactors {
+            occlusion,
+            computed: Vec::new(),
+        }
+    }
+
+    /// The factor per sample for `response`; `None` means 1 everywhere.
+    fn get(&mut self, response: Option<DirtResponse>) -> Option<&[f32]> {
+        let r = response.filter(|_| !self.occlusion.is_empty())?;
+        let k = match self.computed.iter().position(|(c, _)| *c == r) {
+            Some(k) => k,
+            None => {
+                let f = self
+                    .occlusion
+                    .iter()
+                    .map(|&o| r.factor(f64::from(o)) as f32)
+                    .collect();
+                self.computed.push((r, f));
+                self.computed.len() - 1
+            }
+        };
+        Some(&self.computed[k].1)
+    }
+}
+
+/// What a luxel's probe ray (one sub-sample per luxel) found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Probe {
+    /// The probe sample takes nothing from this light (gated, close, off the cone).
+    Missing,
+    Reaches,
+    Blocked,
+}
+
+/// Buffers for [`VisibilityScratch::trace`], reused across a face's lights.
+#[derive(Debug)]
+struct VisibilityScratch {
+    /// Per sample: its ray reaches the light (meaningful where `value != 0`).
+    lit: Vec<bool>,
+    /// Per sample: the first sample at the same point, whose ray stands for both.
+    first_at: Vec<usize>,
+    /// Per sample: its ray was traced for the current light.
+    traced: Vec<bool>,
+    todo: Vec<usize>,
+    unique: Vec<usize>,
+    probes: Vec<Probe>,
+}
+
+impl VisibilityScratch {
+    fn new(first_at: Vec<usize>) -> VisibilityScratch {
+        VisibilityScratch {
+            lit: Vec::new(),
+            first_at,
+            traced: Vec::new(),
+            todo: Vec::new(),
+            unique: Vec::new(),
+            probes: Vec::new(),
+        }
+    }
+
+    /// Fills `lit` for every sample with a non-zero `value`; returns the
+    /// rays cast. `ray(i)` is sample `i`'s (origin, direction, length) and
+    /// `reaches` the lanes of a packet whose rays get through.
+    ///
+    /// `adaptive` (supersampled faces only): first one probe ray per luxel;
+    /// a luxel whose probe agrees with the probes of all 8 neighbours takes
+    /// that answer for all its sub-samples, the others (penumbrae, shadow
+    /// edges, spots where a probe had no ray) trace every sub-sample. A
+    /// straight shadow edge through a luxel always separates its probe from
+    /// a neighbour's; only shadows thinner than a luxel can slip between.
+    /// Moved samples (see [`FaceSamples::moved`]) are always traced.
+    fn trace(
+        &mut self,
+        samples: &FaceSamples,
+        adaptive: bool,
+        value: &[f64],
+        ray: impl Fn(usize) -> ([f32; 3], [f32; 3], f32),
+        packet: &mut RayPacket16,
+        mut reaches: impl FnMut(&mut RayPacket16) -> u16,
+    ) -> u64 {
+        let n = value.len();
+        self.lit.clear();
+        self.lit.resize(n, false);
+        self.traced.clear();
+        self.traced.resize(n, false);
+        self.todo.clear();
+        let per = samples.per_luxel();
+        if !adaptive || per == 1 {
+            self.todo.extend((0..n).filter(|&i| value[i] != 0.0));
+            return self.cast(&ray, packet, &mut reaches);
+        }
+        let axis = samples.per_axis;
+        let probe_sub = (axis / 2) * axis + axis / 2;
+        let luxels = samples.luxels();
+        self.todo.extend(
+            (0..luxels)
+                .map(|l| l * per + probe_sub)
+                .filter(|&i| value[i] != 0.0),
+        );
+        let mut rays = self.cast(&ray, packet, &mut reaches);
+        self.probes.clear();
+        self.probes.extend((0..luxels).map(|l| {
+            let i = l * per + probe_sub;
+            match (value[i] != 0.0, self.lit[i]) {
+                (false, _) => Probe::Missing,
+                (true, true) => Probe::Reaches,
+                (true, false) => Probe::Blocked,
+            }
+        }));
+        self.todo.clear();
+        let (w, h) = (samples.width, samples.height);
+        for l in 0..luxels {
+            let (x, y) = (l % w, l / w);
+            let probe = self.probes[l];
+            let uniform = !samples.moved[l * per + probe_sub]
+                && probe != Probe::Missing
+                && (y.saturating_sub(1)..(y + 2).min(h)).all(|ny| {
+                    (x.saturating_sub(1)..(x + 2).min(w))
+                        .all(|nx| self.probes[ny * w + nx] == probe)
+                });
+            for i in l * per..(l + 1) * per {
+                if value[i] == 0.0 || i == l * per + probe_sub {
+                    continue;
+                }
+                // Moved points (the luxel overhangs the face, or something
+                // rests on it) are off the grid the neighbour test assumes.
+                if uniform && !samples.moved[i] {
+                    self.lit[i] = probe == Probe::Reaches;
+                } else {
+                    self.todo.push(i);
+                }
+            }
+        }
+        rays += self.cast(&ray, packet, &mut reaches);
+        rays
+    }
+
+    /// Traces the samples in `todo`, 16 to a packet, into `lit`; a sample
+    /// at the same point as one already traced takes its answer.
+    fn cast(
+        &mut self,
+        ray: &impl Fn(usize) -> ([f32; 3], [f32; 3], f32),
+        packet: &mut RayPacket16,
+        reaches: &mut impl FnMut(&mut RayPacket16) -> u16,
+    ) -> u64 {
+        self.unique.clear();
+        for &i in &self.todo {
+            let first = self.first_at[i];
+            if !self.traced[first] {
+                self.traced[first] = true;
+                self.unique.push(first);
+            }
+        }
+        let mut rays = 0;
+        for chunk in self.unique.chunks(16) {
+            packet.clear();
+            for (lane, &i) in chunk.iter().enumerate() {
+                let (org, dir, reach) = ray(i);
+                packet.set(lane, org, dir, 0.0, reach);
+            }
+            let active = packet.active_mask();
+            if active == 0 {
+                continue;
+            }
+            rays += u64::from(active.count_ones());
+            let through = active & reaches(packet);
+            for (lane, &i) in chunk.iter().enumerate() {
+                self.lit[i] = through & (1 << lane) != 0;
+            }
+        }
+        for &i in &self.todo {
+            self.lit[i] = self.lit[self.first_at[i]];
+        }
+        rays
     }
 }
 
@@ -252,15 +535,11 @@ pub fn light_face(
     for &p in &samples.points {
         bounds.add_point(Vec3::from_f32(p));
     }
+    let first_at = samples.first_at_same_point();
     let occlusion = match setup.dirt.filter(|_| rules.dirt) {
         Some(sampling) => {
-            let (values, rays) = dirt::occlusion(
-                &samples.points,
-                samples.normal,
-                face.index,
-                &sampling,
-                setup.scene,
-            );
+            let (values, rays) =
+                face_occlusion(setup, samples, face.model, &sampling, setup.adaptive, &first_at);
             counts.dirt_rays += rays;
             values
         }
@@ -278,7 +557,9 @@ pub fn light_face(
     };
 
     let mut packet = RayPacket16::new();
-    let mut lane_value = [0.0f64; 16];
+    let mut dirt_factors = DirtFactors::new(&occlusion, n);
+    let mut scratch = VisibilityScratch::new(first_at);
+    let mut value = vec![0.0f64; n];
     let radius = samples.map.footprint_radius();
     let max_cells = 16 / samples.per_axis.min(16);
     // Samples so close to the current light that it is averaged over their squares.
@@ -294,44 +575,44 @@ pub fn light_face(
             continue;
         }
         near.clear();
-        for (chunk_index, chunk) in samples.points.chunks(16).enumerate() {
-            let base = chunk_index * 16;
-            packet.clear();
-            for (lane, &p) in chunk.iter().enumerate() {
-                let to_light = sub(light.origin, p);
-                let dist = to_light.length();
-                let Some(dir) = to_light.normalized() else {
-                    continue;
-                };
-                let normal = samples.normal_at(base + lane);
-                let dirt = dirt_factor(light.dirt, &occlusion, base + lane);
-                let cells = footprint_cells(to_light, samples.normal, radius, max_cells);
-                if cells > 1 {
-                    // Traced on its own below, point by point over the square.
-                    near.push((base + lane, cells));
-                    continue;
-                }
-                let value = light.contribution(dist, -dir, normal.dot(dir)) * dirt;
-                if value.abs() < setup.gate {
-                    continue;
-                }
-                lane_value[lane] = value;
-                let reach = (dist as f32 - LIGHT_CLEARANCE).max(0.0);
-                packet.set(lane, p, dir.to_f32(), 0.0, reach);
-            }
-            let active = packet.active_mask();
-            if active == 0 {
+        let dirt = dirt_factors.get(light.dirt);
+        for (i, &p) in samples.points.iter().enumerate() {
+            value[i] = 0.0;
+            let to_light = sub(light.origin, p);
+            let Some(dir) = to_light.normalized() else {
+                continue;
+            };
+            let cells = footprint_cells(to_light, samples.normal, radius, max_cells);
+            if cells > 1 {
+                // Traced on its own below, point by point over the square.
+                near.push((i, cells));
                 continue;
             }
-            counts.shadow_rays += u64::from(active.count_ones());
-            let lit = active & !setup.scene.occluded16(&mut packet);
-            for lane in (0..16).filter(|l| lit & (1 << l) != 0) {
-                deposit(light, lane_value[lane], base + lane, &mut sums, &mut floors);
+            let v = light.contribution(to_light.length(), -dir, samples.normal_at(i).dot(dir))
+                * dirt.map_or(1.0, |d| f64::from(d[i]));
+            if v.abs() >= setup.gate {
+                value[i] = v;
+            }
+        }
+        let ray = |i: usize| {
+            let p = samples.points[i];
+            let to_light = sub(light.origin, p);
+            let dist = to_light.length();
+            let dir = (to_light / dist).to_f32();
+            (p, dir, (dist as f32 - LIGHT_CLEARANCE).max(0.0))
+        };
+        counts.shadow_rays +=
+            scratch.trace(samples, setup.adaptive, &value, ray, &mut packet, |p| {
+                !setup.scene.occluded16(p, face.model)
+            });
+        for (i, &v) in value.iter().enumerate() {
+            if scratch.lit[i] {
+                deposit(light, v, i, &mut sums, &mut floors);
             }
         }
         for &(i, cells) in &near {
             let v = footprint_light(setup, samples, i, cells, light, &mut packet, &mut counts)
-                * dirt_factor(light.dirt, &occlusion, i);
+                * dirt.map_or(1.0, |d| f64::from(d[i]));
             deposit(light, v, i, &mut sums, &mut floors);
         }
     }
@@ -339,30 +620,25 @@ pub fn light_face(
     if !setup.cull || setup.vis.may_see_sky(face.index) {
         for sun in suns {
             let dir = sun.to_sun.to_f32();
+            let dirt = dirt_factors.get(sun.dirt);
+            for (i, v) in value.iter_mut().enumerate() {
+                let cos = samples.normal_at(i).dot(sun.to_sun);
+                *v = sun.light
+                    * angle_factor(cos, sun.anglescale)
+                    * dirt.map_or(1.0, |d| f64::from(d[i]));
+                if v.abs() < setup.gate {
+                    *v = 0.0;
+                }
+            }
+            let ray = |i: usize| (samples.points[i], dir, setup.sun_distance);
+            counts.sun_rays +=
+                scratch.trace(samples, setup.adaptive, &value, ray, &mut packet, |p| {
+                    setup.scene.sees_sky16(p, face.model)
+                });
             let target = sums.get(sun.style);
-            for (chunk_index, chunk) in samples.points.chunks(16).enumerate() {
-                let base = chunk_index * 16;
-                packet.clear();
-                for (lane, &p) in chunk.iter().enumerate() {
-                    let cos = samples.normal_at(base + lane).dot(sun.to_sun);
-                    let value = sun.light
-                        * angle_factor(cos, sun.anglescale)
-                        * dirt_factor(sun.dirt, &occlusion, base + lane);
-                    if value.abs() < setup.gate {
-                        continue;
-                    }
-                    lane_value[lane] = value;
-                    packet.set(lane, p, dir, 0.0, setup.sun_distance);
-                }
-                let active = packet.active_mask();
-                if active == 0 {
-                    continue;
-                }
-                counts.sun_rays += u64::from(active.count_ones());
-                let lit = setup.scene.sees_sky16(&mut packet);
-                for lane in (0..16).filter(|l| lit & (1 << l) != 0) {
-                    let v = lane_value[lane];
-                    for (out, c) in target[base + lane].iter_mut().zip(sun.color.to_array()) {
+            for (i, &v) in value.iter().enumerate() {
+                if scratch.lit[i] {
+                    for (out, c) in target[i].iter_mut().zip(sun.color.to_array()) {
                         *out += (v * c) as f32;
                     }
                 }
@@ -371,11 +647,14 @@ pub fn light_face(
     }
 
     if let Some(m) = rules.minlight {
-        let floor = floors.get(0);
-        for (i, f) in floor.iter_mut().enumerate() {
-            let level = m.level * dirt_factor(m.dirt, &occlusion, i);
+        // `--addmin` adds the level to the light; otherwise it is a floor.
+        let target = if m.add { sums.get(0) } else { floors.get(0) };
+        let dirt = dirt_factors.get(m.dirt);
+        for (i, f) in target.iter_mut().enumerate() {
+            let level = m.level * dirt.map_or(1.0, |d| f64::from(d[i]));
             for (out, c) in f.iter_mut().zip(m.color.to_array()) {
-                *out = out.max((level * c) as f32);
+                let value = (level * c) as f32;
+                *out = if m.add { *out + value } else { out.max(value) };
             }
         }
     }

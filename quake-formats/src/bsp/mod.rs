@@ -2,9 +2,11 @@
 //!
 //! The model stores every index as `u32`/`i32` and every bound as `f32`, wide enough for both
 //! versions. Each record type knows its encoding per version ([`Record`]); lumps are read and
-//! written by one generic pair of functions. Trailing BSPX lumps are kept as named byte blobs.
+//! written by one generic pair of functions. Trailing BSPX lumps are kept as named byte blobs;
+//! [`phong`] reads and writes Slipgate's own one.
 
 pub mod limits;
+pub mod phong;
 mod records;
 mod validate;
 
