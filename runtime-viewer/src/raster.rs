@@ -3,6 +3,7 @@
 
 use crate::camera::{ScreenLinear, View};
 use crate::edges::Span;
+use crate::surface_cache::LitSurface;
 use crate::world::Surface;
 
 /// Texture coordinates over the screen for one surface: u/z, v/z and 1/z are screen-linear.
@@ -50,6 +51,25 @@ impl TexMapping {
             u_limit: fixed_limit(size.0),
             v_limit: fixed_limit(size.1),
         }
+    }
+
+    /// The mapping onto a surface-cache entry built at `mip` (its texel (0, 0) is `tex_mins`).
+    pub fn onto_lit_surface(
+        view: &View,
+        surface: &Surface,
+        inverse_depth: ScreenLinear,
+        mip: usize,
+        lit: &LitSurface,
+    ) -> TexMapping {
+        let base = surface.extents.tex_mins;
+        TexMapping::new(
+            view,
+            surface,
+            inverse_depth,
+            base,
+            mip,
+            (lit.width, lit.height),
+        )
     }
 
     /// Exact (u, v) in 16.16 fixed point at the centre of pixel (x, y), clamped to the source.

@@ -226,14 +226,8 @@ impl Renderer {
                     let Some(lit) = self.cache.get(world, ss.face, mip, &self.styles) else {
                         continue;
                     };
-                    let map = TexMapping::new(
-                        view,
-                        surface,
-                        ss.inverse_depth,
-                        surface.extents.tex_mins,
-                        mip,
-                        (lit.width, lit.height),
-                    );
+                    let map =
+                        TexMapping::onto_lit_surface(view, surface, ss.inverse_depth, mip, lit);
                     let (w, texels) = (lit.width, &lit.texels);
                     draw_spans(&mut frame.pixels, width, spans, &map, step, |u, v| {
                         texels[v as usize * w + u as usize]
@@ -287,14 +281,7 @@ impl Renderer {
                 continue;
             };
             drawn += 1;
-            let map = TexMapping::new(
-                view,
-                surface,
-                ss.inverse_depth,
-                surface.extents.tex_mins,
-                mip,
-                (lit.width, lit.height),
-            );
+            let map = TexMapping::onto_lit_surface(view, surface, ss.inverse_depth, mip, lit);
             let depth = &mut self.depth;
             let spans = self.fence_edges.spans_of(1);
             for_each_segment(spans, &map, step, |seg| {
