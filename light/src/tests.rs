@@ -29,52 +29,21 @@ fn quad(a: [f32; 3], b: [f32; 3], c: [f32; 3], d: [f32; 3], normal: [f32; 3]) ->
 
 /// The six outward faces of the box `lo..hi`.
 fn box_faces(lo: [f32; 3], hi: [f32; 3]) -> Vec<Poly> {
-    let [x0, y0, z0] = lo;
-    let [x1, y1, z1] = hi;
-    vec![
-        quad(
-            [x0, y0, z1],
-            [x1, y0, z1],
-            [x1, y1, z1],
-            [x0, y1, z1],
-            [0.0, 0.0, 1.0],
-        ),
-        quad(
-            [x0, y0, z0],
-            [x0, y1, z0],
-            [x1, y1, z0],
-            [x1, y0, z0],
-            [0.0, 0.0, -1.0],
-        ),
-        quad(
-            [x1, y0, z0],
-            [x1, y1, z0],
-            [x1, y1, z1],
-            [x1, y0, z1],
-            [1.0, 0.0, 0.0],
-        ),
-        quad(
-            [x0, y0, z0],
-            [x0, y0, z1],
-            [x0, y1, z1],
-            [x0, y1, z0],
-            [-1.0, 0.0, 0.0],
-        ),
-        quad(
-            [x0, y1, z0],
-            [x0, y1, z1],
-            [x1, y1, z1],
-            [x1, y1, z0],
-            [0.0, 1.0, 0.0],
-        ),
-        quad(
-            [x0, y0, z0],
-            [x1, y0, z0],
-            [x1, y0, z1],
-            [x0, y0, z1],
-            [0.0, -1.0, 0.0],
-        ),
-    ]
+    // Corner i takes hi on axis k when bit k of i is set; each face lists its corners
+    // counter-clockwise seen from outside.
+    let corner = |i: usize| std::array::from_fn(|k| if i >> k & 1 == 1 { hi[k] } else { lo[k] });
+    const FACES: [([usize; 4], [f32; 3]); 6] = [
+        ([4, 5, 7, 6], [0.0, 0.0, 1.0]),
+        ([0, 2, 3, 1], [0.0, 0.0, -1.0]),
+        ([1, 3, 7, 5], [1.0, 0.0, 0.0]),
+        ([0, 4, 6, 2], [-1.0, 0.0, 0.0]),
+        ([2, 6, 7, 3], [0.0, 1.0, 0.0]),
+        ([0, 1, 5, 4], [0.0, -1.0, 0.0]),
+    ];
+    FACES
+        .iter()
+        .map(|&([a, b, c, d], normal)| quad(corner(a), corner(b), corner(c), corner(d), normal))
+        .collect()
 }
 
 /// qbsp's axial texture projection for a normal.
