@@ -306,6 +306,13 @@ impl Engine {
             "-game",
             &game.name,
         ]));
+        // Tests run engines in parallel, and two on the default UDP port clash. The client needs
+        // no network; a dedicated server refuses to start without one, so it gets a free port.
+        if mode.contains(&"-dedicated") {
+            args.extend(["-port".to_string(), free_udp_port().to_string()]);
+        } else {
+            args.push("-noudp".to_string());
+        }
         args.extend(strings(&["+developer", "1"]));
         args
     }
@@ -502,4 +509,13 @@ fn engine_check_passes_a_known_good_bsp_and_fails_a_broken_one() {
         .load("damaged", &damaged)
         .expect_err("the engine must reject a damaged BSP");
     assert!(err.contains("bad surface number"), "{err}");
+}
+
+/// A UDP port nothing holds right now (the OS picks it; the socket closes before the engine
+/// binds it, a race no other test of ours takes part in).
+fn free_udp_port() -> u16 {
+    std::net::UdpSocket::bind("127.0.0.1:0")
+        .and_then(|s| s.local_addr())
+        .map(|a| a.port())
+        .unwrap_or(26000)
 }
