@@ -2,7 +2,7 @@
 //! from another brush by a node plane.
 
 use crate::planes::{PlaneId, PlaneSet};
-use quake_formats::geom::{Bounds, MAX_WORLD_COORD, ON_EPSILON, Plane, Split, Winding};
+use quake_formats::geom::{Bounds, MAX_WORLD_COORD, ON_EPSILON, Plane, PlaneSide, Split, Winding};
 
 /// Brush fragments smaller than this (cubic units) are dropped as numerical slivers.
 const MIN_VOLUME: f64 = 0.1;
@@ -21,6 +21,17 @@ pub struct Side {
     pub used: bool,
     /// Wholly inside other brushes (see [`crate::csg`]): never a splitter, yet not a node plane.
     pub buried: bool,
+}
+
+/// The part of `w` in front of `plane` (none when it lies on it), like
+/// [`Winding::clip_front`] without `keep_on`, but `w` moves through untouched when it lies wholly
+/// in front: clipping a winding by many planes that mostly miss it then allocates nothing.
+pub fn keep_front(w: Winding, plane: &Plane) -> Option<Winding> {
+    match w.side_of(plane) {
+        PlaneSide::Front => Some(w),
+        PlaneSide::Back | PlaneSide::On => None,
+        PlaneSide::Cross => w.clip_front(plane, false),
+    }
 }
 
 /// What a brush does to the tree's structure.
@@ -104,7 +115,7 @@ impl Brush {
                 if i == j {
                     continue;
                 }
-                w = w.and_then(|w| w.clip_front(&other.plane.flipped(), false));
+                w = w.and_then(|w| keep_front(w, &other.plane.flipped()));
             }
             let Some(w) = w.filter(|w| !w.is_tiny()) else {
                 continue;
@@ -222,7 +233,7 @@ impl Brush {
         let mut cut = Some(Winding::base_for_plane(&plane));
         for s in &self.sides {
             let out = self.outward(s, planes);
-            cut = cut.and_then(|w| w.clip_front(&out.flipped(), false));
+            cut = cut.and_then(|w| keep_front(w, &out.flipped()));
         }
         let Some(cut) = cut.filter(|w| !w.is_tiny()) else {
             // The plane grazes an edge or a corner: the cut is too thin to build on.
@@ -230,25 +241,31 @@ impl Brush {
         };
         let mut front_sides = Vec::with_capacity(self.sides.len() + 1);
         let mut back_sides = Vec::with_capacity(self.sides.len() + 1);
+        // Classify first: only sides crossing the plane need splitting.
         for s in &self.sides {
-            match s.winding.split(&plane) {
-                Split::Front(_) => front_sides.push(s.clone()),
-                Split::Back(_) => back_sides.push(s.clone()),
-                Split::Both { front, back } => {
+            match s.winding.side_of(&plane) {
+                PlaneSide::Front => front_sides.push(s.clone()),
+                PlaneSide::Back => back_sides.push(s.clone()),
+                PlaneSide::On => {}
+                PlaneSide::Cross => {
+                    let Split::Both { front, back } = s.winding.split(&plane) else {
+                        continue;
+                    };
+                    let part = |winding| Side {
+                        winding,
+                        plane: s.plane,
+                        flipped: s.flipped,
+                        texinfo: s.texinfo,
+                        used: s.used,
+                        buried: s.buried,
+                    };
                     if !front.is_tiny() {
-                        front_sides.push(Side {
-                            winding: front,
-                            ..s.clone()
-                        });
+                        front_sides.push(part(front));
                     }
                     if !back.is_tiny() {
-                        back_sides.push(Side {
-                            winding: back,
-                            ..s.clone()
-                        });
+                        back_sides.push(part(back));
                     }
                 }
-                Split::On { .. } => {}
             }
         }
         // The front part's new face looks back along the plane, the back part's along it.
@@ -312,6 +329,28 @@ pub(crate) mod tests {
     /// An axial box brush of `contents` in entity 0.
     pub(crate) fn box_brush(planes: &mut PlaneSet, mins: Vec3, maxs: Vec3, contents: i32) -> Brush {
         Brush::from_planes(&box_planes(mins, maxs), planes, contents, 0).expect("box brush")
+    }
+
+    #[test]
+    fn keep_front_matches_clip_front() {
+        let square = Winding::new(vec![
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(0.0, 64.0, 0.0),
+            Vec3::new(64.0, 64.0, 0.0),
+            Vec3::new(64.0, 0.0, 0.0),
+        ]);
+        for plane in [
+            Plane::new(Vec3::new(1.0, 0.0, 0.0), -8.0), // wholly in front
+            Plane::new(Vec3::new(1.0, 0.0, 0.0), 80.0), // wholly behind
+            Plane::new(Vec3::new(0.0, 0.0, 1.0), 0.0),  // on it
+            Plane::new(Vec3::new(-1.0, 0.0, 0.0), -32.0), // across
+        ] {
+            assert_eq!(
+                keep_front(square.clone(), &plane),
+                square.clip_front(&plane, false),
+                "{plane:?}"
+            );
+        }
     }
 
     #[test]

@@ -324,9 +324,11 @@ pub fn compile(
         }
         let brush_class = EntityBrushes::of(index, class);
         // A submodel with an origin brush is built around that brush's centre, which becomes its
-        // "origin" (what rotating entities turn about).
+        // "origin" (what rotating entities turn about); without one, around its origin key.
         let origin = match brush_class {
-            EntityBrushes::Submodel => origin_brush_centre(ent, &mut planes),
+            EntityBrushes::Submodel => {
+                origin_brush_centre(ent, &mut planes).or_else(|| key_origin(&map.entities, ent))
+            }
             _ => None,
         };
         let model = if brush_class == EntityBrushes::Submodel {
@@ -564,6 +566,26 @@ fn merged_phong(ent: &MapEntity, index: usize, class: EntityBrushes) -> FacePhon
         },
         None => FacePhong::default(),
     }
+}
+
+/// The origin a submodel without origin brushes is built around: for Hipnotic's `rotate_*`
+/// entities the origin of the entity their `target` names (an `info_rotate`, the pivot), else
+/// the submodel's own `origin` key. Engines draw a model moved by its origin, so its brushes must
+/// be stored relative to it to appear where the mapper put them.
+fn key_origin(entities: &[MapEntity], ent: &MapEntity) -> Option<Vec3> {
+    let pivot = ent
+        .entity
+        .classname()
+        .starts_with("rotate_")
+        .then(|| ent.entity.get("target"))
+        .flatten()
+        .and_then(|target| {
+            entities
+                .iter()
+                .find(|e| e.entity.get("targetname") == Some(target))
+        });
+    let [x, y, z] = pivot.unwrap_or(ent).entity.get_floats::<3>("origin")?;
+    Some(Vec3::new(x, y, z))
 }
 
 /// Build one entity's brushes, in coordinates relative to `origin`, each with whether it is a

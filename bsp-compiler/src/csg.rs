@@ -10,7 +10,7 @@
 use crate::brush::{Brush, Side};
 use crate::planes::PlaneSet;
 use crate::tree::contents_priority;
-use quake_formats::geom::{Bounds, ON_EPSILON, Split, Vec3, Winding};
+use quake_formats::geom::{Bounds, ON_EPSILON, PlaneSide, Split, Vec3, Winding};
 use rayon::prelude::*;
 
 /// Mark every side of `brushes` that lies wholly inside other brushes as buried. Returns how
@@ -104,29 +104,32 @@ fn clip_outside(
     out: &mut Vec<Winding>,
 ) {
     let mut rest = w;
+    // Whether `rest` is tiny, computed again only when a split changes it.
+    let mut tiny = None;
     for s in &brush.sides {
         let plane = brush.outward(s, planes);
-        match rest.split(&plane) {
-            Split::Front(w) => {
-                out.push(w);
+        // Classify first: most windings lie wholly on one side, and splitting would copy them.
+        match rest.side_of(&plane) {
+            PlaneSide::Front => {
+                out.push(rest);
                 return;
             }
-            Split::Back(w) => rest = w,
-            Split::Both { front, back } => {
-                if !front.is_tiny() {
-                    out.push(front);
-                }
-                rest = back;
+            PlaneSide::On if plane.normal.dot(facing) > 0.0 => {
+                out.push(rest);
+                return;
             }
-            Split::On { winding, .. } => {
-                if plane.normal.dot(facing) > 0.0 {
-                    out.push(winding);
-                    return;
+            PlaneSide::Back | PlaneSide::On => {}
+            PlaneSide::Cross => {
+                if let Split::Both { front, back } = rest.split(&plane) {
+                    if !front.is_tiny() {
+                        out.push(front);
+                    }
+                    rest = back;
+                    tiny = None;
                 }
-                rest = winding;
             }
         }
-        if rest.is_tiny() {
+        if *tiny.get_or_insert_with(|| rest.is_tiny()) {
             return;
         }
     }

@@ -6,11 +6,13 @@
 //! [`portals`], [`outside`] (filling and leaks), [`faces`] (faces from portals,
 //! merging, subdivision), [`hulls`] (clip hulls) and [`surface_tree`] (their trees rebuilt after
 //! filling), [`weld`] (shared vertices, T-junctions) and `emit`. [`compile()`] runs them all;
+//! [`cracks`] checks a written BSP for T-junctions and unshared edges;
 //! [`trace`] moves a hull's box through a written BSP as engines do.
 
 pub mod brush;
 pub mod cli;
 mod compile;
+pub mod cracks;
 pub mod csg;
 mod emit;
 pub mod faces;

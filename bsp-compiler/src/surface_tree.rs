@@ -3,9 +3,10 @@
 //! between solid and open space matter. A second tree built from just those (as id's qbsp did
 //! after filling) needs far fewer clip nodes.
 
+use crate::brush::keep_front;
 use crate::planes::{PlaneId, PlaneSet};
 use crate::portals::Portals;
-use crate::tree::{BuildNode, SplitHeuristic, Tree, flatten, mid_split};
+use crate::tree::{BuildNode, SplitCounts, SplitHeuristic, Tree, count_sorted, flatten, mid_split};
 use quake_formats::bsp::contents;
 use quake_formats::geom::{Bounds, Plane, Split, Vec3, Winding};
 use rayon::prelude::*;
@@ -233,11 +234,13 @@ impl Builder<'_> {
     }
 
     fn choose_splitter(&self, surfaces: &[Surface]) -> Option<PlaneId> {
-        let mut candidates: Vec<PlaneId> = surfaces.iter().map(|s| s.plane).collect();
-        if candidates.is_empty() {
+        // Every surface's plane, sorted: a run's length is how many surfaces a node would take.
+        let mut on_plane: Vec<PlaneId> = surfaces.iter().map(|s| s.plane).collect();
+        if on_plane.is_empty() {
             return None;
         }
-        candidates.sort_unstable();
+        on_plane.sort_unstable();
+        let mut candidates = on_plane.clone();
         candidates.dedup();
         let bounds = surfaces
             .iter()
@@ -256,7 +259,13 @@ impl Builder<'_> {
                     (false, false) => {}
                 }
             }
-            (self.heuristic.key(plane, split, front, back), id)
+            let counts = SplitCounts {
+                split,
+                facing: count_sorted(&on_plane, id),
+                front,
+                back,
+            };
+            (self.heuristic.key(plane, counts), id)
         };
         let work = candidates.len() * surfaces.len();
         if work > 20_000 {
@@ -290,7 +299,7 @@ fn inside_point(planes: &[Plane]) -> Option<Vec3> {
         let mut w = Some(Winding::base_for_plane(&plane.flipped()));
         for (j, other) in planes.iter().enumerate() {
             if i != j {
-                w = w.and_then(|w| w.clip_front(other, false));
+                w = w.and_then(|w| keep_front(w, other));
             }
         }
         for p in w.iter().flat_map(|w| &w.points) {

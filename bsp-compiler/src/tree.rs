@@ -16,26 +16,43 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 /// of their longest axis, as Quake's qbsp does, which keeps big maps' trees shallow.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
 pub enum SplitHeuristic {
-    /// Fewest brushes split; then the most even front/back count; then axial planes.
+    /// Fewest brushes split; then the most brushes with a side on the plane (fewer nodes and
+    /// leaves); then the most even front/back count; then axial planes.
     #[default]
     FewestSplits,
-    /// Quake 2's weighting: five times the splits plus the front/back difference, axial planes
-    /// first on ties.
+    /// Quake 2's weighting: five times the splits less the brushes facing the plane, plus the
+    /// front/back difference, axial planes first on ties.
     Balanced,
 }
 
 /// Nodes whose brushes span more than this on some axis are cut near their middle.
 pub const MID_SPLIT_SIZE: f64 = 1024.0;
 
+/// What a candidate splitting plane does to the brushes (or surfaces) of a node.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SplitCounts {
+    /// Cut in two.
+    pub split: i64,
+    /// Lying on the plane (an unused brush side, a surface): one node serves them all.
+    pub facing: i64,
+    /// Left whole in front and behind.
+    pub front: i64,
+    pub back: i64,
+}
+
+/// How many times `id` occurs in the sorted list `planes`.
+pub fn count_sorted(planes: &[PlaneId], id: PlaneId) -> i64 {
+    (planes.partition_point(|&p| p <= id) - planes.partition_point(|&p| p < id)) as i64
+}
+
 impl SplitHeuristic {
-    /// The ranking of a candidate `plane` that splits `split` things and leaves `front` and
-    /// `back` whole on either side: lower is better.
-    pub fn key(self, plane: &Plane, split: i64, front: i64, back: i64) -> (i64, i64, i64) {
-        let imbalance = (front - back).abs();
+    /// The ranking of a candidate `plane`: lower is better.
+    pub fn key(self, plane: &Plane, c: SplitCounts) -> (i64, i64, i64, i64) {
+        let imbalance = (c.front - c.back).abs();
         let non_axial = i64::from(plane.axial().is_none());
         match self {
-            SplitHeuristic::FewestSplits => (split, imbalance, non_axial),
-            SplitHeuristic::Balanced => (5 * split + imbalance, non_axial, 0),
+            SplitHeuristic::FewestSplits => (c.split, -c.facing, imbalance, non_axial),
+            SplitHeuristic::Balanced => (5 * (c.split - c.facing) + imbalance, non_axial, 0, 0),
         }
     }
 }
@@ -412,6 +429,21 @@ impl Builder<'_> {
         }
         let hints = unused(Some(BrushKind::Hint));
         let candidates = if hints.is_empty() { candidates } else { hints };
+        // Each brush's unused side planes, once per brush, sorted: how many brushes a plane
+        // would serve as a node (a plane many sides lie on saves nodes and leaves).
+        let mut facing_planes: Vec<PlaneId> = Vec::new();
+        for b in brushes {
+            let mut own: Vec<PlaneId> = b
+                .sides
+                .iter()
+                .filter(|s| !s.used && !s.buried)
+                .map(|s| s.plane)
+                .collect();
+            own.sort_unstable();
+            own.dedup();
+            facing_planes.extend(own);
+        }
+        facing_planes.sort_unstable();
         let score = |&id: &PlaneId| {
             let plane = self.planes.get(id);
             let (mut front, mut back, mut split) = (0i64, 0i64, 0i64);
@@ -423,7 +455,13 @@ impl Builder<'_> {
                     (false, false) => {}
                 }
             }
-            (self.heuristic.key(plane, split, front, back), id)
+            let counts = SplitCounts {
+                split,
+                facing: count_sorted(&facing_planes, id),
+                front,
+                back,
+            };
+            (self.heuristic.key(plane, counts), id)
         };
         let work = candidates.len() * brushes.len();
         if work > 20_000 {
@@ -494,6 +532,28 @@ mod tests {
 
     fn solid_box(planes: &mut PlaneSet, lo: Vec3, hi: Vec3) -> Brush {
         Brush::from_planes(&box_planes(lo, hi), planes, contents::SOLID, 0).expect("box")
+    }
+
+    #[test]
+    fn planes_shared_by_many_brushes_split_first() {
+        // A row of boxes sharing their floor, top and y planes: one node each for those serves
+        // every box, so they go first and the tree needs a single leaf between two boxes.
+        let mut planes = PlaneSet::new();
+        let brushes: Vec<Brush> = (0..4)
+            .map(|i| {
+                let x = 128.0 * f64::from(i);
+                solid_box(
+                    &mut planes,
+                    Vec3::new(x, 0.0, 0.0),
+                    Vec3::new(x + 64.0, 64.0, 64.0),
+                )
+            })
+            .collect();
+        for heuristic in [SplitHeuristic::FewestSplits, SplitHeuristic::Balanced] {
+            let tree = build_tree(brushes.clone(), &planes, heuristic, false);
+            let leaves = tree.nodes.iter().filter(|n| n.is_leaf()).count();
+            assert_eq!(leaves, 4 + 4 + 5, "{heuristic:?}");
+        }
     }
 
     #[test]

@@ -5,7 +5,7 @@ use quake_formats::geom::{POINT_EPSILON, Vec3};
 use std::collections::HashMap;
 
 /// Distance from an edge within which a vertex counts as lying on it.
-const TJUNCTION_EPSILON: f64 = 0.02;
+pub const TJUNCTION_EPSILON: f64 = 0.02;
 /// Cell size of the T-junction search grid.
 const GRID: f64 = 64.0;
 

@@ -569,6 +569,34 @@ fn origin_brushes_set_the_origin_of_their_model() {
 }
 
 #[test]
+fn origin_keys_and_rotate_targets_set_the_origin_of_their_model() {
+    let door = box_brush([32.0, -8.0, -128.0], [96.0, 8.0, 0.0], "door");
+    let plain = compile_text(&room_map_with(false, "", &brush_entity("func_wall", &door)));
+    let pivot =
+        "{\n\"classname\" \"info_rotate\"\n\"targetname\" \"pivot\"\n\"origin\" \"64 0 -64\"\n}\n";
+    for entity in [
+        // An origin key alone (Quake 2 style)...
+        format!("{{\n\"classname\" \"func_wall\"\n\"origin\" \"64 0 -64\"\n{door}}}\n"),
+        // ...or Hipnotic's rotate_object turning about the info_rotate it targets.
+        format!("{{\n\"classname\" \"rotate_object\"\n\"target\" \"pivot\"\n{door}}}\n{pivot}"),
+    ] {
+        let out = compile_text(&room_map_with(false, "", &entity));
+        let bsp = &out.bsp;
+        assert_eq!(errors(bsp), Vec::<String>::new());
+        assert!(
+            bsp.entity_text().contains("\"origin\" \"64 0 -64\""),
+            "{entity}"
+        );
+        assert_eq!(bsp.models[1].mins, [-32.0, -8.0, -64.0], "{entity}");
+        assert_eq!(bsp.models[1].maxs, [32.0, 8.0, 64.0], "{entity}");
+        assert_eq!(
+            model_texels(bsp, 1, [64.0, 0.0, -64.0]),
+            model_texels(&plain.bsp, 1, [0.0; 3])
+        );
+    }
+}
+
+#[test]
 fn same_input_gives_the_same_bytes() {
     let pillar = box_brush([-16.0, -20.0, -128.0], [16.0, 16.0, 100.0], "pillar");
     let text = room_map(false, &pillar);

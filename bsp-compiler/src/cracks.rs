@@ -1,0 +1,266 @@
+//! Crack finding on a written BSP: places where faces that meet do not share their edges, so an
+//! engine's rasteriser can leave pixel gaps between them.
+//!
+//! Within each model it reports T-junctions (a face vertex on the open interior of another face's
+//! edge), directed edges used by more than two faces, and distinct vertex indices at the same
+//! position. Faces of every kind count (sky, liquids, fences): engines draw them all, so a
+//! T-junction between water and a wall shows as a crack like any other. Indices the validator
+//! would reject are skipped, never trusted.
+
+use crate::weld::TJUNCTION_EPSILON;
+use quake_formats::Bsp;
+use quake_formats::geom::{POINT_EPSILON, Vec3};
+use std::collections::{BTreeMap, BTreeSet, HashMap};
+
+/// Cell size of the vertex search grid.
+const GRID: f64 = 64.0;
+
+/// A vertex lying inside another face's edge.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TJunction {
+    pub model: usize,
+    /// The face whose edge the vertex splits.
+    pub face: usize,
+    pub edge: [u32; 2],
+    pub vertex: u32,
+    pub position: [f32; 3],
+}
+
+/// Everything [`find_cracks`] found.
+#[derive(Debug, Default, Clone, PartialEq)]
+pub struct CrackReport {
+    pub tjunctions: Vec<TJunction>,
+    /// `(model, [from, to], faces)`: a directed edge used by more than two faces.
+    pub overused_edges: Vec<(usize, [u32; 2], usize)>,
+    /// `(model, a, b)`: two vertex indices used by one model within [`POINT_EPSILON`].
+    pub duplicate_vertices: Vec<(usize, u32, u32)>,
+}
+
+impl CrackReport {
+    pub fn is_empty(&self) -> bool {
+        self.tjunctions.is_empty()
+            && self.overused_edges.is_empty()
+            && self.duplicate_vertices.is_empty()
+    }
+
+    /// One line of counts, with the first T-junction as an example.
+    pub fn summary(&self) -> String {
+        let mut s = format!(
+            "{} T-junctions, {} overused edges, {} duplicate vertices",
+            self.tjunctions.len(),
+            self.overused_edges.len(),
+            self.duplicate_vertices.len()
+        );
+        if let Some(t) = self.tjunctions.first() {
+            s += &format!(
+                "; first: vertex {} {:?} inside edge {:?} of face {} (model {})",
+                t.vertex, t.position, t.edge, t.face, t.model
+            );
+        }
+        s
+    }
+}
+
+/// The vertex indices of face `f` in winding order, or `None` when an index is out of range.
+fn face_vertices(bsp: &Bsp, f: usize) -> Option<Vec<u32>> {
+    let face = bsp.faces.get(f)?;
+    let first = face.first_edge as usize;
+    let surfedges = bsp
+        .surfedges
+        .get(first..first.checked_add(face.num_edges as usize)?)?;
+    surfedges
+        .iter()
+        .map(|&se| {
+            let edge = bsp.edges.get(se.unsigned_abs() as usize)?;
+            let v = if se >= 0 { edge[0] } else { edge[1] };
+            ((v as usize) < bsp.vertices.len()).then_some(v)
+        })
+        .collect()
+}
+
+fn cell(p: Vec3) -> [i64; 3] {
+    let c = |v: f64| (v / GRID).floor() as i64;
+    [c(p.x), c(p.y), c(p.z)]
+}
+
+/// The grid cells within reach of segment `a..b`: those around points sampled along it.
+fn cells_along(a: Vec3, b: Vec3, out: &mut BTreeSet<[i64; 3]>) {
+    out.clear();
+    let steps = ((b - a).length() / (GRID * 0.5)).ceil().max(1.0) as usize;
+    for i in 0..=steps {
+        let [x, y, z] = cell(a.lerp(b, i as f64 / steps as f64));
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    out.insert([x + dx, y + dy, z + dz]);
+                }
+            }
+        }
+    }
+}
+
+/// Find the cracks of every model of `bsp`.
+pub fn find_cracks(bsp: &Bsp) -> CrackReport {
+    let mut report = CrackReport::default();
+    for (mi, model) in bsp.models.iter().enumerate() {
+        let first = model.first_face as usize;
+        let faces: Vec<(usize, Vec<u32>)> = (first..first.saturating_add(model.num_faces as usize))
+            .filter_map(|f| Some((f, face_vertices(bsp, f)?)))
+            .collect();
+        check_model(bsp, mi, &faces, &mut report);
+    }
+    report
+}
+
+fn check_model(bsp: &Bsp, model: usize, faces: &[(usize, Vec<u32>)], report: &mut CrackReport) {
+    let pos = |v: u32| Vec3::from_f32(bsp.vertices[v as usize]);
+    let used: BTreeSet<u32> = faces
+        .iter()
+        .flat_map(|(_, vs)| vs.iter().copied())
+        .collect();
+    let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+    for &v in &used {
+        grid.entry(cell(pos(v))).or_default().push(v);
+    }
+
+    for &v in &used {
+        let [x, y, z] = cell(pos(v));
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    for &w in grid.get(&[x + dx, y + dy, z + dz]).into_iter().flatten() {
+                        if w > v && pos(w).near(pos(v), POINT_EPSILON) {
+                            report.duplicate_vertices.push((model, v, w));
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    let mut directed: BTreeMap<[u32; 2], usize> = BTreeMap::new();
+    let mut cells = BTreeSet::new();
+    for (f, vs) in faces {
+        for k in 0..vs.len() {
+            let (a, b) = (vs[k], vs[(k + 1) % vs.len()]);
+            *directed.entry([a, b]).or_default() += 1;
+            let (pa, pb) = (pos(a), pos(b));
+            let d = pb - pa;
+            let len = d.length();
+            if len < POINT_EPSILON {
+                continue;
+            }
+            cells_along(pa, pb, &mut cells);
+            for &v in cells.iter().filter_map(|c| grid.get(c)).flatten() {
+                let pv = pos(v);
+                let along = (pv - pa).dot(d) / len;
+                if v == a
+                    || v == b
+                    || along <= POINT_EPSILON
+                    || along >= len - POINT_EPSILON
+                    || (pa + d * (along / len) - pv).length() >= TJUNCTION_EPSILON
+                {
+                    continue;
+                }
+                report.tjunctions.push(TJunction {
+                    model,
+                    face: *f,
+                    edge: [a, b],
+                    vertex: v,
+                    position: bsp.vertices[v as usize],
+                });
+            }
+        }
+    }
+    report.overused_edges.extend(
+        directed
+            .into_iter()
+            .filter(|&(_, n)| n > 2)
+            .map(|(e, n)| (model, e, n)),
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use quake_formats::bsp::{BspVersion, Face, Model};
+
+    /// A BSP with one model whose faces are the given vertex loops.
+    fn bsp_of(vertices: &[[f32; 3]], loops: &[&[u32]]) -> Bsp {
+        let mut bsp = Bsp::new(BspVersion::Bsp29);
+        bsp.vertices = vertices.to_vec();
+        bsp.edges.push([0, 0]);
+        for l in loops {
+            let first_edge = bsp.surfedges.len() as u32;
+            for k in 0..l.len() {
+                bsp.surfedges.push(bsp.edges.len() as i32);
+                bsp.edges.push([l[k], l[(k + 1) % l.len()]]);
+            }
+            bsp.faces.push(Face {
+                plane: 0,
+                side: 0,
+                first_edge,
+                num_edges: l.len() as u32,
+                texinfo: 0,
+                styles: [255; 4],
+                light_offset: -1,
+            });
+        }
+        bsp.models.push(Model {
+            mins: [0.0; 3],
+            maxs: [0.0; 3],
+            origin: [0.0; 3],
+            head_nodes: [0; 4],
+            vis_leafs: 0,
+            first_face: 0,
+            num_faces: loops.len() as u32,
+        });
+        bsp
+    }
+
+    const SQUARE_AND_HALVES: [[f32; 3]; 6] = [
+        [0.0, 0.0, 0.0],
+        [64.0, 0.0, 0.0],
+        [64.0, 64.0, 0.0],
+        [0.0, 64.0, 0.0],
+        [128.0, 0.0, 0.0],
+        [128.0, 64.0, 0.0],
+    ];
+
+    #[test]
+    fn a_vertex_inside_a_neighbours_edge_is_a_tjunction() {
+        // The right square is cut in two at y 32; its cut point lies inside the left one's edge.
+        let mut vertices = SQUARE_AND_HALVES.to_vec();
+        vertices.extend([[64.0, 32.0, 0.0], [128.0, 32.0, 0.0]]);
+        let bsp = bsp_of(&vertices, &[&[0, 1, 2, 3], &[1, 4, 7, 6], &[6, 7, 5, 2]]);
+        let report = find_cracks(&bsp);
+        assert_eq!(report.tjunctions.len(), 1, "{}", report.summary());
+        assert_eq!(
+            (report.tjunctions[0].face, report.tjunctions[0].vertex),
+            (0, 6)
+        );
+
+        // With the vertex inserted into the left square the edge is shared and nothing is left.
+        let fixed = bsp_of(&vertices, &[&[0, 1, 6, 2, 3], &[1, 4, 7, 6], &[6, 7, 5, 2]]);
+        assert!(find_cracks(&fixed).is_empty());
+    }
+
+    #[test]
+    fn duplicate_positions_and_overused_edges_are_reported() {
+        let mut vertices = SQUARE_AND_HALVES.to_vec();
+        vertices.push([64.0, 64.0005, 0.0]);
+        let bsp = bsp_of(&vertices, &[&[0, 1, 2, 3], &[1, 4, 5, 6]]);
+        assert_eq!(find_cracks(&bsp).duplicate_vertices, vec![(0, 2, 6)]);
+
+        let bsp = bsp_of(&vertices, &[&[0, 1, 2], &[0, 1, 3], &[0, 1, 5]]);
+        assert_eq!(find_cracks(&bsp).overused_edges, vec![(0, [0, 1], 3)]);
+    }
+
+    #[test]
+    fn out_of_range_indices_are_skipped() {
+        let mut bsp = bsp_of(&SQUARE_AND_HALVES, &[&[0, 1, 2, 3]]);
+        bsp.surfedges[2] = 99;
+        bsp.models[0].num_faces = 5;
+        assert!(find_cracks(&bsp).is_empty());
+    }
+}
