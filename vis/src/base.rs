@@ -10,10 +10,17 @@ use crate::portals::{OneWayPortal, PortalGraph};
 use quake_formats::geom::ON_EPSILON;
 
 /// The plane test of classic vis: could anything seen through `p` be seen through `q` next?
+/// Bounding spheres wholly on one side of a plane answer without testing the points.
 pub fn may_see_through(p: &OneWayPortal, q: &OneWayPortal) -> bool {
-    !q.behind(&p.plane)
-        && q.winding.iter().any(|&v| p.plane.distance(v) > ON_EPSILON)
-        && p.winding.iter().any(|&v| q.plane.distance(v) < -ON_EPSILON)
+    let q_beyond = match q.sphere_side(&p.plane) {
+        Some(front) => front,
+        None => q.winding.iter().any(|&v| p.plane.distance(v) > ON_EPSILON),
+    };
+    let p_behind = || match p.sphere_side(&q.plane) {
+        Some(front) => !front,
+        None => p.winding.iter().any(|&v| q.plane.distance(v) < -ON_EPSILON),
+    };
+    q_beyond && p_behind()
 }
 
 /// The portals possibly visible through `source` (its "mightsee" set), flooding leaf by leaf

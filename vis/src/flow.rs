@@ -84,7 +84,6 @@ pub struct Workspace {
     pub covered: u64,
     frames: Vec<Frame>,
     scratch: Vec<Vec3>,
-    planes: Vec<Plane>,
     explored: Explored,
 }
 
@@ -152,11 +151,12 @@ impl Walk<'_> {
                 continue; // nothing unseen can be seen through it
             }
             let portal = &graph.portals[q];
-            if !clip_front(&portal.winding, &self.base.plane, &mut cur.pass) {
+            if !clip_within(&portal.winding, portal, &self.base.plane, &mut cur.pass) {
                 continue;
             }
             // The source part that can look through `portal` lies behind its plane.
-            if !clip_front(&prev.source, &portal.plane.flipped(), &mut cur.source) {
+            let behind = portal.plane.flipped();
+            if !clip_within(&prev.source, self.base, &behind, &mut cur.source) {
                 continue;
             }
             cur.plane = portal.plane;
@@ -164,8 +164,8 @@ impl Walk<'_> {
             cur.separators_ready = false;
             // In the base's own leaf (no pass yet) a portal is seen unless coplanar with the base.
             if prev.has_pass
-                && (!clip_in_place(&mut cur.pass, &prev.plane, &mut ws.scratch)
-                    || !self.narrow(ws, prev, &mut cur))
+                && (!clip_in_place(&mut cur.pass, portal, &prev.plane, &mut ws.scratch)
+                    || !self.narrow(ws, prev, &mut cur, portal))
             {
                 continue;
             }
@@ -195,11 +195,15 @@ impl Walk<'_> {
             return;
         }
         frame.separators.clear();
+        let mut keep = |plane| {
+            frame.separators.push(plane);
+            true
+        };
         if self.ctx.level >= 1 {
-            separating_planes(&frame.source, &frame.pass, true, &mut frame.separators);
+            separating_planes(&frame.source, &frame.pass, true, &mut keep);
         }
         if self.ctx.level >= 2 {
-            separating_planes(&frame.pass, &frame.source, false, &mut frame.separators);
+            separating_planes(&frame.pass, &frame.source, false, &mut keep);
         }
         frame.separators_ready = true;
     }
@@ -210,152 +214,220 @@ impl Walk<'_> {
         self.ensure_separators(frame);
         let portals = &self.ctx.graph.portals;
         let separators = &frame.separators;
+        // Spheres first: a plane culling by its sphere saves another's test of the points.
         frame.might.prune_unknown(&self.seen, |r| {
-            separators
-                .iter()
-                .any(|plane| portals[r].wholly_behind(plane))
+            let portal = &portals[r];
+            separators.iter().any(|plane| portal.behind(plane))
+                || separators.iter().any(|plane| portal.wholly_behind(plane))
         })
     }
 
-    /// Clip the new pass (and from level 3 the source) by separating planes; false when the
-    /// line of sight is cut off.
-    fn narrow(&self, ws: &mut Workspace, prev: &mut Frame, cur: &mut Frame) -> bool {
+    /// Clip the new pass through `portal` (and from level 3 the source) by separating planes;
+    /// false when the line of sight is cut off.
+    fn narrow(
+        &self,
+        ws: &mut Workspace,
+        prev: &mut Frame,
+        cur: &mut Frame,
+        portal: &OneWayPortal,
+    ) -> bool {
         let level = self.ctx.level;
         if level == 0 {
             return true;
         }
         self.ensure_separators(prev);
         for plane in &prev.separators {
-            if !clip_in_place(&mut cur.pass, plane, &mut ws.scratch) {
+            if !clip_in_place(&mut cur.pass, portal, plane, &mut ws.scratch) {
                 return false;
             }
         }
-        if level >= 3 {
-            ws.planes.clear();
-            separating_planes(&cur.pass, &prev.pass, true, &mut ws.planes);
-            if level >= 4 {
-                separating_planes(&prev.pass, &cur.pass, false, &mut ws.planes);
-            }
-            for plane in &ws.planes {
-                if !clip_in_place(&mut cur.source, plane, &mut ws.scratch) {
-                    return false;
-                }
-            }
+        if level < 3 {
+            return true;
         }
-        true
+        // Each plane clips the source as soon as it is found: once nothing is left, the
+        // remaining planes need not be made.
+        let base = self.base;
+        let mut clip = |plane: Plane| clip_in_place(&mut cur.source, base, &plane, &mut ws.scratch);
+        separating_planes(&cur.pass, &prev.pass, true, &mut clip)
+            && (level < 4 || separating_planes(&prev.pass, &cur.pass, false, &mut clip))
     }
 }
 
-/// Append the planes through an edge of `a` and a point of `b` that separate them: `b` in front
-/// (at least one point strictly), `a` behind when `a_behind`, else in front and `b` behind.
-/// Each edge of `a` has at most one such plane (more points of `b` only repeat it when they lie
-/// in it), so the search for an edge stops at the first.
-fn separating_planes(a: &[Vec3], b: &[Vec3], a_behind: bool, out: &mut Vec<Plane>) {
-    let n = a.len();
+/// Hand `found` the planes through an edge of `a` and a point of `b` that separate them: `b` in
+/// front (at least one point strictly), `a` behind when `a_behind`, else in front and `b`
+/// behind. Each edge of `a` has at most one such plane (more points of `b` only repeat it when
+/// they lie in it), so the search for an edge stops at the first. Stops, returning false, as
+/// soon as `found` returns false.
+///
+/// Candidates are tested with their normal not normalized, comparing squared distances against
+/// the squared epsilon scaled by the normal's squared length: most are rejected, and this spares
+/// them the square root and divisions, the slowest part of the search.
+fn separating_planes(
+    a: &[Vec3],
+    b: &[Vec3],
+    a_behind: bool,
+    found: &mut impl FnMut(Plane) -> bool,
+) -> bool {
+    const EPSILON_2: f64 = ON_EPSILON * ON_EPSILON;
+    let (n, m) = (a.len(), b.len());
     for i in 0..n {
-        let l = (i + 1) % n;
+        let l = if i + 1 == n { 0 } else { i + 1 };
         let edge = a[l] - a[i];
-        for (j, &bp) in b.iter().enumerate() {
-            let Some(normal) = edge.cross(bp - a[i]).normalized() else {
+        'candidates: for (j, &bp) in b.iter().enumerate() {
+            let raw = edge.cross(bp - a[i]);
+            let len2 = raw.dot(raw);
+            if len2 <= 1e-24 {
+                continue; // `bp` on the edge's line: no plane
+            }
+            // `d` is the distance times the normal's length: `|d| > ON_EPSILON` in these terms.
+            let reach2 = EPSILON_2 * len2;
+            let beyond = |d: f64| d * d > reach2;
+            // Orient so that `a` is behind; skip planes `a` lies in.
+            let Some(a_side) = (0..n)
+                .filter(|&k| k != i && k != l)
+                .map(|k| raw.dot(a[k] - bp))
+                .find(|&d| beyond(d))
+            else {
                 continue;
             };
-            let mut plane = Plane::new(normal, normal.dot(bp));
-            // Orient so that `a` is behind; skip planes `a` lies in.
-            let a_side = a
-                .iter()
-                .enumerate()
-                .filter(|&(k, _)| k != i && k != l)
-                .map(|(_, &v)| plane.distance(v))
-                .find(|d| d.abs() > ON_EPSILON);
-            match a_side {
-                None => continue,
-                Some(d) if d > 0.0 => plane = plane.flipped(),
-                Some(_) => {}
+            let sign = if a_side > 0.0 { -1.0 } else { 1.0 };
+            // The neighbours of `bp` on the convex `b` are the usual ones to fail: first.
+            let neighbours = [(j + 1) % m, (j + m - 1) % m];
+            let behind = |k: usize| {
+                let d = sign * raw.dot(b[k] - bp);
+                k != j && d < 0.0 && beyond(d)
+            };
+            if neighbours.into_iter().any(behind) {
+                continue;
             }
             let mut any_front = false;
-            let separates = b
-                .iter()
-                .enumerate()
-                .filter(|&(k, _)| k != j)
-                .all(|(_, &v)| {
-                    let d = plane.distance(v);
-                    any_front |= d > ON_EPSILON;
-                    d >= -ON_EPSILON
-                });
-            if separates && any_front {
-                out.push(if a_behind { plane } else { plane.flipped() });
-                break;
+            for (k, &v) in b.iter().enumerate() {
+                let d = sign * raw.dot(v - bp);
+                if k == j {
+                    continue;
+                }
+                if d < 0.0 && beyond(d) {
+                    continue 'candidates;
+                }
+                any_front |= d > 0.0 && beyond(d);
             }
+            if !any_front {
+                continue;
+            }
+            let normal = raw / len2.sqrt();
+            let plane = Plane::new(normal, normal.dot(bp));
+            if !found(if (sign > 0.0) == a_behind {
+                plane
+            } else {
+                plane.flipped()
+            }) {
+                return false;
+            }
+            break;
         }
     }
+    true
 }
 
 /// Keep the part of `input` in front of `plane` in `out`; points within [`ON_EPSILON`] count as
 /// on the plane. False (and `out` unspecified) when no point lies in front: a winding lying in
 /// the plane is cut away too.
 pub fn clip_front(input: &[Vec3], plane: &Plane, out: &mut Vec<Vec3>) -> bool {
-    const STACK_POINTS: usize = 64;
-    let n = input.len();
-    let mut stack_dists = [0.0f64; STACK_POINTS];
-    let mut heap_dists = Vec::new();
-    let dists: &mut [f64] = if n <= STACK_POINTS {
-        &mut stack_dists[..n]
-    } else {
-        heap_dists.resize(n, 0.0);
-        &mut heap_dists
-    };
+    out.clear();
+    match cut(input, plane) {
+        None => false,
+        Some(false) => {
+            out.extend_from_slice(input);
+            true
+        }
+        Some(true) => {
+            split_front(input, plane, out);
+            true
+        }
+    }
+}
+
+/// How `plane` cuts `input`: `None` when no point lies in front (by more than [`ON_EPSILON`]),
+/// else whether any lies behind, so that clipping changes the winding.
+fn cut(input: &[Vec3], plane: &Plane) -> Option<bool> {
     let mut front = false;
     let mut back = false;
-    for (d, &p) in dists.iter_mut().zip(input) {
-        *d = plane.distance(p);
-        front |= *d > ON_EPSILON;
-        back |= *d < -ON_EPSILON;
+    for &p in input {
+        let d = plane.distance(p);
+        front |= d > ON_EPSILON;
+        back |= d < -ON_EPSILON;
     }
-    out.clear();
-    if !front {
-        return false;
-    }
-    if !back {
-        out.extend_from_slice(input);
-        return true;
-    }
+    front.then_some(back)
+}
+
+/// Append to `out` the part of `input` in front of `plane`, which [`cut`] found to cut it.
+fn split_front(input: &[Vec3], plane: &Plane, out: &mut Vec<Vec3>) {
+    // Distances are computed again rather than kept: cheaper than a buffer for small windings.
+    let n = input.len();
+    let mut d = plane.distance(input[0]);
     for i in 0..n {
-        let (p, d) = (input[i], dists[i]);
+        let j = (i + 1) % n;
+        let dn = plane.distance(input[j]);
+        let p = input[i];
         if d >= -ON_EPSILON {
             out.push(p);
         }
-        if d.abs() <= ON_EPSILON {
-            continue;
-        }
-        let j = (i + 1) % n;
-        let dn = dists[j];
-        if dn.abs() <= ON_EPSILON || (dn > 0.0) == (d > 0.0) {
-            continue;
-        }
-        let mut mid = p.lerp(input[j], d / (d - dn));
-        // Keep axial coordinates exact so axial splits do not drift.
-        for axis in 0..3 {
-            if plane.normal[axis] == 1.0 {
-                mid[axis] = plane.dist;
-            } else if plane.normal[axis] == -1.0 {
-                mid[axis] = -plane.dist;
+        if d.abs() > ON_EPSILON && dn.abs() > ON_EPSILON && (dn > 0.0) != (d > 0.0) {
+            let mut mid = p.lerp(input[j], d / (d - dn));
+            // Keep axial coordinates exact so axial splits do not drift.
+            for axis in 0..3 {
+                if plane.normal[axis] == 1.0 {
+                    mid[axis] = plane.dist;
+                } else if plane.normal[axis] == -1.0 {
+                    mid[axis] = -plane.dist;
+                }
             }
+            out.push(mid);
         }
-        out.push(mid);
+        d = dn;
     }
-    true
 }
 
-/// [`clip_front`] replacing `winding`, with `scratch` as the other buffer.
-fn clip_in_place(winding: &mut Vec<Vec3>, plane: &Plane, scratch: &mut Vec<Vec3>) -> bool {
-    let kept = clip_front(winding, plane, scratch);
-    std::mem::swap(winding, scratch);
-    kept
+/// [`clip_front`] of `input`, a part of `bound`'s winding: a bounding sphere wholly on one side
+/// of the plane decides without testing the points.
+fn clip_within(input: &[Vec3], bound: &OneWayPortal, plane: &Plane, out: &mut Vec<Vec3>) -> bool {
+    match bound.sphere_side(plane) {
+        Some(true) => {
+            out.clear();
+            out.extend_from_slice(input);
+            true
+        }
+        Some(false) => false,
+        None => clip_front(input, plane, out),
+    }
+}
+
+/// [`clip_within`] replacing `winding`, with `scratch` as the other buffer.
+fn clip_in_place(
+    winding: &mut Vec<Vec3>,
+    bound: &OneWayPortal,
+    plane: &Plane,
+    scratch: &mut Vec<Vec3>,
+) -> bool {
+    match bound.sphere_side(plane) {
+        Some(kept) => kept,
+        None => match cut(winding, plane) {
+            None => false,
+            Some(false) => true,
+            Some(true) => {
+                scratch.clear();
+                split_front(winding, plane, scratch);
+                std::mem::swap(winding, scratch);
+                true
+            }
+        },
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sample::SplitMix64;
     use quake_formats::geom::{Split, Winding};
 
     fn square() -> Vec<Vec3> {
@@ -406,7 +478,10 @@ mod tests {
             .map(|&v| v + Vec3::new(32.0, 0.0, 64.0))
             .collect();
         let mut planes = Vec::new();
-        separating_planes(&source, &pass, true, &mut planes);
+        separating_planes(&source, &pass, true, &mut |p| {
+            planes.push(p);
+            true
+        });
         assert!(!planes.is_empty());
         for plane in &planes {
             assert!(source.iter().all(|&v| plane.distance(v) <= ON_EPSILON));
@@ -417,5 +492,115 @@ mod tests {
         let outside = Vec3::new(-64.0, 32.0, 128.0);
         assert!(planes.iter().all(|p| p.distance(inside) >= -ON_EPSILON));
         assert!(planes.iter().any(|p| p.distance(outside) < -ON_EPSILON));
+    }
+
+    /// A regular polygon of 3 to 8 points, axial or on a random plane, somewhere in a map.
+    fn random_winding(rng: &mut SplitMix64) -> Vec<Vec3> {
+        let sides = 3 + rng.below(6);
+        let mut coordinate = || rng.unit() * 2.0 - 1.0;
+        let center = Vec3::new(coordinate(), coordinate(), coordinate()) * 1024.0;
+        let axis = Vec3::new(coordinate(), coordinate(), coordinate());
+        let (u, v) = match axis.cross(Vec3::new(0.0, 0.0, 1.0)).normalized() {
+            Some(u) if coordinate() > 0.0 => (u, axis.cross(u).normalized().unwrap_or(u)),
+            _ => (Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0)),
+        };
+        let radius = 8.0 + (coordinate() + 1.0) * 64.0;
+        (0..sides)
+            .map(|k| {
+                let t = std::f64::consts::TAU * k as f64 / sides as f64;
+                center + u * (radius * t.cos()) + v * (radius * t.sin())
+            })
+            .collect()
+    }
+
+    /// The search with every candidate's normal normalized, as classic vis does it: the
+    /// reference the scaled comparisons of [`separating_planes`] must agree with.
+    fn separating_planes_normalized(a: &[Vec3], b: &[Vec3], a_behind: bool) -> Vec<Plane> {
+        let mut out = Vec::new();
+        let n = a.len();
+        for i in 0..n {
+            let l = (i + 1) % n;
+            for (j, &bp) in b.iter().enumerate() {
+                let Some(normal) = (a[l] - a[i]).cross(bp - a[i]).normalized() else {
+                    continue;
+                };
+                let mut plane = Plane::new(normal, normal.dot(bp));
+                let a_side = (0..n)
+                    .filter(|&k| k != i && k != l)
+                    .map(|k| plane.distance(a[k]))
+                    .find(|d| d.abs() > ON_EPSILON);
+                match a_side {
+                    None => continue,
+                    Some(d) if d > 0.0 => plane = plane.flipped(),
+                    Some(_) => {}
+                }
+                let others = b.iter().enumerate().filter(|&(k, _)| k != j);
+                let separates = others
+                    .clone()
+                    .all(|(_, &v)| plane.distance(v) >= -ON_EPSILON);
+                if separates && others.clone().any(|(_, &v)| plane.distance(v) > ON_EPSILON) {
+                    out.push(if a_behind { plane } else { plane.flipped() });
+                    break;
+                }
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn separators_match_the_normalized_search() {
+        let mut rng = SplitMix64::new(4);
+        let mut found = 0;
+        for _ in 0..2000 {
+            let a = random_winding(&mut rng);
+            let mut b = random_winding(&mut rng);
+            if rng.below(4) == 0 {
+                // Parallel edges: near-ties between candidates, as axial maps are full of.
+                b = a.iter().map(|&v| v + Vec3::new(16.0, 0.0, 96.0)).collect();
+            }
+            for a_behind in [true, false] {
+                let mut planes = Vec::new();
+                separating_planes(&a, &b, a_behind, &mut |p| {
+                    planes.push(p);
+                    true
+                });
+                assert_eq!(planes, separating_planes_normalized(&a, &b, a_behind));
+                found += planes.len();
+            }
+        }
+        assert!(found > 1000, "too few separators to compare: {found}");
+    }
+
+    #[test]
+    fn sphere_early_outs_agree_with_clipping_the_points() {
+        let mut rng = SplitMix64::new(9);
+        let mut scratch = Vec::new();
+        for _ in 0..2000 {
+            let winding = random_winding(&mut rng);
+            let Some(plane) = Winding::new(winding.clone()).plane() else {
+                continue;
+            };
+            let portal = OneWayPortal::new(winding.clone(), plane, 0, 1);
+            let normal = Vec3::new(rng.unit() - 0.5, rng.unit() - 0.5, rng.unit() - 0.5);
+            let Some(normal) = normal.normalized() else {
+                continue;
+            };
+            // Planes from far in front of the winding to far behind it.
+            let offset = (rng.unit() * 2.0 - 1.0) * 2.0 * portal.radius;
+            let cut = Plane::new(normal, normal.dot(portal.center) + offset);
+            let mut expected = Vec::new();
+            let kept = clip_front(&winding, &cut, &mut expected);
+            let mut within = Vec::new();
+            assert_eq!(clip_within(&winding, &portal, &cut, &mut within), kept);
+            let mut in_place = winding.clone();
+            assert_eq!(
+                clip_in_place(&mut in_place, &portal, &cut, &mut scratch),
+                kept
+            );
+            if kept {
+                assert_eq!(within, expected);
+                assert_eq!(in_place, expected);
+            }
+        }
     }
 }

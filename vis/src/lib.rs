@@ -236,10 +236,14 @@ fn full_flow(graph: &PortalGraph, mightsee: &[BitSet], level: u8, progress: bool
             let Ok(mut ws) = workspaces[thread.index()].lock() else {
                 return;
             };
+            // Largest mightsee first within a wave: the biggest flows start early, so fewer
+            // threads wait for a late one at the wave's end (the order changes no result).
             loop {
-                let i = next.fetch_add(1, Ordering::Relaxed);
-                let Some(&p) = wave.get(i) else { break };
-                let _ = results[i].set(flow::portal_flow(&ctx, p, &mut ws));
+                let taken = next.fetch_add(1, Ordering::Relaxed);
+                let Some(i) = wave.len().checked_sub(taken + 1) else {
+                    break;
+                };
+                let _ = results[i].set(flow::portal_flow(&ctx, wave[i], &mut ws));
                 bar.inc(1);
             }
         });

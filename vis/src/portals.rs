@@ -9,7 +9,7 @@
 //! into the leaf it leads to: whatever is seen through it lies in front of it.
 
 use crate::VisError;
-use quake_formats::geom::{ON_EPSILON, Plane, Vec3};
+use quake_formats::geom::{ON_EPSILON, POINT_EPSILON, Plane, Vec3};
 use quake_formats::prt::PortalFile;
 
 /// A portal seen from one side: looking from `from_cluster` through `winding` into `to_cluster`.
@@ -26,7 +26,12 @@ pub struct OneWayPortal {
 }
 
 impl OneWayPortal {
-    fn new(winding: Vec<Vec3>, plane: Plane, from_cluster: u32, to_cluster: u32) -> OneWayPortal {
+    pub(crate) fn new(
+        winding: Vec<Vec3>,
+        plane: Plane,
+        from_cluster: u32,
+        to_cluster: u32,
+    ) -> OneWayPortal {
         let center = winding.iter().fold(Vec3::ZERO, |a, &v| a + v) / winding.len().max(1) as f64;
         let radius = winding
             .iter()
@@ -47,6 +52,23 @@ impl OneWayPortal {
     #[inline]
     pub fn behind(&self, plane: &Plane) -> bool {
         plane.distance(self.center) < -self.radius - ON_EPSILON
+    }
+
+    /// The side of `plane` the bounding sphere lies wholly on, so that every point of the
+    /// winding, or of any part of it, does too: `Some(true)` in front by more than
+    /// [`ON_EPSILON`], `Some(false)` behind by more, `None` when the sphere reaches closer.
+    /// [`POINT_EPSILON`] to spare covers rounding, so point tests agree with the answer.
+    #[inline]
+    pub fn sphere_side(&self, plane: &Plane) -> Option<bool> {
+        let d = plane.distance(self.center);
+        let reach = self.radius + ON_EPSILON + POINT_EPSILON;
+        if d > reach {
+            Some(true)
+        } else if d < -reach {
+            Some(false)
+        } else {
+            None
+        }
     }
 
     /// True when every point of the winding lies behind `plane` (by more than [`ON_EPSILON`]).
