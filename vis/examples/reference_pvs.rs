@@ -2,7 +2,7 @@
 //! `cargo run --release -p slipgate-vis --example reference_pvs -- [MAP.map REFERENCE.bsp ...]`
 //! (default: LibreQuake's start and e1m3 against the BSPs ericw-tools compiled from them).
 //!
-//! The map is compiled with the project's compiler and vised at the default level. The two BSPs
+//! The map is compiled with the project's compiler and vised at levels 2 and 4. The two BSPs
 //! have different leaves, so they are compared in world space: random point pairs, uniform in
 //! the world's box and kept when both points lie in open leaves of both BSPs. For each pair we
 //! ask each PVS whether the points' leaves may see each other, and trace the segment through
@@ -14,7 +14,7 @@ use quake_formats::geom::Vec3;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use vis::sample::{Hull0, SplitMix64, is_open};
-use vis::{Pvs, VisOptions, compute_vis, read_pvs};
+use vis::{Pvs, VisMode, VisOptions, compute_vis, read_pvs};
 
 const PAIRS: usize = 1_000_000;
 const CHUNK: usize = 4096;
@@ -91,9 +91,9 @@ fn main() {
             .collect()
     };
     println!(
-        "| map | our leaves / reference leaves | pairs | clear (ours / ref tree) | in our PVS | in ref PVS | ours / ref | only ours | only ref | too small (ours / ref) |"
+        "| map | level | our leaves / reference leaves | pairs | clear (ours / ref tree) | in our PVS | in ref PVS | ours / ref | only ours | only ref | too small (ours / ref) |"
     );
-    println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+    println!("|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|");
     for (map, reference) in pairs {
         let source = MapSource::read(&map).expect("read map");
         let options = CompileOptions {
@@ -101,47 +101,53 @@ fn main() {
             ..CompileOptions::default()
         };
         let out = compile(&source, &options).expect("compile");
-        let ours = compute_vis(&out.portals, &VisOptions::default()).expect("vis");
-        let ours = Side::new(&out.bsp, ours.pvs);
         let theirs_bsp = Bsp::read(&std::fs::read(&reference).expect("read")).expect("parse");
         let theirs = Side::new(&theirs_bsp, read_pvs(&theirs_bsp).expect("reference PVS"));
-        let world = &out.bsp.models[0];
-        let lo = Vec3::new(
-            world.mins[0] as f64,
-            world.mins[1] as f64,
-            world.mins[2] as f64,
-        );
-        let hi = Vec3::new(
-            world.maxs[0] as f64,
-            world.maxs[1] as f64,
-            world.maxs[2] as f64,
-        );
-        let counts = (0..PAIRS.div_ceil(CHUNK))
-            .into_par_iter()
-            .map(|chunk| sample_chunk(&ours, &theirs, lo, hi, chunk as u64))
-            .reduce(Counts::default, |mut a, b| {
-                a.add(&b);
-                a
-            });
-        let pct = |n: usize| 100.0 * n as f64 / counts.pairs as f64;
-        let name = map
-            .file_stem()
-            .map_or(String::new(), |s| s.to_string_lossy().into_owned());
-        println!(
-            "| {name} | {} / {} | {} | {:.2}% / {:.2}% | {:.2}% | {:.2}% | {:.3} | {:.2}% | {:.2}% | {} / {} |",
-            ours.pvs.num_leafs(),
-            theirs.pvs.num_leafs(),
-            counts.pairs,
-            pct(counts.clear_ours),
-            pct(counts.clear_theirs),
-            pct(counts.in_ours),
-            pct(counts.in_theirs),
-            counts.in_ours as f64 / counts.in_theirs.max(1) as f64,
-            pct(counts.only_ours),
-            pct(counts.only_theirs),
-            counts.too_small_ours,
-            counts.too_small_theirs,
-        );
+        for level in [2, 4] {
+            let options = VisOptions {
+                mode: VisMode::Full { level },
+                ..VisOptions::default()
+            };
+            let ours = compute_vis(&out.portals, &options).expect("vis");
+            let ours = Side::new(&out.bsp, ours.pvs);
+            let world = &out.bsp.models[0];
+            let lo = Vec3::new(
+                world.mins[0] as f64,
+                world.mins[1] as f64,
+                world.mins[2] as f64,
+            );
+            let hi = Vec3::new(
+                world.maxs[0] as f64,
+                world.maxs[1] as f64,
+                world.maxs[2] as f64,
+            );
+            let counts = (0..PAIRS.div_ceil(CHUNK))
+                .into_par_iter()
+                .map(|chunk| sample_chunk(&ours, &theirs, lo, hi, chunk as u64))
+                .reduce(Counts::default, |mut a, b| {
+                    a.add(&b);
+                    a
+                });
+            let pct = |n: usize| 100.0 * n as f64 / counts.pairs as f64;
+            let name = map
+                .file_stem()
+                .map_or(String::new(), |s| s.to_string_lossy().into_owned());
+            println!(
+                "| {name} | {level} | {} / {} | {} | {:.2}% / {:.2}% | {:.2}% | {:.2}% | {:.3} | {:.2}% | {:.2}% | {} / {} |",
+                ours.pvs.num_leafs(),
+                theirs.pvs.num_leafs(),
+                counts.pairs,
+                pct(counts.clear_ours),
+                pct(counts.clear_theirs),
+                pct(counts.in_ours),
+                pct(counts.in_theirs),
+                counts.in_ours as f64 / counts.in_theirs.max(1) as f64,
+                pct(counts.only_ours),
+                pct(counts.only_theirs),
+                counts.too_small_ours,
+                counts.too_small_theirs,
+            );
+        }
     }
 }
 
