@@ -331,6 +331,16 @@ pub(crate) mod tests {
         Brush::from_planes(&box_planes(mins, maxs), planes, contents, 0).expect("box brush")
     }
 
+    /// The solid 64-unit cube at the origin most single-brush tests start from.
+    pub(crate) fn solid_cube(planes: &mut PlaneSet) -> Brush {
+        box_brush(
+            planes,
+            Vec3::ZERO,
+            Vec3::new(64.0, 64.0, 64.0),
+            quake_formats::bsp::contents::SOLID,
+        )
+    }
+
     #[test]
     fn keep_front_matches_clip_front() {
         let square = Winding::new(vec![

@@ -122,17 +122,12 @@ pub fn emit_clipnodes(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::brush::tests::{box_brush, box_planes};
+    use crate::brush::tests::{box_planes, solid_cube};
 
     #[test]
     fn box_grows_by_the_hull_size() {
         let mut planes = PlaneSet::new();
-        let b = box_brush(
-            &mut planes,
-            Vec3::ZERO,
-            Vec3::new(64.0, 64.0, 64.0),
-            contents::SOLID,
-        );
+        let b = solid_cube(&mut planes);
         let (mins, maxs) = HULL_BOXES[0];
         let g = expand_brush(&b, &mut planes, mins, maxs).expect("grown");
         assert_eq!(g.bounds.mins, Vec3::new(-16.0, -16.0, -32.0));

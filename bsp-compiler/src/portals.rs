@@ -245,19 +245,14 @@ impl Builder {
 mod tests {
     use super::*;
     use crate::brush::Brush;
-    use crate::brush::tests::{box_brush, box_planes};
+    use crate::brush::tests::{box_planes, solid_cube};
     use crate::tree::{SplitHeuristic, build_tree};
     use quake_formats::bsp::contents;
 
     #[test]
     fn portals_of_a_single_box_close_every_leaf() {
         let mut planes = PlaneSet::new();
-        let b = box_brush(
-            &mut planes,
-            Vec3::ZERO,
-            Vec3::new(64.0, 64.0, 64.0),
-            contents::SOLID,
-        );
+        let b = solid_cube(&mut planes);
         let bounds = b.bounds;
         let tree = build_tree(vec![b], &planes, SplitHeuristic::FewestSplits, true);
         let portals = make_portals(&tree, &planes, &bounds);

@@ -6,10 +6,9 @@
 use crate::brush::keep_front;
 use crate::planes::{PlaneId, PlaneSet};
 use crate::portals::Portals;
-use crate::tree::{BuildNode, SplitCounts, SplitHeuristic, Tree, count_sorted, flatten, mid_split};
+use crate::tree::{BuildNode, SplitHeuristic, Tree, best_splitter, flatten, mid_split};
 use quake_formats::bsp::contents;
 use quake_formats::geom::{Bounds, Plane, Split, Vec3, Winding};
-use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Space left between the surfaces and the box bounding the root's region.
@@ -248,31 +247,14 @@ impl Builder<'_> {
         if let Some(mid) = mid_split(&bounds, &candidates, self.planes) {
             return Some(mid);
         }
-        let score = |&id: &PlaneId| {
-            let plane = self.planes.get(id);
-            let (mut front, mut back, mut split) = (0i64, 0i64, 0i64);
-            for s in surfaces {
-                match s.sides_of(plane) {
-                    (true, true) => split += 1,
-                    (true, false) => front += 1,
-                    (false, true) => back += 1,
-                    (false, false) => {}
-                }
-            }
-            let counts = SplitCounts {
-                split,
-                facing: count_sorted(&on_plane, id),
-                front,
-                back,
-            };
-            (self.heuristic.key(plane, counts), id)
-        };
-        let work = candidates.len() * surfaces.len();
-        if work > 20_000 {
-            candidates.par_iter().map(score).min().map(|(_, id)| id)
-        } else {
-            candidates.iter().map(score).min().map(|(_, id)| id)
-        }
+        best_splitter(
+            &candidates,
+            surfaces,
+            Surface::sides_of,
+            &on_plane,
+            self.planes,
+            self.heuristic,
+        )
     }
 
     /// The contents of a leaf, which no surface crosses: from a surface on its boundary, else

@@ -57,6 +57,44 @@ impl SplitHeuristic {
     }
 }
 
+/// The candidate with the lowest [`SplitHeuristic::key`] over a node's `items` (brushes or
+/// surfaces), each telling with `sides_of` which sides of a plane it reaches. `facing` is the
+/// sorted list of planes the items lie on, one entry per item.
+pub fn best_splitter<T: Sync>(
+    candidates: &[PlaneId],
+    items: &[T],
+    sides_of: impl Fn(&T, &Plane) -> (bool, bool) + Sync,
+    facing: &[PlaneId],
+    planes: &PlaneSet,
+    heuristic: SplitHeuristic,
+) -> Option<PlaneId> {
+    let score = |&id: &PlaneId| {
+        let plane = planes.get(id);
+        let (mut front, mut back, mut split) = (0i64, 0i64, 0i64);
+        for item in items {
+            match sides_of(item, plane) {
+                (true, true) => split += 1,
+                (true, false) => front += 1,
+                (false, true) => back += 1,
+                (false, false) => {}
+            }
+        }
+        let counts = SplitCounts {
+            split,
+            facing: count_sorted(facing, id),
+            front,
+            back,
+        };
+        (heuristic.key(plane, counts), id)
+    };
+    // Scoring is candidates x items; small nodes are not worth a fork.
+    if candidates.len() * items.len() > 20_000 {
+        candidates.par_iter().map(score).min().map(|(_, id)| id)
+    } else {
+        candidates.iter().map(score).min().map(|(_, id)| id)
+    }
+}
+
 /// For a node whose contents span `bounds`, larger than [`MID_SPLIT_SIZE`]: the axial candidate
 /// closest to the middle of its longest axis.
 pub fn mid_split(bounds: &Bounds, candidates: &[PlaneId], planes: &PlaneSet) -> Option<PlaneId> {
@@ -444,31 +482,14 @@ impl Builder<'_> {
             facing_planes.extend(own);
         }
         facing_planes.sort_unstable();
-        let score = |&id: &PlaneId| {
-            let plane = self.planes.get(id);
-            let (mut front, mut back, mut split) = (0i64, 0i64, 0i64);
-            for b in brushes {
-                match b.sides_of(plane) {
-                    (true, true) => split += 1,
-                    (true, false) => front += 1,
-                    (false, true) => back += 1,
-                    (false, false) => {}
-                }
-            }
-            let counts = SplitCounts {
-                split,
-                facing: count_sorted(&facing_planes, id),
-                front,
-                back,
-            };
-            (self.heuristic.key(plane, counts), id)
-        };
-        let work = candidates.len() * brushes.len();
-        if work > 20_000 {
-            candidates.par_iter().map(score).min().map(|(_, id)| id)
-        } else {
-            candidates.iter().map(score).min().map(|(_, id)| id)
-        }
+        best_splitter(
+            &candidates,
+            brushes,
+            Brush::sides_of,
+            &facing_planes,
+            self.planes,
+            self.heuristic,
+        )
     }
 }
 
@@ -483,17 +504,12 @@ fn strongest_contents<'a>(brushes: impl Iterator<Item = &'a Brush>) -> i32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::brush::tests::{box_brush, box_planes};
+    use crate::brush::tests::{box_brush, box_planes, solid_cube};
 
     #[test]
     fn single_box_gives_one_solid_leaf_and_empty_around() {
         let mut planes = PlaneSet::new();
-        let b = box_brush(
-            &mut planes,
-            Vec3::ZERO,
-            Vec3::new(64.0, 64.0, 64.0),
-            contents::SOLID,
-        );
+        let b = solid_cube(&mut planes);
         let tree = build_tree(vec![b], &planes, SplitHeuristic::FewestSplits, true);
         let leaves: Vec<_> = tree.nodes.iter().filter(|n| n.is_leaf()).collect();
         assert_eq!(leaves.len(), 7);
