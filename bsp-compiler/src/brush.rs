@@ -409,13 +409,7 @@ pub(crate) mod tests {
     #[test]
     fn split_keeps_thin_parts_covered() {
         let mut planes = PlaneSet::new();
-        let b = Brush::from_planes(
-            &box_planes(Vec3::ZERO, Vec3::new(64.0, 64.0, 64.0)),
-            &mut planes,
-            -2,
-            0,
-        )
-        .expect("brush");
+        let b = solid_cube(&mut planes);
         let n = Vec3::new(1.0, 0.0, 1.0).normalized().expect("n");
         let corner = Vec3::new(64.0, 32.0, 64.0);
         let (cut, flipped) = planes.insert(&Plane::new(n, n.dot(corner) - 0.02));
@@ -429,13 +423,7 @@ pub(crate) mod tests {
     #[test]
     fn split_conserves_volume_and_adds_cut_faces() {
         let mut planes = PlaneSet::new();
-        let b = Brush::from_planes(
-            &box_planes(Vec3::ZERO, Vec3::new(64.0, 64.0, 64.0)),
-            &mut planes,
-            -2,
-            0,
-        )
-        .expect("brush");
+        let b = solid_cube(&mut planes);
         let (cut, _) = planes.insert(&Plane::new(Vec3::new(0.6, 0.8, 0.0), 40.0));
         let (f, bk) = b.clone().split(cut, &planes);
         let (f, bk) = (f.expect("front"), bk.expect("back"));
