@@ -313,7 +313,7 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
         gate: options.gate,
         sun_distance: prep.sun_distance,
         dirt: prep.lights.uses_dirt().then_some(prep.lights.dirt),
-        adaptive: options.quality != Quality::Reference && std::env::var_os("NOADAPT").is_none(),
+        adaptive: options.quality != Quality::Reference,
     };
     let wanted: Vec<usize> = match &options.only_faces {
         Some(list) => list.clone(),

@@ -133,9 +133,4 @@ impl TraceScene {
         }
         out
     }
-
-    /// Distance along unit `dir` from `org` to the first surface, if any within `max`.
-    pub fn hit_distance(&self, org: [f32; 3], dir: [f32; 3], max: f32) -> Option<f32> {
-        self.scene.intersect(org, dir, 0.0, max).map(|h| h.t)
-    }
 }

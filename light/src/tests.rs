@@ -7,7 +7,7 @@ use quake_formats::extents::LightmapExtents;
 use quake_formats::geom::Vec3;
 use quake_formats::miptex::{MipTex, TextureLump};
 
-use crate::faces::face_geometry;
+use crate::faces::{FaceKind, face_geometry};
 use crate::samples::{FaceRegion, face_samples};
 use crate::scene::TraceScene;
 use crate::{Options, Quality, apply_lighting, compare, compute_lighting};
@@ -910,4 +910,82 @@ fn phong_on_func_detail_reaches_light_through_the_bsp() {
         assert_eq!(lump[f.index].group, want, "face {}", f.index);
     }
     compute_lighting(&smooth, &options(Quality::Default)).expect("light");
+}
+
+/// Every lit face's luxels (style 0) and the rays cast, at `per_axis`
+/// samples per luxel axis, with adaptive supersampling on or off.
+fn traced_faces(bsp: &Bsp, per_axis: usize, adaptive: bool) -> (Vec<Vec<[f32; 3]>>, u64) {
+    let prep = crate::prepare(bsp, &Options::default()).expect("prepare");
+    let setup = crate::trace::TraceSetup {
+        bsp,
+        faces: &prep.faces,
+        scene: &prep.scene,
+        vis: &prep.vis,
+        lights: &prep.point_lights,
+        light_leafs: &prep.light_leafs,
+        suns: &prep.lights.suns,
+        cull: true,
+        gate: 0.001,
+        sun_distance: prep.sun_distance,
+        dirt: prep.lights.uses_dirt().then_some(prep.lights.dirt),
+        adaptive,
+    };
+    let mut rays = 0;
+    let luxels = prep
+        .faces
+        .iter()
+        .filter(|f| f.kind == FaceKind::Lit)
+        .map(|geom| {
+            let (samples, _) = face_samples(geom, per_axis, &prep.scene, bsp);
+            let rules = crate::trace::FaceRules {
+                dirt: true,
+                ..Default::default()
+            };
+            let (light, counts) = crate::trace::light_face(&setup, &samples, &rules);
+            rays += counts.rays();
+            light.styles[0].1.clone()
+        })
+        .collect();
+    (luxels, rays)
+}
+
+#[test]
+fn adaptive_supersampling_matches_tracing_every_sub_sample() {
+    // Straight shadow edges wider than a luxel, from a light and from a sun;
+    // the floor's last luxel column overhangs its edge (moved samples).
+    let scenes = [
+        shadow_scene("\"light\" \"200\" \"delay\" \"3\" \"_anglescale\" \"0\""),
+        overhang_scene("\"_shadow\" \"1\"", false),
+        overhang_scene("\"_shadow\" \"1\"", true),
+        corner_scene("", ""),
+    ];
+    for (k, bsp) in scenes.iter().enumerate() {
+        for per_axis in [2, 4] {
+            let (full, full_rays) = traced_faces(bsp, per_axis, false);
+            let (adaptive, adaptive_rays) = traced_faces(bsp, per_axis, true);
+            assert_eq!(full, adaptive, "scene {k}, {per_axis}x{per_axis}");
+            assert!(
+                adaptive_rays < full_rays,
+                "scene {k}: {adaptive_rays} >= {full_rays}"
+            );
+        }
+    }
+}
+
+#[test]
+fn adaptive_dirt_stays_close_to_measuring_every_sample() {
+    let bsp = corner_scene("\"_dirt\" \"1\"", "");
+    for per_axis in [1, 4] {
+        let (full, full_rays) = traced_faces(&bsp, per_axis, false);
+        let (adaptive, adaptive_rays) = traced_faces(&bsp, per_axis, true);
+        let worst = full
+            .iter()
+            .flatten()
+            .zip(adaptive.iter().flatten())
+            .map(|(a, b)| (a[0] - b[0]).abs())
+            .fold(0.0f32, f32::max);
+        // Light units of a 200 light (100 grey levels): within 1.5 levels.
+        assert!(worst <= 3.0, "{per_axis}: {worst}");
+        assert!(adaptive_rays < full_rays, "{adaptive_rays} >= {full_rays}");
+    }
 }

@@ -244,7 +244,11 @@ fn face_occlusion(
         unique.sort_unstable();
         unique.dedup();
         let (values, rays) = dirt::occlusion_at(samples, &unique, model, sampling, setup.scene);
-        let value_of = |i: usize| unique.binary_search(&first_at[i]).map_or(0.0, |k| values[k]);
+        let value_of = |i: usize| {
+            unique
+                .binary_search(&first_at[i])
+                .map_or(0.0, |k| values[k])
+        };
         (indices.iter().map(|&i| value_of(i)).collect(), rays)
     };
     if !adaptive {
@@ -374,12 +378,13 @@ struct VisibilityScratch {
 
 impl VisibilityScratch {
     fn new(first_at: Vec<usize>) -> VisibilityScratch {
+        let n = first_at.len();
         VisibilityScratch {
-            lit: Vec::new(),
+            lit: Vec::with_capacity(n),
             first_at,
-            traced: Vec::new(),
-            todo: Vec::new(),
-            unique: Vec::new(),
+            traced: Vec::with_capacity(n),
+            todo: Vec::with_capacity(n),
+            unique: Vec::with_capacity(n),
             probes: Vec::new(),
         }
     }
@@ -444,8 +449,9 @@ impl VisibilityScratch {
                     (x.saturating_sub(1)..(x + 2).min(w))
                         .all(|nx| self.probes[ny * w + nx] == probe)
                 });
-            for i in l * per..(l + 1) * per {
-                if value[i] == 0.0 || i == l * per + probe_sub {
+            let first = l * per;
+            for (i, &v) in value.iter().enumerate().skip(first).take(per) {
+                if v == 0.0 || i == first + probe_sub {
                     continue;
                 }
                 // Moved points (the luxel overhangs the face, or something
@@ -538,8 +544,14 @@ pub fn light_face(
     let first_at = samples.first_at_same_point();
     let occlusion = match setup.dirt.filter(|_| rules.dirt) {
         Some(sampling) => {
-            let (values, rays) =
-                face_occlusion(setup, samples, face.model, &sampling, setup.adaptive, &first_at);
+            let (values, rays) = face_occlusion(
+                setup,
+                samples,
+                face.model,
+                &sampling,
+                setup.adaptive,
+                &first_at,
+            );
             counts.dirt_rays += rays;
             values
         }

@@ -1,0 +1,73 @@
+//! The rows of README's speed-against-error table for one map:
+//! `cargo run --release -p slipgate-light --example speed_error -- MAP.bsp STRIDE`.
+//! Time (best of 3) and rays are for the whole map; RMSE and max error
+//! (8-bit levels) are against `--reference` on every STRIDE-th face.
+
+use light::{Options, Quality, compare, compute_lighting, finish_lighting, trace_lighting};
+
+fn main() -> anyhow::Result<()> {
+    let mut args = std::env::args().skip(1);
+    let (Some(path), Some(stride)) = (args.next(), args.next()) else {
+        anyhow::bail!("usage: speed_error MAP.bsp STRIDE");
+    };
+    let stride: usize = stride.parse()?;
+    anyhow::ensure!(stride > 0, "STRIDE must be at least 1");
+    let bsp = quake_formats::Bsp::read(&std::fs::read(&path)?)?;
+    let some_faces = Some((0..bsp.faces.len()).step_by(stride).collect::<Vec<_>>());
+    let reference = trace_lighting(
+        &bsp,
+        &Options {
+            quality: Quality::Reference,
+            only_faces: some_faces.clone(),
+            ..Options::default()
+        },
+    )?;
+    println!(
+        "reference on every {stride}th face: {:.1} s",
+        reference.stats.seconds_trace
+    );
+    let modes = [
+        ("default", Quality::Default, 0),
+        ("--extra", Quality::Extra, 0),
+        ("--extra4", Quality::Extra4, 0),
+        ("--soft", Quality::Default, 1),
+        ("--extra4 --soft", Quality::Extra4, 1),
+    ];
+    println!("| mode | trace time | rays | RMSE | max | RMSE / max vs filtered reference |");
+    println!("|---|---|---|---|---|---|");
+    for (name, quality, soft_radius) in modes {
+        let options = Options {
+            quality,
+            soft_radius,
+            ..Options::default()
+        };
+        let mut best = f64::INFINITY;
+        let mut rays = 0;
+        for _ in 0..3 {
+            let s = compute_lighting(&bsp, &options)?.stats;
+            best = best.min(s.seconds_trace);
+            rays = s.shadow_rays + s.sun_rays + s.dirt_rays + s.placement_rays;
+        }
+        let part = compute_lighting(
+            &bsp,
+            &Options {
+                only_faces: some_faces.clone(),
+                ..options.clone()
+            },
+        )?;
+        let e = compare(&part, &finish_lighting(&reference, 0));
+        let filtered = if soft_radius > 0 {
+            let f = compare(&part, &finish_lighting(&reference, soft_radius));
+            format!("{:.2} / {}", f.rmse, f.max)
+        } else {
+            String::new()
+        };
+        println!(
+            "| {name} | {best:.2} s | {:.1} M | {:.2} | {} | {filtered} |",
+            rays as f64 / 1e6,
+            e.rmse,
+            e.max
+        );
+    }
+    Ok(())
+}
