@@ -319,7 +319,11 @@ pub fn compile(
                     origin: Vec3::new(x, y, z),
                 });
             }
-            entities.push(ent.entity.clone());
+            // A brushless func_group / func_detail (an editor group of point entities) has
+            // nothing to merge and no spawn function in any game: leave it out, as with brushes.
+            if EntityBrushes::of(index, class) == EntityBrushes::Submodel {
+                entities.push(ent.entity.clone());
+            }
             continue;
         }
         let brush_class = EntityBrushes::of(index, class);

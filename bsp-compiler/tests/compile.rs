@@ -721,3 +721,20 @@ fn corpus_maps_compile() {
         }
     }
 }
+
+/// Editor groups merge into the world: none of them reaches the entity lump, even one that holds
+/// only point entities (TrenchBroom writes those; e2m4 had 88, each a "no spawn function").
+#[test]
+fn world_merged_entities_leave_the_entity_lump() {
+    let pillar = box_brush([-16.0, -16.0, -128.0], [16.0, 16.0, 0.0], "pillar");
+    let entities = format!(
+        "{}{}{{\n\"classname\" \"func_group\"\n\"_tb_type\" \"_tb_group\"\n}}\n",
+        brush_entity("func_group", &pillar),
+        brush_entity("func_detail", ""),
+    );
+    let out = compile_text(&room_map_with(false, "", &entities));
+    let text = out.bsp.entity_text();
+    assert!(!text.contains("func_group"), "{text}");
+    assert!(!text.contains("func_detail"), "{text}");
+    assert!(text.contains("info_player_start"), "{text}");
+}
