@@ -989,3 +989,58 @@ fn adaptive_dirt_stays_close_to_measuring_every_sample() {
         assert!(adaptive_rays < full_rays, "{adaptive_rays} >= {full_rays}");
     }
 }
+
+#[test]
+fn shared_leaf_walk_agrees_with_walking_each_point() {
+    // Clusters of points (a luxel's square) inside the room, inside the
+    // column, inside the walls and straddling their faces.
+    let bsp = detail_column_bsp("");
+    let per_point = |p: &[f32; 3]| {
+        bsp.leaf_at(*p)
+            .and_then(|l| bsp.leafs.get(l))
+            .is_some_and(|l| l.contents == quake_formats::bsp::contents::SOLID)
+    };
+    let mut solid_seen = 0;
+    for cx in (-160..=160).step_by(20) {
+        for cz in (-160..=160).step_by(20) {
+            let cluster: Vec<[f32; 3]> = (0..16)
+                .map(|k| {
+                    let (u, v) = ((k % 4) as f32 * 5.0, (k / 4) as f32 * 5.0);
+                    [cx as f32 + u, 0.5 * cz as f32 + v, cz as f32 + 0.3 * u]
+                })
+                .collect();
+            let expected: Vec<bool> = cluster.iter().map(per_point).collect();
+            solid_seen += expected.iter().filter(|&&s| s).count();
+            assert_eq!(
+                crate::samples::solid_points(&bsp, &cluster),
+                expected,
+                "cluster at {cx} {cz}"
+            );
+        }
+    }
+    assert!(solid_seen > 0, "some clusters reach into solid");
+    assert!(crate::samples::solid_points(&bsp, &[]).is_empty());
+}
+
+#[test]
+fn dirt_is_measured_only_where_light_arrives() {
+    // The corner scene, and the same room with a linear light whose reach
+    // (40 units) ends far above the floor: its dark samples need no dirt rays.
+    let lit = corner_scene("\"_dirt\" \"1\"", "");
+    let mut polys = vec![floor(256.0)];
+    polys.extend(box_faces([192.0, -64.0, 0.0], [320.0, 320.0, 256.0]));
+    let dark = synthetic_bsp(
+        &polys,
+        "{ \"classname\" \"worldspawn\" \"_dirt\" \"1\" }\n\
+         { \"classname\" \"light\" \"origin\" \"96 128 200\" \"light\" \"40\" }\n",
+    );
+    let rays = |bsp: &Bsp| {
+        compute_lighting(bsp, &options(Quality::Default))
+            .expect("light")
+            .stats
+            .dirt_rays
+    };
+    let (lit_rays, dark_rays) = (rays(&lit), rays(&dark));
+    assert!(lit_rays > 0);
+    assert!(dark_rays < lit_rays, "{dark_rays} >= {lit_rays}");
+}

@@ -407,7 +407,13 @@ impl Bsp {
 
     /// The leaf containing `point`, walking the world model's hull 0 tree.
     pub fn leaf_at(&self, point: [f32; 3]) -> Option<usize> {
-        let mut node = *self.models.first()?.head_nodes.first()?;
+        self.leaf_from(*self.models.first()?.head_nodes.first()?, point)
+    }
+
+    /// The leaf containing `point`, walking down from `node` (a child
+    /// index: negative for a leaf), for callers that know the point lies
+    /// below it.
+    pub fn leaf_from(&self, mut node: i32, point: [f32; 3]) -> Option<usize> {
         let mut steps = 0;
         while node >= 0 {
             let n = self.nodes.get(node as usize)?;
