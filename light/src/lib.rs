@@ -301,6 +301,7 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
     let start = Instant::now();
     let prep = prepare(bsp, options)?;
     let setup_done = Instant::now();
+    let light_reaches = trace::light_reaches(&prep.point_lights, options.gate);
     let setup = TraceSetup {
         bsp,
         faces: &prep.faces,
@@ -308,6 +309,7 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
         vis: &prep.vis,
         lights: &prep.point_lights,
         light_leafs: &prep.light_leafs,
+        light_reaches: &light_reaches,
         suns: &prep.lights.suns,
         cull: !options.no_cull && options.quality != Quality::Reference,
         gate: options.gate,

@@ -565,6 +565,7 @@ fn column_scene(world_keys: &str) -> Bsp {
 fn edge_jumps(world_keys: &str) -> Vec<f64> {
     let bsp = column_scene(world_keys);
     let prep = crate::prepare(&bsp, &Options::default()).expect("prepare");
+    let light_reaches = crate::trace::light_reaches(&prep.point_lights, 0.001);
     let setup = crate::trace::TraceSetup {
         bsp: &bsp,
         faces: &prep.faces,
@@ -572,6 +573,7 @@ fn edge_jumps(world_keys: &str) -> Vec<f64> {
         vis: &prep.vis,
         lights: &prep.point_lights,
         light_leafs: &prep.light_leafs,
+        light_reaches: &light_reaches,
         suns: &[],
         cull: true,
         gate: 0.001,
@@ -916,6 +918,7 @@ fn phong_on_func_detail_reaches_light_through_the_bsp() {
 /// samples per luxel axis, with adaptive supersampling on or off.
 fn traced_faces(bsp: &Bsp, per_axis: usize, adaptive: bool) -> (Vec<Vec<[f32; 3]>>, u64) {
     let prep = crate::prepare(bsp, &Options::default()).expect("prepare");
+    let light_reaches = crate::trace::light_reaches(&prep.point_lights, 0.001);
     let setup = crate::trace::TraceSetup {
         bsp,
         faces: &prep.faces,
@@ -923,6 +926,7 @@ fn traced_faces(bsp: &Bsp, per_axis: usize, adaptive: bool) -> (Vec<Vec<[f32; 3]
         vis: &prep.vis,
         lights: &prep.point_lights,
         light_leafs: &prep.light_leafs,
+        light_reaches: &light_reaches,
         suns: &prep.lights.suns,
         cull: true,
         gate: 0.001,

@@ -107,6 +107,8 @@ pub struct TraceSetup<'a> {
     pub lights: &'a [PointLight],
     /// World leaf of each light (None: in solid or outside; no PVS culling).
     pub light_leafs: &'a [Option<u32>],
+    /// Each light's cut-off, from [`light_reaches`] with `gate`.
+    pub light_reaches: &'a [LightReach],
     pub suns: &'a [SunLight],
     /// Skip lights that cannot reach a face (range, plane side, PVS, sky PVS).
     pub cull: bool,
@@ -197,8 +199,28 @@ fn sub(a: Vec3, b: [f32; 3]) -> Vec3 {
     a - Vec3::from_f32(b)
 }
 
-/// Distance from `p` to the box `b` (0 inside).
-fn box_distance(b: &Bounds, p: Vec3) -> f64 {
+/// Where a light is and how far it reaches, packed for the per-face cull
+/// (e1m1 tests about 950k face/light pairs).
+#[derive(Debug, Clone, Copy)]
+pub struct LightReach {
+    origin: Vec3,
+    /// Square of [`PointLight::range`] (infinite for lights that never fade).
+    range_squared: f64,
+}
+
+/// Each light's [`LightReach`] at contribution cut-off `gate`.
+pub fn light_reaches(lights: &[PointLight], gate: f64) -> Vec<LightReach> {
+    lights
+        .iter()
+        .map(|l| LightReach {
+            origin: l.origin,
+            range_squared: l.range(gate).powi(2),
+        })
+        .collect()
+}
+
+/// Squared distance from `p` to the box `b` (0 inside).
+fn box_distance_squared(b: &Bounds, p: Vec3) -> f64 {
     let mut d2 = 0.0;
     for axis in 0..3 {
         let excess = (b.mins[axis] - p[axis])
@@ -206,7 +228,7 @@ fn box_distance(b: &Bounds, p: Vec3) -> f64 {
             .max(0.0);
         d2 += excess * excess;
     }
-    d2.sqrt()
+    d2
 }
 
 /// Occlusion may be interpolated between grid points that differ by at
@@ -626,9 +648,10 @@ pub fn light_face(
     let mut near: Vec<(usize, usize)> = Vec::new();
     for (li, light) in lights.iter().enumerate() {
         counts.pairs += 1;
+        let reach = &setup.light_reaches[li];
         if setup.cull
-            && (face.plane.distance(light.origin) <= 0.0
-                || box_distance(&bounds, light.origin) > light.range(setup.gate)
+            && (face.plane.distance(reach.origin) <= 0.0
+                || box_distance_squared(&bounds, reach.origin) > reach.range_squared
                 || !setup.vis.may_reach(setup.light_leafs[li], face.index))
         {
             counts.pairs_culled += 1;
