@@ -185,6 +185,34 @@ pub struct Prepared {
     pub phong: Vec<Option<Vec<Vec3>>>,
 }
 
+impl Prepared {
+    /// What tracing reads, with lights cut off at `light_reaches` (built with `gate`).
+    pub fn trace_setup<'a>(
+        &'a self,
+        bsp: &'a Bsp,
+        light_reaches: &'a [trace::LightReach],
+        gate: f64,
+        cull: bool,
+        adaptive: bool,
+    ) -> TraceSetup<'a> {
+        TraceSetup {
+            bsp,
+            faces: &self.faces,
+            scene: &self.scene,
+            vis: &self.vis,
+            lights: &self.point_lights,
+            light_leafs: &self.light_leafs,
+            light_reaches,
+            suns: &self.lights.suns,
+            cull,
+            gate,
+            sun_distance: self.sun_distance,
+            dirt: self.lights.uses_dirt().then_some(self.lights.dirt),
+            adaptive,
+        }
+    }
+}
+
 /// Reads faces, entities and visibility and builds the Embree scene.
 ///
 /// # Errors
@@ -302,21 +330,13 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
     let prep = prepare(bsp, options)?;
     let setup_done = Instant::now();
     let light_reaches = trace::light_reaches(&prep.point_lights, options.gate);
-    let setup = TraceSetup {
+    let setup = prep.trace_setup(
         bsp,
-        faces: &prep.faces,
-        scene: &prep.scene,
-        vis: &prep.vis,
-        lights: &prep.point_lights,
-        light_leafs: &prep.light_leafs,
-        light_reaches: &light_reaches,
-        suns: &prep.lights.suns,
-        cull: !options.no_cull && options.quality != Quality::Reference,
-        gate: options.gate,
-        sun_distance: prep.sun_distance,
-        dirt: prep.lights.uses_dirt().then_some(prep.lights.dirt),
-        adaptive: options.quality != Quality::Reference,
-    };
+        &light_reaches,
+        options.gate,
+        !options.no_cull && options.quality != Quality::Reference,
+        options.quality != Quality::Reference,
+    );
     let wanted: Vec<usize> = match &options.only_faces {
         Some(list) => list.clone(),
         None => (0..prep.faces.len()).collect(),

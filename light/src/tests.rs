@@ -27,6 +27,20 @@ fn quad(a: [f32; 3], b: [f32; 3], c: [f32; 3], d: [f32; 3], normal: [f32; 3]) ->
     }
 }
 
+/// A sky ceiling at z 512, facing down over the test floors.
+fn sky_ceiling() -> Poly {
+    Poly {
+        sky: true,
+        ..quad(
+            [-512.0, -512.0, 512.0],
+            [768.0, -512.0, 512.0],
+            [768.0, 768.0, 512.0],
+            [-512.0, 768.0, 512.0],
+            [0.0, 0.0, -1.0],
+        )
+    }
+}
+
 /// The six outward faces of the box `lo..hi`.
 fn box_faces(lo: [f32; 3], hi: [f32; 3]) -> Vec<Poly> {
     // Corner i takes hi on axis k when bit k of i is set; each face lists its corners
@@ -344,15 +358,7 @@ fn switchable_lights_get_their_own_style() {
 fn sun_reaches_only_what_sees_the_sky() {
     // A floor under a sky ceiling, with an opaque slab shading part of it.
     let mut polys = vec![floor(256.0)];
-    let mut ceiling = quad(
-        [-512.0, -512.0, 512.0],
-        [768.0, -512.0, 512.0],
-        [768.0, 768.0, 512.0],
-        [-512.0, 768.0, 512.0],
-        [0.0, 0.0, -1.0],
-    );
-    ceiling.sky = true;
-    polys.push(ceiling);
+    polys.push(sky_ceiling());
     polys.extend(box_faces([0.0, 0.0, 200.0], [128.0, 256.0, 208.0]));
     let ents = "{ \"classname\" \"worldspawn\" \"_sunlight\" \"200\" \"_anglescale\" \"0\" }\n";
     let bsp = synthetic_bsp(&polys, ents);
@@ -567,19 +573,9 @@ fn edge_jumps(world_keys: &str) -> Vec<f64> {
     let prep = crate::prepare(&bsp, &Options::default()).expect("prepare");
     let light_reaches = crate::trace::light_reaches(&prep.point_lights, 0.001);
     let setup = crate::trace::TraceSetup {
-        bsp: &bsp,
-        faces: &prep.faces,
-        scene: &prep.scene,
-        vis: &prep.vis,
-        lights: &prep.point_lights,
-        light_leafs: &prep.light_leafs,
-        light_reaches: &light_reaches,
         suns: &[],
-        cull: true,
-        gate: 0.001,
-        sun_distance: prep.sun_distance,
         dirt: None,
-        adaptive: true,
+        ..prep.trace_setup(&bsp, &light_reaches, 0.001, true, true)
     };
     // Value and position of every sample at mid height of each column face.
     let rows: Vec<Vec<(Vec3, f64)>> = (1..=8)
@@ -646,15 +642,7 @@ fn overhang_scene(model_keys: &str, sun: bool) -> Bsp {
     let mut model = box_faces([96.0, 96.0, 0.0], [160.0, 160.0, 64.0]);
     model.extend(box_faces([32.0, 32.0, 64.0], [224.0, 224.0, 80.0]));
     let (world_keys, light) = if sun {
-        let mut sky = quad(
-            [-512.0, -512.0, 512.0],
-            [768.0, -512.0, 512.0],
-            [768.0, 768.0, 512.0],
-            [-512.0, 768.0, 512.0],
-            [0.0, 0.0, -1.0],
-        );
-        sky.sky = true;
-        world.push(sky);
+        world.push(sky_ceiling());
         let keys = "\"_sunlight\" \"200\" \"_sun_mangle\" \"180 -57 0\" \"_anglescale\" \"0\"";
         (keys, String::new())
     } else {
@@ -919,21 +907,7 @@ fn phong_on_func_detail_reaches_light_through_the_bsp() {
 fn traced_faces(bsp: &Bsp, per_axis: usize, adaptive: bool) -> (Vec<Vec<[f32; 3]>>, u64) {
     let prep = crate::prepare(bsp, &Options::default()).expect("prepare");
     let light_reaches = crate::trace::light_reaches(&prep.point_lights, 0.001);
-    let setup = crate::trace::TraceSetup {
-        bsp,
-        faces: &prep.faces,
-        scene: &prep.scene,
-        vis: &prep.vis,
-        lights: &prep.point_lights,
-        light_leafs: &prep.light_leafs,
-        light_reaches: &light_reaches,
-        suns: &prep.lights.suns,
-        cull: true,
-        gate: 0.001,
-        sun_distance: prep.sun_distance,
-        dirt: prep.lights.uses_dirt().then_some(prep.lights.dirt),
-        adaptive,
-    };
+    let setup = prep.trace_setup(bsp, &light_reaches, 0.001, true, adaptive);
     let mut rays = 0;
     let luxels = prep
         .faces
