@@ -1,28 +1,17 @@
 //! End-to-end tests of the `slipgate` command: exit codes, `info`, `convert`.
 
+#[path = "support/corpus.rs"]
+mod support_corpus;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+use support_corpus::corpus;
 
 fn slipgate(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_slipgate"))
         .args(args)
         .output()
         .expect("run slipgate")
-}
-
-fn corpus(rel: &str) -> Option<PathBuf> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/corpus")
-        .join(rel);
-    if p.exists() {
-        Some(p)
-    } else {
-        eprintln!(
-            "SKIPPED: {} not found (needs ../shared/corpus)",
-            p.display()
-        );
-        None
-    }
 }
 
 fn scratch(name: &str) -> PathBuf {

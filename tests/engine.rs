@@ -19,6 +19,8 @@
 
 #[path = "support/progs.rs"]
 mod progs;
+#[path = "support/corpus.rs"]
+mod support_corpus;
 
 use quake_formats::Bsp;
 use quake_formats::entities::{Entity, parse_entities};
@@ -27,6 +29,7 @@ use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
+use support_corpus::corpus;
 
 /// A load takes about a second; the limit only keeps a hung engine from hanging the test.
 const ENGINE_TIMEOUT: Duration = Duration::from_secs(20);
@@ -106,19 +109,6 @@ fn engine(test: &str, index: u32) -> Option<Engine> {
         xvfb,
         display: 100 + pid % 500 * 8 + index,
     })
-}
-
-fn corpus(rel: &str) -> Option<PathBuf> {
-    let p = repo().join("../shared/corpus").join(rel);
-    if p.exists() {
-        Some(p)
-    } else {
-        eprintln!(
-            "SKIPPED: {} not found (needs ../shared/corpus)",
-            p.display()
-        );
-        None
-    }
 }
 
 /// A game directory ready to run one map.
