@@ -235,15 +235,7 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
     }
 
     // Nodes, leaves and models.
-    bsp.leafs.push(Leaf {
-        contents: contents::SOLID,
-        vis_offset: -1,
-        mins: [0.0; 3],
-        maxs: [0.0; 3],
-        first_marksurface: 0,
-        num_marksurfaces: 0,
-        ambient: [0; 4],
-    });
+    bsp.leafs.push(Leaf::SHARED_SOLID);
     let mut world_leaf_index: HashMap<u32, u32> = HashMap::new();
     for (mi, m) in input.models.iter().enumerate() {
         let (first_face, num_faces) = model_faces[mi];

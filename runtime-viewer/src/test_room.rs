@@ -49,15 +49,7 @@ pub fn room_bsp(wall0_style: u8) -> Bsp {
         ([0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, -1.0, 0.0]),
     ];
     let bounds = ([-HALF; 3], [HALF; 3]);
-    bsp.leafs.push(Leaf {
-        contents: contents::SOLID,
-        vis_offset: -1,
-        mins: [0.0; 3],
-        maxs: [0.0; 3],
-        first_marksurface: 0,
-        num_marksurfaces: 0,
-        ambient: [0; 4],
-    });
+    bsp.leafs.push(Leaf::SHARED_SOLID);
     bsp.leafs.push(Leaf {
         contents: contents::EMPTY,
         vis_offset: -1,

@@ -201,15 +201,7 @@ impl VoxelWorld {
     /// else is the solid leaf 0. No faces; enough for vis lumps and tracing.
     pub fn bsp(&self) -> Bsp {
         let mut bsp = Bsp::default();
-        bsp.leafs.push(Leaf {
-            contents: contents::SOLID,
-            vis_offset: -1,
-            mins: [0.0; 3],
-            maxs: [0.0; 3],
-            first_marksurface: 0,
-            num_marksurfaces: 0,
-            ambient: [0; 4],
-        });
+        bsp.leafs.push(Leaf::SHARED_SOLID);
         for c in self.open_cells() {
             let lo = self.corner(c).to_f32();
             let hi = self.corner(c.map(|x| x + 1)).to_f32();

@@ -215,6 +215,19 @@ pub struct Leaf {
     pub ambient: [u8; 4],
 }
 
+impl Leaf {
+    /// Leaf 0 of every BSP: the one solid leaf all hull 0 trees share, with no PVS row.
+    pub const SHARED_SOLID: Leaf = Leaf {
+        contents: contents::SOLID,
+        vis_offset: -1,
+        mins: [0.0; 3],
+        maxs: [0.0; 3],
+        first_marksurface: 0,
+        num_marksurfaces: 0,
+        ambient: [0; 4],
+    };
+}
+
 impl Record for Leaf {
     const LUMP: &'static str = "leafs";
     fn size(v: BspVersion) -> usize {
