@@ -7,7 +7,7 @@
 //! T-junction between water and a wall shows as a crack like any other. Indices the validator
 //! would reject are skipped, never trusted.
 
-use crate::weld::TJUNCTION_EPSILON;
+use crate::weld::{TJUNCTION_EPSILON, cell_and_neighbours};
 use quake_formats::Bsp;
 use quake_formats::geom::{POINT_EPSILON, Vec3};
 use std::collections::{BTreeMap, BTreeSet, HashMap};
@@ -63,19 +63,10 @@ impl CrackReport {
 
 /// The vertex indices of face `f` in winding order, or `None` when an index is out of range.
 fn face_vertices(bsp: &Bsp, f: usize) -> Option<Vec<u32>> {
-    let face = bsp.faces.get(f)?;
-    let first = face.first_edge as usize;
-    let surfedges = bsp
-        .surfedges
-        .get(first..first.checked_add(face.num_edges as usize)?)?;
-    surfedges
-        .iter()
-        .map(|&se| {
-            let edge = bsp.edges.get(se.unsigned_abs() as usize)?;
-            let v = if se >= 0 { edge[0] } else { edge[1] };
-            ((v as usize) < bsp.vertices.len()).then_some(v)
-        })
-        .collect()
+    let vs = bsp.face_vertex_indices(bsp.faces.get(f)?)?;
+    vs.iter()
+        .all(|&v| (v as usize) < bsp.vertices.len())
+        .then_some(vs)
 }
 
 fn cell(p: Vec3) -> [i64; 3] {
@@ -88,14 +79,9 @@ fn cells_along(a: Vec3, b: Vec3, out: &mut BTreeSet<[i64; 3]>) {
     out.clear();
     let steps = ((b - a).length() / (GRID * 0.5)).ceil().max(1.0) as usize;
     for i in 0..=steps {
-        let [x, y, z] = cell(a.lerp(b, i as f64 / steps as f64));
-        for dx in -1..=1 {
-            for dy in -1..=1 {
-                for dz in -1..=1 {
-                    out.insert([x + dx, y + dy, z + dz]);
-                }
-            }
-        }
+        out.extend(cell_and_neighbours(cell(
+            a.lerp(b, i as f64 / steps as f64),
+        )));
     }
 }
 
@@ -124,15 +110,10 @@ fn check_model(bsp: &Bsp, model: usize, faces: &[(usize, Vec<u32>)], report: &mu
     }
 
     for &v in &used {
-        let [x, y, z] = cell(pos(v));
-        for dx in -1..=1 {
-            for dy in -1..=1 {
-                for dz in -1..=1 {
-                    for &w in grid.get(&[x + dx, y + dy, z + dz]).into_iter().flatten() {
-                        if w > v && pos(w).near(pos(v), POINT_EPSILON) {
-                            report.duplicate_vertices.push((model, v, w));
-                        }
-                    }
+        for c in cell_and_neighbours(cell(pos(v))) {
+            for &w in grid.get(&c).into_iter().flatten() {
+                if w > v && pos(w).near(pos(v), POINT_EPSILON) {
+                    report.duplicate_vertices.push((model, v, w));
                 }
             }
         }

@@ -16,6 +16,13 @@ pub struct VertexWelder {
     cells: HashMap<[i64; 3], Vec<u32>>,
 }
 
+/// A grid cell and the 26 around it: every cell a point within one cell width can fall in.
+pub(crate) fn cell_and_neighbours([x, y, z]: [i64; 3]) -> impl Iterator<Item = [i64; 3]> {
+    (-1..=1).flat_map(move |dx| {
+        (-1..=1).flat_map(move |dy| (-1..=1).map(move |dz| [x + dx, y + dy, z + dz]))
+    })
+}
+
 impl VertexWelder {
     fn cell(p: Vec3) -> [i64; 3] {
         // Cells several epsilons wide; neighbours are searched, so the size only affects speed.
@@ -24,23 +31,17 @@ impl VertexWelder {
     }
 
     pub fn weld(&mut self, p: Vec3) -> u32 {
-        let [x, y, z] = Self::cell(p);
-        for dx in -1..=1 {
-            for dy in -1..=1 {
-                for dz in -1..=1 {
-                    if let Some(ids) = self.cells.get(&[x + dx, y + dy, z + dz])
-                        && let Some(&id) = ids
-                            .iter()
-                            .find(|&&id| self.positions[id as usize].near(p, POINT_EPSILON))
-                    {
-                        return id;
-                    }
-                }
-            }
+        let cell = Self::cell(p);
+        let found = cell_and_neighbours(cell)
+            .filter_map(|c| self.cells.get(&c))
+            .flatten()
+            .find(|&&id| self.positions[id as usize].near(p, POINT_EPSILON));
+        if let Some(&id) = found {
+            return id;
         }
         let id = self.positions.len() as u32;
         self.positions.push(p);
-        self.cells.entry([x, y, z]).or_default().push(id);
+        self.cells.entry(cell).or_default().push(id);
         id
     }
 }

@@ -366,14 +366,22 @@ impl Bsp {
     /// The vertices of a face in winding order (edges followed by their direction).
     /// Indices are bounds-checked; a broken face yields `None`.
     pub fn face_vertices(&self, face: &Face) -> Option<Vec<[f32; 3]>> {
+        self.face_vertex_indices(face)?
+            .into_iter()
+            .map(|v| self.vertices.get(v as usize).copied())
+            .collect()
+    }
+
+    /// The vertex indices of `face` in winding order, or `None` when an edge index is out of
+    /// range (vertex indices are returned as stored, not checked).
+    pub fn face_vertex_indices(&self, face: &Face) -> Option<Vec<u32>> {
         let first = face.first_edge as usize;
         let surfedges = self.surfedges.get(first..first + face.num_edges as usize)?;
         surfedges
             .iter()
             .map(|&se| {
                 let edge = self.edges.get(se.unsigned_abs() as usize)?;
-                let v = if se >= 0 { edge[0] } else { edge[1] };
-                self.vertices.get(v as usize).copied()
+                Some(if se >= 0 { edge[0] } else { edge[1] })
             })
             .collect()
     }
