@@ -296,6 +296,13 @@ fn face_occlusion(
     let index = |gx: usize, gy: usize| {
         ((gy / axis) * samples.width + gx / axis) * axis * axis + (gy % axis) * axis + gx % axis
     };
+    // The four grid samples around grid position (gx, gy), when the face's grid has them.
+    let corners = |gx: usize, gy: usize| {
+        let (x0, y0) = (gx / stride * stride, gy / stride * stride);
+        let (x1, y1) = (x0 + stride, y0 + stride);
+        (x1 < gw && y1 < gh)
+            .then(|| [(x0, y0), (x1, y0), (x0, y1), (x1, y1)].map(|(x, y)| index(x, y)))
+    };
     let mut known: Vec<Option<f32>> = vec![None; n];
     // First the needed grid and moved samples, and the grid corners of the
     // other needed samples (what they may be interpolated from).
@@ -310,11 +317,7 @@ fn face_occlusion(
                 first.push(i);
                 continue;
             }
-            let (x0, y0) = (gx / stride * stride, gy / stride * stride);
-            let (x1, y1) = (x0 + stride, y0 + stride);
-            if x1 < gw && y1 < gh {
-                first.extend([(x0, y0), (x1, y0), (x0, y1), (x1, y1)].map(|(x, y)| index(x, y)));
-            }
+            first.extend(corners(gx, gy).into_iter().flatten());
         }
     }
     first.sort_unstable();
@@ -330,15 +333,9 @@ fn face_occlusion(
             if known[i].is_some() || !needed[i] {
                 continue;
             }
-            let (x0, y0) = (gx / stride * stride, gy / stride * stride);
-            let (x1, y1) = (x0 + stride, y0 + stride);
-            let corners = (x1 < gw && y1 < gh).then(|| {
-                [(x0, y0), (x1, y0), (x0, y1), (x1, y1)].map(|(x, y)| {
-                    let c = index(x, y);
-                    known[c].filter(|_| !samples.moved[c])
-                })
-            });
-            let Some([Some(a), Some(b), Some(c), Some(d)]) = corners else {
+            let around =
+                corners(gx, gy).map(|cs| cs.map(|c| known[c].filter(|_| !samples.moved[c])));
+            let Some([Some(a), Some(b), Some(c), Some(d)]) = around else {
                 rest.push(i);
                 continue;
             };
@@ -347,8 +344,8 @@ fn face_occlusion(
                 rest.push(i);
                 continue;
             }
-            let fx = (gx - x0) as f32 / stride as f32;
-            let fy = (gy - y0) as f32 / stride as f32;
+            let fx = (gx % stride) as f32 / stride as f32;
+            let fy = (gy % stride) as f32 / stride as f32;
             let top = a + (b - a) * fx;
             let bottom = c + (d - c) * fx;
             known[i] = Some(top + (bottom - top) * fy);
@@ -622,7 +619,6 @@ pub fn light_face(
     for &p in &samples.points {
         bounds.add_point(Vec3::from_f32(p));
     }
-    let first_at = samples.first_at_same_point();
     // Dirt is measured after the shadow rays, only where some light that
     // takes it arrives (half of e3m4's luxels are dark).
     let dirt_sampling = setup.dirt.filter(|_| rules.dirt);
@@ -639,7 +635,7 @@ pub fn light_face(
     };
 
     let mut packet = RayPacket16::new();
-    let mut scratch = VisibilityScratch::new(first_at.clone());
+    let mut scratch = VisibilityScratch::new(samples.first_at_same_point());
     let mut arrivals: Vec<Arrival> = Vec::new();
     let mut value = vec![0.0f64; n];
     let radius = samples.map.footprint_radius();
@@ -735,7 +731,7 @@ pub fn light_face(
                 face.model,
                 &sampling,
                 setup.adaptive,
-                &first_at,
+                &scratch.first_at,
                 &needed,
             );
             counts.dirt_rays += rays;
