@@ -16,11 +16,13 @@
 //! Windings never grow past [`MAX_WORLD_COORD`]; a base winding for a plane spans that extent.
 //!
 //! A few stages need a tolerance with a meaning of their own; each is a named constant beside its
-//! one use: the engine's clip-hull trace epsilon (`bsp-compiler/src/trace.rs`, 1/32, must match
+//! use: the engine's clip-hull trace epsilon (`bsp-compiler/src/trace.rs`, 1/32, must match
 //! engines), the distance at which a vertex splits another face's edge
-//! (`bsp-compiler/src/weld.rs`), how close a point must be to a face to share its phong normals
-//! (`light/src/phong.rs`), and how far outside an edge a reference-render ray hit still counts
-//! (`runtime-viewer/src/reference.rs`).
+//! (`bsp-compiler/src/weld.rs`; the crack checker in `cracks.rs` tests with the same constant),
+//! how close a point must be to a face to share its phong normals (`light/src/phong.rs`), how far
+//! a group of light sample points must clear a node plane to walk the BSP tree together
+//! (`light/src/samples.rs`, `SHARED_WALK_MARGIN`), and how far outside an edge a reference-render
+//! ray hit still counts (`runtime-viewer/src/reference.rs`).
 
 mod plane;
 mod vec3;
