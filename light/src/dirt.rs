@@ -76,23 +76,12 @@ fn in_front(d: [f32; 3], face_normal: Vec3) -> [f32; 3] {
     }
 }
 
-/// Occlusion of each sample point of `samples` (a face of brush model
-/// `model`): the mean over the dirt rays, cast in a cone around the
-/// sample's shading normal (the `_phong` one where the face has them), of
-/// `1 - hit distance / depth` (0 for a ray that reaches no opaque surface
-/// within `depth`; sky does not occlude). Returns the values and the number
-/// of rays cast.
-pub fn occlusion(
-    samples: &FaceSamples,
-    model: usize,
-    sampling: &DirtSampling,
-    scene: &TraceScene,
-) -> (Vec<f32>, u64) {
-    let all: Vec<usize> = (0..samples.points.len()).collect();
-    occlusion_at(samples, &all, model, sampling, scene)
-}
-
-/// [`occlusion`] of the samples `indices` only (values in that order).
+/// Occlusion of the samples `indices` of `samples` (a face of brush model
+/// `model`), in that order: the mean over the dirt rays, cast in a cone
+/// around the sample's shading normal (the `_phong` one where the face has
+/// them), of `1 - hit distance / depth` (0 for a ray that reaches no opaque
+/// surface within `depth`; sky does not occlude). Returns the values and the
+/// number of rays cast.
 pub fn occlusion_at(
     samples: &FaceSamples,
     indices: &[usize],

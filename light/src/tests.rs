@@ -735,7 +735,8 @@ fn dirt_cone_follows_the_phong_normal() {
     let (mut samples, _) = face_samples(&prep.faces[0], 1, &prep.scene, &bsp);
     let sampling = crate::lights::DirtSampling::default();
     let occlusion = |samples: &crate::samples::FaceSamples| {
-        crate::dirt::occlusion(samples, 0, &sampling, &prep.scene).0
+        let all: Vec<usize> = (0..samples.points.len()).collect();
+        crate::dirt::occlusion_at(samples, &all, 0, &sampling, &prep.scene).0
     };
     let flat = occlusion(&samples);
     let tilted = |x: f64| Vec3::new(x, 0.0, 1.0).normalized().expect("unit").to_f32();

@@ -240,7 +240,7 @@ const DIRT_SMOOTH: f32 = 0.05;
 /// and 0.399 with 0.05 (the default mode gains nothing from it).
 const DIRT_SMOOTH_SUPERSAMPLED: f32 = 0.01;
 
-/// Dirt occlusion of every sample of a face (see [`dirt::occlusion`]) and
+/// Dirt occlusion of every sample of a face (see [`dirt::occlusion_at`]) and
 /// the rays cast. With `adaptive`, it is measured on a coarse grid (every
 /// `stride`-th sample along each axis of the face's sample grid: one per
 /// luxel when supersampling, every other luxel otherwise) and at every moved
