@@ -119,7 +119,7 @@ pub struct TraceSetup<'a> {
     /// How to measure dirt; `None` when no light, sun or minlight takes dirt.
     pub dirt: Option<DirtSampling>,
     /// Supersampled faces trace sub-samples only where luxels disagree
-    /// (see [`VisibilityScratch::trace`]); off for the reference.
+    /// (see `VisibilityScratch::trace`); off for the reference.
     pub adaptive: bool,
 }
 
