@@ -84,39 +84,69 @@ pub fn expand_brush(brush: &Brush, planes: &mut PlaneSet, mins: Vec3, maxs: Vec3
     Brush::from_planes(&grown, planes, contents::SOLID, brush.source).ok()
 }
 
-/// Append the clip nodes of `tree` to `out`; returns the head (a clip node index, or contents
-/// when the whole hull is one leaf). Nodes whose children are the same contents collapse.
+/// Append the clip nodes of `tree` to `out` in pre-order (each node before its children, so
+/// the head comes first and every node of the hull is numbered at or after it, which
+/// QuakeSpasm-family engines require); returns the head (a clip node index, or contents when
+/// the whole hull is one leaf). Nodes whose children are the same contents collapse.
 pub fn emit_clipnodes(
     tree: &Tree,
     plane_index: &mut dyn FnMut(u32) -> u32,
     out: &mut Vec<ClipNode>,
 ) -> i32 {
-    fn walk(
-        tree: &Tree,
-        node: u32,
-        plane_index: &mut dyn FnMut(u32) -> u32,
-        out: &mut Vec<ClipNode>,
-    ) -> i32 {
-        let n = &tree.nodes[node as usize];
-        let Some(plane) = n.plane else {
-            return if n.contents == contents::SOLID {
-                contents::SOLID
-            } else {
-                contents::EMPTY
-            };
+    let collapsed = collapsed_contents(tree);
+    let mut head = contents::EMPTY;
+    // (tree node, where its clip node number goes: None for the head, else (clip node, side)).
+    let mut stack = vec![(0u32, None::<(usize, usize)>)];
+    while let Some((node, slot)) = stack.pop() {
+        let value = match collapsed[node as usize] {
+            Some(leaf_contents) => leaf_contents,
+            None => {
+                let n = &tree.nodes[node as usize];
+                let plane = n.plane.expect("a node that does not collapse has a plane");
+                let index = out.len();
+                out.push(ClipNode {
+                    plane: plane_index(plane),
+                    children: [0, 0],
+                });
+                stack.push((n.children[1], Some((index, 1))));
+                stack.push((n.children[0], Some((index, 0))));
+                index as i32
+            }
         };
-        let front = walk(tree, n.children[0], plane_index, out);
-        let back = walk(tree, n.children[1], plane_index, out);
-        if front == back && front < 0 {
-            return front;
+        match slot {
+            Some((parent, side)) => out[parent].children[side] = value,
+            None => head = value,
         }
-        out.push(ClipNode {
-            plane: plane_index(plane),
-            children: [front, back],
-        });
-        (out.len() - 1) as i32
     }
-    walk(tree, 0, plane_index, out)
+    head
+}
+
+/// Per tree node, the one contents its whole subtree holds (solid or empty, as clip hulls
+/// know them), or `None` when it needs a clip node.
+fn collapsed_contents(tree: &Tree) -> Vec<Option<i32>> {
+    let mut collapsed = vec![None; tree.nodes.len()];
+    // Children are finished before their parent: visit in reverse of a pre-order walk.
+    let mut order = Vec::with_capacity(tree.nodes.len());
+    let mut stack = vec![0u32];
+    while let Some(n) = stack.pop() {
+        order.push(n);
+        let node = &tree.nodes[n as usize];
+        if node.plane.is_some() {
+            stack.extend(node.children);
+        }
+    }
+    for &n in order.iter().rev() {
+        let node = &tree.nodes[n as usize];
+        collapsed[n as usize] = match node.plane {
+            None if node.contents == contents::SOLID => Some(contents::SOLID),
+            None => Some(contents::EMPTY),
+            Some(_) => {
+                let [front, back] = node.children.map(|c| collapsed[c as usize]);
+                if front == back { front } else { None }
+            }
+        };
+    }
+    collapsed
 }
 
 #[cfg(test)]

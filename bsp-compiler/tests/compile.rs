@@ -521,6 +521,45 @@ fn brush_entities_become_submodels() {
     check_round_trip(bsp);
 }
 
+/// Every node and clip node a model reaches comes after its parent, so after the model's head:
+/// QuakeSpasm rejects a clip node numbered below the head ("SV_RecursiveHullCheck: bad node
+/// number") on the first trace.
+fn assert_pre_order(bsp: &Bsp) {
+    for (m, model) in bsp.models.iter().enumerate() {
+        for hull in 0..3 {
+            let head = model.head_nodes[hull];
+            let mut stack = vec![head];
+            while let Some(n) = stack.pop() {
+                if n < 0 {
+                    continue;
+                }
+                let children = if hull == 0 {
+                    bsp.nodes[n as usize].children
+                } else {
+                    bsp.clipnodes[n as usize].children
+                };
+                for c in children.into_iter().filter(|&c| c >= 0) {
+                    assert!(c > n, "model {m} hull {hull}: node {n} has child {c}");
+                    stack.push(c);
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn nodes_and_clip_nodes_are_numbered_head_first() {
+    let door = format!(
+        "}}\n{{\n\"classname\" \"func_door\"\n{}",
+        box_brush([-32.0, -8.0, -128.0], [32.0, 8.0, 0.0], "door")
+    );
+    let pillar = box_brush([40.0, 40.0, -128.0], [72.0, 72.0, 128.0], "wall");
+    let out = compile_text(&room_map(false, &format!("{pillar}{door}")));
+    assert_eq!(out.bsp.models.len(), 2);
+    assert!(out.bsp.models.iter().all(|m| m.head_nodes[1] >= 0));
+    assert_pre_order(&out.bsp);
+}
+
 /// Each vertex of model `m`'s faces moved by `origin`, with its texture coordinates.
 fn model_texels(bsp: &Bsp, m: usize, origin: [f32; 3]) -> Vec<[i64; 5]> {
     let model = &bsp.models[m];
