@@ -66,7 +66,7 @@ pub(super) fn check(c: &mut Checker) {
     {
         c.report(Rule::Bsp29Limit, "header", 0, e.to_string());
     }
-    check_planes_and_vertices(c);
+    check_floats_and_planes(c);
     check_nodes(c);
     check_faces(c);
     check_leafs(c);
@@ -74,7 +74,7 @@ pub(super) fn check(c: &mut Checker) {
     check_models(c);
 }
 
-fn check_planes_and_vertices(c: &mut Checker) {
+fn check_floats_and_planes(c: &mut Checker) {
     let bsp = c.bsp;
     for (i, p) in bsp.planes.iter().enumerate() {
         c.finite(
