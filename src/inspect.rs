@@ -1,17 +1,25 @@
 //! `info` and `convert`: looking at and rewriting files without compiling anything.
 
 use anyhow::{Context, Result, bail};
-use quake_formats::bsp::LUMP_NAMES;
+use quake_formats::bsp::{LUMP_NAMES, Rule};
 use quake_formats::fsutil::{read_file, write_atomic};
 use quake_formats::wad::Wad;
-use quake_formats::{Bsp, BspVersion, Severity, validate};
-use std::path::PathBuf;
+use quake_formats::{Bsp, BspVersion, Problem, Severity, validate};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+
+/// Problems printed per rule before the rest are only counted.
+const SHOWN_PER_RULE: usize = 20;
 
 #[derive(clap::Args, Debug)]
 pub struct InfoArgs {
     /// The BSP file to inspect
-    file: PathBuf,
+    #[arg(required_unless_present = "rules")]
+    file: Option<PathBuf>,
+    /// Print the rules the validator checks (id, severity, engines, message) and exit
+    #[arg(long, conflicts_with = "file")]
+    rules: bool,
 }
 
 #[derive(clap::Args, Debug)]
@@ -29,14 +37,39 @@ pub struct ConvertArgs {
 }
 
 pub fn info(args: &InfoArgs) -> Result<ExitCode> {
-    let bytes = read_file(&args.file)?;
-    let bsp = Bsp::read(&bytes).with_context(|| format!("{}", args.file.display()))?;
+    match &args.file {
+        Some(file) => info_file(file),
+        None => {
+            print_rules();
+            Ok(ExitCode::SUCCESS)
+        }
+    }
+}
+
+fn info_file(file: &Path) -> Result<ExitCode> {
+    let bytes = read_file(file)?;
+    let bsp = Bsp::read(&bytes).with_context(|| format!("{}", file.display()))?;
     println!(
         "{}: {} ({} bytes)",
-        args.file.display(),
+        file.display(),
         bsp.version,
         bytes.len()
     );
+    print_counts(&bsp);
+    let problems = validate(&bsp);
+    print_problems(&problems);
+    let errors = problems
+        .iter()
+        .filter(|p| p.severity == Severity::Error)
+        .count();
+    Ok(if errors > 0 {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+fn print_counts(bsp: &Bsp) {
     let counts = [
         bsp.entities.len(),
         bsp.planes.len(),
@@ -73,25 +106,48 @@ pub fn info(args: &InfoArgs) -> Result<ExitCode> {
         entities.len(),
         bsp.models.len()
     );
+}
 
-    let problems = validate(&bsp);
+/// Every problem, at most [`SHOWN_PER_RULE`] per rule, then a count per rule.
+fn print_problems(problems: &[Problem]) {
+    if problems.is_empty() {
+        println!("valid: no problems found");
+        return;
+    }
+    let mut by_rule: BTreeMap<Rule, Vec<&Problem>> = BTreeMap::new();
+    for p in problems {
+        by_rule.entry(p.rule).or_default().push(p);
+    }
+    for (rule, list) in &by_rule {
+        for p in list.iter().take(SHOWN_PER_RULE) {
+            println!("{p}");
+        }
+        if list.len() > SHOWN_PER_RULE {
+            println!("  ... and {} more [{rule}]", list.len() - SHOWN_PER_RULE);
+        }
+    }
     let errors = problems
         .iter()
         .filter(|p| p.severity == Severity::Error)
         .count();
-    for p in &problems {
-        println!("{p}");
+    let summary: Vec<String> = by_rule
+        .iter()
+        .map(|(rule, list)| format!("{rule} {}", list.len()))
+        .collect();
+    println!(
+        "{errors} error(s), {} warning(s): {}",
+        problems.len() - errors,
+        summary.join(", ")
+    );
+}
+
+fn print_rules() {
+    for rule in Rule::ALL {
+        let info = rule.info();
+        println!("{} ({}; {})", info.id, info.severity, info.engines);
+        println!("  message: {}", info.message);
+        println!("  checks:  {}", info.checks);
     }
-    if problems.is_empty() {
-        println!("valid: no problems found");
-    } else {
-        println!("{errors} error(s), {} warning(s)", problems.len() - errors);
-    }
-    Ok(if errors > 0 {
-        ExitCode::from(1)
-    } else {
-        ExitCode::SUCCESS
-    })
 }
 
 pub fn convert(args: &ConvertArgs) -> Result<()> {

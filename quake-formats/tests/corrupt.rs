@@ -8,7 +8,9 @@ use quake_formats::{Bsp, BspVersion, FormatError, Severity, validate};
 /// A one-face BSP built by hand: a 64x64 floor quad in one leaf.
 fn tiny_bsp(version: BspVersion) -> Bsp {
     let mut bsp = Bsp::new(version);
-    bsp.set_entity_text("{\n\"classname\" \"worldspawn\"\n}\n");
+    bsp.set_entity_text(
+        "{\n\"classname\" \"worldspawn\"\n}\n{\n\"classname\" \"info_player_start\"\n}\n",
+    );
     bsp.planes.push(BspPlane {
         normal: [0.0, 0.0, 1.0],
         dist: 0.0,

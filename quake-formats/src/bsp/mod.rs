@@ -13,7 +13,7 @@ mod validate;
 pub use records::{
     ClipNode, Face, Leaf, Model, Node, Plane as BspPlane, TexInfo, contents, texinfo_flags,
 };
-pub use validate::{Problem, Severity, validate};
+pub use validate::{Problem, Rule, RuleInfo, Severity, validate};
 
 use crate::bytes::{PutLe, Reader};
 use crate::error::{FormatError, Result};

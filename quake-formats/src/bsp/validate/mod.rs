@@ -1,0 +1,92 @@
+//! The rules a BSP must follow: the format's structure (every index and offset in range, no NaN)
+//! and what real engines enforce when they load or play it (QuakeSpasm and its descendants,
+//! DarkPlaces, FTE, and the vanilla engines), each a named [`Rule`] with the engine's message.
+//! `quake-formats/README.md` holds the table of rules; `slipgate info` prints the problems.
+
+mod counts;
+mod entities;
+mod rules;
+mod structure;
+mod surfaces;
+mod textures;
+mod trees;
+
+pub use rules::{Rule, RuleInfo};
+
+use super::Bsp;
+
+/// How bad a problem is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Severity {
+    /// A mainstream engine (QuakeSpasm family, DarkPlaces or FTE) refuses the file, reads out of
+    /// bounds or crashes loading or playing it.
+    Error,
+    /// Only vanilla or limited engines refuse it, or play goes wrong (named in the detail).
+    Warning,
+}
+
+impl std::fmt::Display for Severity {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Severity::Error => "error",
+            Severity::Warning => "warning",
+        })
+    }
+}
+
+/// One thing wrong with a BSP: the rule it breaks and the lump and record where.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Problem {
+    pub rule: Rule,
+    /// The rule's severity, kept here for callers that only filter.
+    pub severity: Severity,
+    pub lump: &'static str,
+    /// The record's index in its lump (0 for whole-lump problems).
+    pub index: usize,
+    pub detail: String,
+}
+
+impl std::fmt::Display for Problem {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let info = self.rule.info();
+        write!(
+            f,
+            "{}: {}[{}]: {} [{}; {}: {}]",
+            self.severity, self.lump, self.index, self.detail, info.id, info.engines, info.message
+        )
+    }
+}
+
+/// Collects problems while the rule families look at one BSP.
+struct Checker<'a> {
+    bsp: &'a Bsp,
+    problems: Vec<Problem>,
+}
+
+impl Checker<'_> {
+    fn report(&mut self, rule: Rule, lump: &'static str, index: usize, detail: String) {
+        self.problems.push(Problem {
+            rule,
+            severity: rule.severity(),
+            lump,
+            index,
+            detail,
+        });
+    }
+}
+
+/// Every problem found; with no [`Severity::Error`] the engines named in the rules load and play
+/// the file.
+pub fn validate(bsp: &Bsp) -> Vec<Problem> {
+    let mut c = Checker {
+        bsp,
+        problems: Vec::new(),
+    };
+    structure::check(&mut c);
+    trees::check(&mut c);
+    surfaces::check(&mut c);
+    textures::check(&mut c);
+    counts::check(&mut c);
+    entities::check(&mut c);
+    c.problems
+}

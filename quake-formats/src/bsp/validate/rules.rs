@@ -1,0 +1,417 @@
+//! The named list of rules: what each checks, which engines enforce it and in what words.
+
+use super::Severity;
+
+/// One thing the validator checks. Each rule has a stable short id (printed by `slipgate info`),
+/// one severity, the engines that enforce it and, where they print one, their message. The table
+/// in `quake-formats/README.md` lists them all.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Rule {
+    // Structure: what any reader of the format needs.
+    IndexRange,
+    NonFinite,
+    PlaneNormal,
+    Bsp29Limit,
+    EntityText,
+    FaceEdges,
+    ContentsValue,
+    LightmapRange,
+    NoWorldModel,
+    // What engines enforce when they load or play the file.
+    NoNodes,
+    WorldHeadNode,
+    HullNodeRange,
+    TreeCycle,
+    ClipHullsMissing,
+    NodeSameChildren,
+    LeafZeroSolid,
+    SurfaceExtents,
+    SurfaceExtentsVanilla,
+    UnlitFaceVerts,
+    TextureAlignment,
+    AnimationName,
+    AnimationFrames,
+    SkyTextureSize,
+    SkyNameCase,
+    TexinfoMiptex,
+    TextureMissing,
+    LeafCount,
+    VisLeafs,
+    VisLeafsVanilla,
+    ModelCount,
+    ModelCountVanilla,
+    Worldspawn,
+    WorldspawnFirst,
+    PlayerStart,
+}
+
+/// What a rule is, for printing and for the documentation table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RuleInfo {
+    /// Stable short id, e.g. `hull-node-range`.
+    pub id: &'static str,
+    pub severity: Severity,
+    /// The engine families that enforce the rule.
+    pub engines: &'static str,
+    /// What those engines print (or do, when they print nothing).
+    pub message: &'static str,
+    /// What the validator checks.
+    pub checks: &'static str,
+}
+
+const QS: &str = "QuakeSpasm, vkQuake, Ironwail";
+
+impl Rule {
+    pub const ALL: [Rule; 34] = [
+        Rule::IndexRange,
+        Rule::NonFinite,
+        Rule::PlaneNormal,
+        Rule::Bsp29Limit,
+        Rule::EntityText,
+        Rule::FaceEdges,
+        Rule::ContentsValue,
+        Rule::LightmapRange,
+        Rule::NoWorldModel,
+        Rule::NoNodes,
+        Rule::WorldHeadNode,
+        Rule::HullNodeRange,
+        Rule::TreeCycle,
+        Rule::ClipHullsMissing,
+        Rule::NodeSameChildren,
+        Rule::LeafZeroSolid,
+        Rule::SurfaceExtents,
+        Rule::SurfaceExtentsVanilla,
+        Rule::UnlitFaceVerts,
+        Rule::TextureAlignment,
+        Rule::AnimationName,
+        Rule::AnimationFrames,
+        Rule::SkyTextureSize,
+        Rule::SkyNameCase,
+        Rule::TexinfoMiptex,
+        Rule::TextureMissing,
+        Rule::LeafCount,
+        Rule::VisLeafs,
+        Rule::VisLeafsVanilla,
+        Rule::ModelCount,
+        Rule::ModelCountVanilla,
+        Rule::Worldspawn,
+        Rule::WorldspawnFirst,
+        Rule::PlayerStart,
+    ];
+
+    pub fn id(self) -> &'static str {
+        self.info().id
+    }
+
+    pub fn severity(self) -> Severity {
+        self.info().severity
+    }
+
+    pub fn info(self) -> RuleInfo {
+        use Severity::{Error, Warning};
+        let (id, severity, engines, message, checks) = match self {
+            Rule::IndexRange => (
+                "index-range",
+                Error,
+                "all engines",
+                "reads out of bounds, or a Mod_Load* error such as \"Mod_LoadMarksurfaces: bad \
+                 surface number\"",
+                "every index, offset and range into another lump lies inside it",
+            ),
+            Rule::NonFinite => (
+                "non-finite",
+                Error,
+                "all engines",
+                "NaN spreads through traces, culling and lightmaps",
+                "no plane, vertex, bound, texture axis or model origin holds NaN or infinity",
+            ),
+            Rule::PlaneNormal => (
+                "plane-normal",
+                Error,
+                "all engines",
+                "traces and point tests measure distances with the normal",
+                "every plane normal has length 1 (within 0.01)",
+            ),
+            Rule::Bsp29Limit => (
+                "bsp29-limit",
+                Error,
+                "all engines (the format)",
+                "16-bit fields wrap",
+                "a BSP29 file's counts and bounds fit its 16-bit fields",
+            ),
+            Rule::EntityText => (
+                "entity-text",
+                Error,
+                "all engines",
+                "\"ED_LoadFromFile: found %s when expecting {\" (Host_Error)",
+                "the entity lump is NUL-terminated and parses",
+            ),
+            Rule::FaceEdges => (
+                "face-edges",
+                Error,
+                "DarkPlaces, Ironwail",
+                "a negative triangle count (DarkPlaces); \"surfnum %d: bad numedges %d\" (Ironwail)",
+                "every face has at least 3 edges",
+            ),
+            Rule::ContentsValue => (
+                "contents-value",
+                Error,
+                "all engines",
+                "a leaf whose contents is not negative is walked as a node",
+                "leaf contents and clip node contents children are -1..-15",
+            ),
+            Rule::LightmapRange => (
+                "lightmap-range",
+                Error,
+                "QuakeSpasm family, vanilla",
+                "reads lightmaps past the lighting lump",
+                "a lit face's lightmaps (one per style, sized from its extents) lie inside the \
+                 lighting lump",
+            ),
+            Rule::NoWorldModel => (
+                "no-world-model",
+                Error,
+                "all engines",
+                "model 0 is the world",
+                "the models lump has at least one model",
+            ),
+            Rule::NoNodes => (
+                "no-nodes",
+                Error,
+                "DarkPlaces, QuakeSpasm family",
+                "\"Mod_Q1BSP_LoadNodes: missing BSP tree in %s\" (DarkPlaces); QuakeSpasm reads node 0",
+                "the nodes lump is not empty",
+            ),
+            Rule::WorldHeadNode => (
+                "world-head-node",
+                Error,
+                QS,
+                "\"SV_HullPointContents: bad node number\" (point contents start at node 0)",
+                "the world model's hull 0 head is node 0",
+            ),
+            Rule::HullNodeRange => (
+                "hull-node-range",
+                Error,
+                QS,
+                "\"SV_RecursiveHullCheck: bad node number\" (Sys_Error on the first trace)",
+                "for every model and hulls 0-2, every node reachable from the head is numbered at \
+                 or after the head (a hull spans its head to the lump's last node)",
+            ),
+            Rule::TreeCycle => (
+                "tree-cycle",
+                Error,
+                "all engines",
+                "Mod_SetParent recurses without end; traces never reach a leaf",
+                "no node or clip node reachable from a head leads back to itself",
+            ),
+            Rule::ClipHullsMissing => (
+                "clip-hulls-missing",
+                Warning,
+                QS,
+                "\"SV_RecursiveHullCheck: bad node number\" once a player or monster moves",
+                "a file whose models name clip hull heads has clip nodes",
+            ),
+            Rule::NodeSameChildren => (
+                "node-same-children",
+                Error,
+                "DarkPlaces (mod_bsp_portalize 1, the default of older builds such as Debian's)",
+                "\"Mod_Q1BSP_RecursiveNodePortals: corrupt node hierarchy\" (Host_Error)",
+                "no node of the world's tree has the same child on both sides",
+            ),
+            Rule::LeafZeroSolid => (
+                "leaf-zero-solid",
+                Warning,
+                "all engines",
+                "leaf 0 is the shared solid leaf: never drawn, never in a PVS",
+                "leaf 0's contents are solid",
+            ),
+            Rule::SurfaceExtents => (
+                "surface-extents",
+                Error,
+                "QuakeSpasm family, DarkPlaces",
+                "\"Bad surface extents\" (Sys_Error; Host_Error in DarkPlaces)",
+                "a face without TEX_SPECIAL spans at most 2000 texels per axis (QuakeSpasm family); \
+                 a face DarkPlaces lightmaps (not TEX_SPECIAL, or lit) at most 256 luxels",
+            ),
+            Rule::SurfaceExtentsVanilla => (
+                "surface-extents-vanilla",
+                Warning,
+                "WinQuake, GLQuake",
+                "\"Bad surface extents\" (Sys_Error)",
+                "a face without TEX_SPECIAL spans at most 256 texels per axis (WinQuake; GLQuake \
+                 allows 512)",
+            ),
+            Rule::UnlitFaceVerts => (
+                "unlit-face-verts",
+                Error,
+                "QuakeSpasm, vkQuake, GLQuake",
+                "\"numverts = %i\" (Sys_Error) for liquids; sky overruns a 64-vertex buffer",
+                "liquid (`*`) faces have at most 60 edges; sky faces and unlit faces without a \
+                 texture at most 64",
+            ),
+            Rule::TextureAlignment => (
+                "texture-alignment",
+                Warning,
+                "WinQuake, GLQuake",
+                "\"Texture %s is not 16 aligned\" (Sys_Error; newer engines only warn)",
+                "texture width and height are multiples of 16",
+            ),
+            Rule::AnimationName => (
+                "animation-name",
+                Error,
+                "QuakeSpasm family, vanilla, FTE",
+                "\"Bad animating texture %s\" (Sys_Error; FTE fails the load; DarkPlaces only \
+                 prints it)",
+                "a `+` texture's second character is a frame: 0-9 or a-j (either case)",
+            ),
+            Rule::AnimationFrames => (
+                "animation-frames",
+                Error,
+                "QuakeSpasm family, vanilla, FTE",
+                "\"Missing frame %i of %s\" (Sys_Error; FTE fails the load; DarkPlaces only \
+                 prints it)",
+                "every animated sequence (`+` textures sharing the name after the frame) has all \
+                 its frames from 0 (and from a) up to its highest",
+            ),
+            Rule::SkyTextureSize => (
+                "sky-texture-size",
+                Warning,
+                "QuakeSpasm family, vanilla",
+                "\"Sky texture %s is %d x %d, expected 256 x 128\" (QuakeSpasm); vanilla reads \
+                 256x128 texels anyway",
+                "textures named sky* are 256x128",
+            ),
+            Rule::SkyNameCase => (
+                "sky-name-case",
+                Error,
+                "DarkPlaces (older builds, e.g. Debian's 0~20180908)",
+                "segfaults loading a sky texture whose name is not lower case (current \
+                 DarkPlaces lower-cases names first, \"so we don't crash on e2m9\")",
+                "a texture whose name starts with sky in any case starts with lower-case sky",
+            ),
+            Rule::TexinfoMiptex => (
+                "texinfo-miptex",
+                Warning,
+                "WinQuake, GLQuake",
+                "\"miptex >= loadmodel->numtextures\" (Sys_Error); newer engines draw no texture",
+                "every texinfo names a slot of the texture lump",
+            ),
+            Rule::TextureMissing => (
+                "texture-missing",
+                Warning,
+                "all engines",
+                "drawn with the notexture checkerboard",
+                "every texture a texinfo names is stored (its offset is not -1)",
+            ),
+            Rule::LeafCount => (
+                "leaf-count",
+                Error,
+                QS,
+                "\"Mod_LoadLeafs: %i leafs exceeds limit of 32767.\" (Host_Error)",
+                "a BSP29 file has at most 32767 leafs",
+            ),
+            Rule::VisLeafs => (
+                "vis-leafs",
+                Error,
+                "QuakeSpasm family, vanilla",
+                "R_MarkLeaves reads leafs past the end",
+                "the world model's visleafs is at most the leaf count minus one",
+            ),
+            Rule::VisLeafsVanilla => (
+                "vis-leafs-vanilla",
+                Warning,
+                "WinQuake, GLQuake",
+                "PVS buffers of MAX_MAP_LEAFS (8192) overflow",
+                "the world model's visleafs is at most 8192",
+            ),
+            Rule::ModelCount => (
+                "model-count",
+                Error,
+                QS,
+                "\"PF_precache_model: overflow\" (Host_Error): the submodels fill the 2048-entry \
+                 model table",
+                "the world and submodels leave room in a 2048-entry model table for the game \
+                 code's models (at most 2046 models)",
+            ),
+            Rule::ModelCountVanilla => (
+                "model-count-vanilla",
+                Warning,
+                "WinQuake, GLQuake, protocol 15",
+                "\"PF_precache_model: overflow\" in a 256-entry table; protocol 15 sends model \
+                 numbers in one byte",
+                "the world and submodels leave room in a 256-entry model table (at most 254 models)",
+            ),
+            Rule::Worldspawn => (
+                "worldspawn",
+                Error,
+                "QuakeSpasm family, vanilla (with id1-style game code)",
+                "\"SV_ModelIndex: model progs/player.mdl not precached\" (Sys_Error when the player \
+                 spawns: the game code's worldspawn() precaches it)",
+                "there is a worldspawn entity",
+            ),
+            Rule::WorldspawnFirst => (
+                "worldspawn-first",
+                Warning,
+                "all engines",
+                "the first entity is spawned as the world (edict 0), whatever its class",
+                "the first entity is the worldspawn",
+            ),
+            Rule::PlayerStart => (
+                "player-start",
+                Warning,
+                "id1 and LibreQuake game code",
+                "\"PutClientInServer: no info_player_start on level\" (single player)",
+                "there is an info_player_start",
+            ),
+        };
+        RuleInfo {
+            id,
+            severity,
+            engines,
+            message,
+            checks,
+        }
+    }
+}
+
+impl std::fmt::Display for Rule {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.id())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ids_are_unique_and_kebab_case() {
+        let mut ids: Vec<&str> = Rule::ALL.iter().map(|r| r.id()).collect();
+        assert!(ids.iter().all(|id| {
+            id.chars()
+                .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-')
+        }));
+        ids.sort_unstable();
+        ids.dedup();
+        assert_eq!(ids.len(), Rule::ALL.len());
+    }
+
+    #[test]
+    fn all_lists_every_rule_once_in_order() {
+        let mut sorted = Rule::ALL;
+        sorted.sort();
+        assert_eq!(sorted, Rule::ALL);
+        assert_eq!(Rule::ALL.first(), Some(&Rule::IndexRange));
+        assert_eq!(Rule::ALL.last(), Some(&Rule::PlayerStart));
+    }
+
+    /// The README's rule table names every rule with its severity, so the two cannot drift.
+    #[test]
+    fn readme_documents_every_rule() {
+        let readme = include_str!("../../../README.md");
+        for rule in Rule::ALL {
+            let row = format!("| `{}` | {} |", rule.id(), rule.severity());
+            assert!(readme.contains(&row), "README lacks the row {row}");
+        }
+    }
+}

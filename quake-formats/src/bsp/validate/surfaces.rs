@@ -1,0 +1,103 @@
+//! Faces as engines build surfaces from them: lightmap extents, lightmap data, polygon buffers.
+
+use super::{Checker, Rule};
+use crate::bsp::limits::{
+    DARKPLACES_MAX_LIGHTMAP_SIZE, GLQUAKE_MAX_SURFACE_EXTENT, MAX_SURFACE_EXTENT,
+    QUAKESPASM_MAX_SURFACE_EXTENT, QUAKESPASM_MAX_UNLIT_FACE_VERTS, QUAKESPASM_MAX_WARP_FACE_VERTS,
+};
+use crate::bsp::records::texinfo_flags;
+use crate::bsp::{Face, TexInfo};
+use crate::extents::LightmapExtents;
+
+pub(super) fn check(c: &mut Checker) {
+    let bsp = c.bsp;
+    for (i, f) in bsp.faces.iter().enumerate() {
+        let Some(tex) = bsp.texinfo.get(f.texinfo as usize) else {
+            continue; // `structure` reports the index
+        };
+        check_polygon_buffers(c, i, f, tex);
+        let Some(points) = bsp.face_vertices(f) else {
+            continue;
+        };
+        let ext = LightmapExtents::from_points(&points, &tex.vecs);
+        check_extents(c, i, f, tex, &ext);
+        check_lightmap_data(c, i, f, tex, &ext);
+    }
+}
+
+/// QuakeSpasm refuses non-special faces over 2000 texels and DarkPlaces faces it lightmaps over
+/// 256 luxels; WinQuake refuses non-special faces over 256 texels, GLQuake over 512.
+fn check_extents(c: &mut Checker, i: usize, f: &Face, tex: &TexInfo, ext: &LightmapExtents) {
+    let special = tex.flags & texinfo_flags::SPECIAL != 0;
+    let lightmapped_by_darkplaces = !special || f.light_offset != -1;
+    let widest = ext.extents[0].max(ext.extents[1]);
+    let luxels = ext.luxel_size();
+    let detail = format!(
+        "spans {}x{} texels ({}x{} luxels){}",
+        ext.extents[0],
+        ext.extents[1],
+        luxels[0],
+        luxels[1],
+        if special { ", TEX_SPECIAL" } else { "" }
+    );
+    if (!special && widest > QUAKESPASM_MAX_SURFACE_EXTENT)
+        || (lightmapped_by_darkplaces && luxels[0].max(luxels[1]) > DARKPLACES_MAX_LIGHTMAP_SIZE)
+    {
+        c.report(Rule::SurfaceExtents, "faces", i, detail);
+    } else if !special && widest > MAX_SURFACE_EXTENT {
+        let which = if widest > GLQUAKE_MAX_SURFACE_EXTENT {
+            "WinQuake and GLQuake"
+        } else {
+            "WinQuake"
+        };
+        c.report(
+            Rule::SurfaceExtentsVanilla,
+            "faces",
+            i,
+            format!("{detail}: {which} refuse it"),
+        );
+    }
+}
+
+/// A lit face's lightmaps (one per style) must lie inside the lighting lump.
+fn check_lightmap_data(c: &mut Checker, i: usize, f: &Face, tex: &TexInfo, ext: &LightmapExtents) {
+    if f.light_offset < 0 || tex.flags & texinfo_flags::SPECIAL != 0 {
+        return;
+    }
+    let bsp = c.bsp;
+    let styles = f.styles.iter().filter(|&&s| s != 255).count().max(1);
+    let needed = ext.luxel_count() * styles;
+    let offset = f.light_offset as usize;
+    if offset + needed > bsp.lighting.len() {
+        let detail = format!(
+            "lightmap at {offset} ({needed} bytes for {styles} style(s)) runs past the lighting \
+             lump ({} bytes)",
+            bsp.lighting.len()
+        );
+        c.report(Rule::LightmapRange, "faces", i, detail);
+    }
+}
+
+/// QuakeSpasm and vkQuake copy sky, liquid and unlit untextured faces into a 64-vertex buffer
+/// and subdivide liquids from a 60-vertex one.
+fn check_polygon_buffers(c: &mut Checker, i: usize, f: &Face, tex: &TexInfo) {
+    let bsp = c.bsp;
+    let texture = bsp
+        .textures
+        .textures
+        .get(tex.miptex as usize)
+        .and_then(Option::as_ref);
+    let name = texture.map(|t| t.name());
+    let (kind, max) = match name.as_deref() {
+        Some(n) if n.starts_with('*') => ("liquid", QUAKESPASM_MAX_WARP_FACE_VERTS),
+        Some(n) if n.get(..3).is_some_and(|p| p.eq_ignore_ascii_case("sky")) => {
+            ("sky", QUAKESPASM_MAX_UNLIT_FACE_VERTS)
+        }
+        None if f.light_offset == -1 => ("unlit untextured", QUAKESPASM_MAX_UNLIT_FACE_VERTS),
+        _ => return,
+    };
+    if f.num_edges as usize > max {
+        let detail = format!("{kind} face has {} edges, more than {max}", f.num_edges);
+        c.report(Rule::UnlitFaceVerts, "faces", i, detail);
+    }
+}
