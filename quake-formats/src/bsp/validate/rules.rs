@@ -206,7 +206,7 @@ impl Rule {
             ),
             Rule::ClipHullsMissing => (
                 "clip-hulls-missing",
-                Warning,
+                Error,
                 QS,
                 "\"SV_RecursiveHullCheck: bad node number\" once a player or monster moves",
                 "a file whose models name clip hull heads has clip nodes",
