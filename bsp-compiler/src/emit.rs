@@ -287,15 +287,17 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
         }
     }
 
-    let mut used = Vec::with_capacity(textures.used_textures.len());
-    for &t in &textures.used_textures {
-        used.push(Some(
-            input
-                .wads
-                .miptex(&input.texture_names[t as usize], input.warnings),
-        ));
-    }
-    bsp.textures.textures = used;
+    let used: Vec<&str> = textures
+        .used_textures
+        .iter()
+        .map(|&t| input.texture_names[t as usize].as_str())
+        .collect();
+    bsp.textures.textures = input
+        .wads
+        .texture_lump(&used, input.warnings)
+        .into_iter()
+        .map(Some)
+        .collect();
     bsp.texinfo = textures.out_infos;
     bsp.set_phong_faces(&phong);
     bsp.planes = planes.planes;

@@ -179,9 +179,58 @@ impl TextureRole {
     }
 }
 
+/// A frame of an animated texture: `+`, the frame, then the name all frames of the animation
+/// share. Frames `0`-`9` are the main cycle, `a`-`j` the alternate one engines show on an
+/// entity whose frame is 1 (a pressed button).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct AnimationFrame<'a> {
+    pub base: &'a str,
+    pub alternate: bool,
+    /// 0 to 9 within its cycle.
+    pub index: u8,
+}
+
+impl<'a> AnimationFrame<'a> {
+    /// `None` for a name without a leading `+`, or whose frame is out of range (which
+    /// QuakeSpasm refuses to load).
+    pub fn of(name: &'a str) -> Option<AnimationFrame<'a>> {
+        let rest = name.strip_prefix('+')?;
+        let frame = rest.chars().next()?.to_ascii_lowercase();
+        let (alternate, index) = match frame {
+            '0'..='9' => (false, frame as u8 - b'0'),
+            'a'..='j' => (true, frame as u8 - b'a'),
+            _ => return None,
+        };
+        Some(AnimationFrame {
+            base: &rest[1..],
+            alternate,
+            index,
+        })
+    }
+
+    /// The name of frame `index` (0 to 9) of this animation's main or alternate cycle.
+    pub fn sibling(&self, alternate: bool, index: u8) -> String {
+        let first = if alternate { b'a' } else { b'0' };
+        format!("+{}{}", char::from(first + index), self.base)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn animation_frames_from_names() {
+        let f = AnimationFrame::of("+3butnn").expect("animated");
+        assert_eq!((f.base, f.alternate, f.index), ("butnn", false, 3));
+        assert_eq!(f.sibling(false, 0), "+0butnn");
+        assert_eq!(f.sibling(true, 9), "+jbutnn");
+        let f = AnimationFrame::of("+Bbutnn").expect("alternate");
+        assert_eq!((f.base, f.alternate, f.index), ("butnn", true, 1));
+        assert_eq!(AnimationFrame::of("+kbutnn"), None);
+        assert_eq!(AnimationFrame::of("+"), None);
+        assert_eq!(AnimationFrame::of("butnn"), None);
+    }
 
     fn standard(shift: [f64; 2], rotation: f64, scale: [f64; 2]) -> Projection {
         Projection::Standard {

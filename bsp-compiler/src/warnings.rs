@@ -23,6 +23,15 @@ pub enum Warning {
     MissingTexture {
         name: String,
     },
+    /// A frame below one the map uses is in no WAD: a placeholder fills the gap, since engines
+    /// refuse an animation with a missing frame.
+    MissingAnimationFrame {
+        name: String,
+    },
+    /// A `+` name whose frame is not `0`-`9` or `a`-`j`: QuakeSpasm refuses to load the map.
+    BadAnimationName {
+        name: String,
+    },
     /// A point entity whose origin is inside a solid or sky brush (it does not flood).
     EntityInSolid {
         entity: usize,
@@ -71,6 +80,14 @@ impl std::fmt::Display for Warning {
                     "texture {name} not found in any WAD; using a placeholder"
                 )
             }
+            Warning::MissingAnimationFrame { name } => write!(
+                f,
+                "animation frame {name} not found in any WAD; using a placeholder to complete the animation"
+            ),
+            Warning::BadAnimationName { name } => write!(
+                f,
+                "texture {name}: a leading + must be followed by a frame 0-9 or a-j; QuakeSpasm refuses to load the map"
+            ),
             Warning::EntityInSolid {
                 entity,
                 classname,

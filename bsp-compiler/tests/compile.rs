@@ -3,7 +3,9 @@
 use bsp_compiler::{CompileOptions, CompileOutput, MapSource, Warning, compile};
 use quake_formats::bsp::contents;
 use quake_formats::geom::Vec3;
+use quake_formats::miptex::MipTex;
 use quake_formats::prt::PortalFile;
+use quake_formats::wad::{Wad, WadLump};
 use quake_formats::{Bsp, Severity, validate};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -776,4 +778,64 @@ fn world_merged_entities_leave_the_entity_lump() {
     assert!(!text.contains("func_group"), "{text}");
     assert!(!text.contains("func_detail"), "{text}");
     assert!(text.contains("info_player_start"), "{text}");
+}
+
+/// Regression: a button using only `+3button` was written with that one frame (QuakeSpasm:
+/// "Missing frame 0 of +3BUTNN"), and a placeholder named `SKY4` crashed DarkPlaces 2018, which
+/// counts sky textures case-sensitively before it lowercases names.
+#[test]
+fn animations_are_completed_and_names_lowercased() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("animated_textures");
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let frame = |name: &str| {
+        let mips = std::array::from_fn(|level| vec![7u8; (32usize >> level).pow(2)]);
+        WadLump::miptex(MipTex::new(name, 32, 32, mips))
+    };
+    let wad = Wad::new(
+        ["+0button", "+1button", "+2button", "+3button", "+abutton"]
+            .into_iter()
+            .map(frame)
+            .collect(),
+    );
+    std::fs::write(dir.join("anim.wad"), wad.write()).expect("write WAD");
+    let extra = box_brush([-64.0, 120.0, -64.0], [-32.0, 128.0, -32.0], "+3BUTTON")
+        + &box_brush([-32.0, -32.0, 96.0], [32.0, 32.0, 128.0], "SKY4")
+        + &box_brush([32.0, -32.0, -128.0], [64.0, 32.0, -96.0], "+1LIFT");
+    let source = MapSource {
+        path: PathBuf::from("inline.map"),
+        text: room_map(false, &extra).replace("none.wad", "anim.wad"),
+    };
+    let options = CompileOptions {
+        wad_dirs: vec![dir],
+        ..CompileOptions::default()
+    };
+    let out = compile(&source, &options).expect("compile");
+    assert_eq!(errors(&out.bsp), Vec::<String>::new());
+    let mut names: Vec<String> = out
+        .bsp
+        .textures
+        .textures
+        .iter()
+        .map(|t| {
+            let t = t.as_ref().expect("every texture is written");
+            assert!(t.mips.is_some(), "{} has pixels", t.name());
+            t.name()
+        })
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "+0button", "+0lift", "+1button", "+1lift", "+2button", "+3button", "+abutton",
+            "ceiling", "floor", "sky4", "wall"
+        ]
+    );
+    assert_eq!(faces_with_texture(&out.bsp, "+3button"), 5);
+    assert!(
+        out.warnings.contains(&Warning::MissingAnimationFrame {
+            name: "+0lift".to_string()
+        }),
+        "{:?}",
+        out.warnings
+    );
 }
