@@ -1,7 +1,10 @@
 //! End-to-end compiles of small maps written inline, and of the corpus maps.
 
+use bsp_compiler::faces::{MIN_SQUARENESS, projection_squareness};
 use bsp_compiler::{CompileOptions, CompileOutput, MapSource, Warning, compile};
 use quake_formats::bsp::contents;
+use quake_formats::bsp::limits::MAX_SURFACE_EXTENT;
+use quake_formats::extents::LightmapExtents;
 use quake_formats::geom::Vec3;
 use quake_formats::prt::PortalFile;
 use quake_formats::{Bsp, Severity, validate};
@@ -129,6 +132,57 @@ fn leaf_contents(bsp: &Bsp, p: [f32; 3]) -> i32 {
 fn face_normal(bsp: &Bsp, f: &quake_formats::bsp::Face) -> [f32; 3] {
     let n = bsp.planes[f.plane as usize].normal;
     if f.side == 1 { n.map(|c| -c) } else { n }
+}
+
+/// Every face's texture projects onto it squarely enough to be mapped back (light tools invert
+/// the projection). Regression: ericw-tools' light stopped on e3m4 at a sliver of wall the tree
+/// left between brushes, textured with the floor axes of a side on another plane.
+fn assert_textures_project_squarely(bsp: &Bsp, name: &str) {
+    for (i, f) in bsp.faces.iter().enumerate() {
+        let vecs = bsp.texinfo[f.texinfo as usize]
+            .vecs
+            .map(|row| row.map(f64::from));
+        let [x, y, z] = face_normal(bsp, f).map(f64::from);
+        let square = projection_squareness(&vecs, Vec3::new(x, y, z));
+        assert!(
+            square >= MIN_SQUARENESS,
+            "{name}: face {i} (texinfo {}) meets its texture at squareness {square}",
+            f.texinfo
+        );
+    }
+}
+
+/// A side whose Valve axes meet it edge-on (floor axes on a wall) gets Quake's projection for its
+/// plane, and is cut for its lightmap like any other wall.
+#[test]
+fn edge_on_textures_are_squared_up_and_cut() {
+    let pillar = box_brush([-16.0, -500.0, -512.0], [16.0, 500.0, 0.0], "pillar").replacen(
+        "pillar 0 0 0 1 1",
+        "pillar [ 1 0 0 0 ] [ 0 -1 0 0 ] 0 1 1",
+        1,
+    );
+    let text = format!(
+        "{{\n\"classname\" \"worldspawn\"\n{}{pillar}}}\n{{\n\"classname\" \"info_player_start\"\n\"origin\" \"100 0 -400\"\n}}\n",
+        room(-512.0, 512.0, 16.0, false)
+    );
+    let out = compile_text(&text);
+    let bsp = &out.bsp;
+    assert_eq!(errors(bsp), Vec::<String>::new());
+    assert!(out.stats.face_stats.squared_up >= 1, "{:?}", out.stats);
+    assert_textures_project_squarely(bsp, "pillar");
+    let mut pieces = 0;
+    for f in &bsp.faces {
+        let points = bsp.face_vertices(f).expect("vertices");
+        if face_normal(bsp, f) != [1.0, 0.0, 0.0] || points.iter().any(|p| p[0] != 16.0) {
+            continue;
+        }
+        pieces += 1;
+        let tex = &bsp.texinfo[f.texinfo as usize];
+        let e = LightmapExtents::from_points(&points, &tex.vecs);
+        assert!(e.extents.iter().all(|&x| x <= MAX_SURFACE_EXTENT), "{e:?}");
+    }
+    // 1000 by 512 units: at most 240 texels a piece.
+    assert!(pieces >= 5 * 3, "{pieces} pieces");
 }
 
 #[test]
@@ -679,6 +733,7 @@ fn repository_maps_compile() {
             let name = path.display().to_string();
             assert_eq!(errors(&out.bsp), Vec::<String>::new(), "{name}");
             assert_finite_bounds(&out.bsp, &name);
+            assert_textures_project_squarely(&out.bsp, &name);
             assert_eq!(out.leak.is_some(), name.ends_with("leak.map"), "{name}");
             count += 1;
         }
@@ -706,6 +761,7 @@ fn compile_corpus_map(rel: &str) -> Option<CompileOutput> {
     let out = compile(&source, &options).expect("compile");
     assert_eq!(errors(&out.bsp), Vec::<String>::new(), "{rel}");
     assert_finite_bounds(&out.bsp, rel);
+    assert_textures_project_squarely(&out.bsp, rel);
     check_round_trip(&out.bsp);
     let prt = PortalFile::parse(&out.portals.write()).expect("prt");
     assert_eq!(prt.num_leafs as i32, out.bsp.models[0].vis_leafs, "{rel}");
