@@ -9,7 +9,7 @@ use crate::planes::{PlaneId, PlaneSet};
 use crate::tree::{Tree, engine_contents, is_see_through};
 use crate::wad_lookup::WadSet;
 use crate::warnings::Warning;
-use crate::weld::{VertexWelder, fix_tjunctions};
+use crate::weld::{VertexWelder, fix_tjunctions, remove_degenerate_vertices};
 use quake_formats::bsp::{BspPlane, Face, Leaf, Model, Node, TexInfo, contents, texinfo_flags};
 use quake_formats::entities::{Entity, write_entities};
 use quake_formats::geom::{Bounds, Plane, Vec3};
@@ -177,10 +177,7 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
     let mut model_faces: Vec<(u32, u32)> = vec![(0, 0); input.models.len()];
     let mut phong = Vec::with_capacity(pending.len());
     for (pf, mut poly) in pending.iter().zip(polygons) {
-        poly.dedup();
-        while poly.len() > 1 && poly.first() == poly.last() {
-            poly.pop();
-        }
+        remove_degenerate_vertices(&mut poly, &welder.positions);
         if poly.len() < 3 {
             continue;
         }

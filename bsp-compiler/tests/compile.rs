@@ -152,6 +152,22 @@ fn assert_textures_project_squarely(bsp: &Bsp, name: &str) {
     }
 }
 
+/// No face visits a vertex twice: a spike or a knot of near-coincident vertices would use its own
+/// edges in both directions (e3m4 had 94 such faces, q1_mountain 53).
+fn assert_faces_are_simple(bsp: &Bsp, name: &str) {
+    for (i, f) in bsp.faces.iter().enumerate() {
+        let vertices = bsp.face_vertex_indices(f).expect("face vertices");
+        let mut distinct = vertices.clone();
+        distinct.sort_unstable();
+        distinct.dedup();
+        assert_eq!(
+            distinct.len(),
+            vertices.len(),
+            "{name}: face {i} visits a vertex twice: {vertices:?}"
+        );
+    }
+}
+
 /// A side whose Valve axes meet it edge-on (floor axes on a wall) gets Quake's projection for its
 /// plane, and is cut for its lightmap like any other wall.
 #[test]
@@ -734,6 +750,7 @@ fn repository_maps_compile() {
             assert_eq!(errors(&out.bsp), Vec::<String>::new(), "{name}");
             assert_finite_bounds(&out.bsp, &name);
             assert_textures_project_squarely(&out.bsp, &name);
+            assert_faces_are_simple(&out.bsp, &name);
             assert_eq!(out.leak.is_some(), name.ends_with("leak.map"), "{name}");
             count += 1;
         }
@@ -762,6 +779,7 @@ fn compile_corpus_map(rel: &str) -> Option<CompileOutput> {
     assert_eq!(errors(&out.bsp), Vec::<String>::new(), "{rel}");
     assert_finite_bounds(&out.bsp, rel);
     assert_textures_project_squarely(&out.bsp, rel);
+    assert_faces_are_simple(&out.bsp, rel);
     check_round_trip(&out.bsp);
     let prt = PortalFile::parse(&out.portals.write()).expect("prt");
     assert_eq!(prt.num_leafs as i32, out.bsp.models[0].vis_leafs, "{rel}");
