@@ -94,6 +94,17 @@ pub enum CompileError {
     },
     #[error("{}: the first entity must be worldspawn, found {found:?}", path.display())]
     NoWorldspawn { path: PathBuf, found: String },
+    /// Nothing in the world to draw or see (id's qbsp stopped here too: "Entity with no valid
+    /// brushes").
+    #[error(
+        "{}: worldspawn (entity 0) has no brushes to build{detail}: there is no world to compile",
+        path.display()
+    )]
+    EmptyWorld {
+        path: PathBuf,
+        /// Why the brushes the map gives it, if any, were left out.
+        detail: String,
+    },
     #[error("writing the BSP: {0}")]
     Format(#[from] FormatError),
 }
@@ -386,6 +397,7 @@ pub fn compile(
         }
     }
     progress.finish();
+    require_world_brushes(source, &map.entities, &models[0], &warnings)?;
     if skipped_hint > 0 {
         warnings.push(Warning::Unsupported {
             what: format!("{skipped_hint} hint brushes in brush entities are ignored"),
@@ -568,6 +580,48 @@ fn square_up_projections(
         out.faces = faces;
     }
     squared
+}
+
+/// The world must have brushes to draw or see: without any (nothing given, or only clip, origin
+/// or bad brushes), engines would load an empty void, and the world model would have no node to
+/// start at but one with the same leaf on both sides, which DarkPlaces rejects ("corrupt node
+/// hierarchy").
+fn require_world_brushes(
+    source: &MapSource,
+    entities: &[MapEntity],
+    world: &ModelInput,
+    warnings: &[Warning],
+) -> Result<(), CompileError> {
+    if !world.brushes.is_empty() {
+        return Ok(());
+    }
+    let merged =
+        |i: usize| EntityBrushes::of(i, entities[i].entity.classname()) != EntityBrushes::Submodel;
+    let given: usize = (0..entities.len())
+        .filter(|&i| merged(i))
+        .map(|i| entities[i].brushes.len())
+        .sum();
+    let first_bad = warnings.iter().find_map(|w| match w {
+        Warning::BadBrush {
+            entity,
+            line,
+            reason,
+            ..
+        } if merged(*entity) => Some((line, reason)),
+        _ => None,
+    });
+    let detail = match first_bad {
+        _ if given == 0 => String::new(),
+        Some((line, reason)) => format!(
+            " ({given} given: only clip, origin or bad brushes; the first bad one, line {line}: \
+             {reason})"
+        ),
+        None => format!(" ({given} given: only clip or origin brushes)"),
+    };
+    Err(CompileError::EmptyWorld {
+        path: source.path.clone(),
+        detail,
+    })
 }
 
 fn is_origin_brush(mb: &MapBrush) -> bool {

@@ -168,6 +168,11 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
         .collect();
     let tjunction_vertices = fix_tjunctions(&welder.positions, &mut polygons);
     bsp.vertices = welder.positions.iter().map(|p| p.to_f32()).collect();
+    if bsp.vertices.is_empty() {
+        // Edge 0 (below) names vertex 0, which must exist even in a world with no faces (one of
+        // only clip, hint or liquid-less invisible brushes).
+        bsp.vertices.push([0.0; 3]);
+    }
 
     // Faces, edges and, per model node and leaf, which faces they hold.
     bsp.edges.push([0, 0]); // edge 0 cannot be negated, so it is never used

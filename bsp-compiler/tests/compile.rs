@@ -1,7 +1,7 @@
 //! End-to-end compiles of small maps written inline, and of the corpus maps.
 
 use bsp_compiler::faces::{MIN_SQUARENESS, projection_squareness};
-use bsp_compiler::{CompileOptions, CompileOutput, MapSource, Warning, compile};
+use bsp_compiler::{CompileError, CompileOptions, CompileOutput, MapSource, Warning, compile};
 use quake_formats::bsp::contents;
 use quake_formats::bsp::limits::MAX_SURFACE_EXTENT;
 use quake_formats::extents::LightmapExtents;
@@ -75,12 +75,16 @@ fn brush_entity(classname: &str, brushes: &str) -> String {
     format!("{{\n\"classname\" \"{classname}\"\n{brushes}}}\n")
 }
 
-fn compile_text(text: &str) -> CompileOutput {
+fn try_compile(text: &str) -> Result<CompileOutput, CompileError> {
     let source = MapSource {
         path: PathBuf::from("inline.map"),
         text: text.to_string(),
     };
-    compile(&source, &CompileOptions::default()).expect("compile")
+    compile(&source, &CompileOptions::default())
+}
+
+fn compile_text(text: &str) -> CompileOutput {
+    try_compile(text).expect("compile")
 }
 
 fn errors(bsp: &Bsp) -> Vec<String> {
@@ -832,6 +836,88 @@ fn corpus_maps_compile() {
                 out.leak.map(|l| l.entity)
             );
         }
+    }
+}
+
+const PLAYER_START: &str = "{\n\"classname\" \"info_player_start\"\n\"origin\" \"0 0 32\"\n}\n";
+
+fn world_with(brushes: &str) -> String {
+    format!("{{\n\"classname\" \"worldspawn\"\n{brushes}}}\n")
+}
+
+/// A world with nothing to draw or see is an error naming the file and worldspawn, never a file
+/// (one whose edge 0 named a vertex that did not exist, or whose world node had one leaf on both
+/// sides), even when a brush entity has brushes.
+#[test]
+fn a_world_without_brushes_is_an_error() {
+    let door = brush_entity("func_door", &box_brush([0.0; 3], [8.0; 3], "door"));
+    let degenerate = "{\n( 0 0 0 ) ( 0 0 0 ) ( 0 0 0 ) wall 0 0 0 1 1\n\
+                      ( 0 0 0 ) ( 1 0 0 ) ( 0 1 0 ) wall 0 0 0 1 1\n}\n";
+    let clip = box_brush([0.0; 3], [8.0; 3], "clip");
+    let origin = box_brush([0.0; 3], [8.0; 3], "origin");
+    let clip_and_origin = format!("{clip}{origin}");
+    let clip_and_bad = format!("{clip}{degenerate}");
+    for (brushes, entities, detail) in [
+        ("", PLAYER_START.to_string(), ""),
+        ("", format!("{door}{PLAYER_START}"), ""),
+        (
+            degenerate,
+            PLAYER_START.to_string(),
+            " (1 given: only clip, origin or bad brushes; the first bad one, line 3: face 0 has \
+             collinear points)",
+        ),
+        (
+            clip_and_bad.as_str(),
+            PLAYER_START.to_string(),
+            " (2 given: only clip, origin or bad brushes; the first bad one, line 11: face 0 has \
+             collinear points)",
+        ),
+        (
+            clip_and_origin.as_str(),
+            PLAYER_START.to_string(),
+            " (2 given: only clip or origin brushes)",
+        ),
+    ] {
+        let text = format!("{}{entities}", world_with(brushes));
+        let err = match try_compile(&text) {
+            Err(e @ CompileError::EmptyWorld { .. }) => e,
+            other => panic!("{text}: {:?}", other.map(|o| o.stats)),
+        };
+        assert_eq!(
+            err.to_string(),
+            format!(
+                "inline.map: worldspawn (entity 0) has no brushes to build{detail}: there is no \
+                 world to compile"
+            )
+        );
+    }
+}
+
+/// A world of brushes that are not solid walls (liquid, sky, invisible, hint) is a valid, leaking
+/// map with the contents each kind means.
+#[test]
+fn worlds_without_walls_compile_to_valid_files() {
+    let inside = [0.0, 0.0, -32.0];
+    // Texture, hull 0 and hull 1 contents inside the brush, and whether it has faces.
+    for (texture, hull0, hull1, drawn) in [
+        ("*water", contents::WATER, contents::EMPTY, true),
+        ("sky1", contents::SKY, contents::SOLID, true),
+        ("trigger", contents::SOLID, contents::SOLID, false),
+        ("skip", contents::SOLID, contents::SOLID, false),
+        ("hint", contents::EMPTY, contents::EMPTY, false),
+    ] {
+        let brush = box_brush([-64.0, -64.0, -64.0], [64.0, 64.0, 0.0], texture);
+        let out = compile_text(&format!("{}{PLAYER_START}", world_with(&brush)));
+        let bsp = &out.bsp;
+        assert_eq!(errors(bsp), Vec::<String>::new(), "{texture}");
+        // Not `check_round_trip`: the `qbsp` crate cannot read the empty texture lump of a world
+        // that draws nothing, which engines (and ericw-tools) accept.
+        let back = Bsp::read(&bsp.write().expect("write")).expect("read back");
+        assert_eq!(errors(&back), Vec::<String>::new(), "{texture}");
+        assert!(out.leak.is_some(), "{texture}");
+        assert_eq!(!bsp.faces.is_empty(), drawn, "{texture}");
+        assert_eq!(leaf_contents(bsp, inside), hull0, "{texture}");
+        assert_eq!(hull_contents(bsp, 1, inside), hull1, "{texture}");
     }
 }
 
