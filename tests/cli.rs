@@ -189,3 +189,36 @@ fn vis_of_the_demo_map_is_never_too_small() {
         in_pvs[0]
     );
 }
+
+/// A map whose worldspawn has no brushes stops `bsp` and `build` with exit 1, an error naming the
+/// file and worldspawn, and no files written (the BSP it used to write failed `info`).
+#[test]
+fn a_world_without_brushes_is_an_error_and_writes_nothing() {
+    let dir = scratch("empty-world");
+    std::fs::create_dir_all(&dir).expect("dir");
+    let map = dir.join("empty.map");
+    std::fs::write(
+        &map,
+        "{\n\"classname\" \"worldspawn\"\n}\n\
+         {\n\"classname\" \"info_player_start\"\n\"origin\" \"0 0 32\"\n}\n",
+    )
+    .expect("write map");
+    let map_arg = map.to_str().expect("utf8");
+    for command in ["bsp", "build"] {
+        let out = slipgate(&[command, map_arg]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{command}: {stderr}");
+        assert!(
+            stderr.contains(&format!(
+                "{map_arg}: worldspawn (entity 0) has no brushes to build"
+            )),
+            "{command}: {stderr}"
+        );
+        for ext in ["bsp", "prt", "pts", "png"] {
+            assert!(
+                !map.with_extension(ext).exists(),
+                "{command} wrote a .{ext}"
+            );
+        }
+    }
+}

@@ -4,7 +4,10 @@
 use crate::brush::{Brush, BrushKind, BrushPlane};
 use crate::csg::mark_hidden_sides;
 use crate::emit::{EmitInput, emit};
-use crate::faces::{FaceStats, FaceTexInfo, ModelFace, faces_from_portals, merge_faces, subdivide};
+use crate::faces::{
+    FaceStats, FaceTexInfo, MIN_SQUARENESS, ModelFace, cut_for_lightmaps, faces_from_portals,
+    merge_faces, projection_squareness,
+};
 use crate::hulls::{HULL_BOXES, expand_brush};
 use crate::map::{MapBrush, MapEntity, MapError, parse_map};
 use crate::outside::{FillOutcome, Leak, Occupant, fill_outside};
@@ -12,7 +15,7 @@ use crate::planes::PlaneSet;
 use crate::portals::{Portals, make_cluster_portals, make_portals};
 use crate::progress::Progress;
 use crate::surface_tree::rebuild_from_surfaces;
-use crate::texinfo::TextureRole;
+use crate::texinfo::{Projection, TextureRole};
 use crate::tree::{
     DETAIL_WALL, FENCE, ILLUSIONARY, SplitHeuristic, Tree, build_tree, engine_contents,
 };
@@ -21,7 +24,7 @@ use crate::warnings::Warning;
 use quake_formats::bsp::contents;
 use quake_formats::bsp::phong::{self, FacePhong};
 use quake_formats::entities::Entity;
-use quake_formats::geom::{Bounds, Vec3};
+use quake_formats::geom::{Bounds, Plane, Vec3};
 use quake_formats::prt::PortalFile;
 use quake_formats::{Bsp, BspVersion, FormatError};
 use rayon::prelude::*;
@@ -91,6 +94,17 @@ pub enum CompileError {
     },
     #[error("{}: the first entity must be worldspawn, found {found:?}", path.display())]
     NoWorldspawn { path: PathBuf, found: String },
+    /// Nothing in the world to draw or see (id's qbsp stopped here too: "Entity with no valid
+    /// brushes").
+    #[error(
+        "{}: worldspawn (entity 0) has no brushes to build{detail}: there is no world to compile",
+        path.display()
+    )]
+    EmptyWorld {
+        path: PathBuf,
+        /// Why the brushes the map gives it, if any, were left out.
+        detail: String,
+    },
     #[error("writing the BSP: {0}")]
     Format(#[from] FormatError),
 }
@@ -383,6 +397,7 @@ pub fn compile(
         }
     }
     progress.finish();
+    require_world_brushes(source, &map.entities, &models[0], &warnings)?;
     if skipped_hint > 0 {
         warnings.push(Warning::Unsupported {
             what: format!("{skipped_hint} hint brushes in brush entities are ignored"),
@@ -435,7 +450,6 @@ pub fn compile(
         fs.from_portals += out.face_stats.from_portals;
         fs.untextured += out.face_stats.untextured;
         fs.after_merge += out.face_stats.after_merge;
-        fs.after_subdivide += out.face_stats.after_subdivide;
         match &out.fill {
             Some(FillOutcome::Leaked(l)) => {
                 warnings.push(Warning::Leak {
@@ -451,6 +465,9 @@ pub fn compile(
         }
         outputs.push(out);
     }
+    stats.face_stats.squared_up =
+        square_up_projections(&mut outputs, &planes, &mut table, options.subdivide);
+    stats.face_stats.after_subdivide = outputs.iter().map(|o| o.faces.len()).sum();
     for (name, sum) in MODEL_PHASES.iter().zip(phase_sums) {
         timings.push((format!("  {name} (sum over models)"), sum));
     }
@@ -522,6 +539,88 @@ pub fn compile(
         leak,
         warnings,
         stats,
+    })
+}
+
+/// Give each face whose texture meets it edge-on (a mapper's degenerate Valve axes, or a sliver
+/// the tree left between brushes, textured from a side on another plane) Quake's own projection
+/// of that texture for its plane, as ericw-tools' qbsp repairs such sides, then cut it for its
+/// lightmap. Returns how many faces it squared up.
+fn square_up_projections(
+    outputs: &mut [ModelOutput],
+    planes: &PlaneSet,
+    table: &mut TexInfoTable,
+    subdivide: f64,
+) -> usize {
+    let quake = Projection::Standard {
+        shift: [0.0; 2],
+        rotation: 0.0,
+        scale: [1.0; 2],
+    };
+    let mut squared = 0;
+    for out in outputs {
+        let mut faces = Vec::with_capacity(out.faces.len());
+        for mut f in std::mem::take(&mut out.faces) {
+            let normal = f.normal(planes);
+            let info = table.infos[f.texinfo as usize];
+            if projection_squareness(&info.vecs, normal) >= MIN_SQUARENESS {
+                faces.push(f);
+                continue;
+            }
+            squared += 1;
+            let name = table.names[info.texture as usize].clone();
+            let vecs = quake.vecs(&Plane::new(normal, 0.0));
+            f.texinfo = table.intern(&name, vecs, info.phong);
+            let squared_info = FaceTexInfo {
+                vecs,
+                role: info.role,
+            };
+            cut_for_lightmaps(f, &squared_info, subdivide, &mut faces);
+        }
+        out.faces = faces;
+    }
+    squared
+}
+
+/// The world must have brushes to draw or see: without any (nothing given, or only clip, origin
+/// or bad brushes), engines would load an empty void, and the world model would have no node to
+/// start at but one with the same leaf on both sides, which DarkPlaces rejects ("corrupt node
+/// hierarchy").
+fn require_world_brushes(
+    source: &MapSource,
+    entities: &[MapEntity],
+    world: &ModelInput,
+    warnings: &[Warning],
+) -> Result<(), CompileError> {
+    if !world.brushes.is_empty() {
+        return Ok(());
+    }
+    let merged =
+        |i: usize| EntityBrushes::of(i, entities[i].entity.classname()) != EntityBrushes::Submodel;
+    let given: usize = (0..entities.len())
+        .filter(|&i| merged(i))
+        .map(|i| entities[i].brushes.len())
+        .sum();
+    let first_bad = warnings.iter().find_map(|w| match w {
+        Warning::BadBrush {
+            entity,
+            line,
+            reason,
+            ..
+        } if merged(*entity) => Some((line, reason)),
+        _ => None,
+    });
+    let detail = match first_bad {
+        _ if given == 0 => String::new(),
+        Some((line, reason)) => format!(
+            " ({given} given: only clip, origin or bad brushes; the first bad one, line {line}: \
+             {reason})"
+        ),
+        None => format!(" ({given} given: only clip or origin brushes)"),
+    };
+    Err(CompileError::EmptyWorld {
+        path: source.path.clone(),
+        detail,
     })
 }
 
@@ -813,23 +912,13 @@ fn build_model(
     let mut faces = Vec::with_capacity(merged.len());
     for f in merged {
         let info = &texinfos[f.texinfo as usize];
-        if info.role.is_special() {
+        if projection_squareness(&info.vecs, f.normal(planes)) < MIN_SQUARENESS {
+            // Cut once it has a projection of its own: see `square_up_projections`.
             faces.push(f);
             continue;
         }
-        let mut pieces = Vec::new();
-        subdivide(
-            f.winding.clone(),
-            &info.vecs,
-            options.subdivide,
-            &mut pieces,
-        );
-        faces.extend(pieces.into_iter().map(|w| ModelFace {
-            winding: w,
-            ..f.clone()
-        }));
+        cut_for_lightmaps(f, info, options.subdivide, &mut faces);
     }
-    face_stats.after_subdivide = faces.len();
     timings[3] = t.elapsed().as_secs_f64();
     progress.advance(counts[0]);
 

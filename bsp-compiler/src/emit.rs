@@ -9,7 +9,7 @@ use crate::planes::{PlaneId, PlaneSet};
 use crate::tree::{Tree, engine_contents, is_see_through};
 use crate::wad_lookup::WadSet;
 use crate::warnings::Warning;
-use crate::weld::{VertexWelder, fix_tjunctions};
+use crate::weld::{VertexWelder, fix_tjunctions, remove_degenerate_vertices};
 use quake_formats::bsp::{BspPlane, Face, Leaf, Model, Node, TexInfo, contents, texinfo_flags};
 use quake_formats::entities::{Entity, write_entities};
 use quake_formats::geom::{Bounds, Plane, Vec3};
@@ -168,6 +168,11 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
         .collect();
     let tjunction_vertices = fix_tjunctions(&welder.positions, &mut polygons);
     bsp.vertices = welder.positions.iter().map(|p| p.to_f32()).collect();
+    if bsp.vertices.is_empty() {
+        // Edge 0 (below) names vertex 0, which must exist even in a world with no faces (one of
+        // only clip, hint or liquid-less invisible brushes).
+        bsp.vertices.push([0.0; 3]);
+    }
 
     // Faces, edges and, per model node and leaf, which faces they hold.
     bsp.edges.push([0, 0]); // edge 0 cannot be negated, so it is never used
@@ -177,10 +182,7 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
     let mut model_faces: Vec<(u32, u32)> = vec![(0, 0); input.models.len()];
     let mut phong = Vec::with_capacity(pending.len());
     for (pf, mut poly) in pending.iter().zip(polygons) {
-        poly.dedup();
-        while poly.len() > 1 && poly.first() == poly.last() {
-            poly.pop();
-        }
+        remove_degenerate_vertices(&mut poly, &welder.positions);
         if poly.len() < 3 {
             continue;
         }

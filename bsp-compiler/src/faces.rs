@@ -2,7 +2,7 @@
 //! on the portal, then merged (coplanar, same texinfo) and subdivided for lightmaps.
 
 use crate::brush::{Brush, BrushKind};
-use crate::planes::PlaneId;
+use crate::planes::{PlaneId, PlaneSet};
 use crate::portals::Portals;
 use crate::texinfo::TextureRole;
 use crate::tree::{
@@ -29,6 +29,14 @@ pub struct ModelFace {
     pub leaves: Vec<u32>,
 }
 
+impl ModelFace {
+    /// The normal of the side the face is seen from.
+    pub fn normal(&self, planes: &PlaneSet) -> Vec3 {
+        let n = planes.get(self.plane).normal;
+        if self.back { -n } else { n }
+    }
+}
+
 /// What face making needs to know about a map texinfo.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FaceTexInfo {
@@ -43,7 +51,26 @@ pub struct FaceStats {
     /// Portal faces whose texture had to be guessed (no brush side found on the portal).
     pub untextured: usize,
     pub after_merge: usize,
+    /// Merged faces whose texture met them edge-on, given Quake's projection for their plane.
+    pub squared_up: usize,
     pub after_subdivide: usize,
+}
+
+/// The least [`projection_squareness`] a face keeps its texture's projection with: below it
+/// (closer than about 6 degrees to edge-on) the texture is smeared tenfold or more, which no
+/// mapper means, and at 0 light tools cannot map texture space back onto the face at all
+/// (ericw-tools' light stops on such a face).
+pub const MIN_SQUARENESS: f64 = 0.1;
+
+/// How squarely a texture projects onto a face with unit `normal`: the |cosine| of the angle
+/// between it and the normal of the texture's s/t plane, 0 when the texture meets the face
+/// edge-on (floor axes on a wall) or an axis is zero.
+pub fn projection_squareness(vecs: &[[f64; 4]; 2], normal: Vec3) -> f64 {
+    let axis = |row: &[f64; 4]| Vec3::new(row[0], row[1], row[2]);
+    axis(&vecs[0])
+        .cross(axis(&vecs[1]))
+        .normalized()
+        .map_or(0.0, |t| t.dot(normal).abs())
 }
 
 /// Whether a face on the boundary of a leaf of contents `owner` is seen from the leaf on its
@@ -295,6 +322,20 @@ pub fn subdivide(w: Winding, vecs: &[[f64; 4]; 2], size: f64, out: &mut Vec<Wind
     out.extend(pieces);
 }
 
+/// `face` as it is written: cut by [`subdivide`] when lit, whole when special (sky, liquids).
+pub fn cut_for_lightmaps(face: ModelFace, info: &FaceTexInfo, size: f64, out: &mut Vec<ModelFace>) {
+    if info.role.is_special() {
+        out.push(face);
+        return;
+    }
+    let mut pieces = Vec::new();
+    subdivide(face.winding.clone(), &info.vecs, size, &mut pieces);
+    out.extend(pieces.into_iter().map(|winding| ModelFace {
+        winding,
+        ..face.clone()
+    }));
+}
+
 /// One cut along s or t, `size - 16` texels past the minimum (leaving room for the 16-texel
 /// grid rounding), or `None` when the winding is small enough.
 fn cut_once(w: &Winding, vecs: &[[f64; 4]; 2], size: f64) -> Option<(Winding, Winding)> {
@@ -355,6 +396,23 @@ mod tests {
         ]);
         // They share only part of an edge: no common edge, no merge.
         assert!(try_merge(&big, &small, UP).is_none());
+    }
+
+    #[test]
+    fn squareness_of_projections() {
+        let floor = [[1.0, 0.0, 0.0, 0.0], [0.0, -1.0, 0.0, 0.0]];
+        let wall = Vec3::new(0.0, -1.0, 0.0);
+        assert_eq!(projection_squareness(&floor, UP), 1.0);
+        assert_eq!(projection_squareness(&floor, -UP), 1.0);
+        // Floor axes on a wall: the texture meets it edge-on.
+        assert_eq!(projection_squareness(&floor, wall), 0.0);
+        let zero_axis = [[1.0, 0.0, 0.0, 0.0], [0.0; 4]];
+        assert_eq!(projection_squareness(&zero_axis, UP), 0.0);
+        // Scale does not matter, only the angle.
+        let scaled = [[0.25, 0.0, 0.0, 7.0], [0.0, -4.0, 0.0, 3.0]];
+        assert_eq!(projection_squareness(&scaled, UP), 1.0);
+        let tilted = Vec3::new(0.0, 0.6, 0.8);
+        assert!((projection_squareness(&floor, tilted) - 0.8).abs() < 1e-12);
     }
 
     #[test]

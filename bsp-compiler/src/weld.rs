@@ -108,6 +108,42 @@ pub fn fix_tjunctions(positions: &[Vec3], polygons: &mut [Vec<u32>]) -> usize {
     inserted
 }
 
+/// Drop the parts of a welded polygon that its own vertices make degenerate: repeats (`A A`,
+/// also around the end) and loops back to a vertex it already visited, keeping the larger of the
+/// two loops. A spike (`A B A`, as when a sliver's own vertex lies within [`TJUNCTION_EPSILON`] of
+/// its far edge and is inserted there) or a knot of near-coincident vertices inserted on each
+/// other's edges would use edges in both directions within one face: zero area that takes an
+/// edge's second use from the neighbour that needs it. May leave fewer than three vertices.
+pub fn remove_degenerate_vertices(poly: &mut Vec<u32>, positions: &[Vec3]) {
+    loop {
+        poly.dedup();
+        while poly.len() > 1 && poly.first() == poly.last() {
+            poly.pop();
+        }
+        let repeat = (0..poly.len()).find_map(|i| {
+            let j = poly[i + 1..].iter().position(|&v| v == poly[i])?;
+            Some((i, i + 1 + j))
+        });
+        let Some((i, j)) = repeat else {
+            return;
+        };
+        let inner = poly[i..j].to_vec();
+        let outer: Vec<u32> = poly[j..].iter().chain(&poly[..i]).copied().collect();
+        *poly = if area(&inner, positions) > area(&outer, positions) {
+            inner
+        } else {
+            outer
+        };
+    }
+}
+
+/// The area of a closed polygon of vertex indices.
+fn area(poly: &[u32], positions: &[Vec3]) -> f64 {
+    let point = |k: usize| positions[poly[k % poly.len()] as usize];
+    let twice = (0..poly.len()).fold(Vec3::ZERO, |sum, k| sum + point(k).cross(point(k + 1)));
+    twice.length() / 2.0
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -135,5 +171,33 @@ mod tests {
         let mut polys = vec![vec![0, 1, 2, 3]];
         assert_eq!(fix_tjunctions(&positions, &mut polys), 1);
         assert_eq!(polys[0], vec![0, 1, 2, 4, 3]);
+    }
+
+    #[test]
+    fn repeats_spikes_and_knots_are_removed() {
+        // A 64 unit square, a point out on its right, and a knot of points near one corner.
+        let mut positions = vec![
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(0.0, 64.0, 0.0),
+            Vec3::new(64.0, 64.0, 0.0),
+            Vec3::new(64.0, 0.0, 0.0),
+            Vec3::new(96.0, 32.0, 0.0),
+        ];
+        positions.extend(
+            [[0.01, 0.0], [0.01, 0.01], [0.0, 0.01]]
+                .map(|[x, y]| Vec3::new(64.0 + x, 64.0 + y, 0.0)),
+        );
+        let cleaned = |mut poly: Vec<u32>| {
+            remove_degenerate_vertices(&mut poly, &positions);
+            poly
+        };
+        assert_eq!(cleaned(vec![0, 1, 1, 2, 3, 0]), vec![0, 1, 2, 3]);
+        // Out to 4 and straight back, inside the polygon and around its end.
+        assert_eq!(cleaned(vec![0, 1, 2, 4, 2, 3]), vec![2, 3, 0, 1]);
+        assert_eq!(cleaned(vec![4, 2, 3, 0, 1, 2]), vec![2, 3, 0, 1]);
+        // A knot at corner 2, and a polygon that is nothing but a spike.
+        assert_eq!(cleaned(vec![0, 1, 2, 5, 6, 7, 2, 3]), vec![2, 3, 0, 1]);
+        assert!(cleaned(vec![0, 1, 2, 1]).len() < 3);
+        assert_eq!(cleaned(vec![0, 1, 2, 3]), vec![0, 1, 2, 3]);
     }
 }

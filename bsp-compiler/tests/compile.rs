@@ -1,7 +1,10 @@
 //! End-to-end compiles of small maps written inline, and of the corpus maps.
 
-use bsp_compiler::{CompileOptions, CompileOutput, MapSource, Warning, compile};
+use bsp_compiler::faces::{MIN_SQUARENESS, projection_squareness};
+use bsp_compiler::{CompileError, CompileOptions, CompileOutput, MapSource, Warning, compile};
 use quake_formats::bsp::contents;
+use quake_formats::bsp::limits::MAX_SURFACE_EXTENT;
+use quake_formats::extents::LightmapExtents;
 use quake_formats::geom::Vec3;
 use quake_formats::miptex::MipTex;
 use quake_formats::prt::PortalFile;
@@ -74,12 +77,16 @@ fn brush_entity(classname: &str, brushes: &str) -> String {
     format!("{{\n\"classname\" \"{classname}\"\n{brushes}}}\n")
 }
 
-fn compile_text(text: &str) -> CompileOutput {
+fn try_compile(text: &str) -> Result<CompileOutput, CompileError> {
     let source = MapSource {
         path: PathBuf::from("inline.map"),
         text: text.to_string(),
     };
-    compile(&source, &CompileOptions::default()).expect("compile")
+    compile(&source, &CompileOptions::default())
+}
+
+fn compile_text(text: &str) -> CompileOutput {
+    try_compile(text).expect("compile")
 }
 
 fn errors(bsp: &Bsp) -> Vec<String> {
@@ -131,6 +138,73 @@ fn leaf_contents(bsp: &Bsp, p: [f32; 3]) -> i32 {
 fn face_normal(bsp: &Bsp, f: &quake_formats::bsp::Face) -> [f32; 3] {
     let n = bsp.planes[f.plane as usize].normal;
     if f.side == 1 { n.map(|c| -c) } else { n }
+}
+
+/// Every face's texture projects onto it squarely enough to be mapped back (light tools invert
+/// the projection). Regression: ericw-tools' light stopped on e3m4 at a sliver of wall the tree
+/// left between brushes, textured with the floor axes of a side on another plane.
+fn assert_textures_project_squarely(bsp: &Bsp, name: &str) {
+    for (i, f) in bsp.faces.iter().enumerate() {
+        let vecs = bsp.texinfo[f.texinfo as usize]
+            .vecs
+            .map(|row| row.map(f64::from));
+        let [x, y, z] = face_normal(bsp, f).map(f64::from);
+        let square = projection_squareness(&vecs, Vec3::new(x, y, z));
+        assert!(
+            square >= MIN_SQUARENESS,
+            "{name}: face {i} (texinfo {}) meets its texture at squareness {square}",
+            f.texinfo
+        );
+    }
+}
+
+/// No face visits a vertex twice: a spike or a knot of near-coincident vertices would use its own
+/// edges in both directions (e3m4 had 94 such faces, q1_mountain 53).
+fn assert_faces_are_simple(bsp: &Bsp, name: &str) {
+    for (i, f) in bsp.faces.iter().enumerate() {
+        let vertices = bsp.face_vertex_indices(f).expect("face vertices");
+        let mut distinct = vertices.clone();
+        distinct.sort_unstable();
+        distinct.dedup();
+        assert_eq!(
+            distinct.len(),
+            vertices.len(),
+            "{name}: face {i} visits a vertex twice: {vertices:?}"
+        );
+    }
+}
+
+/// A side whose Valve axes meet it edge-on (floor axes on a wall) gets Quake's projection for its
+/// plane, and is cut for its lightmap like any other wall.
+#[test]
+fn edge_on_textures_are_squared_up_and_cut() {
+    let pillar = box_brush([-16.0, -500.0, -512.0], [16.0, 500.0, 0.0], "pillar").replacen(
+        "pillar 0 0 0 1 1",
+        "pillar [ 1 0 0 0 ] [ 0 -1 0 0 ] 0 1 1",
+        1,
+    );
+    let text = format!(
+        "{{\n\"classname\" \"worldspawn\"\n{}{pillar}}}\n{{\n\"classname\" \"info_player_start\"\n\"origin\" \"100 0 -400\"\n}}\n",
+        room(-512.0, 512.0, 16.0, false)
+    );
+    let out = compile_text(&text);
+    let bsp = &out.bsp;
+    assert_eq!(errors(bsp), Vec::<String>::new());
+    assert!(out.stats.face_stats.squared_up >= 1, "{:?}", out.stats);
+    assert_textures_project_squarely(bsp, "pillar");
+    let mut pieces = 0;
+    for f in &bsp.faces {
+        let points = bsp.face_vertices(f).expect("vertices");
+        if face_normal(bsp, f) != [1.0, 0.0, 0.0] || points.iter().any(|p| p[0] != 16.0) {
+            continue;
+        }
+        pieces += 1;
+        let tex = &bsp.texinfo[f.texinfo as usize];
+        let e = LightmapExtents::from_points(&points, &tex.vecs);
+        assert!(e.extents.iter().all(|&x| x <= MAX_SURFACE_EXTENT), "{e:?}");
+    }
+    // 1000 by 512 units: at most 240 texels a piece.
+    assert!(pieces >= 5 * 3, "{pieces} pieces");
 }
 
 #[test]
@@ -681,6 +755,8 @@ fn repository_maps_compile() {
             let name = path.display().to_string();
             assert_eq!(errors(&out.bsp), Vec::<String>::new(), "{name}");
             assert_finite_bounds(&out.bsp, &name);
+            assert_textures_project_squarely(&out.bsp, &name);
+            assert_faces_are_simple(&out.bsp, &name);
             assert_eq!(out.leak.is_some(), name.ends_with("leak.map"), "{name}");
             count += 1;
         }
@@ -708,6 +784,8 @@ fn compile_corpus_map(rel: &str) -> Option<CompileOutput> {
     let out = compile(&source, &options).expect("compile");
     assert_eq!(errors(&out.bsp), Vec::<String>::new(), "{rel}");
     assert_finite_bounds(&out.bsp, rel);
+    assert_textures_project_squarely(&out.bsp, rel);
+    assert_faces_are_simple(&out.bsp, rel);
     check_round_trip(&out.bsp);
     let prt = PortalFile::parse(&out.portals.write()).expect("prt");
     assert_eq!(prt.num_leafs as i32, out.bsp.models[0].vis_leafs, "{rel}");
@@ -760,6 +838,88 @@ fn corpus_maps_compile() {
                 out.leak.map(|l| l.entity)
             );
         }
+    }
+}
+
+const PLAYER_START: &str = "{\n\"classname\" \"info_player_start\"\n\"origin\" \"0 0 32\"\n}\n";
+
+fn world_with(brushes: &str) -> String {
+    format!("{{\n\"classname\" \"worldspawn\"\n{brushes}}}\n")
+}
+
+/// A world with nothing to draw or see is an error naming the file and worldspawn, never a file
+/// (one whose edge 0 named a vertex that did not exist, or whose world node had one leaf on both
+/// sides), even when a brush entity has brushes.
+#[test]
+fn a_world_without_brushes_is_an_error() {
+    let door = brush_entity("func_door", &box_brush([0.0; 3], [8.0; 3], "door"));
+    let degenerate = "{\n( 0 0 0 ) ( 0 0 0 ) ( 0 0 0 ) wall 0 0 0 1 1\n\
+                      ( 0 0 0 ) ( 1 0 0 ) ( 0 1 0 ) wall 0 0 0 1 1\n}\n";
+    let clip = box_brush([0.0; 3], [8.0; 3], "clip");
+    let origin = box_brush([0.0; 3], [8.0; 3], "origin");
+    let clip_and_origin = format!("{clip}{origin}");
+    let clip_and_bad = format!("{clip}{degenerate}");
+    for (brushes, entities, detail) in [
+        ("", PLAYER_START.to_string(), ""),
+        ("", format!("{door}{PLAYER_START}"), ""),
+        (
+            degenerate,
+            PLAYER_START.to_string(),
+            " (1 given: only clip, origin or bad brushes; the first bad one, line 3: face 0 has \
+             collinear points)",
+        ),
+        (
+            clip_and_bad.as_str(),
+            PLAYER_START.to_string(),
+            " (2 given: only clip, origin or bad brushes; the first bad one, line 11: face 0 has \
+             collinear points)",
+        ),
+        (
+            clip_and_origin.as_str(),
+            PLAYER_START.to_string(),
+            " (2 given: only clip or origin brushes)",
+        ),
+    ] {
+        let text = format!("{}{entities}", world_with(brushes));
+        let err = match try_compile(&text) {
+            Err(e @ CompileError::EmptyWorld { .. }) => e,
+            other => panic!("{text}: {:?}", other.map(|o| o.stats)),
+        };
+        assert_eq!(
+            err.to_string(),
+            format!(
+                "inline.map: worldspawn (entity 0) has no brushes to build{detail}: there is no \
+                 world to compile"
+            )
+        );
+    }
+}
+
+/// A world of brushes that are not solid walls (liquid, sky, invisible, hint) is a valid, leaking
+/// map with the contents each kind means.
+#[test]
+fn worlds_without_walls_compile_to_valid_files() {
+    let inside = [0.0, 0.0, -32.0];
+    // Texture, hull 0 and hull 1 contents inside the brush, and whether it has faces.
+    for (texture, hull0, hull1, drawn) in [
+        ("*water", contents::WATER, contents::EMPTY, true),
+        ("sky1", contents::SKY, contents::SOLID, true),
+        ("trigger", contents::SOLID, contents::SOLID, false),
+        ("skip", contents::SOLID, contents::SOLID, false),
+        ("hint", contents::EMPTY, contents::EMPTY, false),
+    ] {
+        let brush = box_brush([-64.0, -64.0, -64.0], [64.0, 64.0, 0.0], texture);
+        let out = compile_text(&format!("{}{PLAYER_START}", world_with(&brush)));
+        let bsp = &out.bsp;
+        assert_eq!(errors(bsp), Vec::<String>::new(), "{texture}");
+        // Not `check_round_trip`: the `qbsp` crate cannot read the empty texture lump of a world
+        // that draws nothing, which engines (and ericw-tools) accept.
+        let back = Bsp::read(&bsp.write().expect("write")).expect("read back");
+        assert_eq!(errors(&back), Vec::<String>::new(), "{texture}");
+        assert!(out.leak.is_some(), "{texture}");
+        assert_eq!(!bsp.faces.is_empty(), drawn, "{texture}");
+        assert_eq!(leaf_contents(bsp, inside), hull0, "{texture}");
+        assert_eq!(hull_contents(bsp, 1, inside), hull1, "{texture}");
     }
 }
 
