@@ -723,8 +723,17 @@ fn build_entity_brushes(
             for row in &mut vecs {
                 row[3] += Vec3::new(row[0], row[1], row[2]).dot(origin);
             }
+            let role = TextureRole::of(&f.texture);
+            if role.is_drawn() && projection_squareness(&vecs, plane.normal) < MIN_SQUARENESS {
+                warnings.push(Warning::DegenerateTextureAxes {
+                    entity,
+                    brush: bi,
+                    line: f.line,
+                    texture: f.texture.clone(),
+                });
+            }
             let texinfo = table.intern(&f.texture, vecs, phong);
-            roles.push(TextureRole::of(&f.texture));
+            roles.push(role);
             faces.push(BrushPlane {
                 plane,
                 texinfo: Some(texinfo),

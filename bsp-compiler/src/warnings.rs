@@ -32,6 +32,14 @@ pub enum Warning {
     BadAnimationName {
         name: String,
     },
+    /// A brush side whose texture axes meet its plane edge-on (degenerate Valve 220 axes): its
+    /// faces get Quake's own projection of the texture instead.
+    DegenerateTextureAxes {
+        entity: usize,
+        brush: usize,
+        line: usize,
+        texture: String,
+    },
     /// A point entity whose origin is inside a solid or sky brush (it does not flood).
     EntityInSolid {
         entity: usize,
@@ -87,6 +95,15 @@ impl std::fmt::Display for Warning {
             Warning::BadAnimationName { name } => write!(
                 f,
                 "texture {name}: a leading + must be followed by a frame 0-9 or a-j; QuakeSpasm refuses to load the map"
+            ),
+            Warning::DegenerateTextureAxes {
+                entity,
+                brush,
+                line,
+                texture,
+            } => write!(
+                f,
+                "line {line}: entity {entity}, brush {brush}: the axes of texture {texture} lie (almost) in the face's plane; using Quake's projection for it"
             ),
             Warning::EntityInSolid {
                 entity,

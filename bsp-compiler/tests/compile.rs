@@ -191,6 +191,15 @@ fn edge_on_textures_are_squared_up_and_cut() {
     let bsp = &out.bsp;
     assert_eq!(errors(bsp), Vec::<String>::new());
     assert!(out.stats.face_stats.squared_up >= 1, "{:?}", out.stats);
+    // The mapper is told which side it was.
+    let side_line = text[..text.find("pillar [").expect("side")].lines().count();
+    assert!(
+        out.warnings.iter().any(|w| matches!(w,
+            Warning::DegenerateTextureAxes { line, texture, .. }
+                if *line == side_line && texture == "pillar")),
+        "{:?}",
+        out.warnings
+    );
     assert_textures_project_squarely(bsp, "pillar");
     let mut pieces = 0;
     for f in &bsp.faces {
