@@ -275,6 +275,9 @@ impl Engine {
         let game = Game::new(self, map, "client");
         let (width, height) = SCREEN;
         let mut script = self.frame_settings(false);
+        // An exit the player walks into (LibreQuake start's episode gates) would load a map that
+        // is not there; with noexit the game code hurts the player instead, and god mode holds.
+        script += "noexit 1\n";
         let report = match self.kind {
             Kind::QuakeSpasm => {
                 script += &format!("map {}\n{}", map.name, waits(SIGNON_FRAMES));
@@ -769,7 +772,7 @@ fn run(
             break Ended::Exited(status);
         }
         polls += 1;
-        if fatal_at.is_none() && polls % 25 == 0 && FATAL.iter().any(|s| read().contains(s)) {
+        if fatal_at.is_none() && polls.is_multiple_of(25) && FATAL.iter().any(|s| read().contains(s)) {
             fatal_at = Some(Instant::now());
         }
         let grace_over = fatal_at.is_some_and(|t| t.elapsed() > Duration::from_secs(2));
