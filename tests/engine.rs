@@ -9,8 +9,8 @@
 //! jumping, turning, firing) and screenshots it. A run fails on a fatal error, a crash, a
 //! timeout, a blank screenshot or a player that never fired.
 //!
-//! The two engines' tests run at once (each runs one engine process at a time) and share the
-//! compiled maps. Screenshots and logs stay in the scratch directory the tests print.
+//! The two engines' tests run at once (each plays two maps at a time) and share the compiled
+//! maps. Screenshots and logs stay in the scratch directory the tests print.
 //! Each engine, its client (which needs `xvfb-run`), `../shared/engine` and `../shared/corpus`
 //! skip independently with a `SKIPPED:` line when absent.
 #![cfg(unix)]
@@ -29,7 +29,8 @@ use maps::{Case, MapSet, NotCompiled};
 use std::os::unix::process::ExitStatusExt;
 use std::path::{Path, PathBuf};
 use std::process::ExitStatus;
-use std::sync::OnceLock;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Mutex, OnceLock};
 use std::time::Instant;
 use support_corpus::corpus;
 
@@ -82,31 +83,39 @@ fn project_maps() -> &'static MapSet {
     })
 }
 
-/// Every corpus map, with its own WADs (`wads/<folder>` beside the `maps/<folder>` it is in;
-/// the id maps have none: placeholder textures). `None` after saying so when the corpus is absent.
+/// Every corpus map (`public/maps/**.map`), with its own WADs (`wads/<folder>` for a map under
+/// `maps/<folder>/`; the id maps have none: placeholder textures). `None` after saying so when
+/// the corpus is absent.
 fn corpus_maps() -> Option<&'static MapSet> {
     static SET: OnceLock<Option<MapSet>> = OnceLock::new();
     SET.get_or_init(|| {
         let root = corpus("public/maps")?;
         let wads = corpus("wads")?;
-        let mut cases = Vec::new();
-        for folder in std::fs::read_dir(&root).expect("corpus maps") {
-            let folder = folder.expect("corpus entry").path();
-            if !folder.is_dir() {
-                continue;
-            }
-            let own_wads = folder.file_name().map(|name| wads.join(name));
-            let wad_dirs: Vec<PathBuf> = own_wads.into_iter().filter(|w| w.is_dir()).collect();
-            cases.extend(
-                maps_in(&folder)
-                    .into_iter()
-                    .map(|m| Case::new(m, wad_dirs.clone())),
-            );
-        }
-        cases.sort_by(|a, b| a.map.cmp(&b.map));
-        Some(MapSet::new(cases, scratch().join("corpus")))
+        let mut maps = Vec::new();
+        maps_under(&root, &mut maps);
+        let cases = maps.into_iter().map(|map| {
+            let folder = map.strip_prefix(&root).ok().and_then(|p| p.iter().next());
+            let own_wads = folder.map(|folder| wads.join(folder));
+            let wad_dirs = own_wads.into_iter().filter(|w| w.is_dir()).collect();
+            Case::new(map, wad_dirs)
+        });
+        Some(MapSet::new(cases.collect(), scratch().join("corpus")))
     })
     .as_ref()
+}
+
+/// The maps in `dir` and below, sorted.
+fn maps_under(dir: &Path, maps: &mut Vec<PathBuf>) {
+    maps.extend(maps_in(dir));
+    let entries = std::fs::read_dir(dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+    let mut folders: Vec<PathBuf> = entries
+        .map(|e| e.expect("directory entry").path())
+        .filter(|p| p.is_dir())
+        .collect();
+    folders.sort();
+    for folder in folders {
+        maps_under(&folder, maps);
+    }
 }
 
 /// A line of the summary: one map in one engine.
@@ -117,61 +126,39 @@ struct Row {
     client: String,
 }
 
-/// Play every map of `set` in `engine` (server, then client), then print a summary and panic
-/// listing every failure.
+/// Engine runs of one test at once: the two tests together keep a 2-core machine busy even
+/// after the faster engine is done.
+const RUNS_AT_ONCE: usize = 2;
+
+/// Play every map of `set` in `engine` ([`RUNS_AT_ONCE`] maps at a time; each map's server, then
+/// its client), then print a summary and panic listing every failure.
 fn play_all(engine: &Engine, set: &'static MapSet) {
     let started = Instant::now();
     let name = engine.kind.name();
     eprintln!("{name}: runs in {}", scratch().display());
+    let next = AtomicUsize::new(0);
+    let results = Mutex::new(Vec::new());
+    std::thread::scope(|scope| {
+        for _ in 0..RUNS_AT_ONCE {
+            scope.spawn(|| {
+                loop {
+                    let index = next.fetch_add(1, Ordering::Relaxed);
+                    if index >= set.len() {
+                        break;
+                    }
+                    set.prefetch(index + 1);
+                    let result = play(engine, set, index);
+                    results.lock().expect("results").push((index, result));
+                }
+            });
+        }
+    });
+    let mut results = results.into_inner().expect("results");
+    results.sort_by_key(|(index, _)| *index);
     let (mut rows, mut failures) = (Vec::new(), Vec::new());
-    for index in 0..set.len() {
-        set.prefetch(index + 1);
-        let map = match set.get(index) {
-            Ok(map) => map,
-            Err(NotCompiled::Skipped(why)) => {
-                eprintln!(
-                    "note: {} does not compile, not played: {why}",
-                    set.name(index)
-                );
-                continue;
-            }
-            Err(NotCompiled::Failed(why)) => {
-                failures.push(format!("{}: {why}", set.name(index)));
-                continue;
-            }
-        };
-        let mut row = Row {
-            map: map.name.clone(),
-            compiled: format!("{:.1} s, vis {}", map.seconds, map.vis),
-            server: "-".to_string(),
-            client: "-".to_string(),
-        };
-        let mut record = |mode: &str, result: Result<Outcome, String>| match result {
-            Ok(outcome) => {
-                for note in &outcome.notes {
-                    eprintln!("{name} {mode} {}: note: {note}", map.name);
-                }
-                if let Some(shot) = &outcome.screenshot {
-                    eprintln!("{name} {}: screenshot {}", map.name, shot.display());
-                }
-                summary(&outcome)
-            }
-            Err(why) => {
-                failures.push(format!("{name} {mode} {}: {why}", map.name));
-                "FAILED".to_string()
-            }
-        };
-        if engine.has_server() {
-            row.server = record("server", engine.serve(map));
-        }
-        if engine.has_client() {
-            row.client = record("client", engine.play(map));
-        }
-        eprintln!(
-            "{name} {}: server {}; client {}",
-            row.map, row.server, row.client
-        );
-        rows.push(row);
+    for (_, (row, failed)) in results {
+        rows.extend(row);
+        failures.extend(failed);
     }
     eprintln!("\n{name}: {} maps in {:.1?}", rows.len(), started.elapsed());
     eprintln!("| map | compile | {name} server | {name} client |\n|---|---|---|---|");
@@ -182,6 +169,57 @@ fn play_all(engine: &Engine, set: &'static MapSet) {
         );
     }
     assert!(failures.is_empty(), "\n{}", failures.join("\n\n"));
+}
+
+/// Map `index` in `engine`: its summary line (none when it was not compiled) and its failures.
+fn play(engine: &Engine, set: &MapSet, index: usize) -> (Option<Row>, Vec<String>) {
+    let name = engine.kind.name();
+    let map = match set.get(index) {
+        Ok(map) => map,
+        Err(NotCompiled::Skipped(why)) => {
+            eprintln!(
+                "note: {} does not compile, not played: {why}",
+                set.name(index)
+            );
+            return (None, Vec::new());
+        }
+        Err(NotCompiled::Failed(why)) => {
+            return (None, vec![format!("{}: {why}", set.name(index))]);
+        }
+    };
+    let mut failures = Vec::new();
+    let mut record = |mode: &str, result: Result<Outcome, String>| match result {
+        Ok(outcome) => {
+            for note in &outcome.notes {
+                eprintln!("{name} {mode} {}: note: {note}", map.name);
+            }
+            if let Some(shot) = &outcome.screenshot {
+                eprintln!("{name} {}: screenshot {}", map.name, shot.display());
+            }
+            summary(&outcome)
+        }
+        Err(why) => {
+            failures.push(format!("{name} {mode} {}: {why}", map.name));
+            "FAILED".to_string()
+        }
+    };
+    let mut row = Row {
+        map: map.name.clone(),
+        compiled: format!("{:.1} s, vis {}", map.seconds, map.vis),
+        server: "-".to_string(),
+        client: "-".to_string(),
+    };
+    if engine.has_server() {
+        row.server = record("server", engine.serve(map));
+    }
+    if engine.has_client() {
+        row.client = record("client", engine.play(map));
+    }
+    eprintln!(
+        "{name} {}: server {}; client {}",
+        row.map, row.server, row.client
+    );
+    (Some(row), failures)
 }
 
 fn summary(outcome: &Outcome) -> String {

@@ -772,7 +772,10 @@ fn run(
             break Ended::Exited(status);
         }
         polls += 1;
-        if fatal_at.is_none() && polls.is_multiple_of(25) && FATAL.iter().any(|s| read().contains(s)) {
+        if fatal_at.is_none()
+            && polls.is_multiple_of(25)
+            && FATAL.iter().any(|s| read().contains(s))
+        {
             fatal_at = Some(Instant::now());
         }
         let grace_over = fatal_at.is_some_and(|t| t.elapsed() > Duration::from_secs(2));
