@@ -246,9 +246,8 @@ impl Engine {
         script += "quit\n";
         game.write_script(&script);
         let mut args = game.engine_args(self.kind);
-        match self.kind {
-            Kind::QuakeSpasm => args.extend(strings(&["-dedicated", "1"])),
-            Kind::DarkPlaces => {}
+        if self.kind == Kind::QuakeSpasm {
+            args.extend(strings(&["-dedicated", "1"]));
         }
         // A server needs a UDP port; tests run servers at once, so each gets a free one.
         args.extend(["-port".to_string(), free_udp_port().to_string()]);
@@ -270,87 +269,19 @@ impl Engine {
 
     /// Play the map in the client from the player start, which it screenshots first.
     pub fn play(&self, map: &Compiled) -> Result<Outcome, String> {
-        let exe = self.client.as_ref().expect("a client");
         let xvfb = self.xvfb.as_ref().expect("xvfb-run");
         let game = Game::new(self, map, "client");
-        let (width, height) = SCREEN;
-        let mut script = self.frame_settings(false);
-        // An exit the player walks into (LibreQuake start's episode gates) would load a map that
-        // is not there; with noexit the game code hurts the player instead, and god mode holds.
-        script += "noexit 1\n";
-        let report = match self.kind {
-            Kind::QuakeSpasm => {
-                script += &format!("map {}\n{}", map.name, waits(SIGNON_FRAMES));
-                script += &play_script("screenshot tga");
-                "edict 1\nquit\n"
-            }
-            Kind::DarkPlaces => {
-                // A `wait` holds back what the server stuffs into the command buffer, and sign-on
-                // needs that (`cl_begindownloads`): so no waits before the player exists.
-                // `defer 0` runs the poll again next frame without holding the buffer.
-                script += "sv_cheats 1\nset slipgate_health 0\n\
-                    alias slipgate_poll \"prvm_edictget server 1 health slipgate_health; slipgate_poll_$slipgate_health\"\n\
-                    alias slipgate_poll_0 \"defer 0 slipgate_poll\"\n\
-                    alias slipgate_poll_100 \"exec slipgate_play.cfg\"\n";
-                script += &format!("map {}\nslipgate_poll\n", map.name);
-                game.write_file(
-                    "slipgate_play.cfg",
-                    &(waits(SPAWNED_FRAMES) + &play_script("screenshot") + DARKPLACES_REPORT),
-                );
-                ""
-            }
-        };
-        game.write_script(&(script + report));
-
-        let display = next_display().to_string();
-        let screen = format!("-screen 0 {width}x{height}x24");
-        let mut args = strings(&["-a", "-n", &display, "-s", &screen, path_str(exe)]);
-        args.extend(game.engine_args(self.kind));
-        match self.kind {
-            Kind::QuakeSpasm => {
-                let size = [width.to_string(), height.to_string()];
-                args.extend(strings(&["-width", &size[0], "-height", &size[1]]));
-                args.extend(strings(&["-window", "-noudp"]));
-            }
-            Kind::DarkPlaces => {
-                // Its single-player server opens a UDP port too.
-                args.extend(["-port".to_string(), free_udp_port().to_string()]);
-                args.extend(strings(&["+vid_fullscreen", "0"]));
-                args.extend(["+vid_width".to_string(), width.to_string()]);
-                args.extend(["+vid_height".to_string(), height.to_string()]);
-            }
-        }
-        args.push("-nosound".to_string());
-        args.extend(game.script_args());
+        self.write_client_scripts(&game, map);
         // Mesa's llvmpipe can deadlock joining its worker threads at exit (XCloseDisplay):
         // without worker threads it cannot. No shader cache in the user's home.
         let env = [
             ("LP_NUM_THREADS", "0"),
             ("MESA_SHADER_CACHE_DISABLE", "true"),
         ];
-        let run = game.run(xvfb, &args, &env, CLIENT_TIMEOUT);
+        let run = game.run(xvfb, &self.client_args(&game), &env, CLIENT_TIMEOUT);
         let shot = game.take_screenshot();
         run.check(&["godmode ON", "slipgate: played"])?;
-        let shot = shot.map_err(|e| run.fail(&e))?;
-        let image = std::fs::read(&shot)
-            .map_err(|e| e.to_string())
-            .and_then(|bytes| tga::read(&bytes))
-            .map_err(|e| run.fail(&format!("screenshot {}: {e}", shot.display())))?;
-        if (image.width, image.height) != (width as usize, height as usize) {
-            return Err(run.fail(&format!(
-                "screenshot {} is {}x{}, not {width}x{height}",
-                shot.display(),
-                image.width,
-                image.height
-            )));
-        }
-        let colours = image.colours();
-        if colours < MIN_VIEW_COLOURS {
-            return Err(run.fail(&format!(
-                "screenshot {} is blank: {colours} colours in the view",
-                shot.display()
-            )));
-        }
+        let (shot, colours) = shot.and_then(check_screenshot).map_err(|e| run.fail(&e))?;
         let player = PlayerReport::parse(self.kind, &run.output).map_err(|e| run.fail(&e))?;
         if player.health <= 0.0 || player.rockets >= ROCKETS_GIVEN {
             return Err(run.fail(&format!(
@@ -367,6 +298,58 @@ impl Engine {
         Ok(run.outcome(game_time, Some(shot), Some(colours)))
     }
 
+    /// The client's script: load the map, wait for the player, [`play_script`], report.
+    fn write_client_scripts(&self, game: &Game, map: &Compiled) {
+        let mut script = self.frame_settings(false);
+        // An exit the player walks into (LibreQuake start's episode gates) would load a map that
+        // is not there; with noexit the game code hurts the player instead, and god mode holds.
+        script += "noexit 1\n";
+        match self.kind {
+            Kind::QuakeSpasm => {
+                script += &format!("map {}\n{}", map.name, waits(SIGNON_FRAMES));
+                script += &play_script("screenshot tga");
+                script += "edict 1\nquit\n";
+            }
+            Kind::DarkPlaces => {
+                // A `wait` holds back what the server stuffs into the command buffer, and sign-on
+                // needs that (`cl_begindownloads`): so no waits before the player exists.
+                // `defer 0` runs the poll again next frame without holding the buffer.
+                script += "sv_cheats 1\nset slipgate_health 0\n\
+                    alias slipgate_poll \"prvm_edictget server 1 health slipgate_health; slipgate_poll_$slipgate_health\"\n\
+                    alias slipgate_poll_0 \"defer 0 slipgate_poll\"\n\
+                    alias slipgate_poll_100 \"exec slipgate_play.cfg\"\n";
+                script += &format!("map {}\nslipgate_poll\n", map.name);
+                let play = waits(SPAWNED_FRAMES) + &play_script("screenshot") + DARKPLACES_REPORT;
+                game.write_file("slipgate_play.cfg", &play);
+            }
+        }
+        game.write_script(&script);
+    }
+
+    /// `xvfb-run` arguments: a virtual screen of [`SCREEN`]'s size and the client in it.
+    fn client_args(&self, game: &Game) -> Vec<String> {
+        let exe = self.client.as_ref().expect("a client");
+        let (width, height) = (SCREEN.0.to_string(), SCREEN.1.to_string());
+        let display = next_display().to_string();
+        let screen = format!("-screen 0 {width}x{height}x24");
+        let mut args = strings(&["-a", "-n", &display, "-s", &screen, path_str(exe)]);
+        args.extend(game.engine_args(self.kind));
+        match self.kind {
+            Kind::QuakeSpasm => args.extend(strings(&[
+                "-width", &width, "-height", &height, "-window", "-noudp",
+            ])),
+            Kind::DarkPlaces => {
+                // Its single-player server opens a UDP port too.
+                args.extend(["-port".to_string(), free_udp_port().to_string()]);
+                args.extend(strings(&["+vid_fullscreen", "0", "+vid_width", &width]));
+                args.extend(strings(&["+vid_height", &height]));
+            }
+        }
+        args.push("-nosound".to_string());
+        args.extend(game.script_args());
+        args
+    }
+
     /// Script lines that fix each frame's game time and let frames run as fast as they can.
     fn frame_settings(&self, dedicated: bool) -> String {
         let mut lines = format!("host_framerate {FRAME_SECONDS}\n");
@@ -380,15 +363,41 @@ impl Engine {
             (Kind::DarkPlaces, true) => lines += "sys_ticrate 0.01\n",
             // The single-player server runs as many frames as the wall time since the last
             // client frame holds, each at most sys_ticrate long: the longest frame, so a slow
-            // (software-rendered) client frame is one server frame, not ten. No frame rate cap;
-            // screenshots as TGA.
+            // (software-rendered) client frame is one server frame, not ten. No frame rate cap,
+            // no console lines over the screenshot, screenshots as TGA.
             (Kind::DarkPlaces, false) => {
                 lines += "sys_ticrate 0.1\nsv_fixedframeratesingleplayer 0\ncl_maxfps 0\n\
-                          cl_maxidlefps 0\nscr_screenshot_jpeg 0\nscr_screenshot_png 0\n"
+                          cl_maxidlefps 0\ncon_notify 0\nscr_screenshot_jpeg 0\n\
+                          scr_screenshot_png 0\n"
             }
         }
         lines
     }
+}
+
+/// Read the screenshot: [`SCREEN`]'s size and not blank. `Ok` holds it and its colour count.
+fn check_screenshot(shot: PathBuf) -> Result<(PathBuf, usize), String> {
+    let image = std::fs::read(&shot)
+        .map_err(|e| e.to_string())
+        .and_then(|bytes| tga::read(&bytes))
+        .map_err(|e| format!("screenshot {}: {e}", shot.display()))?;
+    let (width, height) = (SCREEN.0 as usize, SCREEN.1 as usize);
+    if (image.width, image.height) != (width, height) {
+        return Err(format!(
+            "screenshot {} is {}x{}, not {width}x{height}",
+            shot.display(),
+            image.width,
+            image.height
+        ));
+    }
+    let colours = image.colours();
+    if colours < MIN_VIEW_COLOURS {
+        return Err(format!(
+            "screenshot {} is blank: {colours} colours",
+            shot.display()
+        ));
+    }
+    Ok((shot, colours))
 }
 
 /// DarkPlaces' end of play: the player's state and the game time.

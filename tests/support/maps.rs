@@ -67,6 +67,14 @@ pub struct MapSet {
 
 impl MapSet {
     pub fn new(cases: Vec<Case>, dir: PathBuf) -> MapSet {
+        let mut names: Vec<&str> = cases.iter().map(|c| c.name.as_str()).collect();
+        names.sort();
+        names.dedup();
+        assert_eq!(
+            names.len(),
+            cases.len(),
+            "two maps of one name: they would share a BSP"
+        );
         std::fs::create_dir_all(&dir).expect("scratch dir");
         let compiled = cases.iter().map(|_| OnceLock::new()).collect();
         MapSet {
