@@ -147,7 +147,7 @@ pub struct Outcome {
     pub game_time: Option<f32>,
     pub screenshot: Option<PathBuf>,
     pub view_colours: Option<usize>,
-    /// Lines matching [`NOTES`], each with how often it came.
+    /// Lines matching [`NOTES`], with how often each came.
     pub notes: Vec<String>,
 }
 
@@ -728,11 +728,13 @@ fn signal_name(signal: i32) -> &'static str {
     }
 }
 
+/// The lines matching [`NOTES`], those that differ only in numbers (entity numbers,
+/// coordinates) counted as one.
 fn notes(output: &str) -> Vec<String> {
-    let mut counts: BTreeMap<&str, usize> = BTreeMap::new();
+    let mut counts: BTreeMap<String, usize> = BTreeMap::new();
     for line in output.lines() {
         if NOTES.iter().any(|n| line.contains(n)) {
-            *counts.entry(line.trim()).or_default() += 1;
+            *counts.entry(without_numbers(line.trim())).or_default() += 1;
         }
     }
     counts
@@ -741,10 +743,23 @@ fn notes(output: &str) -> Vec<String> {
             if n > 1 {
                 format!("{line} (x{n})")
             } else {
-                line.to_string()
+                line
             }
         })
         .collect()
+}
+
+/// `line` with each run of digits replaced by `#`.
+fn without_numbers(line: &str) -> String {
+    let mut text = String::with_capacity(line.len());
+    for c in line.chars() {
+        if !c.is_ascii_digit() {
+            text.push(c);
+        } else if !text.ends_with('#') {
+            text.push('#');
+        }
+    }
+    text
 }
 
 /// Run `program` in its own process group (killed whole when stopped: `xvfb-run` starts the X
@@ -834,4 +849,36 @@ fn free_udp_port() -> u16 {
 
 fn strings(args: &[&str]) -> Vec<String> {
     args.iter().map(|s| s.to_string()).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn notes_count_lines_that_differ_in_numbers_as_one() {
+        let output = "warning: empty submodel *7 in maps/e1m3.bsp\n\
+                      warning: empty submodel *15 in maps/e1m3.bsp\n\
+                      Server spawned.\n\
+                      walkmonster in wall at: '1712.0 -480.0 256.0'\n";
+        assert_eq!(
+            notes(output),
+            [
+                "walkmonster in wall at: '#.# -#.# #.#'",
+                "warning: empty submodel *# in maps/e#m#.bsp (x2)",
+            ]
+        );
+    }
+
+    #[test]
+    fn each_engine_reports_the_players_state_its_own_way() {
+        let quakespasm = "EDICT 1:\nmodelindex 4.0\nhealth         100.0\nammo_rockets    98.0\n\n";
+        let player = PlayerReport::parse(Kind::QuakeSpasm, quakespasm).expect("parse");
+        assert_eq!((player.health, player.rockets), (100.0, 98.0));
+        let darkplaces = "slipgate: health 100 rockets 96 \ntime: 11.1\n";
+        let player = PlayerReport::parse(Kind::DarkPlaces, darkplaces).expect("parse");
+        assert_eq!((player.health, player.rockets), (100.0, 96.0));
+        assert_eq!(game_time(darkplaces), Some(11.1));
+        assert!(PlayerReport::parse(Kind::QuakeSpasm, "no edicts").is_err());
+    }
 }
