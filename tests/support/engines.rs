@@ -253,6 +253,7 @@ impl Engine {
         args.extend(["-port".to_string(), free_udp_port().to_string()]);
         args.extend(game.script_args());
         let run = game.run(exe, &args, &[], SERVER_TIMEOUT);
+        game.clear_user_dir();
         let mut required = vec!["Server spawned.", "slipgate: served"];
         let game_time = game_time(&run.output);
         if self.kind == Kind::DarkPlaces {
@@ -280,6 +281,7 @@ impl Engine {
         ];
         let run = game.run(xvfb, &self.client_args(&game), &env, CLIENT_TIMEOUT);
         let shot = game.take_screenshot();
+        game.clear_user_dir();
         run.check(&["godmode ON", "slipgate: played"])?;
         let (shot, colours) = shot.and_then(check_screenshot).map_err(|e| run.fail(&e))?;
         let player = PlayerReport::parse(self.kind, &run.output).map_err(|e| run.fail(&e))?;
@@ -610,10 +612,10 @@ impl Game {
         Ok(shot)
     }
 
-    /// Remove what the engine wrote for this run outside the run's directory, and the game
-    /// directory (links and scripts); the logs and the screenshot stay.
+    /// After a run that passed: remove the game directory (links and scripts) and DarkPlaces'
+    /// home; the logs and the screenshot stay. (What the engine wrote under the user's home goes
+    /// after every run, passed or not.)
     fn clean_up(&self) {
-        self.clear_user_dir();
         std::fs::remove_dir_all(&self.home).ok();
         std::fs::remove_dir_all(self.base.join(&self.name)).ok();
         std::fs::remove_file(self.base.join("id1")).ok();
