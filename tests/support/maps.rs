@@ -1,0 +1,179 @@
+//! The maps the engine tests play, compiled as a mapper would: `slipgate bsp`, `vis`, `light`.
+//!
+//! A [`MapSet`] compiles each map once, on first use, whichever test asks first: the tests of both
+//! engines walk the same set in the same order, and each asks for the next map in the background
+//! while it plays the current one, so compiling overlaps playing.
+
+use quake_formats::Bsp;
+use quake_formats::entities::parse_entities;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::OnceLock;
+use std::time::Instant;
+
+/// A map to compile and play.
+pub struct Case {
+    /// The name the engine loads it by (`maps/NAME.bsp`).
+    pub name: String,
+    pub map: PathBuf,
+    /// Where `slipgate bsp` looks for the map's WADs.
+    pub wad_dirs: Vec<PathBuf>,
+    pub bsp_options: &'static [&'static str],
+    /// A compile failure is expected for some (`maps/hard/`): it skips the map, saying so,
+    /// instead of failing.
+    pub may_fail_to_compile: bool,
+}
+
+impl Case {
+    pub fn new(map: PathBuf, wad_dirs: Vec<PathBuf>) -> Case {
+        let name = map.file_stem().and_then(|s| s.to_str()).expect("map name");
+        Case {
+            name: name.to_string(),
+            map,
+            wad_dirs,
+            bsp_options: &[],
+            may_fail_to_compile: false,
+        }
+    }
+}
+
+/// A compiled map, ready to play.
+#[derive(Clone)]
+pub struct Compiled {
+    pub name: String,
+    pub bsp: PathBuf,
+    /// The coloured light file beside the BSP, when light wrote one.
+    pub lit: Option<PathBuf>,
+    /// Where the player starts (the first `info_player_start`).
+    pub start: Option<[f64; 3]>,
+    /// "full" or why it was not.
+    pub vis: &'static str,
+    /// Wall time of the three stages.
+    pub seconds: f64,
+}
+
+/// Why a map was not played.
+pub enum NotCompiled {
+    /// A map allowed to fail to compile did: skip it.
+    Skipped(String),
+    Failed(String),
+}
+
+pub struct MapSet {
+    cases: Vec<Case>,
+    compiled: Vec<OnceLock<Result<Compiled, NotCompiled>>>,
+    dir: PathBuf,
+}
+
+impl MapSet {
+    pub fn new(cases: Vec<Case>, dir: PathBuf) -> MapSet {
+        let mut names: Vec<&str> = cases.iter().map(|c| c.name.as_str()).collect();
+        names.sort();
+        names.dedup();
+        assert_eq!(
+            names.len(),
+            cases.len(),
+            "two maps of one name: they would share a BSP"
+        );
+        std::fs::create_dir_all(&dir).expect("scratch dir");
+        let compiled = cases.iter().map(|_| OnceLock::new()).collect();
+        MapSet {
+            cases,
+            compiled,
+            dir,
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.cases.len()
+    }
+
+    pub fn name(&self, index: usize) -> &str {
+        &self.cases[index].name
+    }
+
+    /// Map `index`, compiled now unless it already was (or another test is compiling it, in
+    /// which case this waits for that).
+    pub fn get(&self, index: usize) -> &Result<Compiled, NotCompiled> {
+        self.compiled[index].get_or_init(|| compile(&self.cases[index], &self.dir))
+    }
+
+    /// Start compiling map `index` in the background, if there is one.
+    pub fn prefetch(&'static self, index: usize) {
+        if index < self.len() {
+            std::thread::spawn(move || {
+                self.get(index);
+            });
+        }
+    }
+}
+
+fn compile(case: &Case, dir: &Path) -> Result<Compiled, NotCompiled> {
+    let started = Instant::now();
+    let bsp = dir.join(format!("{}.bsp", case.name));
+    let bsp_arg = path_str(&bsp);
+    let mut bsp_args = vec!["bsp"];
+    for wads in &case.wad_dirs {
+        bsp_args.extend(["--wad-dir", path_str(wads)]);
+    }
+    bsp_args.extend(case.bsp_options);
+    bsp_args.extend([path_str(&case.map), bsp_arg]);
+    slipgate(&bsp_args).map_err(|e| {
+        if case.may_fail_to_compile {
+            NotCompiled::Skipped(e)
+        } else {
+            NotCompiled::Failed(e)
+        }
+    })?;
+    // Full vis, as a mapper ships a map: the release build does it in seconds on every corpus
+    // map. A leaking map (its pointfile written) has no outside to leave out: its portals reach
+    // the whole void and full vis would run for many minutes, so it gets the fast pass, which
+    // still writes a real visibility lump.
+    let leaked = bsp.with_extension("pts").exists();
+    let vis: &[&str] = if leaked {
+        &["vis", "--fast", bsp_arg]
+    } else {
+        &["vis", bsp_arg]
+    };
+    slipgate(vis).map_err(NotCompiled::Failed)?;
+    slipgate(&["light", bsp_arg]).map_err(NotCompiled::Failed)?;
+
+    let bytes = std::fs::read(&bsp).expect("read the BSP");
+    let text = Bsp::read(&bytes)
+        .map(|b| String::from_utf8_lossy(&b.entities).into_owned())
+        .unwrap_or_default();
+    let entities = parse_entities(&text).unwrap_or_default();
+    let start = entities
+        .iter()
+        .find(|e| e.classname() == "info_player_start")
+        .and_then(|e| e.get_floats::<3>("origin"));
+    let lit = Some(bsp.with_extension("lit")).filter(|p| p.exists());
+    Ok(Compiled {
+        name: case.name.clone(),
+        bsp,
+        lit,
+        start,
+        vis: if leaked { "fast (leaks)" } else { "full" },
+        seconds: started.elapsed().as_secs_f64(),
+    })
+}
+
+fn slipgate(args: &[&str]) -> Result<(), String> {
+    let out = Command::new(env!("CARGO_BIN_EXE_slipgate"))
+        .args(args)
+        .output()
+        .expect("run slipgate");
+    if out.status.success() {
+        return Ok(());
+    }
+    Err(format!(
+        "slipgate {} failed ({}):\n{}",
+        args.join(" "),
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    ))
+}
+
+pub fn path_str(p: &Path) -> &str {
+    p.to_str().expect("UTF-8 path")
+}
