@@ -1014,6 +1014,60 @@ fn dirt_occlusion_does_not_depend_on_the_rays_traced_beside_it() {
     }
 }
 
+/// `maps/demo.map` compiled by slipgate-bsp, with a sun and a sky dome added
+/// to its worldspawn, so that every kind of ray is traced.
+fn demo_bsp_with_sun() -> Bsp {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../maps/demo.map");
+    let source = bsp_compiler::MapSource::read(&path).expect("maps/demo.map");
+    let out =
+        bsp_compiler::compile(&source, &bsp_compiler::CompileOptions::default()).expect("compile");
+    let mut bsp = out.bsp;
+    let worldspawn = "\"classname\" \"worldspawn\"";
+    let text = bsp.entity_text().replacen(
+        worldspawn,
+        &format!(
+            "{worldspawn} \"_sunlight\" \"150\" \"_sun_mangle\" \"30 -60 0\" \"_sunlight2\" \"60\""
+        ),
+        1,
+    );
+    assert_ne!(text, bsp.entity_text(), "demo.map has a worldspawn");
+    bsp.set_entity_text(&text);
+    bsp
+}
+
+#[test]
+fn output_does_not_depend_on_the_thread_count() {
+    // Faces are lit in parallel: nothing a face's result rests on (its packets,
+    // probes, dirt grid, shared points) may depend on which thread lit it.
+    let bsp = demo_bsp_with_sun();
+    let lit_bytes = |threads: usize, options: &Options| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("thread pool");
+        let lighting = pool
+            .install(|| compute_lighting(&bsp, options))
+            .expect("light");
+        let mut lit = bsp.clone();
+        let rgb = apply_lighting(&mut lit, &lighting);
+        (lit.lighting, rgb)
+    };
+    for (quality, dirt_mode, soft_radius) in [(Quality::Default, 0.0, 0), (Quality::Extra, 1.0, 1)]
+    {
+        let mut options = options(quality);
+        options.soft_radius = soft_radius;
+        options.overrides.dirt = true;
+        options.overrides.dirt_mode = Some(dirt_mode);
+        options.overrides.sunsamples = 16;
+        let one = lit_bytes(1, &options);
+        assert!(one.0.iter().any(|&b| b > 0), "{quality:?}: lit");
+        assert!(
+            one == lit_bytes(2, &options),
+            "{quality:?}, dirt mode {dirt_mode}: 1 and 2 threads differ"
+        );
+    }
+}
+
 #[test]
 fn shared_leaf_walk_agrees_with_walking_each_point() {
     // Clusters of points (a luxel's square) inside the room, inside the
