@@ -966,7 +966,7 @@ fn adaptive_dirt_stays_close_to_measuring_every_sample() {
             .fold(0.0f32, f32::max);
         // Samples measured in both runs cast the same rays and agree exactly
         // (no ray here meets an edge: see the next test), so this is the
-        // interpolation error alone: 1.4 light units at 1×1 and 1.6 at 4×4,
+        // interpolation error alone: 2.1 light units at 1×1 and 0.2 at 4×4,
         // the same with Embree's SSE2, SSE4.2, AVX and AVX2 kernels. The bound,
         // 1.5 grey levels of this 200 light, is below one dirt ray's whole
         // weight (200 / 48 = 4.2 units): a ray that came out differently fails.
@@ -979,11 +979,12 @@ fn adaptive_dirt_stays_close_to_measuring_every_sample() {
 fn dirt_occlusion_does_not_depend_on_the_rays_traced_beside_it() {
     // A ray that meets a triangle's edge exactly is a tie Embree breaks one
     // way or the other depending on the kernel: the CPU's vector width, and
-    // whether the packet holds one ray or many. The ordered pattern used to
-    // cast rays in the axis planes and on the diagonals of axial faces, so
-    // from grid-aligned samples they met grid-aligned edges exactly (the
-    // corner wall's foot, 256 units along, and the floor's edge 32 up and 32
-    // across): one sample measured alone and among its neighbours differed.
+    // whether the packet holds one ray or many. Ordered rays of axial faces
+    // run along the axis planes and diagonals, and before they started off
+    // the sample (dirt::RAY_START_SHIFT) they met grid-aligned edges exactly
+    // from grid-aligned samples (at the wall's foot, in the floor edge's
+    // plane; and 32 up and 32 across, onto that edge): one sample measured
+    // alone and among its neighbours differed.
     let bsp = corner_scene("\"_dirt\" \"1\"", "");
     for mode in [DirtMode::Ordered, DirtMode::Random] {
         let mut prep = crate::prepare(&bsp, &Options::default()).expect("prepare");
