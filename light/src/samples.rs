@@ -21,7 +21,6 @@ use quake_formats::geom::{Plane, Vec3, Winding};
 
 use crate::embree::{RayPacket16, sys};
 use crate::faces::FaceGeom;
-use crate::lights::tangent_basis;
 use crate::scene::TraceScene;
 
 /// Distance of sample points in front of their face, in map units.
@@ -31,19 +30,6 @@ const WALL_CLEARANCE: f32 = 1.0;
 /// How far inside the face's edges points moved onto the face stay (less
 /// on faces too narrow for it).
 pub const FACE_INSET: f64 = 0.5;
-
-/// How far (units) rays leave their sample point along the face's two
-/// tangent directions ([`FaceSamples::ray_start`]). Sample points sit on the
-/// luxel grid, and so do most edges and lights: a ray along an axis plane or
-/// a diagonal (the ordered dirt pattern's, an axial sun's, one to a light
-/// straight above) met grid-aligned edges exactly, a tie Embree breaks one
-/// way or the other with the CPU's vector width and with the other rays in
-/// the packet (the corner scene's wall foot measured dirt 0.185 or 0.247).
-/// Moved by these two unequal binary fractions (exact in f32), such a ray
-/// passes those edges by at least 1/64 · cos 45° = 0.011 units, over 20 f32
-/// steps at coordinates up to 4096. (Turning the dirt azimuths half a step
-/// instead raised the default mode's error against `--reference` by 1–2 %.)
-pub const RAY_START_SHIFT: [f64; 2] = [1.0 / 32.0, 1.0 / 64.0];
 
 /// The sample points of one face.
 #[derive(Debug, Clone)]
@@ -65,8 +51,6 @@ pub struct FaceSamples {
     pub moved: Vec<bool>,
     /// Where the samples' texture coordinates land on the face.
     pub map: SurfaceMap,
-    /// [`RAY_START_SHIFT`] along the face's tangents.
-    ray_shift: Vec3,
 }
 
 impl FaceSamples {
@@ -76,12 +60,6 @@ impl FaceSamples {
 
     pub fn per_luxel(&self) -> usize {
         self.per_axis * self.per_axis
-    }
-
-    /// Where rays from point `p` (a sample, or a point of its square) start:
-    /// [`RAY_START_SHIFT`] along the face, off the grid the map is built on.
-    pub fn ray_start(&self, p: [f32; 3]) -> [f32; 3] {
-        (Vec3::from_f32(p) + self.ray_shift).to_f32()
     }
 
     /// Per sample, the first sample at exactly the same point (itself when
@@ -358,14 +336,7 @@ pub fn face_samples(
         })
         .unzip();
     counts.clamped += clamped.iter().filter(|&&c| c).count() as u64;
-    let [u, v] = tangent_basis(face.plane.normal);
-    let ray_shift = u * RAY_START_SHIFT[0] + v * RAY_START_SHIFT[1];
-    let open = Open {
-        centre,
-        ray_shift,
-        check_leaf: face.model == 0,
-    };
-    let (points, pulled) = into_open(&on_face, &open, scene, bsp, &mut counts);
+    let (points, pulled) = into_open(&on_face, centre, face.model == 0, scene, bsp, &mut counts);
     let moved = clamped.iter().zip(&pulled).map(|(&c, &p)| c || p).collect();
     (
         FaceSamples {
@@ -378,38 +349,24 @@ pub fn face_samples(
             normals: Vec::new(),
             moved,
             map,
-            ray_shift,
         },
         counts,
     )
 }
 
-/// Where [`into_open`] pulls points back to.
-struct Open {
-    /// The face's centre, lifted like its points.
-    centre: Vec3,
-    /// [`RAY_START_SHIFT`] along the face: the line from the centre to a
-    /// point is tested this far to the side, off the grid.
-    ray_shift: Vec3,
-    /// Move points still in a solid leaf onto the centre (world faces).
-    check_leaf: bool,
-}
-
-/// Each of `points` if nothing stands between it and `open.centre`, else
-/// pulled back along that line to [`WALL_CLEARANCE`] in front of the
-/// obstacle; onto the centre if it is still in a solid world leaf. Also says
-/// which moved. The rays all leave the centre, so they go 16 to a coherent
-/// packet.
+/// Each of `points` if nothing stands between it and `centre`, else pulled
+/// back along that line to [`WALL_CLEARANCE`] in front of the obstacle;
+/// onto `centre` if it is still in a solid world leaf. Also says which
+/// moved. The rays all leave the centre, so they go 16 to a coherent packet.
 fn into_open(
     points: &[Vec3],
-    open: &Open,
+    centre: Vec3,
+    check_leaf: bool,
     scene: &TraceScene,
     bsp: &Bsp,
     counts: &mut PlacementCounts,
 ) -> (Vec<[f32; 3]>, Vec<bool>) {
-    let centre = open.centre;
     let c = centre.to_f32();
-    let ray_from = (centre + open.ray_shift).to_f32();
     let mut out: Vec<[f32; 3]> = points.iter().map(|p| p.to_f32()).collect();
     let mut moved = vec![false; points.len()];
     let away: Vec<usize> = (0..points.len())
@@ -425,7 +382,7 @@ fn into_open(
             let len = d.length();
             lens[lane] = len as f32;
             dirs[lane] = (d / len).to_f32();
-            packet.set(lane, ray_from, dirs[lane], 0.0, len as f32 + WALL_CLEARANCE);
+            packet.set(lane, c, dirs[lane], 0.0, len as f32 + WALL_CLEARANCE);
         }
         counts.rays += u64::from(packet.active_mask().count_ones());
         let ids = scene.scene.first_hit_geom16(&mut packet, true);
@@ -444,7 +401,7 @@ fn into_open(
             counts.pulled_back += 1;
         }
     }
-    if open.check_leaf {
+    if check_leaf {
         let solid = solid_points(bsp, &out);
         for ((p, m), solid) in out.iter_mut().zip(&mut moved).zip(solid) {
             if solid {

@@ -981,7 +981,7 @@ fn dirt_occlusion_does_not_depend_on_the_rays_traced_beside_it() {
     // way or the other depending on the kernel: the CPU's vector width, and
     // whether the packet holds one ray or many. Ordered rays of axial faces
     // run along the axis planes and diagonals, and before they started off
-    // the sample (samples::RAY_START_SHIFT) they met grid-aligned edges exactly
+    // the sample (dirt::RAY_START_SHIFT) they met grid-aligned edges exactly
     // from grid-aligned samples (at the wall's foot, in the floor edge's
     // plane; and 32 up and 32 across, onto that edge): one sample measured
     // alone and among its neighbours differed.

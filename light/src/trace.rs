@@ -51,17 +51,6 @@ fn unshadowed(light: &PointLight, p: Vec3, normal: Vec3) -> Option<(f64, Vec3, f
     Some((light.contribution(dist, -dir, normal.dot(dir)), dir, dist))
 }
 
-/// The direction of a shadow ray from `start` to a light at `origin`, and
-/// how far it goes (stopping [`LIGHT_CLEARANCE`] short of the light).
-fn toward(origin: Vec3, start: [f32; 3]) -> ([f32; 3], f32) {
-    let to_light = sub(origin, start);
-    let dist = to_light.length();
-    (
-        (to_light / dist).to_f32(),
-        (dist as f32 - LIGHT_CLEARANCE).max(0.0),
-    )
-}
-
 /// Adaptive supersampling of one close light: the mean of what `light` adds
 /// over `cells x cells` points spread across sample `i`'s square, each with
 /// its own shadow ray. A point that lands inside solid (the square reaching
@@ -90,13 +79,12 @@ fn footprint_light(
     for chunk in points.chunks(16) {
         packet.clear();
         for (lane, &q) in chunk.iter().enumerate() {
-            let Some((value, _, _)) = unshadowed(light, q, normal) else {
+            let Some((value, dir, dist)) = unshadowed(light, q, normal) else {
                 continue;
             };
             lane_value[lane] = value;
-            let start = samples.ray_start(q.to_f32());
-            let (dir, reach) = toward(light.origin, start);
-            packet.set(lane, start, dir, 0.0, reach);
+            let reach = (dist as f32 - LIGHT_CLEARANCE).max(0.0);
+            packet.set(lane, q.to_f32(), dir.to_f32(), 0.0, reach);
         }
         let active = packet.active_mask();
         counts.shadow_rays += u64::from(active.count_ones());
@@ -684,9 +672,11 @@ pub fn light_face(
             }
         }
         let ray = |i: usize| {
-            let start = samples.ray_start(samples.points[i]);
-            let (dir, reach) = toward(light.origin, start);
-            (start, dir, reach)
+            let p = samples.points[i];
+            let to_light = sub(light.origin, p);
+            let dist = to_light.length();
+            let dir = (to_light / dist).to_f32();
+            (p, dir, (dist as f32 - LIGHT_CLEARANCE).max(0.0))
         };
         counts.shadow_rays +=
             scratch.trace(samples, setup.adaptive, &value, ray, &mut packet, |p| {
@@ -715,13 +705,7 @@ pub fn light_face(
                     *v = 0.0;
                 }
             }
-            let ray = |i: usize| {
-                (
-                    samples.ray_start(samples.points[i]),
-                    dir,
-                    setup.sun_distance,
-                )
-            };
+            let ray = |i: usize| (samples.points[i], dir, setup.sun_distance);
             counts.sun_rays +=
                 scratch.trace(samples, setup.adaptive, &value, ray, &mut packet, |p| {
                     setup.scene.sees_sky16(p, face.model)
