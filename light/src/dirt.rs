@@ -111,7 +111,6 @@ pub fn occlusion_at(
     let flat_basis = basis_of(samples.normal);
     let flat_ordered = ordered_directions(flat_basis, cone);
     let shift = flat_basis[0] * RAY_START_SHIFT[0] + flat_basis[1] * RAY_START_SHIFT[1];
-    let start = |i: usize| (Vec3::from_f32(samples.points[i]) + shift).to_f32();
     let depth = sampling.depth as f32;
     let mut packet = RayPacket16::new();
     let mut rays = 0u64;
@@ -120,9 +119,11 @@ pub fn occlusion_at(
     // that nearly coincide, which Embree traverses faster than 16 directions
     // from one point. Each sample still sums its rays in pattern order.
     let mut own: Vec<Vec<[f32; 3]>> = Vec::new();
+    let mut starts = [[0.0f32; 3]; 16];
     for chunk in indices.chunks(16) {
         own.clear();
-        for &i in chunk {
+        for (lane, &i) in chunk.iter().enumerate() {
+            starts[lane] = (Vec3::from_f32(samples.points[i]) + shift).to_f32();
             own.push(match sampling.mode {
                 DirtMode::Ordered if samples.normals.is_empty() => Vec::new(),
                 DirtMode::Ordered => ordered_directions(basis_of(samples.normal_at(i)), cone),
@@ -141,9 +142,9 @@ pub fn occlusion_at(
         let mut gathered = [0.0f32; 16];
         for k in 0..RAYS_PER_SAMPLE {
             packet.clear();
-            for (lane, &i) in chunk.iter().enumerate() {
+            for (lane, &start) in starts[..chunk.len()].iter().enumerate() {
                 let d = dirs_of(lane)[k];
-                packet.set(lane, start(i), in_front(d, samples.normal), 0.0, depth);
+                packet.set(lane, start, in_front(d, samples.normal), 0.0, depth);
             }
             rays += chunk.len() as u64;
             let hits = scene.opaque_hits16(&mut packet, model);
