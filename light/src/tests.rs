@@ -1123,3 +1123,12 @@ fn dirt_is_measured_only_where_light_arrives() {
     assert!(lit_rays > 0);
     assert!(dark_rays < lit_rays, "{dark_rays} >= {lit_rays}");
 }
+
+#[test]
+fn embree_errors_are_told_once() {
+    // `SLIPGATE_EMBREE_CONFIG=isa=avx512` on a CPU without it printed the
+    // message twice: once as the light error, once as its source.
+    let error = crate::LightError::from(crate::embree::EmbreeError::InvalidInput("bad".into()));
+    let told = format!("{:#}", anyhow::Error::from(error));
+    assert_eq!(told.matches("bad").count(), 1, "{told}");
+}
