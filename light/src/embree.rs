@@ -311,6 +311,22 @@ unsafe extern "C" fn record_error(user_ptr: *mut c_void, _code: sys::RTCError, m
     *slot.lock().unwrap_or_else(PoisonError::into_inner) = Some(text);
 }
 
+/// Environment variable whose value is appended to the config string of the
+/// devices [`Device::new`] creates: Embree 3 options such as `isa=avx2`,
+/// `isa=sse4.2` (which vector kernels trace the rays) or `verbose=1`.
+pub const CONFIG_ENV: &str = "SLIPGATE_EMBREE_CONFIG";
+
+/// The config string for a device with `threads` builder threads, followed by
+/// the options `extra`.
+fn device_config(threads: usize, extra: &str) -> String {
+    let extra = extra.trim();
+    if extra.is_empty() {
+        format!("threads={threads},set_affinity=0")
+    } else {
+        format!("threads={threads},set_affinity=0,{extra}")
+    }
+}
+
 /// An Embree device; cheap to clone (reference counted).
 #[derive(Clone)]
 pub struct Device {
@@ -327,15 +343,37 @@ impl fmt::Debug for Device {
 
 impl Device {
     /// Creates a device whose BVH builder uses at most `threads` threads
-    /// (0 = all hardware threads). The count is capped at the machine's
-    /// parallelism so Embree's TBB pool does not oversubscribe alongside rayon.
+    /// (0 = all hardware threads), with the options in the environment
+    /// variable [`CONFIG_ENV`] if it is set (see [`Device::with_options`]).
     ///
     /// # Errors
-    /// Fails if Embree cannot create a device (e.g. unsupported CPU).
+    /// As [`Device::with_options`]; also when [`CONFIG_ENV`] is not Unicode.
     pub fn new(threads: usize) -> Result<Self, EmbreeError> {
+        let extra = match std::env::var(CONFIG_ENV) {
+            Ok(extra) => extra,
+            Err(std::env::VarError::NotPresent) => String::new(),
+            Err(std::env::VarError::NotUnicode(_)) => {
+                return Err(EmbreeError::InvalidInput(format!(
+                    "{CONFIG_ENV} is not valid Unicode"
+                )));
+            }
+        };
+        Self::with_options(threads, &extra)
+    }
+
+    /// Creates a device whose BVH builder uses at most `threads` threads
+    /// (0 = all hardware threads), followed by the Embree options `extra`
+    /// (e.g. `isa=sse4.2`, which runs the SSE kernels on any x86-64 CPU).
+    /// The count is capped at the machine's parallelism so Embree's TBB pool
+    /// does not oversubscribe alongside rayon.
+    ///
+    /// # Errors
+    /// Fails if Embree cannot create a device (e.g. unsupported CPU, or an
+    /// `isa` in `extra` that this CPU lacks).
+    pub fn with_options(threads: usize, extra: &str) -> Result<Self, EmbreeError> {
         let hw = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
         let threads = if threads == 0 { hw } else { threads.min(hw) };
-        let config = CString::new(format!("threads={threads},set_affinity=0"))
+        let config = CString::new(device_config(threads, extra))
             .map_err(|_| EmbreeError::InvalidInput("device config contained NUL".into()))?;
         // SAFETY: `config` is a valid NUL-terminated string for the call.
         let raw = unsafe { sys::rtcNewDevice(config.as_ptr()) };
@@ -908,6 +946,27 @@ mod tests {
             assert!(!scene.occluded([0.5, 0.5, 1.0], down, 2.0, 1.0));
             assert!(!scene.occluded([f32::NAN, 0.5, 1.0], down, 0.0, 10.0));
         }
+    }
+
+    #[test]
+    fn device_options_follow_ours() {
+        assert_eq!(device_config(3, ""), "threads=3,set_affinity=0");
+        assert_eq!(
+            device_config(3, " isa=sse4.2 "),
+            "threads=3,set_affinity=0,isa=sse4.2"
+        );
+        // SSE2 kernels run on every x86-64 CPU.
+        let sse2 = Device::with_options(1, "isa=sse2").expect("SSE2 device");
+        let mut b = SceneBuilder::new(&sse2).expect("scene");
+        b.add_triangle_mesh(
+            &[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            &[[0, 1, 2]],
+        )
+        .expect("mesh");
+        let scene = b.commit().expect("commit");
+        assert!(scene.occluded([0.25, 0.25, 1.0], [0.0, 0.0, -1.0], 0.0, 2.0));
+        // An option Embree rejects comes back as an error.
+        assert!(Device::with_options(1, "isa=").is_err());
     }
 
     #[test]

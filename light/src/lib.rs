@@ -66,7 +66,7 @@ pub enum LightError {
     BadFace { index: usize, detail: String },
     #[error("more switchable lights (distinct targetnames) than light styles 32..254")]
     TooManySwitchableLights,
-    #[error("{0}")]
+    #[error(transparent)]
     Embree(#[from] EmbreeError),
     /// A damaged `SLIPGATE_PHONG` lump (the message names it).
     #[error("{0}")]
