@@ -162,6 +162,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         s.seconds_setup,
         s.rays_per_second / 1e6
     );
+    if s.fullbright {
+        eprintln!(
+            "light: no lights, suns or minlight: lighting lump left empty (engines draw the map fullbright)"
+        );
+    }
     if s.faces_with_dropped_styles > 0 {
         eprintln!(
             "light: warning: {} faces are reached by more than 4 light styles; the dimmest were dropped",

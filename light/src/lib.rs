@@ -140,6 +140,9 @@ pub struct Stats {
     pub sun_directions: usize,
     pub switchable_styles: usize,
     pub coloured: bool,
+    /// The map has no light source (light, sun, lit surface or minlight): the lighting lump is
+    /// left empty, which engines draw fullbright.
+    pub fullbright: bool,
     pub shadow_rays: u64,
     pub sun_rays: u64,
     /// Ambient-occlusion rays (`_dirt`).
@@ -186,6 +189,14 @@ pub struct Prepared {
 }
 
 impl Prepared {
+    /// Whether anything gives light: a light entity, a sun or sky dome, a `_surface` light that
+    /// found its texture, or a minlight.
+    pub fn has_light_sources(&self) -> bool {
+        !self.point_lights.is_empty()
+            || !self.lights.suns.is_empty()
+            || self.lights.minlight.values().any(|m| m.level > 0.0)
+    }
+
     /// What tracing reads, with lights cut off at `light_reaches` (built with `gate`).
     pub fn trace_setup<'a>(
         &'a self,
@@ -341,9 +352,12 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
         Some(list) => list.clone(),
         None => (0..prep.faces.len()).collect(),
     };
+    // With nothing to give light, engines draw a map with an empty lighting lump fullbright
+    // (a lump of zeros would be black), as they draw a map never lit.
+    let fullbright = !prep.has_light_sources();
     let lit_faces: Vec<usize> = wanted
         .into_iter()
-        .filter(|&f| prep.faces.get(f).is_some_and(|g| g.kind == FaceKind::Lit))
+        .filter(|&f| !fullbright && prep.faces.get(f).is_some_and(|g| g.kind == FaceKind::Lit))
         .collect();
     let per_axis = options.quality.samples_per_axis();
     let bar = progress_bar(lit_faces.len(), options.progress);
@@ -379,6 +393,7 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
         sun_directions: prep.lights.suns.len(),
         switchable_styles: prep.lights.switchable_styles.len(),
         coloured: prep.lights.is_coloured(),
+        fullbright,
         ..Stats::default()
     };
     let mut faces = Vec::with_capacity(results.len());

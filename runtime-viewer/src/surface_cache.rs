@@ -15,8 +15,9 @@ use crate::camera::{NEAR_CLIP, View};
 use crate::textures::{FENCE_TRANSPARENT_INDEX, TextureKind};
 use crate::world::{Surface, World};
 
-/// Light value of a face without a lightmap (engines draw those fully lit).
-const UNLIT_LIGHT: u32 = 255;
+/// Light value of every face of a map without lighting data: engines draw it fully lit. (In a
+/// map with lighting data, a face without a lightmap is dark, as in engines.)
+const UNLIT_MAP_LIGHT: u32 = 255;
 /// Style value for normal light ('m').
 pub const NORMAL_STYLE: u32 = 256;
 
@@ -176,7 +177,8 @@ pub fn build_lit_surface(
                 }
             }
         }
-        None => block.fill([UNLIT_LIGHT * NORMAL_STYLE; 3]),
+        None if world.light.is_empty() => block.fill([UNLIT_MAP_LIGHT * NORMAL_STYLE; 3]),
+        None => {}
     }
     let tex = &world.textures[surface.texture];
     let holes = surface.kind == TextureKind::Fence;
@@ -375,7 +377,10 @@ impl SurfaceCache {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_room::room;
+    use crate::test_room::{room, room_bsp};
+    use crate::textures::PaletteSource;
+    use quake_formats::Bsp;
+    use quake_formats::palette::Palette;
 
     #[test]
     fn least_recently_used_surfaces_go_first() {
@@ -408,6 +413,31 @@ mod tests {
         assert_eq!((cache.stats.hits, cache.stats.misses), (3, 0));
         cache.get(&world, 1, 0, &styles);
         assert_eq!(cache.stats.misses, 1, "face 1 was evicted");
+    }
+
+    /// As engines: a map without lighting data is fully lit; in a lit map, a face without a
+    /// lightmap is dark.
+    #[test]
+    fn faces_without_lightmaps_are_dark_unless_the_map_has_no_light() {
+        let texel = |bsp: Bsp, face: usize| {
+            let world =
+                World::new(bsp, &Palette::slipgate(), PaletteSource::Builtin, None).expect("room");
+            let s = world.surfaces[face].as_ref().expect("wall");
+            let lit = build_lit_surface(&world, s, 0, &LightStyles::default());
+            let idx = world.textures[0].index_at(0, s.extents.tex_mins[0], s.extents.tex_mins[1]);
+            (lit.texels[0], idx, world.palette.clone())
+        };
+        let mut unlit_face = room_bsp(0);
+        unlit_face.faces[1].light_offset = -1;
+        let (dark, idx, palette) = texel(unlit_face, 1);
+        assert_eq!(dark, palette.shade(idx, [0; 3]));
+        let mut unlit_map = room_bsp(0);
+        unlit_map.lighting.clear();
+        for f in &mut unlit_map.faces {
+            f.light_offset = -1;
+        }
+        let (bright, idx, palette) = texel(unlit_map, 1);
+        assert_eq!(bright, palette.shade(idx, [UNLIT_MAP_LIGHT; 3]));
     }
 
     #[test]
