@@ -97,7 +97,14 @@ fn corpus_maps() -> Option<&'static MapSet> {
             let folder = map.strip_prefix(&root).ok().and_then(|p| p.iter().next());
             let own_wads = folder.map(|folder| wads.join(folder));
             let wad_dirs = own_wads.into_iter().filter(|w| w.is_dir()).collect();
-            Case::new(map, wad_dirs)
+            let empty_view = map.ends_with("ericw-tools/q1_cube.map").then_some(
+                "ericw-tools' cube: one brush in the void, below the player start's view, its one \
+                 texture missing",
+            );
+            Case {
+                empty_view,
+                ..Case::new(map, wad_dirs)
+            }
         });
         Some(MapSet::new(cases.collect(), scratch().join("corpus")))
     })
@@ -187,6 +194,9 @@ fn play(engine: &Engine, set: &MapSet, index: usize) -> (Option<Row>, Vec<String
             return (None, vec![format!("{}: {why}", set.name(index))]);
         }
     };
+    if let Some(why) = map.empty_view {
+        eprintln!("note: {}: its screenshot may be empty: {why}", map.name);
+    }
     let mut failures = Vec::new();
     let mut record = |mode: &str, result: Result<Outcome, String>| match result {
         Ok(outcome) => {
@@ -279,6 +289,7 @@ fn engine_servers_pass_a_known_good_bsp_and_fail_a_damaged_one() {
         start: None,
         vis: "",
         seconds: 0.0,
+        empty_view: None,
     };
     let mut bytes = std::fs::read(&good).expect("read");
     let marksurfaces_lump = 4 + 11 * 8;

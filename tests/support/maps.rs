@@ -22,6 +22,9 @@ pub struct Case {
     /// A compile failure is expected for some (`maps/hard/`): it skips the map, saying so,
     /// instead of failing.
     pub may_fail_to_compile: bool,
+    /// Why the view from the player start shows (next to) nothing, for the rare map built so:
+    /// its screenshot need not be textured.
+    pub empty_view: Option<&'static str>,
 }
 
 impl Case {
@@ -33,6 +36,7 @@ impl Case {
             wad_dirs,
             bsp_options: &[],
             may_fail_to_compile: false,
+            empty_view: None,
         }
     }
 }
@@ -50,6 +54,8 @@ pub struct Compiled {
     pub vis: &'static str,
     /// Wall time of the three stages.
     pub seconds: f64,
+    /// See [`Case::empty_view`].
+    pub empty_view: Option<&'static str>,
 }
 
 /// Why a map was not played.
@@ -155,6 +161,7 @@ fn compile(case: &Case, dir: &Path) -> Result<Compiled, NotCompiled> {
         start,
         vis: if leaked { "fast (leaks)" } else { "full" },
         seconds: started.elapsed().as_secs_f64(),
+        empty_view: case.empty_view,
     })
 }
 
