@@ -1,23 +1,16 @@
 //! End-to-end tests of the `slipgate` command: exit codes, `info`, `convert`.
 
+#[path = "support/command.rs"]
+mod command;
 #[path = "support/corpus.rs"]
 mod support_corpus;
 
+use command::slipgate;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 use support_corpus::corpus;
 
-fn slipgate(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_slipgate"))
-        .args(args)
-        .output()
-        .expect("run slipgate")
-}
-
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("slipgate-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir.join(name)
+    command::scratch("cli", name)
 }
 
 #[test]

@@ -2,25 +2,19 @@
 //! of them, and for each rule a copy broken in just that way makes `info` name the rule (and exit
 //! 1 when the rule is an error).
 
+#[path = "support/command.rs"]
+mod command;
+
+use command::slipgate;
 use quake_formats::bsp::{ClipNode, Rule, contents, texinfo_flags};
 use quake_formats::entities::{parse_entities, write_entities};
 use quake_formats::{Bsp, Severity, string_to_name16};
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 use std::sync::OnceLock;
 
-fn slipgate(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_slipgate"))
-        .args(args)
-        .output()
-        .expect("run slipgate")
-}
-
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("slipgate-rules-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir.join(name)
+    command::scratch("rules", name)
 }
 
 fn path_str(p: &Path) -> &str {
