@@ -6,7 +6,7 @@
 mod command;
 
 use command::slipgate;
-use quake_formats::bsp::{ClipNode, Rule, contents, texinfo_flags};
+use quake_formats::bsp::{BspPlane, ClipNode, Node, Rule, contents, texinfo_flags};
 use quake_formats::entities::{parse_entities, write_entities};
 use quake_formats::{Bsp, Severity, string_to_name16};
 use std::collections::BTreeSet;
@@ -145,6 +145,10 @@ fn breakers() -> Vec<(Rule, Break)> {
         (Rule::ClipHullsMissing, Model(|b| b.clipnodes.clear())),
         (Rule::NodeSameChildren, Model(node_with_one_child_twice)),
         (
+            Rule::NodePlaneOutsideRegion,
+            Model(node_plane_behind_its_region),
+        ),
+        (
             Rule::LeafZeroSolid,
             Model(|b| b.leafs[0].contents = contents::EMPTY),
         ),
@@ -238,6 +242,25 @@ fn node_loops(b: &mut Bsp) {
 fn node_with_one_child_twice(b: &mut Bsp) {
     let node = &mut b.nodes[0];
     node.children[1] = node.children[0];
+}
+
+/// A node put between the head and its front child whose plane, the head's moved far behind it,
+/// misses the head's front half: its front child takes the whole region, its back child (the
+/// solid leaf) none.
+fn node_plane_behind_its_region(b: &mut Bsp) {
+    let head = b.nodes[0];
+    let moved = BspPlane {
+        dist: b.planes[head.plane as usize].dist - 4096.0,
+        ..b.planes[head.plane as usize]
+    };
+    b.planes.push(moved);
+    let node = b.nodes.len() as i32;
+    b.nodes.push(Node {
+        plane: b.planes.len() as u32 - 1,
+        children: [head.children[0], -1],
+        ..head
+    });
+    b.nodes[0].children[0] = node;
 }
 
 /// Texture axes of every texinfo multiplied: faces span `factor` times the texels.

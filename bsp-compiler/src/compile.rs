@@ -915,7 +915,7 @@ fn build_model(
     timings[4] += t.elapsed().as_secs_f64();
     let t = Instant::now();
     let mut face_stats = FaceStats::default();
-    let raw = faces_from_portals(&tree, &portals, texinfos, &mut face_stats);
+    let raw = faces_from_portals(&tree, &portals, planes, texinfos, &mut face_stats);
     let merged = merge_faces(raw, |f| *planes.get(f.plane));
     face_stats.after_merge = merged.len();
     let mut faces = Vec::with_capacity(merged.len());

@@ -1,13 +1,11 @@
 //! Faces: made from the portals where leaf contents change, textured from the brush side lying
 //! on the portal, then merged (coplanar, same texinfo) and subdivided for lightmaps.
 
-use crate::brush::{Brush, BrushKind};
+use crate::brush::{Brush, BrushKind, Side};
 use crate::planes::{PlaneId, PlaneSet};
 use crate::portals::Portals;
 use crate::texinfo::TextureRole;
-use crate::tree::{
-    Tree, TreeNode, contents_priority, engine_contents, is_see_through, shows_faces_behind,
-};
+use crate::tree::{Tree, contents_priority, engine_contents, is_see_through, shows_faces_behind};
 use quake_formats::bsp::contents;
 use quake_formats::bsp::limits::MAX_SURFACE_EXTENT;
 use quake_formats::extents::LightmapExtents;
@@ -48,7 +46,8 @@ pub struct FaceTexInfo {
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
 pub struct FaceStats {
     pub from_portals: usize,
-    /// Portal faces whose texture had to be guessed (no brush side found on the portal).
+    /// Portal faces whose texture had to be guessed (no brush side of the leaf on the portal:
+    /// the nearest side's).
     pub untextured: usize,
     pub after_merge: usize,
     /// Merged faces whose texture met them edge-on, given Quake's projection for their plane.
@@ -84,27 +83,81 @@ fn seen_from(owner: i32, viewer: i32, own_side: bool) -> bool {
     }
 }
 
-/// The texinfo of the side of `leaf`'s brushes on `plane` facing out of it (`flipped` as in
-/// [`crate::brush::Side`]). Brushes of the leaf's own contents come first.
-fn side_texinfo(leaf: &TreeNode, plane: PlaneId, flipped: bool) -> Option<u32> {
-    let mut brushes: Vec<&Brush> = leaf
-        .brushes
-        .iter()
-        .filter(|b| b.contents == leaf.contents)
-        .collect();
-    if brushes.is_empty() {
-        brushes = leaf
+/// How much a brush side's plane turned away from a face's counts against it, in units of
+/// distance per unit of (1 - cosine): 5 degrees weigh about as much as 4 units.
+const TURN_WEIGHT: f64 = 1000.0;
+
+/// Where the texture of a face on a portal is looked for.
+struct TextureSearch<'a> {
+    tree: &'a Tree,
+    portals: &'a Portals,
+    planes: &'a PlaneSet,
+}
+
+impl TextureSearch<'_> {
+    /// The texinfo of the side of leaf `owner`'s brushes on `plane` facing out of it (`flipped`
+    /// as in [`crate::brush::Side`]), brushes of the leaf's own contents first; failing that,
+    /// of the side whose outward plane lies closest to the face (centred at `center`) among
+    /// the brushes of `owner` and of the leaves of its contents next to it; `None` when
+    /// `owner`'s brushes have no textured side. The tree leaves out a side within the epsilon of
+    /// a node plane or cutting off a sliver, so a leaf may have no side on its face; in a crack
+    /// filled whole the wall's own side is in the next leaf.
+    fn texinfo(&self, owner: u32, plane: PlaneId, flipped: bool, center: Vec3) -> Option<u32> {
+        let leaf = &self.tree.nodes[owner as usize];
+        let mut brushes: Vec<&Brush> = leaf
             .brushes
             .iter()
-            .filter(|b| b.kind != BrushKind::Hint)
+            .filter(|b| b.contents == leaf.contents)
             .collect();
+        if brushes.is_empty() {
+            brushes = leaf.brushes.iter().filter(|b| is_textured(b)).collect();
+        }
+        let own = textured_sides(brushes);
+        if let Some(s) = own
+            .iter()
+            .find(|s| s.plane == plane && s.flipped == flipped)
+            .or_else(|| own.iter().find(|s| s.plane == plane))
+        {
+            return s.texinfo;
+        }
+        if own.is_empty() {
+            return None;
+        }
+        let next_to = self.portals.leaf_portals[owner as usize]
+            .iter()
+            .map(|&p| self.portals.other(p, owner))
+            .filter(|&n| n != self.portals.outside)
+            .map(|n| &self.tree.nodes[n as usize])
+            .filter(|n| n.contents == leaf.contents)
+            .flat_map(|n| n.brushes.iter().filter(|b| is_textured(b)));
+        let face = self.outward(plane, flipped);
+        let gap = |s: &Side| {
+            let o = self.outward(s.plane, s.flipped);
+            o.distance(center).abs() + TURN_WEIGHT * (1.0 - o.normal.dot(face.normal))
+        };
+        own.into_iter()
+            .chain(textured_sides(next_to))
+            .min_by(|a, b| gap(a).total_cmp(&gap(b)))
+            .and_then(|s| s.texinfo)
     }
-    let sides = || brushes.iter().flat_map(|b| b.sides.iter());
-    sides()
-        .find(|s| s.plane == plane && s.flipped == flipped && s.texinfo.is_some())
-        .or_else(|| sides().find(|s| s.plane == plane && s.texinfo.is_some()))
-        .or_else(|| sides().find(|s| s.texinfo.is_some()))
-        .and_then(|s| s.texinfo)
+
+    fn outward(&self, id: PlaneId, flipped: bool) -> Plane {
+        let p = self.planes.get(id);
+        if flipped { p.flipped() } else { *p }
+    }
+}
+
+fn is_textured(b: &Brush) -> bool {
+    b.kind != BrushKind::Hint
+}
+
+/// The sides of `brushes` that carry a map face's texture.
+fn textured_sides<'a>(brushes: impl IntoIterator<Item = &'a Brush>) -> Vec<&'a Side> {
+    brushes
+        .into_iter()
+        .flat_map(|b| &b.sides)
+        .filter(|s| s.texinfo.is_some())
+        .collect()
 }
 
 /// The leaves a face seen from `viewer` is listed in. A face behind a fence or a detail wall
@@ -133,9 +186,15 @@ fn viewing_leaves(tree: &Tree, portals: &Portals, viewer: u32) -> Vec<u32> {
 pub fn faces_from_portals(
     tree: &Tree,
     portals: &Portals,
+    planes: &PlaneSet,
     texinfos: &[FaceTexInfo],
     stats: &mut FaceStats,
 ) -> Vec<ModelFace> {
+    let search = TextureSearch {
+        tree,
+        portals,
+        planes,
+    };
     let mut faces = Vec::new();
     for p in &portals.portals {
         let (Some(node), Some(plane)) = (p.on_node, p.plane_id) else {
@@ -161,7 +220,8 @@ pub fn faces_from_portals(
             .iter()
             .flat_map(|br| br.sides.iter())
             .any(|s| s.plane == plane && s.flipped == owner_is_front && s.texinfo.is_some());
-        let Some(texinfo) = side_texinfo(owner_node, plane, owner_is_front) else {
+        let center = p.winding.center();
+        let Some(texinfo) = search.texinfo(owner, plane, owner_is_front, center) else {
             continue;
         };
         if !texinfos[texinfo as usize].role.is_drawn() {

@@ -22,6 +22,7 @@ pub mod outside;
 pub mod planes;
 pub mod portals;
 pub mod progress;
+mod region;
 pub mod surface_tree;
 pub mod texinfo;
 pub mod trace;

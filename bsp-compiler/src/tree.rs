@@ -5,6 +5,7 @@
 
 use crate::brush::{Brush, BrushKind};
 use crate::planes::{PlaneId, PlaneSet};
+use crate::region::{Region, Sliver};
 use quake_formats::bsp::contents;
 use quake_formats::geom::{Bounds, Plane, Vec3};
 use rayon::prelude::*;
@@ -284,6 +285,10 @@ pub(crate) enum BuildNode {
     },
 }
 
+/// Space between the brushes and the box bounding the root's region, so that every brush side
+/// crosses it.
+const REGION_MARGIN: f64 = 8.0;
+
 /// Subtrees with at least this many brushes are built in parallel.
 const PARALLEL_BRUSHES: usize = 64;
 
@@ -310,7 +315,19 @@ pub fn build_tree(
         keep_brushes,
         splits: AtomicUsize::new(0),
     };
-    let root = builder.build(brushes, Phase::Structural);
+    let bounds = brushes
+        .iter()
+        .fold(Bounds::EMPTY, |acc, b| acc.union(&b.bounds));
+    let bounds = if bounds.is_empty() {
+        Bounds {
+            mins: Vec3::ZERO,
+            maxs: Vec3::ZERO,
+        }
+    } else {
+        bounds
+    };
+    let region = Region::around(&bounds, REGION_MARGIN);
+    let root = builder.build(brushes, Phase::Structural, region);
     let mut nodes = Vec::new();
     flatten(root, &mut nodes);
     Tree {
@@ -375,28 +392,30 @@ impl Phase {
 }
 
 impl Builder<'_> {
-    fn build(&self, brushes: Vec<Brush>, phase: Phase) -> BuildNode {
-        // A fragment of the strongest contents filling the region decides it whatever lies
-        // inside: splitting further would only cut up space of one contents. Above the
-        // structural leaves only a structural fragment may end the structure.
-        let strongest = brushes.iter().map(|b| contents_priority(b.contents)).max();
-        let filled = brushes.iter().any(|b| {
-            Some(contents_priority(b.contents)) == strongest
-                && b.fills_node()
-                && phase.splits_with(b)
-        });
-        let splitter = if filled {
-            None
-        } else {
-            self.choose_splitter(&brushes, phase)
+    /// The subtree of the node whose space is `region`, holding `brushes` (parts of them may
+    /// lie outside it).
+    fn build(&self, brushes: Vec<Brush>, phase: Phase, region: Region) -> BuildNode {
+        let mut brushes = self.fit_to_region(brushes, &region);
+        let (splitter, filled) = loop {
+            if strongest_fills(&brushes, phase) {
+                break (None, true);
+            }
+            let Some(plane) = self.choose_splitter(&brushes, phase) else {
+                break (None, false);
+            };
+            if let Some(parts) = region.split_cleanly(self.planes.get(plane)) {
+                break (Some((plane, parts)), false);
+            }
+            // Rare: choose again with the sliver given to the rest of the region.
+            brushes = self.absorb_sliver(brushes, plane, &region);
         };
-        let Some(plane) = splitter else {
+        let Some((plane, [front_region, back_region])) = splitter else {
             if phase == Phase::Structural && !filled && brushes.iter().any(Brush::is_detail) {
                 let structural_contents =
                     strongest_contents(brushes.iter().filter(|b| !b.is_detail()));
                 return BuildNode::Cluster {
                     structural_contents,
-                    detail: Box::new(self.build(brushes, Phase::Detail)),
+                    detail: Box::new(self.build(brushes, Phase::Detail, region)),
                 };
             }
             return BuildNode::Leaf {
@@ -427,14 +446,82 @@ impl Builder<'_> {
             }
         }
         let (f, b) = if parallel {
-            rayon::join(|| self.build(front, phase), || self.build(back, phase))
+            rayon::join(
+                || self.build(front, phase, front_region),
+                || self.build(back, phase, back_region),
+            )
         } else {
-            (self.build(front, phase), self.build(back, phase))
+            (
+                self.build(front, phase, front_region),
+                self.build(back, phase, back_region),
+            )
         };
         BuildNode::Split {
             plane,
             children: Box::new([f, b]),
         }
+    }
+
+    /// The brushes that reach into `region`, each side whose plane misses the region marked
+    /// used. Brushes reach past their node's region where a split left one part too thin to
+    /// build and kept the brush whole on both sides (see `Brush::split`), and a side may lie
+    /// within the epsilon of the region's boundary; inside the region such a side bounds
+    /// nothing: as a splitter it would make a node with an empty child, and it must not keep
+    /// the brush from filling the region.
+    fn fit_to_region(&self, brushes: Vec<Brush>, region: &Region) -> Vec<Brush> {
+        // A used side lies on a plane above (or was found here to miss a region above), so the
+        // region lies inside it.
+        let fit = |mut b: Brush| {
+            for s in b.sides.iter_mut().filter(|s| !s.used) {
+                let (front, back) = region.sides_of(self.planes.get(s.plane));
+                // Whether the region reaches out of the brush past the side, and into it.
+                let (outside, inside) = if s.flipped {
+                    (back, front)
+                } else {
+                    (front, back)
+                };
+                match (outside, inside) {
+                    (true, true) => {}
+                    (true, false) => return None,
+                    (false, _) => s.used = true,
+                }
+            }
+            Some(b)
+        };
+        // Above the parallel subtrees this is on every build's path: spread it too.
+        if brushes.len() >= PARALLEL_BRUSHES {
+            brushes.into_par_iter().filter_map(fit).collect()
+        } else {
+            brushes.into_iter().filter_map(fit).collect()
+        }
+    }
+
+    /// `brushes` without what lies in the sliver of `region` that the plane `id` cuts off (see
+    /// [`Region::split_cleanly`]), the plane's sides marked used: the sliver goes with the rest
+    /// of the region instead of becoming a node with a degenerate child. A brush inside the
+    /// plane only reaches into the sliver and is left out; one outside it is taken to reach
+    /// across the sliver. In a crack every brush is taken to reach across: what seals it stays.
+    fn absorb_sliver(&self, brushes: Vec<Brush>, id: PlaneId, region: &Region) -> Vec<Brush> {
+        let sliver = region.sliver(self.planes.get(id));
+        brushes
+            .into_iter()
+            .filter_map(|mut b| {
+                for s in b.sides.iter_mut().filter(|s| s.plane == id) {
+                    // A brush lies behind its side's outward plane: in front of the canonical
+                    // plane when the side is flipped.
+                    let inside = if s.flipped {
+                        Sliver::Front
+                    } else {
+                        Sliver::Back
+                    };
+                    if inside == sliver {
+                        return None;
+                    }
+                    s.used = true;
+                }
+                Some(b)
+            })
+            .collect()
     }
 
     /// The best unused side plane, or `None` when every side has been used (a leaf). Big nodes
@@ -491,6 +578,16 @@ impl Builder<'_> {
             self.heuristic,
         )
     }
+}
+
+/// Whether a fragment of the strongest contents fills the region: it decides the region whatever
+/// lies inside, and splitting further would only cut up space of one contents. Above the
+/// structural leaves only a structural fragment may end the structure.
+fn strongest_fills(brushes: &[Brush], phase: Phase) -> bool {
+    let strongest = brushes.iter().map(|b| contents_priority(b.contents)).max();
+    brushes.iter().any(|b| {
+        Some(contents_priority(b.contents)) == strongest && b.fills_node() && phase.splits_with(b)
+    })
 }
 
 /// The strongest contents among `brushes`, empty when there are none.
@@ -611,6 +708,66 @@ mod tests {
         assert_eq!(find(Vec3::new(95.0, 32.0, 32.0)), contents::EMPTY);
         let (skip_plane, _) = planes.insert(&Plane::new(Vec3::new(1.0, 0.0, 0.0), 90.0));
         assert!(tree.nodes.iter().all(|n| n.plane != Some(skip_plane)));
+    }
+
+    /// Walks `tree` from the root with each node's region (the box `bounds` grown as
+    /// `build_tree` grows it, cut by the planes above): every node's plane must cut its region
+    /// cleanly.
+    fn assert_planes_cut_their_regions(tree: &Tree, planes: &PlaneSet, bounds: &Bounds) {
+        let mut stack = vec![(0u32, Region::around(bounds, REGION_MARGIN))];
+        while let Some((n, region)) = stack.pop() {
+            let node = &tree.nodes[n as usize];
+            let Some(id) = node.plane else { continue };
+            let plane = planes.get(id);
+            let Some([front, back]) = region.split_cleanly(plane) else {
+                panic!("node {n}: plane {plane:?}");
+            };
+            stack.push((node.children[0], front));
+            stack.push((node.children[1], back));
+        }
+    }
+
+    /// The cause of DarkPlaces' "new portal was clipped away" on LibreQuake e3m4: a brush
+    /// reaching past a split by less than it can be cut is kept whole on both sides, so on the
+    /// side it barely reaches its far sides were still candidates, and one became a node whose
+    /// plane lies outside the node's region (its back child empty).
+    #[test]
+    fn brushes_kept_whole_past_a_split_give_no_planes_outside_the_region() {
+        let mut planes = PlaneSet::new();
+        // Reaches 0.05 above the hint plane z = 0: that part is too small to build.
+        let post = solid_box(
+            &mut planes,
+            Vec3::new(0.0, 0.0, -64.0),
+            Vec3::new(1.0, 1.0, 0.05),
+        );
+        let floor = solid_box(
+            &mut planes,
+            Vec3::new(-64.0, -64.0, -80.0),
+            Vec3::new(64.0, 64.0, -64.0),
+        );
+        let (hint_plane, _) = planes.insert(&Plane::new(Vec3::new(0.0, 0.0, 1.0), 0.0));
+        let mut hint = Brush::from_planes(
+            &box_planes(Vec3::new(-64.0, -64.0, -8.0), Vec3::new(64.0, 64.0, 0.0)),
+            &mut planes,
+            contents::EMPTY,
+            2,
+        )
+        .expect("hint");
+        hint.kind = BrushKind::Hint;
+        for s in &mut hint.sides {
+            s.buried = s.plane != hint_plane;
+        }
+        let brushes = vec![post, floor, hint];
+        let bounds = brushes
+            .iter()
+            .fold(Bounds::EMPTY, |acc, b| acc.union(&b.bounds));
+        let tree = build_tree(brushes, &planes, SplitHeuristic::FewestSplits, true);
+        assert_eq!(tree.nodes[0].plane, Some(hint_plane));
+        assert_planes_cut_their_regions(&tree, &planes, &bounds);
+        let find = |p: Vec3| tree.nodes[tree.leaf_at(&planes, p) as usize].contents;
+        assert_eq!(find(Vec3::new(0.5, 0.5, -32.0)), contents::SOLID);
+        assert_eq!(find(Vec3::new(0.5, 0.5, 8.0)), contents::EMPTY);
+        assert_eq!(find(Vec3::new(8.0, 0.5, -32.0)), contents::EMPTY);
     }
 
     #[test]

@@ -2,8 +2,8 @@
 
 use bsp_compiler::faces::{MIN_SQUARENESS, projection_squareness};
 use bsp_compiler::{CompileError, CompileOptions, CompileOutput, MapSource, Warning, compile};
-use quake_formats::bsp::contents;
 use quake_formats::bsp::limits::MAX_SURFACE_EXTENT;
+use quake_formats::bsp::{Rule, contents};
 use quake_formats::extents::LightmapExtents;
 use quake_formats::geom::Vec3;
 use quake_formats::miptex::MipTex;
@@ -128,6 +128,16 @@ fn assert_finite_bounds(bsp: &Bsp, name: &str) {
     for (i, n) in bsp.nodes.iter().enumerate() {
         assert!(finite(&n.mins) && finite(&n.maxs), "{name}: node {i}");
     }
+}
+
+/// DarkPlaces builds a portal on every node's plane at load; none may miss its node's region.
+fn assert_node_planes_cross_their_regions(bsp: &Bsp, name: &str) {
+    let outside: Vec<String> = validate(bsp)
+        .into_iter()
+        .filter(|p| p.rule == Rule::NodePlaneOutsideRegion)
+        .map(|p| p.to_string())
+        .collect();
+    assert_eq!(outside, Vec::<String>::new(), "{name}");
 }
 
 fn leaf_contents(bsp: &Bsp, p: [f32; 3]) -> i32 {
@@ -739,6 +749,25 @@ fn syntax_errors_name_the_place() {
     assert!(err.to_string().starts_with("broken.map:4:"), "{err}");
 }
 
+/// Regression (DarkPlaces' "new portal was clipped away" on LibreQuake e3m4): a post reaching
+/// past a hint plane by less than it can be cut was kept whole above it too, and its foot became
+/// a node plane above the hint, where it crosses nothing.
+#[test]
+fn a_post_grazing_a_hint_gives_no_node_outside_its_region() {
+    let post = box_brush([0.0, 0.0, -128.0], [1.0, 1.0, 0.05], "wall");
+    let mut faces: Vec<String> = box_brush([-128.0, -128.0, -8.0], [128.0, 128.0, 0.0], "skip")
+        .lines()
+        .map(str::to_string)
+        .collect();
+    // Line 0 is the brace; the +z face comes fifth.
+    faces[5] = faces[5].replace("skip", "hint");
+    let hint = faces.join("\n") + "\n";
+    let out = compile_text(&room_map(false, &(post + &hint)));
+    assert_node_planes_cross_their_regions(&out.bsp, "post and hint");
+    assert_eq!(leaf_contents(&out.bsp, [0.5, 0.5, -64.0]), contents::SOLID);
+    assert_eq!(leaf_contents(&out.bsp, [0.5, 0.5, 16.0]), contents::EMPTY);
+}
+
 /// Every map of the repository's `maps/` compiles to a valid BSP; only the leak test leaks.
 #[test]
 fn repository_maps_compile() {
@@ -764,6 +793,7 @@ fn repository_maps_compile() {
             let name = path.display().to_string();
             assert_eq!(errors(&out.bsp), Vec::<String>::new(), "{name}");
             assert_finite_bounds(&out.bsp, &name);
+            assert_node_planes_cross_their_regions(&out.bsp, &name);
             assert_textures_project_squarely(&out.bsp, &name);
             assert_faces_are_simple(&out.bsp, &name);
             assert_eq!(out.leak.is_some(), name.ends_with("leak.map"), "{name}");
@@ -793,6 +823,7 @@ fn compile_corpus_map(rel: &str) -> Option<CompileOutput> {
     let out = compile(&source, &options).expect("compile");
     assert_eq!(errors(&out.bsp), Vec::<String>::new(), "{rel}");
     assert_finite_bounds(&out.bsp, rel);
+    assert_node_planes_cross_their_regions(&out.bsp, rel);
     assert_textures_project_squarely(&out.bsp, rel);
     assert_faces_are_simple(&out.bsp, rel);
     check_round_trip(&out.bsp);

@@ -13,7 +13,9 @@ mod validate;
 pub use records::{
     ClipNode, Face, Leaf, Model, Node, Plane as BspPlane, TexInfo, contents, texinfo_flags,
 };
-pub use validate::{Problem, Rule, RuleInfo, Severity, validate};
+pub use validate::{
+    DARKPLACES_PORTAL_EPSILON, Problem, Rule, RuleInfo, Severity, darkplaces_divide, validate,
+};
 
 use crate::bytes::{PutLe, Reader};
 use crate::error::{FormatError, Result};

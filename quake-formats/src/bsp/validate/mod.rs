@@ -5,12 +5,14 @@
 
 mod counts;
 mod entities;
+mod node_portals;
 mod rules;
 mod structure;
 mod surfaces;
 mod textures;
 mod trees;
 
+pub use node_portals::{DARKPLACES_PORTAL_EPSILON, darkplaces_divide};
 pub use rules::{Rule, RuleInfo};
 
 use super::Bsp;
@@ -84,6 +86,7 @@ pub fn validate(bsp: &Bsp) -> Vec<Problem> {
     };
     structure::check(&mut c);
     trees::check(&mut c);
+    node_portals::check(&mut c);
     surfaces::check(&mut c);
     textures::check(&mut c);
     counts::check(&mut c);

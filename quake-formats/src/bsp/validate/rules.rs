@@ -24,6 +24,7 @@ pub enum Rule {
     TreeCycle,
     ClipHullsMissing,
     NodeSameChildren,
+    NodePlaneOutsideRegion,
     LeafZeroSolid,
     SurfaceExtents,
     SurfaceExtentsVanilla,
@@ -62,7 +63,7 @@ pub struct RuleInfo {
 const QS: &str = "QuakeSpasm, vkQuake, Ironwail";
 
 impl Rule {
-    pub const ALL: [Rule; 34] = [
+    pub const ALL: [Rule; 35] = [
         Rule::IndexRange,
         Rule::NonFinite,
         Rule::PlaneNormal,
@@ -78,6 +79,7 @@ impl Rule {
         Rule::TreeCycle,
         Rule::ClipHullsMissing,
         Rule::NodeSameChildren,
+        Rule::NodePlaneOutsideRegion,
         Rule::LeafZeroSolid,
         Rule::SurfaceExtents,
         Rule::SurfaceExtentsVanilla,
@@ -217,6 +219,16 @@ impl Rule {
                 "DarkPlaces (mod_bsp_portalize 1, the default of older builds such as Debian's)",
                 "\"Mod_Q1BSP_RecursiveNodePortals: corrupt node hierarchy\" (Host_Error)",
                 "no node of the world's tree has the same child on both sides",
+            ),
+            Rule::NodePlaneOutsideRegion => (
+                "node-plane-outside-region",
+                Warning,
+                "DarkPlaces (mod_bsp_portalize 1, the default of older builds such as Debian's)",
+                "\"Mod_Q1BSP_RecursiveNodePortals: WARNING: new portal was clipped away\"; the \
+                 node's children get no portal between them, which portal culling and \
+                 r_drawportals use",
+                "no node of the world's tree has a plane that misses its region, as DarkPlaces \
+                 finds it building portals at load (its procedure replayed in its precision)",
             ),
             Rule::LeafZeroSolid => (
                 "leaf-zero-solid",
