@@ -47,11 +47,16 @@ pub const BLOCK_LUXELS: usize = 4;
 /// A face no wider (half-diagonal) than this fraction of its clamped distance from a receiving
 /// face is gathered from as one point. Blocks (half-diagonal 45 units) never need splitting:
 /// the kernel is flat within the 128-unit clamp.
-const ONE_POINT_RATIO: f64 = 0.35;
+const ONE_POINT_RATIO: f64 = 1.0;
 /// Grey levels (at gamma 1) that culling may take from any luxel, at most.
-pub const CULL_BUDGET_LEVELS: f64 = 0.1;
+pub const CULL_BUDGET_LEVELS: f64 = 0.5;
 /// A shadow ray is skipped when what it could bring is below this many light units.
 const RAY_GATE: f64 = 1e-4;
+/// Bounce is measured at every this many luxels along each axis, and between where it is smooth.
+pub const GRID_STRIDE: usize = 4;
+/// Grey levels (at gamma 1) by which the corners of a grid cell may differ for the luxels
+/// inside to be interpolated.
+pub const SMOOTH_LEVELS: f64 = 2.0;
 
 /// Worldspawn `_bounce` and its keys (and their command-line overrides).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -406,6 +411,8 @@ pub struct Gather<'a> {
     pub kernel: f64,
     /// Light units culling may drop per luxel.
     pub budget: f64,
+    /// Light units by which a grid cell's corners may differ for its inside to be interpolated.
+    pub smooth: f64,
     /// No culling (the reference's passes).
     pub cull: bool,
 }
@@ -484,42 +491,122 @@ impl Gather<'_> {
         elements
     }
 
-    /// Bounced light at each luxel of `r`, per style.
+    /// Bounced light at each luxel of `r`, per style: measured on a grid of every
+    /// [`GRID_STRIDE`]th luxel (and the last row and column), interpolated bilinearly inside a
+    /// grid cell whose corners differ by at most `smooth` light units, measured elsewhere.
     pub fn face(&self, r: &Receivers, counts: &mut BounceCounts) -> StyleLuxels {
+        let elements = self.elements(r, counts);
         let n = r.points.len();
         let mut out: StyleLuxels = Vec::new();
+        let (w, h) = (r.width, r.height);
+        let grid = |size: usize| {
+            let mut at: Vec<usize> = (0..size).step_by(GRID_STRIDE).collect();
+            if at.last() != Some(&(size - 1)) {
+                at.push(size - 1);
+            }
+            at
+        };
+        let (xs, ys) = (grid(w), grid(h));
+        let corners: Vec<usize> = ys
+            .iter()
+            .flat_map(|&y| xs.iter().map(move |&x| y * w + x))
+            .collect();
+        self.measure(r, &elements, &corners, &mut out, counts);
+        let mut known = vec![false; n];
+        for &i in &corners {
+            known[i] = true;
+        }
+        let cells = |at: &[usize]| -> Vec<(usize, usize)> {
+            if at.len() == 1 {
+                vec![(at[0], at[0])]
+            } else {
+                at.windows(2).map(|p| (p[0], p[1])).collect()
+            }
+        };
+        let mut rest = Vec::new();
+        for &(y0, y1) in &cells(&ys) {
+            for &(x0, x1) in &cells(&xs) {
+                let c = [y0 * w + x0, y0 * w + x1, y1 * w + x0, y1 * w + x1];
+                let smooth = out.iter().all(|(_, v)| {
+                    (0..3).all(|k| {
+                        let vals = c.map(|i| v[i][k]);
+                        let lo = vals.iter().copied().fold(f32::INFINITY, f32::min);
+                        let hi = vals.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+                        f64::from(hi - lo) <= self.smooth
+                    })
+                });
+                for y in y0..=y1 {
+                    for x in x0..=x1 {
+                        let i = y * w + x;
+                        if known[i] {
+                            continue;
+                        }
+                        known[i] = true;
+                        if !smooth {
+                            rest.push(i);
+                            continue;
+                        }
+                        let fx = if x1 > x0 {
+                            (x - x0) as f32 / (x1 - x0) as f32
+                        } else {
+                            0.0
+                        };
+                        let fy = if y1 > y0 {
+                            (y - y0) as f32 / (y1 - y0) as f32
+                        } else {
+                            0.0
+                        };
+                        for (_, v) in out.iter_mut() {
+                            let [a, b, cc, d] = c.map(|k| v[k]);
+                            v[i] = std::array::from_fn(|k| {
+                                let top = a[k] + (b[k] - a[k]) * fx;
+                                let bottom = cc[k] + (d[k] - cc[k]) * fx;
+                                top + (bottom - top) * fy
+                            });
+                        }
+                    }
+                }
+            }
+        }
+        self.measure(r, &elements, &rest, &mut out, counts);
+        out
+    }
+
+    /// Gathers from `elements` at the luxels `which` of `r`, adding into `out`.
+    fn measure(
+        &self,
+        r: &Receivers,
+        elements: &[Element],
+        which: &[usize],
+        out: &mut StyleLuxels,
+        counts: &mut BounceCounts,
+    ) {
+        let n = r.points.len();
         let mut packet = RayPacket16::new();
         let mut lane_sample = [0usize; 16];
         let mut lane_weight = [0.0f64; 16];
-        for e in self.elements(r, counts) {
+        for e in elements {
             let brightest = e
                 .flux
                 .iter()
                 .map(|f| f64::from(f[0].max(f[1]).max(f[2])))
                 .fold(0.0, f64::max);
             let mut lanes = 0;
-            let mut i = 0;
-            while i < n || lanes > 0 {
-                if i < n {
-                    let p = Vec3::from_f32(r.points[i]);
-                    let to = e.point - p;
-                    let d = to.length();
-                    let normal = Vec3::from_f32(r.normals[i]);
-                    let (cos_r, cos_e) = (normal.dot(to) / d, -e.normal.dot(to) / d);
-                    let clamped = d.max(HOTSPOT_CLAMP);
-                    let weight = self.kernel * cos_r * cos_e / (clamped * clamped);
-                    if d > 0.0 && cos_r > 0.0 && cos_e > 0.0 && weight * brightest >= RAY_GATE {
-                        packet.set(lanes, p.to_f32(), (to / d).to_f32(), 0.0, d as f32);
-                        lane_sample[lanes] = i;
-                        lane_weight[lanes] = weight;
-                        lanes += 1;
-                    }
-                    i += 1;
-                    if lanes < 16 && i < n {
-                        continue;
-                    }
+            for (k, &i) in which.iter().enumerate() {
+                let p = Vec3::from_f32(r.points[i]);
+                let to = e.point - p;
+                let d = to.length();
+                let normal = Vec3::from_f32(r.normals[i]);
+                let (cos_r, cos_e) = (normal.dot(to) / d, -e.normal.dot(to) / d);
+                let clamped = d.max(HOTSPOT_CLAMP);
+                let weight = self.kernel * cos_r * cos_e / (clamped * clamped);
+                if d > 0.0 && cos_r > 0.0 && cos_e > 0.0 && weight * brightest >= RAY_GATE {
+                    packet.set(lanes, p.to_f32(), (to / d).to_f32(), 0.0, d as f32);
+                    lane_sample[lanes] = i;
+                    lane_weight[lanes] = weight;
+                    lanes += 1;
                 }
-                if lanes == 0 {
+                if lanes == 0 || (lanes < 16 && k + 1 < which.len()) {
                     continue;
                 }
                 let active = packet.active_mask();
@@ -527,7 +614,7 @@ impl Gather<'_> {
                 let through = active & !self.scene.occluded16(&mut packet, r.model);
                 for lane in (0..lanes).filter(|l| through & (1 << l) != 0) {
                     add_light(
-                        &mut out,
+                        out,
                         n,
                         e.styles,
                         e.flux,
@@ -539,7 +626,6 @@ impl Gather<'_> {
                 lanes = 0;
             }
         }
-        out
     }
 }
 

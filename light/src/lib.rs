@@ -481,6 +481,7 @@ fn bounce_light(
             emission: &emission,
             kernel: settings.kernel(),
             budget: bounce::CULL_BUDGET_LEVELS / prep.lights.rangescale.max(1e-6),
+            smooth: bounce::SMOOTH_LEVELS / prep.lights.rangescale.max(1e-6),
             cull: true,
         };
         // The last pass is needed only where lightmaps are wanted; earlier ones where light
