@@ -32,6 +32,9 @@ pub struct BuildArgs {
     /// Ambient occlusion ("dirt") on every light
     #[arg(long)]
     dirt: bool,
+    /// Bounced light (one pass of diffuse interreflection)
+    #[arg(long)]
+    bounce: bool,
     /// Preview size, WIDTHxHEIGHT
     #[arg(long, default_value = "640x480")]
     size: String,
@@ -76,6 +79,7 @@ pub fn build(args: &BuildArgs) -> Result<()> {
         (args.extra4, "--extra4"),
         (args.soft, "--soft"),
         (args.dirt, "--dirt"),
+        (args.bounce, "--bounce"),
     ] {
         if on {
             argv.push(flag.into());

@@ -58,7 +58,9 @@ fn normalise_single_dash(args: impl Iterator<Item = String>) -> Vec<String> {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse_from(normalise_single_dash(std::env::args()));
+    let cli = Cli::parse_from(light::cli::join_optional_values(normalise_single_dash(
+        std::env::args(),
+    )));
     match run(cli.command) {
         Ok(code) => code,
         Err(e) => {

@@ -6,6 +6,8 @@ use anyhow::Context;
 use quake_formats::Bsp;
 use quake_formats::fsutil::{read_file, write_atomic};
 
+use quake_formats::palette::Palette;
+
 use crate::lights::GlobalOverrides;
 use crate::{
     ErrorStats, Options, Quality, compare, compute_lighting, finish_lighting, trace_lighting,
@@ -71,6 +73,29 @@ pub struct Args {
     /// Add minlight to every luxel's light instead of raising dark luxels to it.
     #[arg(long)]
     pub addmin: bool,
+    /// Diffuse interreflection, N passes (`--bounce` = 1; overrides worldspawn `_bounce`).
+    #[arg(
+        long,
+        value_name = "N",
+        num_args = 0..=1,
+        require_equals = true,
+        default_missing_value = "1"
+    )]
+    pub bounce: Option<usize>,
+    /// Brightness of bounced light (overrides worldspawn `_bouncescale`, default 1).
+    #[arg(long, value_name = "S")]
+    pub bouncescale: Option<f64>,
+    /// 0 = surfaces reflect grey, 1 = their texture's mean colour (overrides
+    /// `_bouncecolorscale`, default 0).
+    #[arg(long, value_name = "W")]
+    pub bouncecolorscale: Option<f64>,
+    /// Styled (switchable, animated) light bounces too (as worldspawn `_bouncestyled 1`).
+    #[arg(long)]
+    pub bouncestyled: bool,
+    /// Palette for texture colours (`--bouncecolorscale`); default: `gfx/palette.lmp` in the
+    /// BSP's folder or up to three above it, else Slipgate's own palette.
+    #[arg(long, value_name = "FILE.lmp")]
+    pub palette: Option<PathBuf>,
     /// Consider every light for every face (no range, plane-side or PVS culling).
     #[arg(long)]
     pub no_cull: bool,
@@ -105,10 +130,15 @@ impl Args {
                 dirt_gain: self.dirtgain,
                 dirt_angle: self.dirtangle,
                 addmin: self.addmin,
+                bounce: self.bounce,
+                bounce_scale: self.bouncescale,
+                bounce_color_scale: self.bouncecolorscale,
+                bounce_styled: self.bouncestyled,
             },
             only_faces: None,
             no_cull: self.no_cull,
             progress: true,
+            palette: None,
         }
     }
 
@@ -129,11 +159,52 @@ fn lit_path(bsp: &Path) -> PathBuf {
     bsp.with_extension("lit")
 }
 
+/// The palette `--palette` names, else `gfx/palette.lmp` in the BSP's folder or up to three
+/// folders above it; `None`: Slipgate's own.
+fn find_palette(args: &Args) -> anyhow::Result<Option<Palette>> {
+    let dir = args.bsp.parent().unwrap_or(Path::new("."));
+    let found = args.palette.clone().or_else(|| {
+        dir.ancestors()
+            .take(4)
+            .map(|a| a.join("gfx").join("palette.lmp"))
+            .find(|p| p.is_file())
+    });
+    found
+        .map(|path| {
+            let data = read_file(&path)?;
+            Palette::from_bytes(&data).with_context(|| format!("{}", path.display()))
+        })
+        .transpose()
+}
+
+/// Options whose value is optional (`--bounce [N]`, `--soft [N]`, ericw-tools' spelling) take a
+/// following number as their value: `--bounce 2` becomes `--bounce=2`, while `--bounce
+/// map.bsp` leaves the BSP as the positional argument.
+pub fn join_optional_values(args: impl IntoIterator<Item = String>) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for a in args {
+        let joins = out
+            .last()
+            .is_some_and(|prev| prev == "--bounce" || prev == "--soft")
+            && !a.is_empty()
+            && a.chars().all(|c| c.is_ascii_digit());
+        match out.last_mut() {
+            Some(prev) if joins => {
+                prev.push('=');
+                prev.push_str(&a);
+            }
+            _ => out.push(a),
+        }
+    }
+    out
+}
+
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let path = &args.bsp;
     let data = read_file(path)?;
     let mut bsp = Bsp::read(&data).with_context(|| format!("{}", path.display()))?;
     let mut options = args.options(args.quality());
+    options.palette = find_palette(args)?;
     if let Some(stride) = args.face_stride {
         anyhow::ensure!(stride > 0, "--face-stride must be at least 1");
         options.only_faces = Some((0..bsp.faces.len()).step_by(stride).collect());
@@ -247,4 +318,21 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         write_atomic(stats_path, serde_json::to_string_pretty(&json)?.as_bytes())?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn strings(a: &[&str]) -> Vec<String> {
+        a.iter().map(|s| s.to_string()).collect()
+    }
+
+    #[test]
+    fn optional_values_join_only_numbers() {
+        let joined = join_optional_values(strings(&["light", "--bounce", "2", "x.bsp"]));
+        assert_eq!(joined, strings(&["light", "--bounce=2", "x.bsp"]));
+        let alone = join_optional_values(strings(&["light", "--bounce", "x.bsp", "--soft"]));
+        assert_eq!(alone, strings(&["light", "--bounce", "x.bsp", "--soft"]));
+    }
 }

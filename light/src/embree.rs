@@ -731,7 +731,12 @@ impl Scene {
     /// inactive lane. Embree shortens `tfar` of lanes that hit, so call
     /// [`RayPacket16::set`] again before reusing a lane.
     pub fn first_hit_geom16(&self, packet: &mut RayPacket16, coherent: bool) -> [u32; 16] {
-        let mut ids = [sys::RTC_INVALID_GEOMETRY_ID; 16];
+        self.first_hits16(packet, coherent).map(|(geom, _)| geom)
+    }
+
+    /// As [`Scene::first_hit_geom16`], with the primitive (triangle) id of each hit.
+    pub fn first_hits16(&self, packet: &mut RayPacket16, coherent: bool) -> [(u32, u32); 16] {
+        let mut ids = [(sys::RTC_INVALID_GEOMETRY_ID, 0); 16];
         if packet.active_mask() == 0 {
             return ids;
         }
@@ -763,7 +768,7 @@ impl Scene {
         packet.rays.tfar = rayhit.ray.tfar;
         for (i, id) in ids.iter_mut().enumerate() {
             if packet.valid.0[i] != 0 {
-                *id = rayhit.hit.geomID[i];
+                *id = (rayhit.hit.geomID[i], rayhit.hit.primID[i]);
             }
         }
         ids

@@ -21,6 +21,7 @@
 //! rays look for; liquids (`*` textures) let light through, as in id's tool.
 
 pub mod bench;
+pub mod bounce;
 pub mod cli;
 pub mod dirt;
 pub mod embree;
@@ -42,13 +43,14 @@ use quake_formats::entities::{parse_entities, write_entities};
 use quake_formats::geom::{Bounds, Vec3};
 use rayon::prelude::*;
 
+use crate::bounce::{BounceCounts, StyleLuxels};
 use crate::embree::{Device, EmbreeError};
 use crate::faces::{FaceKind, face_geometry};
 use crate::lights::{GlobalOverrides, parse_lights};
 use crate::output::{FaceLightmap, Finish, finish_face};
-use crate::samples::{PlacementCounts, face_samples};
+use crate::samples::{FaceSamples, PlacementCounts, face_samples};
 use crate::scene::TraceScene;
-use crate::trace::{FaceLight, FaceRules, TraceCounts, TraceSetup, light_face};
+use crate::trace::{FaceLight, FaceRules, SampleLight, TraceCounts, TraceSetup, trace_face};
 use crate::visibility::Visibility;
 
 /// Everything that can stop lighting a map.
@@ -111,6 +113,8 @@ pub struct Options {
     /// `--no-cull`: consider every light for every face (implied by `Reference`).
     pub no_cull: bool,
     pub progress: bool,
+    /// Colours of texture pixels, for `_bouncecolorscale` (default: Slipgate's own palette).
+    pub palette: Option<quake_formats::palette::Palette>,
 }
 
 impl Default for Options {
@@ -123,6 +127,7 @@ impl Default for Options {
             only_faces: None,
             no_cull: false,
             progress: false,
+            palette: None,
         }
     }
 }
@@ -148,6 +153,14 @@ pub struct Stats {
     /// Ambient-occlusion rays (`_dirt`).
     pub dirt_rays: u64,
     pub placement_rays: u64,
+    /// Bounce: passes run, shadow (or, for the reference, gathering) rays cast, and
+    /// receiving/emitting face pairs looked at and culled (PVS and facing, then energy).
+    pub bounce_passes: usize,
+    pub bounce_rays: u64,
+    pub bounce_pairs: u64,
+    pub bounce_pairs_culled: u64,
+    pub bounce_pairs_energy_culled: u64,
+    pub seconds_bounce: f64,
     /// Points outside their face moved onto it (inset from its edges).
     pub points_clamped_to_face: u64,
     pub points_pulled_back: u64,
@@ -324,44 +337,53 @@ fn face_rules<'a>(lights: &'a lights::MapLights, geom: &faces::FaceGeom) -> Face
                 .as_ref()
                 .is_none_or(|t| !t.eq_ignore_ascii_case(&geom.texture))
         });
+    let dirt = !lights.no_dirt_models.contains(&geom.model);
     FaceRules {
         minlight,
-        dirt: !lights.no_dirt_models.contains(&geom.model),
+        dirt,
         minlight_only: lights.lightignore_models.contains(&geom.model),
+        bounce_dirt: lights.bounce.dirt.filter(|_| dirt && lights.bounce.is_on()),
     }
 }
 
-/// Traces every lit face of `bsp` (or `options.only_faces`): light units per
-/// luxel and style, minlight included.
-///
-/// # Errors
-/// Bad entities or faces, or an Embree failure.
-pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, LightError> {
-    let start = Instant::now();
-    let prep = prepare(bsp, options)?;
-    let setup_done = Instant::now();
-    let light_reaches = trace::light_reaches(&prep.point_lights, options.gate);
-    let setup = prep.trace_setup(
-        bsp,
-        &light_reaches,
-        options.gate,
-        !options.no_cull && options.quality != Quality::Reference,
-        options.quality != Quality::Reference,
-    );
-    let wanted: Vec<usize> = match &options.only_faces {
-        Some(list) => list.clone(),
-        None => (0..prep.faces.len()).collect(),
-    };
-    // With nothing to give light, engines draw a map with an empty lighting lump fullbright
-    // (a lump of zeros would be black), as they draw a map never lit.
-    let fullbright = !prep.has_light_sources();
-    let lit_faces: Vec<usize> = wanted
-        .into_iter()
-        .filter(|&f| !fullbright && prep.faces.get(f).is_some_and(|g| g.kind == FaceKind::Lit))
-        .collect();
-    let per_axis = options.quality.samples_per_axis();
-    let bar = progress_bar(lit_faces.len(), options.progress);
-    let results: Vec<(FaceLight, PlacementCounts, TraceCounts, u64)> = lit_faces
+/// One face after direct light: what later steps need of it.
+struct Traced {
+    face: usize,
+    /// Its light per sample (faces whose lightmap is wanted).
+    light: Option<SampleLight>,
+    /// Its sample points (kept for the reference's bounce gathering).
+    samples: Option<FaceSamples>,
+    /// Where it receives bounced light (when bouncing).
+    receivers: Option<bounce::Receivers>,
+    /// The light it reflects (when bouncing and the face reflects).
+    reflected: Option<StyleLuxels>,
+    placement: PlacementCounts,
+    counts: TraceCounts,
+    sample_count: u64,
+}
+
+/// What a run of [`trace_faces`] keeps of each face.
+#[derive(Debug, Clone, Copy)]
+struct Keep<'a> {
+    wanted: &'a [bool],
+    reflectance: &'a [Option<[f32; 3]>],
+    bouncing: bool,
+    samples: bool,
+}
+
+/// Direct light of `faces` at `quality`.
+fn trace_faces(
+    bsp: &Bsp,
+    prep: &Prepared,
+    setup: &TraceSetup,
+    faces: &[usize],
+    quality: Quality,
+    keep: Keep,
+    bar: &indicatif::ProgressBar,
+) -> Vec<Traced> {
+    let per_axis = quality.samples_per_axis();
+    let styled = prep.lights.bounce.styled;
+    faces
         .par_iter()
         .map(|&f| {
             let geom = &prep.faces[f];
@@ -374,19 +396,221 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
                     .collect();
             }
             let rules = face_rules(&prep.lights, geom);
-            let (light, counts) = light_face(&setup, &samples, &rules);
+            let (light, counts) = trace_face(setup, &samples, &rules);
             bar.inc(1);
-            (light, placement, counts, samples.points.len() as u64)
+            let reflected =
+                (keep.bouncing && keep.reflectance[f].is_some()).then(|| light.reflected(styled));
+            Traced {
+                face: f,
+                light: keep.wanted[f].then_some(light),
+                receivers: keep
+                    .bouncing
+                    .then(|| bounce::Receivers::new(&samples, geom)),
+                reflected,
+                placement,
+                counts,
+                sample_count: samples.points.len() as u64,
+                samples: (keep.samples && keep.wanted[f]).then_some(samples),
+            }
         })
+        .collect()
+}
+
+/// Bounced light per face (by index; per luxel, or per sample for the reference), `passes`
+/// passes of it. `traced` is the direct light of every lit face; with `reference`, `field`
+/// is the same at `--extra4` (the reference's emitters) and bounce is gathered at the samples
+/// of `traced` by [`bounce::reference::gather`].
+fn bounce_light(
+    prep: &Prepared,
+    reflectance: &[Option<[f32; 3]>],
+    traced: &[Traced],
+    field: &[Traced],
+    reference: bool,
+    counts: &mut BounceCounts,
+) -> Vec<StyleLuxels> {
+    let settings = prep.lights.bounce;
+    let n = prep.faces.len();
+    let emitters: Vec<bounce::EmitterGeom> = (0..n)
+        .filter(|&f| reflectance[f].is_some())
+        .filter_map(|f| bounce::EmitterGeom::new(&prep.faces[f]))
         .collect();
+    let mut light: Vec<Option<StyleLuxels>> = vec![None; n];
+    for t in field {
+        light[t.face] = t.reflected.clone().filter(|r| !r.is_empty());
+    }
+    let mut total: Vec<StyleLuxels> = vec![Vec::new(); n];
+    for pass in 1..=settings.passes {
+        let last = pass == settings.passes;
+        if reference {
+            let f = bounce::reference::Field {
+                faces: &prep.faces,
+                reflectance,
+                light: &light,
+                kernel: settings.kernel(),
+            };
+            let gathered: Vec<(usize, StyleLuxels, BounceCounts)> = traced
+                .par_iter()
+                .filter_map(|t| Some((t.face, t.samples.as_ref()?)))
+                .map(|(face, samples)| {
+                    let mut c = BounceCounts::default();
+                    let model = prep.faces[face].model;
+                    let b =
+                        bounce::reference::gather(&f, &prep.scene, samples, model, pass, &mut c);
+                    (face, b, c)
+                })
+                .collect();
+            for (face, b, c) in gathered {
+                bounce::accumulate(&mut total[face], &b);
+                counts.add(&c);
+            }
+            if last {
+                break;
+            }
+        }
+        let emission: Vec<Option<bounce::Emission>> = emitters
+            .iter()
+            .map(|e| {
+                let rho = reflectance[e.face]?;
+                bounce::Emission::new(e, rho, light[e.face].as_ref()?)
+            })
+            .collect();
+        let gather = bounce::Gather {
+            scene: &prep.scene,
+            vis: &prep.vis,
+            emitters: &emitters,
+            emission: &emission,
+            kernel: settings.kernel(),
+            budget: bounce::CULL_BUDGET_LEVELS / prep.lights.rangescale.max(1e-6),
+            smooth: bounce::SMOOTH_LEVELS / prep.lights.rangescale.max(1e-6),
+            cull: true,
+        };
+        // The last pass is needed only where lightmaps are wanted; earlier ones where light
+        // reflects again.
+        let receiving: Vec<&Traced> = if last {
+            traced.iter().filter(|t| t.light.is_some()).collect()
+        } else {
+            field.iter().filter(|t| t.reflected.is_some()).collect()
+        };
+        let gathered: Vec<(usize, StyleLuxels, BounceCounts)> = receiving
+            .par_iter()
+            .filter_map(|t| Some((t.face, t.receivers.as_ref()?)))
+            .map(|(face, r)| {
+                let mut c = BounceCounts::default();
+                (face, gather.face(r, &mut c), c)
+            })
+            .collect();
+        let mut next: Vec<Option<StyleLuxels>> = vec![None; n];
+        for (face, b, c) in gathered {
+            counts.add(&c);
+            if !reference {
+                bounce::accumulate(&mut total[face], &b);
+            }
+            if reflectance[face].is_some() && !b.is_empty() {
+                next[face] = Some(b);
+            }
+        }
+        light = next;
+    }
+    total
+}
+
+/// Traces every lit face of `bsp` (or `options.only_faces`): light units per
+/// luxel and style, minlight and bounced light included.
+///
+/// # Errors
+/// Bad entities or faces, or an Embree failure.
+pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, LightError> {
+    let start = Instant::now();
+    let prep = prepare(bsp, options)?;
+    let setup_done = Instant::now();
+    let light_reaches = trace::light_reaches(&prep.point_lights, options.gate);
+    let reference = options.quality == Quality::Reference;
+    let setup = prep.trace_setup(
+        bsp,
+        &light_reaches,
+        options.gate,
+        !options.no_cull && !reference,
+        !reference,
+    );
+    let n = prep.faces.len();
+    let mut wanted = vec![options.only_faces.is_none(); n];
+    for &f in options.only_faces.iter().flatten() {
+        if let Some(w) = wanted.get_mut(f) {
+            *w = true;
+        }
+    }
+    // With nothing to give light, engines draw a map with an empty lighting lump fullbright
+    // (a lump of zeros would be black), as they draw a map never lit.
+    let fullbright = !prep.has_light_sources();
+    let lit = |f: &usize| !fullbright && prep.faces[*f].kind == FaceKind::Lit;
+    let bouncing = prep.lights.bounce.is_on() && !fullbright;
+    let palette = options
+        .palette
+        .clone()
+        .unwrap_or_else(quake_formats::palette::Palette::slipgate);
+    let reflectance = if bouncing {
+        bounce::face_reflectance(bsp, &prep.faces, &prep.lights, &palette)
+    } else {
+        vec![None; n]
+    };
+    // Bounce needs every face's direct light (they all reflect, and receive for later passes).
+    let to_trace: Vec<usize> = (0..n)
+        .filter(lit)
+        .filter(|&f| bouncing || wanted[f])
+        .collect();
+    let bar = progress_bar(to_trace.len(), options.progress);
+    let keep = Keep {
+        wanted: &wanted,
+        reflectance: &reflectance,
+        bouncing: bouncing && !reference,
+        samples: bouncing && reference,
+    };
+    let traced = if bouncing && reference {
+        let mine: Vec<usize> = to_trace.iter().copied().filter(|&f| wanted[f]).collect();
+        trace_faces(bsp, &prep, &setup, &mine, options.quality, keep, &bar)
+    } else {
+        trace_faces(bsp, &prep, &setup, &to_trace, options.quality, keep, &bar)
+    };
     bar.finish_and_clear();
     let trace_done = Instant::now();
+
+    let mut bounce_counts = BounceCounts::default();
+    let mut bounced = if bouncing && reference {
+        // The reference's emitters: every face's direct light at --extra4.
+        let fine = prep.trace_setup(bsp, &light_reaches, options.gate, true, true);
+        let keep = Keep {
+            bouncing: true,
+            samples: false,
+            ..keep
+        };
+        let hidden = indicatif::ProgressBar::hidden();
+        let field = trace_faces(bsp, &prep, &fine, &to_trace, Quality::Extra4, keep, &hidden);
+        bounce_light(
+            &prep,
+            &reflectance,
+            &traced,
+            &field,
+            true,
+            &mut bounce_counts,
+        )
+    } else if bouncing {
+        bounce_light(
+            &prep,
+            &reflectance,
+            &traced,
+            &traced,
+            false,
+            &mut bounce_counts,
+        )
+    } else {
+        Vec::new()
+    };
+    let bounce_done = Instant::now();
 
     let mut placement = PlacementCounts::default();
     let mut counts = TraceCounts::default();
     let mut stats = Stats {
         faces: bsp.faces.len(),
-        faces_lit: results.len(),
         scene_triangles: prep.scene.triangles,
         point_lights: prep.lights.points.len(),
         surface_lights: prep.surface_lights,
@@ -396,13 +620,27 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
         fullbright,
         ..Stats::default()
     };
-    let mut faces = Vec::with_capacity(results.len());
-    for (light, p, c, samples) in results {
-        placement.add(&p);
-        counts.add(&c);
+    let mut faces = Vec::new();
+    for t in traced {
+        placement.add(&t.placement);
+        counts.add(&t.counts);
+        let Some(light) = t.light else {
+            continue;
+        };
+        stats.samples += t.sample_count;
+        let light = light.finish(bounced.get_mut(t.face).map_or(&[][..], |b| &b[..]));
         stats.luxels += (light.width * light.height) as u64;
-        stats.samples += samples;
         faces.push(light);
+    }
+    stats.faces_lit = faces.len();
+    if bouncing {
+        // Bounced light takes the reflecting texture's colour.
+        stats.coloured |= faces.iter().any(|f| {
+            f.styles
+                .iter()
+                .flat_map(|(_, l)| l)
+                .any(|c| c[0] != c[1] || c[1] != c[2])
+        });
     }
     stats.shadow_rays = counts.shadow_rays;
     stats.sun_rays = counts.sun_rays;
@@ -413,10 +651,21 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
     stats.points_moved_to_centre = placement.to_centre;
     stats.face_light_pairs = counts.pairs;
     stats.face_light_pairs_culled = counts.pairs_culled;
+    stats.bounce_passes = if bouncing {
+        prep.lights.bounce.passes
+    } else {
+        0
+    };
+    stats.bounce_rays = bounce_counts.rays;
+    stats.bounce_pairs = bounce_counts.pairs;
+    stats.bounce_pairs_culled = bounce_counts.pairs_culled;
+    stats.bounce_pairs_energy_culled = bounce_counts.pairs_energy_culled;
     stats.seconds_setup = (setup_done - start).as_secs_f64();
     stats.seconds_trace = (trace_done - setup_done).as_secs_f64();
+    stats.seconds_bounce = (bounce_done - trace_done).as_secs_f64();
     stats.seconds_total = start.elapsed().as_secs_f64();
-    stats.rays_per_second = (counts.rays() + placement.rays) as f64 / stats.seconds_trace.max(1e-9);
+    stats.rays_per_second = (counts.rays() + placement.rays + bounce_counts.rays) as f64
+        / (stats.seconds_trace + stats.seconds_bounce).max(1e-9);
     Ok(RawLighting {
         faces,
         entity_text: prep.entity_text,

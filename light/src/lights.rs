@@ -13,6 +13,7 @@ use quake_formats::entities::Entity;
 use quake_formats::geom::Vec3;
 
 use crate::LightError;
+use crate::bounce::{BounceSettings, MAX_BOUNCE_PASSES};
 
 /// `light` value of a light entity without one (or with `light 0`, as
 /// ericw-tools treats it).
@@ -191,6 +192,8 @@ pub struct PointLight {
     pub anglescale: f64,
     /// How dirt darkens this light (`None`: it ignores dirt).
     pub dirt: Option<DirtResponse>,
+    /// Its light bounces (false for `_bounce 0`).
+    pub bounce: bool,
     /// Entity index it came from (for messages).
     pub entity: usize,
 }
@@ -310,6 +313,12 @@ pub struct GlobalOverrides {
     pub dirt_angle: Option<f64>,
     /// `--addmin`: minlight is added to style 0 instead of raising it to a floor.
     pub addmin: bool,
+    /// `--bounce N`, `--bouncescale`, `--bouncecolorscale`, `--bouncestyled`: override the
+    /// worldspawn keys of the same names.
+    pub bounce: Option<usize>,
+    pub bounce_scale: Option<f64>,
+    pub bounce_color_scale: Option<f64>,
+    pub bounce_styled: bool,
 }
 
 impl Default for GlobalOverrides {
@@ -325,6 +334,10 @@ impl Default for GlobalOverrides {
             dirt_gain: None,
             dirt_angle: None,
             addmin: false,
+            bounce: None,
+            bounce_scale: None,
+            bounce_color_scale: None,
+            bounce_styled: false,
         }
     }
 }
@@ -345,6 +358,10 @@ pub struct MapLights {
     pub no_dirt_models: Vec<usize>,
     /// Brush models whose faces get minlight only (`_lightignore 1`).
     pub lightignore_models: Vec<usize>,
+    /// Brush models whose faces do not reflect light (`_bounce 0`).
+    pub no_bounce_models: Vec<usize>,
+    /// Diffuse interreflection (`_bounce` and its keys).
+    pub bounce: BounceSettings,
     /// How dirt occlusion is measured (used only when something takes dirt).
     pub dirt: DirtSampling,
     /// Brush models (0 = world) with `_phong` smoothing, and their angle in degrees.
@@ -615,6 +632,8 @@ pub fn parse_lights(
         })
     };
     let minlight_dirt = dirt_if(wk.float("_minlight_dirt")?, global_dirt, global_response);
+    let mut bounce = bounce_settings(&wk, overrides)?;
+    bounce.dirt = global_dirt.then_some(global_response);
 
     let mut out = MapLights {
         points: Vec::new(),
@@ -625,6 +644,8 @@ pub fn parse_lights(
         self_shadow_models: Vec::new(),
         no_dirt_models: Vec::new(),
         lightignore_models: Vec::new(),
+        no_bounce_models: Vec::new(),
+        bounce,
         dirt,
         phong: HashMap::new(),
         model_origins: HashMap::new(),
@@ -727,6 +748,9 @@ pub fn parse_lights(
             if k.float("_lightignore")? == Some(1.0) {
                 out.lightignore_models.push(model);
             }
+            if k.float("_bounce")?.is_some_and(|b| b <= 0.0) {
+                out.no_bounce_models.push(model);
+            }
             if let Some(level) = k.float("_minlight")?.filter(|m| *m != 0.0) {
                 let color = k.color_any(&["_minlight_color", "_mincolor"])?;
                 out.minlight.insert(
@@ -821,6 +845,7 @@ pub fn parse_lights(
             spot: aim.map(|dir| Spot::new(dir, angle, softangle)),
             anglescale,
             dirt,
+            bounce: k.float("_bounce")?.is_none_or(|b| b > 0.0),
             entity: index,
         };
         match e.get("_surface").filter(|t| !t.is_empty()) {
@@ -845,6 +870,34 @@ pub fn parse_lights(
         }
     }
     Ok(out)
+}
+
+/// Worldspawn's `_bounce`, `_bouncescale`, `_bouncecolorscale` and `_bouncestyled`, with the
+/// command line's overrides.
+fn bounce_settings(wk: &Keys, o: &GlobalOverrides) -> Result<BounceSettings, LightError> {
+    let passes = match o.bounce {
+        Some(n) => n,
+        None => match wk.float("_bounce")? {
+            Some(n) if n >= 0.0 && n.fract() == 0.0 => n as usize,
+            Some(_) => return Err(wk.bad("_bounce", "a whole number of passes, 0 or more")),
+            None => 0,
+        },
+    };
+    Ok(BounceSettings {
+        passes: passes.min(MAX_BOUNCE_PASSES),
+        scale: o
+            .bounce_scale
+            .or(wk.float("_bouncescale")?)
+            .unwrap_or(1.0)
+            .max(0.0),
+        color_scale: o
+            .bounce_color_scale
+            .or(wk.float("_bouncecolorscale")?)
+            .unwrap_or(0.0)
+            .clamp(0.0, 1.0),
+        styled: o.bounce_styled || wk.float("_bouncestyled")? == Some(1.0),
+        dirt: None,
+    })
 }
 
 /// `_deviance`: `light` as `count` lights spread through a ball of `radius`,
@@ -920,6 +973,7 @@ mod tests {
             spot: None,
             anglescale: 0.5,
             dirt: None,
+            bounce: true,
             entity: 0,
         }
     }

@@ -14,6 +14,8 @@ use crate::faces::{FaceGeom, FaceKind};
 pub struct TraceScene {
     pub scene: Scene,
     sky_geom: u32,
+    /// The face of each opaque triangle (by primitive id).
+    opaque_faces: Vec<u32>,
     /// Per `_shadowself` model (not already in `scene`): its own faces.
     own: HashMap<usize, Scene>,
     /// Triangles in the scene (opaque + sky) and the `_shadowself` scenes.
@@ -25,6 +27,8 @@ pub struct TraceScene {
 struct Mesh {
     vertices: Vec<[f32; 3]>,
     triangles: Vec<[u32; 3]>,
+    /// The face each triangle comes from.
+    faces: Vec<u32>,
 }
 
 impl Mesh {
@@ -33,6 +37,7 @@ impl Mesh {
         self.vertices.extend(face.points.iter().map(|p| p.to_f32()));
         for i in 1..face.points.len() as u32 - 1 {
             self.triangles.push([base, base + i, base + i + 1]);
+            self.faces.push(face.index as u32);
         }
     }
 }
@@ -79,6 +84,7 @@ impl TraceScene {
         Ok(TraceScene {
             scene: builder.commit()?,
             sky_geom,
+            opaque_faces: opaque.faces,
             own,
             triangles,
         })
@@ -110,6 +116,33 @@ impl TraceScene {
         // tfar now ends at each lane's first hit: the model blocks the sky
         // only if it lies nearer.
         sky & !self.own_occluded16(packet, model)
+    }
+
+    /// For each active lane of `packet`, cast from a face of `model`, the
+    /// opaque face it meets first and the distance to it (`None`: it meets
+    /// nothing, the sky, or `model`'s own `_shadowself` scene first).
+    pub fn first_faces16(
+        &self,
+        packet: &mut RayPacket16,
+        model: usize,
+    ) -> [Option<(usize, f32)>; 16] {
+        let hits = self.scene.first_hits16(packet, false);
+        let mut out = [None; 16];
+        for (lane, (geom, prim)) in hits.iter().enumerate() {
+            if *geom != self.sky_geom && *geom != sys::RTC_INVALID_GEOMETRY_ID {
+                out[lane] = self
+                    .opaque_faces
+                    .get(*prim as usize)
+                    .map(|&f| (f as usize, packet.tfar(lane)));
+            }
+        }
+        let own = self.own_occluded16(packet, model);
+        for (lane, hit) in out.iter_mut().enumerate() {
+            if own & (1 << lane) != 0 {
+                *hit = None;
+            }
+        }
+        out
     }
 
     /// For each active lane of `packet`, cast from a face of `model`, the

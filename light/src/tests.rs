@@ -1087,6 +1087,8 @@ fn output_does_not_depend_on_the_thread_count() {
         options.overrides.dirt = true;
         options.overrides.dirt_mode = Some(dirt_mode);
         options.overrides.sunsamples = 16;
+        // Bounce gathers across faces: one pass, and two with supersampling.
+        options.overrides.bounce = Some(if quality == Quality::Default { 1 } else { 2 });
         let one = lit_bytes(1, &options);
         assert!(one.0.iter().any(|&b| b > 0), "{quality:?}: lit");
         assert!(
@@ -1158,4 +1160,105 @@ fn embree_errors_are_told_once() {
     let error = crate::LightError::from(crate::embree::EmbreeError::InvalidInput("bad".into()));
     let told = format!("{:#}", anyhow::Error::from(error));
     assert_eq!(told.matches("bad").count(), 1, "{told}");
+}
+
+/// Grey style-0 bytes of `face`, when it has a lightmap.
+fn face_grey(lighting: &crate::Lighting, face: usize) -> Vec<u8> {
+    lighting
+        .lightmaps
+        .iter()
+        .find(|m| m.face == face)
+        .map(|m| m.grey[0].clone())
+        .unwrap_or_default()
+}
+
+/// Index of the box's underside in [`shadow_scene`] (floor, then the box's +z and −z faces).
+const BOX_UNDERSIDE: usize = 2;
+
+#[test]
+fn bounce_lights_the_underside_of_the_box_only_when_asked() {
+    let bsp = shadow_scene("");
+    let plain = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
+    assert!(face_grey(&plain, BOX_UNDERSIDE).iter().all(|&b| b == 0));
+    let mut bounced = options(Quality::Default);
+    bounced.overrides.bounce = Some(1);
+    let lit = compute_lighting(&bsp, &bounced).expect("light");
+    let under = face_grey(&lit, BOX_UNDERSIDE);
+    assert!(under.iter().all(|&b| b > 0), "lit by the floor: {under:?}");
+    assert!(!lit.coloured, "grey reflectance keeps white light white");
+    // Worldspawn's key does the same; a light's `_bounce 0` opts its light out.
+    let keyed = shadow_scene("")
+        .entity_text()
+        .replace("\"worldspawn\"", "\"worldspawn\" \"_bounce\" \"1\"");
+    let mut by_key = bsp.clone();
+    by_key.set_entity_text(&keyed);
+    let from_key = compute_lighting(&by_key, &options(Quality::Default)).expect("light");
+    assert_eq!(face_grey(&from_key, BOX_UNDERSIDE), under);
+    let opted_out = compute_lighting(&shadow_scene("\"_bounce\" \"0\""), &bounced).expect("light");
+    assert!(face_grey(&opted_out, BOX_UNDERSIDE).iter().all(|&b| b == 0));
+}
+
+#[test]
+fn bounce_is_close_to_the_reference_and_never_black_where_it_is_lit() {
+    let bsp = shadow_scene("");
+    let mut fast = options(Quality::Default);
+    fast.overrides.bounce = Some(1);
+    let mut exact = options(Quality::Reference);
+    exact.overrides.bounce = Some(1);
+    let reference = compute_lighting(&bsp, &exact).expect("reference");
+    let ref_under = face_grey(&reference, BOX_UNDERSIDE);
+    assert!(ref_under.iter().all(|&b| b > 0), "reference: {ref_under:?}");
+    for quality in [Quality::Default, Quality::Extra4] {
+        fast.quality = quality;
+        let lit = compute_lighting(&bsp, &fast).expect("light");
+        let under = face_grey(&lit, BOX_UNDERSIDE);
+        for (i, (&a, &r)) in under.iter().zip(&ref_under).enumerate() {
+            assert!(
+                r == 0 || a > 0,
+                "{quality:?}: luxel {i} black, reference {r}"
+            );
+            assert!(
+                a.abs_diff(r) <= 1,
+                "{quality:?}: luxel {i}: {a} against {r}"
+            );
+        }
+        // Bounce adds little error to the direct light's own.
+        let direct = compare(
+            &compute_lighting(&bsp, &options(quality)).expect("light"),
+            &compute_lighting(&bsp, &options(Quality::Reference)).expect("reference"),
+        );
+        let e = compare(&lit, &reference);
+        assert!(
+            e.rmse < direct.rmse + 0.5,
+            "{quality:?}: {e:?} against {direct:?}"
+        );
+    }
+}
+
+#[test]
+fn coloured_bounce_writes_a_lit_only_when_the_texture_is_coloured() {
+    let mut bsp = shadow_scene("");
+    let mut options = options(Quality::Default);
+    options.overrides.bounce = Some(1);
+    options.overrides.bounce_color_scale = Some(1.0);
+    // Palette index 0 (every texel of the test textures) grey, then red.
+    let mut palette = quake_formats::palette::Palette::slipgate();
+    palette.colors[0] = [128, 128, 128];
+    options.palette = Some(palette.clone());
+    assert!(!compute_lighting(&bsp, &options).expect("light").coloured);
+    palette.colors[0] = [200, 40, 40];
+    options.palette = Some(palette);
+    let lit = compute_lighting(&bsp, &options).expect("light");
+    assert!(lit.coloured);
+    let under = lit
+        .lightmaps
+        .iter()
+        .find(|m| m.face == BOX_UNDERSIDE)
+        .expect("underside");
+    assert!(
+        under.rgb[0].iter().all(|c| c[0] > c[1]),
+        "reddened by the floor"
+    );
+    let lit_bytes = apply_lighting(&mut bsp, &lit);
+    assert!(lit_bytes.is_some());
 }

@@ -132,6 +132,9 @@ pub struct FaceRules<'a> {
     pub dirt: bool,
     /// `_lightignore`: minlight only, no lights or suns.
     pub minlight_only: bool,
+    /// Bounced light will be added and darkened by dirt this way: dirt is
+    /// then measured at every sample (bounce reaches where lights do not).
+    pub bounce_dirt: Option<DirtResponse>,
 }
 
 /// Per-luxel colour of each style a face receives, in light units.
@@ -170,6 +173,7 @@ impl TraceCounts {
 }
 
 /// Per-sample buffers, one per style (style 0 always present and first).
+#[derive(Debug)]
 struct StyleBuffers {
     len: usize,
     styles: Vec<(u8, Vec<[f32; 3]>)>,
@@ -586,20 +590,139 @@ impl Arrival {
 }
 
 /// Adds `value` of `light` (its colour) to sample `i`, or for a local
-/// minlight raises the sample's floor to it.
-fn deposit(
-    light: &PointLight,
-    value: f64,
-    i: usize,
-    sums: &mut StyleBuffers,
-    floors: &mut StyleBuffers,
-) {
+/// minlight raises the sample's floor to it. Light of a `_bounce 0` light
+/// is also kept in `no_bounce`, so it can be taken out of what reflects.
+fn deposit(light: &PointLight, value: f64, i: usize, out: &mut SampleLight) {
     let local_min = light.falloff == Falloff::LocalMin;
-    let target = if local_min { floors } else { sums };
-    let out = &mut target.get(light.style)[i];
-    for (o, c) in out.iter_mut().zip(light.color.to_array()) {
+    let target = if local_min {
+        &mut out.floors
+    } else {
+        &mut out.sums
+    };
+    let slot = &mut target.get(light.style)[i];
+    for (o, c) in slot.iter_mut().zip(light.color.to_array()) {
         let add = (value * c) as f32;
         *o = if local_min { o.max(add) } else { *o + add };
+    }
+    if !local_min && !light.bounce {
+        let len = out.sums.len;
+        let kept = out.no_bounce.get_or_insert_with(|| StyleBuffers::new(len));
+        for (o, c) in kept.get(light.style)[i]
+            .iter_mut()
+            .zip(light.color.to_array())
+        {
+            *o += (value * c) as f32;
+        }
+    }
+}
+
+/// A face's light per sample before minlight floors are applied, so that
+/// bounced light can still be added (floors apply to the sum).
+#[derive(Debug)]
+pub struct SampleLight {
+    pub face: usize,
+    pub width: usize,
+    pub height: usize,
+    per_luxel: usize,
+    sums: StyleBuffers,
+    floors: StyleBuffers,
+    /// `--addmin` minlight of style 0, added when finishing (it does not bounce).
+    added_minlight: Option<Vec<[f32; 3]>>,
+    /// The part of `sums` from `_bounce 0` lights.
+    no_bounce: Option<StyleBuffers>,
+    /// Per sample, the dirt factor of bounced light (empty: none).
+    bounce_dirt: Vec<f32>,
+}
+
+/// Luxel means of per-sample values, `per` samples to a luxel.
+fn luxel_means(values: &[[f32; 3]], per: usize) -> Vec<[f32; 3]> {
+    values
+        .chunks(per)
+        .map(|c| {
+            let mut acc = [0.0f32; 3];
+            for v in c {
+                for k in 0..3 {
+                    acc[k] += v[k];
+                }
+            }
+            acc.map(|a| a / per as f32)
+        })
+        .collect()
+}
+
+impl SampleLight {
+    /// Per style, the luxel means of the light that reflects: lights and
+    /// suns without minlight or `_bounce 0` lights; style 0 only unless
+    /// `styled`. Styles with no light are left out.
+    pub fn reflected(&self, styled: bool) -> Vec<(u8, Vec<[f32; 3]>)> {
+        let mut out = Vec::new();
+        for (style, values) in &self.sums.styles {
+            if *style != 0 && !styled {
+                continue;
+            }
+            let mut values = values.clone();
+            if let Some(no) = &self.no_bounce
+                && let Some((_, minus)) = no.styles.iter().find(|(s, _)| s == style)
+            {
+                for (v, m) in values.iter_mut().zip(minus) {
+                    for k in 0..3 {
+                        v[k] = (v[k] - m[k]).max(0.0);
+                    }
+                }
+            }
+            if values.iter().any(|v| v.iter().any(|&c| c > 0.0)) {
+                out.push((*style, luxel_means(&values, self.per_luxel)));
+            }
+        }
+        out
+    }
+
+    /// Adds `bounce` (per style, per luxel (given to each of the luxel's
+    /// samples) or per sample, times each sample's dirt factor), applies
+    /// minlight and the floors, and averages samples to luxels.
+    pub fn finish(mut self, bounce: &[(u8, Vec<[f32; 3]>)]) -> FaceLight {
+        let per = self.per_luxel;
+        if let Some(min) = &self.added_minlight {
+            for (s, m) in self.sums.get(0).iter_mut().zip(min) {
+                for k in 0..3 {
+                    s[k] += m[k];
+                }
+            }
+        }
+        for (style, luxels) in bounce {
+            let dirt = &self.bounce_dirt;
+            let sums = self.sums.get(*style);
+            let step = if luxels.len() == sums.len() { 1 } else { per };
+            for (i, s) in sums.iter_mut().enumerate() {
+                let Some(b) = luxels.get(i / step) else {
+                    continue;
+                };
+                let f = dirt.get(i).copied().unwrap_or(1.0);
+                for k in 0..3 {
+                    s[k] += b[k] * f;
+                }
+            }
+        }
+        for (style, floor) in &self.floors.styles {
+            let sum = self.sums.get(*style);
+            for (s, f) in sum.iter_mut().zip(floor) {
+                for c in 0..3 {
+                    s[c] = s[c].max(f[c]);
+                }
+            }
+        }
+        let styles = self
+            .sums
+            .styles
+            .into_iter()
+            .map(|(style, values)| (style, luxel_means(&values, per)))
+            .collect();
+        FaceLight {
+            face: self.face,
+            width: self.width,
+            height: self.height,
+            styles,
+        }
     }
 }
 
@@ -609,12 +732,31 @@ pub fn light_face(
     samples: &FaceSamples,
     rules: &FaceRules,
 ) -> (FaceLight, TraceCounts) {
+    let (light, counts) = trace_face(setup, samples, rules);
+    (light.finish(&[]), counts)
+}
+
+/// Lights one face's samples: the light per sample, before floors.
+pub fn trace_face(
+    setup: &TraceSetup,
+    samples: &FaceSamples,
+    rules: &FaceRules,
+) -> (SampleLight, TraceCounts) {
     let face = &setup.faces[samples.face];
     let n = samples.points.len();
     let mut counts = TraceCounts::default();
-    let mut sums = StyleBuffers::new(n);
-    // Local-minlight (delay 4) lights raise luxels to a floor instead of adding.
-    let mut floors = StyleBuffers::new(n);
+    let mut out = SampleLight {
+        face: samples.face,
+        width: samples.width,
+        height: samples.height,
+        per_luxel: samples.per_luxel(),
+        sums: StyleBuffers::new(n),
+        // Local-minlight (delay 4) lights raise luxels to a floor instead of adding.
+        floors: StyleBuffers::new(n),
+        added_minlight: None,
+        no_bounce: None,
+        bounce_dirt: Vec::new(),
+    };
     let mut bounds = Bounds::EMPTY;
     for &p in &samples.points {
         bounds.add_point(Vec3::from_f32(p));
@@ -721,7 +863,9 @@ pub fn light_face(
 
     let occlusion = match dirt_sampling {
         Some(sampling) => {
-            let mut needed = vec![rules.minlight.is_some_and(|m| m.dirt.is_some()); n];
+            let everywhere =
+                rules.minlight.is_some_and(|m| m.dirt.is_some()) || rules.bounce_dirt.is_some();
+            let mut needed = vec![everywhere; n];
             for a in arrivals.iter().filter(|a| a.dirty) {
                 needed[a.sample as usize] = true;
             }
@@ -753,11 +897,12 @@ pub fn light_face(
             continue;
         }
         match a.source {
-            Source::Light(li) => deposit(&lights[li], v, i, &mut sums, &mut floors),
+            Source::Light(li) => deposit(&lights[li], v, i, &mut out),
             Source::Sun(si) => {
                 let sun = &suns[si];
-                for (out, c) in sums.get(sun.style)[i].iter_mut().zip(sun.color.to_array()) {
-                    *out += (v * c) as f32;
+                let slot = &mut out.sums.get(sun.style)[i];
+                for (o, c) in slot.iter_mut().zip(sun.color.to_array()) {
+                    *o += (v * c) as f32;
                 }
             }
         }
@@ -765,52 +910,23 @@ pub fn light_face(
 
     if let Some(m) = rules.minlight {
         // `--addmin` adds the level to the light; otherwise it is a floor.
-        let target = if m.add { sums.get(0) } else { floors.get(0) };
         let dirt = dirt_factors.get(m.dirt);
-        for (i, f) in target.iter_mut().enumerate() {
+        let values = (0..n).map(|i| {
             let level = m.level * dirt.map_or(1.0, |d| f64::from(d[i]));
-            for (out, c) in f.iter_mut().zip(m.color.to_array()) {
-                let value = (level * c) as f32;
-                *out = if m.add { *out + value } else { out.max(value) };
+            m.color.to_array().map(|c| (level * c) as f32)
+        });
+        if m.add {
+            out.added_minlight = Some(values.collect());
+        } else {
+            for (f, v) in out.floors.get(0).iter_mut().zip(values) {
+                for k in 0..3 {
+                    f[k] = f[k].max(v[k]);
+                }
             }
         }
     }
-    for (style, floor) in &floors.styles {
-        let sum = sums.get(*style);
-        for (s, f) in sum.iter_mut().zip(floor) {
-            for c in 0..3 {
-                s[c] = s[c].max(f[c]);
-            }
-        }
+    if let Some(d) = dirt_factors.get(rules.bounce_dirt) {
+        out.bounce_dirt = d.to_vec();
     }
-
-    let per = samples.per_luxel();
-    let styles = sums
-        .styles
-        .into_iter()
-        .map(|(style, values)| {
-            let luxels = values
-                .chunks(per)
-                .map(|c| {
-                    let mut acc = [0.0f32; 3];
-                    for v in c {
-                        for k in 0..3 {
-                            acc[k] += v[k];
-                        }
-                    }
-                    acc.map(|a| a / per as f32)
-                })
-                .collect();
-            (style, luxels)
-        })
-        .collect();
-    (
-        FaceLight {
-            face: samples.face,
-            width: samples.width,
-            height: samples.height,
-            styles,
-        },
-        counts,
-    )
+    (out, counts)
 }

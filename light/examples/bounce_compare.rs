@@ -1,0 +1,119 @@
+//! Bounce against the reference, ours and ericw-tools': `bounce_compare UNLIT.bsp STRIDE
+//! [ERICW_LIT.bsp]`. Lights every STRIDE-th face of UNLIT.bsp with `--bounce` (default and
+//! `--extra4`) and with `--reference --bounce`, and reads ericw-tools' lightmaps of the same
+//! faces from ERICW_LIT.bsp (its `light -bounce` of the same BSP); errors are in grey levels.
+
+use light::output::FaceLightmap;
+use light::{Lighting, Options, Quality, compare, compute_lighting};
+use quake_formats::Bsp;
+
+/// The lightmaps `bsp` holds for `faces` (grey only), as a [`Lighting`] to compare.
+fn read_lightmaps(bsp: &Bsp, faces: &[usize]) -> Lighting {
+    let mut lightmaps = Vec::new();
+    for &f in faces {
+        let face = &bsp.faces[f];
+        let Some(verts) = bsp.face_vertices(face) else {
+            continue;
+        };
+        let Some(ti) = bsp.texinfo.get(face.texinfo as usize) else {
+            continue;
+        };
+        let ext = quake_formats::extents::LightmapExtents::from_points(&verts, &ti.vecs);
+        let [w, h] = ext.luxel_size();
+        if face.light_offset < 0 {
+            continue;
+        }
+        let styles: Vec<u8> = face.styles.iter().copied().filter(|&s| s != 255).collect();
+        let grey = (0..styles.len())
+            .map(|k| {
+                let at = face.light_offset as usize + k * w * h;
+                bsp.lighting
+                    .get(at..at + w * h)
+                    .map_or(vec![0; w * h], <[u8]>::to_vec)
+            })
+            .collect();
+        lightmaps.push(FaceLightmap {
+            face: f,
+            width: w,
+            height: h,
+            styles,
+            grey,
+            rgb: Vec::new(),
+        });
+    }
+    Lighting {
+        lightmaps,
+        entity_text: None,
+        coloured: false,
+        stats: light::Stats::default(),
+    }
+}
+
+/// RMSE, max and share of luxels more than 2 levels off.
+fn report(name: &str, a: &Lighting, reference: &Lighting) {
+    let e = compare(a, reference);
+    let mut over2 = 0u64;
+    for m in &a.lightmaps {
+        if let Some(r) = reference.lightmaps.iter().find(|r| r.face == m.face)
+            && let (Some(x), Some(y)) = (m.grey.first(), r.grey.first())
+        {
+            over2 += x.iter().zip(y).filter(|(p, q)| p.abs_diff(**q) > 2).count() as u64;
+        }
+    }
+    println!(
+        "{name}: RMSE {:.3}, max {}, > 2 levels {:.2} % of {} luxels",
+        e.rmse,
+        e.max,
+        100.0 * over2 as f64 / e.luxels.max(1) as f64,
+        e.luxels
+    );
+}
+
+fn main() -> anyhow::Result<()> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let (Some(path), Some(stride)) = (args.first(), args.get(1)) else {
+        anyhow::bail!("usage: bounce_compare UNLIT.bsp STRIDE [ERICW_LIT.bsp]");
+    };
+    let stride: usize = stride.parse()?;
+    anyhow::ensure!(stride > 0, "STRIDE must be at least 1");
+    let bsp = Bsp::read(&std::fs::read(path)?)?;
+    let faces: Vec<usize> = (0..bsp.faces.len()).step_by(stride).collect();
+    let run = |quality: Quality, bounce: bool| {
+        let mut o = Options {
+            quality,
+            only_faces: Some(faces.clone()),
+            ..Options::default()
+        };
+        o.overrides.bounce = bounce.then_some(1);
+        compute_lighting(&bsp, &o)
+    };
+    let reference = run(Quality::Reference, true)?;
+    println!(
+        "reference with bounce: {:.1} s",
+        reference.stats.seconds_total
+    );
+    let direct_reference = run(Quality::Reference, false)?;
+    for (name, quality) in [("default", Quality::Default), ("--extra4", Quality::Extra4)] {
+        report(
+            &format!("ours {name} --bounce"),
+            &run(quality, true)?,
+            &reference,
+        );
+        report(
+            &format!("ours {name}, no bounce, vs direct reference"),
+            &run(quality, false)?,
+            &direct_reference,
+        );
+    }
+    if let Some(theirs) = args.get(2) {
+        let lit = Bsp::read(&std::fs::read(theirs)?)?;
+        let lightmaps = read_lightmaps(&lit, &faces);
+        report("ericw-tools -bounce", &lightmaps, &reference);
+        report(
+            "ericw-tools -bounce vs our direct reference",
+            &lightmaps,
+            &direct_reference,
+        );
+    }
+    Ok(())
+}
