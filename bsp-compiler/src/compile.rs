@@ -9,10 +9,11 @@ use crate::faces::{
     merge_faces, projection_squareness,
 };
 use crate::hulls::{HULL_BOXES, expand_brush};
-use crate::map::{MapBrush, MapEntity, MapError, parse_map};
+use crate::map::{MapBrush, MapEntity, MapError, parse_map, read_map_text};
 use crate::outside::{FillOutcome, Leak, Occupant, fill_outside};
 use crate::planes::PlaneSet;
 use crate::portals::{Portals, make_cluster_portals, make_portals};
+use crate::prefab::{PrefabError, expand_prefabs};
 use crate::progress::Progress;
 use crate::surface_tree::rebuild_from_surfaces;
 use crate::texinfo::{Projection, TextureRole};
@@ -41,15 +42,10 @@ pub struct MapSource {
 
 impl MapSource {
     pub fn read(path: &Path) -> Result<MapSource, CompileError> {
-        let bytes = std::fs::read(path).map_err(|source| CompileError::Io {
+        let text = read_map_text(path).map_err(|source| CompileError::Io {
             path: path.to_path_buf(),
             source,
         })?;
-        // Quake text is Latin-1: map each byte to the char of the same value.
-        let text = match String::from_utf8(bytes) {
-            Ok(s) => s,
-            Err(e) => e.into_bytes().iter().map(|&b| b as char).collect(),
-        };
         Ok(MapSource {
             path: path.to_path_buf(),
             text,
@@ -86,6 +82,8 @@ impl Default for CompileOptions {
 pub enum CompileError {
     #[error(transparent)]
     Map(#[from] MapError),
+    #[error(transparent)]
+    Prefab(#[from] PrefabError),
     #[error("{}: {source}", path.display())]
     Io {
         path: PathBuf,
@@ -298,7 +296,7 @@ pub fn compile(
     };
 
     let t = Instant::now();
-    let map = parse_map(&source.path, &source.text)?;
+    let map = expand_prefabs(parse_map(&source.path, &source.text)?, &source.path)?;
     let classname = map
         .entities
         .first()

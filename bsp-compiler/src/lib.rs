@@ -21,6 +21,7 @@ pub mod map;
 pub mod outside;
 pub mod planes;
 pub mod portals;
+pub mod prefab;
 pub mod progress;
 mod region;
 pub mod surface_tree;
