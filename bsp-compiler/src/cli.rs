@@ -1,5 +1,6 @@
 //! The command line: `slipgate-bsp [--bsp2] [--wad-dir DIR]... IN.map [OUT.bsp]`.
 
+use crate::tree::MID_SPLIT_SIZE;
 use crate::{CompileOptions, MapSource, Progress, ProgressEvent, SplitHeuristic, compile};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -25,12 +26,84 @@ pub struct Args {
     /// How node planes are chosen: fewest-splits or balanced
     #[arg(long, default_value = "fewest-splits")]
     pub heuristic: SplitHeuristic,
-    /// Largest lightmap span of a face in texels before it is cut
+    /// Largest lightmap span of a face in texels before it is cut (0: never cut)
     #[arg(long, default_value_t = 240.0)]
     pub subdivide: f64,
+    /// Never cut faces for their lightmaps (--subdivide 0; needs an engine without the 256-texel
+    /// surface limit)
+    #[arg(long)]
+    pub nosubdivide: bool,
+    /// Cut nodes larger than this (units, on any axis) near their middle before choosing planes
+    /// by the heuristic (0: never)
+    #[arg(long, value_name = "N", default_value_t = MID_SPLIT_SIZE)]
+    pub maxnodesize: f64,
+    /// Make a leak an error: nothing but the .pts pointfile is written, and the exit status is 1
+    #[arg(long)]
+    pub leaktest: bool,
+    /// Keep the void outside the map instead of filling it (for debugging; leaks are not looked
+    /// for)
+    #[arg(long)]
+    pub nofill: bool,
+    /// Build no clip hulls: players and monsters collide with nothing but point-sized hull 0
+    /// (for engines that collide with brushes, with --wrbrushes)
+    #[arg(long)]
+    pub noclip: bool,
+    /// Write textures as names and sizes without pixels, for engines that load them from
+    /// elsewhere (FTE, QuakeSpasm-Spiked); the WADs are still read for the sizes
+    #[arg(long)]
+    pub notex: bool,
+    /// Leave out func_detail brushes
+    #[arg(long)]
+    pub omitdetail: bool,
+    /// Leave out func_detail_wall brushes
+    #[arg(long)]
+    pub omitdetailwall: bool,
+    /// Leave out func_detail_illusionary brushes
+    #[arg(long)]
+    pub omitdetailillusionary: bool,
+    /// Leave out func_detail_fence brushes
+    #[arg(long)]
+    pub omitdetailfence: bool,
+    /// Write the BSPX BRUSHLIST lump: every model's brushes, for engines and importers that
+    /// collide with brushes (FTE, bevy_trenchbroom)
+    #[arg(long, alias = "bspx")]
+    pub wrbrushes: bool,
     /// Write counts and timings as JSON
     #[arg(long, value_name = "FILE.json")]
     pub stats: Option<PathBuf>,
+}
+
+impl Args {
+    /// The compile the options ask for.
+    pub fn compile_options(&self) -> CompileOptions {
+        let omit = [
+            (self.omitdetail, "func_detail"),
+            (self.omitdetailwall, "func_detail_wall"),
+            (self.omitdetailillusionary, "func_detail_illusionary"),
+            (self.omitdetailfence, "func_detail_fence"),
+        ]
+        .into_iter()
+        .filter(|(on, _)| *on)
+        .map(|(_, class)| class.to_string())
+        .collect();
+        CompileOptions {
+            bsp2: self.bsp2,
+            wad_dirs: self.wad_dirs.clone(),
+            heuristic: self.heuristic,
+            max_node_size: self.maxnodesize,
+            subdivide: if self.nosubdivide {
+                0.0
+            } else {
+                self.subdivide
+            },
+            fill: !self.nofill,
+            clip_hulls: !self.noclip,
+            omit,
+            texture_data: !self.notex,
+            brush_list: self.wrbrushes,
+            progress: progress_bar(),
+        }
+    }
 }
 
 /// A progress bar on stderr for each long phase, when stderr is a terminal.
@@ -70,18 +143,27 @@ fn progress_bar() -> Progress {
 
 pub fn run(args: &Args) -> Result<()> {
     let source = MapSource::read(&args.input)?;
-    let options = CompileOptions {
-        bsp2: args.bsp2,
-        wad_dirs: args.wad_dirs.clone(),
-        heuristic: args.heuristic,
-        subdivide: args.subdivide,
-        progress: progress_bar(),
-    };
-    let out = compile(&source, &options)?;
+    let out = compile(&source, &args.compile_options())?;
     let bsp_path = args
         .output
         .clone()
         .unwrap_or_else(|| args.input.with_extension("bsp"));
+    if args.leaktest
+        && let Some(leak) = &out.leak
+    {
+        let pts_path = bsp_path.with_extension("pts");
+        write_atomic(&pts_path, write_pointfile(&leak.pointfile).as_bytes())?;
+        anyhow::bail!(
+            "--leaktest: the map leaks (entity {}, {} at {} {} {}, reaches the void); nothing \
+             written but the pointfile {}",
+            leak.entity,
+            leak.classname,
+            leak.origin.x,
+            leak.origin.y,
+            leak.origin.z,
+            pts_path.display()
+        );
+    }
     let bytes = out.bsp.write().context("encoding the BSP")?;
     write_atomic(&bsp_path, &bytes)?;
     write_atomic(

@@ -2,6 +2,7 @@
 //! outside, make faces, and emit the BSP and portal file.
 
 use crate::brush::{Brush, BrushKind, BrushPlane};
+use crate::brushlist::{ListedBrush, brush_list_lump};
 use crate::csg::mark_hidden_sides;
 use crate::emit::{EmitInput, emit};
 use crate::faces::{
@@ -18,7 +19,8 @@ use crate::progress::Progress;
 use crate::surface_tree::rebuild_from_surfaces;
 use crate::texinfo::{Projection, TextureRole};
 use crate::tree::{
-    DETAIL_WALL, FENCE, ILLUSIONARY, SplitHeuristic, Tree, build_tree, engine_contents,
+    DETAIL_WALL, FENCE, ILLUSIONARY, MID_SPLIT_SIZE, SplitHeuristic, Splitting, Tree, build_tree,
+    engine_contents,
 };
 use crate::wad_lookup::WadSet;
 use crate::warnings::Warning;
@@ -60,8 +62,20 @@ pub struct CompileOptions {
     /// Directories searched for WADs (the map's own directory is searched last).
     pub wad_dirs: Vec<PathBuf>,
     pub heuristic: SplitHeuristic,
-    /// Largest span of a lit face in texels before it is cut.
+    /// Nodes spanning more than this are cut near their middle first (0: never).
+    pub max_node_size: f64,
+    /// Largest span of a lit face in texels before it is cut (0: never cut).
     pub subdivide: f64,
+    /// Fill the void outside the map (off keeps it, for debugging; leaks are not looked for).
+    pub fill: bool,
+    /// Build clip hulls 1 and 2 (off: every model is empty to them).
+    pub clip_hulls: bool,
+    /// Classnames whose brushes are left out of the compile (`--omitdetail` and its kin).
+    pub omit: Vec<String>,
+    /// Write texture pixels (off: names and sizes only, for engines that have the textures).
+    pub texture_data: bool,
+    /// Write the BSPX `BRUSHLIST` lump (see [`crate::brushlist`]).
+    pub brush_list: bool,
     /// Where the long phases report their progress.
     pub progress: Progress,
 }
@@ -72,7 +86,13 @@ impl Default for CompileOptions {
             bsp2: false,
             wad_dirs: Vec::new(),
             heuristic: SplitHeuristic::default(),
+            max_node_size: MID_SPLIT_SIZE,
             subdivide: 240.0,
+            fill: true,
+            clip_hulls: true,
+            omit: Vec::new(),
+            texture_data: true,
+            brush_list: false,
             progress: Progress::default(),
         }
     }
@@ -318,11 +338,16 @@ pub fn compile(
     let mut entities: Vec<Entity> = Vec::new();
     let mut occupants = Vec::new();
     let mut skipped_hint = 0;
+    // Per model, when `brush_list` asks for them.
+    let mut listed: Vec<Vec<ListedBrush>> = Vec::new();
     let progress = &options.progress;
     progress.start("brushes", map.entities.len());
     for (index, ent) in map.entities.iter().enumerate() {
         progress.advance(1);
         let class = ent.entity.classname();
+        if index > 0 && options.omit.iter().any(|c| c == class) {
+            continue;
+        }
         if index > 0 && ent.brushes.is_empty() {
             if let Some([x, y, z]) = ent.entity.get_floats::<3>("origin") {
                 occupants.push(Occupant {
@@ -374,6 +399,14 @@ pub fn compile(
         stats.brushes += ent.brushes.len();
         stats.bad_brushes += bad;
         skipped_hint += hints;
+        if options.brush_list {
+            listed.resize_with(models.len(), Vec::new);
+            listed[model].extend(
+                built
+                    .iter()
+                    .filter_map(|(b, clip)| listed_brush(b, *clip, &planes)),
+            );
+        }
         let m = &mut models[model];
         for (brush, clip) in built {
             let collides = matches!(
@@ -381,7 +414,8 @@ pub fn compile(
                 contents::SOLID | contents::SKY
             );
             for (hull, (mins, maxs)) in HULL_BOXES.iter().enumerate() {
-                if (collides || clip)
+                if options.clip_hulls
+                    && (collides || clip)
                     && let Some(g) = expand_brush(&brush, &mut planes, *mins, *maxs)
                 {
                     m.hull_brushes[hull].push(g);
@@ -501,6 +535,15 @@ pub fn compile(
         warnings: &mut warnings,
     });
     let mut bsp = emitted.bsp;
+    if options.brush_list {
+        listed.resize_with(bsp.models.len(), Vec::new);
+        bsp.bspx.push(brush_list_lump(&listed));
+    }
+    if !options.texture_data {
+        for t in bsp.textures.textures.iter_mut().flatten() {
+            t.mips = None;
+        }
+    }
     if bsp.version == BspVersion::Bsp29
         && let Err(e) = bsp.check_bsp29_limits()
     {
@@ -797,6 +840,18 @@ fn build_entity_brushes(
     (out, bad, hints)
 }
 
+/// A built brush as the `BRUSHLIST` lump stores it: clip brushes collide as solid; brushes
+/// nothing collides with (hint, illusionary) are left out.
+fn listed_brush(brush: &Brush, clip: bool, planes: &PlaneSet) -> Option<ListedBrush> {
+    let contents = match engine_contents(brush.contents) {
+        _ if clip => contents::SOLID,
+        _ if brush.kind == BrushKind::Hint => return None,
+        contents::EMPTY => return None,
+        c => c,
+    };
+    Some(ListedBrush::of(brush, contents, planes))
+}
+
 /// Fill the outside of a clip hull's tree, flooding from the world's point entities, and
 /// rebuild it from what is left.
 fn fill_hull(
@@ -804,7 +859,7 @@ fn fill_hull(
     planes: &PlaneSet,
     bounds: &Bounds,
     occupants: &[Occupant],
-    heuristic: SplitHeuristic,
+    heuristic: Splitting,
 ) {
     if bounds.is_empty() {
         return;
@@ -840,7 +895,10 @@ fn build_model(
             maxs: Vec3::new(1.0, 1.0, 1.0),
         };
     }
-    let heuristic = options.heuristic;
+    let heuristic = Splitting {
+        heuristic: options.heuristic,
+        max_node_size: options.max_node_size,
+    };
     let progress = &options.progress;
     let t = Instant::now();
     let mut brushes = m.brushes;
@@ -893,7 +951,7 @@ fn build_model(
 
     let t = Instant::now();
     let is_world = m.entity == 0;
-    let fill = is_world.then(|| {
+    let fill = (is_world && options.fill).then(|| {
         let flood = cluster_portals.as_ref().unwrap_or(&portals);
         fill_outside(&mut tree, planes, flood, occupants, &mut warnings)
     });

@@ -384,7 +384,8 @@ pub fn subdivide(w: Winding, vecs: &[[f64; 4]; 2], size: f64, out: &mut Vec<Wind
 
 /// `face` as it is written: cut by [`subdivide`] when lit, whole when special (sky, liquids).
 pub fn cut_for_lightmaps(face: ModelFace, info: &FaceTexInfo, size: f64, out: &mut Vec<ModelFace>) {
-    if info.role.is_special() {
+    // A size of 0 asks for no subdivision at all (ericw-tools' `-subdivide 0`).
+    if info.role.is_special() || size <= 0.0 {
         out.push(face);
         return;
     }

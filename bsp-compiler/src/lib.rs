@@ -10,6 +10,7 @@
 //! [`trace`] moves a hull's box through a written BSP as engines do.
 
 pub mod brush;
+pub mod brushlist;
 pub mod cli;
 mod compile;
 pub mod cracks;

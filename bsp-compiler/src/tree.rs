@@ -26,8 +26,27 @@ pub enum SplitHeuristic {
     Balanced,
 }
 
-/// Nodes whose brushes span more than this on some axis are cut near their middle.
+/// Nodes whose brushes span more than this on some axis are cut near their middle (by default:
+/// see [`Splitting::max_node_size`]).
 pub const MID_SPLIT_SIZE: f64 = 1024.0;
+
+/// How a tree's nodes are split.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Splitting {
+    pub heuristic: SplitHeuristic,
+    /// Nodes whose contents span more than this on some axis are cut near their middle first
+    /// (ericw-tools' `-maxnodesize`); 0 never does.
+    pub max_node_size: f64,
+}
+
+impl From<SplitHeuristic> for Splitting {
+    fn from(heuristic: SplitHeuristic) -> Splitting {
+        Splitting {
+            heuristic,
+            max_node_size: MID_SPLIT_SIZE,
+        }
+    }
+}
 
 /// What a candidate splitting plane does to the brushes (or surfaces) of a node.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -96,12 +115,17 @@ pub fn best_splitter<T: Sync>(
     }
 }
 
-/// For a node whose contents span `bounds`, larger than [`MID_SPLIT_SIZE`]: the axial candidate
+/// For a node whose contents span `bounds`, larger than `max_size` (not 0): the axial candidate
 /// closest to the middle of its longest axis.
-pub fn mid_split(bounds: &Bounds, candidates: &[PlaneId], planes: &PlaneSet) -> Option<PlaneId> {
+pub fn mid_split(
+    bounds: &Bounds,
+    candidates: &[PlaneId],
+    planes: &PlaneSet,
+    max_size: f64,
+) -> Option<PlaneId> {
     let size = bounds.maxs - bounds.mins;
     let axis = (0..3).max_by(|&a, &b| size[a].total_cmp(&size[b]).then(b.cmp(&a)))?;
-    if size[axis] <= MID_SPLIT_SIZE {
+    if max_size <= 0.0 || size[axis] <= max_size {
         return None;
     }
     let middle = bounds.center()[axis];
@@ -294,7 +318,7 @@ const PARALLEL_BRUSHES: usize = 64;
 
 struct Builder<'a> {
     planes: &'a PlaneSet,
-    heuristic: SplitHeuristic,
+    splitting: Splitting,
     keep_brushes: bool,
     splits: AtomicUsize,
 }
@@ -306,12 +330,12 @@ struct Builder<'a> {
 pub fn build_tree(
     brushes: Vec<Brush>,
     planes: &PlaneSet,
-    heuristic: SplitHeuristic,
+    splitting: impl Into<Splitting>,
     keep_brushes: bool,
 ) -> Tree {
     let builder = Builder {
         planes,
-        heuristic,
+        splitting: splitting.into(),
         keep_brushes,
         splits: AtomicUsize::new(0),
     };
@@ -549,7 +573,12 @@ impl Builder<'_> {
         let bounds = brushes
             .iter()
             .fold(Bounds::EMPTY, |acc, b| acc.union(&b.bounds));
-        if let Some(mid) = mid_split(&bounds, &candidates, self.planes) {
+        if let Some(mid) = mid_split(
+            &bounds,
+            &candidates,
+            self.planes,
+            self.splitting.max_node_size,
+        ) {
             return Some(mid);
         }
         let hints = unused(Some(BrushKind::Hint));
@@ -575,7 +604,7 @@ impl Builder<'_> {
             Brush::sides_of,
             &facing_planes,
             self.planes,
-            self.heuristic,
+            self.splitting.heuristic,
         )
     }
 }

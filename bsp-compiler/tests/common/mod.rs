@@ -71,11 +71,18 @@ pub fn brush_entity(classname: &str, brushes: &str) -> String {
 }
 
 pub fn try_compile(text: &str) -> Result<CompileOutput, CompileError> {
+    try_compile_with(text, &CompileOptions::default())
+}
+
+pub fn try_compile_with(
+    text: &str,
+    options: &CompileOptions,
+) -> Result<CompileOutput, CompileError> {
     let source = MapSource {
         path: PathBuf::from("inline.map"),
         text: text.to_string(),
     };
-    compile(&source, &CompileOptions::default())
+    compile(&source, options)
 }
 
 pub fn compile_text(text: &str) -> CompileOutput {
