@@ -19,8 +19,8 @@ use crate::progress::Progress;
 use crate::surface_tree::rebuild_from_surfaces;
 use crate::texinfo::{Projection, TextureRole};
 use crate::tree::{
-    DETAIL_WALL, FENCE, ILLUSIONARY, MID_SPLIT_SIZE, SplitHeuristic, Splitting, Tree, build_tree,
-    engine_contents,
+    DETAIL_WALL, FENCE, ILLUSIONARY, MID_SPLIT_SIZE, SplitHeuristic, Splitting, Tree, VISBLOCKER,
+    build_tree, engine_contents,
 };
 use crate::wad_lookup::WadSet;
 use crate::warnings::Warning;
@@ -238,6 +238,8 @@ enum EntityBrushes {
     Fence,
     /// `func_detail_illusionary`: drawn detail without collision.
     Illusionary,
+    /// `func_illusionary_visblocker`: drawn, walked through, and closed to vis.
+    VisBlocker,
     /// A brush entity of its own.
     Submodel,
 }
@@ -251,13 +253,16 @@ impl EntityBrushes {
             "func_detail_wall" => EntityBrushes::DetailWall,
             "func_detail_fence" => EntityBrushes::Fence,
             "func_detail_illusionary" => EntityBrushes::Illusionary,
+            "func_illusionary_visblocker" => EntityBrushes::VisBlocker,
             _ => EntityBrushes::Submodel,
         }
     }
 
     fn kind(self) -> BrushKind {
         match self {
-            EntityBrushes::World | EntityBrushes::Submodel => BrushKind::Structural,
+            EntityBrushes::World | EntityBrushes::Submodel | EntityBrushes::VisBlocker => {
+                BrushKind::Structural
+            }
             _ => BrushKind::Detail,
         }
     }
@@ -747,6 +752,7 @@ fn build_entity_brushes(
     let mut out = Vec::new();
     let (mut bad, mut hints) = (0, 0);
     let phong = merged_phong(ent, entity, class);
+    let mirror_inside = ent.entity.get_float("_mirrorinside").map(|v| v != 0.0);
     for (bi, mb) in ent.brushes.iter().enumerate() {
         if is_origin_brush(mb) {
             continue;
@@ -794,6 +800,7 @@ fn build_entity_brushes(
             EntityBrushes::Fence => FENCE,
             EntityBrushes::DetailWall => DETAIL_WALL,
             EntityBrushes::Illusionary => ILLUSIONARY,
+            EntityBrushes::VisBlocker => VISBLOCKER,
             EntityBrushes::World | EntityBrushes::Detail => {
                 if roles.contains(&TextureRole::Sky) {
                     contents::SKY
@@ -824,6 +831,7 @@ fn build_entity_brushes(
                 } else {
                     b.kind = class.kind();
                 }
+                b.mirror_inside = mirror_inside;
                 out.push((b, clip));
             }
             Err(reason) => {

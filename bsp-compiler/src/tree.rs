@@ -162,12 +162,16 @@ pub const DETAIL_WALL: i32 = -102;
 /// Compiler-only contents of `func_detail_illusionary` brushes: drawn from outside, written as
 /// empty.
 pub const ILLUSIONARY: i32 = -101;
+/// Compiler-only contents of `func_illusionary_visblocker` brushes: drawn from both sides and
+/// walked through like water, but vis does not see through them (no portal enters them).
+/// Written as empty.
+pub const VISBLOCKER: i32 = -103;
 
 /// The contents engines see for a leaf of compiler contents `c`.
 pub fn engine_contents(c: i32) -> i32 {
     match c {
         FENCE | DETAIL_WALL => contents::SOLID,
-        ILLUSIONARY => contents::EMPTY,
+        ILLUSIONARY | VISBLOCKER => contents::EMPTY,
         c => c,
     }
 }
@@ -175,13 +179,14 @@ pub fn engine_contents(c: i32) -> i32 {
 /// Ranking of contents: a region holding several brushes takes the strongest.
 pub fn contents_priority(c: i32) -> u8 {
     match c {
-        contents::SOLID => 8,
-        DETAIL_WALL => 7,
-        FENCE => 6,
-        contents::SKY => 5,
-        contents::LAVA => 4,
-        contents::SLIME => 3,
-        contents::WATER => 2,
+        contents::SOLID => 9,
+        DETAIL_WALL => 8,
+        FENCE => 7,
+        contents::SKY => 6,
+        contents::LAVA => 5,
+        contents::SLIME => 4,
+        contents::WATER => 3,
+        VISBLOCKER => 2,
         ILLUSIONARY => 1,
         _ => 0,
     }
@@ -195,7 +200,7 @@ pub fn is_opaque(c: i32) -> bool {
 /// Whether faces behind leaves of these contents are kept whole: sight passes through them, or
 /// (detail walls) they are told not to cut the faces they touch.
 pub fn shows_faces_behind(c: i32) -> bool {
-    is_see_through(c) || c == DETAIL_WALL
+    is_see_through(c) || c == DETAIL_WALL || c == VISBLOCKER
 }
 
 /// Whether sight passes through leaves of these contents. Liquids count: modern engines draw
