@@ -112,6 +112,7 @@ mod tests {
             "-maxnodesize",
             "512",
             "-wrbrushes",
+            "-onlyents",
             "x.map",
         ];
         let cli = Cli::try_parse_from(normalise_single_dash(args.iter().map(|s| s.to_string())))
@@ -123,6 +124,6 @@ mod tests {
         assert!(bsp.leaktest && !options.texture_data && !options.fill && !options.clip_hulls);
         assert_eq!(options.omit, ["func_detail"]);
         assert_eq!((options.subdivide, options.max_node_size), (0.0, 512.0));
-        assert!(options.brush_list);
+        assert!(options.brush_list && bsp.onlyents);
     }
 }

@@ -1,13 +1,15 @@
 //! The command line: `slipgate-bsp [--bsp2] [--wad-dir DIR]... IN.map [OUT.bsp]`.
 
+use crate::onlyents::replace_entities;
 use crate::tree::MID_SPLIT_SIZE;
 use crate::{CompileOptions, MapSource, Progress, ProgressEvent, SplitHeuristic, compile};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use quake_formats::Bsp;
 use quake_formats::fsutil::write_atomic;
 use quake_formats::pts::write_pointfile;
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 #[derive(clap::Args, Debug, Clone)]
@@ -68,6 +70,10 @@ pub struct Args {
     /// collide with brushes (FTE, bevy_trenchbroom)
     #[arg(long, alias = "bspx")]
     pub wrbrushes: bool,
+    /// Only replace the entities of the existing BSP (OUT.bsp) with the .map's, keeping its
+    /// geometry, vis and light; its brush entities must match the BSP's models
+    #[arg(long)]
+    pub onlyents: bool,
     /// Write counts and timings as JSON
     #[arg(long, value_name = "FILE.json")]
     pub stats: Option<PathBuf>,
@@ -104,6 +110,20 @@ impl Args {
             progress: progress_bar(),
         }
     }
+}
+
+fn only_entities(source: &MapSource, args: &Args, bsp_path: &Path) -> Result<()> {
+    let bytes = std::fs::read(bsp_path)
+        .with_context(|| format!("--onlyents: reading {}", bsp_path.display()))?;
+    let mut bsp = Bsp::read(&bytes).with_context(|| format!("reading {}", bsp_path.display()))?;
+    replace_entities(source, &args.compile_options().omit, &mut bsp)?;
+    write_atomic(bsp_path, &bsp.write().context("encoding the BSP")?)?;
+    println!(
+        "wrote the entities of {} into {}",
+        args.input.display(),
+        bsp_path.display()
+    );
+    Ok(())
 }
 
 /// A progress bar on stderr for each long phase, when stderr is a terminal.
@@ -143,11 +163,14 @@ fn progress_bar() -> Progress {
 
 pub fn run(args: &Args) -> Result<()> {
     let source = MapSource::read(&args.input)?;
-    let out = compile(&source, &args.compile_options())?;
     let bsp_path = args
         .output
         .clone()
         .unwrap_or_else(|| args.input.with_extension("bsp"));
+    if args.onlyents {
+        return only_entities(&source, args, &bsp_path);
+    }
+    let out = compile(&source, &args.compile_options())?;
     if args.leaktest
         && let Some(leak) = &out.leak
     {

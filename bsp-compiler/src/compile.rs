@@ -10,7 +10,7 @@ use crate::faces::{
     merge_faces, projection_squareness,
 };
 use crate::hulls::{HULL_BOXES, expand_brush};
-use crate::map::{MapBrush, MapEntity, MapError, parse_map, read_map_text};
+use crate::map::{MapBrush, MapEntity, MapError, MapFile, parse_map, read_map_text};
 use crate::outside::{FillOutcome, Leak, Occupant, fill_outside};
 use crate::planes::PlaneSet;
 use crate::portals::{Portals, make_cluster_portals, make_portals};
@@ -321,18 +321,7 @@ pub fn compile(
     };
 
     let t = Instant::now();
-    let map = expand_prefabs(parse_map(&source.path, &source.text)?, &source.path)?;
-    let classname = map
-        .entities
-        .first()
-        .map(|e| e.entity.classname())
-        .unwrap_or("");
-    if classname != "worldspawn" {
-        return Err(CompileError::NoWorldspawn {
-            path: source.path.clone(),
-            found: classname.to_string(),
-        });
-    }
+    let map = read_map(source)?;
     stats.entities = map.entities.len();
     timings.push(("parse".to_string(), t.elapsed().as_secs_f64()));
 
@@ -340,7 +329,7 @@ pub fn compile(
     let mut planes = PlaneSet::new();
     let mut table = TexInfoTable::default();
     let mut models: Vec<ModelInput> = vec![ModelInput::new(0)];
-    let mut entities: Vec<Entity> = Vec::new();
+    let entities = lump_entities(&map, &options.omit);
     let mut occupants = Vec::new();
     let mut skipped_hint = 0;
     // Per model, when `brush_list` asks for them.
@@ -361,37 +350,19 @@ pub fn compile(
                     origin: Vec3::new(x, y, z),
                 });
             }
-            // A brushless func_group / func_detail (an editor group of point entities) has
-            // nothing to merge and no spawn function in any game: leave it out, as with brushes.
-            if EntityBrushes::of(index, class) == EntityBrushes::Submodel {
-                entities.push(ent.entity.clone());
-            }
             continue;
         }
         let brush_class = EntityBrushes::of(index, class);
-        // A submodel with an origin brush is built around that brush's centre, which becomes its
-        // "origin" (what rotating entities turn about); without one, around its origin key.
         let origin = match brush_class {
-            EntityBrushes::Submodel => {
-                origin_brush_centre(ent, &mut planes).or_else(|| key_origin(&map.entities, ent))
-            }
+            EntityBrushes::Submodel => submodel_origin(&map.entities, ent, &mut planes),
             _ => None,
         };
         let model = if brush_class == EntityBrushes::Submodel {
             models.push(ModelInput::new(index));
-            let mut e = ent.entity.clone();
-            e.set("model", format!("*{}", models.len() - 1));
-            if let Some(o) = origin {
-                e.set("origin", format!("{} {} {}", o.x, o.y, o.z));
-            }
-            entities.push(e);
             models.len() - 1
         } else {
             0
         };
-        if index == 0 {
-            entities.push(ent.entity.clone());
-        }
         let (built, bad, hints) = build_entity_brushes(
             ent,
             index,
@@ -586,6 +557,61 @@ pub fn compile(
         warnings,
         stats,
     })
+}
+
+/// Parse a map, its prefabs expanded; the first entity must be worldspawn.
+pub(crate) fn read_map(source: &MapSource) -> Result<MapFile, CompileError> {
+    let map = expand_prefabs(parse_map(&source.path, &source.text)?, &source.path)?;
+    let classname = map
+        .entities
+        .first()
+        .map(|e| e.entity.classname())
+        .unwrap_or("");
+    if classname != "worldspawn" {
+        return Err(CompileError::NoWorldspawn {
+            path: source.path.clone(),
+            found: classname.to_string(),
+        });
+    }
+    Ok(map)
+}
+
+/// The entity lump's entities for `map` (leaving out the classes in `omit`): worldspawn, the
+/// point entities, and each brush entity not merged into the world, numbered `*1`, `*2`... in
+/// order, with the origin its brushes are built around. Merged entities (`func_group`,
+/// `func_detail*`, brushless ones too: they have no spawn function in any game) are left out.
+pub(crate) fn lump_entities(map: &MapFile, omit: &[String]) -> Vec<Entity> {
+    let mut planes = PlaneSet::new();
+    let mut models = 0;
+    let mut out = Vec::new();
+    for (index, ent) in map.entities.iter().enumerate() {
+        let class = ent.entity.classname();
+        if index > 0 && omit.iter().any(|c| c == class) {
+            continue;
+        }
+        if index == 0 || EntityBrushes::of(index, class) != EntityBrushes::Submodel {
+            if index == 0 {
+                out.push(ent.entity.clone());
+            }
+            continue;
+        }
+        let mut e = ent.entity.clone();
+        if !ent.brushes.is_empty() {
+            models += 1;
+            e.set("model", format!("*{models}"));
+            if let Some(o) = submodel_origin(&map.entities, ent, &mut planes) {
+                e.set("origin", format!("{} {} {}", o.x, o.y, o.z));
+            }
+        }
+        out.push(e);
+    }
+    out
+}
+
+/// A submodel with an origin brush is built around that brush's centre, which becomes its
+/// "origin" (what rotating entities turn about); without one, around its origin key.
+fn submodel_origin(entities: &[MapEntity], ent: &MapEntity, planes: &mut PlaneSet) -> Option<Vec3> {
+    origin_brush_centre(ent, planes).or_else(|| key_origin(entities, ent))
 }
 
 /// Give each face whose texture meets it edge-on (a mapper's degenerate Valve axes, or a sliver

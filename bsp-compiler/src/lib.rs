@@ -19,6 +19,7 @@ mod emit;
 pub mod faces;
 pub mod hulls;
 pub mod map;
+pub mod onlyents;
 pub mod outside;
 pub mod planes;
 pub mod portals;
