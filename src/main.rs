@@ -113,6 +113,8 @@ mod tests {
             "512",
             "-wrbrushes",
             "-onlyents",
+            "-convert",
+            "valve",
             "x.map",
         ];
         let cli = Cli::try_parse_from(normalise_single_dash(args.iter().map(|s| s.to_string())))
@@ -125,5 +127,6 @@ mod tests {
         assert_eq!(options.omit, ["func_detail"]);
         assert_eq!((options.subdivide, options.max_node_size), (0.0, 512.0));
         assert!(options.brush_list && bsp.onlyents);
+        assert_eq!(bsp.convert, Some(bsp_compiler::convert::MapFormat::Valve));
     }
 }

@@ -1,5 +1,7 @@
 //! The command line: `slipgate-bsp [--bsp2] [--wad-dir DIR]... IN.map [OUT.bsp]`.
 
+use crate::convert::{MapFormat, convert_map};
+use crate::map::parse_map;
 use crate::onlyents::replace_entities;
 use crate::tree::MID_SPLIT_SIZE;
 use crate::{CompileOptions, MapSource, Progress, ProgressEvent, SplitHeuristic, compile};
@@ -74,6 +76,10 @@ pub struct Args {
     /// geometry, vis and light; its brush entities must match the BSP's models
     #[arg(long)]
     pub onlyents: bool,
+    /// Rewrite the .map with its texture projections in this format, as IN-FORMAT.map beside
+    /// it, instead of compiling (to Valve 220 exactly; to Quake as near as Quake can come)
+    #[arg(long, value_name = "FORMAT")]
+    pub convert: Option<MapFormat>,
     /// Write counts and timings as JSON
     #[arg(long, value_name = "FILE.json")]
     pub stats: Option<PathBuf>,
@@ -110,6 +116,33 @@ impl Args {
             progress: progress_bar(),
         }
     }
+}
+
+fn convert(source: &MapSource, format: MapFormat) -> Result<()> {
+    let map = parse_map(&source.path, &source.text)?;
+    let (text, approximate) = convert_map(&map, format);
+    let stem = source
+        .path
+        .file_stem()
+        .unwrap_or_default()
+        .to_string_lossy();
+    let out = source
+        .path
+        .with_file_name(format!("{stem}-{}.map", format.name()));
+    // Back to Latin-1, as the map was read.
+    let bytes: Vec<u8> = text
+        .chars()
+        .map(|c| u8::try_from(u32::from(c)).unwrap_or(b'?'))
+        .collect();
+    write_atomic(&out, &bytes)?;
+    println!("wrote {}", out.display());
+    if approximate > 0 {
+        eprintln!(
+            "warning: {approximate} faces have texture axes Quake's format cannot express; \
+             their textures are projected as near as it can"
+        );
+    }
+    Ok(())
 }
 
 fn only_entities(source: &MapSource, args: &Args, bsp_path: &Path) -> Result<()> {
@@ -169,6 +202,9 @@ pub fn run(args: &Args) -> Result<()> {
         .unwrap_or_else(|| args.input.with_extension("bsp"));
     if args.onlyents {
         return only_entities(&source, args, &bsp_path);
+    }
+    if let Some(format) = args.convert {
+        return convert(&source, format);
     }
     let out = compile(&source, &args.compile_options())?;
     if args.leaktest

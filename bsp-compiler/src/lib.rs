@@ -13,6 +13,7 @@ pub mod brush;
 pub mod brushlist;
 pub mod cli;
 mod compile;
+pub mod convert;
 pub mod cracks;
 pub mod csg;
 mod emit;
