@@ -1,27 +1,12 @@
 //! `--onlyents` on a project map compiled, vis'd and lit: the entities change, every other lump
 //! stays byte for byte; a change to the brush entities is refused, saying what changed.
 
+mod common;
+
 use clap::Parser;
+use common::{BspCli, LightCli, VisCli};
 use quake_formats::Bsp;
 use std::path::{Path, PathBuf};
-
-#[derive(Parser)]
-struct BspCli {
-    #[command(flatten)]
-    args: bsp_compiler::cli::Args,
-}
-
-#[derive(Parser)]
-struct VisCli {
-    #[command(flatten)]
-    args: vis::cli::Args,
-}
-
-#[derive(Parser)]
-struct LightCli {
-    #[command(flatten)]
-    args: light::cli::Args,
-}
 
 fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")

@@ -96,3 +96,22 @@ pub fn errors(bsp: &Bsp) -> Vec<String> {
         .map(|p| p.to_string())
         .collect()
 }
+
+/// The stage commands' arguments, parsed as the `slipgate` command parses them.
+#[derive(clap::Parser)]
+pub struct BspCli {
+    #[command(flatten)]
+    pub args: bsp_compiler::cli::Args,
+}
+
+#[derive(clap::Parser)]
+pub struct VisCli {
+    #[command(flatten)]
+    pub args: vis::cli::Args,
+}
+
+#[derive(clap::Parser)]
+pub struct LightCli {
+    #[command(flatten)]
+    pub args: light::cli::Args,
+}
