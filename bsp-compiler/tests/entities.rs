@@ -116,3 +116,34 @@ fn a_visblocker_blocks_vis_but_not_movement_or_sight_of_its_faces() {
         assert!(p.leafs != [a, b] && p.leafs != [b, a]);
     }
 }
+
+/// The feature map (`tests/maps/features.map`): prefabs (one nested, turned, scaled), water
+/// that mirrors inside (func_detail by default, func_illusionary by `_mirrorinside`) and a
+/// visblocker compile without a warning and validate without a problem of any severity.
+#[test]
+fn the_feature_map_compiles_clean() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let source = bsp_compiler::MapSource::read(&dir.join("tests/maps/features.map")).expect("read");
+    let options = bsp_compiler::CompileOptions {
+        wad_dirs: vec![dir.join("../maps")],
+        ..bsp_compiler::CompileOptions::default()
+    };
+    let out = bsp_compiler::compile(&source, &options).expect("compile");
+    let warnings: Vec<String> = out.warnings.iter().map(|w| w.to_string()).collect();
+    assert_eq!(warnings, Vec::<String>::new());
+    let problems: Vec<String> = quake_formats::validate(&out.bsp)
+        .iter()
+        .map(|p| p.to_string())
+        .collect();
+    assert_eq!(problems, Vec::<String>::new());
+    let bsp = &out.bsp;
+    // The world, the func_wall prefab and the func_illusionary water.
+    assert_eq!(bsp.models.len(), 3);
+    let text = bsp.entity_text();
+    assert!(!text.contains("misc_external_map") && !text.contains("visblocker"));
+    // The illusionary water is drawn from inside: 6 faces out, 6 in.
+    assert_eq!(model_faces(bsp, 2, "*water1").0, 12);
+    // The nested prefab's half-size pillar (its cap at 64..72 up) is in the world.
+    let cap = bsp.leaf_at([-208.0, 0.0, 68.0]).expect("leaf");
+    assert_eq!(bsp.leafs[cap].contents, contents::SOLID);
+}
