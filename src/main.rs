@@ -99,4 +99,36 @@ mod tests {
             ]
         );
     }
+
+    #[test]
+    fn ericw_spellings_of_compiler_options_parse() {
+        let args = [
+            "slipgate",
+            "bsp",
+            "-leaktest",
+            "-notex",
+            "-nofill",
+            "-noclip",
+            "-omitdetail",
+            "-nosubdivide",
+            "-maxnodesize",
+            "512",
+            "-wrbrushes",
+            "-onlyents",
+            "-convert",
+            "valve",
+            "x.map",
+        ];
+        let cli = Cli::try_parse_from(normalise_single_dash(args.iter().map(|s| s.to_string())))
+            .expect("parse");
+        let Command::Bsp(bsp) = cli.command else {
+            panic!("not the bsp command");
+        };
+        let options = bsp.compile_options();
+        assert!(bsp.leaktest && !options.texture_data && !options.fill && !options.clip_hulls);
+        assert_eq!(options.omit, ["func_detail"]);
+        assert_eq!((options.subdivide, options.max_node_size), (0.0, 512.0));
+        assert!(options.brush_list && bsp.onlyents);
+        assert_eq!(bsp.convert, Some(bsp_compiler::convert::MapFormat::Valve));
+    }
 }

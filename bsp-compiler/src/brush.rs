@@ -55,6 +55,9 @@ pub struct Brush {
     /// Index of the map brush this came from, within its model.
     pub source: u32,
     pub kind: BrushKind,
+    /// The entity's `_mirrorinside`: whether its faces are also drawn seen from inside it
+    /// (`None`: the default for its contents, see [`crate::faces`]).
+    pub mirror_inside: Option<bool>,
 }
 
 /// A plane of a brush being built, with the texinfo of its map face.
@@ -156,6 +159,7 @@ impl Brush {
             contents,
             source,
             kind,
+            mirror_inside: None,
         };
         (brush.volume() >= MIN_VOLUME).then_some(brush)
     }
@@ -286,8 +290,14 @@ impl Brush {
             buried: false,
         });
         match (
-            Brush::with_sides(front_sides, self.contents, self.source, self.kind),
-            Brush::with_sides(back_sides, self.contents, self.source, self.kind),
+            Brush::with_sides(front_sides, self.contents, self.source, self.kind).map(|b| Brush {
+                mirror_inside: self.mirror_inside,
+                ..b
+            }),
+            Brush::with_sides(back_sides, self.contents, self.source, self.kind).map(|b| Brush {
+                mirror_inside: self.mirror_inside,
+                ..b
+            }),
         ) {
             (Some(front), Some(back)) => (Some(front), Some(back)),
             _ => self.on_both_sides(),

@@ -1,12 +1,17 @@
 //! The command line: `slipgate-bsp [--bsp2] [--wad-dir DIR]... IN.map [OUT.bsp]`.
 
+use crate::convert::{MapFormat, convert_map};
+use crate::map::parse_map;
+use crate::onlyents::replace_entities;
+use crate::tree::MID_SPLIT_SIZE;
 use crate::{CompileOptions, MapSource, Progress, ProgressEvent, SplitHeuristic, compile};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use quake_formats::Bsp;
 use quake_formats::fsutil::write_atomic;
 use quake_formats::pts::write_pointfile;
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 #[derive(clap::Args, Debug, Clone)]
@@ -25,12 +30,133 @@ pub struct Args {
     /// How node planes are chosen: fewest-splits or balanced
     #[arg(long, default_value = "fewest-splits")]
     pub heuristic: SplitHeuristic,
-    /// Largest lightmap span of a face in texels before it is cut
+    /// Largest lightmap span of a face in texels before it is cut (0: never cut)
     #[arg(long, default_value_t = 240.0)]
     pub subdivide: f64,
+    /// Never cut faces for their lightmaps (--subdivide 0; needs an engine without the 256-texel
+    /// surface limit)
+    #[arg(long)]
+    pub nosubdivide: bool,
+    /// Cut nodes larger than this (units, on any axis) near their middle before choosing planes
+    /// by the heuristic (0: never)
+    #[arg(long, value_name = "N", default_value_t = MID_SPLIT_SIZE)]
+    pub maxnodesize: f64,
+    /// Make a leak an error: nothing but the .pts pointfile is written, and the exit status is 1
+    #[arg(long)]
+    pub leaktest: bool,
+    /// Keep the void outside the map instead of filling it (for debugging; leaks are not looked
+    /// for)
+    #[arg(long)]
+    pub nofill: bool,
+    /// Build no clip hulls: players and monsters collide with nothing but point-sized hull 0
+    /// (for engines that collide with brushes, with --wrbrushes)
+    #[arg(long)]
+    pub noclip: bool,
+    /// Write textures as names and sizes without pixels, for engines that load them from
+    /// elsewhere (FTE, QuakeSpasm-Spiked); the WADs are still read for the sizes
+    #[arg(long)]
+    pub notex: bool,
+    /// Leave out func_detail brushes
+    #[arg(long)]
+    pub omitdetail: bool,
+    /// Leave out func_detail_wall brushes
+    #[arg(long)]
+    pub omitdetailwall: bool,
+    /// Leave out func_detail_illusionary brushes
+    #[arg(long)]
+    pub omitdetailillusionary: bool,
+    /// Leave out func_detail_fence brushes
+    #[arg(long)]
+    pub omitdetailfence: bool,
+    /// Write the BSPX BRUSHLIST lump: every model's brushes, for engines and importers that
+    /// collide with brushes (FTE, bevy_trenchbroom)
+    #[arg(long, alias = "bspx")]
+    pub wrbrushes: bool,
+    /// Only replace the entities of the existing BSP (OUT.bsp) with the .map's, keeping its
+    /// geometry, vis and light; its brush entities must match the BSP's models
+    #[arg(long)]
+    pub onlyents: bool,
+    /// Rewrite the .map with its texture projections in this format, as IN-FORMAT.map beside
+    /// it, instead of compiling (to Valve 220 exactly; to Quake as near as Quake can come)
+    #[arg(long, value_name = "FORMAT")]
+    pub convert: Option<MapFormat>,
     /// Write counts and timings as JSON
     #[arg(long, value_name = "FILE.json")]
     pub stats: Option<PathBuf>,
+}
+
+impl Args {
+    /// The compile the options ask for.
+    pub fn compile_options(&self) -> CompileOptions {
+        let omit = [
+            (self.omitdetail, "func_detail"),
+            (self.omitdetailwall, "func_detail_wall"),
+            (self.omitdetailillusionary, "func_detail_illusionary"),
+            (self.omitdetailfence, "func_detail_fence"),
+        ]
+        .into_iter()
+        .filter(|(on, _)| *on)
+        .map(|(_, class)| class.to_string())
+        .collect();
+        CompileOptions {
+            bsp2: self.bsp2,
+            wad_dirs: self.wad_dirs.clone(),
+            heuristic: self.heuristic,
+            max_node_size: self.maxnodesize,
+            subdivide: if self.nosubdivide {
+                0.0
+            } else {
+                self.subdivide
+            },
+            fill: !self.nofill,
+            clip_hulls: !self.noclip,
+            omit,
+            texture_data: !self.notex,
+            brush_list: self.wrbrushes,
+            progress: progress_bar(),
+        }
+    }
+}
+
+fn convert(source: &MapSource, format: MapFormat) -> Result<()> {
+    let map = parse_map(&source.path, &source.text)?;
+    let (text, approximate) = convert_map(&map, format);
+    let stem = source
+        .path
+        .file_stem()
+        .unwrap_or_default()
+        .to_string_lossy();
+    let out = source
+        .path
+        .with_file_name(format!("{stem}-{}.map", format.name()));
+    // Back to Latin-1, as the map was read.
+    let bytes: Vec<u8> = text
+        .chars()
+        .map(|c| u8::try_from(u32::from(c)).unwrap_or(b'?'))
+        .collect();
+    write_atomic(&out, &bytes)?;
+    println!("wrote {}", out.display());
+    if approximate > 0 {
+        eprintln!(
+            "warning: {approximate} faces have texture axes Quake's format cannot express; \
+             their textures are projected as near as it can"
+        );
+    }
+    Ok(())
+}
+
+fn only_entities(source: &MapSource, args: &Args, bsp_path: &Path) -> Result<()> {
+    let bytes = std::fs::read(bsp_path)
+        .with_context(|| format!("--onlyents: reading {}", bsp_path.display()))?;
+    let mut bsp = Bsp::read(&bytes).with_context(|| format!("reading {}", bsp_path.display()))?;
+    replace_entities(source, &args.compile_options().omit, &mut bsp)?;
+    write_atomic(bsp_path, &bsp.write().context("encoding the BSP")?)?;
+    println!(
+        "wrote the entities of {} into {}",
+        args.input.display(),
+        bsp_path.display()
+    );
+    Ok(())
 }
 
 /// A progress bar on stderr for each long phase, when stderr is a terminal.
@@ -70,18 +196,33 @@ fn progress_bar() -> Progress {
 
 pub fn run(args: &Args) -> Result<()> {
     let source = MapSource::read(&args.input)?;
-    let options = CompileOptions {
-        bsp2: args.bsp2,
-        wad_dirs: args.wad_dirs.clone(),
-        heuristic: args.heuristic,
-        subdivide: args.subdivide,
-        progress: progress_bar(),
-    };
-    let out = compile(&source, &options)?;
     let bsp_path = args
         .output
         .clone()
         .unwrap_or_else(|| args.input.with_extension("bsp"));
+    if args.onlyents {
+        return only_entities(&source, args, &bsp_path);
+    }
+    if let Some(format) = args.convert {
+        return convert(&source, format);
+    }
+    let out = compile(&source, &args.compile_options())?;
+    if args.leaktest
+        && let Some(leak) = &out.leak
+    {
+        let pts_path = bsp_path.with_extension("pts");
+        write_atomic(&pts_path, write_pointfile(&leak.pointfile).as_bytes())?;
+        anyhow::bail!(
+            "--leaktest: the map leaks (entity {}, {} at {} {} {}, reaches the void); nothing \
+             written but the pointfile {}",
+            leak.entity,
+            leak.classname,
+            leak.origin.x,
+            leak.origin.y,
+            leak.origin.z,
+            pts_path.display()
+        );
+    }
     let bytes = out.bsp.write().context("encoding the BSP")?;
     write_atomic(&bsp_path, &bytes)?;
     write_atomic(

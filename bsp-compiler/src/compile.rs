@@ -2,6 +2,7 @@
 //! outside, make faces, and emit the BSP and portal file.
 
 use crate::brush::{Brush, BrushKind, BrushPlane};
+use crate::brushlist::{ListedBrush, brush_list_lump};
 use crate::csg::mark_hidden_sides;
 use crate::emit::{EmitInput, emit};
 use crate::faces::{
@@ -9,15 +10,17 @@ use crate::faces::{
     merge_faces, projection_squareness,
 };
 use crate::hulls::{HULL_BOXES, expand_brush};
-use crate::map::{MapBrush, MapEntity, MapError, parse_map};
+use crate::map::{MapBrush, MapEntity, MapError, MapFile, parse_map, read_map_text};
 use crate::outside::{FillOutcome, Leak, Occupant, fill_outside};
 use crate::planes::PlaneSet;
 use crate::portals::{Portals, make_cluster_portals, make_portals};
+use crate::prefab::{PrefabError, expand_prefabs};
 use crate::progress::Progress;
 use crate::surface_tree::rebuild_from_surfaces;
 use crate::texinfo::{Projection, TextureRole};
 use crate::tree::{
-    DETAIL_WALL, FENCE, ILLUSIONARY, SplitHeuristic, Tree, build_tree, engine_contents,
+    DETAIL_WALL, FENCE, ILLUSIONARY, MID_SPLIT_SIZE, SplitHeuristic, Splitting, Tree, VISBLOCKER,
+    build_tree, engine_contents,
 };
 use crate::wad_lookup::WadSet;
 use crate::warnings::Warning;
@@ -41,15 +44,10 @@ pub struct MapSource {
 
 impl MapSource {
     pub fn read(path: &Path) -> Result<MapSource, CompileError> {
-        let bytes = std::fs::read(path).map_err(|source| CompileError::Io {
+        let text = read_map_text(path).map_err(|source| CompileError::Io {
             path: path.to_path_buf(),
             source,
         })?;
-        // Quake text is Latin-1: map each byte to the char of the same value.
-        let text = match String::from_utf8(bytes) {
-            Ok(s) => s,
-            Err(e) => e.into_bytes().iter().map(|&b| b as char).collect(),
-        };
         Ok(MapSource {
             path: path.to_path_buf(),
             text,
@@ -64,8 +62,20 @@ pub struct CompileOptions {
     /// Directories searched for WADs (the map's own directory is searched last).
     pub wad_dirs: Vec<PathBuf>,
     pub heuristic: SplitHeuristic,
-    /// Largest span of a lit face in texels before it is cut.
+    /// Nodes spanning more than this are cut near their middle first (0: never).
+    pub max_node_size: f64,
+    /// Largest span of a lit face in texels before it is cut (0: never cut).
     pub subdivide: f64,
+    /// Fill the void outside the map (off keeps it, for debugging; leaks are not looked for).
+    pub fill: bool,
+    /// Build clip hulls 1 and 2 (off: every model is empty to them).
+    pub clip_hulls: bool,
+    /// Classnames whose brushes are left out of the compile (`--omitdetail` and its kin).
+    pub omit: Vec<String>,
+    /// Write texture pixels (off: names and sizes only, for engines that have the textures).
+    pub texture_data: bool,
+    /// Write the BSPX `BRUSHLIST` lump (see [`crate::brushlist`]).
+    pub brush_list: bool,
     /// Where the long phases report their progress.
     pub progress: Progress,
 }
@@ -76,7 +86,13 @@ impl Default for CompileOptions {
             bsp2: false,
             wad_dirs: Vec::new(),
             heuristic: SplitHeuristic::default(),
+            max_node_size: MID_SPLIT_SIZE,
             subdivide: 240.0,
+            fill: true,
+            clip_hulls: true,
+            omit: Vec::new(),
+            texture_data: true,
+            brush_list: false,
             progress: Progress::default(),
         }
     }
@@ -86,6 +102,8 @@ impl Default for CompileOptions {
 pub enum CompileError {
     #[error(transparent)]
     Map(#[from] MapError),
+    #[error(transparent)]
+    Prefab(#[from] PrefabError),
     #[error("{}: {source}", path.display())]
     Io {
         path: PathBuf,
@@ -220,6 +238,8 @@ enum EntityBrushes {
     Fence,
     /// `func_detail_illusionary`: drawn detail without collision.
     Illusionary,
+    /// `func_illusionary_visblocker`: drawn, walked through, and closed to vis.
+    VisBlocker,
     /// A brush entity of its own.
     Submodel,
 }
@@ -233,13 +253,16 @@ impl EntityBrushes {
             "func_detail_wall" => EntityBrushes::DetailWall,
             "func_detail_fence" => EntityBrushes::Fence,
             "func_detail_illusionary" => EntityBrushes::Illusionary,
+            "func_illusionary_visblocker" => EntityBrushes::VisBlocker,
             _ => EntityBrushes::Submodel,
         }
     }
 
     fn kind(self) -> BrushKind {
         match self {
-            EntityBrushes::World | EntityBrushes::Submodel => BrushKind::Structural,
+            EntityBrushes::World | EntityBrushes::Submodel | EntityBrushes::VisBlocker => {
+                BrushKind::Structural
+            }
             _ => BrushKind::Detail,
         }
     }
@@ -298,18 +321,7 @@ pub fn compile(
     };
 
     let t = Instant::now();
-    let map = parse_map(&source.path, &source.text)?;
-    let classname = map
-        .entities
-        .first()
-        .map(|e| e.entity.classname())
-        .unwrap_or("");
-    if classname != "worldspawn" {
-        return Err(CompileError::NoWorldspawn {
-            path: source.path.clone(),
-            found: classname.to_string(),
-        });
-    }
+    let map = read_map(source)?;
     stats.entities = map.entities.len();
     timings.push(("parse".to_string(), t.elapsed().as_secs_f64()));
 
@@ -317,14 +329,19 @@ pub fn compile(
     let mut planes = PlaneSet::new();
     let mut table = TexInfoTable::default();
     let mut models: Vec<ModelInput> = vec![ModelInput::new(0)];
-    let mut entities: Vec<Entity> = Vec::new();
+    let entities = lump_entities(&map, &options.omit);
     let mut occupants = Vec::new();
     let mut skipped_hint = 0;
+    // Per model, when `brush_list` asks for them.
+    let mut listed: Vec<Vec<ListedBrush>> = Vec::new();
     let progress = &options.progress;
     progress.start("brushes", map.entities.len());
     for (index, ent) in map.entities.iter().enumerate() {
         progress.advance(1);
         let class = ent.entity.classname();
+        if index > 0 && options.omit.iter().any(|c| c == class) {
+            continue;
+        }
         if index > 0 && ent.brushes.is_empty() {
             if let Some([x, y, z]) = ent.entity.get_floats::<3>("origin") {
                 occupants.push(Occupant {
@@ -333,37 +350,19 @@ pub fn compile(
                     origin: Vec3::new(x, y, z),
                 });
             }
-            // A brushless func_group / func_detail (an editor group of point entities) has
-            // nothing to merge and no spawn function in any game: leave it out, as with brushes.
-            if EntityBrushes::of(index, class) == EntityBrushes::Submodel {
-                entities.push(ent.entity.clone());
-            }
             continue;
         }
         let brush_class = EntityBrushes::of(index, class);
-        // A submodel with an origin brush is built around that brush's centre, which becomes its
-        // "origin" (what rotating entities turn about); without one, around its origin key.
         let origin = match brush_class {
-            EntityBrushes::Submodel => {
-                origin_brush_centre(ent, &mut planes).or_else(|| key_origin(&map.entities, ent))
-            }
+            EntityBrushes::Submodel => submodel_origin(&map.entities, ent, &mut planes),
             _ => None,
         };
         let model = if brush_class == EntityBrushes::Submodel {
             models.push(ModelInput::new(index));
-            let mut e = ent.entity.clone();
-            e.set("model", format!("*{}", models.len() - 1));
-            if let Some(o) = origin {
-                e.set("origin", format!("{} {} {}", o.x, o.y, o.z));
-            }
-            entities.push(e);
             models.len() - 1
         } else {
             0
         };
-        if index == 0 {
-            entities.push(ent.entity.clone());
-        }
         let (built, bad, hints) = build_entity_brushes(
             ent,
             index,
@@ -376,6 +375,14 @@ pub fn compile(
         stats.brushes += ent.brushes.len();
         stats.bad_brushes += bad;
         skipped_hint += hints;
+        if options.brush_list {
+            listed.resize_with(models.len(), Vec::new);
+            listed[model].extend(
+                built
+                    .iter()
+                    .filter_map(|(b, clip)| listed_brush(b, *clip, &planes)),
+            );
+        }
         let m = &mut models[model];
         for (brush, clip) in built {
             let collides = matches!(
@@ -383,7 +390,8 @@ pub fn compile(
                 contents::SOLID | contents::SKY
             );
             for (hull, (mins, maxs)) in HULL_BOXES.iter().enumerate() {
-                if (collides || clip)
+                if options.clip_hulls
+                    && (collides || clip)
                     && let Some(g) = expand_brush(&brush, &mut planes, *mins, *maxs)
                 {
                     m.hull_brushes[hull].push(g);
@@ -503,6 +511,15 @@ pub fn compile(
         warnings: &mut warnings,
     });
     let mut bsp = emitted.bsp;
+    if options.brush_list {
+        listed.resize_with(bsp.models.len(), Vec::new);
+        bsp.bspx.push(brush_list_lump(&listed));
+    }
+    if !options.texture_data {
+        for t in bsp.textures.textures.iter_mut().flatten() {
+            t.mips = None;
+        }
+    }
     if bsp.version == BspVersion::Bsp29
         && let Err(e) = bsp.check_bsp29_limits()
     {
@@ -540,6 +557,61 @@ pub fn compile(
         warnings,
         stats,
     })
+}
+
+/// Parse a map, its prefabs expanded; the first entity must be worldspawn.
+pub(crate) fn read_map(source: &MapSource) -> Result<MapFile, CompileError> {
+    let map = expand_prefabs(parse_map(&source.path, &source.text)?, &source.path)?;
+    let classname = map
+        .entities
+        .first()
+        .map(|e| e.entity.classname())
+        .unwrap_or("");
+    if classname != "worldspawn" {
+        return Err(CompileError::NoWorldspawn {
+            path: source.path.clone(),
+            found: classname.to_string(),
+        });
+    }
+    Ok(map)
+}
+
+/// The entity lump's entities for `map` (leaving out the classes in `omit`): worldspawn, the
+/// point entities, and each brush entity not merged into the world, numbered `*1`, `*2`... in
+/// order, with the origin its brushes are built around. Merged entities (`func_group`,
+/// `func_detail*`, brushless ones too: they have no spawn function in any game) are left out.
+pub(crate) fn lump_entities(map: &MapFile, omit: &[String]) -> Vec<Entity> {
+    let mut planes = PlaneSet::new();
+    let mut models = 0;
+    let mut out = Vec::new();
+    for (index, ent) in map.entities.iter().enumerate() {
+        let class = ent.entity.classname();
+        if index > 0 && omit.iter().any(|c| c == class) {
+            continue;
+        }
+        if index == 0 || EntityBrushes::of(index, class) != EntityBrushes::Submodel {
+            if index == 0 {
+                out.push(ent.entity.clone());
+            }
+            continue;
+        }
+        let mut e = ent.entity.clone();
+        if !ent.brushes.is_empty() {
+            models += 1;
+            e.set("model", format!("*{models}"));
+            if let Some(o) = submodel_origin(&map.entities, ent, &mut planes) {
+                e.set("origin", format!("{} {} {}", o.x, o.y, o.z));
+            }
+        }
+        out.push(e);
+    }
+    out
+}
+
+/// A submodel with an origin brush is built around that brush's centre, which becomes its
+/// "origin" (what rotating entities turn about); without one, around its origin key.
+fn submodel_origin(entities: &[MapEntity], ent: &MapEntity, planes: &mut PlaneSet) -> Option<Vec3> {
+    origin_brush_centre(ent, planes).or_else(|| key_origin(entities, ent))
 }
 
 /// Give each face whose texture meets it edge-on (a mapper's degenerate Valve axes, or a sliver
@@ -706,6 +778,7 @@ fn build_entity_brushes(
     let mut out = Vec::new();
     let (mut bad, mut hints) = (0, 0);
     let phong = merged_phong(ent, entity, class);
+    let mirror_inside = ent.entity.get_float("_mirrorinside").map(|v| v != 0.0);
     for (bi, mb) in ent.brushes.iter().enumerate() {
         if is_origin_brush(mb) {
             continue;
@@ -753,6 +826,7 @@ fn build_entity_brushes(
             EntityBrushes::Fence => FENCE,
             EntityBrushes::DetailWall => DETAIL_WALL,
             EntityBrushes::Illusionary => ILLUSIONARY,
+            EntityBrushes::VisBlocker => VISBLOCKER,
             EntityBrushes::World | EntityBrushes::Detail => {
                 if roles.contains(&TextureRole::Sky) {
                     contents::SKY
@@ -783,6 +857,7 @@ fn build_entity_brushes(
                 } else {
                     b.kind = class.kind();
                 }
+                b.mirror_inside = mirror_inside;
                 out.push((b, clip));
             }
             Err(reason) => {
@@ -799,6 +874,18 @@ fn build_entity_brushes(
     (out, bad, hints)
 }
 
+/// A built brush as the `BRUSHLIST` lump stores it: clip brushes collide as solid; brushes
+/// nothing collides with (hint, illusionary) are left out.
+fn listed_brush(brush: &Brush, clip: bool, planes: &PlaneSet) -> Option<ListedBrush> {
+    let contents = match engine_contents(brush.contents) {
+        _ if clip => contents::SOLID,
+        _ if brush.kind == BrushKind::Hint => return None,
+        contents::EMPTY => return None,
+        c => c,
+    };
+    Some(ListedBrush::of(brush, contents, planes))
+}
+
 /// Fill the outside of a clip hull's tree, flooding from the world's point entities, and
 /// rebuild it from what is left.
 fn fill_hull(
@@ -806,7 +893,7 @@ fn fill_hull(
     planes: &PlaneSet,
     bounds: &Bounds,
     occupants: &[Occupant],
-    heuristic: SplitHeuristic,
+    heuristic: Splitting,
 ) {
     if bounds.is_empty() {
         return;
@@ -842,7 +929,10 @@ fn build_model(
             maxs: Vec3::new(1.0, 1.0, 1.0),
         };
     }
-    let heuristic = options.heuristic;
+    let heuristic = Splitting {
+        heuristic: options.heuristic,
+        max_node_size: options.max_node_size,
+    };
     let progress = &options.progress;
     let t = Instant::now();
     let mut brushes = m.brushes;
@@ -895,7 +985,7 @@ fn build_model(
 
     let t = Instant::now();
     let is_world = m.entity == 0;
-    let fill = is_world.then(|| {
+    let fill = (is_world && options.fill).then(|| {
         let flood = cluster_portals.as_ref().unwrap_or(&portals);
         fill_outside(&mut tree, planes, flood, occupants, &mut warnings)
     });

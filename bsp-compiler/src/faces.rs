@@ -5,7 +5,10 @@ use crate::brush::{Brush, BrushKind, Side};
 use crate::planes::{PlaneId, PlaneSet};
 use crate::portals::Portals;
 use crate::texinfo::TextureRole;
-use crate::tree::{Tree, contents_priority, engine_contents, is_see_through, shows_faces_behind};
+use crate::tree::{
+    Tree, TreeNode, VISBLOCKER, contents_priority, engine_contents, is_see_through,
+    shows_faces_behind,
+};
 use quake_formats::bsp::contents;
 use quake_formats::bsp::limits::MAX_SURFACE_EXTENT;
 use quake_formats::extents::LightmapExtents;
@@ -72,15 +75,28 @@ pub fn projection_squareness(vecs: &[[f64; 4]; 2], normal: Vec3) -> f64 {
         .map_or(0.0, |t| t.dot(normal).abs())
 }
 
-/// Whether a face on the boundary of a leaf of contents `owner` is seen from the leaf on its
-/// other side (`own_side` false) or from inside the owner: only liquid surfaces are seen from
-/// within (illusionary and fence brushes show their outsides only).
-fn seen_from(owner: i32, viewer: i32, own_side: bool) -> bool {
+/// Whether a face on the boundary of leaf `owner` is seen from the leaf of contents `viewer` on
+/// its other side (`own_side` false) or from inside the owner (see [`mirrors_inside`]).
+fn seen_from(owner: &TreeNode, viewer: i32, own_side: bool) -> bool {
     if own_side {
-        matches!(owner, contents::WATER | contents::SLIME | contents::LAVA)
+        mirrors_inside(owner)
     } else {
         shows_faces_behind(viewer)
     }
+}
+
+/// Whether the faces of a leaf's brushes are drawn seen from inside it: as its brushes'
+/// `_mirrorinside` says, else (as in ericw-tools) for liquids and vis blockers, which players
+/// look out of, and not for solid, fence or illusionary brushes.
+pub fn mirrors_inside(leaf: &TreeNode) -> bool {
+    leaf.brushes
+        .iter()
+        .filter(|b| b.contents == leaf.contents)
+        .find_map(|b| b.mirror_inside)
+        .unwrap_or(matches!(
+            leaf.contents,
+            contents::WATER | contents::SLIME | contents::LAVA | VISBLOCKER
+        ))
 }
 
 /// How much a brush side's plane turned away from a face's counts against it, in units of
@@ -229,7 +245,7 @@ pub fn faces_from_portals(
         }
         for (viewer, front) in [(a, true), (b, false)] {
             let viewer_contents = tree.nodes[viewer as usize].contents;
-            if !seen_from(owner_node.contents, viewer_contents, viewer == owner) {
+            if !seen_from(owner_node, viewer_contents, viewer == owner) {
                 continue;
             }
             stats.from_portals += 1;
@@ -384,7 +400,8 @@ pub fn subdivide(w: Winding, vecs: &[[f64; 4]; 2], size: f64, out: &mut Vec<Wind
 
 /// `face` as it is written: cut by [`subdivide`] when lit, whole when special (sky, liquids).
 pub fn cut_for_lightmaps(face: ModelFace, info: &FaceTexInfo, size: f64, out: &mut Vec<ModelFace>) {
-    if info.role.is_special() {
+    // A size of 0 asks for no subdivision at all (ericw-tools' `-subdivide 0`).
+    if info.role.is_special() || size <= 0.0 {
         out.push(face);
         return;
     }

@@ -10,17 +10,21 @@
 //! [`trace`] moves a hull's box through a written BSP as engines do.
 
 pub mod brush;
+pub mod brushlist;
 pub mod cli;
 mod compile;
+pub mod convert;
 pub mod cracks;
 pub mod csg;
 mod emit;
 pub mod faces;
 pub mod hulls;
 pub mod map;
+pub mod onlyents;
 pub mod outside;
 pub mod planes;
 pub mod portals;
+pub mod prefab;
 pub mod progress;
 mod region;
 pub mod surface_tree;

@@ -57,6 +57,16 @@ pub struct MapFile {
     pub entities: Vec<MapEntity>,
 }
 
+/// A `.map` file's text. Quake text is Latin-1: bytes that are not UTF-8 become the chars of
+/// the same value.
+pub fn read_map_text(path: &Path) -> std::io::Result<String> {
+    let bytes = std::fs::read(path)?;
+    Ok(match String::from_utf8(bytes) {
+        Ok(s) => s,
+        Err(e) => e.into_bytes().iter().map(|&b| b as char).collect(),
+    })
+}
+
 /// Parse `text`; `file` is only used in error messages.
 pub fn parse_map(file: &Path, text: &str) -> Result<MapFile, MapError> {
     let mut p = Parser {

@@ -6,7 +6,7 @@
 use crate::brush::keep_front;
 use crate::planes::{PlaneId, PlaneSet};
 use crate::portals::Portals;
-use crate::tree::{BuildNode, SplitHeuristic, Tree, best_splitter, flatten, mid_split};
+use crate::tree::{BuildNode, Splitting, Tree, best_splitter, flatten, mid_split};
 use quake_formats::bsp::contents;
 use quake_formats::geom::{Bounds, Plane, Split, Vec3, Winding};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -73,7 +73,7 @@ pub fn rebuild_from_surfaces(
     tree: &Tree,
     portals: &Portals,
     planes: &PlaneSet,
-    heuristic: SplitHeuristic,
+    splitting: impl Into<Splitting>,
 ) -> Tree {
     let solid = |leaf: u32| tree.nodes[leaf as usize].contents == contents::SOLID;
     let mut surfaces = Vec::new();
@@ -97,7 +97,7 @@ pub fn rebuild_from_surfaces(
     let builder = Builder {
         old: tree,
         planes,
-        heuristic,
+        splitting: splitting.into(),
         splits: AtomicUsize::new(0),
     };
     let root = if surfaces.is_empty() {
@@ -130,7 +130,7 @@ struct Builder<'a> {
     /// The tree being replaced, asked for the contents of regions without surfaces.
     old: &'a Tree,
     planes: &'a PlaneSet,
-    heuristic: SplitHeuristic,
+    splitting: Splitting,
     splits: AtomicUsize,
 }
 
@@ -244,7 +244,12 @@ impl Builder<'_> {
         let bounds = surfaces
             .iter()
             .fold(Bounds::EMPTY, |acc, s| acc.union(&s.bounds));
-        if let Some(mid) = mid_split(&bounds, &candidates, self.planes) {
+        if let Some(mid) = mid_split(
+            &bounds,
+            &candidates,
+            self.planes,
+            self.splitting.max_node_size,
+        ) {
             return Some(mid);
         }
         best_splitter(
@@ -253,7 +258,7 @@ impl Builder<'_> {
             Surface::sides_of,
             &on_plane,
             self.planes,
-            self.heuristic,
+            self.splitting.heuristic,
         )
     }
 
@@ -298,7 +303,7 @@ mod tests {
     use crate::brush::Brush;
     use crate::brush::tests::box_planes;
     use crate::portals::make_portals;
-    use crate::tree::build_tree;
+    use crate::tree::{SplitHeuristic, build_tree};
 
     fn contents_at(tree: &Tree, planes: &PlaneSet, p: Vec3) -> i32 {
         tree.nodes[tree.leaf_at(planes, p) as usize].contents

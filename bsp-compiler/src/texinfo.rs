@@ -54,6 +54,21 @@ const BASE_AXES: [[Vec3; 3]; 6] = [
     ],
 ];
 
+/// The s and t axes Quake projects a face with `normal` onto, before rotation and scale: those
+/// of the closest base direction (earlier entries win ties, as in Quake).
+pub fn base_axes(normal: Vec3) -> [Vec3; 2] {
+    let mut best = 0;
+    let mut best_dot = 0.0;
+    for (i, axes) in BASE_AXES.iter().enumerate() {
+        let d = normal.dot(axes[0]);
+        if d > best_dot {
+            best_dot = d;
+            best = i;
+        }
+    }
+    [BASE_AXES[best][1], BASE_AXES[best][2]]
+}
+
 fn nonzero_scale(s: f64) -> f64 {
     if s == 0.0 { 1.0 } else { s }
 }
@@ -74,17 +89,7 @@ impl Projection {
                 rotation,
                 scale,
             } => {
-                // The closest base direction wins; earlier entries win ties, as in Quake.
-                let mut best = 0;
-                let mut best_dot = 0.0;
-                for (i, axes) in BASE_AXES.iter().enumerate() {
-                    let d = plane.normal.dot(axes[0]);
-                    if d > best_dot {
-                        best_dot = d;
-                        best = i;
-                    }
-                }
-                let mut axes = [BASE_AXES[best][1], BASE_AXES[best][2]];
+                let mut axes = base_axes(plane.normal);
                 let (sin, cos) = match rotation {
                     0.0 => (0.0, 1.0),
                     90.0 => (1.0, 0.0),

@@ -26,8 +26,27 @@ pub enum SplitHeuristic {
     Balanced,
 }
 
-/// Nodes whose brushes span more than this on some axis are cut near their middle.
+/// Nodes whose brushes span more than this on some axis are cut near their middle (by default:
+/// see [`Splitting::max_node_size`]).
 pub const MID_SPLIT_SIZE: f64 = 1024.0;
+
+/// How a tree's nodes are split.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Splitting {
+    pub heuristic: SplitHeuristic,
+    /// Nodes whose contents span more than this on some axis are cut near their middle first
+    /// (ericw-tools' `-maxnodesize`); 0 never does.
+    pub max_node_size: f64,
+}
+
+impl From<SplitHeuristic> for Splitting {
+    fn from(heuristic: SplitHeuristic) -> Splitting {
+        Splitting {
+            heuristic,
+            max_node_size: MID_SPLIT_SIZE,
+        }
+    }
+}
 
 /// What a candidate splitting plane does to the brushes (or surfaces) of a node.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -96,12 +115,17 @@ pub fn best_splitter<T: Sync>(
     }
 }
 
-/// For a node whose contents span `bounds`, larger than [`MID_SPLIT_SIZE`]: the axial candidate
+/// For a node whose contents span `bounds`, larger than `max_size` (not 0): the axial candidate
 /// closest to the middle of its longest axis.
-pub fn mid_split(bounds: &Bounds, candidates: &[PlaneId], planes: &PlaneSet) -> Option<PlaneId> {
+pub fn mid_split(
+    bounds: &Bounds,
+    candidates: &[PlaneId],
+    planes: &PlaneSet,
+    max_size: f64,
+) -> Option<PlaneId> {
     let size = bounds.maxs - bounds.mins;
     let axis = (0..3).max_by(|&a, &b| size[a].total_cmp(&size[b]).then(b.cmp(&a)))?;
-    if size[axis] <= MID_SPLIT_SIZE {
+    if max_size <= 0.0 || size[axis] <= max_size {
         return None;
     }
     let middle = bounds.center()[axis];
@@ -138,12 +162,16 @@ pub const DETAIL_WALL: i32 = -102;
 /// Compiler-only contents of `func_detail_illusionary` brushes: drawn from outside, written as
 /// empty.
 pub const ILLUSIONARY: i32 = -101;
+/// Compiler-only contents of `func_illusionary_visblocker` brushes: drawn from both sides and
+/// walked through like water, but vis does not see through them (no portal enters them).
+/// Written as empty.
+pub const VISBLOCKER: i32 = -103;
 
 /// The contents engines see for a leaf of compiler contents `c`.
 pub fn engine_contents(c: i32) -> i32 {
     match c {
         FENCE | DETAIL_WALL => contents::SOLID,
-        ILLUSIONARY => contents::EMPTY,
+        ILLUSIONARY | VISBLOCKER => contents::EMPTY,
         c => c,
     }
 }
@@ -151,13 +179,14 @@ pub fn engine_contents(c: i32) -> i32 {
 /// Ranking of contents: a region holding several brushes takes the strongest.
 pub fn contents_priority(c: i32) -> u8 {
     match c {
-        contents::SOLID => 8,
-        DETAIL_WALL => 7,
-        FENCE => 6,
-        contents::SKY => 5,
-        contents::LAVA => 4,
-        contents::SLIME => 3,
-        contents::WATER => 2,
+        contents::SOLID => 9,
+        DETAIL_WALL => 8,
+        FENCE => 7,
+        contents::SKY => 6,
+        contents::LAVA => 5,
+        contents::SLIME => 4,
+        contents::WATER => 3,
+        VISBLOCKER => 2,
         ILLUSIONARY => 1,
         _ => 0,
     }
@@ -171,7 +200,7 @@ pub fn is_opaque(c: i32) -> bool {
 /// Whether faces behind leaves of these contents are kept whole: sight passes through them, or
 /// (detail walls) they are told not to cut the faces they touch.
 pub fn shows_faces_behind(c: i32) -> bool {
-    is_see_through(c) || c == DETAIL_WALL
+    is_see_through(c) || c == DETAIL_WALL || c == VISBLOCKER
 }
 
 /// Whether sight passes through leaves of these contents. Liquids count: modern engines draw
@@ -294,7 +323,7 @@ const PARALLEL_BRUSHES: usize = 64;
 
 struct Builder<'a> {
     planes: &'a PlaneSet,
-    heuristic: SplitHeuristic,
+    splitting: Splitting,
     keep_brushes: bool,
     splits: AtomicUsize,
 }
@@ -306,12 +335,12 @@ struct Builder<'a> {
 pub fn build_tree(
     brushes: Vec<Brush>,
     planes: &PlaneSet,
-    heuristic: SplitHeuristic,
+    splitting: impl Into<Splitting>,
     keep_brushes: bool,
 ) -> Tree {
     let builder = Builder {
         planes,
-        heuristic,
+        splitting: splitting.into(),
         keep_brushes,
         splits: AtomicUsize::new(0),
     };
@@ -549,7 +578,12 @@ impl Builder<'_> {
         let bounds = brushes
             .iter()
             .fold(Bounds::EMPTY, |acc, b| acc.union(&b.bounds));
-        if let Some(mid) = mid_split(&bounds, &candidates, self.planes) {
+        if let Some(mid) = mid_split(
+            &bounds,
+            &candidates,
+            self.planes,
+            self.splitting.max_node_size,
+        ) {
             return Some(mid);
         }
         let hints = unused(Some(BrushKind::Hint));
@@ -575,7 +609,7 @@ impl Builder<'_> {
             Brush::sides_of,
             &facing_planes,
             self.planes,
-            self.heuristic,
+            self.splitting.heuristic,
         )
     }
 }

@@ -1,5 +1,9 @@
 //! End-to-end compiles of small maps written inline, and of the corpus maps.
 
+mod common;
+
+use common::*;
+
 use bsp_compiler::faces::{MIN_SQUARENESS, projection_squareness};
 use bsp_compiler::{CompileError, CompileOptions, CompileOutput, MapSource, Warning, compile};
 use quake_formats::bsp::limits::MAX_SURFACE_EXTENT;
@@ -9,93 +13,9 @@ use quake_formats::geom::Vec3;
 use quake_formats::miptex::MipTex;
 use quake_formats::prt::PortalFile;
 use quake_formats::wad::{Wad, WadLump};
-use quake_formats::{Bsp, Severity, validate};
+use quake_formats::{Bsp, validate};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
-
-/// A brush face line in the standard format for the axial box face with outward normal along
-/// `axis` (0..3) and `positive`.
-fn box_brush(mins: [f64; 3], maxs: [f64; 3], texture: &str) -> String {
-    let (a, b) = (mins, maxs);
-    // Three points per plane, clockwise seen from outside.
-    let faces = [
-        // +x
-        [[b[0], a[1], a[2]], [b[0], a[1], b[2]], [b[0], b[1], a[2]]],
-        // -x
-        [[a[0], a[1], a[2]], [a[0], b[1], a[2]], [a[0], a[1], b[2]]],
-        // +y
-        [[a[0], b[1], a[2]], [b[0], b[1], a[2]], [a[0], b[1], b[2]]],
-        // -y
-        [[a[0], a[1], a[2]], [a[0], a[1], b[2]], [b[0], a[1], a[2]]],
-        // +z
-        [[a[0], a[1], b[2]], [a[0], b[1], b[2]], [b[0], a[1], b[2]]],
-        // -z
-        [[a[0], a[1], a[2]], [b[0], a[1], a[2]], [a[0], b[1], a[2]]],
-    ];
-    let mut s = String::from("{\n");
-    for f in faces {
-        for p in f {
-            s.push_str(&format!("( {} {} {} ) ", p[0], p[1], p[2]));
-        }
-        s.push_str(&format!("{texture} 0 0 0 1 1\n"));
-    }
-    s.push_str("}\n");
-    s
-}
-
-/// A closed room: inside `lo..hi`, walls `t` thick. `hole` cuts a gap into the +x wall.
-fn room(lo: f64, hi: f64, t: f64, hole: bool) -> String {
-    let (a, b) = (lo - t, hi + t);
-    let mut s = String::new();
-    s += &box_brush([a, a, a], [b, b, lo], "floor"); // floor
-    s += &box_brush([a, a, hi], [b, b, b], "ceiling"); // ceiling
-    s += &box_brush([a, a, lo], [lo, b, hi], "wall"); // -x
-    if hole {
-        s += &box_brush([hi, a, lo], [b, 0.0, hi], "wall");
-        s += &box_brush([hi, 32.0, lo], [b, b, hi], "wall");
-    } else {
-        s += &box_brush([hi, a, lo], [b, b, hi], "wall"); // +x
-    }
-    s += &box_brush([lo, a, lo], [hi, lo, hi], "wall"); // -y
-    s += &box_brush([lo, hi, lo], [hi, b, hi], "wall"); // +y
-    s
-}
-
-fn room_map(hole: bool, extra: &str) -> String {
-    room_map_with(hole, extra, "")
-}
-
-/// The room, with `extra` brushes in worldspawn and the entity blocks `entities` after it.
-fn room_map_with(hole: bool, extra: &str, entities: &str) -> String {
-    format!(
-        "{{\n\"classname\" \"worldspawn\"\n\"wad\" \"none.wad\"\n{}{extra}}}\n{entities}{{\n\"classname\" \"info_player_start\"\n\"origin\" \"-32 -32 -100\"\n}}\n",
-        room(-128.0, 128.0, 16.0, hole)
-    )
-}
-
-fn brush_entity(classname: &str, brushes: &str) -> String {
-    format!("{{\n\"classname\" \"{classname}\"\n{brushes}}}\n")
-}
-
-fn try_compile(text: &str) -> Result<CompileOutput, CompileError> {
-    let source = MapSource {
-        path: PathBuf::from("inline.map"),
-        text: text.to_string(),
-    };
-    compile(&source, &CompileOptions::default())
-}
-
-fn compile_text(text: &str) -> CompileOutput {
-    try_compile(text).expect("compile")
-}
-
-fn errors(bsp: &Bsp) -> Vec<String> {
-    validate(bsp)
-        .into_iter()
-        .filter(|p| p.severity == Severity::Error)
-        .map(|p| p.to_string())
-        .collect()
-}
 
 /// Written and read back, by us and by the independent `qbsp` crate.
 fn check_round_trip(bsp: &Bsp) {

@@ -1,0 +1,149 @@
+//! Entities ericw-tools' users rely on: `_mirrorinside` on brush entities and liquids, and
+//! `func_illusionary_visblocker`.
+
+mod common;
+
+use bsp_compiler::trace::hull_point_contents;
+use common::*;
+use quake_formats::Bsp;
+use quake_formats::bsp::contents;
+use quake_formats::prt::PortalFile;
+
+/// The centre of the brushes these tests mirror.
+const CENTRE: [f32; 3] = [0.0, 0.0, -96.0];
+
+/// Faces with `texture` in model `model`, and how many of them are drawn seen from [`CENTRE`].
+fn model_faces(bsp: &Bsp, model: usize, texture: &str) -> (usize, usize) {
+    let m = &bsp.models[model];
+    let range = m.first_face as usize..(m.first_face + m.num_faces) as usize;
+    let mut count = 0;
+    let mut inward = 0;
+    let centre = CENTRE;
+    for f in &bsp.faces[range] {
+        let t = bsp.texinfo[f.texinfo as usize].miptex as usize;
+        if bsp.textures.textures[t]
+            .as_ref()
+            .is_none_or(|m| m.name() != texture)
+        {
+            continue;
+        }
+        count += 1;
+        let plane = &bsp.planes[f.plane as usize];
+        let sign = if f.side != 0 { -1.0 } else { 1.0 };
+        let d = (0..3).map(|i| plane.normal[i] * centre[i]).sum::<f32>() - plane.dist;
+        if sign * d > 0.0 {
+            inward += 1;
+        }
+    }
+    (count, inward)
+}
+
+fn water_box() -> String {
+    box_brush([-64.0, -64.0, -128.0], [64.0, 64.0, -64.0], "*water1")
+}
+
+#[test]
+fn mirrorinside_gives_brush_entities_faces_seen_from_inside() {
+    let bush = box_brush([-32.0, -32.0, -128.0], [32.0, 32.0, -64.0], "leaves");
+    let plain = compile_text(&room_map_with(
+        false,
+        "",
+        &brush_entity("func_illusionary", &bush),
+    ))
+    .bsp;
+    let mirrored_entity =
+        format!("{{\n\"classname\" \"func_illusionary\"\n\"_mirrorinside\" \"1\"\n{bush}}}\n");
+    let mirrored = compile_text(&room_map_with(false, "", &mirrored_entity)).bsp;
+    assert_eq!(errors(&mirrored), Vec::<String>::new());
+    assert_eq!(model_faces(&plain, 1, "leaves"), (6, 0));
+    assert_eq!(model_faces(&mirrored, 1, "leaves"), (12, 6));
+}
+
+#[test]
+fn liquids_in_detail_and_groups_mirror_unless_told_not_to() {
+    for class in ["func_detail", "func_group"] {
+        let default = compile_text(&room_map_with(
+            false,
+            "",
+            &brush_entity(class, &water_box()),
+        ));
+        let off = format!(
+            "{{\n\"classname\" \"{class}\"\n\"_mirrorinside\" \"0\"\n{}}}\n",
+            water_box()
+        );
+        let off = compile_text(&room_map_with(false, "", &off));
+        assert_eq!(errors(&off.bsp), Vec::<String>::new());
+        // Its five open sides (it stands on the floor): from both sides, or from outside only.
+        assert_eq!(model_faces(&default.bsp, 0, "*water1"), (10, 5), "{class}");
+        assert_eq!(model_faces(&off.bsp, 0, "*water1"), (5, 0), "{class}");
+    }
+}
+
+#[test]
+fn a_visblocker_blocks_vis_but_not_movement_or_sight_of_its_faces() {
+    // A wall of it across the room at x = 0.
+    let blocker = brush_entity(
+        "func_illusionary_visblocker",
+        &box_brush([-8.0, -128.0, -128.0], [8.0, 128.0, 128.0], "*water1"),
+    );
+    let out = compile_text(&room_map_with(false, "", &blocker));
+    let bsp = &out.bsp;
+    assert!(out.leak.is_none());
+    assert_eq!(errors(bsp), Vec::<String>::new());
+    assert!(!bsp.entity_text().contains("visblocker"));
+    // Walked through: empty in every hull.
+    assert_eq!(
+        bsp.leafs[bsp.leaf_at([0.0, 0.0, 0.0]).expect("leaf")].contents,
+        contents::EMPTY
+    );
+    for hull in 1..3 {
+        assert_eq!(
+            hull_point_contents(bsp, 0, hull, [0.0, 0.0, 0.0]),
+            contents::EMPTY,
+            "hull {hull}"
+        );
+    }
+    // Drawn from both sides and from within: both faces of each of its two open sides.
+    assert_eq!(model_faces(bsp, 0, "*water1").0, 4);
+    // No portal enters it: vis sees the room as two halves that cannot see each other.
+    let prt = PortalFile::parse(&out.portals.write()).expect("prt");
+    let a = bsp.leaf_at([-64.0, 0.0, 0.0]).expect("leaf") as u32 - 1;
+    let b = bsp.leaf_at([64.0, 0.0, 0.0]).expect("leaf") as u32 - 1;
+    let inside = bsp.leaf_at([0.0, 0.0, 0.0]).expect("leaf") as u32 - 1;
+    assert_ne!(a, b);
+    for p in &prt.portals {
+        assert!(!p.leafs.contains(&inside), "{:?}", p.leafs);
+        assert!(p.leafs != [a, b] && p.leafs != [b, a]);
+    }
+}
+
+/// The feature map (`tests/maps/features.map`): prefabs (one nested, turned, scaled), water
+/// that mirrors inside (func_detail by default, func_illusionary by `_mirrorinside`) and a
+/// visblocker compile without a warning and validate without a problem of any severity.
+#[test]
+fn the_feature_map_compiles_clean() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let source = bsp_compiler::MapSource::read(&dir.join("tests/maps/features.map")).expect("read");
+    let options = bsp_compiler::CompileOptions {
+        wad_dirs: vec![dir.join("../maps")],
+        ..bsp_compiler::CompileOptions::default()
+    };
+    let out = bsp_compiler::compile(&source, &options).expect("compile");
+    let warnings: Vec<String> = out.warnings.iter().map(|w| w.to_string()).collect();
+    assert_eq!(warnings, Vec::<String>::new());
+    let problems: Vec<String> = quake_formats::validate(&out.bsp)
+        .iter()
+        .map(|p| p.to_string())
+        .collect();
+    assert_eq!(problems, Vec::<String>::new());
+    let bsp = &out.bsp;
+    // The world, the func_wall prefab and the func_illusionary water.
+    assert_eq!(bsp.models.len(), 3);
+    let text = bsp.entity_text();
+    assert!(!text.contains("misc_external_map") && !text.contains("visblocker"));
+    // The illusionary water is drawn from inside: 6 faces out, 6 in.
+    assert_eq!(model_faces(bsp, 2, "*water1").0, 12);
+    // The nested prefab's half-size pillar (its cap at 64..72 up) is in the world.
+    let cap = bsp.leaf_at([-208.0, 0.0, 68.0]).expect("leaf");
+    assert_eq!(bsp.leafs[cap].contents, contents::SOLID);
+}
