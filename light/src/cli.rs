@@ -96,6 +96,20 @@ pub struct Args {
     /// BSP's folder or up to three above it, else Slipgate's own palette.
     #[arg(long, value_name = "FILE.lmp")]
     pub palette: Option<PathBuf>,
+    /// Always write a `.lit` beside the BSP, even when every light is white (ericw-tools' `-lit`).
+    #[arg(long, conflicts_with = "nolit")]
+    pub lit: bool,
+    /// Never write a `.lit`, even for coloured light (engines then show it grey); a `.lit` left
+    /// from an earlier run is removed.
+    #[arg(long)]
+    pub nolit: bool,
+    /// Only update the entity lump: give switchable lights (`targetname`) their styles without
+    /// relighting, after `slipgate bsp --onlyents` replaced the entities.
+    #[arg(long, conflicts_with_all = ["compare_reference", "bench_occlusion"])]
+    pub onlyents: bool,
+    /// Worker threads for tracing (default: one per core).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
+    pub threads: Option<u16>,
     /// Consider every light for every face (no range, plane-side or PVS culling).
     #[arg(long)]
     pub no_cull: bool,
@@ -199,10 +213,45 @@ pub fn join_optional_values(args: impl IntoIterator<Item = String>) -> Vec<Strin
     out
 }
 
+/// Whether to write a `.lit` file beside the lit BSP.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum LitFile {
+    /// Only when some light is coloured.
+    WhenColoured,
+    Always,
+    Never,
+}
+
+impl Args {
+    fn lit_file(&self) -> LitFile {
+        if self.nolit {
+            LitFile::Never
+        } else if self.lit {
+            LitFile::Always
+        } else {
+            LitFile::WhenColoured
+        }
+    }
+}
+
 pub fn run(args: &Args) -> anyhow::Result<()> {
+    match args.threads {
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(usize::from(n))
+            .build()
+            .context("starting the worker threads")?
+            .install(|| run_with_current_threads(args)),
+        None => run_with_current_threads(args),
+    }
+}
+
+fn run_with_current_threads(args: &Args) -> anyhow::Result<()> {
     let path = &args.bsp;
     let data = read_file(path)?;
     let mut bsp = Bsp::read(&data).with_context(|| format!("{}", path.display()))?;
+    if args.onlyents {
+        return update_entities_only(args, bsp);
+    }
     let mut options = args.options(args.quality());
     options.palette = find_palette(args)?;
     if let Some(stride) = args.face_stride {
@@ -293,28 +342,57 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
 
     let lit = crate::apply_lighting(&mut bsp, &lighting);
+    let lit = match args.lit_file() {
+        LitFile::WhenColoured => lit,
+        // White light: each luxel's grey level in all three channels.
+        LitFile::Always => lit.or_else(|| {
+            let rgb: Vec<u8> = bsp.lighting.iter().flat_map(|&g| [g, g, g]).collect();
+            Some(quake_formats::lit::write_lit(&rgb))
+        }),
+        LitFile::Never => None,
+    };
     let out = args.output.as_ref().unwrap_or(path);
     write_atomic(out, &bsp.write()?)?;
-    let lit_file = lit_path(out);
-    match lit {
-        Some(bytes) => write_atomic(&lit_file, &bytes)?,
-        None if lit_file.exists() => {
-            // Engines would load a stale .lit over the new lightmaps.
-            std::fs::remove_file(&lit_file)
-                .with_context(|| format!("removing stale {}", lit_file.display()))?;
-            eprintln!(
-                "light: removed {} (left from an earlier run; no light is coloured now)",
-                lit_file.display()
-            );
-        }
-        None => {}
-    }
+    write_or_remove_lit(&lit_path(out), lit)?;
     if let Some(stats_path) = &args.stats {
         let mut json = serde_json::to_value(&lighting.stats)?;
         if let serde_json::Value::Object(map) = &mut json {
             map.extend(extra);
             map.insert("quality".into(), serde_json::to_value(options.quality)?);
         }
+        write_atomic(stats_path, serde_json::to_string_pretty(&json)?.as_bytes())?;
+    }
+    Ok(())
+}
+
+/// Writes the `.lit`, or removes one left from an earlier run: engines would load a stale `.lit`
+/// over the new lightmaps.
+fn write_or_remove_lit(lit_file: &Path, lit: Option<Vec<u8>>) -> anyhow::Result<()> {
+    match lit {
+        Some(bytes) => write_atomic(lit_file, &bytes)?,
+        None if lit_file.exists() => {
+            std::fs::remove_file(lit_file)
+                .with_context(|| format!("removing stale {}", lit_file.display()))?;
+            eprintln!(
+                "light: removed {} (left from an earlier run; no .lit is wanted now)",
+                lit_file.display()
+            );
+        }
+        None => {}
+    }
+    Ok(())
+}
+
+/// `--onlyents`: the entity lump gets the switchable lights' styles; lightmaps and `.lit` stay.
+fn update_entities_only(args: &Args, mut bsp: Bsp) -> anyhow::Result<()> {
+    let path = &args.bsp;
+    let named = crate::update_entities_only(&mut bsp)
+        .with_context(|| format!("entities of {}", path.display()))?;
+    eprintln!("light: --onlyents: {named} switchable light names given styles; lightmaps kept");
+    let out = args.output.as_ref().unwrap_or(path);
+    write_atomic(out, &bsp.write()?)?;
+    if let Some(stats_path) = &args.stats {
+        let json = serde_json::json!({ "onlyents": true, "switchable_names_styled": named });
         write_atomic(stats_path, serde_json::to_string_pretty(&json)?.as_bytes())?;
     }
     Ok(())

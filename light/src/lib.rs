@@ -725,6 +725,22 @@ pub fn apply_lighting(bsp: &mut Bsp, lighting: &Lighting) -> Option<Vec<u8>> {
         .then(|| quake_formats::lit::write_lit(&rgb))
 }
 
+/// `--onlyents`: gives switchable lights their styles in the entity lump (the lump `slipgate bsp
+/// --onlyents` just replaced) without relighting; the lightmaps stay as they are. Returns how many
+/// switchable light names got a style.
+///
+/// # Errors
+/// An entity lump that does not parse, a `style` that is not a number, or more switchable lights
+/// than styles.
+pub fn update_entities_only(bsp: &mut Bsp) -> Result<usize, LightError> {
+    let mut entities = parse_entities(&bsp.entity_text())?;
+    let assigned = lights::assign_switchable_styles(&mut entities)?;
+    if !assigned.is_empty() {
+        bsp.set_entity_text(&write_entities(&entities));
+    }
+    Ok(assigned.len())
+}
+
 /// Per-luxel difference between two lightings of the same faces, in 8-bit levels.
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
 pub struct ErrorStats {

@@ -927,7 +927,9 @@ pub fn split_light(light: &PointLight, radius: f64, count: usize) -> Vec<PointLi
 /// Gives each `targetname` of a light entity without an explicit `style` its
 /// own style from 32 up (lights sharing a name share it) and writes it into
 /// the entity, so the game's switching code finds it.
-fn assign_switchable_styles(entities: &mut [Entity]) -> Result<Vec<(String, u8)>, LightError> {
+pub(crate) fn assign_switchable_styles(
+    entities: &mut [Entity],
+) -> Result<Vec<(String, u8)>, LightError> {
     let mut assigned: Vec<(String, u8)> = Vec::new();
     for (index, e) in entities.iter_mut().enumerate() {
         if !e.classname().starts_with("light") {

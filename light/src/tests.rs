@@ -11,7 +11,7 @@ use crate::faces::{FaceKind, face_geometry};
 use crate::lights::DirtMode;
 use crate::samples::{FaceRegion, face_samples};
 use crate::scene::TraceScene;
-use crate::{Options, Quality, apply_lighting, compare, compute_lighting};
+use crate::{Options, Quality, apply_lighting, compare, compute_lighting, update_entities_only};
 
 /// A polygon with its outward normal and whether it is sky.
 struct Poly {
@@ -375,6 +375,76 @@ fn switchable_lights_get_their_own_style() {
     let floor = &lighting.lightmaps[0];
     assert!(floor.grey[0].iter().all(|&v| v == 0), "style 0 is dark");
     assert!(floor.grey[1].iter().any(|&v| v > 20));
+}
+
+#[test]
+fn onlyents_styles_switchable_lights_and_keeps_lightmaps() {
+    let mut bsp = shadow_scene("\"light\" \"300\"");
+    let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
+    apply_lighting(&mut bsp, &lighting);
+    let (lightmaps, faces) = (bsp.lighting.clone(), bsp.faces.clone());
+    // What `slipgate bsp --onlyents` leaves after the light got a name.
+    let renamed = bsp.entity_text().replace(
+        "\"classname\" \"light\"",
+        "\"classname\" \"light\" \"targetname\" \"lamp\"",
+    );
+    bsp.set_entity_text(&renamed);
+    assert_eq!(update_entities_only(&mut bsp).expect("entities"), 1);
+    assert!(bsp.entity_text().contains("\"style\" \"32\""));
+    assert_eq!(
+        (bsp.lighting.clone(), bsp.faces.clone()),
+        (lightmaps, faces)
+    );
+}
+
+/// Runs `slipgate light ARGS` on `bsp` written into a scratch folder; returns the folder.
+fn light_cli(name: &str, bsp: &Bsp, args: &[&str]) -> std::path::PathBuf {
+    use clap::Parser;
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        args: crate::cli::Args,
+    }
+    let dir = std::env::temp_dir().join(format!("slipgate-light-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("scratch folder");
+    let path = dir.join("scene.bsp");
+    std::fs::write(&path, bsp.write().expect("write")).expect("write bsp");
+    let mut argv = vec!["light".to_string()];
+    argv.extend(args.iter().map(|a| a.to_string()));
+    argv.push(path.display().to_string());
+    let cli = Cli::try_parse_from(argv).expect("arguments");
+    crate::cli::run(&cli.args).expect("light");
+    dir
+}
+
+#[test]
+fn lit_and_nolit_force_or_forbid_the_lit_file() {
+    let white = shadow_scene("\"light\" \"300\"");
+    let dir = light_cli("lit", &white, &["--lit"]);
+    let bsp = Bsp::read(&std::fs::read(dir.join("scene.bsp")).expect("bsp")).expect("read");
+    let lit = std::fs::read(dir.join("scene.lit")).expect("--lit writes a .lit for white light");
+    let rgb = quake_formats::lit::read_lit(&lit, bsp.lighting.len()).expect("valid .lit");
+    assert!(
+        rgb.chunks(3)
+            .zip(&bsp.lighting)
+            .all(|(c, &g)| c == [g, g, g])
+    );
+
+    let red = shadow_scene("\"light\" \"300\" \"_color\" \"255 0 0\"");
+    let dir = light_cli("nolit", &red, &["--nolit"]);
+    assert!(!dir.join("scene.lit").exists(), "--nolit writes no .lit");
+    std::fs::remove_dir_all(dir).ok();
+}
+
+#[test]
+fn threads_option_gives_the_same_bytes() {
+    let scene = shadow_scene("\"light\" \"300\"");
+    let one = light_cli("threads1", &scene, &["--threads", "1"]);
+    let two = light_cli("threads2", &scene, &["--threads", "2"]);
+    let read = |d: &std::path::Path| std::fs::read(d.join("scene.bsp")).expect("bsp");
+    assert_eq!(read(&one), read(&two));
+    std::fs::remove_dir_all(one).ok();
+    std::fs::remove_dir_all(two).ok();
 }
 
 #[test]
