@@ -141,7 +141,7 @@ impl Density {
     pub fn for_quality(quality: Quality) -> Density {
         match quality {
             Quality::Default => Density {
-                stride: 4,
+                stride: 2,
                 strata: 8,
             },
             Quality::Extra => Density {
