@@ -1,8 +1,11 @@
 //! Bounce against the reference, ours and ericw-tools': `bounce_compare UNLIT.bsp STRIDE
-//! [ERICW_LIT.bsp]`. Lights every STRIDE-th face of UNLIT.bsp with `--bounce` (default and
-//! `--extra4`) and with `--reference --bounce`, and reads ericw-tools' lightmaps of the same
-//! faces from ERICW_LIT.bsp (its `light -bounce` of the same BSP); errors are in grey levels.
+//! [ERICW_LIT.bsp] [GRIDxSTRATA ...]`. Lights every STRIDE-th face of UNLIT.bsp with `--bounce`
+//! (default and `--extra4`) and with `--reference --bounce`, and reads ericw-tools' lightmaps of
+//! the same faces from ERICW_LIT.bsp (its `light -bounce` of the same BSP); errors are in grey
+//! levels. Each `GRIDxSTRATA` (for example `4x8`) also runs both modes with the fast bounce's
+//! receivers every GRID luxels casting STRATA² rays each.
 
+use light::bounce::Density;
 use light::output::FaceLightmap;
 use light::{Lighting, Options, Quality, compare, compute_lighting};
 use quake_formats::Bsp;
@@ -69,43 +72,70 @@ fn report(name: &str, a: &Lighting, reference: &Lighting) {
     );
 }
 
+/// `GRIDxSTRATA` as a density.
+fn parse_density(arg: &str) -> Option<Density> {
+    let (stride, strata) = arg.split_once('x')?;
+    Some(Density {
+        stride: stride.parse().ok().filter(|&s| s > 0)?,
+        strata: strata.parse().ok().filter(|&s| s > 0)?,
+    })
+}
+
 fn main() -> anyhow::Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let (Some(path), Some(stride)) = (args.first(), args.get(1)) else {
-        anyhow::bail!("usage: bounce_compare UNLIT.bsp STRIDE [ERICW_LIT.bsp]");
+        anyhow::bail!("usage: bounce_compare UNLIT.bsp STRIDE [ERICW_LIT.bsp] [GRIDxSTRATA ...]");
     };
     let stride: usize = stride.parse()?;
     anyhow::ensure!(stride > 0, "STRIDE must be at least 1");
+    let theirs = args.get(2).filter(|a| parse_density(a).is_none());
+    let mut densities = vec![None];
+    for arg in args.iter().skip(2).filter(|a| Some(*a) != theirs) {
+        let density =
+            parse_density(arg).ok_or_else(|| anyhow::anyhow!("not GRIDxSTRATA: {arg}"))?;
+        densities.push(Some(density));
+    }
     let bsp = Bsp::read(&std::fs::read(path)?)?;
     let faces: Vec<usize> = (0..bsp.faces.len()).step_by(stride).collect();
-    let run = |quality: Quality, bounce: bool| {
+    let run = |quality: Quality, bounce: bool, density: Option<Density>| {
         let mut o = Options {
             quality,
             only_faces: Some(faces.clone()),
+            bounce_density: density,
             ..Options::default()
         };
         o.overrides.bounce = bounce.then_some(1);
         compute_lighting(&bsp, &o)
     };
-    let reference = run(Quality::Reference, true)?;
+    let reference = run(Quality::Reference, true, None)?;
     println!(
         "reference with bounce: {:.1} s",
         reference.stats.seconds_total
     );
-    let direct_reference = run(Quality::Reference, false)?;
+    let direct_reference = run(Quality::Reference, false, None)?;
     for (name, quality) in [("default", Quality::Default), ("--extra4", Quality::Extra4)] {
-        report(
-            &format!("ours {name} --bounce"),
-            &run(quality, true)?,
-            &reference,
-        );
+        for &density in &densities {
+            let lit = run(quality, true, density)?;
+            let d = density.unwrap_or_else(|| Density::for_quality(quality));
+            report(
+                &format!(
+                    "ours {name} --bounce (grid {}, {} rays; {} bounce rays, {:.2} s)",
+                    d.stride,
+                    d.strata * d.strata,
+                    lit.stats.bounce_rays,
+                    lit.stats.seconds_bounce
+                ),
+                &lit,
+                &reference,
+            );
+        }
         report(
             &format!("ours {name}, no bounce, vs direct reference"),
-            &run(quality, false)?,
+            &run(quality, false, None)?,
             &direct_reference,
         );
     }
-    if let Some(theirs) = args.get(2) {
+    if let Some(theirs) = theirs {
         let lit = Bsp::read(&std::fs::read(theirs)?)?;
         let lightmaps = read_lightmaps(&lit, &faces);
         report("ericw-tools -bounce", &lightmaps, &reference);

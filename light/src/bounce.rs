@@ -9,26 +9,25 @@
 //! and factor 0.5), integrated over the surfaces instead of taken at one point per face. Each
 //! further pass reflects the light the previous pass brought.
 //!
-//! The fast method: each reflecting face's lightmap is diced into blocks of
-//! [`BLOCK_LUXELS`]² luxels (64 units, ericw-tools' dicing size), each a point emitter with the
-//! block's flux (luxel light × the part of the luxel inside the face). A receiving face takes
-//! from the faces its leaves' PVS holds, that face it and that it faces; faces whose bound on
-//! what they could bring is smallest are dropped while the bounds dropped add up to at most
-//! [`CULL_BUDGET_LEVELS`] of a grey level. A face that is small against its distance is gathered
-//! from as one point; the others block by block. One shadow ray per luxel and emitter, 16
-//! luxels to a packet.
+//! The fast method is a final gather with the reference's estimator: receivers on a grid of
+//! every few luxels ([`Density`]) each cast stratified cosine-distributed rays; a ray reads the
+//! light of the reflecting face it meets first at the point it meets it (the face's lightmap,
+//! bilinear). Its cost is receivers × rays, whatever the number of reflecting faces; the PVS
+//! and distance cut nothing by hand, as rays only meet what is in sight. Bounce between
+//! receivers is bilinear. Rays are keyed by face, luxel and pass, so results do not depend on
+//! threads.
 
 use quake_formats::Bsp;
 use quake_formats::bsp::limits::LIGHTMAP_SCALE;
-use quake_formats::geom::{Bounds, Plane, Vec3, Winding};
+use quake_formats::geom::Vec3;
 use quake_formats::palette::Palette;
 
+use crate::Quality;
 use crate::embree::RayPacket16;
 use crate::faces::{FaceGeom, FaceKind};
-use crate::lights::{DirtResponse, MapLights};
+use crate::lights::{DirtResponse, MapLights, tangent_basis};
 use crate::samples::FaceSamples;
 use crate::scene::TraceScene;
-use crate::visibility::Visibility;
 
 pub mod reference;
 
@@ -40,23 +39,6 @@ pub const GREY_REFLECTANCE: f32 = 127.0 / 255.0;
 pub const KERNEL_SCALE: f64 = 0.5;
 /// Distances below this count as this (ericw-tools' bounce hotspot clamp).
 pub const HOTSPOT_CLAMP: f64 = 128.0;
-/// Emitter points stand this far in front of their face.
-const EMITTER_LIFT: f64 = 1.0;
-/// Luxels along each side of an emitter block.
-pub const BLOCK_LUXELS: usize = 4;
-/// A face no wider (half-diagonal) than this fraction of its clamped distance from a receiving
-/// face is gathered from as one point. Blocks (half-diagonal 45 units) never need splitting:
-/// the kernel is flat within the 128-unit clamp.
-const ONE_POINT_RATIO: f64 = 1.0;
-/// Grey levels (at gamma 1) that culling may take from any luxel, at most.
-pub const CULL_BUDGET_LEVELS: f64 = 0.5;
-/// A shadow ray is skipped when what it could bring is below this many light units.
-const RAY_GATE: f64 = 1e-4;
-/// Bounce is measured at every this many luxels along each axis, and between where it is smooth.
-pub const GRID_STRIDE: usize = 4;
-/// Grey levels (at gamma 1) by which the corners of a grid cell may differ for the luxels
-/// inside to be interpolated.
-pub const SMOOTH_LEVELS: f64 = 2.0;
 
 /// Worldspawn `_bounce` and its keys (and their command-line overrides).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -146,190 +128,283 @@ pub fn face_reflectance(
         .collect()
 }
 
-/// Area and centroid of a convex polygon.
-fn area_centroid(points: &[Vec3]) -> (f64, Vec3) {
-    let Some(&first) = points.first() else {
-        return (0.0, Vec3::ZERO);
-    };
-    let mut area = 0.0;
-    let mut sum = Vec3::ZERO;
-    for pair in points[1..].windows(2) {
-        let a = (pair[0] - first).cross(pair[1] - first).length() / 2.0;
-        area += a;
-        sum += (first + pair[0] + pair[1]) * (a / 3.0);
-    }
-    if area > 0.0 {
-        (area, sum / area)
-    } else {
-        (0.0, first)
+/// How densely the fast method gathers: a receiver every `stride` luxels along each axis (and
+/// at the last row and column), each casting `strata²` rays.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Density {
+    pub stride: usize,
+    pub strata: usize,
+}
+
+impl Density {
+    /// The density of each quality mode; the reference's later passes gather at every luxel.
+    pub fn for_quality(quality: Quality) -> Density {
+        match quality {
+            Quality::Default => Density {
+                stride: 2,
+                strata: 8,
+            },
+            Quality::Extra => Density {
+                stride: 2,
+                strata: 12,
+            },
+            Quality::Extra4 => Density {
+                stride: 2,
+                strata: 16,
+            },
+            Quality::Reference => Density {
+                stride: 1,
+                strata: 16,
+            },
+        }
     }
 }
 
-/// The part of `face` whose texture coordinates lie in `[s0, s1] x [t0, t1]`.
-fn clip_to_st(face: &FaceGeom, s: [f64; 2], t: [f64; 2]) -> Option<Winding> {
-    let mut w = Some(Winding::new(face.points.clone()));
-    for (axis, range) in [(0, s), (1, t)] {
+/// A well-mixed 64-bit hash (splitmix64's finaliser).
+fn mix(mut x: u64) -> u64 {
+    x = (x ^ (x >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    x = (x ^ (x >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    x ^ (x >> 31)
+}
+
+/// Two numbers in [0, 1) from `key`.
+fn jitter(key: u64) -> (f64, f64) {
+    let h = mix(key);
+    let unit = |bits: u64| (bits >> 11) as f64 / (1u64 << 53) as f64;
+    (unit(h), unit(mix(h ^ 0x9e37_79b9_7f4a_7c15)))
+}
+
+/// The jitter key of point `index` of `face` in `pass`: rays depend on nothing else (not on
+/// threads or the order faces are gathered in).
+pub fn point_key(face: usize, index: usize, pass: usize) -> u64 {
+    mix(mix(mix(face as u64) ^ index as u64) ^ pass as u64)
+}
+
+/// Where one point gathers: its position, its face's normal (rays are spread around it) and its
+/// shading normal (`_phong`; the face normal otherwise), and the key of its rays' jitter.
+#[derive(Debug, Clone, Copy)]
+pub struct GatherPoint {
+    pub point: Vec3,
+    pub flat: Vec3,
+    pub shading: Vec3,
+    pub key: u64,
+}
+
+/// What reflecting surfaces give off: per face, its reflectance and its light per luxel.
+pub struct Field<'a> {
+    pub faces: &'a [FaceGeom],
+    pub reflectance: &'a [Option<[f32; 3]>],
+    /// Per face (by index): its light per style and luxel, when it has any.
+    pub light: &'a [Option<StyleLuxels>],
+    /// [`BounceSettings::kernel`].
+    pub kernel: f64,
+}
+
+/// The light of `face` at world point `q`, bilinear between luxel centres.
+fn light_at(face: &FaceGeom, luxels: &[[f32; 3]], q: Vec3) -> [f32; 3] {
+    let [w, h] = face.extents.luxel_size();
+    let coord = |axis: usize, size: usize| {
         let v = face.vecs[axis];
         let dir = Vec3::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2]));
-        let len = dir.length();
-        if len == 0.0 {
-            return None;
-        }
-        // World point p has coordinate dir · (p − origin) + v[3].
-        let offset = f64::from(v[3]) - dir.dot(face.origin);
-        let n = dir / len;
-        let keep_above = Plane::new(n, (range[0] - offset) / len);
-        let keep_below = Plane::new(-n, -(range[1] - offset) / len);
-        w = w
-            .and_then(|w| w.clip_front(&keep_above, false))
-            .and_then(|w| w.clip_front(&keep_below, false));
-    }
-    w
+        let st = dir.dot(q - face.origin) + f64::from(v[3]);
+        let f = ((st - f64::from(face.extents.tex_mins[axis])) / f64::from(LIGHTMAP_SCALE))
+            .clamp(0.0, size.saturating_sub(1) as f64);
+        let i = (f.floor() as usize).min(size.saturating_sub(1));
+        (
+            i,
+            (i + 1).min(size.saturating_sub(1)),
+            (f - i as f64) as f32,
+        )
+    };
+    let (x0, x1, fx) = coord(0, w);
+    let (y0, y1, fy) = coord(1, h);
+    let at = |x: usize, y: usize| luxels.get(y * w + x).copied().unwrap_or_default();
+    let (a, b, c, d) = (at(x0, y0), at(x1, y0), at(x0, y1), at(x1, y1));
+    std::array::from_fn(|k| {
+        let top = a[k] + (b[k] - a[k]) * fx;
+        let bottom = c[k] + (d[k] - c[k]) * fx;
+        top + (bottom - top) * fy
+    })
 }
 
-/// One block of an emitter: a point and the luxels whose light it carries.
-#[derive(Debug, Clone)]
-struct Block {
-    point: Vec3,
-    /// Luxel index and the area of the luxel inside the face.
-    luxels: Vec<(u32, f32)>,
-}
+/// Rays go no further than this.
+const RAY_LENGTH: f32 = 65536.0;
 
-/// A reflecting face diced into blocks of its lightmap.
-#[derive(Debug, Clone)]
-pub struct EmitterGeom {
-    pub face: usize,
-    normal: Vec3,
-    plane: Plane,
-    /// Bounds of the face's points.
-    bounds: Bounds,
-    /// The area-weighted centre, lifted.
-    point: Vec3,
-    /// Half the bounds' diagonal.
-    radius: f64,
-    blocks: Vec<Block>,
-}
-
-impl EmitterGeom {
-    /// `None` for a face with no area.
-    pub fn new(face: &FaceGeom) -> Option<EmitterGeom> {
-        let [w, h] = face.extents.luxel_size();
-        let half = f64::from(LIGHTMAP_SCALE) / 2.0;
-        let lift = face.plane.normal * EMITTER_LIFT;
-        let mut blocks = Vec::new();
-        let (mut total, mut moment) = (0.0, Vec3::ZERO);
-        for by in (0..h).step_by(BLOCK_LUXELS) {
-            for bx in (0..w).step_by(BLOCK_LUXELS) {
-                let (mut area, mut sum) = (0.0, Vec3::ZERO);
-                let mut luxels = Vec::new();
-                for y in by..(by + BLOCK_LUXELS).min(h) {
-                    for x in bx..(bx + BLOCK_LUXELS).min(w) {
-                        let [s, t] = face.extents.luxel_st(x, y);
-                        let piece = clip_to_st(face, [s - half, s + half], [t - half, t + half]);
-                        let (a, c) = piece.map_or((0.0, Vec3::ZERO), |p| area_centroid(&p.points));
-                        if a > 0.0 {
-                            luxels.push(((y * w + x) as u32, a as f32));
-                            area += a;
-                            sum += c * a;
-                        }
-                    }
+impl Field<'_> {
+    /// Adds the light `at` receives into slot `i` of `out` (`n` slots per style): `strata²`
+    /// cosine-distributed rays around the face normal, one per cell of a stratified grid
+    /// jittered by `at.key`. A ray that first meets the front of a reflecting face at `q`
+    /// brings `π · kernel · ρ E(q) · min(1, d²/128²)` (times the shading/flat cosine ratio),
+    /// over the number of rays: the model's integral with `dA = d² dω / cos θq`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn gather_at(
+        &self,
+        scene: &TraceScene,
+        model: usize,
+        at: &GatherPoint,
+        strata: usize,
+        out: &mut StyleLuxels,
+        n: usize,
+        i: usize,
+        counts: &mut BounceCounts,
+    ) {
+        let rays = strata * strata;
+        let [t0, t1] = tangent_basis(at.flat);
+        let scale = self.kernel * std::f64::consts::PI / rays as f64;
+        let mut packet = RayPacket16::new();
+        let mut dirs = [Vec3::ZERO; 16];
+        for first in (0..rays).step_by(16) {
+            packet.clear();
+            let lanes = (rays - first).min(16);
+            for (lane, dir) in dirs.iter_mut().enumerate().take(lanes) {
+                let r = first + lane;
+                let (j1, j2) = jitter(at.key.wrapping_add(r as u64));
+                let u1 = ((r / strata) as f64 + j1) / strata as f64;
+                let u2 = ((r % strata) as f64 + j2) / strata as f64;
+                let radius = u1.sqrt();
+                let phi = std::f64::consts::TAU * u2;
+                *dir = t0 * (radius * phi.cos())
+                    + t1 * (radius * phi.sin())
+                    + at.flat * (1.0 - u1).sqrt();
+                packet.set(lane, at.point.to_f32(), dir.to_f32(), 0.0, RAY_LENGTH);
+            }
+            counts.rays += lanes as u64;
+            let hits = scene.first_faces16(&mut packet, model);
+            for (lane, hit) in hits.iter().enumerate().take(lanes) {
+                let Some((f, t)) = *hit else {
+                    continue;
+                };
+                let (Some(face), Some(Some(rho)), Some(Some(light))) = (
+                    self.faces.get(f),
+                    self.reflectance.get(f),
+                    self.light.get(f),
+                ) else {
+                    continue;
+                };
+                let dir = dirs[lane];
+                let cos_flat = at.flat.dot(dir);
+                if face.plane.normal.dot(dir) >= 0.0 || cos_flat <= 0.0 {
+                    continue; // the back of a face, or a grazing ray
                 }
-                if area > 0.0 {
-                    total += area;
-                    moment += sum;
-                    blocks.push(Block {
-                        point: sum / area + lift,
-                        luxels,
-                    });
+                let cos_shading = at.shading.dot(dir).max(0.0);
+                let near = (f64::from(t) / HOTSPOT_CLAMP).min(1.0);
+                let weight = scale * cos_shading / cos_flat * near * near;
+                let q = at.point + dir * f64::from(t);
+                for (style, luxels) in light {
+                    let e = light_at(face, luxels, q);
+                    let flux = std::array::from_fn(|k| e[k] * rho[k]);
+                    add_light(out, n, &[*style], &[flux], i, weight);
                 }
             }
         }
-        if total <= 0.0 {
-            return None;
-        }
-        let mut bounds = Bounds::EMPTY;
-        for &p in &face.points {
-            bounds.add_point(p);
-        }
-        Some(EmitterGeom {
-            face: face.index,
-            normal: face.plane.normal,
-            plane: face.plane,
-            bounds,
-            point: moment / total + lift,
-            radius: (bounds.maxs - bounds.mins).length() / 2.0,
-            blocks,
-        })
     }
-}
 
-/// What one emitter gives off in one pass: flux (light × area × reflectance) per style, per
-/// block and in total.
-#[derive(Debug, Clone)]
-pub struct Emission {
-    styles: Vec<u8>,
-    /// `[block][style]`.
-    blocks: Vec<Vec<[f32; 3]>>,
-    total: Vec<[f32; 3]>,
-    /// Sum over styles of the brightest channel of `total`.
-    bound: f64,
-}
-
-impl Emission {
-    /// `None` when the face gives off nothing.
-    pub fn new(geom: &EmitterGeom, reflectance: [f32; 3], light: &StyleLuxels) -> Option<Emission> {
-        let styles: Vec<u8> = light.iter().map(|(s, _)| *s).collect();
-        let blocks: Vec<Vec<[f32; 3]>> = geom
-            .blocks
-            .iter()
-            .map(|b| {
-                light
-                    .iter()
-                    .map(|(_, luxels)| {
-                        let mut flux = [0.0f32; 3];
-                        for &(l, area) in &b.luxels {
-                            let v = luxels.get(l as usize).copied().unwrap_or_default();
-                            for k in 0..3 {
-                                flux[k] += v[k] * area * reflectance[k];
-                            }
-                        }
-                        flux
-                    })
-                    .collect()
-            })
-            .collect();
-        let mut total = vec![[0.0f32; 3]; styles.len()];
-        for b in &blocks {
-            for (t, f) in total.iter_mut().zip(b) {
-                for k in 0..3 {
-                    t[k] += f[k];
-                }
+    /// Bounced light at each luxel of `r`, per style: gathered at a grid of receivers every
+    /// `density.stride` luxels (and the last row and column), bilinear between them.
+    pub fn gather_face(
+        &self,
+        scene: &TraceScene,
+        r: &Receivers,
+        pass: usize,
+        density: Density,
+        counts: &mut BounceCounts,
+    ) -> StyleLuxels {
+        let xs = grid(r.width, density.stride);
+        let ys = grid(r.height, density.stride);
+        let cells = xs.len() * ys.len();
+        let mut at_grid: StyleLuxels = Vec::new();
+        for (gy, &y) in ys.iter().enumerate() {
+            for (gx, &x) in xs.iter().enumerate() {
+                let l = y * r.width + x;
+                let at = GatherPoint {
+                    point: Vec3::from_f32(r.points[l]),
+                    flat: r.normal,
+                    shading: Vec3::from_f32(r.normals[l]),
+                    key: point_key(r.face, l, pass),
+                };
+                let slot = gy * xs.len() + gx;
+                self.gather_at(
+                    scene,
+                    r.model,
+                    &at,
+                    density.strata,
+                    &mut at_grid,
+                    cells,
+                    slot,
+                    counts,
+                );
             }
         }
-        let bound: f64 = total
-            .iter()
-            .map(|t| f64::from(t[0].max(t[1]).max(t[2])))
-            .sum();
-        (bound > 0.0).then_some(Emission {
-            styles,
-            blocks,
-            total,
-            bound,
-        })
+        interpolate(&at_grid, &xs, &ys, r.width, r.height)
     }
 }
 
-/// Where a face receives bounced light: one point and normal per luxel.
+/// Every `stride`th index below `size`, and the last.
+fn grid(size: usize, stride: usize) -> Vec<usize> {
+    let mut at: Vec<usize> = (0..size).step_by(stride.max(1)).collect();
+    if size > 0 && at.last() != Some(&(size - 1)) {
+        at.push(size - 1);
+    }
+    at
+}
+
+/// For each index below the grid's last: the grid cell it lies in and how far across.
+fn cell_of(at: &[usize]) -> Vec<(usize, usize, f32)> {
+    let Some(&last) = at.last() else {
+        return Vec::new();
+    };
+    let mut out = Vec::with_capacity(last + 1);
+    for (j, pair) in at.windows(2).enumerate() {
+        for x in pair[0]..pair[1] {
+            out.push((j, j + 1, (x - pair[0]) as f32 / (pair[1] - pair[0]) as f32));
+        }
+    }
+    let j = at.len() - 1;
+    out.push((j, j, 0.0));
+    out
+}
+
+/// `at_grid` (per style, `xs.len() × ys.len()` values) spread bilinearly onto `w × h` luxels.
+fn interpolate(
+    at_grid: &StyleLuxels,
+    xs: &[usize],
+    ys: &[usize],
+    w: usize,
+    h: usize,
+) -> StyleLuxels {
+    let (cx, cy) = (cell_of(xs), cell_of(ys));
+    let gw = xs.len();
+    at_grid
+        .iter()
+        .map(|(style, values)| {
+            let v = |gx: usize, gy: usize| values[gy * gw + gx];
+            let mut luxels = Vec::with_capacity(w * h);
+            for &(y0, y1, fy) in cy.iter().take(h) {
+                for &(x0, x1, fx) in cx.iter().take(w) {
+                    let (a, b, c, d) = (v(x0, y0), v(x1, y0), v(x0, y1), v(x1, y1));
+                    luxels.push(std::array::from_fn(|k| {
+                        let top = a[k] + (b[k] - a[k]) * fx;
+                        let bottom = c[k] + (d[k] - c[k]) * fx;
+                        top + (bottom - top) * fy
+                    }));
+                }
+            }
+            (*style, luxels)
+        })
+        .collect()
+}
+
+/// Where a face receives bounced light: one point and shading normal per luxel.
 #[derive(Debug, Clone)]
 pub struct Receivers {
     pub face: usize,
     pub model: usize,
     pub width: usize,
     pub height: usize,
+    /// The face's normal.
+    pub normal: Vec3,
     pub points: Vec<[f32; 3]>,
     pub normals: Vec<[f32; 3]>,
-    plane: Plane,
-    bounds: Bounds,
 }
 
 impl Receivers {
@@ -339,293 +414,27 @@ impl Receivers {
         let pick = (axis / 2) * axis + axis / 2;
         let per = samples.per_luxel();
         let indices = (0..samples.luxels()).map(|l| l * per + pick);
-        let points: Vec<[f32; 3]> = indices.clone().map(|i| samples.points[i]).collect();
-        let normals = indices.map(|i| samples.normal_at(i).to_f32()).collect();
-        let mut bounds = Bounds::EMPTY;
-        for &p in &points {
-            bounds.add_point(Vec3::from_f32(p));
-        }
         Receivers {
             face: samples.face,
             model: face.model,
             width: samples.width,
             height: samples.height,
-            points,
-            normals,
-            plane: face.plane,
-            bounds,
+            normal: samples.normal,
+            points: indices.clone().map(|i| samples.points[i]).collect(),
+            normals: indices.map(|i| samples.normal_at(i).to_f32()).collect(),
         }
     }
-}
-
-/// Squared distance between two boxes (0 when they touch).
-fn box_gap_squared(a: &Bounds, b: &Bounds) -> f64 {
-    (0..3)
-        .map(|i| {
-            let gap = (a.mins[i] - b.maxs[i]).max(b.mins[i] - a.maxs[i]).max(0.0);
-            gap * gap
-        })
-        .sum()
-}
-
-/// True if some corner of `b` is in front of `plane`.
-fn in_front(plane: &Plane, b: &Bounds) -> bool {
-    (0..8).any(|c| {
-        let p = Vec3::new(
-            if c & 1 == 0 { b.mins.x } else { b.maxs.x },
-            if c & 2 == 0 { b.mins.y } else { b.maxs.y },
-            if c & 4 == 0 { b.mins.z } else { b.maxs.z },
-        );
-        plane.distance(p) > 0.0
-    })
 }
 
 /// Work done gathering bounced light.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct BounceCounts {
     pub rays: u64,
-    /// Receiving face / emitting face pairs considered, and those culled by PVS or facing, and
-    /// by energy.
-    pub pairs: u64,
-    pub pairs_culled: u64,
-    pub pairs_energy_culled: u64,
 }
 
 impl BounceCounts {
     pub fn add(&mut self, o: &BounceCounts) {
         self.rays += o.rays;
-        self.pairs += o.pairs;
-        self.pairs_culled += o.pairs_culled;
-        self.pairs_energy_culled += o.pairs_energy_culled;
-    }
-}
-
-/// Everything a pass of gathering reads.
-pub struct Gather<'a> {
-    pub scene: &'a TraceScene,
-    pub vis: &'a Visibility,
-    pub emitters: &'a [EmitterGeom],
-    /// This pass's emission of each emitter (same order).
-    pub emission: &'a [Option<Emission>],
-    /// [`BounceSettings::kernel`].
-    pub kernel: f64,
-    /// Light units culling may drop per luxel.
-    pub budget: f64,
-    /// Light units by which a grid cell's corners may differ for its inside to be interpolated.
-    pub smooth: f64,
-    /// No culling (the reference's passes).
-    pub cull: bool,
-}
-
-/// One point emitter: where, facing which way, and its flux per style.
-struct Element<'a> {
-    point: Vec3,
-    normal: Vec3,
-    flux: &'a [[f32; 3]],
-    styles: &'a [u8],
-}
-
-impl Gather<'_> {
-    /// The emitters `r` takes light from, as point elements, nearest-to-cull last.
-    fn elements(&self, r: &Receivers, counts: &mut BounceCounts) -> Vec<Element<'_>> {
-        let seen = if self.cull {
-            self.vis.leaves_seen_from(r.face)
-        } else {
-            None
-        };
-        let mut candidates: Vec<(f64, usize, f64)> = Vec::new();
-        for (i, (em, emission)) in self.emitters.iter().zip(self.emission).enumerate() {
-            let Some(emission) = emission else {
-                continue;
-            };
-            if em.face == r.face {
-                continue;
-            }
-            counts.pairs += 1;
-            let visible = seen.as_ref().is_none_or(|s| self.vis.face_in(s, em.face));
-            if !visible || !in_front(&em.plane, &r.bounds) || !in_front(&r.plane, &em.bounds) {
-                counts.pairs_culled += 1;
-                continue;
-            }
-            let gap = box_gap_squared(&r.bounds, &em.bounds).sqrt();
-            let clamped = gap.max(HOTSPOT_CLAMP);
-            candidates.push((self.kernel * emission.bound / (clamped * clamped), i, gap));
-        }
-        if self.cull {
-            // The faces that could bring least go first, while together they stay in budget.
-            candidates.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-            let mut dropped = 0.0;
-            let keep_from = candidates
-                .iter()
-                .position(|c| {
-                    dropped += c.0;
-                    dropped > self.budget
-                })
-                .unwrap_or(candidates.len());
-            counts.pairs_energy_culled += keep_from as u64;
-            candidates.drain(..keep_from);
-        }
-        let mut elements = Vec::new();
-        for (_, i, gap) in candidates {
-            let (em, Some(emission)) = (&self.emitters[i], &self.emission[i]) else {
-                continue;
-            };
-            if !self.cull || em.radius > ONE_POINT_RATIO * gap.max(HOTSPOT_CLAMP) {
-                for (b, flux) in em.blocks.iter().zip(&emission.blocks) {
-                    elements.push(Element {
-                        point: b.point,
-                        normal: em.normal,
-                        flux,
-                        styles: &emission.styles,
-                    });
-                }
-            } else {
-                elements.push(Element {
-                    point: em.point,
-                    normal: em.normal,
-                    flux: &emission.total,
-                    styles: &emission.styles,
-                });
-            }
-        }
-        elements
-    }
-
-    /// Bounced light at each luxel of `r`, per style: measured on a grid of every
-    /// [`GRID_STRIDE`]th luxel (and the last row and column), interpolated bilinearly inside a
-    /// grid cell whose corners differ by at most `smooth` light units, measured elsewhere.
-    pub fn face(&self, r: &Receivers, counts: &mut BounceCounts) -> StyleLuxels {
-        let elements = self.elements(r, counts);
-        let n = r.points.len();
-        let mut out: StyleLuxels = Vec::new();
-        let (w, h) = (r.width, r.height);
-        let grid = |size: usize| {
-            let mut at: Vec<usize> = (0..size).step_by(GRID_STRIDE).collect();
-            if at.last() != Some(&(size - 1)) {
-                at.push(size - 1);
-            }
-            at
-        };
-        let (xs, ys) = (grid(w), grid(h));
-        let corners: Vec<usize> = ys
-            .iter()
-            .flat_map(|&y| xs.iter().map(move |&x| y * w + x))
-            .collect();
-        self.measure(r, &elements, &corners, &mut out, counts);
-        let mut known = vec![false; n];
-        for &i in &corners {
-            known[i] = true;
-        }
-        let cells = |at: &[usize]| -> Vec<(usize, usize)> {
-            if at.len() == 1 {
-                vec![(at[0], at[0])]
-            } else {
-                at.windows(2).map(|p| (p[0], p[1])).collect()
-            }
-        };
-        let mut rest = Vec::new();
-        for &(y0, y1) in &cells(&ys) {
-            for &(x0, x1) in &cells(&xs) {
-                let c = [y0 * w + x0, y0 * w + x1, y1 * w + x0, y1 * w + x1];
-                let smooth = out.iter().all(|(_, v)| {
-                    (0..3).all(|k| {
-                        let vals = c.map(|i| v[i][k]);
-                        let lo = vals.iter().copied().fold(f32::INFINITY, f32::min);
-                        let hi = vals.iter().copied().fold(f32::NEG_INFINITY, f32::max);
-                        f64::from(hi - lo) <= self.smooth
-                    })
-                });
-                for y in y0..=y1 {
-                    for x in x0..=x1 {
-                        let i = y * w + x;
-                        if known[i] {
-                            continue;
-                        }
-                        known[i] = true;
-                        if !smooth {
-                            rest.push(i);
-                            continue;
-                        }
-                        let fx = if x1 > x0 {
-                            (x - x0) as f32 / (x1 - x0) as f32
-                        } else {
-                            0.0
-                        };
-                        let fy = if y1 > y0 {
-                            (y - y0) as f32 / (y1 - y0) as f32
-                        } else {
-                            0.0
-                        };
-                        for (_, v) in out.iter_mut() {
-                            let [a, b, cc, d] = c.map(|k| v[k]);
-                            v[i] = std::array::from_fn(|k| {
-                                let top = a[k] + (b[k] - a[k]) * fx;
-                                let bottom = cc[k] + (d[k] - cc[k]) * fx;
-                                top + (bottom - top) * fy
-                            });
-                        }
-                    }
-                }
-            }
-        }
-        self.measure(r, &elements, &rest, &mut out, counts);
-        out
-    }
-
-    /// Gathers from `elements` at the luxels `which` of `r`, adding into `out`.
-    fn measure(
-        &self,
-        r: &Receivers,
-        elements: &[Element],
-        which: &[usize],
-        out: &mut StyleLuxels,
-        counts: &mut BounceCounts,
-    ) {
-        let n = r.points.len();
-        let mut packet = RayPacket16::new();
-        let mut lane_sample = [0usize; 16];
-        let mut lane_weight = [0.0f64; 16];
-        for e in elements {
-            let brightest = e
-                .flux
-                .iter()
-                .map(|f| f64::from(f[0].max(f[1]).max(f[2])))
-                .fold(0.0, f64::max);
-            let mut lanes = 0;
-            for (k, &i) in which.iter().enumerate() {
-                let p = Vec3::from_f32(r.points[i]);
-                let to = e.point - p;
-                let d = to.length();
-                let normal = Vec3::from_f32(r.normals[i]);
-                let (cos_r, cos_e) = (normal.dot(to) / d, -e.normal.dot(to) / d);
-                let clamped = d.max(HOTSPOT_CLAMP);
-                let weight = self.kernel * cos_r * cos_e / (clamped * clamped);
-                if d > 0.0 && cos_r > 0.0 && cos_e > 0.0 && weight * brightest >= RAY_GATE {
-                    packet.set(lanes, p.to_f32(), (to / d).to_f32(), 0.0, d as f32);
-                    lane_sample[lanes] = i;
-                    lane_weight[lanes] = weight;
-                    lanes += 1;
-                }
-                if lanes == 0 || (lanes < 16 && k + 1 < which.len()) {
-                    continue;
-                }
-                let active = packet.active_mask();
-                counts.rays += u64::from(active.count_ones());
-                let through = active & !self.scene.occluded16(&mut packet, r.model);
-                for lane in (0..lanes).filter(|l| through & (1 << l) != 0) {
-                    add_light(
-                        out,
-                        n,
-                        e.styles,
-                        e.flux,
-                        lane_sample[lane],
-                        lane_weight[lane],
-                    );
-                }
-                packet.clear();
-                lanes = 0;
-            }
-        }
     }
 }
 
@@ -674,19 +483,6 @@ mod tests {
     use super::*;
 
     #[test]
-    fn area_and_centroid_of_a_square() {
-        let sq = [
-            Vec3::new(0.0, 0.0, 0.0),
-            Vec3::new(4.0, 0.0, 0.0),
-            Vec3::new(4.0, 2.0, 0.0),
-            Vec3::new(0.0, 2.0, 0.0),
-        ];
-        let (a, c) = area_centroid(&sq);
-        assert!((a - 8.0).abs() < 1e-12);
-        assert!(c.near(Vec3::new(2.0, 1.0, 0.0), 1e-12));
-    }
-
-    #[test]
     fn texture_mean_goes_through_the_palette() {
         let mut palette = Palette::slipgate();
         palette.colors[1] = [255, 0, 0];
@@ -694,5 +490,34 @@ mod tests {
         let tex =
             quake_formats::miptex::MipTex::new("t", 2, 1, [vec![1, 2], vec![1], vec![1], vec![1]]);
         assert_eq!(texture_mean(&tex, &palette), Some([0.5, 0.0, 0.5]));
+    }
+
+    #[test]
+    fn jitter_is_in_the_unit_square_and_varies() {
+        let a = jitter(1);
+        let b = jitter(2);
+        assert!((0.0..1.0).contains(&a.0) && (0.0..1.0).contains(&a.1));
+        assert_ne!(a, b);
+    }
+
+    #[test]
+    fn grid_keeps_the_last_row_and_interpolation_is_exact_on_planes() {
+        assert_eq!(grid(9, 4), vec![0, 4, 8]);
+        assert_eq!(grid(10, 4), vec![0, 4, 8, 9]);
+        assert_eq!(grid(1, 4), vec![0]);
+        let (w, h) = (10, 3);
+        let (xs, ys) = (grid(w, 4), grid(h, 4));
+        let plane = |x: usize, y: usize| 2.0 * x as f32 + 5.0 * y as f32 + 1.0;
+        let values = ys
+            .iter()
+            .flat_map(|&y| xs.iter().map(move |&x| [plane(x, y); 3]))
+            .collect();
+        let out = interpolate(&vec![(0, values)], &xs, &ys, w, h);
+        for y in 0..h {
+            for x in 0..w {
+                let v = out[0].1[y * w + x][0];
+                assert!((v - plane(x, y)).abs() < 1e-4, "({x}, {y}): {v}");
+            }
+        }
     }
 }

@@ -153,6 +153,7 @@ impl Args {
             no_cull: self.no_cull,
             progress: true,
             palette: None,
+            bounce_density: None,
         }
     }
 

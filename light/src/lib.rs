@@ -115,6 +115,9 @@ pub struct Options {
     pub progress: bool,
     /// Colours of texture pixels, for `_bouncecolorscale` (default: Slipgate's own palette).
     pub palette: Option<quake_formats::palette::Palette>,
+    /// Where and how densely the fast bounce gathers, instead of the quality mode's; for
+    /// measurements.
+    pub bounce_density: Option<bounce::Density>,
 }
 
 impl Default for Options {
@@ -128,6 +131,7 @@ impl Default for Options {
             no_cull: false,
             progress: false,
             palette: None,
+            bounce_density: None,
         }
     }
 }
@@ -157,9 +161,6 @@ pub struct Stats {
     /// receiving/emitting face pairs looked at and culled (PVS and facing, then energy).
     pub bounce_passes: usize,
     pub bounce_rays: u64,
-    pub bounce_pairs: u64,
-    pub bounce_pairs_culled: u64,
-    pub bounce_pairs_energy_culled: u64,
     pub seconds_bounce: f64,
     /// Points outside their face moved onto it (inset from its edges).
     pub points_clamped_to_face: u64,
@@ -417,23 +418,21 @@ fn trace_faces(
 }
 
 /// Bounced light per face (by index; per luxel, or per sample for the reference), `passes`
-/// passes of it. `traced` is the direct light of every lit face; with `reference`, `field`
-/// is the same at `--extra4` (the reference's emitters) and bounce is gathered at the samples
-/// of `traced` by [`bounce::reference::gather`].
+/// passes of it, gathered at `density`. `traced` is the direct light of every lit face; with
+/// `reference`, `field` is the same at `--extra4` (the reference's emitters) and bounce is
+/// gathered at the samples of `traced` by [`bounce::reference::gather`] (the light a pass
+/// brings to the faces of `field`, for the next pass, at `density`).
 fn bounce_light(
     prep: &Prepared,
     reflectance: &[Option<[f32; 3]>],
     traced: &[Traced],
     field: &[Traced],
     reference: bool,
+    density: bounce::Density,
     counts: &mut BounceCounts,
 ) -> Vec<StyleLuxels> {
     let settings = prep.lights.bounce;
     let n = prep.faces.len();
-    let emitters: Vec<bounce::EmitterGeom> = (0..n)
-        .filter(|&f| reflectance[f].is_some())
-        .filter_map(|f| bounce::EmitterGeom::new(&prep.faces[f]))
-        .collect();
     let mut light: Vec<Option<StyleLuxels>> = vec![None; n];
     for t in field {
         light[t.face] = t.reflected.clone().filter(|r| !r.is_empty());
@@ -441,21 +440,27 @@ fn bounce_light(
     let mut total: Vec<StyleLuxels> = vec![Vec::new(); n];
     for pass in 1..=settings.passes {
         let last = pass == settings.passes;
+        let emitting = bounce::Field {
+            faces: &prep.faces,
+            reflectance,
+            light: &light,
+            kernel: settings.kernel(),
+        };
         if reference {
-            let f = bounce::reference::Field {
-                faces: &prep.faces,
-                reflectance,
-                light: &light,
-                kernel: settings.kernel(),
-            };
             let gathered: Vec<(usize, StyleLuxels, BounceCounts)> = traced
                 .par_iter()
                 .filter_map(|t| Some((t.face, t.samples.as_ref()?)))
                 .map(|(face, samples)| {
                     let mut c = BounceCounts::default();
                     let model = prep.faces[face].model;
-                    let b =
-                        bounce::reference::gather(&f, &prep.scene, samples, model, pass, &mut c);
+                    let b = bounce::reference::gather(
+                        &emitting,
+                        &prep.scene,
+                        samples,
+                        model,
+                        pass,
+                        &mut c,
+                    );
                     (face, b, c)
                 })
                 .collect();
@@ -467,36 +472,19 @@ fn bounce_light(
                 break;
             }
         }
-        let emission: Vec<Option<bounce::Emission>> = emitters
+        // Wanted faces receive every pass (unless the reference measures them); reflecting ones
+        // every pass but the last, for the next.
+        let receiving: Vec<&Traced> = field
             .iter()
-            .map(|e| {
-                let rho = reflectance[e.face]?;
-                bounce::Emission::new(e, rho, light[e.face].as_ref()?)
-            })
+            .filter(|t| (!reference && t.light.is_some()) || (!last && t.reflected.is_some()))
             .collect();
-        let gather = bounce::Gather {
-            scene: &prep.scene,
-            vis: &prep.vis,
-            emitters: &emitters,
-            emission: &emission,
-            kernel: settings.kernel(),
-            budget: bounce::CULL_BUDGET_LEVELS / prep.lights.rangescale.max(1e-6),
-            smooth: bounce::SMOOTH_LEVELS / prep.lights.rangescale.max(1e-6),
-            cull: true,
-        };
-        // The last pass is needed only where lightmaps are wanted; earlier ones where light
-        // reflects again.
-        let receiving: Vec<&Traced> = if last {
-            traced.iter().filter(|t| t.light.is_some()).collect()
-        } else {
-            field.iter().filter(|t| t.reflected.is_some()).collect()
-        };
         let gathered: Vec<(usize, StyleLuxels, BounceCounts)> = receiving
             .par_iter()
             .filter_map(|t| Some((t.face, t.receivers.as_ref()?)))
             .map(|(face, r)| {
                 let mut c = BounceCounts::default();
-                (face, gather.face(r, &mut c), c)
+                let b = emitting.gather_face(&prep.scene, r, pass, density, &mut c);
+                (face, b, c)
             })
             .collect();
         let mut next: Vec<Option<StyleLuxels>> = vec![None; n];
@@ -591,6 +579,7 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
             &traced,
             &field,
             true,
+            bounce::Density::for_quality(Quality::Reference),
             &mut bounce_counts,
         )
     } else if bouncing {
@@ -600,6 +589,9 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
             &traced,
             &traced,
             false,
+            options
+                .bounce_density
+                .unwrap_or_else(|| bounce::Density::for_quality(options.quality)),
             &mut bounce_counts,
         )
     } else {
@@ -657,9 +649,6 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
         0
     };
     stats.bounce_rays = bounce_counts.rays;
-    stats.bounce_pairs = bounce_counts.pairs;
-    stats.bounce_pairs_culled = bounce_counts.pairs_culled;
-    stats.bounce_pairs_energy_culled = bounce_counts.pairs_energy_culled;
     stats.seconds_setup = (setup_done - start).as_secs_f64();
     stats.seconds_trace = (trace_done - setup_done).as_secs_f64();
     stats.seconds_bounce = (bounce_done - trace_done).as_secs_f64();

@@ -110,44 +110,6 @@ impl Visibility {
                 .any(|&l| l == light_leaf || bit(row, l) || self.is_liquid(l))
     }
 
-    /// The leaves some leaf of world face `face` may see (bit `j` = leaf `j + 1`, its own leaves
-    /// included, every liquid leaf too: light passes through liquids), or `None` when nothing can
-    /// be culled (a brush-model face, a leaf without a row, a face in a liquid leaf).
-    pub fn leaves_seen_from(&self, face: usize) -> Option<Vec<u8>> {
-        let leafs = self.face_leafs.get(face).filter(|l| !l.is_empty())?;
-        let mut seen = vec![0u8; self.leaf_contents.len().div_ceil(8)];
-        fn mark(seen: &mut [u8], leaf: u32) {
-            if leaf > 0 {
-                seen[(leaf as usize - 1) / 8] |= 1 << ((leaf - 1) % 8);
-            }
-        }
-        for &leaf in leafs {
-            if self.is_liquid(leaf) {
-                return None;
-            }
-            let row = self.rows.get(leaf as usize)?.as_ref()?;
-            mark(&mut seen, leaf);
-            for (i, byte) in row.iter().enumerate() {
-                if let Some(s) = seen.get_mut(i) {
-                    *s |= byte;
-                }
-            }
-        }
-        for leaf in 1..self.leaf_contents.len() as u32 {
-            if self.is_liquid(leaf) {
-                mark(&mut seen, leaf);
-            }
-        }
-        Some(seen)
-    }
-
-    /// False only if `seen` (from [`Visibility::leaves_seen_from`]) proves no leaf of `face`
-    /// is in it.
-    pub fn face_in(&self, seen: &[u8], face: usize) -> bool {
-        let leafs = &self.face_leafs[face];
-        leafs.is_empty() || leafs.iter().any(|&l| bit(seen, l))
-    }
-
     /// False only if vis data proves `face` cannot see any sky face.
     pub fn may_see_sky(&self, face: usize) -> bool {
         let leafs = &self.face_leafs[face];
@@ -221,26 +183,6 @@ mod tests {
         // Regression: marksurfaces listing a door's faces made lights skip the door.
         assert!(vis.may_reach(Some(1), 1));
         assert!(vis.may_reach(None, 0), "light in solid: no culling");
-    }
-
-    #[test]
-    fn faces_in_unseen_leaves_are_culled_for_bounce() {
-        let (bsp, mut faces) = two_rooms(contents::EMPTY);
-        faces[1].model = 0;
-        let mut bsp = bsp;
-        // Face 0 in leaf 1, face 1 in leaf 2; neither leaf sees the other.
-        bsp.leafs[1].first_marksurface = 0;
-        bsp.leafs[1].num_marksurfaces = 1;
-        bsp.leafs[2].first_marksurface = 1;
-        bsp.leafs[2].num_marksurfaces = 1;
-        let vis = Visibility::new(&bsp, &faces);
-        let seen = vis.leaves_seen_from(0).expect("a world face with vis");
-        assert!(vis.face_in(&seen, 0));
-        assert!(!vis.face_in(&seen, 1));
-        bsp.leafs[2].contents = contents::WATER;
-        let vis = Visibility::new(&bsp, &faces);
-        let seen = vis.leaves_seen_from(0).expect("a world face with vis");
-        assert!(vis.face_in(&seen, 1), "light crosses liquids");
     }
 
     #[test]
