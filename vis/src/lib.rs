@@ -76,6 +76,9 @@ pub enum VisError {
     Threads(String),
     #[error("the BSP's hull 0 tree is broken: {0}")]
     BadTree(String),
+    /// The BSP breaks a rule that would make vis read out of bounds ([`quake_formats::check_usable`]).
+    #[error(transparent)]
+    Unusable(#[from] quake_formats::FormatError),
 }
 
 /// Which algorithm computes the sets.
