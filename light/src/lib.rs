@@ -232,7 +232,8 @@ impl Prepared {
 /// # Errors
 /// Bad entities or faces, or an Embree failure.
 pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
-    quake_formats::check_usable(bsp).map_err(LightError::Unusable)?;
+    quake_formats::bsp::check_usable_for(bsp, quake_formats::bsp::TreeUse::IfPresent)
+        .map_err(LightError::Unusable)?;
     let mut entities = parse_entities(&bsp.entity_text())?;
     let map_lights = parse_lights(&mut entities, &options.overrides)?;
     let entity_text = (!map_lights.switchable_styles.is_empty()).then(|| write_entities(&entities));

@@ -16,7 +16,6 @@ impl Rule {
             Rule::IndexRange
                 | Rule::NonFinite
                 | Rule::PlaneNormal
-                | Rule::EntityText
                 | Rule::FaceEdges
                 | Rule::ContentsValue
                 | Rule::LightmapRange
@@ -37,12 +36,28 @@ const PROBLEMS_SHOWN: usize = 3;
 /// lines recursively on 2 MiB worker stacks).
 pub const MAX_TREE_DEPTH: usize = 4096;
 
+/// Whether a stage walks the world's hull 0 tree.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TreeUse {
+    Needed,
+    /// The stage uses the tree when the file has one (light culls by it) and works from the faces
+    /// alone when the nodes lump is empty; a tree that is there must still be sound.
+    IfPresent,
+}
+
 /// The problems of `bsp` that tools refuse, as [`FormatError::Refused`]; `Ok` when there are
 /// none. Every stage's library entry calls this before reading the file's indices.
 pub fn check_usable(bsp: &Bsp) -> Result<()> {
+    check_usable_for(bsp, TreeUse::Needed)
+}
+
+/// [`check_usable`] for a stage that may not need the tree.
+pub fn check_usable_for(bsp: &Bsp, tree: TreeUse) -> Result<()> {
+    let no_tree_allowed = tree == TreeUse::IfPresent && bsp.nodes.is_empty();
     let refused: Vec<String> = validate(bsp)
         .into_iter()
         .filter(|p| p.severity == Severity::Error && p.rule.refused_by_tools())
+        .filter(|p| !(no_tree_allowed && is_about_the_missing_tree(p)))
         .map(|p| p.to_string())
         .chain(tree_shape_problem(bsp))
         .collect();
@@ -53,6 +68,12 @@ pub fn check_usable(bsp: &Bsp) -> Result<()> {
         count: refused.len(),
         shown: refused[..refused.len().min(PROBLEMS_SHOWN)].join("; "),
     })
+}
+
+/// A file without nodes breaks `no-nodes` and, in every model, `index-range` for its head node.
+fn is_about_the_missing_tree(p: &super::Problem) -> bool {
+    p.rule == Rule::NoNodes
+        || (p.rule == Rule::IndexRange && p.lump == "models" && p.detail.starts_with("head node"))
 }
 
 /// What engines tolerate but would make a tool's walk exponential or too deep: a hull 0 node
@@ -185,6 +206,16 @@ mod tests {
                 ..bsp.nodes[0]
             })
             .collect();
+    }
+
+    #[test]
+    fn a_file_without_nodes_passes_only_for_stages_that_can_do_without() {
+        let mut bsp = one_split();
+        bsp.nodes.clear();
+        assert!(check_usable(&bsp).is_err());
+        assert!(check_usable_for(&bsp, TreeUse::IfPresent).is_ok());
+        bsp.marksurfaces.push(7);
+        assert!(check_usable_for(&bsp, TreeUse::IfPresent).is_err());
     }
 
     #[test]
