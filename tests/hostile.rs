@@ -197,3 +197,106 @@ fn byte_flipped_bsps_end_in_an_error_or_a_usable_output_in_every_stage() {
         "only {refused} of {SEEDS} refused"
     );
 }
+
+/// Each stage's outputs after a complete run, to compare what a killed run leaves with.
+struct Outputs {
+    bsp: Vec<u8>,
+    prt: Vec<u8>,
+    lit: Option<Vec<u8>>,
+}
+
+fn outputs(bsp: &Path) -> Outputs {
+    Outputs {
+        bsp: std::fs::read(bsp).expect("read bsp"),
+        prt: std::fs::read(bsp.with_extension("prt")).expect("read prt"),
+        lit: std::fs::read(bsp.with_extension("lit")).ok(),
+    }
+}
+
+fn restore(bsp: &Path, outputs: &Outputs) {
+    std::fs::write(bsp, &outputs.bsp).expect("write bsp");
+    std::fs::write(bsp.with_extension("prt"), &outputs.prt).expect("write prt");
+    let lit = bsp.with_extension("lit");
+    match &outputs.lit {
+        Some(bytes) => std::fs::write(&lit, bytes).expect("write lit"),
+        None => {
+            let _ = std::fs::remove_file(&lit);
+        }
+    }
+}
+
+/// Kills `slipgate args` with SIGKILL after `delay`, or lets it finish first.
+fn kill_after(args: &[&str], delay: Duration) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_slipgate"))
+        .args(args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("run slipgate");
+    let start = Instant::now();
+    while start.elapsed() < delay {
+        if child.try_wait().expect("wait").is_some() {
+            return;
+        }
+        std::thread::sleep(Duration::from_micros(200));
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+}
+
+#[test]
+fn a_stage_killed_at_any_moment_leaves_the_old_outputs_or_the_new_ones() {
+    // The demo map: big enough that each stage takes a while, with coloured light (a .lit).
+    let map = project_map("demo.map");
+    let bsp = scratch("demo.bsp");
+    let b = bsp.to_str().expect("utf8");
+    let wad_dir = project_map("");
+    let compile_args = [
+        "bsp",
+        map.to_str().expect("utf8"),
+        b,
+        "--wad-dir",
+        wad_dir.to_str().expect("utf8"),
+    ];
+    let stages: [&[&str]; 3] = [&compile_args, &["vis", b], &["light", b]];
+    // The files after each stage in turn, and how long each took.
+    let mut after = Vec::new();
+    let mut seconds = Vec::new();
+    for args in stages {
+        let start = Instant::now();
+        let out = command::slipgate(args);
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        seconds.push(start.elapsed().as_secs_f64());
+        after.push(outputs(&bsp));
+    }
+    assert!(after[2].lit.is_some(), "the demo map's light writes a .lit");
+    let mut flips = Flips(13);
+    for (stage, args) in stages.into_iter().enumerate() {
+        // Before a stage: what the stage before it left (before `bsp`: a finished build).
+        let before = &after[if stage == 0 { 2 } else { stage - 1 }];
+        let done = &after[stage];
+        for kill in 0..8 {
+            restore(&bsp, before);
+            let delay = seconds[stage] * 1.2 * flips.below(1000) as f64 / 1000.0;
+            kill_after(args, Duration::from_secs_f64(delay));
+            let now = outputs(&bsp);
+            let what = format!("{args:?} killed after {delay:.3} s (kill {kill})");
+            assert!(
+                now.bsp == before.bsp || now.bsp == done.bsp,
+                "{what}: a partial .bsp"
+            );
+            assert!(
+                now.prt == before.prt || now.prt == done.prt,
+                "{what}: a partial .prt"
+            );
+            assert!(
+                now.lit == before.lit || now.lit == done.lit,
+                "{what}: a partial .lit"
+            );
+        }
+    }
+}
