@@ -33,7 +33,7 @@ const PROBLEMS_SHOWN: usize = 3;
 
 /// The deepest hull 0 tree tools accept. Real maps stay far below (LibreQuake's lq1m1 is 42 deep,
 /// e1m3 38); the file must not decide how deep a tool's recursive walk goes (vis traces sight
-/// lines recursively on 2 MiB worker stacks).
+/// lines and recovers portals from the tree recursively).
 pub const MAX_TREE_DEPTH: usize = 4096;
 
 /// Whether a stage walks the world's hull 0 tree.

@@ -398,10 +398,10 @@ mod tests {
     fn a_deep_chain_on_one_plane_is_given_up_in_bounded_work() {
         // Every node's portal lies on the one plane, so each bounds every deeper node.
         let mut bsp = two_splits(0.0);
-        let depth = 100_000;
+        let depth: i32 = 100_000;
         bsp.planes[1] = bsp.planes[0];
         bsp.nodes = (0..depth)
-            .map(|i| node(0, [if i + 1 < depth { i as i32 + 1 } else { -2 }, -3]))
+            .map(|i| node(0, [if i + 1 < depth { i + 1 } else { -2 }, -3]))
             .collect();
         let start = std::time::Instant::now();
         clipped_away_nodes(&bsp);
