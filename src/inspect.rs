@@ -162,6 +162,7 @@ pub fn convert(args: &ConvertArgs) -> Result<()> {
             .write()
     } else {
         let bsp = Bsp::read(&bytes).with_context(|| format!("{name}"))?;
+        quake_formats::check_usable(&bsp).with_context(|| format!("{name}"))?;
         let version = if args.bsp2 {
             BspVersion::Bsp2
         } else if args.bsp29 {

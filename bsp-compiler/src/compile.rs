@@ -125,6 +125,10 @@ pub enum CompileError {
     },
     #[error("writing the BSP: {0}")]
     Format(#[from] FormatError),
+    /// The compiled BSP breaks a rule every later stage refuses (`quake_formats::check_usable`),
+    /// e.g. a face whose texture scale makes its lightmap extents huge.
+    #[error("{}: the compiled BSP would be {refused}", path.display())]
+    Unusable { path: PathBuf, refused: FormatError },
 }
 
 /// Counts and timings of one compile.
@@ -550,6 +554,11 @@ pub fn compile(
         .map_or(emitted.portals.num_leafs as usize, Vec::len);
     stats.tjunction_vertices = emitted.tjunction_vertices;
     stats.timings = timings;
+    // The last line of defence: never hand on a BSP every later stage would refuse.
+    quake_formats::check_usable(&bsp).map_err(|refused| CompileError::Unusable {
+        path: source.path.clone(),
+        refused,
+    })?;
     Ok(CompileOutput {
         bsp,
         portals: emitted.portals,

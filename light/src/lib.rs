@@ -73,6 +73,9 @@ pub enum LightError {
     /// A damaged `SLIPGATE_PHONG` lump (the message names it).
     #[error("{0}")]
     PhongLump(quake_formats::FormatError),
+    /// The BSP breaks a rule that would make light read out of bounds ([`quake_formats::check_usable`]).
+    #[error(transparent)]
+    Unusable(quake_formats::FormatError),
 }
 
 /// How much work to spend per luxel.
@@ -243,6 +246,8 @@ impl Prepared {
 /// # Errors
 /// Bad entities or faces, or an Embree failure.
 pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
+    quake_formats::bsp::check_usable_for(bsp, quake_formats::bsp::TreeUse::IfPresent)
+        .map_err(LightError::Unusable)?;
     let mut entities = parse_entities(&bsp.entity_text())?;
     let map_lights = parse_lights(&mut entities, &options.overrides)?;
     let entity_text = (!map_lights.switchable_styles.is_empty()).then(|| write_entities(&entities));

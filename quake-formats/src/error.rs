@@ -50,6 +50,11 @@ pub enum FormatError {
     },
     #[error("palette: expected 768 bytes, found {0}")]
     PaletteSize(usize),
+    #[error(
+        "refused: {count} problem(s) would make tools read out of bounds or never finish \
+         ({shown}); `slipgate info` lists them all"
+    )]
+    Refused { count: usize, shown: String },
     #[error("line {line}: {detail}")]
     Syntax { line: usize, detail: String },
     /// The OS error is the `source`, so `{:#}` chains print it once.

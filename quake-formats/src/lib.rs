@@ -22,6 +22,6 @@ pub mod pts;
 pub mod visrle;
 pub mod wad;
 
-pub use bsp::{Bsp, BspVersion, Problem, PvsRow, Severity, validate};
+pub use bsp::{Bsp, BspVersion, Problem, PvsRow, Severity, check_usable, validate};
 pub use bytes::{latin1_to_string, name16_to_string, string_to_latin1, string_to_name16};
 pub use error::FormatError;

@@ -189,8 +189,11 @@ fn parse_portal(line: usize, text: &str, num_ends: u32) -> Result<PrtPortal> {
         let v: f64 = f
             .parse()
             .map_err(|_| err(format!("coordinate {f:?} is not a number")))?;
-        if !v.is_finite() {
-            return Err(err(format!("coordinate {f:?} is not finite")));
+        // Portal files hold single-precision coordinates (the writer rounds to f32).
+        if !(v as f32).is_finite() {
+            return Err(err(format!(
+                "coordinate {f:?} is not a finite 32-bit number"
+            )));
         }
         coords.push(v);
     }
@@ -256,6 +259,15 @@ mod tests {
     fn bad_leaf_names_line() {
         let err =
             PortalFile::parse("PRT1\n2\n1\n3 0 5 (0 0 0) (1 0 0) (0 1 0)\n").expect_err("leaf 5");
+        assert!(err.to_string().contains("line 4"), "{err}");
+    }
+
+    #[test]
+    fn coordinates_beyond_single_precision_are_refused() {
+        // Found by fuzzing (fuzz/corpus/prt/crash-62b6e2cb...): 1.2e45 read as f64, then
+        // written as "inf", which the reader refuses.
+        let text = "PRT1\n2\n1\n3 0 1 (0 0 0 ) (1157777777777777777777777777777777777777777772 0 0 ) (0 1 0 )\n";
+        let err = PortalFile::parse(text).expect_err("beyond f32");
         assert!(err.to_string().contains("line 4"), "{err}");
     }
 }

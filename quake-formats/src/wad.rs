@@ -89,7 +89,12 @@ impl Wad {
         }
         let count = r.i32()?;
         let dir_ofs = r.i32()?;
-        if count < 0 || dir_ofs < 0 || count as usize > data.len() / ENTRY_LEN {
+        // The directory must lie inside the file even when empty: the writer puts it back
+        // where it was, so an offset past the end would size the rewritten file.
+        let dir_fits = |count: usize, ofs: usize| {
+            count <= data.len() / ENTRY_LEN && ofs <= data.len() - count * ENTRY_LEN
+        };
+        if count < 0 || dir_ofs < 0 || !dir_fits(count as usize, dir_ofs as usize) {
             return Err(FormatError::BadLump {
                 lump: "WAD directory",
                 detail: format!("{count} entries at offset {dir_ofs} do not fit the file"),
@@ -218,5 +223,18 @@ mod tests {
         for cut in [4, 11, bytes.len() - 1] {
             assert!(Wad::read(&bytes[..cut]).is_err());
         }
+    }
+
+    #[test]
+    fn an_empty_directory_past_the_end_is_an_error() {
+        // Found by fuzzing: an 18-byte WAD naming no lumps in a directory at offset 721 million
+        // was read, and rewriting it padded the file out to that offset (a 700 MB allocation).
+        let mut bytes = b"WAD2".to_vec();
+        bytes.extend(0i32.to_le_bytes());
+        bytes.extend(0x2b00_0000i32.to_le_bytes());
+        let err = Wad::read(&bytes).expect_err("directory past the end");
+        assert!(err.to_string().contains("do not fit"), "{err}");
+        let empty = Wad::new(Vec::new()).write();
+        assert!(Wad::read(&empty).is_ok());
     }
 }

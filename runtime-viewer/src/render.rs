@@ -311,6 +311,7 @@ mod tests {
     use super::*;
     use crate::reference::{compare, render_reference};
     use crate::test_room::{FENCE_FACE, room, room_under_chain, room_with_fence};
+    use quake_formats::bsp::MAX_TREE_DEPTH;
 
     fn start_camera(world: &World, angles: [f64; 3]) -> Camera {
         let (origin, _) = world.player_start().expect("room has a start");
@@ -427,9 +428,15 @@ mod tests {
     }
 
     #[test]
+    fn a_chain_deeper_than_the_gate_allows_is_refused() {
+        let error = room_under_chain(MAX_TREE_DEPTH + 1).err().expect("refused");
+        assert!(error.contains("deeper than"), "{error}");
+    }
+
+    #[test]
     fn a_very_deep_node_chain_renders_without_overflowing_the_stack() {
         // Regression: the visibility walk and the reference trace recursed once per node level.
-        let deep = room_under_chain(100_000);
+        let deep = room_under_chain(MAX_TREE_DEPTH - 64).expect("a chain the gate allows");
         let shallow = room(0);
         // Small: every reference ray walks the whole chain.
         let camera = Camera {

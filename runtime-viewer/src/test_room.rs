@@ -204,8 +204,9 @@ pub fn room_with_fence() -> World {
 }
 
 /// The room below a chain of `depth` extra nodes, each splitting on a plane the room lies in
-/// front of, with solid behind: the same picture at the end of a degenerate, very deep tree.
-pub fn room_under_chain(depth: usize) -> World {
+/// front of, with solid behind: the same picture at the end of a degenerate, very deep tree (or
+/// the gate's refusal, when deeper than it allows).
+pub fn room_under_chain(depth: usize) -> Result<World, String> {
     let mut bsp = room_bsp(0);
     let plane = bsp.planes.len() as u32;
     bsp.planes.push(BspPlane {
@@ -233,5 +234,5 @@ pub fn room_under_chain(depth: usize) -> World {
     if depth > 0 {
         bsp.models[0].head_nodes[0] = first;
     }
-    World::new(bsp, &Palette::slipgate(), PaletteSource::Builtin, None).expect("valid chain")
+    World::new(bsp, &Palette::slipgate(), PaletteSource::Builtin, None)
 }

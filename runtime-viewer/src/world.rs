@@ -123,6 +123,7 @@ impl World {
         palette_source: PaletteSource,
         lit: Option<Vec<u8>>,
     ) -> Result<World, String> {
+        quake_formats::check_usable(&bsp).map_err(|e| e.to_string())?;
         let entities = parse_entities(&bsp.entity_text()).map_err(|e| format!("entities: {e}"))?;
         let mut stats = LoadStats {
             faces: bsp.faces.len(),

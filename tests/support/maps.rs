@@ -25,6 +25,16 @@ pub struct Case {
     /// Why the view from the player start shows (next to) nothing, for the rare map built so:
     /// its screenshot need not be textured.
     pub empty_view: Option<&'static str>,
+    /// An engine known to refuse the map, and the words of its error: a bug found and not yet
+    /// fixed, reported as a note instead of a failure while the engine says exactly that.
+    pub known_error: Option<KnownError>,
+}
+
+/// See [`Case::known_error`].
+#[derive(Clone, Copy)]
+pub struct KnownError {
+    pub engine: &'static str,
+    pub message: &'static str,
 }
 
 impl Case {
@@ -37,6 +47,7 @@ impl Case {
             bsp_options: &[],
             may_fail_to_compile: false,
             empty_view: None,
+            known_error: None,
         }
     }
 }
@@ -56,6 +67,8 @@ pub struct Compiled {
     pub seconds: f64,
     /// See [`Case::empty_view`].
     pub empty_view: Option<&'static str>,
+    /// See [`Case::known_error`].
+    pub known_error: Option<KnownError>,
 }
 
 /// Why a map was not played.
@@ -162,6 +175,7 @@ fn compile(case: &Case, dir: &Path) -> Result<Compiled, NotCompiled> {
         vis: if leaked { "fast (leaks)" } else { "full" },
         seconds: started.elapsed().as_secs_f64(),
         empty_view: case.empty_view,
+        known_error: case.known_error,
     })
 }
 

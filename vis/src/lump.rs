@@ -37,8 +37,10 @@ pub fn world_vis_leafs(bsp: &Bsp) -> Result<usize, VisError> {
     Ok(n)
 }
 
-/// Refuse a portal file made for another BSP (or another compile of it).
+/// Refuse a BSP tools cannot read safely ([`quake_formats::check_usable`]) and a portal file made
+/// for another BSP (or another compile of it).
 pub fn check_portals_match(bsp: &Bsp, prt_leafs: usize) -> Result<(), VisError> {
+    quake_formats::check_usable(bsp)?;
     let vis_leafs = world_vis_leafs(bsp)?;
     if vis_leafs != prt_leafs {
         return Err(VisError::LeafCountMismatch {

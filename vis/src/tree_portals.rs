@@ -20,6 +20,7 @@ struct Tree<'a> {
 
 /// PRT1 portals between the open leaves of the world model.
 pub fn portals_from_bsp(bsp: &Bsp) -> Result<PortalFile, VisError> {
+    quake_formats::check_usable(bsp)?;
     // Checks node and leaf references once; the walk below relies on them.
     crate::sample::Hull0::new(bsp)?;
     let vis_leafs = world_vis_leafs(bsp)?;

@@ -14,7 +14,8 @@ pub use records::{
     ClipNode, Face, Leaf, Model, Node, Plane as BspPlane, TexInfo, contents, texinfo_flags,
 };
 pub use validate::{
-    DARKPLACES_PORTAL_EPSILON, Problem, Rule, RuleInfo, Severity, darkplaces_divide, validate,
+    DARKPLACES_PORTAL_EPSILON, MAX_TREE_DEPTH, Problem, Rule, RuleInfo, Severity, TreeUse,
+    check_usable, check_usable_for, darkplaces_divide, validate,
 };
 
 use crate::bytes::{PutLe, Reader};

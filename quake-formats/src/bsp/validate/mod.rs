@@ -5,6 +5,7 @@
 
 mod counts;
 mod entities;
+mod gate;
 mod node_portals;
 mod rules;
 mod structure;
@@ -12,6 +13,7 @@ mod surfaces;
 mod textures;
 mod trees;
 
+pub use gate::{MAX_TREE_DEPTH, TreeUse, check_usable, check_usable_for};
 pub use node_portals::{DARKPLACES_PORTAL_EPSILON, darkplaces_divide};
 pub use rules::{Rule, RuleInfo};
 

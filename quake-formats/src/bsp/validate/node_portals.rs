@@ -16,6 +16,16 @@ pub const DARKPLACES_PORTAL_EPSILON: f64 = 1.0 / 32.0;
 const QUAD_SIZE: f64 = 1024.0 * 1024.0 * 1024.0;
 /// DarkPlaces' `MAX_PORTALPOINTS`: a node portal with this many points is dropped too.
 const MAX_POINTS: usize = 64;
+/// Portal clips and splits the replay may spend per node of the world's tree before it gives up
+/// and reports what it found so far. Real maps spend about 30 per node (LibreQuake's lq1m1 and
+/// e1m3 30, start 22); a file built so every portal bounds every deeper node (a chain of nodes on
+/// one plane) costs time and memory quadratic in its depth, in DarkPlaces as here.
+const WORK_PER_NODE: usize = 256;
+/// Work the replay may always spend, whatever the node count.
+const WORK_MIN: usize = 1 << 16;
+/// The most portals one node's region may have before the replay gives up: real maps reach 228
+/// (e1m3; lq1m1 184), the chain above one more per level.
+const MAX_BOUNDING: usize = 1024;
 
 type Point = [f64; 3];
 
@@ -71,6 +81,7 @@ pub(super) fn clipped_away_nodes(bsp: &Bsp) -> Vec<usize> {
         lists: vec![Vec::new(); bsp.nodes.len()],
         visited: vec![false; bsp.nodes.len()],
         clipped_away: Vec::new(),
+        work_left: WORK_MIN + WORK_PER_NODE * bsp.nodes.len(),
     };
     let mut stack = vec![head];
     while let Some(node) = stack.pop() {
@@ -101,6 +112,8 @@ struct Portalizer<'a> {
     lists: Vec<Vec<usize>>,
     visited: Vec<bool>,
     clipped_away: Vec<usize>,
+    /// What is left of the replay's budget (see [`WORK_PER_NODE`]).
+    work_left: usize,
 }
 
 impl Portalizer<'_> {
@@ -127,6 +140,11 @@ impl Portalizer<'_> {
             .into_iter()
             .rev()
             .collect();
+        if bounding.len() > MAX_BOUNDING {
+            return None;
+        }
+        // Each bounding portal is clipped against once and split once.
+        self.work_left = self.work_left.checked_sub(1 + 2 * bounding.len())?;
         let points = self.node_portal(node, plane, &bounding);
         self.add(Portal {
             plane,
@@ -374,6 +392,21 @@ mod tests {
         let triangle = [[-10.0, 0.0, 0.0], [10.0, 5.0, 0.0], [-10.0, 10.0, 0.0]];
         let (front, _) = darkplaces_divide(&triangle, [1.0, 0.0, 0.0], 0.0, 1.0 / 32.0);
         assert_eq!(front.len(), 3);
+    }
+
+    #[test]
+    fn a_deep_chain_on_one_plane_is_given_up_in_bounded_work() {
+        // Every node's portal lies on the one plane, so each bounds every deeper node.
+        let mut bsp = two_splits(0.0);
+        let depth: i32 = 100_000;
+        bsp.planes[1] = bsp.planes[0];
+        bsp.nodes = (0..depth)
+            .map(|i| node(0, [if i + 1 < depth { i + 1 } else { -2 }, -3]))
+            .collect();
+        let start = std::time::Instant::now();
+        clipped_away_nodes(&bsp);
+        let seconds = start.elapsed().as_secs_f64();
+        assert!(seconds < 5.0, "{seconds} s");
     }
 
     #[test]
