@@ -35,12 +35,30 @@ pub struct BuildArgs {
     /// Bounced light (one pass of diffuse interreflection)
     #[arg(long)]
     bounce: bool,
+    /// More options for the bsp stage, as one string (e.g. "-leaktest -wrbrushes"; ericw-tools'
+    /// single-dash spellings work)
+    #[arg(long, value_name = "OPTIONS", allow_hyphen_values = true)]
+    bsp_opts: Option<String>,
+    /// More options for the vis stage, as one string
+    #[arg(long, value_name = "OPTIONS", allow_hyphen_values = true)]
+    vis_opts: Option<String>,
+    /// More options for the light stage, as one string (e.g. "-bounce 2 -lit")
+    #[arg(long, value_name = "OPTIONS", allow_hyphen_values = true)]
+    light_opts: Option<String>,
     /// Preview size, WIDTHxHEIGHT
     #[arg(long, default_value = "640x480")]
     size: String,
     /// Skip the preview picture
     #[arg(long)]
     no_preview: bool,
+}
+
+/// A stage's `--*-opts` string as arguments, spelled as the stage's own command takes them.
+fn extra_args(opts: Option<&str>) -> Vec<OsString> {
+    let words = std::iter::once(String::new())
+        .chain(opts.unwrap_or("").split_whitespace().map(str::to_string));
+    let normalised = light::cli::join_optional_values(crate::normalise_single_dash(words));
+    normalised.into_iter().skip(1).map(OsString::from).collect()
 }
 
 /// Parse a stage's own arguments, so `build` runs exactly what the stage's command would.
@@ -63,6 +81,7 @@ pub fn build(args: &BuildArgs) -> Result<()> {
     for dir in &args.wad_dirs {
         argv.extend(["--wad-dir".into(), dir.clone().into()]);
     }
+    argv.extend(extra_args(args.bsp_opts.as_deref()));
     eprintln!("== bsp");
     bsp_compiler::cli::run(&stage_args("bsp", argv)?)?;
 
@@ -70,6 +89,7 @@ pub fn build(args: &BuildArgs) -> Result<()> {
     if args.fast {
         argv.push("--fast".into());
     }
+    argv.extend(extra_args(args.vis_opts.as_deref()));
     eprintln!("== vis");
     vis::cli::run(&stage_args("vis", argv)?)?;
 
@@ -85,6 +105,7 @@ pub fn build(args: &BuildArgs) -> Result<()> {
             argv.push(flag.into());
         }
     }
+    argv.extend(extra_args(args.light_opts.as_deref()));
     eprintln!("== light");
     light::cli::run(&stage_args("light", argv)?)?;
 
@@ -106,4 +127,37 @@ pub fn build(args: &BuildArgs) -> Result<()> {
         start.elapsed().as_secs_f64()
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stage_options_take_ericw_spellings() {
+        let words = |a: Vec<OsString>| {
+            a.into_iter()
+                .map(|w| w.into_string().unwrap())
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(
+            words(extra_args(Some("-leaktest  -maxnodesize 512"))),
+            ["--leaktest", "--maxnodesize", "512"]
+        );
+        assert_eq!(
+            words(extra_args(Some("-bounce 2 -lit"))),
+            ["--bounce=2", "--lit"]
+        );
+        assert!(extra_args(None).is_empty());
+        let light: light::cli::Args = stage_args("light", {
+            let mut argv = vec![OsString::from("x.bsp")];
+            argv.extend(extra_args(Some("-bounce 2 -lit -threads 1")));
+            argv
+        })
+        .expect("light options parse");
+        assert_eq!(
+            (light.bounce, light.lit, light.threads),
+            (Some(2), true, Some(1))
+        );
+    }
 }
