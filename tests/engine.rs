@@ -66,6 +66,11 @@ fn project_maps() -> &'static MapSet {
         maps.extend(maps_in(&repo().join("maps/test")));
         maps.push(repo().join("maps/leak/sealed.map"));
         let mut cases: Vec<Case> = maps.into_iter().map(|m| Case::new(m, wads())).collect();
+        // Prefabs (nested, turned, scaled), `_mirrorinside` water and a visblocker.
+        cases.push(Case::new(
+            repo().join("bsp-compiler/tests/maps/features.map"),
+            wads(),
+        ));
         cases.push(Case {
             name: "demo_bsp2".to_string(),
             bsp_options: &["--bsp2"],
