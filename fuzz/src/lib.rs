@@ -82,7 +82,10 @@ pub fn prt(data: &[u8]) {
     };
     let bytes = vis::set_bytes(&prt);
     if bytes > vis::MAX_SET_BYTES {
-        assert!(vis::compute_vis(&prt, &options).is_err(), "vis takes {bytes} bytes");
+        assert!(
+            vis::compute_vis(&prt, &options).is_err(),
+            "vis takes {bytes} bytes"
+        );
     }
     if bytes > FUZZ_SET_BYTES {
         return;
