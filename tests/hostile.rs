@@ -113,7 +113,7 @@ impl Flips {
 fn flipped(bytes: &[u8], seed: u64) -> Vec<u8> {
     let mut flips = Flips(seed);
     let mut out = bytes.to_vec();
-    let skip = if seed % 2 == 0 { 124 } else { 0 };
+    let skip = if seed.is_multiple_of(2) { 124 } else { 0 };
     for _ in 0..1 + flips.below(8) {
         let at = skip + flips.below(out.len() - skip);
         out[at] = flips.next() as u8;

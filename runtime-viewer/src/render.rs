@@ -429,7 +429,9 @@ mod tests {
 
     #[test]
     fn a_chain_deeper_than_the_gate_allows_is_refused() {
-        let error = room_under_chain(MAX_TREE_DEPTH + 1).err().expect("refused");
+        let Err(error) = room_under_chain(MAX_TREE_DEPTH + 1) else {
+            panic!("a chain deeper than the gate allows was accepted");
+        };
         assert!(error.contains("deeper than"), "{error}");
     }
 
