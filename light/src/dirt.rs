@@ -17,25 +17,40 @@ const ELEVATION_STEPS: usize = 3;
 /// Rays per sample point, in both modes.
 pub const RAYS_PER_SAMPLE: usize = AZIMUTH_STEPS * ELEVATION_STEPS;
 
-/// A direction `elevation` radians off the axis `n` and `azimuth` around it.
-fn cone_direction(basis: [Vec3; 3], azimuth: f64, elevation: f64) -> Vec3 {
-    let [u, v, n] = basis;
+/// The components along `u`, `v` and `n` of a direction `elevation`
+/// radians off the axis `n` and `azimuth` around it.
+fn cone_components(azimuth: f64, elevation: f64) -> [f64; 3] {
     let (se, ce) = elevation.sin_cos();
-    u * (se * azimuth.cos()) + v * (se * azimuth.sin()) + n * ce
+    [se * azimuth.cos(), se * azimuth.sin(), ce]
 }
 
-/// The ordered pattern: rings at evenly spaced elevations, evenly spaced
-/// azimuths on each ring (elevations at the middle of their steps).
-fn ordered_directions(basis: [Vec3; 3], cone: f64) -> Vec<[f32; 3]> {
+/// The direction with `components` in `basis`.
+fn in_basis(basis: [Vec3; 3], components: [f64; 3]) -> Vec3 {
+    let [u, v, n] = basis;
+    u * components[0] + v * components[1] + n * components[2]
+}
+
+/// The ordered pattern in the face's own terms (see [`ordered_directions`]):
+/// the same for every sample, so the sines and cosines are taken once.
+fn ordered_components(cone: f64) -> Vec<[f64; 3]> {
     let azimuth_step = std::f64::consts::TAU / AZIMUTH_STEPS as f64;
     let elevation_step = cone / ELEVATION_STEPS as f64;
     (0..AZIMUTH_STEPS)
         .flat_map(|a| {
             (0..ELEVATION_STEPS).map(move |e| {
                 let elevation = elevation_step * (e as f64 + 0.5);
-                cone_direction(basis, azimuth_step * a as f64, elevation).to_f32()
+                cone_components(azimuth_step * a as f64, elevation)
             })
         })
+        .collect()
+}
+
+/// The ordered pattern: rings at evenly spaced elevations, evenly spaced
+/// azimuths on each ring (elevations at the middle of their steps).
+fn ordered_directions(basis: [Vec3; 3], components: &[[f64; 3]]) -> Vec<[f32; 3]> {
+    components
+        .iter()
+        .map(|&c| in_basis(basis, c).to_f32())
         .collect()
 }
 
@@ -70,7 +85,7 @@ fn random_directions(basis: [Vec3; 3], cone: f64, face: usize, sample: usize) ->
         .map(|k| {
             let azimuth = std::f64::consts::TAU * unit_hash(seed + 2 * k);
             let elevation = cone * unit_hash(seed + 2 * k + 1);
-            cone_direction(basis, azimuth, elevation).to_f32()
+            in_basis(basis, cone_components(azimuth, elevation)).to_f32()
         })
         .collect()
 }
@@ -109,7 +124,8 @@ pub fn occlusion_at(
     };
     // Without per-sample normals every sample shares one ordered pattern.
     let flat_basis = basis_of(samples.normal);
-    let flat_ordered = ordered_directions(flat_basis, cone);
+    let ordered = ordered_components(cone);
+    let flat_ordered = ordered_directions(flat_basis, &ordered);
     let shift = flat_basis[0] * RAY_START_SHIFT[0] + flat_basis[1] * RAY_START_SHIFT[1];
     let depth = sampling.depth as f32;
     let mut packet = RayPacket16::new();
@@ -126,7 +142,7 @@ pub fn occlusion_at(
             starts[lane] = (Vec3::from_f32(samples.points[i]) + shift).to_f32();
             own.push(match sampling.mode {
                 DirtMode::Ordered if samples.normals.is_empty() => Vec::new(),
-                DirtMode::Ordered => ordered_directions(basis_of(samples.normal_at(i)), cone),
+                DirtMode::Ordered => ordered_directions(basis_of(samples.normal_at(i)), &ordered),
                 DirtMode::Random => {
                     random_directions(basis_of(samples.normal_at(i)), cone, samples.face, i)
                 }
@@ -172,7 +188,7 @@ mod tests {
         let n = Vec3::new(0.0, 0.6, 0.8);
         let [u, v] = tangent_basis(n);
         let cone = 60f64.to_radians();
-        let ordered = ordered_directions([u, v, n], cone);
+        let ordered = ordered_directions([u, v, n], &ordered_components(cone));
         let random = random_directions([u, v, n], cone, 3, 7);
         assert_eq!(ordered.len(), RAYS_PER_SAMPLE);
         assert_eq!(random.len(), RAYS_PER_SAMPLE);

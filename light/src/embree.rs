@@ -835,6 +835,17 @@ impl RayPacket16 {
         self.rays.tfar[lane]
     }
 
+    /// Keeps only the lanes in `lanes` active and ends each at `tfar(lane) * scale`.
+    pub fn keep_shortened(&mut self, lanes: u16, scale: f32) {
+        for i in 0..16 {
+            if lanes & (1 << i) == 0 {
+                self.valid.0[i] = 0;
+            } else {
+                self.rays.tfar[i] *= scale;
+            }
+        }
+    }
+
     /// Deactivates every lane.
     pub fn clear(&mut self) {
         self.valid.0 = [0; 16];

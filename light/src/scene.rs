@@ -10,10 +10,15 @@ use crate::LightError;
 use crate::embree::{Device, RayPacket16, Scene, SceneBuilder, sys};
 use crate::faces::{FaceGeom, FaceKind};
 
+/// Sun rays are tested for blockers up to this fraction of their distance to the sky.
+const SKY_HIT_SHORTEN: f32 = 1.0 - 1e-5;
+
 /// A committed scene and the geometry id of its sky faces.
 pub struct TraceScene {
     pub scene: Scene,
     sky_geom: u32,
+    /// The sky faces alone, to find where a sun ray meets the sky first.
+    sky_only: Option<Scene>,
     /// The face of each opaque triangle (by primitive id).
     opaque_faces: Vec<u32>,
     /// Per `_shadowself` model (not already in `scene`): its own faces.
@@ -78,12 +83,20 @@ impl TraceScene {
             triangles += mesh.triangles.len();
             own.insert(model, builder.commit()?);
         }
+        let sky_only = if sky.triangles.is_empty() {
+            None
+        } else {
+            let mut builder = SceneBuilder::new(device)?;
+            builder.add_triangle_mesh(&sky.vertices, &sky.triangles)?;
+            Some(builder.commit()?)
+        };
         let mut builder = SceneBuilder::new(device)?;
         builder.add_triangle_mesh(&opaque.vertices, &opaque.triangles)?;
         let sky_geom = builder.add_triangle_mesh(&sky.vertices, &sky.triangles)?;
         Ok(TraceScene {
             scene: builder.commit()?,
             sky_geom,
+            sky_only,
             opaque_faces: opaque.faces,
             own,
             triangles,
@@ -108,14 +121,22 @@ impl TraceScene {
 
     /// Bit `i` set if lane `i` of `packet`, cast from a face of `model`,
     /// reaches a sky face before anything else.
+    /// First where each ray meets the sky (sky faces alone, a small scene),
+    /// then whether anything blocks it before that: an occlusion query,
+    /// which stops at any hit, where one closest-hit query over everything
+    /// must rule out every nearer surface.
     pub fn sees_sky16(&self, packet: &mut RayPacket16, model: usize) -> u16 {
-        let ids = self.scene.first_hit_geom16(packet, true);
+        let Some(sky_only) = &self.sky_only else {
+            return 0;
+        };
+        let ids = sky_only.first_hit_geom16(packet, true);
         let sky = (0..16)
-            .filter(|&i| ids[i] == self.sky_geom && ids[i] != sys::RTC_INVALID_GEOMETRY_ID)
+            .filter(|&i| ids[i] != sys::RTC_INVALID_GEOMETRY_ID)
             .fold(0, |m, i| m | (1 << i));
-        // tfar now ends at each lane's first hit: the model blocks the sky
-        // only if it lies nearer.
-        sky & !self.own_occluded16(packet, model)
+        // Just short of the sky hit, so the sky face itself does not block.
+        packet.keep_shortened(sky, SKY_HIT_SHORTEN);
+        let blocked = self.scene.occluded16(packet, true);
+        sky & !blocked & !self.own_occluded16(packet, model)
     }
 
     /// For each active lane of `packet`, cast from a face of `model`, the

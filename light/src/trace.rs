@@ -235,6 +235,43 @@ fn box_distance_squared(b: &Bounds, p: Vec3) -> f64 {
     d2
 }
 
+/// Sky faces closer to a box's edge than this still count as reachable
+/// (sample points and rays are f32).
+const SKY_BOX_MARGIN: f64 = 1.0;
+
+/// For each box in `sky`, the offsets `q - p` from a point `p` in `samples`
+/// to a point `q` in it (the box `sky - samples`, a little wider): a sun
+/// ray from a sample can only meet that sky if its direction meets this box.
+fn sky_offsets(sky: &[Bounds], samples: &Bounds) -> Vec<Bounds> {
+    let margin = Vec3::new(SKY_BOX_MARGIN, SKY_BOX_MARGIN, SKY_BOX_MARGIN);
+    sky.iter()
+        .map(|b| Bounds {
+            mins: b.mins - samples.maxs - margin,
+            maxs: b.maxs - samples.mins + margin,
+        })
+        .collect()
+}
+
+/// Whether the ray from the origin along `d` meets any of `boxes`.
+fn direction_meets_any(boxes: &[Bounds], d: Vec3) -> bool {
+    boxes.iter().any(|b| {
+        let (mut near, mut far) = (0.0f64, f64::INFINITY);
+        for axis in 0..3 {
+            let (lo, hi) = (b.mins[axis], b.maxs[axis]);
+            if d[axis] == 0.0 {
+                if lo > 0.0 || hi < 0.0 {
+                    return false;
+                }
+                continue;
+            }
+            let (t0, t1) = (lo / d[axis], hi / d[axis]);
+            near = near.max(t0.min(t1));
+            far = far.min(t0.max(t1));
+        }
+        near <= far
+    })
+}
+
 /// Occlusion may be interpolated between grid points that differ by at
 /// most this much (a light's dirt factor then moves by about as much).
 const DIRT_SMOOTH: f32 = 0.05;
@@ -837,8 +874,19 @@ pub fn trace_face(
         }
     }
 
-    if !setup.cull || setup.vis.may_see_sky(face.index) {
+    if !suns.is_empty() && (!setup.cull || setup.vis.may_see_sky(face.index)) {
+        let sky_offsets = setup
+            .cull
+            .then(|| setup.vis.visible_sky_bounds(face.index))
+            .flatten()
+            .map(|sky| sky_offsets(&sky, &bounds));
         for (si, sun) in suns.iter().enumerate() {
+            if sky_offsets
+                .as_ref()
+                .is_some_and(|offsets| !direction_meets_any(offsets, sun.to_sun))
+            {
+                continue;
+            }
             let dir = sun.to_sun.to_f32();
             for (i, v) in value.iter_mut().enumerate() {
                 let cos = samples.normal_at(i).dot(sun.to_sun);
@@ -929,4 +977,33 @@ pub fn trace_face(
         out.bounce_dirt = d.to_vec();
     }
     (out, counts)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cube(mins: [f64; 3], maxs: [f64; 3]) -> Bounds {
+        Bounds {
+            mins: Vec3::new(mins[0], mins[1], mins[2]),
+            maxs: Vec3::new(maxs[0], maxs[1], maxs[2]),
+        }
+    }
+
+    #[test]
+    fn sun_directions_are_kept_only_toward_visible_sky() {
+        // Samples on a 64x64 floor at z 0, a skylight 128 units above its middle.
+        let floor = cube([0.0, 0.0, 0.0], [64.0, 64.0, 0.0]);
+        let skylight = cube([16.0, 16.0, 128.0], [48.0, 48.0, 128.0]);
+        let offsets = sky_offsets(&[skylight], &floor);
+        let up = Vec3::new(0.0, 0.0, 1.0);
+        assert!(direction_meets_any(&offsets, up));
+        // From the floor's corner (0, 0) to the skylight's far corner (48, 48).
+        let steepest_slant = Vec3::new(48.0, 48.0, 128.0).normalized().unwrap();
+        assert!(direction_meets_any(&offsets, steepest_slant));
+        let too_low = Vec3::new(1.0, 0.0, 0.5).normalized().unwrap();
+        assert!(!direction_meets_any(&offsets, too_low));
+        assert!(!direction_meets_any(&offsets, -up));
+        assert!(!direction_meets_any(&[], up), "no sky in sight");
+    }
 }

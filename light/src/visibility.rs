@@ -4,12 +4,18 @@
 //! face. Anything without vis data (no vis lump, a leaf without a row, a
 //! light in solid, a brush-model face) is treated as visible.
 
+use std::collections::BTreeMap;
+
 use quake_formats::Bsp;
 use quake_formats::PvsRow;
 use quake_formats::bsp::contents;
-use quake_formats::geom::Vec3;
+use quake_formats::geom::{Bounds, Vec3};
 
 use crate::faces::{FaceGeom, FaceKind};
+
+/// At most this many boxes stand for the sky a face sees (each direction of
+/// each face is tested against all of them).
+const MAX_SKY_BOXES: usize = 16;
 
 /// Decompressed PVS rows plus which leaves hold each face.
 pub struct Visibility {
@@ -19,6 +25,8 @@ pub struct Visibility {
     face_leafs: Vec<Vec<u32>>,
     /// Per leaf: its PVS holds a leaf with a sky face.
     leaf_sees_sky: Vec<bool>,
+    /// Each leaf that holds sky faces, with the box around them.
+    sky_leaf_bounds: Vec<(u32, Bounds)>,
     leaf_contents: Vec<i32>,
 }
 
@@ -56,13 +64,17 @@ impl Visibility {
                 }
             }
         }
-        let mut sky_leafs: Vec<u32> = faces
-            .iter()
-            .filter(|f| f.kind == FaceKind::Sky)
-            .flat_map(|f| face_leafs[f.index].iter().copied())
-            .collect();
-        sky_leafs.sort_unstable();
-        sky_leafs.dedup();
+        let mut sky_boxes: BTreeMap<u32, Bounds> = BTreeMap::new();
+        for f in faces.iter().filter(|f| f.kind == FaceKind::Sky) {
+            for &leaf in &face_leafs[f.index] {
+                let b = sky_boxes.entry(leaf).or_insert(Bounds::EMPTY);
+                for &p in &f.points {
+                    b.add_point(p);
+                }
+            }
+        }
+        let sky_leaf_bounds: Vec<(u32, Bounds)> = sky_boxes.into_iter().collect();
+        let sky_leafs: Vec<u32> = sky_leaf_bounds.iter().map(|(l, _)| *l).collect();
         let leaf_sees_sky = rows
             .iter()
             .enumerate()
@@ -75,6 +87,7 @@ impl Visibility {
             rows,
             face_leafs,
             leaf_sees_sky,
+            sky_leaf_bounds,
             leaf_contents: bsp.leafs.iter().map(|l| l.contents).collect(),
         }
     }
@@ -117,6 +130,38 @@ impl Visibility {
             || leafs
                 .iter()
                 .any(|&l| self.leaf_sees_sky.get(l as usize).copied().unwrap_or(true))
+    }
+
+    /// Boxes around the sky faces `face` may see, one per leaf holding
+    /// them; `None` when vis data cannot tell (every direction may reach sky).
+    pub fn visible_sky_bounds(&self, face: usize) -> Option<Vec<Bounds>> {
+        let leafs = &self.face_leafs[face];
+        if leafs.is_empty() {
+            return None;
+        }
+        let mut seen = vec![false; self.sky_leaf_bounds.len()];
+        for &l in leafs {
+            let row = self.rows.get(l as usize)?.as_ref()?;
+            for (k, (s, _)) in self.sky_leaf_bounds.iter().enumerate() {
+                seen[k] |= *s == l || bit(row, *s);
+            }
+        }
+        let visible: Vec<Bounds> = self
+            .sky_leaf_bounds
+            .iter()
+            .zip(seen)
+            .filter(|(_, seen)| *seen)
+            .map(|((_, b), _)| *b)
+            .collect();
+        // Leaves next to each other in the BSP's order are mostly near each
+        // other: merging runs of them keeps the per-direction test cheap.
+        let run = visible.len().div_ceil(MAX_SKY_BOXES).max(1);
+        Some(
+            visible
+                .chunks(run)
+                .map(|c| c.iter().fold(Bounds::EMPTY, |u, b| u.union(b)))
+                .collect(),
+        )
     }
 }
 
