@@ -6,14 +6,13 @@
 
 #[path = "support/command.rs"]
 mod command;
+#[path = "support/hard.rs"]
+mod hard;
 
 use command::slipgate;
+use hard::{hard_maps, maps_dir};
 use quake_formats::{Bsp, BspVersion, Severity, validate};
-use std::path::{Path, PathBuf};
-
-fn maps_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("maps")
-}
+use std::path::Path;
 
 /// What the compiler must do with a hard map.
 #[derive(Debug, Default)]
@@ -121,12 +120,7 @@ fn run_map(map: &Path) {
 
 #[test]
 fn every_hard_map_goes_through_every_stage() {
-    let mut maps: Vec<PathBuf> = std::fs::read_dir(maps_dir().join("hard"))
-        .expect("maps/hard")
-        .map(|e| e.expect("entry").path())
-        .filter(|p| p.extension().is_some_and(|e| e == "map"))
-        .collect();
-    maps.sort();
+    let maps = hard_maps();
     assert!(maps.len() >= 16, "only {} hard maps", maps.len());
     for map in &maps {
         run_map(map);

@@ -3,19 +3,19 @@
 //! same motion) wherever a point lies further than [`PLANE_CLEARANCE`] from every plane it is
 //! tested against. ARCHITECTURE.md's epsilon policy names this test.
 
+#[path = "support/hard.rs"]
+mod hard;
+
 use bsp_compiler::{CompileOptions, MapSource, compile};
+use hard::{hard_maps, maps_dir};
 use quake_formats::Bsp;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Points closer than this to a node plane on their way down either tree are not compared: there
 /// a motion of 1e-4 units (or 1e-6 rad at 33000 units: 0.033) may rightly move them across.
 const PLANE_CLEARANCE: f64 = 0.1;
 /// Sample points per axis of the world's bounds.
 const GRID: usize = 12;
-
-fn maps_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("maps")
-}
 
 /// A rigid motion: a turn about the z axis, then a shift.
 #[derive(Clone, Copy)]
@@ -142,12 +142,7 @@ fn check_motion(
 
 #[test]
 fn tiny_motions_do_not_flip_contents_or_leaks() {
-    let mut maps: Vec<PathBuf> = std::fs::read_dir(maps_dir().join("hard"))
-        .expect("maps/hard")
-        .map(|e| e.expect("entry").path())
-        .filter(|p| p.extension().is_some_and(|e| e == "map"))
-        .collect();
-    maps.sort();
+    let maps = hard_maps();
     let motions = [
         (
             Motion {

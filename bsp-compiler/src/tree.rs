@@ -722,18 +722,12 @@ mod tests {
         );
         let (hint_plane, _) = planes.insert(&Plane::new(Vec3::new(1.0, 0.0, 0.0), 100.0));
         assert_ne!(without.nodes[0].plane, Some(hint_plane));
-        let mut hint = Brush::from_planes(
-            &box_planes(Vec3::new(90.0, -8.0, -8.0), Vec3::new(100.0, 72.0, 72.0)),
+        let hint = hint_box(
             &mut planes,
-            contents::EMPTY,
-            2,
-        )
-        .expect("hint");
-        hint.kind = BrushKind::Hint;
-        // One hint face; the others are skip.
-        for s in &mut hint.sides {
-            s.buried = s.plane != hint_plane;
-        }
+            Vec3::new(90.0, -8.0, -8.0),
+            Vec3::new(100.0, 72.0, 72.0),
+            hint_plane,
+        );
         brushes.push(hint);
         let tree = build_tree(brushes, &planes, SplitHeuristic::FewestSplits, false);
         assert_eq!(tree.nodes[0].plane, Some(hint_plane));
@@ -742,6 +736,18 @@ mod tests {
         assert_eq!(find(Vec3::new(95.0, 32.0, 32.0)), contents::EMPTY);
         let (skip_plane, _) = planes.insert(&Plane::new(Vec3::new(1.0, 0.0, 0.0), 90.0));
         assert!(tree.nodes.iter().all(|n| n.plane != Some(skip_plane)));
+    }
+
+    /// An empty box brush of entity 2 whose face on `hint_plane` is a hint; its other faces are
+    /// skip.
+    fn hint_box(planes: &mut PlaneSet, lo: Vec3, hi: Vec3, hint_plane: PlaneId) -> Brush {
+        let mut hint =
+            Brush::from_planes(&box_planes(lo, hi), planes, contents::EMPTY, 2).expect("hint");
+        hint.kind = BrushKind::Hint;
+        for s in &mut hint.sides {
+            s.buried = s.plane != hint_plane;
+        }
+        hint
     }
 
     /// Walks `tree` from the root with each node's region (the box `bounds` grown as
@@ -780,17 +786,12 @@ mod tests {
             Vec3::new(64.0, 64.0, -64.0),
         );
         let (hint_plane, _) = planes.insert(&Plane::new(Vec3::new(0.0, 0.0, 1.0), 0.0));
-        let mut hint = Brush::from_planes(
-            &box_planes(Vec3::new(-64.0, -64.0, -8.0), Vec3::new(64.0, 64.0, 0.0)),
+        let hint = hint_box(
             &mut planes,
-            contents::EMPTY,
-            2,
-        )
-        .expect("hint");
-        hint.kind = BrushKind::Hint;
-        for s in &mut hint.sides {
-            s.buried = s.plane != hint_plane;
-        }
+            Vec3::new(-64.0, -64.0, -8.0),
+            Vec3::new(64.0, 64.0, 0.0),
+            hint_plane,
+        );
         let brushes = vec![post, floor, hint];
         let bounds = brushes
             .iter()

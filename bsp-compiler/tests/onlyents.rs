@@ -6,6 +6,7 @@ mod common;
 use clap::Parser;
 use common::{BspCli, LightCli, VisCli};
 use quake_formats::Bsp;
+use quake_formats::bsp::LUMP_NAMES;
 use std::path::{Path, PathBuf};
 
 fn repo() -> PathBuf {
@@ -30,24 +31,6 @@ fn lumps(bytes: &[u8]) -> Vec<Vec<u8>> {
         })
         .collect()
 }
-
-const LUMP_NAMES: [&str; 15] = [
-    "entities",
-    "planes",
-    "textures",
-    "vertices",
-    "visibility",
-    "nodes",
-    "texinfo",
-    "faces",
-    "lighting",
-    "clipnodes",
-    "leafs",
-    "marksurfaces",
-    "edges",
-    "surfedges",
-    "models",
-];
 
 #[test]
 fn onlyents_changes_the_entities_and_nothing_else() {
