@@ -5,7 +5,8 @@
 # machine), and the table gives the best of RUNS runs.
 #   - bsp: both compile the same .map.
 #   - vis: both run full vis on our BSP and portals (the same input).
-#   - light: both light our BSP (after our full vis), default and `-extra4 -soft`.
+#   - light: both light our BSP (after our full vis): default, `-extra4 -soft`, `-bounce`, and
+#     `-extra4 -soft -bounce -dirt` (LibreQuake's release settings).
 # Usage: [RUNS=3] bench/corpus.sh [MAP.map ...]   (default: id e1m1 and LibreQuake e3m4)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -47,7 +48,7 @@ for run in $(seq "$runs"); do
     cp "$m.prt" "v_$m.prt"
     timed "$m/vis/slipgate" "$slipgate" vis "$m.bsp"
     [ -z "$ericw" ] || timed "$m/vis/ericw" "$anchor/vis" "v_$m.bsp"
-    for mode in default "-extra4 -soft"; do
+    for mode in default "-extra4 -soft" "-bounce" "-extra4 -soft -bounce -dirt"; do
       flags=${mode#default}
       key=${mode// /}
       cp "$m.bsp" "l_$m.bsp"
