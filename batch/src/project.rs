@@ -44,6 +44,8 @@ pub enum ProjectError {
     },
     #[error("{}: [map.{name:?}] names no map the project builds", path.display())]
     UnknownOverride { path: PathBuf, name: String },
+    #[error("{}: {} lies outside the project folder", path.display(), map.display())]
+    Outside { path: PathBuf, map: PathBuf },
     #[error("{}: no .map files to build", path.display())]
     NoMaps { path: PathBuf },
 }
@@ -253,11 +255,26 @@ fn glob_maps(file: &Path, root: &Path, pattern: &str) -> Result<Vec<String>, Pro
     };
     let full = root.join(pattern);
     let paths = glob::glob(&full.to_string_lossy()).map_err(|e| bad(e.to_string()))?;
+    let canonical = |p: &Path| {
+        p.canonicalize().map_err(|source| ProjectError::Io {
+            path: p.to_path_buf(),
+            source,
+        })
+    };
+    let root = canonical(root)?;
     let mut names = Vec::new();
     for entry in paths {
         let path = entry.map_err(|e| bad(e.to_string()))?;
         if path.is_file() {
-            names.push(relative_name(root, &path));
+            let path = canonical(&path)?;
+            if !path.starts_with(&root) {
+                // Its outputs would land outside the output folder.
+                return Err(ProjectError::Outside {
+                    path: file.to_path_buf(),
+                    map: path,
+                });
+            }
+            names.push(relative_name(&root, &path));
         }
     }
     Ok(names)
@@ -346,5 +363,10 @@ preview = false
         .expect("write");
         let err = Project::load(&file).expect_err("unknown override");
         assert!(err.to_string().contains("b.map"), "{err}");
+        let inner = dir.path().join("sub").join("p.toml");
+        std::fs::create_dir_all(dir.path().join("sub")).expect("mkdir");
+        std::fs::write(&inner, "maps = [\"../a.map\"]\n").expect("write");
+        let err = Project::load(&inner).expect_err("outside");
+        assert!(err.to_string().contains("outside the project"), "{err}");
     }
 }
