@@ -298,3 +298,39 @@ fn corpus_maps_build_and_then_come_from_the_cache() {
         "cached {second:.1} s vs first {first:.1} s"
     );
 }
+
+/// A batch stopped while lighting a map left the records of the stages before light: the next
+/// run starts at light. (Records are written atomically as stages finish, so removing the last
+/// ones is what a kill at that moment leaves.)
+#[test]
+fn an_interrupted_batch_resumes_after_the_last_finished_stage() {
+    let root = project("resume", &["demo220.map", "test/corridors.map"]);
+    assert_success(&batch(&root, &[]));
+    let whole = files(&root.join("out"));
+    let first = manifest(&root.join("out/slipgate-manifest.json"));
+    let corridors = first["built"]
+        .as_array()
+        .expect("built")
+        .iter()
+        .find(|m| m["map"] == "test/corridors.map")
+        .expect("corridors built");
+    for stage in corridors["stages"].as_array().expect("stages") {
+        if stage["stage"] == "light" || stage["stage"] == "preview" {
+            let key = stage["key"].as_str().expect("key");
+            let record = root.join(format!(".slipgate-cache/stages/{key}.json"));
+            std::fs::remove_file(record).expect("remove a record");
+        }
+    }
+    std::fs::remove_dir_all(root.join("out")).expect("remove outputs");
+
+    assert_success(&batch(&root, &[]));
+    let stages = stages_cached(&manifest(&root.join("out/slipgate-manifest.json")));
+    let ran: Vec<&String> = stages["test/corridors.map"]
+        .iter()
+        .filter(|(_, cached)| !**cached)
+        .map(|(stage, _)| stage)
+        .collect();
+    assert_eq!(ran, ["light", "preview"]);
+    assert!(stages["demo220.map"].values().all(|&cached| cached));
+    assert_eq!(files(&root.join("out")), whole);
+}
