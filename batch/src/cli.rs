@@ -3,7 +3,7 @@
 
 use crate::manifest::{Shard, collect};
 use crate::schedule::{default_memory_budget, parse_memory};
-use crate::stages::MapOutcome;
+use crate::stages::{MapOutcome, STAGES};
 use crate::{BatchOptions, Observer, run_batch};
 use anyhow::Result;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -96,7 +96,7 @@ fn run_collect(args: &Args) -> Result<ExitCode> {
     }
 }
 
-/// A spinner per map on a terminal; elsewhere (CI logs) a line as each map finishes.
+/// A bar per map on a terminal (stages done, the one running); elsewhere (CI logs) a line as each map finishes.
 struct Bars {
     multi: MultiProgress,
     terminal: bool,
@@ -126,8 +126,9 @@ impl Observer for Bars {
         if !self.terminal {
             return;
         }
-        let bar = self.multi.add(ProgressBar::new_spinner());
-        if let Ok(style) = ProgressStyle::with_template("{spinner} {prefix:30} {msg:10} {elapsed}")
+        let bar = self.multi.add(ProgressBar::new(STAGES.len() as u64));
+        if let Ok(style) =
+            ProgressStyle::with_template("{spinner} {prefix:30} [{bar:5}] {msg:10} {elapsed}")
         {
             bar.set_style(style);
         }
@@ -140,7 +141,11 @@ impl Observer for Bars {
     }
 
     fn stage_started(&self, map: &str, stage: &str) {
-        self.with_bar(map, |bar| bar.set_message(stage.to_string()));
+        let done = STAGES.iter().position(|s| *s == stage).unwrap_or(0);
+        self.with_bar(map, |bar| {
+            bar.set_position(done as u64);
+            bar.set_message(stage.to_string());
+        });
     }
 
     fn map_finished(&self, outcome: &MapOutcome) {

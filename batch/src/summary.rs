@@ -1,4 +1,5 @@
-//! The table printed at the end of a batch: one row per stage of each map.
+//! The table printed at the end of a batch: one row per stage of each map (a cached stage's time,
+//! in brackets, is what it took when it ran).
 
 use crate::stages::MapOutcome;
 use std::fmt::Write;
@@ -12,7 +13,12 @@ pub fn table(maps: &[MapOutcome]) -> String {
             rows.push([
                 map.map.clone(),
                 run.stage.clone(),
-                format!("{:.2} s", run.seconds),
+                // A cached stage: what it took when it ran.
+                if run.cached {
+                    format!("({:.2} s)", run.seconds)
+                } else {
+                    format!("{:.2} s", run.seconds)
+                },
                 run.counts.clone(),
                 if run.cached { "cached" } else { "ran" }.into(),
                 "ok".into(),
