@@ -155,7 +155,8 @@ fn check_light(map: &MapFile, bsp: &quake_formats::Bsp) -> Result<(), Failure> {
 
 /// `map` with brushes deleted, one at a time, for as long as `property` still fails.
 fn shrink(map: &Map, seed: u64, property: &str) -> Map {
-    let still_fails = |m: &Map| matches!(check(m, seed), Err(f) if f.property == property);
+    let still_fails =
+        |m: &Map| matches!(check(&m.to_text(), seed), Err(f) if f.property == property);
     let mut map = map.clone();
     loop {
         let mut changed = false;
