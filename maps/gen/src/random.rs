@@ -62,7 +62,7 @@ const LIQUIDS: [&str; 3] = ["*water1", "*water1", "*slime1"];
 /// One room: its air and where it sits on the grid.
 #[derive(Debug, Clone, Copy)]
 struct Room {
-    cell: (i32, i32),
+    cell: Cell,
     air: Bounds,
 }
 
@@ -99,9 +99,12 @@ fn pick<T: Copy>(rng: &mut SplitMix64, list: &[T]) -> T {
     list[rng.below(list.len())]
 }
 
-/// Grid cells for `count` rooms, each new one beside an earlier one, with the links between
-/// them: a random tree.
-fn layout(rng: &mut SplitMix64, count: usize) -> (Vec<(i32, i32)>, Vec<(usize, usize)>) {
+/// A room's place on the grid.
+type Cell = (i32, i32);
+
+/// Grid cells for `count` rooms, each new one beside an earlier one, with the links (indices of
+/// two cells) between them: a random tree.
+fn layout(rng: &mut SplitMix64, count: usize) -> (Vec<Cell>, Vec<(usize, usize)>) {
     let mut cells = vec![(0, 0)];
     let mut links = Vec::new();
     while cells.len() < count.max(1) {
@@ -116,7 +119,7 @@ fn layout(rng: &mut SplitMix64, count: usize) -> (Vec<(i32, i32)>, Vec<(usize, u
     (cells, links)
 }
 
-fn room_at(rng: &mut SplitMix64, cell: (i32, i32)) -> Room {
+fn room_at(rng: &mut SplitMix64, cell: Cell) -> Room {
     let c = [f64::from(cell.0) * CELL, f64::from(cell.1) * CELL];
     let hx = grid(rng, MIN_HALF, MAX_HALF, 8.0);
     let hy = grid(rng, MIN_HALF, MAX_HALF, 8.0);
