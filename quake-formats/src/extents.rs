@@ -2,7 +2,11 @@
 //!
 //! Computed one way for everyone (compiler, light, viewer, validator), in the precision engines
 //! use: vertex and texture-vector components are `f32` in the file and are multiplied and summed
-//! in `f64`, as QuakeSpasm and its descendants do, so our luxel grid lands where theirs does.
+//! in `f64`, as QuakeSpasm and its descendants do, and each sum is then rounded to `f32`, because
+//! every engine keeps it in a `float` (QuakeSpasm's `val`, vanilla's x87 result stored to a
+//! float) before snapping it to the grid. Without that rounding a coordinate a few millionths
+//! below a grid line (common on rotated brushes) snaps one luxel further out than in the engine,
+//! and the engine then reads the face's lightmap with the wrong row length.
 
 use crate::bsp::limits::LIGHTMAP_SCALE;
 
@@ -25,10 +29,10 @@ impl LightmapExtents {
         for p in points {
             for axis in 0..2 {
                 let v = &vecs[axis];
-                let val = p[0] as f64 * v[0] as f64
+                let val = (p[0] as f64 * v[0] as f64
                     + p[1] as f64 * v[1] as f64
                     + p[2] as f64 * v[2] as f64
-                    + v[3] as f64;
+                    + v[3] as f64) as f32 as f64;
                 mins[axis] = mins[axis].min(val);
                 maxs[axis] = maxs[axis].max(val);
             }
@@ -114,6 +118,26 @@ mod tests {
         let e = LightmapExtents::from_points(&pts, &AXIAL);
         assert_eq!(e.tex_mins, [0, -16]);
         assert_eq!(e.extents, [32, 48]);
+    }
+
+    /// Face 9288 of our BSP of LibreQuake e1m3 (a brush rotated 10 degrees): its coordinates lie
+    /// within 5e-5 texels of grid lines, on either side. Summed in f64 alone they gave 5x4 luxels;
+    /// QuakeSpasm, rounding each sum to a float, reads 3x3, so it drew our lightmap skewed.
+    #[test]
+    fn sums_are_rounded_to_f32_as_engines_store_them() {
+        let vecs = [
+            [0.984_807_73, -0.173_648_18, 0.0, 3.661_621_1],
+            [-0.173_648_18, -0.984_807_73, 0.0, 0.667_358_4],
+        ];
+        let pts = [
+            [2765.9216, 227.831_38, 32.0],
+            [2734.4077, 233.388_12, 32.0],
+            [2739.9644, 264.901_98, 32.0],
+            [2771.4783, 259.345_2, 32.0],
+        ];
+        let e = LightmapExtents::from_points(&pts, &vecs);
+        assert_eq!(e.tex_mins, [2656, -736]);
+        assert_eq!(e.luxel_size(), [3, 3]);
     }
 
     #[test]

@@ -2,12 +2,14 @@
 //!
 //! [`textures`] paints procedural textures and quantises them to `Palette::slipgate()`;
 //! [`level`] turns boxes of open space into sealed shells of brushes; [`maps`] defines the demo
-//! map, the hard cases, the leak pair and the corridor test map; [`brush`] writes `.map` text.
+//! map, the hard cases, the leak pair and the corridor test map; [`brush`] writes `.map` text;
+//! [`random`] makes seeded random maps for property tests.
 
 pub mod brush;
 pub mod cli;
 pub mod level;
 pub mod maps;
+pub mod random;
 pub mod textures;
 
 use quake_formats::FormatError;
