@@ -195,7 +195,7 @@ fn three_shards_give_the_bytes_of_one_run() {
 }
 
 #[test]
-fn a_changed_light_value_reruns_only_ents_and_light() {
+fn changed_light_keys_rerun_only_ents_and_light() {
     let root = project("light", &["demo.map", "demo220.map"]);
     assert_success(&batch(&root, &[]));
     let map = root.join("demo.map");
@@ -206,19 +206,19 @@ fn a_changed_light_value_reruns_only_ents_and_light() {
     std::fs::write(&map, changed).expect("edit the map");
 
     assert_success(&batch(&root, &[]));
-    let stages = stages_cached(&manifest(&root.join("out/slipgate-manifest.json")));
-    let expected: BTreeMap<String, bool> = [
-        ("bsp", true),
-        ("vis", true),
-        ("ents", false),
-        ("light", false),
-        ("preview", false),
-    ]
-    .into_iter()
-    .map(|(s, c)| (s.to_string(), c))
-    .collect();
-    assert_eq!(stages["demo.map"], expected);
-    assert!(stages["demo220.map"].values().all(|&cached| cached));
+    assert_only_light_reran(&root);
+
+    // Light's keys of worldspawn (a sun) are the same kind of change.
+    let text = std::fs::read_to_string(&map).expect("map text");
+    let sunny = text.replacen(
+        "\"classname\" \"worldspawn\"",
+        "\"classname\" \"worldspawn\"\n\"_sunlight\" \"150\"\n\"_sun_mangle\" \"30 -60 0\"",
+        1,
+    );
+    assert_ne!(sunny, text, "the demo map's worldspawn");
+    std::fs::write(&map, sunny).expect("edit the map");
+    assert_success(&batch(&root, &[]));
+    assert_only_light_reran(&root);
 
     // The same bytes as a build from nothing.
     let fresh = root.join("fresh");
@@ -234,6 +234,24 @@ fn a_changed_light_value_reruns_only_ents_and_light() {
     );
     assert_success(&rebuilt);
     assert_eq!(files(&out), files(&root.join("out")));
+}
+
+/// The demo map's bsp and vis came from the cache, its ents, light and preview ran; the other
+/// map was all cached.
+fn assert_only_light_reran(root: &Path) {
+    let stages = stages_cached(&manifest(&root.join("out/slipgate-manifest.json")));
+    let expected: BTreeMap<String, bool> = [
+        ("bsp", true),
+        ("vis", true),
+        ("ents", false),
+        ("light", false),
+        ("preview", false),
+    ]
+    .into_iter()
+    .map(|(s, c)| (s.to_string(), c))
+    .collect();
+    assert_eq!(stages["demo.map"], expected);
+    assert!(stages["demo220.map"].values().all(|&cached| cached));
 }
 
 #[test]

@@ -11,9 +11,11 @@
 //! Every key also holds the tool's identity (version and the hash of the running program). The
 //! geometry view is the map after prefabs are spliced in, without line numbers, with every point
 //! entity whose classname starts with `light` cut down to its `classname`, `origin` and
-//! `targetname`: those are all the compiler reads of a light. So a map whose lights changed only
-//! their other keys (`light`, `_color`, `wait`, `style`, ...) keeps its bsp and vis, and re-runs
-//! only the cheap entity replacement, light and the preview; moving a light re-runs everything.
+//! `targetname`, and worldspawn to the keys the compiler reads of it ([`WORLDSPAWN_KEYS_COMPILED`]).
+//! So a map whose lights changed only their other keys (`light`, `_color`, `wait`, `style`, ...),
+//! or whose worldspawn changed only light's keys (`_sunlight`, `_dirt`, ...), keeps its bsp and
+//! vis, and re-runs only the cheap entity replacement, light and the preview; moving a light
+//! re-runs everything.
 //! The ents step puts the same entity lump into the BSP as a full compile would, so the result
 //! is byte-identical to a build from scratch.
 
@@ -333,15 +335,38 @@ fn geometry_view(source: &MapSource) -> Result<MapFile, String> {
                 face.line = 0;
             }
         }
-        if entity.brushes.is_empty() && entity.entity.classname().starts_with("light") {
-            entity
-                .entity
-                .pairs
-                .retain(|(k, _)| matches!(k.as_str(), "classname" | "origin" | "targetname"));
-        }
+    }
+    for (index, entity) in map.entities.iter_mut().enumerate() {
+        let read = if index == 0 {
+            WORLDSPAWN_KEYS_COMPILED.as_slice()
+        } else if entity.brushes.is_empty() && entity.entity.classname().starts_with("light") {
+            LIGHT_KEYS_COMPILED.as_slice()
+        } else {
+            continue;
+        };
+        entity
+            .entity
+            .pairs
+            .retain(|(k, _)| read.contains(&k.as_str()));
     }
     Ok(map)
 }
+
+/// The keys of a light the compiler reads: `origin` decides what the outside fill floods, and a
+/// `targetname` could name a rotating entity's pivot.
+const LIGHT_KEYS_COMPILED: [&str; 3] = ["classname", "origin", "targetname"];
+
+/// The keys of worldspawn the compiler reads (its others, `_sunlight`, `light`, `_dirt`,
+/// `_bounce`..., are light's). A new key the compiler reads must be added here.
+const WORLDSPAWN_KEYS_COMPILED: [&str; 7] = [
+    "classname",
+    "wad",
+    "_phong",
+    "_phong_angle",
+    "_mirrorinside",
+    "origin",
+    "targetname",
+];
 
 /// The WADs the compile will read, found as the compiler finds them, with their bytes.
 fn wads_used(
