@@ -523,3 +523,67 @@ fn preview_stage(
         })
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn view(text: &str) -> String {
+        let source = MapSource {
+            path: PathBuf::from("test.map"),
+            text: text.to_string(),
+        };
+        let mut key = KeyHasher::new("view");
+        key.debug_field("geometry", &geometry_view(&source).expect("parses"));
+        key.finish()
+    }
+
+    const BOX: &str = "( 0 0 0 ) ( 0 1 0 ) ( 1 0 0 ) floor1 0 0 0 1 1\n\
+                       ( 0 0 8 ) ( 1 0 8 ) ( 0 1 8 ) floor1 0 0 0 1 1\n\
+                       ( 0 0 0 ) ( 0 0 1 ) ( 0 1 0 ) floor1 0 0 0 1 1\n\
+                       ( 8 0 0 ) ( 8 1 0 ) ( 8 0 1 ) floor1 0 0 0 1 1\n\
+                       ( 0 0 0 ) ( 1 0 0 ) ( 0 0 1 ) floor1 0 0 0 1 1\n\
+                       ( 0 8 0 ) ( 0 8 1 ) ( 1 8 0 ) floor1 0 0 0 1 1\n";
+
+    fn map(world_keys: &str, light: &str, comment: &str) -> String {
+        format!(
+            "{comment}{{\n\"classname\" \"worldspawn\"\n{world_keys}{{\n{BOX}}}\n}}\n\
+             {{\n\"classname\" \"light\"\n{light}}}\n\
+             {{\n\"classname\" \"info_player_start\"\n\"origin\" \"4 4 4\"\n}}\n"
+        )
+    }
+
+    #[test]
+    fn the_geometry_view_leaves_out_what_only_light_reads() {
+        let base = view(&map("\"wad\" \"a.wad\"\n", "\"origin\" \"2 2 2\"\n", ""));
+        let same = [
+            // A light's brightness and colour, and lines moved by a comment.
+            map(
+                "\"wad\" \"a.wad\"\n",
+                "\"origin\" \"2 2 2\"\n\"light\" \"300\"\n\"_color\" \"1 0 0\"\n",
+                "// moved\n// down\n",
+            ),
+            // Worldspawn's sun.
+            map(
+                "\"wad\" \"a.wad\"\n\"_sunlight\" \"200\"\n",
+                "\"origin\" \"2 2 2\"\n",
+                "",
+            ),
+        ];
+        for text in &same {
+            assert_eq!(view(text), base, "{text}");
+        }
+        let different = [
+            map("\"wad\" \"a.wad\"\n", "\"origin\" \"2 2 3\"\n", ""),
+            map("\"wad\" \"b.wad\"\n", "\"origin\" \"2 2 2\"\n", ""),
+            map(
+                "\"wad\" \"a.wad\"\n\"_phong\" \"1\"\n",
+                "\"origin\" \"2 2 2\"\n",
+                "",
+            ),
+        ];
+        for text in &different {
+            assert_ne!(view(text), base, "{text}");
+        }
+    }
+}
