@@ -30,12 +30,9 @@ pub enum ProjectError {
         #[source]
         source: std::io::Error,
     },
-    #[error("{}: {source}", path.display())]
-    Toml {
-        path: PathBuf,
-        #[source]
-        source: toml::de::Error,
-    },
+    /// The parser's message (several lines, pointing at the place).
+    #[error("{}: {message}", path.display())]
+    Toml { path: PathBuf, message: String },
     #[error("{}: bad glob {pattern:?}: {message}", path.display())]
     Glob {
         path: PathBuf,
@@ -162,9 +159,9 @@ impl Project {
             source,
         };
         let text = std::fs::read_to_string(path).map_err(io)?;
-        let file: ProjectFile = toml::from_str(&text).map_err(|source| ProjectError::Toml {
+        let file: ProjectFile = toml::from_str(&text).map_err(|e| ProjectError::Toml {
             path: path.to_path_buf(),
-            source,
+            message: e.to_string(),
         })?;
         let root = match path.parent() {
             Some(dir) if !dir.as_os_str().is_empty() => dir.to_path_buf(),
