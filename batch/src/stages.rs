@@ -47,6 +47,8 @@ pub struct StageRun {
     pub cached: bool,
     pub seconds: f64,
     pub counts: String,
+    /// The hash of each output the stage made (`bsp`, `prt`, `lit`, `png`).
+    pub outputs: BTreeMap<String, String>,
 }
 
 /// Why a map failed: the stage and the error.
@@ -160,6 +162,7 @@ fn cached_stage(
             cached: true,
             seconds: record.seconds,
             counts: record.counts.clone(),
+            outputs: record.outputs.clone(),
         });
         return Ok(record);
     }
@@ -188,6 +191,7 @@ fn cached_stage(
         cached: false,
         seconds: record.seconds,
         counts: record.counts.clone(),
+        outputs: record.outputs.clone(),
     });
     Ok(record)
 }
