@@ -479,7 +479,15 @@ fn light_stage(
     }
     cached_stage(ctx, "light", key.finish(), runs, || {
         let mut bsp = read_bsp(&blob(ctx, "ents", with_entities, "bsp").map_err(|f| f.message)?)?;
-        let lighting = light::compute_lighting(&bsp, &options).map_err(|e| e.to_string())?;
+        let lighting = match args.threads {
+            Some(n) => rayon::ThreadPoolBuilder::new()
+                .num_threads(usize::from(n))
+                .build()
+                .map_err(|e| format!("starting the worker threads: {e}"))?
+                .install(|| light::compute_lighting(&bsp, &options)),
+            None => light::compute_lighting(&bsp, &options),
+        }
+        .map_err(|e| e.to_string())?;
         let coloured = light::apply_lighting(&mut bsp, &lighting);
         let lit = args.lit_to_write(&bsp, coloured);
         let mut outputs = vec![("bsp", bsp.write().map_err(|e| e.to_string())?)];
