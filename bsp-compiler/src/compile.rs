@@ -486,17 +486,9 @@ pub fn compile(
     stats.leaked = leak.is_some();
 
     let t = Instant::now();
-    let mut search = options.wad_dirs.clone();
-    if let Some(dir) = source.path.parent() {
-        search.push(if dir.as_os_str().is_empty() {
-            PathBuf::from(".")
-        } else {
-            dir.to_path_buf()
-        });
-    }
     let wads = WadSet::load(
         map.entities[0].entity.get("wad").unwrap_or(""),
-        &search,
+        &wad_search_dirs(source, options),
         &mut warnings,
     );
     let version = if options.bsp2 {
@@ -569,6 +561,20 @@ pub fn compile(
 }
 
 /// Parse a map, its prefabs expanded; the first entity must be worldspawn.
+/// The folders searched, in order, for the WADs a map names: `options.wad_dirs`, then the map's
+/// own folder.
+pub fn wad_search_dirs(source: &MapSource, options: &CompileOptions) -> Vec<PathBuf> {
+    let mut search = options.wad_dirs.clone();
+    if let Some(dir) = source.path.parent() {
+        search.push(if dir.as_os_str().is_empty() {
+            PathBuf::from(".")
+        } else {
+            dir.to_path_buf()
+        });
+    }
+    search
+}
+
 pub(crate) fn read_map(source: &MapSource) -> Result<MapFile, CompileError> {
     let map = expand_prefabs(parse_map(&source.path, &source.text)?, &source.path)?;
     let classname = map

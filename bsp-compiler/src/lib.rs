@@ -39,6 +39,7 @@ pub mod weld;
 
 pub use compile::{
     CompileError, CompileOptions, CompileOutput, CompileStats, MapSource, MapTexInfo, compile,
+    wad_search_dirs,
 };
 pub use outside::Leak;
 pub use progress::{Progress, ProgressEvent};
