@@ -8,6 +8,7 @@ pub mod brush;
 pub mod cli;
 pub mod level;
 pub mod maps;
+pub mod open;
 pub mod textures;
 
 use quake_formats::FormatError;
