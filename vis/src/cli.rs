@@ -126,10 +126,7 @@ pub fn partial_path(bsp: &Path, shard: Shard) -> PathBuf {
     saved_path(bsp, &format!("vis.{}-of-{}", shard.index + 1, shard.count))
 }
 
-fn checkpoint<'a>(
-    args: &Args,
-    save: &'a SaveFlows<'a>,
-) -> Option<Checkpoint<'a>> {
+fn checkpoint<'a>(args: &Args, save: &'a SaveFlows<'a>) -> Option<Checkpoint<'a>> {
     (args.save_interval > 0.0 && !args.fast).then(|| Checkpoint {
         every: Duration::from_secs_f64(args.save_interval),
         save,
