@@ -24,7 +24,7 @@ fn main() {
     let n = graph.portals.len();
     let mightsee: Vec<_> = (0..n).map(|p| vis::base::mightsee(&graph, p)).collect();
     let results: Vec<OnceLock<vis::BitSet>> = (0..n).map(|_| OnceLock::new()).collect();
-    let plan = FlowPlan::new(&mightsee);
+    let plan = FlowPlan::new(&mightsee, vis::Grouping::Auto);
     let order: Vec<usize> = plan.waves().flatten().copied().collect();
     let mut ws = vis::flow::Workspace::default();
     let mut costs = Vec::new();

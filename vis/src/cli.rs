@@ -69,6 +69,7 @@ pub fn run(args: &Args) -> Result<()> {
             },
             threads: args.threads,
             progress: true,
+            ..Default::default()
         };
         let state_path = saved_path(&args.bsp, "vis.state");
         let known = resume_state(args, &inputs, Shard::WHOLE, &state_path)?;
@@ -208,6 +209,7 @@ fn run_shard(args: &Args, inputs: &Inputs, shard: Shard) -> Result<()> {
         &inputs.prt,
         args.level,
         args.threads,
+        crate::Grouping::Auto,
         shard,
         known,
         checkpoint.as_ref(),
@@ -223,10 +225,11 @@ fn run_shard(args: &Args, inputs: &Inputs, shard: Shard) -> Result<()> {
     write_atomic(&out, &partial.write())?;
     remove_state(&state_path);
     eprintln!(
-        "vis shard {shard}: {} of {} one-way portal flows written to {}; base vis {:.2} s, flow {:.2} s",
+        "vis shard {shard}: {} of {} one-way portal flows written to {} (the plan has {} final group(s) to share); base vis {:.2} s, flow {:.2} s",
         partial.results.len(),
         flows.portals,
         out.display(),
+        flows.groups,
         flows.base_seconds,
         flows.flow_seconds
     );

@@ -26,7 +26,7 @@ pub use clusters::Clusters;
 pub use lump::{LumpStats, check_portals_match, read_pvs, write_vis};
 pub use portals::PortalGraph;
 pub use pvs::Pvs;
-pub use schedule::{FlowPlan, Shard};
+pub use schedule::{FlowPlan, Grouping, Shard};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use quake_formats::prt::PortalFile;
@@ -111,6 +111,8 @@ pub struct VisOptions {
     pub threads: Option<usize>,
     /// Show a progress bar on stderr (only drawn when stderr is a terminal).
     pub progress: bool,
+    /// Whether the full flow is planned in groups for shards ([`FlowPlan`]).
+    pub grouping: Grouping,
 }
 
 impl Default for VisOptions {
@@ -119,6 +121,7 @@ impl Default for VisOptions {
             mode: VisMode::Full { level: 4 },
             threads: None,
             progress: false,
+            grouping: Grouping::Auto,
         }
     }
 }
@@ -188,7 +191,7 @@ pub fn compute_vis_resuming(
             VisMode::Fast => mightsee.clone(),
             VisMode::Full { level } => {
                 let wanted = vec![true; mightsee.len()];
-                let plan = FlowPlan::new(&mightsee);
+                let plan = FlowPlan::new(&mightsee, options.grouping);
                 let job = FlowJob {
                     graph: &setup.graph,
                     mightsee: &mightsee,
@@ -221,6 +224,8 @@ pub struct ShardFlows {
     pub portals: usize,
     /// The results the shard hands on ([`FlowPlan::owned`]), by portal, ascending.
     pub results: Vec<(usize, BitSet)>,
+    /// Final groups in the plan ([`FlowPlan::groups`]): more shards than this get no final work.
+    pub groups: usize,
     pub base_seconds: f64,
     pub flow_seconds: f64,
 }
@@ -232,6 +237,7 @@ pub fn compute_shard(
     prt: &PortalFile,
     level: u8,
     threads: Option<usize>,
+    grouping: Grouping,
     shard: Shard,
     known: KnownFlows,
     checkpoint: Option<&Checkpoint>,
@@ -240,7 +246,7 @@ pub fn compute_shard(
     Ok(setup.pool.install(|| {
         let (mightsee, base_seconds) = base_vis(&setup.graph);
         let start = Instant::now();
-        let plan = FlowPlan::new(&mightsee);
+        let plan = FlowPlan::new(&mightsee, grouping);
         let wanted = plan.runs(shard);
         let job = FlowJob {
             graph: &setup.graph,
@@ -260,6 +266,7 @@ pub fn compute_shard(
         ShardFlows {
             portals: mightsee.len(),
             results,
+            groups: plan.groups(),
             base_seconds,
             flow_seconds: start.elapsed().as_secs_f64(),
         }
@@ -520,12 +527,18 @@ mod tests {
     #[test]
     fn shards_joined_give_the_sets_of_one_run() {
         let prt = caves();
-        let whole = compute_vis(&prt, &VisOptions::default()).expect("vis");
+        let grouped = VisOptions {
+            grouping: Grouping::Always,
+            ..VisOptions::default()
+        };
+        let whole = compute_vis(&prt, &grouped).expect("vis");
         for count in [1, 2, 3, 16, 17] {
             let mut flows: Vec<Option<BitSet>> = Vec::new();
             for index in 0..count {
                 let shard = Shard { index, count };
-                let part = compute_shard(&prt, 4, Some(2), shard, Vec::new(), None).expect("shard");
+                let part =
+                    compute_shard(&prt, 4, Some(2), Grouping::Always, shard, Vec::new(), None)
+                        .expect("shard");
                 flows.resize(part.portals, None);
                 for (p, set) in part.results {
                     assert!(flows[p].replace(set).is_none(), "portal {p} twice");
@@ -545,6 +558,7 @@ mod tests {
         let prt = caves();
         let options = VisOptions {
             threads: Some(2),
+            grouping: Grouping::Always,
             ..VisOptions::default()
         };
         let whole = compute_vis(&prt, &options).expect("vis");

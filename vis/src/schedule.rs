@@ -6,7 +6,8 @@
 //! those holding [`FINAL_COST`] of the estimated work, are cut into [`FINAL_GROUPS`] groups of
 //! neighbouring portals; a final flow is bounded only by shared flows and by those of its own
 //! group, so groups can run on different machines. Every shard runs the shared flows itself and
-//! its groups; a whole run runs them all, and the bounds, hence the sets, are the same.
+//! its groups; a whole run runs them all, and the bounds, hence the sets, are the same. Maps too
+//! small to be worth sharding ([`GROUPED_MIN_WORK`]) get one final group.
 
 use crate::bitset::BitSet;
 
@@ -19,6 +20,23 @@ const MIN_WAVE_PORTALS: usize = 16;
 const FINAL_COST: f64 = 0.8;
 /// How many final groups: the most shards that share the work.
 const FINAL_GROUPS: usize = 16;
+/// Maps whose estimated flow work ([`estimated_cost`] summed over portals) is below this get one
+/// final group: every flow is bounded by all earlier waves, the fastest plan for one machine,
+/// and a sharded run gives all the final work to its first shard. Grouping costs a whole run
+/// 1.6-1.8 times the work, so only maps big enough to be worth sharding pay it. Measured
+/// estimates: LibreQuake e3m4 7.2e8, e2m4 3.7e9, id e1m1 4.9e9, retrojam1 9.9e9 (9 CPU seconds),
+/// `maps/open` 1.3e10 (38 CPU seconds with one group).
+pub const GROUPED_MIN_WORK: f64 = 1.1e10;
+
+/// Whether the plan cuts the final portals into groups for shards.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum Grouping {
+    /// Groups only for maps of at least [`GROUPED_MIN_WORK`] estimated work.
+    #[default]
+    Auto,
+    /// Groups whatever the map's size (tests use it to shard small maps).
+    Always,
+}
 
 /// A flow's estimated work from its mightsee count: the walk meets each portal it might see on
 /// paths whose number grows with the count too.
@@ -75,14 +93,18 @@ pub struct FlowPlan {
 }
 
 impl FlowPlan {
-    pub fn new(mightsee: &[BitSet]) -> FlowPlan {
+    pub fn new(mightsee: &[BitSet], grouping: Grouping) -> FlowPlan {
         let n = mightsee.len();
         let counts: Vec<usize> = mightsee.iter().map(BitSet::count).collect();
         let cost = |p: usize| estimated_cost(counts[p]);
         let mut order: Vec<usize> = (0..n).collect();
         order.sort_by_key(|&p| (counts[p], p));
         let total: f64 = (0..n).map(cost).sum();
-        let groups = FINAL_GROUPS;
+        let groups = if grouping == Grouping::Always || total >= GROUPED_MIN_WORK {
+            FINAL_GROUPS
+        } else {
+            1
+        };
         // Walk back from the costliest until the final portals hold their share of the work.
         let mut final_start = n;
         let mut final_cost = 0.0;
@@ -117,6 +139,11 @@ impl FlowPlan {
             group_of,
             group_cost,
         }
+    }
+
+    /// How many final groups the plan has: the most shards that can share the final work.
+    pub fn groups(&self) -> usize {
+        self.group_cost.len()
     }
 
     /// Every wave in run order.
@@ -218,22 +245,35 @@ mod tests {
     }
 
     #[test]
+    fn a_map_too_small_to_shard_gets_one_group_bounded_by_every_earlier_wave() {
+        let counts: Vec<usize> = (0..400).map(|i| (i * 37) % 101).collect();
+        let plan = FlowPlan::new(&sets(&counts), Grouping::Auto);
+        assert_eq!(plan.groups(), 1);
+        for base in 0..400 {
+            for q in (0..400).step_by(7) {
+                assert_eq!(plan.bounds(base, q), plan.wave_of[q] < plan.wave_of[base]);
+            }
+        }
+        assert_eq!(plan.shard_groups(4), [vec![1], vec![], vec![], vec![]]);
+    }
+
+    #[test]
     fn the_costliest_portals_are_final_and_the_waves_cover_every_portal_once() {
         let mightsee = sets(&[5, 1, 90, 3, 40, 2, 0, 70, 8, 8]);
-        let plan = FlowPlan::new(&mightsee);
+        let plan = FlowPlan::new(&mightsee, Grouping::Always);
         assert!(!plan.is_shared(2) && !plan.is_shared(7));
         assert!(plan.is_shared(6) && plan.is_shared(1));
         let mut all: Vec<usize> = plan.waves().flatten().copied().collect();
         all.sort();
         assert_eq!(all, (0..10).collect::<Vec<_>>());
-        assert_eq!(FlowPlan::new(&[]).waves().count(), 0);
+        assert_eq!(FlowPlan::new(&[], Grouping::Auto).waves().count(), 0);
     }
 
     #[test]
     fn flows_are_bounded_by_earlier_waves_of_their_own_group_or_shared_ones() {
-        let counts: Vec<usize> = (0..4000).map(|i| (i * 37) % 1001).collect();
+        let counts: Vec<usize> = (0..4000).map(|i| (i * 37) % 4001).collect();
         let mightsee = sets(&counts);
-        let plan = FlowPlan::new(&mightsee);
+        let plan = FlowPlan::new(&mightsee, Grouping::Always);
         let groups: std::collections::BTreeSet<u32> = plan.group_of.iter().copied().collect();
         assert_eq!(groups.len(), FINAL_GROUPS + 1, "{groups:?}");
         for base in (0..4000).step_by(7) {
@@ -251,9 +291,9 @@ mod tests {
 
     #[test]
     fn shards_are_balanced_by_cost_and_together_own_every_portal_once() {
-        let counts: Vec<usize> = (0..2000).map(|i| (i * 37) % 101).collect();
+        let counts: Vec<usize> = (0..2000).map(|i| (i * 37) % 5001).collect();
         let mightsee = sets(&counts);
-        let plan = FlowPlan::new(&mightsee);
+        let plan = FlowPlan::new(&mightsee, Grouping::Always);
         let biggest = plan.group_cost.iter().copied().fold(0.0, f64::max);
         for count in [1, 2, 3, 4, 7, 50] {
             let groups = plan.shard_groups(count);
