@@ -28,9 +28,9 @@ fn valve_face(points: [[f64; 3]; 3], u: [f64; 3], v: [f64; 3], rotation: f64) ->
     for p in points {
         write!(s, "( {:?} {:?} {:?} ) ", p[0], p[1], p[2]).expect("write");
     }
-    write!(
+    writeln!(
         s,
-        "crate [ {:?} {:?} {:?} 0 ] [ {:?} {:?} {:?} 0 ] {rotation} 1 1\n",
+        "crate [ {:?} {:?} {:?} 0 ] [ {:?} {:?} {:?} 0 ] {rotation} 1 1",
         u[0], u[1], u[2], v[0], v[1], v[2]
     )
     .expect("write");
