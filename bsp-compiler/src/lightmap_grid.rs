@@ -190,3 +190,135 @@ fn nudged(vecs: &[[f32; 4]; 2], steps: [usize; 2]) -> [[f32; 4]; 2] {
     }
     v
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use quake_formats::bsp::{Face, TexInfo};
+
+    /// s along a texture turned 10 degrees; t constant (0.5) on the z = 0 plane.
+    const VECS: [[f32; 4]; 2] = [
+        [0.984_807_7, -0.173_648_18, 0.0, 3.661_621],
+        [0.0, 0.0, -1.0, 0.5],
+    ];
+
+    fn add_face(bsp: &mut Bsp, points: &[[f32; 3]]) {
+        let first_edge = bsp.surfedges.len() as u32;
+        let first_vertex = bsp.vertices.len() as u32;
+        bsp.vertices.extend_from_slice(points);
+        let n = points.len() as u32;
+        for k in 0..n {
+            bsp.surfedges.push(bsp.edges.len() as i32);
+            bsp.edges
+                .push([first_vertex + k, first_vertex + (k + 1) % n]);
+        }
+        bsp.faces.push(Face {
+            plane: 0,
+            side: 0,
+            first_edge,
+            num_edges: n,
+            texinfo: 0,
+            styles: [0, 255, 255, 255],
+            light_offset: -1,
+        });
+    }
+
+    /// Face 0 has a vertex the engines snap to different grid lines, fixed by every step; each
+    /// of faces 1-4 agrees as it is but has its extreme vertices where two of the steps make the
+    /// engines disagree. No step suits all five: face 0 gets a texinfo of its own, nudged by the
+    /// first step, and the rest keep theirs.
+    fn conflicting_faces() -> Bsp {
+        let mut bsp = Bsp::new(BspVersion::Bsp29);
+        bsp.edges.push([0, 0]);
+        bsp.texinfo.push(TexInfo {
+            vecs: VECS,
+            miptex: 0,
+            flags: 0,
+        });
+        let faces: [[[f32; 3]; 3]; 5] = [
+            [
+                [160.220_55, 469.040_65, 0.0],
+                [130.0, 469.040_65, 0.0],
+                [130.0, 440.0, 0.0],
+            ],
+            [
+                [1490.782_7, 275.425_72, 0.0],
+                [641.025_15, 155.008_35, 0.0],
+                [1065.903_9, 282.425_72, 0.0],
+            ],
+            [
+                [311.087_04, 311.463_26, 0.0],
+                [273.870_97, 468.242_03, 0.0],
+                [292.479, 475.242_03, 0.0],
+            ],
+            [
+                [2350.862, 454.381_01, 0.0],
+                [1534.156_9, 336.412_54, 0.0],
+                [1942.509_5, 461.381_01, 0.0],
+            ],
+            [
+                [2236.942_9, 177.054_69, 0.0],
+                [1977.521_5, 270.749_05, 0.0],
+                [2107.232_2, 277.749_05, 0.0],
+            ],
+        ];
+        for f in &faces {
+            add_face(&mut bsp, f);
+        }
+        bsp
+    }
+
+    fn disagreeing(bsp: &Bsp) -> Vec<usize> {
+        (0..bsp.faces.len())
+            .filter(|&i| {
+                let points = bsp.face_vertices(&bsp.faces[i]).expect("face");
+                let vecs = bsp.texinfo[bsp.faces[i].texinfo as usize].vecs;
+                LightmapExtents::engines_disagree(&points, &vecs) != [false, false]
+            })
+            .collect()
+    }
+
+    #[test]
+    fn faces_needing_different_steps_split_their_texinfo() {
+        let mut bsp = conflicting_faces();
+        assert_eq!(disagreeing(&bsp), [0]);
+        let stats = agree_on_lightmap_grid(&mut bsp);
+        assert_eq!(
+            stats,
+            LightmapGridStats {
+                faces_disagreeing: 1,
+                nudged_texinfos: 0,
+                split_texinfos: 1,
+                unresolved_faces: 0,
+            }
+        );
+        assert_eq!(disagreeing(&bsp), Vec::<usize>::new());
+        assert_eq!(bsp.texinfo.len(), 2);
+        assert_eq!(bsp.faces[0].texinfo, 1);
+        assert!(bsp.faces[1..].iter().all(|f| f.texinfo == 0));
+        assert_eq!(bsp.texinfo[0].vecs, VECS);
+        assert_eq!(bsp.texinfo[1].vecs[0][3], VECS[0][3] + NUDGE_STEPS[0]);
+        assert_eq!(bsp.texinfo[1].vecs[1], VECS[1]);
+    }
+
+    #[test]
+    fn a_full_texinfo_table_leaves_the_face_and_counts_it() {
+        let mut bsp = conflicting_faces();
+        let filler = bsp.texinfo[0];
+        bsp.texinfo.resize(BSP29_MAX_TEXINFO, filler);
+        let stats = agree_on_lightmap_grid(&mut bsp);
+        assert_eq!((stats.split_texinfos, stats.unresolved_faces), (0, 1));
+        assert_eq!(bsp.texinfo.len(), BSP29_MAX_TEXINFO);
+        assert_eq!(disagreeing(&bsp), [0]);
+    }
+
+    #[test]
+    fn a_face_alone_is_nudged_in_place() {
+        let mut bsp = conflicting_faces();
+        bsp.faces.truncate(1);
+        let stats = agree_on_lightmap_grid(&mut bsp);
+        assert_eq!((stats.nudged_texinfos, stats.split_texinfos), (1, 0));
+        assert_eq!(bsp.texinfo[0].vecs[0][3], VECS[0][3] + NUDGE_STEPS[0]);
+        assert_eq!(disagreeing(&bsp), Vec::<usize>::new());
+    }
+}
