@@ -10,6 +10,7 @@ use crate::faces::{
     merge_faces, projection_squareness,
 };
 use crate::hulls::{HULL_BOXES, expand_brush};
+use crate::lightmap_grid::{LightmapGridStats, agree_on_lightmap_grid};
 use crate::map::{MapBrush, MapEntity, MapError, MapFile, parse_map, read_map_text};
 use crate::outside::{FillOutcome, Leak, Occupant, fill_outside};
 use crate::planes::PlaneSet;
@@ -158,6 +159,8 @@ pub struct CompileStats {
     pub tjunction_vertices: usize,
     pub leaked: bool,
     pub face_stats: FaceStats,
+    /// Texture offsets nudged so QuakeSpasm and DarkPlaces size every lightmap alike.
+    pub lightmap_grid: LightmapGridStats,
     /// Phase name and seconds; phases run per model are summed over models (CPU time).
     pub timings: Vec<(String, f64)>,
 }
@@ -507,6 +510,7 @@ pub fn compile(
         warnings: &mut warnings,
     });
     let mut bsp = emitted.bsp;
+    stats.lightmap_grid = agree_on_lightmap_grid(&mut bsp);
     if options.brush_list {
         listed.resize_with(bsp.models.len(), Vec::new);
         bsp.bspx.push(brush_list_lump(&listed));
