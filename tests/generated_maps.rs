@@ -222,7 +222,22 @@ fn random_maps_keep_every_property() {
     check_seeds(0..24, &RandomOptions::default());
 }
 
-/// The maps this test found, shrunk (`maps/hard/random_*.map`), keep every property.
+/// The seed a shrunk map was found with, from its header ("random map seed N"), so its check
+/// replays the moves and sight lines that found it; 1 when it names none.
+fn found_seed(text: &str) -> u64 {
+    let marker = "random map seed ";
+    text.lines()
+        .take_while(|l| l.starts_with("//"))
+        .find_map(|l| {
+            let rest = &l[l.find(marker)? + marker.len()..];
+            let digits: String = rest.chars().take_while(char::is_ascii_digit).collect();
+            digits.parse().ok()
+        })
+        .unwrap_or(1)
+}
+
+/// The maps this test found, shrunk (`maps/hard/random_*.map`), keep every property, checked
+/// with the seed that found each.
 #[test]
 fn shrunk_failures_keep_every_property() {
     let found: Vec<PathBuf> = hard::hard_maps()
@@ -236,7 +251,7 @@ fn shrunk_failures_keep_every_property() {
     assert!(!found.is_empty(), "no maps/hard/random_*.map");
     for path in found {
         let text = std::fs::read_to_string(&path).expect("read map");
-        if let Err(f) = check(&text, 1) {
+        if let Err(f) = check(&text, found_seed(&text)) {
             panic!("{}: {} fails: {}", path.display(), f.property, f.detail);
         }
     }

@@ -21,7 +21,7 @@ use crate::surface_tree::rebuild_from_surfaces;
 use crate::texinfo::{Projection, TextureRole};
 use crate::tree::{
     DETAIL_WALL, FENCE, ILLUSIONARY, MID_SPLIT_SIZE, SplitHeuristic, Splitting, Tree, VISBLOCKER,
-    build_tree, engine_contents,
+    build_clip_hull_tree, build_tree, engine_contents,
 };
 use crate::wad_lookup::WadSet;
 use crate::warnings::Warning;
@@ -977,12 +977,12 @@ fn build_model(
             let t = Instant::now();
             let (a, b) = rayon::join(
                 || {
-                    let tree = build_tree(h1, planes, heuristic, false);
+                    let tree = build_clip_hull_tree(h1, planes, heuristic);
                     progress.advance(counts[1]);
                     tree
                 },
                 || {
-                    let tree = build_tree(h2, planes, heuristic, false);
+                    let tree = build_clip_hull_tree(h2, planes, heuristic);
                     progress.advance(counts[2]);
                     tree
                 },

@@ -62,23 +62,28 @@ pub fn expand_brush(brush: &Brush, planes: &mut PlaneSet, mins: Vec3, maxs: Vec3
             }
         }
     }
-    let grown: Vec<BrushPlane> = list
-        .iter()
-        .map(|p| {
-            let n = p.normal;
-            let push: f64 = (0..3)
-                .map(|i| {
-                    if n[i] >= 0.0 {
-                        -n[i] * mins[i]
-                    } else {
-                        -n[i] * maxs[i]
-                    }
-                })
-                .sum();
-            BrushPlane {
-                plane: Plane::new(n, p.dist + push),
-                texinfo: None,
-            }
+    // Planes that differ before growing may be one plane after it (a face and a bevel a
+    // millionth of a radian apart, each pushed out by its own support): keep the first, or
+    // building the brush refuses the pair and the hull loses the whole brush.
+    let mut grown_planes: Vec<Plane> = Vec::with_capacity(list.len());
+    for p in &list {
+        let n = p.normal;
+        let push: f64 = (0..3)
+            .map(|i| {
+                if n[i] >= 0.0 {
+                    -n[i] * mins[i]
+                } else {
+                    -n[i] * maxs[i]
+                }
+            })
+            .sum();
+        push_unique(&mut grown_planes, Plane::new(n, p.dist + push));
+    }
+    let grown: Vec<BrushPlane> = grown_planes
+        .into_iter()
+        .map(|plane| BrushPlane {
+            plane,
+            texinfo: None,
         })
         .collect();
     Brush::from_planes(&grown, planes, contents::SOLID, brush.source).ok()
@@ -163,6 +168,65 @@ mod tests {
         assert_eq!(g.bounds.mins, Vec3::new(-16.0, -16.0, -32.0));
         assert_eq!(g.bounds.maxs, Vec3::new(80.0, 80.0, 88.0));
         assert_eq!(g.sides.len(), 6);
+    }
+
+    #[test]
+    fn a_bevel_that_grows_onto_a_face_keeps_the_brush() {
+        // A rotated, tilted func_detail block (generated seed 1089): one of its faces is 5e-7 rad
+        // off vertical; the edge bevel beside it is vertical and 0.001 units further out. They
+        // are two planes until hull 2's box pushes them out, when they became one and building
+        // the grown brush failed, so hull 2 lost the block.
+        let points = [
+            [
+                "-584.0554 643.0143 91.1444",
+                "-606.3677 670.0003 7.7137",
+                "-670.7218 616.7915 7.7137",
+            ],
+            [
+                "-687.9352 637.6105 7.7137",
+                "-623.5811 690.8193 7.7137",
+                "-601.2688 663.8333 91.1444",
+            ],
+            [
+                "-623.5811 690.8193 7.7137",
+                "-606.3677 670.0003 7.7137",
+                "-584.0554 643.0143 91.1444",
+            ],
+            [
+                "-648.4095 589.8055 91.1444",
+                "-670.7218 616.7915 7.7137",
+                "-687.9352 637.6105 7.7137",
+            ],
+            [
+                "-670.7218 616.7915 7.7137",
+                "-606.3677 670.0003 7.7137",
+                "-623.5811 690.8193 7.7137",
+            ],
+            [
+                "-601.2688 663.8333 91.1444",
+                "-584.0554 643.0143 91.1444",
+                "-648.4095 589.8055 91.1444",
+            ],
+        ];
+        let point = |s: &str| {
+            let v: Vec<f64> = s.split(' ').map(|c| c.parse().expect("number")).collect();
+            Vec3::new(v[0], v[1], v[2])
+        };
+        let faces: Vec<BrushPlane> = points
+            .iter()
+            .map(|[a, b, c]| BrushPlane {
+                plane: Plane::from_points(point(a), point(b), point(c))
+                    .expect("plane")
+                    .snapped(),
+                texinfo: Some(0),
+            })
+            .collect();
+        let mut planes = PlaneSet::new();
+        let b = Brush::from_planes(&faces, &mut planes, contents::SOLID, 0).expect("block");
+        for (mins, maxs) in HULL_BOXES {
+            let g = expand_brush(&b, &mut planes, mins, maxs).expect("grown");
+            assert!(g.volume() > b.volume());
+        }
     }
 
     #[test]

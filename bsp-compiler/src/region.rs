@@ -158,7 +158,7 @@ impl Region {
 
     /// The parts in front of and behind a plane that crosses the region. Should the cut come
     /// out too thin to build on, both parts are the whole region.
-    fn split(&self, plane: &Plane) -> [Region; 2] {
+    pub(crate) fn split(&self, plane: &Plane) -> [Region; 2] {
         match self.cross_section(plane) {
             Some(cut) => self.parts(plane, cut),
             None => [self.clone(), self.clone()],

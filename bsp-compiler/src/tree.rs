@@ -325,13 +325,16 @@ struct Builder<'a> {
     planes: &'a PlaneSet,
     splitting: Splitting,
     keep_brushes: bool,
+    /// Every node plane must cut its region cleanly (see [`Region::split_cleanly`]).
+    clean_splits: bool,
     splits: AtomicUsize,
 }
 
 /// Build the tree of `brushes`. `keep_brushes` keeps each leaf's fragments in the result.
 ///
 /// Structural (and hint) brush sides split first; where none is left, the node is a structural
-/// leaf, and the detail brushes in it are split in below.
+/// leaf, and the detail brushes in it are split in below. Every node plane cuts its region
+/// cleanly, for engines that rebuild portals from the tree (DarkPlaces).
 pub fn build_tree(
     brushes: Vec<Brush>,
     planes: &PlaneSet,
@@ -342,27 +345,29 @@ pub fn build_tree(
         planes,
         splitting: splitting.into(),
         keep_brushes,
+        clean_splits: true,
         splits: AtomicUsize::new(0),
     };
-    let bounds = brushes
-        .iter()
-        .fold(Bounds::EMPTY, |acc, b| acc.union(&b.bounds));
-    let bounds = if bounds.is_empty() {
-        Bounds {
-            mins: Vec3::ZERO,
-            maxs: Vec3::ZERO,
-        }
-    } else {
-        bounds
+    builder.tree(brushes)
+}
+
+/// Build the tree of a clip hull's grown `brushes`. No engine rebuilds portals from clip nodes,
+/// so their planes need not cut their regions cleanly: a region too thin for that (between grown
+/// sides less than a portal epsilon apart) is split like any other, where [`build_tree`] would
+/// fill it as a crack, which in a clip hull is an invisible wall.
+pub fn build_clip_hull_tree(
+    brushes: Vec<Brush>,
+    planes: &PlaneSet,
+    splitting: impl Into<Splitting>,
+) -> Tree {
+    let builder = Builder {
+        planes,
+        splitting: splitting.into(),
+        keep_brushes: false,
+        clean_splits: false,
+        splits: AtomicUsize::new(0),
     };
-    let region = Region::around(&bounds, REGION_MARGIN);
-    let root = builder.build(brushes, Phase::Structural, region);
-    let mut nodes = Vec::new();
-    flatten(root, &mut nodes);
-    Tree {
-        nodes,
-        splits: builder.splits.load(Ordering::Relaxed),
-    }
+    builder.tree(brushes)
 }
 
 pub(crate) fn flatten(node: BuildNode, out: &mut Vec<TreeNode>) -> u32 {
@@ -421,6 +426,31 @@ impl Phase {
 }
 
 impl Builder<'_> {
+    fn tree(&self, brushes: Vec<Brush>) -> Tree {
+        let bounds = brushes
+            .iter()
+            .fold(Bounds::EMPTY, |acc, b| acc.union(&b.bounds));
+        let bounds = if bounds.is_empty() {
+            Bounds {
+                mins: Vec3::ZERO,
+                maxs: Vec3::ZERO,
+            }
+        } else {
+            bounds
+        };
+        let root = self.build(
+            brushes,
+            Phase::Structural,
+            Region::around(&bounds, REGION_MARGIN),
+        );
+        let mut nodes = Vec::new();
+        flatten(root, &mut nodes);
+        Tree {
+            nodes,
+            splits: self.splits.load(Ordering::Relaxed),
+        }
+    }
+
     /// The subtree of the node whose space is `region`, holding `brushes` (parts of them may
     /// lie outside it).
     fn build(&self, brushes: Vec<Brush>, phase: Phase, region: Region) -> BuildNode {
@@ -434,6 +464,9 @@ impl Builder<'_> {
             };
             if let Some(parts) = region.split_cleanly(self.planes.get(plane)) {
                 break (Some((plane, parts)), false);
+            }
+            if !self.clean_splits {
+                break (Some((plane, region.split(self.planes.get(plane)))), false);
             }
             // Rare: choose again with the sliver given to the rest of the region.
             brushes = self.absorb_sliver(brushes, plane, &region);
