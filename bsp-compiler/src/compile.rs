@@ -231,7 +231,7 @@ const MODEL_PHASES: [&str; 6] = ["tree", "portals", "outside", "faces", "hulls",
 
 /// How an entity's brushes enter the compile.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum EntityBrushes {
+pub(crate) enum EntityBrushes {
     /// Worldspawn and `func_group`.
     World,
     /// `func_detail`: world brushes that do not split the vis structure.
@@ -249,7 +249,7 @@ enum EntityBrushes {
 }
 
 impl EntityBrushes {
-    fn of(index: usize, classname: &str) -> EntityBrushes {
+    pub(crate) fn of(index: usize, classname: &str) -> EntityBrushes {
         match classname {
             _ if index == 0 => EntityBrushes::World,
             "func_group" => EntityBrushes::World,

@@ -7,7 +7,8 @@
 //! merging, subdivision), [`hulls`] (clip hulls) and [`surface_tree`] (their trees rebuilt after
 //! filling), [`weld`] (shared vertices, T-junctions) and `emit`. [`compile()`] runs them all;
 //! [`cracks`] checks a written BSP for T-junctions and unshared edges;
-//! [`trace`] moves a hull's box through a written BSP as engines do.
+//! [`trace`] moves a hull's box through a written BSP as engines do, and [`hull_check`] measures
+//! whether those moves stop where the map's brushes say.
 
 pub mod brush;
 pub mod brushlist;
@@ -18,6 +19,7 @@ pub mod cracks;
 pub mod csg;
 mod emit;
 pub mod faces;
+pub mod hull_check;
 pub mod hulls;
 pub mod map;
 pub mod onlyents;

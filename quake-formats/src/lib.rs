@@ -4,7 +4,8 @@
 //! that round-trips byte-for-byte: [`bsp`] (BSP29 and BSP2), [`wad`] (WAD2), [`miptex`],
 //! [`palette`], [`entities`], [`prt`] (portal files), [`pts`] (pointfiles), [`lit`] (coloured
 //! lightmaps), [`visrle`] (PVS row compression), [`extents`] (lightmap extents of a face) and
-//! [`geom`] (f64 vectors, planes, windings and the epsilon policy).
+//! [`geom`] (f64 vectors, planes, windings and the epsilon policy); [`rng`] is the seeded
+//! generator the tools sample with.
 
 pub mod bsp;
 mod bytes;
@@ -19,6 +20,7 @@ pub mod miptex;
 pub mod palette;
 pub mod prt;
 pub mod pts;
+pub mod rng;
 pub mod visrle;
 pub mod wad;
 
