@@ -26,6 +26,9 @@ pub struct ReportArgs {
     /// Sight lines sampled per map to check each PVS
     #[arg(long, default_value_t = 200_000)]
     sample_pairs: usize,
+    /// Player-box moves traced per BSP to check its clip hull against the map's brushes
+    #[arg(long, default_value_t = 2000)]
+    hull_traces: usize,
     /// Frames of the viewer's flythrough per span step
     #[arg(long, default_value_t = 120)]
     view_frames: usize,
@@ -75,6 +78,7 @@ pub fn report(args: &ReportArgs) -> Result<()> {
         wad_dirs,
         reference_faces: args.reference_faces,
         sample_pairs: args.sample_pairs,
+        hull_traces: args.hull_traces,
         view_frames: args.view_frames,
         view_size: (320, 240),
         release: !cfg!(debug_assertions),

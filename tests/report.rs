@@ -78,6 +78,8 @@ fn report_measures_every_stage_and_setting_and_draws_its_plots() {
         "20000",
         "--view-frames",
         "10",
+        "--hull-traces",
+        "300",
         "maps/test/corridors.map",
     ]);
     let stderr = String::from_utf8_lossy(&run.stderr);
@@ -105,7 +107,15 @@ fn report_measures_every_stage_and_setting_and_draws_its_plots() {
         assert!(wall.is_finite() && wall > 0.0, "{row}");
         let figures = &row["figures"];
         let error = match row["stage"].as_str() {
-            Some("bsp") => figures["bsp"]["tjunctions"].as_f64(),
+            Some("bsp") => {
+                assert!(figures["bsp"]["hull_traces"].as_u64() > Some(0), "{row}");
+                assert!(
+                    figures["bsp"]["hull_worst_gap"]
+                        .as_f64()
+                        .is_some_and(f64::is_finite)
+                );
+                figures["bsp"]["tjunctions"].as_f64()
+            }
             Some("vis") => {
                 assert_eq!(figures["vis"]["seen_not_in_pvs"], 0, "{row}");
                 figures["vis"]["pvs_over_sampled"].as_f64()

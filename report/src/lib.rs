@@ -39,6 +39,8 @@ pub struct Options {
     pub wad_dirs: Vec<PathBuf>,
     /// About how many faces light's reference lights per map (every Nth face).
     pub reference_faces: usize,
+    /// Player-box moves traced per BSP to check its clip hull against the map's brushes.
+    pub hull_traces: usize,
     /// Sight lines sampled per map to check each PVS.
     pub sample_pairs: usize,
     /// Frames of the viewer's flythrough per span step.
@@ -110,7 +112,7 @@ impl Row {
     /// The error a plot shows (see [`Stage::error_name`]).
     pub fn plot_error(&self) -> Option<f64> {
         Some(match self.figures.as_ref()? {
-            Figures::Bsp(b) => b.cracks() as f64,
+            Figures::Bsp(b) => (b.cracks() + b.hull_disagreements) as f64,
             Figures::Vis(v) => v.pvs_over_sampled,
             Figures::Light(l) => l.rmse,
             Figures::View(v) => v.mean_diff,
@@ -148,7 +150,7 @@ pub enum ReportError {
         source: light::LightError,
     },
     #[error("{}: {what}", path.display())]
-    Stats { path: PathBuf, what: String },
+    Measure { path: PathBuf, what: String },
     #[error("drawing {}: {what}", path.display())]
     Plot { path: PathBuf, what: String },
     #[error("no maps to report on")]

@@ -87,7 +87,10 @@ fn stage_note(report: &Report, stage: Stage) -> String {
     match stage {
         Stage::Bsp => "Counts of the written BSP (portals from its `.prt`); cracks from \
                        `bsp_compiler::cracks` (T-junctions, edges used by more than two faces, \
-                       duplicate vertices)."
+                       duplicate vertices); hull agreement from `bsp_compiler::hull_check`: \
+                       player-box moves traced through clip hull 1 and swept exactly through the \
+                       map's brushes, counted when their stops are more than 0.1 units apart \
+                       (a hull that agrees stops the engine's 1/32 short)."
             .into(),
         Stage::Vis => "PVS against sight lines sampled through hull 0: pairs seen but missing \
                        from the PVS must be 0; PVS / sampled is how many more pairs the PVS \
@@ -133,6 +136,8 @@ fn table(stage: Stage, rows: &[&Row]) -> String {
             "marksurfaces",
             "file KB",
             "cracks",
+            "hull 1 disagreements",
+            "worst gap",
         ],
         Stage::Vis => &[
             "PVS leaves (avg)",
@@ -188,6 +193,8 @@ fn figure_cells(f: &Figures) -> Vec<String> {
             b.marksurfaces.to_string(),
             format!("{:.0}", b.file_bytes as f64 / 1024.0),
             b.cracks().to_string(),
+            format!("{} of {}", b.hull_disagreements, b.hull_traces),
+            format!("{:.3}", b.hull_worst_gap),
         ],
         Figures::Vis(v) => vec![
             format!("{:.1} of {}", v.average_visible, v.leaves),

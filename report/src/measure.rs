@@ -31,6 +31,12 @@ pub struct BspFigures {
     pub tjunctions: usize,
     pub overused_edges: usize,
     pub duplicate_vertices: usize,
+    /// Player-box (hull 1) moves traced through the clip hull and through the map's brushes.
+    pub hull_traces: usize,
+    /// Moves whose two stops are further apart than `HULL_AGREEMENT_TOLERANCE`.
+    pub hull_disagreements: usize,
+    /// The largest gap between the two stops of any move, in units.
+    pub hull_worst_gap: f64,
 }
 
 impl BspFigures {
@@ -39,7 +45,23 @@ impl BspFigures {
     }
 }
 
-pub fn bsp_figures(bsp_path: &Path) -> Result<BspFigures, ReportError> {
+/// The map's brushes as the compiler reads them (prefabs expanded), for the hull check.
+fn read_map(path: &Path) -> Result<bsp_compiler::map::MapFile, ReportError> {
+    let failed = |what: String| ReportError::Measure {
+        path: path.to_path_buf(),
+        what,
+    };
+    let text = bsp_compiler::map::read_map_text(path).map_err(ReportError::io(path))?;
+    let map = bsp_compiler::map::parse_map(path, &text).map_err(|e| failed(e.to_string()))?;
+    bsp_compiler::prefab::expand_prefabs(map, path).map_err(|e| failed(e.to_string()))
+}
+
+/// Counts, cracks and hull agreement of the BSP compiled from `map_path`.
+pub fn bsp_figures(
+    bsp_path: &Path,
+    map_path: &Path,
+    hull_traces: usize,
+) -> Result<BspFigures, ReportError> {
     let bsp = read_bsp(bsp_path)?;
     let prt_path = bsp_path.with_extension("prt");
     let prt_text = std::fs::read(&prt_path).map_err(ReportError::io(&prt_path))?;
@@ -50,6 +72,15 @@ pub fn bsp_figures(bsp_path: &Path) -> Result<BspFigures, ReportError> {
         }
     })?;
     let cracks = bsp_compiler::cracks::find_cracks(&bsp);
+    let options = bsp_compiler::hull_check::HullCheckOptions {
+        traces: hull_traces,
+        ..Default::default()
+    };
+    let hull = bsp_compiler::hull_check::hull_agreement(&read_map(map_path)?, &bsp, &options)
+        .map_err(|e| ReportError::Measure {
+            path: bsp_path.to_path_buf(),
+            what: format!("hull check: {e}"),
+        })?;
     Ok(BspFigures {
         faces: bsp.faces.len(),
         leaves: bsp.leafs.len(),
@@ -63,6 +94,9 @@ pub fn bsp_figures(bsp_path: &Path) -> Result<BspFigures, ReportError> {
         tjunctions: cracks.tjunctions.len(),
         overused_edges: cracks.overused_edges.len(),
         duplicate_vertices: cracks.duplicate_vertices.len(),
+        hull_traces: hull.traces,
+        hull_disagreements: hull.disagreements,
+        hull_worst_gap: hull.worst_gap,
     })
 }
 
@@ -208,14 +242,14 @@ pub struct ViewFigures {
 pub fn json_number(path: &Path, pointer: &str) -> Result<f64, ReportError> {
     let text = std::fs::read(path).map_err(ReportError::io(path))?;
     let value: serde_json::Value =
-        serde_json::from_slice(&text).map_err(|e| ReportError::Stats {
+        serde_json::from_slice(&text).map_err(|e| ReportError::Measure {
             path: path.to_path_buf(),
             what: e.to_string(),
         })?;
     value
         .pointer(pointer)
         .and_then(serde_json::Value::as_f64)
-        .ok_or_else(|| ReportError::Stats {
+        .ok_or_else(|| ReportError::Measure {
             path: path.to_path_buf(),
             what: format!("no number at {pointer}"),
         })

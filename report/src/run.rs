@@ -369,14 +369,18 @@ fn measure_step(
 ) -> Result<Figures, ReportError> {
     let out = output_file(map, setting, tool);
     Ok(match setting.stage {
-        Stage::Bsp => Figures::Bsp(measure::bsp_figures(&out)?),
+        Stage::Bsp => Figures::Bsp(measure::bsp_figures(
+            &out,
+            &map.source,
+            options.hull_traces,
+        )?),
         Stage::Vis => Figures::Vis(measure::vis_figures(&out, options.sample_pairs)?),
         Stage::Light => {
             let refs = references.get_or_insert_with(|| {
                 LightReferences::new(&input_file(map, Stage::Light), options.reference_faces)
                     .map_err(|e| e.to_string())
             });
-            let refs = refs.as_mut().map_err(|e| ReportError::Stats {
+            let refs = refs.as_mut().map_err(|e| ReportError::Measure {
                 path: input_file(map, Stage::Light),
                 what: format!("light's reference: {e}"),
             })?;
@@ -434,7 +438,7 @@ fn write_files(report: &Report, out_dir: &Path) -> Result<(), ReportError> {
             source,
         })
     };
-    let json = serde_json::to_string_pretty(report).map_err(|e| ReportError::Stats {
+    let json = serde_json::to_string_pretty(report).map_err(|e| ReportError::Measure {
         path: out_dir.join("report.json"),
         what: e.to_string(),
     })?;

@@ -25,7 +25,7 @@ impl Stage {
     /// What a plot's error axis shows.
     pub fn error_name(self) -> &'static str {
         match self {
-            Stage::Bsp => "cracks (T-junctions + overused edges + duplicate vertices)",
+            Stage::Bsp => "cracks + player-hull moves that disagree with the brushes",
             Stage::Vis => "PVS / sampled visible pairs",
             Stage::Light => "RMSE against --reference (8-bit levels)",
             Stage::View => "mean difference against the exact renderer (of 255)",
