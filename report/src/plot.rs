@@ -227,3 +227,54 @@ fn draw<DB: DrawingBackend>(
     }
     root.present().map_err(|e| text(&e))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn two_series() -> Vec<Series> {
+        let point = |time, error, setting: &str| Point {
+            time,
+            error,
+            setting: setting.into(),
+        };
+        vec![
+            Series {
+                name: "a (Slipgate)".into(),
+                points: vec![point(0.01, 3.0, "default"), point(0.2, 0.5, "--extra4")],
+            },
+            Series {
+                name: "a (ericw-tools)".into(),
+                points: vec![point(0.05, 0.0, "default")],
+            },
+        ]
+    }
+
+    #[test]
+    fn plots_draw_with_and_without_a_font() {
+        for labels in [false, fonts_available()] {
+            let mut svg = String::new();
+            draw(
+                SVGBackend::with_string(&mut svg, SIZE).into_drawing_area(),
+                Stage::Light,
+                &two_series(),
+                labels,
+            )
+            .expect("draws");
+            assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+            assert_eq!(
+                svg.contains("--extra4"),
+                labels,
+                "setting names only with a font"
+            );
+        }
+    }
+
+    #[test]
+    fn time_labels_get_the_decimals_their_size_needs() {
+        assert_eq!(seconds_label(0.01234), "0.012");
+        assert_eq!(seconds_label(0.5), "0.50");
+        assert_eq!(seconds_label(2.345), "2.3");
+        assert_eq!(seconds_label(95.6), "96");
+    }
+}
