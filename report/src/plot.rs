@@ -160,7 +160,14 @@ fn draw<DB: DrawingBackend>(
     let e_max = points().map(|p| p.error).fold(0.0, f64::max);
     // Room on the right for the last point's setting name.
     let x_range = (t_min / 1.5)..(t_max * 3.0);
-    let y_range = 0.0..(if e_max > 0.0 { e_max * 1.15 } else { 1.0 });
+    // Headroom above the highest point for the legend (about 20 pixels a series).
+    let legend_share = if labels {
+        (20.0 * series.len() as f64 + 30.0) / f64::from(SIZE.1 - 120)
+    } else {
+        0.0
+    };
+    let top = if e_max > 0.0 { e_max } else { 1.0 };
+    let y_range = 0.0..top / (0.92 - legend_share).max(0.3);
 
     let mut builder = ChartBuilder::on(&root);
     builder.margin(20);
