@@ -27,6 +27,7 @@ pub fn run(options: &Options) -> Result<Report, ReportError> {
     if options.maps.is_empty() {
         return Err(ReportError::NoMaps);
     }
+    let anchor_as_given = options.anchor.clone();
     // Steps run in their map's work folder, so every path they are given must be absolute.
     let absolute = |p: &PathBuf| std::path::absolute(p).map_err(ReportError::io(p));
     let options = &Options {
@@ -161,7 +162,7 @@ pub fn run(options: &Options) -> Result<Report, ReportError> {
         machine,
         runs: options.runs.max(1),
         release: options.release,
-        anchor: options.anchor.clone(),
+        anchor: anchor_as_given,
         maps: options.maps.clone(),
         light_references,
         rows,
