@@ -10,7 +10,7 @@ use crate::{Figures, Report, Row};
 pub fn header(report: &Report) -> String {
     let m = &report.machine;
     let build = if report.release {
-        "release build"
+        "Release build"
     } else {
         "DEBUG build (times are not representative; run `cargo run --release -- report`)"
     };
