@@ -5,6 +5,7 @@ mod inspect;
 mod report;
 
 use anyhow::Result;
+use batch::options::normalise_single_dash;
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
@@ -40,24 +41,8 @@ enum Command {
     Convert(inspect::ConvertArgs),
     /// Time every stage at every quality setting and measure its error against its reference
     Report(report::ReportArgs),
-}
-
-/// ericw-tools writes long options with one dash (`-extra4`); clap wants two. Negative numbers
-/// and short flags (`-h`) are left alone.
-fn normalise_single_dash(args: impl Iterator<Item = String>) -> Vec<String> {
-    args.enumerate()
-        .map(|(i, a)| {
-            let is_ericw_long = i > 0
-                && a.len() > 2
-                && a.starts_with('-')
-                && !a.starts_with("--")
-                && a[1..].starts_with(|c: char| c.is_ascii_alphabetic())
-                && a[1..]
-                    .chars()
-                    .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
-            if is_ericw_long { format!("-{a}") } else { a }
-        })
-        .collect()
+    /// Build many maps (a project file or a folder): cached, in parallel, optionally in shards
+    Batch(batch::cli::Args),
 }
 
 fn main() -> ExitCode {
@@ -83,26 +68,13 @@ fn run(command: Command) -> Result<ExitCode> {
         Command::Info(args) => inspect::info(&args),
         Command::Convert(args) => inspect::convert(&args).map(|()| ExitCode::SUCCESS),
         Command::Report(args) => report::report(&args).map(|()| ExitCode::SUCCESS),
+        Command::Batch(args) => batch::cli::run(&args),
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn single_dash_long_options_become_double_dash() {
-        let args = [
-            "slipgate", "light", "-extra4", "-soft", "-h", "--pos", "-100", "x.bsp",
-        ];
-        let out = normalise_single_dash(args.iter().map(|s| s.to_string()));
-        assert_eq!(
-            out,
-            [
-                "slipgate", "light", "--extra4", "--soft", "-h", "--pos", "-100", "x.bsp"
-            ]
-        );
-    }
 
     #[test]
     fn ericw_spellings_of_compiler_options_parse() {

@@ -8,6 +8,7 @@ mod command;
 use command::slipgate;
 use quake_formats::bsp::{BspPlane, ClipNode, Node, Rule, contents, texinfo_flags};
 use quake_formats::entities::{parse_entities, write_entities};
+use quake_formats::extents::LightmapExtents;
 use quake_formats::{Bsp, Severity, string_to_name16};
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -160,6 +161,10 @@ fn breakers() -> Vec<(Rule, Break)> {
             Rule::SurfaceExtentsVanilla,
             Model(|b| scale_texture_axes(b, 4.0)),
         ),
+        (
+            Rule::LightmapExtentsEnginesDisagree,
+            Model(face_on_a_grid_line_the_engines_disagree_about),
+        ),
         (Rule::UnlitFaceVerts, Model(liquid_face_with_61_edges)),
         (
             Rule::TextureAlignment,
@@ -272,6 +277,42 @@ fn scale_texture_axes(b: &mut Bsp, factor: f32) {
             }
         }
     }
+}
+
+/// The first lit face, given a texinfo of its own turned 10 degrees, whose s offset is searched,
+/// f32 step by f32 step around the values that put its furthest vertex on a grid line, for one
+/// where QuakeSpasm's and DarkPlaces' texture coordinates snap to different lines.
+fn face_on_a_grid_line_the_engines_disagree_about(b: &mut Bsp) {
+    let face = b
+        .faces
+        .iter()
+        .position(|f| b.texinfo[f.texinfo as usize].flags & texinfo_flags::SPECIAL == 0)
+        .expect("a lit face");
+    let points = b.face_vertices(&b.faces[face]).expect("face vertices");
+    let mut info = b.texinfo[b.faces[face].texinfo as usize];
+    let (sin, cos) = 10f32.to_radians().sin_cos();
+    let [s, t] = info.vecs;
+    for k in 0..3 {
+        info.vecs[0][k] = cos * s[k] - sin * t[k];
+        info.vecs[1][k] = sin * s[k] + cos * t[k];
+    }
+    let furthest = points
+        .iter()
+        .map(|p| p[0] * info.vecs[0][0] + p[1] * info.vecs[0][1] + p[2] * info.vecs[0][2])
+        .fold(f32::NEG_INFINITY, f32::max);
+    let offsets = (0..64).flat_map(|line| {
+        let on_line = (16 * line) as f32 - furthest;
+        (-64..64).map(move |step| f32::from_bits(on_line.to_bits().wrapping_add_signed(step)))
+    });
+    for offset in offsets {
+        info.vecs[0][3] = offset;
+        if LightmapExtents::engines_disagree(&points, &info.vecs)[0] {
+            b.texinfo.push(info);
+            b.faces[face].texinfo = (b.texinfo.len() - 1) as u32;
+            return;
+        }
+    }
+    panic!("no offset near a grid line makes the engines disagree on face {face}");
 }
 
 /// A water face re-pointed at 61 surfedges (its own edges, repeated).

@@ -34,6 +34,18 @@ pub fn keep_front(w: Winding, plane: &Plane) -> Option<Winding> {
     }
 }
 
+/// The part of `w` (a winding on `plane`) behind `other`. A winding lying on `other` (within
+/// [`ON_EPSILON`]) and facing the same way marks two sides that are one within the epsilon (a
+/// face and a bevel a millionth of a radian apart): the first of them keeps it. Dropping both
+/// would leave the brush without that side, bounded further out by its other planes.
+fn clip_behind(w: Winding, plane: &Plane, other: &Plane, other_first: bool) -> Option<Winding> {
+    let behind = other.flipped();
+    match w.side_of(&behind) {
+        PlaneSide::On => (!other_first && plane.normal.dot(other.normal) > 0.0).then_some(w),
+        _ => keep_front(w, &behind),
+    }
+}
+
 /// What a brush does to the tree's structure.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum BrushKind {
@@ -118,7 +130,7 @@ impl Brush {
                 if i == j {
                     continue;
                 }
-                w = w.and_then(|w| keep_front(w, &other.plane.flipped()));
+                w = w.and_then(|w| clip_behind(w, &face.plane, &other.plane, j < i));
             }
             let Some(w) = w.filter(|w| !w.is_tiny()) else {
                 continue;
@@ -317,6 +329,31 @@ impl Brush {
 pub(crate) mod tests {
     use super::*;
     use quake_formats::geom::Vec3;
+
+    #[test]
+    fn a_side_doubled_by_a_plane_a_millionth_of_a_radian_off_is_kept_once() {
+        // The +Y side of a 64-unit cube and a plane through its top edge tilted 2e-6 rad: they
+        // are not one plane (`same_as`), yet each lies on the other over the cube. Found by
+        // tests/generated_maps.rs, where a hull bevel doubled a nearly vertical face this way
+        // and dropping both let the hull brush reach units further out.
+        let mut faces = box_planes(Vec3::ZERO, Vec3::new(64.0, 64.0, 64.0));
+        let n = Vec3::new(0.0, 1.0, 2e-6).normalized().expect("n");
+        faces.push(BrushPlane {
+            plane: Plane::new(n, n.dot(Vec3::new(0.0, 64.0, 64.0))),
+            texinfo: Some(1),
+        });
+        let mut planes = PlaneSet::new();
+        let b = Brush::from_planes(&faces, &mut planes, quake_formats::bsp::contents::SOLID, 0)
+            .expect("brush");
+        assert!((b.bounds.maxs.y - 64.0).abs() < 0.01, "{:?}", b.bounds);
+        let plus_y = b
+            .sides
+            .iter()
+            .filter(|s| b.outward(s, &planes).normal.y > 0.99)
+            .count();
+        assert_eq!(plus_y, 1, "the first of the two keeps the side");
+        assert_eq!(b.sides.len(), 6);
+    }
 
     /// The six outward planes of an axial box.
     pub(crate) fn box_planes(mins: Vec3, maxs: Vec3) -> Vec<BrushPlane> {

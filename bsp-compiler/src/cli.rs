@@ -268,6 +268,16 @@ pub fn run(args: &Args) -> Result<()> {
         "  {} portals ({} for vis between {} clusters), {} textures, {} texinfo, {} T-junction vertices added",
         s.portals, s.vis_portals, s.clusters, s.textures, s.texinfo, s.tjunction_vertices
     );
+    let grid = &s.lightmap_grid;
+    if grid.faces_disagreeing > 0 {
+        println!(
+            "  {} faces sized differently by QuakeSpasm and DarkPlaces: {} texinfos nudged, {} split, {} faces left",
+            grid.faces_disagreeing,
+            grid.nudged_texinfos,
+            grid.split_texinfos,
+            grid.unresolved_faces
+        );
+    }
     for (phase, secs) in &s.timings {
         println!("  {phase:<28} {secs:8.3} s");
     }

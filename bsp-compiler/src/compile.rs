@@ -10,6 +10,7 @@ use crate::faces::{
     merge_faces, projection_squareness,
 };
 use crate::hulls::{HULL_BOXES, expand_brush};
+use crate::lightmap_grid::{LightmapGridStats, agree_on_lightmap_grid};
 use crate::map::{MapBrush, MapEntity, MapError, MapFile, parse_map, read_map_text};
 use crate::outside::{FillOutcome, Leak, Occupant, fill_outside};
 use crate::planes::PlaneSet;
@@ -158,6 +159,8 @@ pub struct CompileStats {
     pub tjunction_vertices: usize,
     pub leaked: bool,
     pub face_stats: FaceStats,
+    /// Texture offsets nudged so QuakeSpasm and DarkPlaces size every lightmap alike.
+    pub lightmap_grid: LightmapGridStats,
     /// Phase name and seconds; phases run per model are summed over models (CPU time).
     pub timings: Vec<(String, f64)>,
 }
@@ -486,17 +489,9 @@ pub fn compile(
     stats.leaked = leak.is_some();
 
     let t = Instant::now();
-    let mut search = options.wad_dirs.clone();
-    if let Some(dir) = source.path.parent() {
-        search.push(if dir.as_os_str().is_empty() {
-            PathBuf::from(".")
-        } else {
-            dir.to_path_buf()
-        });
-    }
     let wads = WadSet::load(
         map.entities[0].entity.get("wad").unwrap_or(""),
-        &search,
+        &wad_search_dirs(source, options),
         &mut warnings,
     );
     let version = if options.bsp2 {
@@ -515,6 +510,7 @@ pub fn compile(
         warnings: &mut warnings,
     });
     let mut bsp = emitted.bsp;
+    stats.lightmap_grid = agree_on_lightmap_grid(&mut bsp);
     if options.brush_list {
         listed.resize_with(bsp.models.len(), Vec::new);
         bsp.bspx.push(brush_list_lump(&listed));
@@ -569,6 +565,20 @@ pub fn compile(
 }
 
 /// Parse a map, its prefabs expanded; the first entity must be worldspawn.
+/// The folders searched, in order, for the WADs a map names: `options.wad_dirs`, then the map's
+/// own folder.
+pub fn wad_search_dirs(source: &MapSource, options: &CompileOptions) -> Vec<PathBuf> {
+    let mut search = options.wad_dirs.clone();
+    if let Some(dir) = source.path.parent() {
+        search.push(if dir.as_os_str().is_empty() {
+            PathBuf::from(".")
+        } else {
+            dir.to_path_buf()
+        });
+    }
+    search
+}
+
 pub(crate) fn read_map(source: &MapSource) -> Result<MapFile, CompileError> {
     let map = expand_prefabs(parse_map(&source.path, &source.text)?, &source.path)?;
     let classname = map

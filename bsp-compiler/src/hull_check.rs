@@ -11,11 +11,12 @@
 //!
 //! Moves start at random points of the world's open space (hull 0 open there, and the box at
 //! least [`START_CLEARANCE`] from every brush), go a random direction and length, and are traced
-//! both ways. The two stops are compared along the normal of the plane that stopped the trace
-//! that stopped first: how far the other trace's stop is from that plane. A trace that agrees
-//! stops [`crate::trace`]'s epsilon (1/32) short of the exact contact; a hull plane out of place
-//! or missing shows as the distance it is out. Moves that graze a plane show little either way,
-//! so a misplaced plane is found by the moves that meet it head on.
+//! both ways. A hull trace that stops first must stop next to a brush: the gap is how far its
+//! stop is from every grown brush (the largest plane distance, never more than the true
+//! distance). A hull trace that goes further must not have passed through a brush: the gap is
+//! how deep its path reached inside one. An agreeing trace stops [`crate::trace`]'s epsilon
+//! (1/32) short of a brush; it may also stop where its path passes within that epsilon of a
+//! brush's edge without touching it, as engines do.
 
 use crate::compile::EntityBrushes;
 use crate::hulls::HULL_BOXES;
@@ -27,9 +28,9 @@ use quake_formats::geom::{Bounds, ON_EPSILON, Plane, Vec3, Winding};
 use quake_formats::rng::SplitMix64;
 use quake_formats::{Bsp, FormatError};
 
-/// How far (units, along the stopping plane's normal) the hull's stop may be from the exact one:
-/// the engine's trace epsilon (1/32), planes stored in `f32` (under 1/1000 within ±4096) and
-/// plane snapping by the compiler (`DIST_EPSILON`), with room to spare.
+/// How far (units) a hull trace that stops first may stop from every brush, and how deep a hull
+/// trace may reach into one: the engine's trace epsilon (1/32), planes stored in `f32` (under
+/// 1/1000 within ±4096) and the compiler's plane snapping (`DIST_EPSILON`), with room to spare.
 pub const HULL_AGREEMENT_TOLERANCE: f64 = 0.1;
 
 /// Moves start where the box is at least this far from every brush, so rounding a start point
@@ -74,8 +75,8 @@ pub struct HullDisagreement {
     pub hull_start_solid: bool,
     /// Where the exact sweep stopped.
     pub exact_end: [f64; 3],
-    /// How far apart they are along the stopping plane's normal (for a hull that calls the start
-    /// solid: how far the box there is from every brush).
+    /// How far from every brush the hull stopped, or how deep into one it went (for a hull that
+    /// calls the start solid: how far the box there is from every brush).
     pub gap: f64,
 }
 
@@ -128,7 +129,7 @@ pub fn hull_agreement(
         let end = Vec3::from_f32(end.to_f32());
         let hull = trace_hull(bsp, 0, options.hull, start.to_f32(), end.to_f32());
         let exact = sweep(&solids, start, end);
-        let gap = compare(start, end, &hull, &exact, &solids);
+        let gap = compare(start, &hull, exact, &solids);
         out.traces += 1;
         out.worst_gap = out.worst_gap.max(gap);
         if gap > HULL_AGREEMENT_TOLERANCE {
@@ -139,7 +140,7 @@ pub fn hull_agreement(
                     end: end.to_array(),
                     hull_end: Vec3::from_f32(hull.end).to_array(),
                     hull_start_solid: hull.start_solid,
-                    exact_end: start.lerp(end, exact.fraction).to_array(),
+                    exact_end: start.lerp(end, exact).to_array(),
                     gap,
                 });
             }
@@ -148,25 +149,23 @@ pub fn hull_agreement(
     Ok(out)
 }
 
-/// The gap between the two stops (see the module notes).
-fn compare(
-    start: Vec3,
-    end: Vec3,
-    hull: &HullTrace,
-    exact: &Contact,
-    solids: &[GrownBrush],
-) -> f64 {
+/// How far the hull's stop is from what the brushes allow (see the module notes).
+fn compare(start: Vec3, hull: &HullTrace, exact: f64, solids: &[GrownBrush]) -> f64 {
     if hull.start_solid || hull.all_solid {
         return clearance(solids, start);
     }
-    let movement = end - start;
     let hull_fraction = f64::from(hull.fraction);
-    let normal = if hull_fraction < exact.fraction {
-        Vec3::from_f32(hull.normal)
+    let hull_end = Vec3::from_f32(hull.end);
+    if hull_fraction < exact {
+        clearance(solids, hull_end).max(0.0)
+    } else if hull_fraction > exact {
+        solids
+            .iter()
+            .map(|s| s.depth_along(start, hull_end))
+            .fold(0.0, f64::max)
     } else {
-        exact.normal
-    };
-    (hull_fraction - exact.fraction).abs() * movement.dot(normal).abs()
+        0.0
+    }
 }
 
 /// A brush grown by the hull's box: a point is inside when the box there overlaps the brush.
@@ -174,14 +173,6 @@ fn compare(
 struct GrownBrush {
     planes: Vec<Plane>,
     bounds: Bounds,
-}
-
-/// Where an exact sweep stopped: the fraction of the move, and the normal of the plane met
-/// (zero when the move ran free).
-#[derive(Debug, Clone, Copy)]
-struct Contact {
-    fraction: f64,
-    normal: Vec3,
 }
 
 /// Whether a map brush of an entity of class `class` is solid in the world's clip hulls, as the
@@ -302,11 +293,10 @@ fn support(n: Vec3, mins: Vec3, maxs: Vec3) -> f64 {
 }
 
 impl GrownBrush {
-    /// Where the segment `a`→`b` first enters the inside (strictly behind every plane); a start
-    /// already inside is met at fraction 0 with a zero normal.
-    fn entry(&self, a: Vec3, b: Vec3) -> Option<Contact> {
+    /// The part of the segment `a`→`b` strictly inside, as fractions of it; entering at 0 when
+    /// `a` is inside.
+    fn inside(&self, a: Vec3, b: Vec3) -> Option<(f64, f64)> {
         let (mut enter, mut leave) = (0.0f64, 1.0f64);
-        let mut normal = None;
         for plane in &self.planes {
             let (da, db) = (plane.distance(a), plane.distance(b));
             if da >= 0.0 && db >= 0.0 {
@@ -317,18 +307,31 @@ impl GrownBrush {
             }
             let t = da / (da - db);
             if da >= 0.0 {
-                if normal.is_none() || t > enter {
-                    enter = t;
-                    normal = Some(plane.normal);
-                }
+                enter = enter.max(t);
             } else {
                 leave = leave.min(t);
             }
         }
-        (enter < leave).then_some(Contact {
-            fraction: enter,
-            normal: normal.unwrap_or(Vec3::ZERO),
-        })
+        (enter < leave).then_some((enter, leave))
+    }
+
+    /// How deep inside (behind its nearest plane) the segment `a`→`b` reaches; 0 when it stays
+    /// out. Depth along the segment is concave (a minimum of linear functions), so a ternary
+    /// search finds its peak.
+    fn depth_along(&self, a: Vec3, b: Vec3) -> f64 {
+        let Some((mut lo, mut hi)) = self.inside(a, b) else {
+            return 0.0;
+        };
+        let depth = |t: f64| -self.clearance(a.lerp(b, t));
+        for _ in 0..60 {
+            let (m1, m2) = (lo + (hi - lo) / 3.0, hi - (hi - lo) / 3.0);
+            if depth(m1) < depth(m2) {
+                lo = m1;
+            } else {
+                hi = m2;
+            }
+        }
+        depth((lo + hi) / 2.0).max(0.0)
     }
 
     /// How far in front of its nearest plane `p` is (negative inside): at most the distance to
@@ -341,8 +344,8 @@ impl GrownBrush {
     }
 }
 
-/// The exact sweep: the first contact with any grown brush.
-fn sweep(solids: &[GrownBrush], a: Vec3, b: Vec3) -> Contact {
+/// The exact sweep: the fraction of the move `a`→`b` at which the box first touches a brush.
+fn sweep(solids: &[GrownBrush], a: Vec3, b: Vec3) -> f64 {
     let reach = Bounds {
         mins: a.min(b),
         maxs: a.max(b),
@@ -350,14 +353,8 @@ fn sweep(solids: &[GrownBrush], a: Vec3, b: Vec3) -> Contact {
     solids
         .iter()
         .filter(|s| s.bounds.intersects(&reach))
-        .filter_map(|s| s.entry(a, b))
-        .fold(
-            Contact {
-                fraction: 1.0,
-                normal: Vec3::ZERO,
-            },
-            |best, c| if c.fraction < best.fraction { c } else { best },
-        )
+        .filter_map(|s| s.inside(a, b))
+        .fold(1.0, |first, (enter, _)| first.min(enter))
 }
 
 /// The least clearance of `p` from any grown brush.

@@ -5,7 +5,8 @@
 //! BSP tree: structural brushes first, its leaves the vis clusters, then detail below them),
 //! [`portals`], [`outside`] (filling and leaks), [`faces`] (faces from portals,
 //! merging, subdivision), [`hulls`] (clip hulls) and [`surface_tree`] (their trees rebuilt after
-//! filling), [`weld`] (shared vertices, T-junctions) and `emit`. [`compile()`] runs them all;
+//! filling), [`weld`] (shared vertices, T-junctions), `emit` and [`lightmap_grid`] (texture
+//! offsets nudged so engines agree on lightmap sizes). [`compile()`] runs them all;
 //! [`cracks`] checks a written BSP for T-junctions and unshared edges;
 //! [`trace`] moves a hull's box through a written BSP as engines do, and [`hull_check`] measures
 //! whether those moves stop where the map's brushes say.
@@ -21,6 +22,7 @@ mod emit;
 pub mod faces;
 pub mod hull_check;
 pub mod hulls;
+pub mod lightmap_grid;
 pub mod map;
 pub mod onlyents;
 pub mod outside;
@@ -39,6 +41,7 @@ pub mod weld;
 
 pub use compile::{
     CompileError, CompileOptions, CompileOutput, CompileStats, MapSource, MapTexInfo, compile,
+    wad_search_dirs,
 };
 pub use outside::Leak;
 pub use progress::{Progress, ProgressEvent};

@@ -79,6 +79,7 @@ pub fn prt(data: &[u8]) {
         mode: vis::VisMode::Fast,
         threads: Some(1),
         progress: false,
+        ..Default::default()
     };
     let bytes = vis::set_bytes(&prt);
     if bytes > vis::MAX_SET_BYTES {
@@ -141,6 +142,7 @@ fn run_vis(bsp: &mut Bsp) {
         mode: vis::VisMode::Fast,
         threads: Some(1),
         progress: false,
+        ..Default::default()
     };
     let Ok(result) = vis::compute_vis(&prt, &options) else {
         return;

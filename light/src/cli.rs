@@ -224,6 +224,27 @@ enum LitFile {
 }
 
 impl Args {
+    /// The library options these arguments ask for, with the palette `run` would find.
+    pub fn lighting_options(&self) -> anyhow::Result<Options> {
+        let mut options = self.options(self.quality());
+        options.palette = find_palette(self)?;
+        Ok(options)
+    }
+
+    /// The `.lit` to write beside `bsp`, which [`crate::apply_lighting`] just lit and which
+    /// returned `coloured` (`--lit` and `--nolit` decide; `None`: no `.lit`).
+    pub fn lit_to_write(&self, bsp: &Bsp, coloured: Option<Vec<u8>>) -> Option<Vec<u8>> {
+        match self.lit_file() {
+            LitFile::WhenColoured => coloured,
+            // White light: each luxel's grey level in all three channels.
+            LitFile::Always => coloured.or_else(|| {
+                let rgb: Vec<u8> = bsp.lighting.iter().flat_map(|&g| [g, g, g]).collect();
+                Some(quake_formats::lit::write_lit(&rgb))
+            }),
+            LitFile::Never => None,
+        }
+    }
+
     fn lit_file(&self) -> LitFile {
         if self.nolit {
             LitFile::Never
@@ -253,8 +274,7 @@ fn run_with_current_threads(args: &Args) -> anyhow::Result<()> {
     if args.onlyents {
         return update_entities_only(args, bsp);
     }
-    let mut options = args.options(args.quality());
-    options.palette = find_palette(args)?;
+    let mut options = args.lighting_options()?;
     if let Some(stride) = args.face_stride {
         anyhow::ensure!(stride > 0, "--face-stride must be at least 1");
         options.only_faces = Some((0..bsp.faces.len()).step_by(stride).collect());
@@ -343,15 +363,7 @@ fn run_with_current_threads(args: &Args) -> anyhow::Result<()> {
     }
 
     let lit = crate::apply_lighting(&mut bsp, &lighting);
-    let lit = match args.lit_file() {
-        LitFile::WhenColoured => lit,
-        // White light: each luxel's grey level in all three channels.
-        LitFile::Always => lit.or_else(|| {
-            let rgb: Vec<u8> = bsp.lighting.iter().flat_map(|&g| [g, g, g]).collect();
-            Some(quake_formats::lit::write_lit(&rgb))
-        }),
-        LitFile::Never => None,
-    };
+    let lit = args.lit_to_write(&bsp, lit);
     let out = args.output.as_ref().unwrap_or(path);
     write_atomic(out, &bsp.write()?)?;
     write_or_remove_lit(&lit_path(out), lit)?;

@@ -2,7 +2,16 @@
 //!
 //! Computed one way for everyone (compiler, light, viewer, validator), in the precision engines
 //! use: vertex and texture-vector components are `f32` in the file and are multiplied and summed
-//! in `f64`, as QuakeSpasm and its descendants do, so our luxel grid lands where theirs does.
+//! in `f64`, as QuakeSpasm and its descendants do, and each sum is then rounded to `f32`, because
+//! every engine keeps it in a `float` (QuakeSpasm's `val`, vanilla's x87 result stored to a
+//! float) before snapping it to the grid. Without that rounding a coordinate a few millionths
+//! below a grid line (common on rotated brushes) snaps one luxel further out than in the engine,
+//! and the engine then reads the face's lightmap with the wrong row length.
+//!
+//! DarkPlaces differs: [`LightmapExtents::from_points_darkplaces`] is its rule. A coordinate
+//! within a few `f32` steps of a grid line can snap to different lines under the two rules; the
+//! validator's `lightmap-extents-engines-disagree` finds such faces and the compiler nudges
+//! texture offsets until there are none.
 
 use crate::bsp::limits::LIGHTMAP_SCALE;
 
@@ -19,16 +28,49 @@ pub struct LightmapExtents {
 }
 
 impl LightmapExtents {
+    /// The extents QuakeSpasm and its family (and vanilla, and ericw-tools' light) compute.
     pub fn from_points(points: &[[f32; 3]], vecs: &[[f32; 4]; 2]) -> LightmapExtents {
+        Self::snapped(points, vecs, |p, v| {
+            (p[0] as f64 * v[0] as f64
+                + p[1] as f64 * v[1] as f64
+                + p[2] as f64 * v[2] as f64
+                + v[3] as f64) as f32
+        })
+    }
+
+    /// The extents DarkPlaces computes. Its vectors are `float` (`vec_t`) and its dot-product
+    /// macro multiplies and adds in plain `float` arithmetic, left to right: the x and y
+    /// products are added, then the z product, each step rounded to `f32`, and the texture
+    /// offset is added last, rounded again. The running minimum and maximum are floats too; only
+    /// the division by 16 and the floor/ceil happen in `double`, which is exact for a float and
+    /// so matches the other rule's snapping.
+    pub fn from_points_darkplaces(points: &[[f32; 3]], vecs: &[[f32; 4]; 2]) -> LightmapExtents {
+        Self::snapped(points, vecs, |p, v| {
+            (p[0] * v[0] + p[1] * v[1]) + p[2] * v[2] + v[3]
+        })
+    }
+
+    /// Which axes (s, t) the two engine rules put on different grid lines (either end).
+    pub fn engines_disagree(points: &[[f32; 3]], vecs: &[[f32; 4]; 2]) -> [bool; 2] {
+        let a = Self::from_points(points, vecs);
+        let b = Self::from_points_darkplaces(points, vecs);
+        std::array::from_fn(|axis| {
+            a.tex_mins[axis] != b.tex_mins[axis] || a.extents[axis] != b.extents[axis]
+        })
+    }
+
+    /// The texture-space bounds of `points`, each coordinate computed by `coord` from a point
+    /// and a texture axis row, snapped outward to the grid.
+    fn snapped(
+        points: &[[f32; 3]],
+        vecs: &[[f32; 4]; 2],
+        coord: impl Fn(&[f32; 3], &[f32; 4]) -> f32,
+    ) -> LightmapExtents {
         let mut mins = [f64::INFINITY; 2];
         let mut maxs = [f64::NEG_INFINITY; 2];
         for p in points {
             for axis in 0..2 {
-                let v = &vecs[axis];
-                let val = p[0] as f64 * v[0] as f64
-                    + p[1] as f64 * v[1] as f64
-                    + p[2] as f64 * v[2] as f64
-                    + v[3] as f64;
+                let val = coord(p, &vecs[axis]) as f64;
                 mins[axis] = mins[axis].min(val);
                 maxs[axis] = maxs[axis].max(val);
             }
@@ -114,6 +156,62 @@ mod tests {
         let e = LightmapExtents::from_points(&pts, &AXIAL);
         assert_eq!(e.tex_mins, [0, -16]);
         assert_eq!(e.extents, [32, 48]);
+    }
+
+    /// Face 9288 of our BSP of LibreQuake e1m3 (a brush rotated 10 degrees): its coordinates lie
+    /// within 5e-5 texels of grid lines, on either side. Summed in f64 alone they gave 5x4 luxels;
+    /// QuakeSpasm, rounding each sum to a float, reads 3x3, so it drew our lightmap skewed.
+    #[test]
+    fn sums_are_rounded_to_f32_as_engines_store_them() {
+        let vecs = ROTATED_10_DEGREES;
+        let pts = [
+            [2765.9216, 227.831_38, 32.0],
+            [2734.4077, 233.388_12, 32.0],
+            [2739.9644, 264.901_98, 32.0],
+            [2771.4783, 259.345_2, 32.0],
+        ];
+        let e = LightmapExtents::from_points(&pts, &vecs);
+        assert_eq!(e.tex_mins, [2656, -736]);
+        assert_eq!(e.luxel_size(), [3, 3]);
+    }
+
+    const ROTATED_10_DEGREES: [[f32; 4]; 2] = [
+        [0.984_807_7, -0.173_648_18, 0.0, 3.661_621],
+        [-0.173_648_18, -0.984_807_7, 0.0, 0.667_358_4],
+    ];
+
+    /// A vertex of a face textured at 10 degrees lies on the grid line s = 80 when summed in
+    /// f64 (rounded to f32: exactly 80), and one f32 step past it when summed in f32, so
+    /// DarkPlaces gives the face one luxel more along s than QuakeSpasm.
+    #[test]
+    fn darkplaces_sums_in_f32_and_can_snap_to_another_grid_line() {
+        let pts = [
+            [160.220_55, 469.040_65, 32.0],
+            [130.0, 469.040_65, 32.0],
+            [130.0, 440.0, 32.0],
+        ];
+        let qs = LightmapExtents::from_points(&pts, &ROTATED_10_DEGREES);
+        let dp = LightmapExtents::from_points_darkplaces(&pts, &ROTATED_10_DEGREES);
+        assert_eq!(qs.tex_mins[0], dp.tex_mins[0]);
+        assert_eq!((qs.extents[0], dp.extents[0]), (32, 48));
+        assert_eq!(qs.extents[1], dp.extents[1]);
+        assert_eq!(
+            LightmapExtents::engines_disagree(&pts, &ROTATED_10_DEGREES),
+            [true, false]
+        );
+    }
+
+    #[test]
+    fn the_rules_agree_away_from_grid_lines() {
+        let pts = [[0.0, 0.0, 0.0], [31.5, 7.25, 0.0], [8.0, 3.0, 0.0]];
+        assert_eq!(
+            LightmapExtents::engines_disagree(&pts, &ROTATED_10_DEGREES),
+            [false, false]
+        );
+        assert_eq!(
+            LightmapExtents::engines_disagree(&pts, &AXIAL),
+            [false, false]
+        );
     }
 
     #[test]

@@ -65,6 +65,18 @@ pub struct Args {
     pub stats: Option<PathBuf>,
 }
 
+impl Args {
+    /// How the renderer is to draw, as these arguments ask.
+    pub fn render_options(&self) -> RenderOptions {
+        RenderOptions {
+            span_step: self.span_step,
+            use_cache: !self.no_cache,
+            cache_budget: self.cache_mb << 20,
+            time: self.time,
+        }
+    }
+}
+
 fn parse_size(s: &str) -> Result<(usize, usize), String> {
     let (w, h) = s
         .split_once(['x', 'X'])
@@ -84,13 +96,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let world = World::load(&args.map, args.palette.as_deref())?;
     let load_time = start.elapsed().as_secs_f64();
     let camera = initial_camera(&world, args)?;
-    let options = RenderOptions {
-        span_step: args.span_step,
-        use_cache: !args.no_cache,
-        cache_budget: args.cache_mb << 20,
-        time: args.time,
-    };
-    let mut renderer = Renderer::new(&world, options);
+    let mut renderer = Renderer::new(&world, args.render_options());
     let mut report = serde_json::json!({
         "map": args.map,
         "load": world.stats,
@@ -144,7 +150,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         );
         report["frame"] = serde_json::to_value(&stats)?;
         if args.reference {
-            let reference = render_reference(&world, &camera, &renderer.styles, options.time);
+            let reference = render_reference(&world, &camera, &renderer.styles, args.time);
             let path = args.out.with_extension("reference.png");
             write_png(&reference, &path)?;
             let diff = compare(&frame, &reference);
@@ -198,7 +204,8 @@ fn open_window(
     )
 }
 
-fn initial_camera(world: &World, args: &Args) -> anyhow::Result<Camera> {
+/// The camera `--pos`, `--angles`, `--fov` and `--size` ask for; by default at the player start.
+pub fn initial_camera(world: &World, args: &Args) -> anyhow::Result<Camera> {
     let numbers = args.pos.iter().chain(&args.angles).flatten();
     if numbers.clone().any(|v| !v.is_finite()) || !(1.0..=179.0).contains(&args.fov) {
         bail!("--pos and --angles must be finite numbers and --fov between 1 and 179 degrees");

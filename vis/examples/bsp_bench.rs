@@ -56,6 +56,7 @@ fn main() {
             mode,
             threads: None,
             progress: true,
+            ..Default::default()
         };
         let start = Instant::now();
         let result = compute_vis(&prt, &options).expect("vis");

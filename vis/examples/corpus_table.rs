@@ -53,6 +53,7 @@ fn main() {
                 mode,
                 threads: None,
                 progress: false,
+                ..Default::default()
             };
             // Best of `RUNS`: the machine is shared, and every run gives the same sets.
             let mut seconds = f64::INFINITY;

@@ -4,9 +4,10 @@
 
 use quake_formats::Bsp;
 use quake_formats::prt::PortalFile;
+use std::sync::OnceLock;
 use std::time::Instant;
-use vis::PortalGraph;
 use vis::tree_portals::portals_from_bsp;
+use vis::{FlowPlan, PortalGraph};
 
 fn main() {
     let mut args = std::env::args().skip(1);
@@ -22,9 +23,9 @@ fn main() {
     let graph = PortalGraph::from_prt(&prt).expect("graph");
     let n = graph.portals.len();
     let mightsee: Vec<_> = (0..n).map(|p| vis::base::mightsee(&graph, p)).collect();
-    let mut done: Vec<Option<vis::BitSet>> = vec![None; n];
-    let mut order: Vec<usize> = (0..n).collect();
-    order.sort_by_key(|&p| mightsee[p].count());
+    let results: Vec<OnceLock<vis::BitSet>> = (0..n).map(|_| OnceLock::new()).collect();
+    let plan = FlowPlan::new(&mightsee, vis::Grouping::Auto);
+    let order: Vec<usize> = plan.waves().flatten().copied().collect();
     let mut ws = vis::flow::Workspace::default();
     let mut costs = Vec::new();
     let all = Instant::now();
@@ -38,7 +39,8 @@ fn main() {
         let ctx = vis::flow::FlowContext {
             graph: &graph,
             mightsee: &mightsee,
-            done: &done,
+            results: &results,
+            plan: &plan,
             level,
         };
         let seen = vis::flow::portal_flow(&ctx, p, &mut ws);
@@ -49,7 +51,7 @@ fn main() {
             ws.visits - before,
             seen.count(),
         ));
-        done[p] = Some(seen);
+        let _ = results[p].set(seen);
     }
     let seen: usize = costs.iter().map(|c| c.4).sum();
     println!(

@@ -23,6 +23,7 @@ fn main() {
             mode,
             threads: None,
             progress: false,
+            ..Default::default()
         };
         let start = Instant::now();
         let result = compute_vis(&prt, &options).expect("vis");

@@ -34,15 +34,31 @@
 use crate::bitset::{BitSet, WindowBits};
 use crate::explored::Explored;
 use crate::portals::{OneWayPortal, PortalGraph};
+use crate::schedule::FlowPlan;
 use quake_formats::geom::{ON_EPSILON, Plane, Vec3};
+use std::sync::OnceLock;
 
 /// The shared inputs of every portal's flow.
 pub struct FlowContext<'a> {
     pub graph: &'a PortalGraph,
     pub mightsee: &'a [BitSet],
-    /// Finished portals' flow results: tighter than their mightsee.
-    pub done: &'a [Option<BitSet>],
+    /// Finished portals' flow results: tighter than their mightsee. A flow uses only those
+    /// `plan` allows ([`FlowPlan::bounds`]), so results do not depend on timing or sharding.
+    pub results: &'a [OnceLock<BitSet>],
+    pub plan: &'a FlowPlan,
     pub level: u8,
+}
+
+impl FlowContext<'_> {
+    /// The finished flow of `portal` that the flow of `base` may use.
+    #[inline]
+    fn finished(&self, base: usize, portal: usize) -> Option<&BitSet> {
+        if self.plan.bounds(base, portal) {
+            self.results[portal].get()
+        } else {
+            None
+        }
+    }
 }
 
 /// One step of the walk: the state after passing through a portal (or the base, at the head).
@@ -108,7 +124,7 @@ pub fn portal_flow(ctx: &FlowContext, base: usize, ws: &mut Workspace) -> BitSet
     let reverse = PortalGraph::reverse(base);
     let mut seen = BitSet::new(bits);
     head.might.assign_filtered(&ctx.mightsee[base], |r| {
-        match &ctx.done[PortalGraph::reverse(r)] {
+        match ctx.finished(base, PortalGraph::reverse(r)) {
             Some(back) if back.contains(reverse) => {
                 seen.insert(r);
                 false
@@ -119,6 +135,7 @@ pub fn portal_flow(ctx: &FlowContext, base: usize, ws: &mut Workspace) -> BitSet
     });
     let mut walk = Walk {
         ctx,
+        base_index: base,
         base: portal,
         seen,
     };
@@ -130,6 +147,7 @@ pub fn portal_flow(ctx: &FlowContext, base: usize, ws: &mut Workspace) -> BitSet
 
 struct Walk<'a> {
     ctx: &'a FlowContext<'a>,
+    base_index: usize,
     base: &'a OneWayPortal,
     /// Portals seen so far.
     seen: BitSet,
@@ -145,7 +163,7 @@ impl Walk<'_> {
             if !prev.might.contains(q) {
                 continue;
             }
-            let bound = self.ctx.done[q].as_ref().unwrap_or(&self.ctx.mightsee[q]);
+            let bound = (self.ctx.finished(self.base_index, q)).unwrap_or(&self.ctx.mightsee[q]);
             let more = cur.might.assign_and(&prev.might, bound, &self.seen);
             if !more && self.seen.contains(q) {
                 continue; // nothing unseen can be seen through it

@@ -16,6 +16,8 @@ pub mod lump;
 pub mod portals;
 pub mod pvs;
 pub mod sample;
+pub mod saved;
+pub mod schedule;
 pub mod synthetic;
 pub mod tree_portals;
 
@@ -24,14 +26,15 @@ pub use clusters::Clusters;
 pub use lump::{LumpStats, check_portals_match, read_pvs, write_vis};
 pub use portals::PortalGraph;
 pub use pvs::Pvs;
+pub use schedule::{FlowPlan, Grouping, Shard};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use quake_formats::prt::PortalFile;
 use rayon::prelude::*;
 use std::io::IsTerminal;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Mutex, OnceLock};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 /// Everything vis can refuse.
 #[derive(Debug, thiserror::Error)]
@@ -83,6 +86,8 @@ pub enum VisError {
         portals: usize,
         gib: u64,
     },
+    #[error("{flows} portal flow results for {portals} one-way portals")]
+    FlowCount { flows: usize, portals: usize },
     #[error("the BSP's hull 0 tree is broken: {0}")]
     BadTree(String),
     /// The BSP breaks a rule that would make vis read out of bounds ([`quake_formats::check_usable`]).
@@ -106,6 +111,8 @@ pub struct VisOptions {
     pub threads: Option<usize>,
     /// Show a progress bar on stderr (only drawn when stderr is a terminal).
     pub progress: bool,
+    /// Whether the full flow is planned in groups for shards ([`FlowPlan`]).
+    pub grouping: Grouping,
 }
 
 impl Default for VisOptions {
@@ -114,6 +121,7 @@ impl Default for VisOptions {
             mode: VisMode::Full { level: 4 },
             threads: None,
             progress: false,
+            grouping: Grouping::Auto,
         }
     }
 }
@@ -150,17 +158,205 @@ pub struct VisResult {
 
 /// Compute every leaf's potentially visible set from a portal file.
 pub fn compute_vis(prt: &PortalFile, options: &VisOptions) -> Result<VisResult, VisError> {
-    check_set_sizes(prt)?;
-    let graph = PortalGraph::from_prt(prt)?;
-    let clusters = Clusters::from_prt(prt)?;
-    let mut builder = rayon::ThreadPoolBuilder::new().stack_size(64 << 20);
-    if let Some(threads) = options.threads {
-        builder = builder.num_threads(threads);
+    compute_vis_resuming(prt, options, Vec::new(), None)
+}
+
+/// Flow results a run starts from: by portal, those a saved state holds (empty: none).
+pub type KnownFlows = Vec<Option<BitSet>>;
+
+/// Saves a run's progress: called, from a worker thread, with every result finished so far
+/// (by portal, ascending).
+pub type SaveFlows<'a> = dyn Fn(Vec<(usize, &BitSet)>) + Sync + 'a;
+
+/// Saving a run's progress now and then, so a killed run can resume.
+pub struct Checkpoint<'a> {
+    pub every: Duration,
+    pub save: &'a SaveFlows<'a>,
+}
+
+/// [`compute_vis`] starting from the results in `known` (a saved state of the same inputs and
+/// level; results for other inputs give a wrong PVS) and saving progress through `checkpoint`.
+/// The sets are the same as those of one uninterrupted run.
+pub fn compute_vis_resuming(
+    prt: &PortalFile,
+    options: &VisOptions,
+    known: KnownFlows,
+    checkpoint: Option<&Checkpoint>,
+) -> Result<VisResult, VisError> {
+    let setup = Setup::new(prt, options.threads)?;
+    Ok(setup.pool.install(|| {
+        let (mightsee, base_seconds) = base_vis(&setup.graph);
+        let start = Instant::now();
+        let portal_vis = match options.mode {
+            VisMode::Fast => mightsee.clone(),
+            VisMode::Full { level } => {
+                let wanted = vec![true; mightsee.len()];
+                let plan = FlowPlan::new(&mightsee, options.grouping);
+                let job = FlowJob {
+                    graph: &setup.graph,
+                    mightsee: &mightsee,
+                    plan: &plan,
+                    level,
+                    progress: options.progress,
+                    wanted: &wanted,
+                    checkpoint,
+                };
+                let done = full_flow(&job, known);
+                done.into_iter()
+                    .zip(&mightsee)
+                    .map(|(d, m)| d.unwrap_or_else(|| m.clone()))
+                    .collect()
+            }
+        };
+        let flow_seconds = start.elapsed().as_secs_f64();
+        let mut result = setup.finish(&portal_vis);
+        result.stats.average_mightsee = average_count(&mightsee);
+        result.stats.base_seconds = base_seconds;
+        result.stats.flow_seconds = flow_seconds;
+        result
+    }))
+}
+
+/// One shard's part of the full flow ([`compute_shard`]).
+#[derive(Debug, Clone)]
+pub struct ShardFlows {
+    /// One-way portals in the graph.
+    pub portals: usize,
+    /// The results the shard hands on ([`FlowPlan::owned`]), by portal, ascending.
+    pub results: Vec<(usize, BitSet)>,
+    /// Final groups in the plan ([`FlowPlan::groups`]): more shards than this get no final work.
+    pub groups: usize,
+    pub base_seconds: f64,
+    pub flow_seconds: f64,
+}
+
+/// Run the full flow (at `level`) of `shard`'s share of the portals: the shared ones and the
+/// shard's final groups. [`vis_from_flows`] turns the results of all
+/// shards into the same sets [`compute_vis`] gives.
+pub fn compute_shard(
+    prt: &PortalFile,
+    level: u8,
+    threads: Option<usize>,
+    grouping: Grouping,
+    shard: Shard,
+    known: KnownFlows,
+    checkpoint: Option<&Checkpoint>,
+) -> Result<ShardFlows, VisError> {
+    let setup = Setup::new(prt, threads)?;
+    Ok(setup.pool.install(|| {
+        let (mightsee, base_seconds) = base_vis(&setup.graph);
+        let start = Instant::now();
+        let plan = FlowPlan::new(&mightsee, grouping);
+        let wanted = plan.runs(shard);
+        let job = FlowJob {
+            graph: &setup.graph,
+            mightsee: &mightsee,
+            plan: &plan,
+            level,
+            progress: false,
+            wanted: &wanted,
+            checkpoint,
+        };
+        let mut done = full_flow(&job, known);
+        let results: Vec<(usize, BitSet)> = plan
+            .owned(shard)
+            .into_iter()
+            .map(|p| (p, done[p].take().unwrap_or_else(|| mightsee[p].clone())))
+            .collect();
+        ShardFlows {
+            portals: mightsee.len(),
+            results,
+            groups: plan.groups(),
+            base_seconds,
+            flow_seconds: start.elapsed().as_secs_f64(),
+        }
+    }))
+}
+
+/// The sets from every portal's flow result (by one-way portal, as [`compute_shard`] numbers
+/// them; the shards' results joined).
+pub fn vis_from_flows(prt: &PortalFile, flows: &[BitSet]) -> Result<VisResult, VisError> {
+    let setup = Setup::new(prt, None)?;
+    if flows.len() != setup.graph.portals.len() {
+        return Err(VisError::FlowCount {
+            flows: flows.len(),
+            portals: setup.graph.portals.len(),
+        });
     }
-    let pool = builder
-        .build()
-        .map_err(|e| VisError::Threads(e.to_string()))?;
-    Ok(pool.install(|| compute_on_graph(&graph, clusters.as_ref(), options)))
+    Ok(setup.pool.install(|| setup.finish(flows)))
+}
+
+/// What every entry point builds first.
+struct Setup {
+    graph: PortalGraph,
+    clusters: Option<Clusters>,
+    pool: rayon::ThreadPool,
+}
+
+impl Setup {
+    fn new(prt: &PortalFile, threads: Option<usize>) -> Result<Setup, VisError> {
+        check_set_sizes(prt)?;
+        let graph = PortalGraph::from_prt(prt)?;
+        let clusters = Clusters::from_prt(prt)?;
+        let mut builder = rayon::ThreadPoolBuilder::new().stack_size(64 << 20);
+        if let Some(threads) = threads {
+            builder = builder.num_threads(threads);
+        }
+        let pool = builder
+            .build()
+            .map_err(|e| VisError::Threads(e.to_string()))?;
+        Ok(Setup {
+            graph,
+            clusters,
+            pool,
+        })
+    }
+
+    /// Leaf rows from the portals seen through each portal (stats without base and flow).
+    fn finish(&self, portal_vis: &[BitSet]) -> VisResult {
+        let graph = &self.graph;
+        let seen_through: Vec<BitSet> = (0..graph.portals.len())
+            .into_par_iter()
+            .map(|p| Pvs::clusters_behind(graph, p, &portal_vis[p]))
+            .collect();
+        let mut rows = Pvs::cluster_rows(graph, &seen_through);
+        let asymmetric_pairs = Pvs::intersect_with_transpose(&mut rows);
+        let pvs = match &self.clusters {
+            Some(clusters) => clusters.expand(&rows),
+            None => Pvs::new(rows),
+        };
+        let stats = ComputeStats {
+            leafs: pvs.num_leafs(),
+            clusters: graph.num_clusters,
+            portals: graph.portals.len(),
+            degenerate_portals: graph.degenerate,
+            misoriented_portals: if self.clusters.is_some() {
+                0
+            } else {
+                graph.misoriented_portals()
+            },
+            average_portal_vis: average_count(portal_vis),
+            average_visible: pvs.average_visible(),
+            max_visible: pvs.max_visible(),
+            asymmetric_pairs,
+            ..ComputeStats::default()
+        };
+        VisResult { pvs, stats }
+    }
+}
+
+/// Every portal's mightsee, and the seconds it took.
+fn base_vis(graph: &PortalGraph) -> (Vec<BitSet>, f64) {
+    let start = Instant::now();
+    let mightsee = (0..graph.portals.len())
+        .into_par_iter()
+        .map(|p| base::mightsee(graph, p))
+        .collect();
+    (mightsee, start.elapsed().as_secs_f64())
+}
+
+fn average_count(sets: &[BitSet]) -> f64 {
+    sets.iter().map(BitSet::count).sum::<usize>() as f64 / sets.len().max(1) as f64
 }
 
 /// The most memory vis lets its bit sets take ([`set_bytes`]). The biggest real maps need far
@@ -189,89 +385,60 @@ fn check_set_sizes(prt: &PortalFile) -> Result<(), VisError> {
     Ok(())
 }
 
-fn compute_on_graph(
-    graph: &PortalGraph,
-    clusters: Option<&Clusters>,
-    options: &VisOptions,
-) -> VisResult {
-    let n = graph.portals.len();
-    let start = Instant::now();
-    let mightsee: Vec<BitSet> = (0..n)
-        .into_par_iter()
-        .map(|p| base::mightsee(graph, p))
-        .collect();
-    let base_seconds = start.elapsed().as_secs_f64();
-    let average =
-        |sets: &[BitSet]| sets.iter().map(BitSet::count).sum::<usize>() as f64 / n.max(1) as f64;
-
-    let start = Instant::now();
-    let portal_vis = match options.mode {
-        VisMode::Fast => mightsee.clone(),
-        VisMode::Full { level } => full_flow(graph, &mightsee, level, options.progress),
-    };
-    let flow_seconds = start.elapsed().as_secs_f64();
-    let seen_through: Vec<BitSet> = (0..n)
-        .into_par_iter()
-        .map(|p| Pvs::clusters_behind(graph, p, &portal_vis[p]))
-        .collect();
-    let mut rows = Pvs::cluster_rows(graph, &seen_through);
-    let asymmetric_pairs = Pvs::intersect_with_transpose(&mut rows);
-    let pvs = match clusters {
-        Some(clusters) => clusters.expand(&rows),
-        None => Pvs::new(rows),
-    };
-    let stats = ComputeStats {
-        leafs: pvs.num_leafs(),
-        clusters: graph.num_clusters,
-        portals: n,
-        degenerate_portals: graph.degenerate,
-        misoriented_portals: if clusters.is_some() {
-            0
-        } else {
-            graph.misoriented_portals()
-        },
-        average_mightsee: average(&mightsee),
-        average_portal_vis: average(&portal_vis),
-        base_seconds,
-        flow_seconds,
-        average_visible: pvs.average_visible(),
-        max_visible: pvs.max_visible(),
-        asymmetric_pairs,
-    };
-    VisResult { pvs, stats }
+/// One run of the full flow.
+struct FlowJob<'a> {
+    graph: &'a PortalGraph,
+    mightsee: &'a [BitSet],
+    plan: &'a FlowPlan,
+    level: u8,
+    progress: bool,
+    /// By portal: whether to run its flow (a shard skips the other shards' groups).
+    wanted: &'a [bool],
+    checkpoint: Option<&'a Checkpoint<'a>>,
 }
 
-/// Portal flows run in this many waves (fewer when there are few portals): each wave's flows
-/// run in parallel, bounded by the results of the waves before. Fixing the waves by the portal
-/// count alone makes the result the same whatever the thread count and timing.
-const FLOW_WAVES: usize = 200;
-const MIN_WAVE_PORTALS: usize = 16;
-
-/// Run the portal flow for every portal on every worker thread; returns the portals seen
-/// through each. Portals with the smallest mightsee go first: they finish fast, and their
-/// results then bound the bigger ones' flows more tightly than mightsee does.
-fn full_flow(graph: &PortalGraph, mightsee: &[BitSet], level: u8, progress: bool) -> Vec<BitSet> {
-    let n = graph.portals.len();
-    let mut order: Vec<usize> = (0..n).collect();
-    order.sort_by_key(|&p| (mightsee[p].count(), p));
-    let mut done: Vec<Option<BitSet>> = vec![None; n];
-    let bar = progress_bar(n as u64, progress);
+/// Run the portal flows `job` wants, wave by wave ([`FlowPlan`]), on every worker thread,
+/// taking results in `known` as they are; returns the portals seen through each (`None` for
+/// portals not wanted, or whose worker panicked).
+fn full_flow(job: &FlowJob, known: KnownFlows) -> Vec<Option<BitSet>> {
+    let n = job.graph.portals.len();
+    let bar = progress_bar(
+        job.wanted.iter().filter(|&&w| w).count() as u64,
+        job.progress,
+    );
+    // The plan decides which results a flow may use, so known ones can all go in at once.
+    let results: Vec<OnceLock<BitSet>> = (0..n).map(|_| OnceLock::new()).collect();
+    for (p, set) in known.into_iter().enumerate().take(n) {
+        if let Some(set) = set.filter(|s| job.wanted[p] && s.len() == n) {
+            let _ = results[p].set(set);
+            bar.inc(1);
+        }
+    }
     let workspaces: Vec<Mutex<flow::Workspace>> = (0..rayon::current_num_threads())
         .map(|_| Mutex::default())
         .collect();
-    let wave_len = n.div_ceil(FLOW_WAVES).max(MIN_WAVE_PORTALS);
-    for wave in order.chunks(wave_len) {
-        let results: Vec<OnceLock<BitSet>> = wave.iter().map(|_| OnceLock::new()).collect();
-        let ctx = flow::FlowContext {
-            graph,
-            mightsee,
-            done: &done,
-            level,
-        };
+    let saver = job.checkpoint.map(|c| Saver {
+        checkpoint: c,
+        last: Mutex::new(Instant::now()),
+        busy: AtomicBool::new(false),
+    });
+    let ctx = flow::FlowContext {
+        graph: job.graph,
+        mightsee: job.mightsee,
+        results: &results,
+        plan: job.plan,
+        level: job.level,
+    };
+    for wave in job.plan.waves() {
+        let todo: Vec<usize> = wave
+            .iter()
+            .copied()
+            .filter(|&p| job.wanted[p] && results[p].get().is_none())
+            .collect();
         let next = AtomicUsize::new(0);
         rayon::broadcast(|thread| {
             // A worker that panicked poisons only its own workspace; the portals it would have
-            // taken fall back to their mightsee below.
+            // taken fall back to their mightsee.
             let Ok(mut ws) = workspaces[thread.index()].lock() else {
                 return;
             };
@@ -279,22 +446,48 @@ fn full_flow(graph: &PortalGraph, mightsee: &[BitSet], level: u8, progress: bool
             // threads wait for a late one at the wave's end (the order changes no result).
             loop {
                 let taken = next.fetch_add(1, Ordering::Relaxed);
-                let Some(i) = wave.len().checked_sub(taken + 1) else {
+                let Some(i) = todo.len().checked_sub(taken + 1) else {
                     break;
                 };
-                let _ = results[i].set(flow::portal_flow(&ctx, wave[i], &mut ws));
+                let _ = results[todo[i]].set(flow::portal_flow(&ctx, todo[i], &mut ws));
                 bar.inc(1);
+                if let Some(saver) = &saver {
+                    saver.save_if_due(|| {
+                        let finished = results.iter().enumerate();
+                        finished
+                            .filter_map(|(p, r)| r.get().map(|s| (p, s)))
+                            .collect()
+                    });
+                }
             }
         });
-        for (&p, result) in wave.iter().zip(results) {
-            done[p] = result.into_inner();
-        }
     }
     bar.finish_and_clear();
-    done.into_iter()
-        .zip(mightsee)
-        .map(|(d, m)| d.unwrap_or_else(|| m.clone()))
-        .collect()
+    results.into_iter().map(OnceLock::into_inner).collect()
+}
+
+/// Runs a [`Checkpoint`]'s save from whichever worker finds it due, one at a time.
+struct Saver<'a> {
+    checkpoint: &'a Checkpoint<'a>,
+    last: Mutex<Instant>,
+    busy: AtomicBool,
+}
+
+impl Saver<'_> {
+    fn save_if_due<'s>(&self, snapshot: impl FnOnce() -> Vec<(usize, &'s BitSet)>) {
+        let due = self
+            .last
+            .lock()
+            .is_ok_and(|last| last.elapsed() >= self.checkpoint.every);
+        if !due || self.busy.swap(true, Ordering::Acquire) {
+            return;
+        }
+        (self.checkpoint.save)(snapshot());
+        if let Ok(mut last) = self.last.lock() {
+            *last = Instant::now();
+        }
+        self.busy.store(false, Ordering::Release);
+    }
 }
 
 /// A bar with a time estimate on stderr, or a hidden one when stderr is not a terminal.
@@ -325,5 +518,71 @@ mod tests {
         assert!(err.to_string().contains("4000000000 leaves"), "{err}");
         let prt = PortalFile::parse("PRT2\n224314\n0\n0\n").expect("parse");
         assert!(compute_vis(&prt, &VisOptions::default()).is_err());
+    }
+
+    fn caves() -> PortalFile {
+        synthetic::VoxelWorld::random_caves([12, 12, 3], 160, 17).portal_file()
+    }
+
+    #[test]
+    fn shards_joined_give_the_sets_of_one_run() {
+        let prt = caves();
+        let grouped = VisOptions {
+            grouping: Grouping::Always,
+            ..VisOptions::default()
+        };
+        let whole = compute_vis(&prt, &grouped).expect("vis");
+        for count in [1, 2, 3, 16, 17] {
+            let mut flows: Vec<Option<BitSet>> = Vec::new();
+            for index in 0..count {
+                let shard = Shard { index, count };
+                let part =
+                    compute_shard(&prt, 4, Some(2), Grouping::Always, shard, Vec::new(), None)
+                        .expect("shard");
+                flows.resize(part.portals, None);
+                for (p, set) in part.results {
+                    assert!(flows[p].replace(set).is_none(), "portal {p} twice");
+                }
+            }
+            let flows: Vec<BitSet> = flows
+                .into_iter()
+                .map(|f| f.expect("every portal"))
+                .collect();
+            let joined = vis_from_flows(&prt, &flows).expect("join");
+            assert_eq!(joined.pvs, whole.pvs, "{count} shards");
+        }
+    }
+
+    #[test]
+    fn a_run_resumed_from_saved_results_gives_the_same_sets() {
+        let prt = caves();
+        let options = VisOptions {
+            threads: Some(2),
+            grouping: Grouping::Always,
+            ..VisOptions::default()
+        };
+        let whole = compute_vis(&prt, &options).expect("vis");
+        // Save after every flow; resume from a snapshot taken part way.
+        let saves: Mutex<Vec<KnownFlows>> = Mutex::default();
+        let save = |results: Vec<(usize, &BitSet)>| {
+            let mut known: KnownFlows = vec![None; results.first().map_or(0, |r| r.1.len())];
+            for (p, set) in results {
+                known[p] = Some(set.clone());
+            }
+            saves.lock().expect("lock").push(known);
+        };
+        let checkpoint = Checkpoint {
+            every: Duration::ZERO,
+            save: &save,
+        };
+        let saved = compute_vis_resuming(&prt, &options, Vec::new(), Some(&checkpoint))
+            .expect("saving run");
+        assert_eq!(saved.pvs, whole.pvs);
+        let saves = saves.into_inner().expect("lock");
+        assert!(saves.len() > 10, "{} saves", saves.len());
+        for known in [&saves[saves.len() / 3], &saves[saves.len() - 1]] {
+            let resumed = compute_vis_resuming(&prt, &options, known.clone(), None).expect("vis");
+            assert_eq!(resumed.pvs, whole.pvs);
+        }
     }
 }

@@ -20,6 +20,11 @@ fn args(bsp: PathBuf) -> Args {
         threads: Some(1),
         sample_pairs: 1000,
         stats: None,
+        shard: None,
+        partial: Vec::new(),
+        merge: false,
+        resume: false,
+        save_interval: 0.0,
     }
 }
 

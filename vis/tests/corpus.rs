@@ -65,6 +65,7 @@ fn our_vis_on_start_is_never_too_small_and_no_larger_than_the_stored_one() {
         mode: vis::VisMode::Full { level: 2 },
         threads: None,
         progress: false,
+        ..Default::default()
     };
     let ours = vis::compute_vis(&prt, &options).expect("vis").pvs;
     let stored = read_pvs(&bsp).expect("stored");

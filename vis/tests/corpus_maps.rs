@@ -44,6 +44,7 @@ fn check_map(corpus: &Path, rel: &str, pairs: usize) {
             mode,
             threads: None,
             progress: false,
+            ..Default::default()
         };
         let result = compute_vis(&prt, &options).expect("vis");
         let report = sample_visibility(&out.bsp, &result.pvs, pairs, 1).expect("sample");

@@ -13,6 +13,7 @@ fn run(prt: &PortalFile, mode: VisMode) -> Pvs {
         mode,
         threads: Some(2),
         progress: false,
+        ..Default::default()
     };
     compute_vis(prt, &options).expect("vis").pvs
 }
@@ -310,6 +311,7 @@ fn the_pvs_does_not_depend_on_the_thread_count() {
             mode: FULL,
             threads: Some(threads),
             progress: false,
+            ..Default::default()
         };
         compute_vis(&prt, &options).expect("vis").pvs
     };

@@ -1,4 +1,5 @@
-//! `mapgen [OUT_DIR]`: regenerate the maps and WAD.
+//! `mapgen [OUT_DIR]`: regenerate the maps and WAD; `mapgen random --seed N OUT.map`: write one
+//! random map.
 
 use anyhow::Context;
 use std::path::{Path, PathBuf};
@@ -11,6 +12,24 @@ pub struct Args {
     /// Write counts and timings as JSON to this file
     #[arg(long, value_name = "FILE.json")]
     pub stats: Option<PathBuf>,
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+#[derive(clap::Subcommand, Debug, Clone)]
+pub enum Command {
+    /// Write the random map of a seed (the maps `tests/generated_maps.rs` checks)
+    Random {
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Rooms joined by corridors
+        #[arg(long, default_value_t = crate::random::RandomOptions::default().rooms)]
+        rooms: usize,
+        /// Brushes tried in each room
+        #[arg(long, default_value_t = crate::random::RandomOptions::default().objects_per_room)]
+        objects: usize,
+        out: PathBuf,
+    },
 }
 
 /// The `maps/` directory this crate lives in.
@@ -20,6 +39,23 @@ pub fn default_out_dir() -> PathBuf {
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
+    if let Some(Command::Random {
+        seed,
+        rooms,
+        objects,
+        out,
+    }) = &args.command
+    {
+        let options = crate::random::RandomOptions {
+            rooms: *rooms,
+            objects_per_room: *objects,
+        };
+        let text = crate::random::random_map(*seed, &options).to_text();
+        quake_formats::fsutil::write_atomic(out, text.as_bytes())
+            .with_context(|| format!("writing {}", out.display()))?;
+        eprintln!("wrote random map {seed} to {}", out.display());
+        return Ok(());
+    }
     let start = Instant::now();
     let dir = args.out_dir.clone().unwrap_or_else(default_out_dir);
     let files = crate::write_all(&dir)?;

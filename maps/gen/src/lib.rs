@@ -2,12 +2,15 @@
 //!
 //! [`textures`] paints procedural textures and quantises them to `Palette::slipgate()`;
 //! [`level`] turns boxes of open space into sealed shells of brushes; [`maps`] defines the demo
-//! map, the hard cases, the leak pair and the corridor test map; [`brush`] writes `.map` text.
+//! map, the hard cases, the leak pair and the corridor test map; [`brush`] writes `.map` text;
+//! [`random`] makes seeded random maps for property tests; [`open`] the open field for sharded vis.
 
 pub mod brush;
 pub mod cli;
 pub mod level;
 pub mod maps;
+pub mod open;
+pub mod random;
 pub mod textures;
 
 use quake_formats::FormatError;

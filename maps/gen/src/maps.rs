@@ -36,17 +36,17 @@ fn cuboid(lo: [f64; 3], hi: [f64; 3], texture: &str) -> Brush {
     Brush::cuboid(b(lo, hi), texture)
 }
 
-fn worldspawn(message: &str) -> MapEntity {
+pub(crate) fn worldspawn(message: &str) -> MapEntity {
     MapEntity::new("worldspawn")
         .key("message", message)
         .key("wad", WAD_NAME)
 }
 
-fn light(origin: [f64; 3], level: u32) -> MapEntity {
+pub(crate) fn light(origin: [f64; 3], level: u32) -> MapEntity {
     MapEntity::point("light", origin).key("light", &level.to_string())
 }
 
-fn player_start(origin: [f64; 3], angle: u32) -> MapEntity {
+pub(crate) fn player_start(origin: [f64; 3], angle: u32) -> MapEntity {
     MapEntity::point("info_player_start", origin).key("angle", &angle.to_string())
 }
 
@@ -60,7 +60,7 @@ fn lamp(x: f64, y: f64, ceiling: f64) -> (Brush, MapEntity) {
     (brush, light([x, y, ceiling - 24.0], 250))
 }
 
-fn standard(comment: &[&str], entities: Vec<MapEntity>) -> Map {
+pub(crate) fn standard(comment: &[&str], entities: Vec<MapEntity>) -> Map {
     Map {
         comment: comment.iter().map(|s| s.to_string()).collect(),
         format: MapFormat::Standard,
@@ -562,6 +562,11 @@ pub fn all() -> Vec<MapFile> {
             "test/corridors.map",
             "Clip-hull trace test: corridors, a pillar, steps and a platform at documented coordinates.",
             corridors(),
+        ),
+        valid(
+            "open/open.map",
+            "Vis timing: a sealed sky-covered field with pillars and small rooms, from a seed (`open.rs`); full vis takes minutes.",
+            crate::open::open_map(crate::open::SEED),
         ),
     ]
 }

@@ -28,6 +28,7 @@ pub enum Rule {
     LeafZeroSolid,
     SurfaceExtents,
     SurfaceExtentsVanilla,
+    LightmapExtentsEnginesDisagree,
     UnlitFaceVerts,
     TextureAlignment,
     AnimationName,
@@ -63,7 +64,7 @@ pub struct RuleInfo {
 const QS: &str = "QuakeSpasm, vkQuake, Ironwail";
 
 impl Rule {
-    pub const ALL: [Rule; 35] = [
+    pub const ALL: [Rule; 36] = [
         Rule::IndexRange,
         Rule::NonFinite,
         Rule::PlaneNormal,
@@ -83,6 +84,7 @@ impl Rule {
         Rule::LeafZeroSolid,
         Rule::SurfaceExtents,
         Rule::SurfaceExtentsVanilla,
+        Rule::LightmapExtentsEnginesDisagree,
         Rule::UnlitFaceVerts,
         Rule::TextureAlignment,
         Rule::AnimationName,
@@ -252,6 +254,17 @@ impl Rule {
                 "\"Bad surface extents\" (Sys_Error)",
                 "a face without TEX_SPECIAL spans at most 256 texels per axis (WinQuake; GLQuake \
                  allows 512)",
+            ),
+            Rule::LightmapExtentsEnginesDisagree => (
+                "lightmap-extents-engines-disagree",
+                Warning,
+                "DarkPlaces vs QuakeSpasm family",
+                "one of them reads the face's lightmap with another row length or origin than the \
+                 light tool wrote: drawn skewed or shifted (past the lighting lump for the last \
+                 face)",
+                "a face without TEX_SPECIAL gets the same lightmap extents from QuakeSpasm's rule \
+                 (texture coordinates summed in double, kept as float) and DarkPlaces' (summed \
+                 in float)",
             ),
             Rule::UnlitFaceVerts => (
                 "unlit-face-verts",

@@ -21,6 +21,7 @@ pub(super) fn check(c: &mut Checker) {
         };
         let ext = LightmapExtents::from_points(&points, &tex.vecs);
         check_extents(c, i, f, tex, &ext);
+        check_engines_agree(c, i, tex, &points, &ext);
         check_lightmap_data(c, i, f, tex, &ext);
     }
 }
@@ -57,6 +58,40 @@ fn check_extents(c: &mut Checker, i: usize, f: &Face, tex: &TexInfo, ext: &Light
             format!("{detail}: {which} refuse it"),
         );
     }
+}
+
+/// A lit face's lightmap must have one size and origin in every engine: QuakeSpasm's family and
+/// DarkPlaces compute texture coordinates in different precision, which near a grid line can
+/// snap them to different lines.
+fn check_engines_agree(
+    c: &mut Checker,
+    i: usize,
+    tex: &TexInfo,
+    points: &[[f32; 3]],
+    ext: &LightmapExtents,
+) {
+    if tex.flags & texinfo_flags::SPECIAL != 0 {
+        return;
+    }
+    let disagree = LightmapExtents::engines_disagree(points, &tex.vecs);
+    if disagree == [false, false] {
+        return;
+    }
+    let dp = LightmapExtents::from_points_darkplaces(points, &tex.vecs);
+    let axes = match disagree {
+        [true, true] => "s and t",
+        [true, false] => "s",
+        _ => "t",
+    };
+    let detail = format!(
+        "lightmap along {axes}: QuakeSpasm family {:?} from texel {:?}, DarkPlaces {:?} from \
+         texel {:?}",
+        ext.luxel_size(),
+        ext.tex_mins,
+        dp.luxel_size(),
+        dp.tex_mins
+    );
+    c.report(Rule::LightmapExtentsEnginesDisagree, "faces", i, detail);
 }
 
 /// A lit face's lightmaps (one per style) must lie inside the lighting lump.
