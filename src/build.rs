@@ -3,8 +3,9 @@
 
 use anyhow::{Context, Result};
 use clap::{Args, FromArgMatches};
+use serde_json::Value;
 use std::ffi::OsString;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 #[derive(clap::Args, Debug)]
@@ -17,9 +18,12 @@ pub struct BuildArgs {
     /// Extra folders to search for the WADs the map names
     #[arg(long = "wad-dir", value_name = "DIR")]
     wad_dirs: Vec<PathBuf>,
-    /// Base vis only (conservative, coarser, much faster)
+    /// Quick preset: base vis only (conservative, coarser, much faster) and default light
     #[arg(long)]
     fast: bool,
+    /// Release preset: full vis and light with --extra4 --soft --bounce
+    #[arg(long, conflicts_with_all = ["fast", "extra"])]
+    r#final: bool,
     /// Light with 2x2 samples per luxel
     #[arg(long)]
     extra: bool,
@@ -70,57 +74,59 @@ fn stage_args<A: Args + FromArgMatches>(name: &'static str, argv: Vec<OsString>)
     Ok(A::from_arg_matches(&matches)?)
 }
 
+/// One stage's wall time and the stats JSON it wrote.
+struct StageRun {
+    name: &'static str,
+    seconds: f64,
+    stats: Value,
+}
+
+/// Where a stage writes its stats: the path its `--*-opts` name, else one in `scratch`.
+fn stats_path(argv: &mut Vec<OsString>, scratch: &Path, stage: &str) -> PathBuf {
+    let given = argv.iter().enumerate().find_map(|(i, a)| {
+        let a = a.to_str()?;
+        match a.strip_prefix("--stats") {
+            Some("") => argv.get(i + 1).map(PathBuf::from),
+            Some(v) => v.strip_prefix('=').map(PathBuf::from),
+            None => None,
+        }
+    });
+    given.unwrap_or_else(|| {
+        let path = scratch.join(format!("{stage}.json"));
+        argv.extend(["--stats".into(), path.clone().into()]);
+        path
+    })
+}
+
+/// Runs a stage with `--stats`, timing it.
+fn run_stage<A: Args + FromArgMatches>(
+    name: &'static str,
+    mut argv: Vec<OsString>,
+    scratch: &Path,
+    run: impl FnOnce(&A) -> Result<()>,
+) -> Result<StageRun> {
+    let stats = stats_path(&mut argv, scratch, name);
+    eprintln!("== {name}");
+    let start = Instant::now();
+    run(&stage_args(name, argv)?)?;
+    let seconds = start.elapsed().as_secs_f64();
+    let text = std::fs::read(&stats).with_context(|| format!("{}", stats.display()))?;
+    Ok(StageRun {
+        name,
+        seconds,
+        stats: serde_json::from_slice(&text).with_context(|| format!("{}", stats.display()))?,
+    })
+}
+
 pub fn build(args: &BuildArgs) -> Result<()> {
     let start = Instant::now();
     let bsp = args.map.with_extension("bsp");
-
-    let mut argv: Vec<OsString> = vec![args.map.clone().into(), bsp.clone().into()];
-    if args.bsp2 {
-        argv.push("--bsp2".into());
-    }
-    for dir in &args.wad_dirs {
-        argv.extend(["--wad-dir".into(), dir.clone().into()]);
-    }
-    argv.extend(extra_args(args.bsp_opts.as_deref()));
-    eprintln!("== bsp");
-    bsp_compiler::cli::run(&stage_args("bsp", argv)?)?;
-
-    let mut argv: Vec<OsString> = vec![bsp.clone().into()];
-    if args.fast {
-        argv.push("--fast".into());
-    }
-    argv.extend(extra_args(args.vis_opts.as_deref()));
-    eprintln!("== vis");
-    vis::cli::run(&stage_args("vis", argv)?)?;
-
-    let mut argv: Vec<OsString> = vec![bsp.clone().into()];
-    for (on, flag) in [
-        (args.extra, "--extra"),
-        (args.extra4, "--extra4"),
-        (args.soft, "--soft"),
-        (args.dirt, "--dirt"),
-        (args.bounce, "--bounce"),
-    ] {
-        if on {
-            argv.push(flag.into());
-        }
-    }
-    argv.extend(extra_args(args.light_opts.as_deref()));
-    eprintln!("== light");
-    light::cli::run(&stage_args("light", argv)?)?;
-
-    if !args.no_preview {
-        let png = args.map.with_extension("png");
-        let argv: Vec<OsString> = vec![
-            bsp.clone().into(),
-            "--out".into(),
-            png.into(),
-            "--size".into(),
-            args.size.clone().into(),
-        ];
-        eprintln!("== view");
-        runtime_viewer::cli::run(&stage_args("view", argv)?)?;
-    }
+    let scratch = std::env::temp_dir().join(format!("slipgate-build-{}", std::process::id()));
+    std::fs::create_dir_all(&scratch).with_context(|| format!("{}", scratch.display()))?;
+    let stages = run_stages(args, &bsp, &scratch);
+    let _ = std::fs::remove_dir_all(&scratch);
+    let stages = stages?;
+    eprint!("{}", summary(&args.map, &stages));
     eprintln!(
         "build: {} in {:.2} s",
         args.map.display(),
@@ -129,9 +135,189 @@ pub fn build(args: &BuildArgs) -> Result<()> {
     Ok(())
 }
 
+fn run_stages(args: &BuildArgs, bsp: &Path, scratch: &Path) -> Result<Vec<StageRun>> {
+    let mut stages = Vec::new();
+    let mut argv: Vec<OsString> = vec![args.map.clone().into(), bsp.into()];
+    if args.bsp2 {
+        argv.push("--bsp2".into());
+    }
+    for dir in &args.wad_dirs {
+        argv.extend(["--wad-dir".into(), dir.clone().into()]);
+    }
+    argv.extend(extra_args(args.bsp_opts.as_deref()));
+    stages.push(run_stage("bsp", argv, scratch, bsp_compiler::cli::run)?);
+
+    let mut argv: Vec<OsString> = vec![bsp.into()];
+    if args.fast {
+        argv.push("--fast".into());
+    }
+    argv.extend(extra_args(args.vis_opts.as_deref()));
+    stages.push(run_stage("vis", argv, scratch, vis::cli::run)?);
+
+    let mut argv: Vec<OsString> = vec![bsp.into()];
+    for (on, flag) in [
+        (args.extra, "--extra"),
+        (args.extra4 || args.r#final, "--extra4"),
+        (args.soft || args.r#final, "--soft"),
+        (args.dirt, "--dirt"),
+        (args.bounce || args.r#final, "--bounce"),
+    ] {
+        if on {
+            argv.push(flag.into());
+        }
+    }
+    argv.extend(extra_args(args.light_opts.as_deref()));
+    stages.push(run_stage("light", argv, scratch, light::cli::run)?);
+
+    if !args.no_preview {
+        let argv: Vec<OsString> = vec![
+            bsp.into(),
+            "--out".into(),
+            args.map.with_extension("png").into(),
+            "--size".into(),
+            args.size.clone().into(),
+        ];
+        stages.push(run_stage("view", argv, scratch, runtime_viewer::cli::run)?);
+    }
+    Ok(stages)
+}
+
+/// The table printed at the end of a build: time and the main figures of each stage, from the
+/// stats each stage wrote, and the sizes of the files written.
+fn summary(map: &Path, stages: &[StageRun]) -> String {
+    let number = |v: &Value, pointer: &str| v.pointer(pointer).and_then(Value::as_f64);
+    let size = |ext: &str| {
+        let path = map.with_extension(ext);
+        std::fs::metadata(&path).ok().map(|m| {
+            let name = path.file_name().unwrap_or_default().to_string_lossy();
+            format!("{name} {:.0} KB", m.len() as f64 / 1024.0)
+        })
+    };
+    let mut out = String::from("| stage | time | figures | files |\n|---|---|---|---|\n");
+    for stage in stages {
+        let s = &stage.stats;
+        let figures = match stage.name {
+            "bsp" => [
+                ("faces", "faces"),
+                ("leaves", "leaves"),
+                ("nodes", "nodes"),
+                ("clipnodes", "clipnodes"),
+                ("vis_portals", "portals"),
+            ]
+            .iter()
+            .filter_map(|(k, name)| Some(format!("{} {name}", number(s, &format!("/{k}"))?)))
+            .collect::<Vec<_>>()
+            .join(", "),
+            "vis" => format!(
+                "PVS average {:.1} of {} leaves; visibility lump {:.1} KB",
+                number(s, "/compute/average_visible").unwrap_or(0.0),
+                number(s, "/compute/leafs").unwrap_or(0.0),
+                number(s, "/lump/compressed_bytes").unwrap_or(0.0) / 1024.0
+            ),
+            "light" => {
+                let rays: f64 = [
+                    "shadow_rays",
+                    "sun_rays",
+                    "dirt_rays",
+                    "placement_rays",
+                    "bounce_rays",
+                ]
+                .iter()
+                .filter_map(|k| number(s, &format!("/{k}")))
+                .sum();
+                format!(
+                    "{:.2} M rays, {:.1} Mrays/s",
+                    rays / 1e6,
+                    number(s, "/rays_per_second").unwrap_or(0.0) / 1e6
+                )
+            }
+            _ => String::new(),
+        };
+        let files: Vec<String> = match stage.name {
+            "bsp" => ["bsp", "prt"].iter().filter_map(|e| size(e)).collect(),
+            "light" => size("lit").into_iter().collect(),
+            "view" => size("png").into_iter().collect(),
+            _ => Vec::new(),
+        };
+        out += &format!(
+            "| {} | {:.2} s | {figures} | {} |\n",
+            stage.name,
+            stage.seconds,
+            files.join(", ")
+        );
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn parse_build(words: &[&str]) -> Result<BuildArgs, clap::Error> {
+        let command = BuildArgs::augment_args(clap::Command::new("build").no_binary_name(true));
+        BuildArgs::from_arg_matches(&command.try_get_matches_from(words)?)
+    }
+
+    #[test]
+    fn final_is_a_preset_that_excludes_fast() {
+        let f = parse_build(&["x.map", "--final"]).expect("--final parses");
+        assert!(f.r#final && !f.fast);
+        assert!(parse_build(&["x.map", "--final", "--fast"]).is_err());
+        assert!(parse_build(&["x.map", "--fast"]).expect("--fast").fast);
+    }
+
+    #[test]
+    fn stats_go_where_the_options_say_else_to_scratch() {
+        let scratch = Path::new("/tmp/s");
+        let mut argv: Vec<OsString> = vec!["x.bsp".into()];
+        assert_eq!(
+            stats_path(&mut argv, scratch, "vis"),
+            scratch.join("vis.json")
+        );
+        assert_eq!(argv.len(), 3);
+        let mut argv: Vec<OsString> = vec!["x.bsp".into(), "--stats".into(), "mine.json".into()];
+        assert_eq!(
+            stats_path(&mut argv, scratch, "vis"),
+            PathBuf::from("mine.json")
+        );
+        let mut argv: Vec<OsString> = vec!["--stats=m.json".into()];
+        assert_eq!(
+            stats_path(&mut argv, scratch, "vis"),
+            PathBuf::from("m.json")
+        );
+        assert_eq!(argv.len(), 1);
+    }
+
+    #[test]
+    fn summary_names_each_stage_s_figures() {
+        let stage = |name, stats| StageRun {
+            name,
+            seconds: 0.5,
+            stats,
+        };
+        let stages = [
+            stage(
+                "bsp",
+                serde_json::json!({"faces": 61, "leaves": 8, "nodes": 34}),
+            ),
+            stage(
+                "vis",
+                serde_json::json!({"compute": {"average_visible": 5.25, "leafs": 7}}),
+            ),
+            stage(
+                "light",
+                serde_json::json!({"shadow_rays": 1_500_000, "bounce_rays": 500_000,
+                                   "rays_per_second": 4e6}),
+            ),
+        ];
+        let table = summary(Path::new("/nonexistent/x.map"), &stages);
+        assert!(
+            table.contains("| bsp | 0.50 s | 61 faces, 8 leaves, 34 nodes |"),
+            "{table}"
+        );
+        assert!(table.contains("PVS average 5.2 of 7 leaves;"), "{table}");
+        assert!(table.contains("2.00 M rays, 4.0 Mrays/s"), "{table}");
+    }
 
     #[test]
     fn stage_options_take_ericw_spellings() {

@@ -2,6 +2,7 @@
 
 mod build;
 mod inspect;
+mod report;
 
 use anyhow::Result;
 use batch::options::normalise_single_dash;
@@ -38,6 +39,8 @@ enum Command {
     Info(inspect::InfoArgs),
     /// Rewrite a BSP (optionally as BSP29 or BSP2) or a WAD; unchanged data is byte-identical
     Convert(inspect::ConvertArgs),
+    /// Time every stage at every quality setting and measure its error against its reference
+    Report(report::ReportArgs),
     /// Build many maps (a project file or a folder): cached, in parallel, optionally in shards
     Batch(batch::cli::Args),
 }
@@ -64,6 +67,7 @@ fn run(command: Command) -> Result<ExitCode> {
         Command::View(args) => runtime_viewer::cli::run(&args).map(|()| ExitCode::SUCCESS),
         Command::Info(args) => inspect::info(&args),
         Command::Convert(args) => inspect::convert(&args).map(|()| ExitCode::SUCCESS),
+        Command::Report(args) => report::report(&args).map(|()| ExitCode::SUCCESS),
         Command::Batch(args) => batch::cli::run(&args),
     }
 }

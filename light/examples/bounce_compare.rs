@@ -6,68 +6,17 @@
 //! receivers every GRID luxels casting STRATA² rays each.
 
 use light::bounce::Density;
-use light::output::FaceLightmap;
-use light::{Lighting, Options, Quality, compare, compute_lighting};
+use light::{Lighting, Options, Quality, compare, compute_lighting, lightmaps_in};
 use quake_formats::Bsp;
-
-/// The lightmaps `bsp` holds for `faces` (grey only), as a [`Lighting`] to compare.
-fn read_lightmaps(bsp: &Bsp, faces: &[usize]) -> Lighting {
-    let mut lightmaps = Vec::new();
-    for &f in faces {
-        let face = &bsp.faces[f];
-        let Some(verts) = bsp.face_vertices(face) else {
-            continue;
-        };
-        let Some(ti) = bsp.texinfo.get(face.texinfo as usize) else {
-            continue;
-        };
-        let ext = quake_formats::extents::LightmapExtents::from_points(&verts, &ti.vecs);
-        let [w, h] = ext.luxel_size();
-        if face.light_offset < 0 {
-            continue;
-        }
-        let styles: Vec<u8> = face.styles.iter().copied().filter(|&s| s != 255).collect();
-        let grey = (0..styles.len())
-            .map(|k| {
-                let at = face.light_offset as usize + k * w * h;
-                bsp.lighting
-                    .get(at..at + w * h)
-                    .map_or(vec![0; w * h], <[u8]>::to_vec)
-            })
-            .collect();
-        lightmaps.push(FaceLightmap {
-            face: f,
-            width: w,
-            height: h,
-            styles,
-            grey,
-            rgb: Vec::new(),
-        });
-    }
-    Lighting {
-        lightmaps,
-        entity_text: None,
-        coloured: false,
-        stats: light::Stats::default(),
-    }
-}
 
 /// RMSE, max and share of luxels more than 2 levels off.
 fn report(name: &str, a: &Lighting, reference: &Lighting) {
     let e = compare(a, reference);
-    let mut over2 = 0u64;
-    for m in &a.lightmaps {
-        if let Some(r) = reference.lightmaps.iter().find(|r| r.face == m.face)
-            && let (Some(x), Some(y)) = (m.grey.first(), r.grey.first())
-        {
-            over2 += x.iter().zip(y).filter(|(p, q)| p.abs_diff(**q) > 2).count() as u64;
-        }
-    }
     println!(
         "{name}: RMSE {:.3}, max {}, > 2 levels {:.2} % of {} luxels",
         e.rmse,
         e.max,
-        100.0 * over2 as f64 / e.luxels.max(1) as f64,
+        100.0 * e.over_2 as f64 / e.luxels.max(1) as f64,
         e.luxels
     );
 }
@@ -137,7 +86,7 @@ fn main() -> anyhow::Result<()> {
     }
     if let Some(theirs) = theirs {
         let lit = Bsp::read(&std::fs::read(theirs)?)?;
-        let lightmaps = read_lightmaps(&lit, &faces);
+        let lightmaps = lightmaps_in(&lit, &faces);
         report("ericw-tools -bounce", &lightmaps, &reference);
         report(
             "ericw-tools -bounce vs our direct reference",

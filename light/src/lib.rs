@@ -744,6 +744,8 @@ pub struct ErrorStats {
     pub max: u8,
     /// Luxels that differ by more than 8 levels.
     pub over_8: u64,
+    /// Luxels that differ by more than 2 levels.
+    pub over_2: u64,
 }
 
 /// Compares grey lightmaps face by face and style by style (a style only one
@@ -773,11 +775,58 @@ pub fn compare(a: &Lighting, reference: &Lighting) -> ErrorStats {
                 sq += f64::from(d) * f64::from(d);
                 e.max = e.max.max(d);
                 e.over_8 += u64::from(d > 8);
+                e.over_2 += u64::from(d > 2);
             }
         }
     }
     e.rmse = (sq / e.luxels.max(1) as f64).sqrt();
     e
+}
+
+/// The lightmaps `bsp` already holds for `faces` (grey bytes of every style), as a [`Lighting`]
+/// to [`compare`]: how another run or another tool's light is measured against ours. Faces
+/// without a lightmap or with indices out of range are left out.
+pub fn lightmaps_in(bsp: &Bsp, faces: &[usize]) -> Lighting {
+    let mut lightmaps = Vec::new();
+    for &f in faces {
+        let Some(face) = bsp.faces.get(f) else {
+            continue;
+        };
+        let (Some(verts), Some(ti)) = (
+            bsp.face_vertices(face),
+            bsp.texinfo.get(face.texinfo as usize),
+        ) else {
+            continue;
+        };
+        if face.light_offset < 0 {
+            continue;
+        }
+        let [w, h] =
+            quake_formats::extents::LightmapExtents::from_points(&verts, &ti.vecs).luxel_size();
+        let styles: Vec<u8> = face.styles.iter().copied().filter(|&s| s != 255).collect();
+        let grey = (0..styles.len())
+            .map(|k| {
+                let at = face.light_offset as usize + k * w * h;
+                bsp.lighting
+                    .get(at..at + w * h)
+                    .map_or(vec![0; w * h], <[u8]>::to_vec)
+            })
+            .collect();
+        lightmaps.push(FaceLightmap {
+            face: f,
+            width: w,
+            height: h,
+            styles,
+            grey,
+            rgb: Vec::new(),
+        });
+    }
+    Lighting {
+        lightmaps,
+        entity_text: None,
+        coloured: false,
+        stats: Stats::default(),
+    }
 }
 
 #[cfg(test)]

@@ -1,0 +1,156 @@
+//! `slipgate report` on the project's small map: a row per stage and setting, finite figures,
+//! and image files that decode.
+
+#[path = "support/command.rs"]
+mod command;
+
+use std::path::Path;
+
+/// Every setting `slipgate report` measures, as its tables name them.
+const SETTINGS: [(&str, &str); 13] = [
+    ("bsp", "default"),
+    ("vis", "fast"),
+    ("vis", "full"),
+    ("light", "default"),
+    ("light", "--extra"),
+    ("light", "--extra4"),
+    ("light", "--soft"),
+    ("light", "--bounce"),
+    ("light", "--extra4 --soft --bounce"),
+    ("view", "span step 1"),
+    ("view", "span step 8"),
+    ("view", "span step 16"),
+    ("view", "span step 32"),
+];
+
+/// Whether `text` is well-formed enough: every opened tag closed in order.
+fn tags_balance(text: &str) -> bool {
+    let mut open: Vec<String> = Vec::new();
+    let mut rest = text;
+    while let Some(start) = rest.find('<') {
+        let Some(len) = rest[start..].find('>') else {
+            return false;
+        };
+        let tag = &rest[start + 1..start + len];
+        rest = &rest[start + len + 1..];
+        if tag.starts_with('?') || tag.starts_with('!') || tag.ends_with('/') {
+            continue;
+        }
+        let name = |t: &str| t.split_whitespace().next().unwrap_or_default().to_string();
+        if let Some(closing) = tag.strip_prefix('/') {
+            if open.pop() != Some(name(closing)) {
+                return false;
+            }
+        } else {
+            open.push(name(tag));
+        }
+    }
+    open.is_empty()
+}
+
+fn check_png(path: &Path) {
+    let bytes = std::fs::read(path).expect("png written");
+    assert!(
+        bytes.starts_with(b"\x89PNG\r\n\x1a\n"),
+        "{}",
+        path.display()
+    );
+    let mut reader = png::Decoder::new(&bytes[..])
+        .read_info()
+        .expect("png header decodes");
+    let mut pixels = vec![0; reader.output_buffer_size()];
+    let frame = reader.next_frame(&mut pixels).expect("png pixels decode");
+    assert!(frame.width > 100 && frame.height > 100);
+}
+
+#[test]
+fn report_measures_every_stage_and_setting_and_draws_its_plots() {
+    let out = command::scratch("report", "out");
+    let run = command::slipgate(&[
+        "report",
+        "--out-dir",
+        out.to_str().expect("utf8"),
+        "--runs",
+        "1",
+        "--reference-faces",
+        "16",
+        "--sample-pairs",
+        "20000",
+        "--view-frames",
+        "10",
+        "--hull-traces",
+        "300",
+        "maps/test/corridors.map",
+    ]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{stderr}");
+
+    let md = std::fs::read_to_string(out.join("report.md")).expect("report.md");
+    for (stage, setting) in SETTINGS {
+        let section = md
+            .split("\n## ")
+            .find(|s| s.starts_with(&format!("{stage}\n")))
+            .unwrap_or_else(|| panic!("no {stage} section:\n{md}"));
+        let row = format!("| corridors | {setting} | Slipgate |");
+        let found: Vec<&str> = section.lines().filter(|l| l.starts_with(&row)).collect();
+        assert_eq!(found.len(), 1, "{stage} {setting}:\n{md}");
+        assert!(!found[0].contains("failed"), "{}", found[0]);
+    }
+
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("report.json")).expect("report.json"))
+            .expect("report.json parses");
+    let rows = json["rows"].as_array().expect("rows");
+    assert_eq!(rows.len(), SETTINGS.len());
+    for row in rows {
+        let wall = row["timing"]["wall_seconds"].as_f64().expect("a time");
+        assert!(wall.is_finite() && wall > 0.0, "{row}");
+        let figures = &row["figures"];
+        let error = match row["stage"].as_str() {
+            Some("bsp") => {
+                assert!(figures["bsp"]["hull_traces"].as_u64() > Some(0), "{row}");
+                assert!(
+                    figures["bsp"]["hull_worst_gap"]
+                        .as_f64()
+                        .is_some_and(f64::is_finite)
+                );
+                figures["bsp"]["tjunctions"].as_f64()
+            }
+            Some("vis") => {
+                assert_eq!(figures["vis"]["seen_not_in_pvs"], 0, "{row}");
+                figures["vis"]["pvs_over_sampled"].as_f64()
+            }
+            Some("light") => {
+                assert!(figures["light"]["luxels"].as_u64() > Some(0), "{row}");
+                // Read back from the lit BSP, --extra4 is close to the reference: a misread
+                // lightmap would be far off.
+                if row["setting"] == "--extra4" {
+                    assert!(figures["light"]["rmse"].as_f64() < Some(1.0), "{row}");
+                }
+                figures["light"]["rmse"].as_f64()
+            }
+            Some("view") => figures["view"]["mean_diff"].as_f64(),
+            other => panic!("unknown stage {other:?}"),
+        };
+        assert!(error.is_some_and(f64::is_finite), "{row}");
+    }
+
+    let html = std::fs::read_to_string(out.join("report.html")).expect("report.html");
+    assert!(tags_balance(&html), "report.html's tags do not balance");
+    for stage in ["bsp", "vis", "light", "view"] {
+        check_png(&out.join(format!("{stage}.png")));
+        let svg = std::fs::read_to_string(out.join(format!("{stage}.svg"))).expect("svg");
+        assert!(svg.trim_start().starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+        assert!(tags_balance(&svg), "{stage}.svg's tags do not balance");
+        assert!(md.contains(&format!("({stage}.png)")));
+    }
+    assert_eq!(html.matches("<svg").count(), 4);
+    std::fs::remove_dir_all(out.parent().expect("scratch dir")).ok();
+}
+
+#[test]
+fn tag_balance_catches_unclosed_tags() {
+    assert!(tags_balance("<?xml?><svg a=\"1\"><g><line/></g></svg>"));
+    assert!(!tags_balance("<svg><g></svg>"));
+    assert!(!tags_balance("<svg>"));
+}
