@@ -6,51 +6,8 @@
 //! receivers every GRID luxels casting STRATA² rays each.
 
 use light::bounce::Density;
-use light::output::FaceLightmap;
-use light::{Lighting, Options, Quality, compare, compute_lighting};
+use light::{Lighting, Options, Quality, compare, compute_lighting, read_lightmaps};
 use quake_formats::Bsp;
-
-/// The lightmaps `bsp` holds for `faces` (grey only), as a [`Lighting`] to compare.
-fn read_lightmaps(bsp: &Bsp, faces: &[usize]) -> Lighting {
-    let mut lightmaps = Vec::new();
-    for &f in faces {
-        let face = &bsp.faces[f];
-        let Some(verts) = bsp.face_vertices(face) else {
-            continue;
-        };
-        let Some(ti) = bsp.texinfo.get(face.texinfo as usize) else {
-            continue;
-        };
-        let ext = quake_formats::extents::LightmapExtents::from_points(&verts, &ti.vecs);
-        let [w, h] = ext.luxel_size();
-        if face.light_offset < 0 {
-            continue;
-        }
-        let styles: Vec<u8> = face.styles.iter().copied().filter(|&s| s != 255).collect();
-        let grey = (0..styles.len())
-            .map(|k| {
-                let at = face.light_offset as usize + k * w * h;
-                bsp.lighting
-                    .get(at..at + w * h)
-                    .map_or(vec![0; w * h], <[u8]>::to_vec)
-            })
-            .collect();
-        lightmaps.push(FaceLightmap {
-            face: f,
-            width: w,
-            height: h,
-            styles,
-            grey,
-            rgb: Vec::new(),
-        });
-    }
-    Lighting {
-        lightmaps,
-        entity_text: None,
-        coloured: false,
-        stats: light::Stats::default(),
-    }
-}
 
 /// RMSE, max and share of luxels more than 2 levels off.
 fn report(name: &str, a: &Lighting, reference: &Lighting) {

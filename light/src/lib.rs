@@ -735,6 +735,51 @@ pub fn update_entities_only(bsp: &mut Bsp) -> Result<usize, LightError> {
     Ok(assigned.len())
 }
 
+/// The lightmaps a lit `bsp` holds for `faces` (grey only; faces without one are left out), as
+/// a [`Lighting`] to [`compare`]: another tool's output, or ours written earlier.
+pub fn read_lightmaps(bsp: &Bsp, faces: &[usize]) -> Lighting {
+    let mut lightmaps = Vec::new();
+    for &f in faces {
+        let Some(face) = bsp.faces.get(f) else {
+            continue;
+        };
+        let Some(verts) = bsp.face_vertices(face) else {
+            continue;
+        };
+        let Some(ti) = bsp.texinfo.get(face.texinfo as usize) else {
+            continue;
+        };
+        let ext = quake_formats::extents::LightmapExtents::from_points(&verts, &ti.vecs);
+        let [w, h] = ext.luxel_size();
+        if face.light_offset < 0 {
+            continue;
+        }
+        let styles: Vec<u8> = face.styles.iter().copied().filter(|&s| s != 255).collect();
+        let grey = (0..styles.len())
+            .map(|k| {
+                let at = face.light_offset as usize + k * w * h;
+                bsp.lighting
+                    .get(at..at + w * h)
+                    .map_or(vec![0; w * h], <[u8]>::to_vec)
+            })
+            .collect();
+        lightmaps.push(FaceLightmap {
+            face: f,
+            width: w,
+            height: h,
+            styles,
+            grey,
+            rgb: Vec::new(),
+        });
+    }
+    Lighting {
+        lightmaps,
+        entity_text: None,
+        coloured: false,
+        stats: Stats::default(),
+    }
+}
+
 /// Per-luxel difference between two lightings of the same faces, in 8-bit levels.
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
 pub struct ErrorStats {
