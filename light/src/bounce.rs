@@ -340,7 +340,7 @@ impl Field<'_> {
 }
 
 /// Every `stride`th index below `size`, and the last.
-fn grid(size: usize, stride: usize) -> Vec<usize> {
+pub(crate) fn grid(size: usize, stride: usize) -> Vec<usize> {
     let mut at: Vec<usize> = (0..size).step_by(stride.max(1)).collect();
     if size > 0 && at.last() != Some(&(size - 1)) {
         at.push(size - 1);
@@ -349,7 +349,7 @@ fn grid(size: usize, stride: usize) -> Vec<usize> {
 }
 
 /// For each index below the grid's last: the grid cell it lies in and how far across.
-fn cell_of(at: &[usize]) -> Vec<(usize, usize, f32)> {
+pub(crate) fn cell_of(at: &[usize]) -> Vec<(usize, usize, f32)> {
     let Some(&last) = at.last() else {
         return Vec::new();
     };
