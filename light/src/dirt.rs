@@ -125,7 +125,13 @@ pub fn occlusion_at(
     // Without per-sample normals every sample shares one ordered pattern.
     let flat_basis = basis_of(samples.normal);
     let ordered = ordered_components(cone);
-    let flat_ordered = ordered_directions(flat_basis, &ordered);
+    // Each pattern is turned in front of the face once, not per ray.
+    let in_front_all = |dirs: Vec<[f32; 3]>| -> Vec<[f32; 3]> {
+        dirs.into_iter()
+            .map(|d| in_front(d, samples.normal))
+            .collect()
+    };
+    let flat_ordered = in_front_all(ordered_directions(flat_basis, &ordered));
     let shift = flat_basis[0] * RAY_START_SHIFT[0] + flat_basis[1] * RAY_START_SHIFT[1];
     let depth = sampling.depth as f32;
     let mut packet = RayPacket16::new();
@@ -143,10 +149,15 @@ pub fn occlusion_at(
         .iter()
         .map(|&i| match sampling.mode {
             DirtMode::Ordered if samples.normals.is_empty() => Vec::new(),
-            DirtMode::Ordered => ordered_directions(basis_of(samples.normal_at(i)), &ordered),
-            DirtMode::Random => {
-                random_directions(basis_of(samples.normal_at(i)), cone, samples.face, i)
+            DirtMode::Ordered => {
+                in_front_all(ordered_directions(basis_of(samples.normal_at(i)), &ordered))
             }
+            DirtMode::Random => in_front_all(random_directions(
+                basis_of(samples.normal_at(i)),
+                cone,
+                samples.face,
+                i,
+            )),
         })
         .collect();
     let dirs_of = |s: usize| {
@@ -159,18 +170,24 @@ pub fn occlusion_at(
     let n = indices.len();
     let total = n * RAYS_PER_SAMPLE;
     let mut gathered = vec![0.0f32; n];
+    // Direction and sample of the next ray.
+    let (mut k, mut s) = (0, 0);
+    let mut lane_sample = [0usize; 16];
     for first in (0..total).step_by(16) {
         packet.clear();
         let lanes = (total - first).min(16);
-        for lane in 0..lanes {
-            let (k, s) = ((first + lane) / n, (first + lane) % n);
-            let d = dirs_of(s)[k];
-            packet.set(lane, starts[s], in_front(d, samples.normal), 0.0, depth);
+        for (lane, sample) in lane_sample.iter_mut().enumerate().take(lanes) {
+            packet.set(lane, starts[s], dirs_of(s)[k], 0.0, depth);
+            *sample = s;
+            s += 1;
+            if s == n {
+                (k, s) = (k + 1, 0);
+            }
         }
         let hits = scene.opaque_hits16(&mut packet, model);
-        for (lane, hit) in hits.iter().enumerate().take(lanes) {
+        for (hit, &sample) in hits.iter().zip(&lane_sample).take(lanes) {
             if let Some(t) = hit {
-                gathered[(first + lane) % n] += 1.0 - (t / depth).min(1.0);
+                gathered[sample] += 1.0 - (t / depth).min(1.0);
             }
         }
     }
