@@ -262,10 +262,8 @@ impl Field<'_> {
                 let u1 = ((r / strata) as f64 + j1) / strata as f64;
                 let u2 = ((r % strata) as f64 + j2) / strata as f64;
                 let radius = u1.sqrt();
-                let phi = std::f64::consts::TAU * u2;
-                *dir = t0 * (radius * phi.cos())
-                    + t1 * (radius * phi.sin())
-                    + at.flat * (1.0 - u1).sqrt();
+                let (sin, cos) = (std::f64::consts::TAU * u2).sin_cos();
+                *dir = t0 * (radius * cos) + t1 * (radius * sin) + at.flat * (1.0 - u1).sqrt();
                 packet.set(lane, at.point.to_f32(), dir.to_f32(), 0.0, RAY_LENGTH);
             }
             counts.rays += lanes as u64;
