@@ -961,11 +961,20 @@ pub fn trace_face(
                 continue;
             }
             let dir = sun.to_sun.to_f32();
-            for (i, v) in value.iter_mut().enumerate() {
-                let cos = samples.normal_at(i).dot(sun.to_sun);
-                *v = sun.light * angle_factor(cos, sun.anglescale);
-                if v.abs() < setup.gate {
-                    *v = 0.0;
+            let sun_value = |normal: Vec3| {
+                let v = sun.light * angle_factor(normal.dot(sun.to_sun), sun.anglescale);
+                if v.abs() < setup.gate { 0.0 } else { v }
+            };
+            if samples.normals.is_empty() {
+                // A flat face: the same value at every sample (none when the sun is behind it).
+                let v = sun_value(samples.normal);
+                if v == 0.0 {
+                    continue;
+                }
+                value.fill(v);
+            } else {
+                for (i, v) in value.iter_mut().enumerate() {
+                    *v = sun_value(samples.normal_at(i));
                 }
             }
             let ray = |i: usize| (samples.points[i], dir, setup.sun_distance);
