@@ -262,10 +262,8 @@ impl Field<'_> {
                 let u1 = ((r / strata) as f64 + j1) / strata as f64;
                 let u2 = ((r % strata) as f64 + j2) / strata as f64;
                 let radius = u1.sqrt();
-                let phi = std::f64::consts::TAU * u2;
-                *dir = t0 * (radius * phi.cos())
-                    + t1 * (radius * phi.sin())
-                    + at.flat * (1.0 - u1).sqrt();
+                let (sin, cos) = (std::f64::consts::TAU * u2).sin_cos();
+                *dir = t0 * (radius * cos) + t1 * (radius * sin) + at.flat * (1.0 - u1).sqrt();
                 packet.set(lane, at.point.to_f32(), dir.to_f32(), 0.0, RAY_LENGTH);
             }
             counts.rays += lanes as u64;
@@ -340,7 +338,7 @@ impl Field<'_> {
 }
 
 /// Every `stride`th index below `size`, and the last.
-fn grid(size: usize, stride: usize) -> Vec<usize> {
+pub(crate) fn grid(size: usize, stride: usize) -> Vec<usize> {
     let mut at: Vec<usize> = (0..size).step_by(stride.max(1)).collect();
     if size > 0 && at.last() != Some(&(size - 1)) {
         at.push(size - 1);
@@ -349,7 +347,7 @@ fn grid(size: usize, stride: usize) -> Vec<usize> {
 }
 
 /// For each index below the grid's last: the grid cell it lies in and how far across.
-fn cell_of(at: &[usize]) -> Vec<(usize, usize, f32)> {
+pub(crate) fn cell_of(at: &[usize]) -> Vec<(usize, usize, f32)> {
     let Some(&last) = at.last() else {
         return Vec::new();
     };

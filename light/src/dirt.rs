@@ -125,58 +125,77 @@ pub fn occlusion_at(
     // Without per-sample normals every sample shares one ordered pattern.
     let flat_basis = basis_of(samples.normal);
     let ordered = ordered_components(cone);
-    let flat_ordered = ordered_directions(flat_basis, &ordered);
+    // Each pattern is turned in front of the face once, not per ray.
+    let in_front_all = |dirs: Vec<[f32; 3]>| -> Vec<[f32; 3]> {
+        dirs.into_iter()
+            .map(|d| in_front(d, samples.normal))
+            .collect()
+    };
+    let flat_ordered = in_front_all(ordered_directions(flat_basis, &ordered));
     let shift = flat_basis[0] * RAY_START_SHIFT[0] + flat_basis[1] * RAY_START_SHIFT[1];
     let depth = sampling.depth as f32;
     let mut packet = RayPacket16::new();
-    let mut rays = 0u64;
-    let mut values = Vec::with_capacity(indices.len());
-    // A packet holds one direction from up to 16 neighbouring samples: rays
-    // that nearly coincide, which Embree traverses faster than 16 directions
-    // from one point. Each sample still sums its rays in pattern order.
-    let mut own: Vec<Vec<[f32; 3]>> = Vec::new();
-    let mut starts = [[0.0f32; 3]; 16];
-    for chunk in indices.chunks(16) {
-        own.clear();
-        for (lane, &i) in chunk.iter().enumerate() {
-            starts[lane] = (Vec3::from_f32(samples.points[i]) + shift).to_f32();
-            own.push(match sampling.mode {
-                DirtMode::Ordered if samples.normals.is_empty() => Vec::new(),
-                DirtMode::Ordered => ordered_directions(basis_of(samples.normal_at(i)), &ordered),
-                DirtMode::Random => {
-                    random_directions(basis_of(samples.normal_at(i)), cone, samples.face, i)
-                }
-            });
+    // Rays go in pattern order, each direction from every sample in turn, 16
+    // to a packet: a packet holds one direction from up to 16 neighbouring
+    // samples (rays that nearly coincide, which Embree traverses faster than
+    // 16 directions from one point), and no packet is left part empty while
+    // rays remain (a face's few samples fill packets with their next
+    // directions). Each sample sums its rays in pattern order.
+    let starts: Vec<[f32; 3]> = indices
+        .iter()
+        .map(|&i| (Vec3::from_f32(samples.points[i]) + shift).to_f32())
+        .collect();
+    let own: Vec<Vec<[f32; 3]>> = indices
+        .iter()
+        .map(|&i| match sampling.mode {
+            DirtMode::Ordered if samples.normals.is_empty() => Vec::new(),
+            DirtMode::Ordered => {
+                in_front_all(ordered_directions(basis_of(samples.normal_at(i)), &ordered))
+            }
+            DirtMode::Random => in_front_all(random_directions(
+                basis_of(samples.normal_at(i)),
+                cone,
+                samples.face,
+                i,
+            )),
+        })
+        .collect();
+    let dirs_of = |s: usize| {
+        if own[s].is_empty() {
+            &flat_ordered
+        } else {
+            &own[s]
         }
-        let dirs_of = |lane: usize| {
-            if own[lane].is_empty() {
-                &flat_ordered
-            } else {
-                &own[lane]
-            }
-        };
-        let mut gathered = [0.0f32; 16];
-        for k in 0..RAYS_PER_SAMPLE {
-            packet.clear();
-            for (lane, &start) in starts[..chunk.len()].iter().enumerate() {
-                let d = dirs_of(lane)[k];
-                packet.set(lane, start, in_front(d, samples.normal), 0.0, depth);
-            }
-            rays += chunk.len() as u64;
-            let hits = scene.opaque_hits16(&mut packet, model);
-            for (g, t) in gathered.iter_mut().zip(hits) {
-                if let Some(t) = t {
-                    *g += 1.0 - (t / depth).min(1.0);
-                }
+    };
+    let n = indices.len();
+    let total = n * RAYS_PER_SAMPLE;
+    let mut gathered = vec![0.0f32; n];
+    // Direction and sample of the next ray.
+    let (mut k, mut s) = (0, 0);
+    let mut lane_sample = [0usize; 16];
+    for first in (0..total).step_by(16) {
+        packet.clear();
+        let lanes = (total - first).min(16);
+        for (lane, sample) in lane_sample.iter_mut().enumerate().take(lanes) {
+            packet.set(lane, starts[s], dirs_of(s)[k], 0.0, depth);
+            *sample = s;
+            s += 1;
+            if s == n {
+                (k, s) = (k + 1, 0);
             }
         }
-        values.extend(
-            gathered[..chunk.len()]
-                .iter()
-                .map(|g| g / RAYS_PER_SAMPLE as f32),
-        );
+        let hits = scene.opaque_hits16(&mut packet, model);
+        for (hit, &sample) in hits.iter().zip(&lane_sample).take(lanes) {
+            if let Some(t) = hit {
+                gathered[sample] += 1.0 - (t / depth).min(1.0);
+            }
+        }
     }
-    (values, rays)
+    let values = gathered
+        .iter()
+        .map(|g| g / RAYS_PER_SAMPLE as f32)
+        .collect();
+    (values, total as u64)
 }
 
 #[cfg(test)]

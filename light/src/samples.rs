@@ -49,6 +49,10 @@ pub struct FaceSamples {
     /// Per sample: it is not where the texture grid puts it (moved onto the
     /// face, pulled back into the open or onto the centre).
     pub moved: Vec<bool>,
+    /// Per sample: pulled back into the open or onto the centre (moved for
+    /// something other than overhanging the face's edge, so possibly far
+    /// from its neighbours).
+    pub pulled: Vec<bool>,
     /// Where the samples' texture coordinates land on the face.
     pub map: SurfaceMap,
 }
@@ -348,6 +352,7 @@ pub fn face_samples(
             points,
             normals: Vec::new(),
             moved,
+            pulled,
             map,
         },
         counts,

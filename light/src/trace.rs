@@ -281,14 +281,56 @@ const DIRT_SMOOTH: f32 = 0.05;
 /// and 0.399 with 0.05 (the default mode gains nothing from it).
 const DIRT_SMOOTH_SUPERSAMPLED: f32 = 0.01;
 
+/// A grid of points where dirt is measured, over a face's grid of samples
+/// (`gw × gh` positions): every `stride`-th position along each axis, and
+/// the last row and column, so every position lies in a cell.
+struct DirtGrid {
+    xs: Vec<usize>,
+    ys: Vec<usize>,
+    /// Per position along each axis: the grid lines before and after it
+    /// (indices into `xs` / `ys`) and how far across it lies.
+    cx: Vec<(usize, usize, f32)>,
+    cy: Vec<(usize, usize, f32)>,
+}
+
+impl DirtGrid {
+    fn new(gw: usize, gh: usize, stride: usize) -> DirtGrid {
+        let xs = crate::bounce::grid(gw, stride);
+        let ys = crate::bounce::grid(gh, stride);
+        DirtGrid {
+            cx: crate::bounce::cell_of(&xs),
+            cy: crate::bounce::cell_of(&ys),
+            xs,
+            ys,
+        }
+    }
+
+    /// The four grid positions around position (gx, gy) (itself first when
+    /// it is on the grid), and how far across their cell it lies.
+    fn cell(&self, gx: usize, gy: usize) -> ([(usize, usize); 4], f32, f32) {
+        let (x0, x1, fx) = self.cx[gx];
+        let (y0, y1, fy) = self.cy[gy];
+        let (x0, x1, y0, y1) = (self.xs[x0], self.xs[x1], self.ys[y0], self.ys[y1]);
+        ([(x0, y0), (x1, y0), (x0, y1), (x1, y1)], fx, fy)
+    }
+}
+
+/// Coarse dirt cells are this many fine cells wide: occlusion is first
+/// measured on the coarse grid, and cells whose corners differ are refined.
+const DIRT_COARSE_CELLS: usize = 2;
+
 /// Dirt occlusion of every sample of a face (see [`dirt::occlusion_at`]) and
-/// the rays cast. With `adaptive`, it is measured on a coarse grid (every
+/// the rays cast. With `adaptive`, it is measured on a coarse grid of cells
+/// [`DIRT_COARSE_CELLS`] fine cells wide, then on the fine grid (every
 /// `stride`-th sample along each axis of the face's sample grid: one per
-/// luxel when supersampling, every other luxel otherwise) and at every moved
-/// sample; a sample between four grid points that differ by at most
-/// [`DIRT_SMOOTH`] (or [`DIRT_SMOOTH_SUPERSAMPLED`]; none of them moved) takes their bilinear mean, the
-/// others (corners, edges of objects) are measured. Only samples marked in
-/// `needed` get a value (the rest 0); a needed sample's value does not
+/// luxel when supersampling, every other luxel otherwise), both with the
+/// face's last row and column; and at every moved sample. A sample whose
+/// cell's four corners (none of them pulled, see [`FaceSamples::pulled`])
+/// differ by at most [`DIRT_SMOOTH`] (or [`DIRT_SMOOTH_SUPERSAMPLED`]) takes
+/// their bilinear mean, first in the coarse cell, else in the fine one; so
+/// does one whose fine corners the coarse cell predicts to within as much.
+/// The others (corners, edges of objects) are measured. Only samples marked
+/// in `needed` get a value (the rest 0); a needed sample's value does not
 /// depend on which others are needed.
 fn face_occlusion(
     setup: &TraceSetup,
@@ -317,13 +359,21 @@ fn face_occlusion(
         };
         (indices.iter().map(|&i| value_of(i)).collect(), rays)
     };
-    if !adaptive {
-        let (values, rays) = measure(&(0..n).filter(|&i| needed[i]).collect::<Vec<_>>());
-        let mut all = vec![0.0; n];
-        for (i, v) in (0..n).filter(|&i| needed[i]).zip(values) {
-            all[i] = v;
+    let mut known: Vec<Option<f32>> = vec![None; n];
+    let mut rays = 0;
+    let mut measure_into = |known: &mut Vec<Option<f32>>, indices: &mut Vec<usize>| {
+        indices.sort_unstable();
+        indices.dedup();
+        let (values, r) = measure(indices);
+        rays += r;
+        for (&i, v) in indices.iter().zip(values) {
+            known[i] = Some(v);
         }
-        return (all, rays);
+    };
+    if !adaptive {
+        let mut all: Vec<usize> = (0..n).filter(|&i| needed[i]).collect();
+        measure_into(&mut known, &mut all);
+        return (known.into_iter().map(|v| v.unwrap_or(0.0)).collect(), rays);
     }
     let axis = samples.per_axis;
     let stride = axis.max(2);
@@ -334,67 +384,90 @@ fn face_occlusion(
     };
     let (gw, gh) = (samples.width * axis, samples.height * axis);
     // Sample index of grid position (gx, gy).
-    let index = |gx: usize, gy: usize| {
+    let index = |(gx, gy): (usize, usize)| {
         ((gy / axis) * samples.width + gx / axis) * axis * axis + (gy % axis) * axis + gx % axis
     };
-    // The four grid samples around grid position (gx, gy), when the face's grid has them.
-    let corners = |gx: usize, gy: usize| {
-        let (x0, y0) = (gx / stride * stride, gy / stride * stride);
-        let (x1, y1) = (x0 + stride, y0 + stride);
-        (x1 < gw && y1 < gh)
-            .then(|| [(x0, y0), (x1, y0), (x0, y1), (x1, y1)].map(|(x, y)| index(x, y)))
-    };
-    let mut known: Vec<Option<f32>> = vec![None; n];
-    // First the needed grid and moved samples, and the grid corners of the
-    // other needed samples (what they may be interpolated from).
-    let mut first = Vec::new();
+    let mut pending: Vec<(usize, usize)> = Vec::new();
+    let mut batch: Vec<usize> = Vec::new();
+    let mut interpolated: Vec<(usize, f32)> = Vec::new();
     for gy in 0..gh {
         for gx in 0..gw {
-            let i = index(gx, gy);
+            let i = index((gx, gy));
             if !needed[i] {
                 continue;
             }
-            if (gx % stride == 0 && gy % stride == 0) || samples.moved[i] {
-                first.push(i);
-                continue;
+            if samples.moved[i] {
+                batch.push(i);
+            } else {
+                pending.push((gx, gy));
             }
-            first.extend(corners(gx, gy).into_iter().flatten());
         }
     }
-    first.sort_unstable();
-    first.dedup();
-    let (values, mut rays) = measure(&first);
-    for (&i, v) in first.iter().zip(values) {
-        known[i] = Some(v);
-    }
-    let mut rest = Vec::new();
-    for gy in 0..gh {
-        for gx in 0..gw {
-            let i = index(gx, gy);
-            if known[i].is_some() || !needed[i] {
-                continue;
+    // The bilinear mean at (gx, gy) of its cell's corners in `grid` and how
+    // much they differ, when all four are measured (only measured values: a
+    // needed sample's value must not depend on which others are needed) and
+    // none was pulled (possibly far from its grid position; a sample moved
+    // onto the face from past its edge stays beside it).
+    let bilinear = |known: &[Option<f32>], grid: &DirtGrid, (gx, gy): (usize, usize)| {
+        let (corners, fx, fy) = grid.cell(gx, gy);
+        let values = corners.map(|c| {
+            let c = index(c);
+            known[c].filter(|_| !samples.pulled[c])
+        });
+        let [Some(a), Some(b), Some(c), Some(d)] = values else {
+            return None;
+        };
+        let top = a + (b - a) * fx;
+        let bottom = c + (d - c) * fx;
+        let spread = a.max(b).max(c).max(d) - a.min(b).min(c).min(d);
+        Some((top + (bottom - top) * fy, spread))
+    };
+    let coarse = DirtGrid::new(gw, gh, stride * DIRT_COARSE_CELLS);
+    let fine = DirtGrid::new(gw, gh, stride);
+    for (grid, outer) in [(&coarse, None), (&fine, Some(&coarse))] {
+        // The corners of the cells of the samples still pending (a sample on
+        // the grid is its own first corner), then what they let us interpolate.
+        for &(gx, gy) in &pending {
+            let (corners, _, _) = grid.cell(gx, gy);
+            batch.extend(
+                corners
+                    .map(index)
+                    .into_iter()
+                    .filter(|&c| known[c].is_none()),
+            );
+        }
+        measure_into(&mut known, &mut batch);
+        batch.clear();
+        pending.retain(|&at| {
+            if known[index(at)].is_some() {
+                return false;
             }
-            let around =
-                corners(gx, gy).map(|cs| cs.map(|c| known[c].filter(|_| !samples.moved[c])));
-            let Some([Some(a), Some(b), Some(c), Some(d)]) = around else {
-                rest.push(i);
-                continue;
+            let Some((value, spread)) = bilinear(&known, grid, at) else {
+                return true;
             };
-            let (lo, hi) = (a.min(b).min(c).min(d), a.max(b).max(c).max(d));
-            if hi - lo > smooth {
-                rest.push(i);
-                continue;
+            // Corners that differ may still be interpolated between where the
+            // occlusion is close to bilinear (a steady slope away from a wall):
+            // the coarse cell's mean predicts each of them to within `smooth`.
+            let linear = || {
+                let Some(outer) = outer else {
+                    return false;
+                };
+                grid.cell(at.0, at.1).0.iter().all(|&c| {
+                    let measured = known[index(c)];
+                    let predicted = bilinear(&known, outer, c);
+                    matches!((measured, predicted), (Some(m), Some((p, _))) if (m - p).abs() <= smooth)
+                })
+            };
+            if spread > smooth && !linear() {
+                return true;
             }
-            let fx = (gx % stride) as f32 / stride as f32;
-            let fy = (gy % stride) as f32 / stride as f32;
-            let top = a + (b - a) * fx;
-            let bottom = c + (d - c) * fx;
-            known[i] = Some(top + (bottom - top) * fy);
-        }
+            interpolated.push((index(at), value));
+            false
+        });
     }
-    let (values, more) = measure(&rest);
-    rays += more;
-    for (&i, v) in rest.iter().zip(values) {
+    batch.extend(pending.iter().map(|&p| index(p)));
+    measure_into(&mut known, &mut batch);
+    for (i, v) in interpolated {
         known[i] = Some(v);
     }
     (known.into_iter().map(|v| v.unwrap_or(0.0)).collect(), rays)
@@ -888,11 +961,20 @@ pub fn trace_face(
                 continue;
             }
             let dir = sun.to_sun.to_f32();
-            for (i, v) in value.iter_mut().enumerate() {
-                let cos = samples.normal_at(i).dot(sun.to_sun);
-                *v = sun.light * angle_factor(cos, sun.anglescale);
-                if v.abs() < setup.gate {
-                    *v = 0.0;
+            let sun_value = |normal: Vec3| {
+                let v = sun.light * angle_factor(normal.dot(sun.to_sun), sun.anglescale);
+                if v.abs() < setup.gate { 0.0 } else { v }
+            };
+            if samples.normals.is_empty() {
+                // A flat face: the same value at every sample (none when the sun is behind it).
+                let v = sun_value(samples.normal);
+                if v == 0.0 {
+                    continue;
+                }
+                value.fill(v);
+            } else {
+                for (i, v) in value.iter_mut().enumerate() {
+                    *v = sun_value(samples.normal_at(i));
                 }
             }
             let ray = |i: usize| (samples.points[i], dir, setup.sun_distance);
@@ -988,6 +1070,26 @@ mod tests {
             mins: Vec3::new(mins[0], mins[1], mins[2]),
             maxs: Vec3::new(maxs[0], maxs[1], maxs[2]),
         }
+    }
+
+    #[test]
+    fn dirt_grid_cells_reach_the_last_row_and_column() {
+        // 6 × 3 positions, stride 2: lines at x 0, 2, 4, 5 and y 0, 2.
+        let grid = DirtGrid::new(6, 3, 2);
+        assert_eq!(
+            grid.cell(0, 0),
+            ([(0, 0), (2, 0), (0, 2), (2, 2)], 0.0, 0.0)
+        );
+        assert_eq!(
+            grid.cell(3, 1),
+            ([(2, 0), (4, 0), (2, 2), (4, 2)], 0.5, 0.5)
+        );
+        // Past the last full stride: the cell up to the last column, and the last column itself.
+        assert_eq!(grid.cell(4, 1).0, [(4, 0), (5, 0), (4, 2), (5, 2)]);
+        assert_eq!(
+            grid.cell(5, 2),
+            ([(5, 2), (5, 2), (5, 2), (5, 2)], 0.0, 0.0)
+        );
     }
 
     #[test]
