@@ -270,6 +270,13 @@ fn write(path: &Path, map: &Map) {
     std::fs::write(path, map.to_text()).expect("write map");
 }
 
+/// Print a line about a known failure straight to stderr, past the test harness's capture, so
+/// that it shows in every run's log, passing or not.
+fn known_line(line: &str) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr(), "{line}");
+}
+
 /// Check the maps of `seeds`; report every failure (seed, property, the map and a shrunk map)
 /// except those `known` lists, which are printed as `KNOWN` while they still match.
 fn check_seeds(seeds: std::ops::Range<u64>, options: &RandomOptions, known: &[KnownFailure]) {
@@ -279,21 +286,21 @@ fn check_seeds(seeds: std::ops::Range<u64>, options: &RandomOptions, known: &[Kn
         let listed = known.iter().find(|k| k.seed == seed);
         let Err(failure) = check(&map.to_text(), seed) else {
             if let Some(k) = listed {
-                println!(
+                known_line(&format!(
                     "KNOWN seed {seed} ({}) now passes: take it off the list",
                     k.property
-                );
+                ));
             }
             continue;
         };
-        if let Some(k) = listed.filter(|k| k.property == failure.property) {
-            if failure.measured <= k.bound {
-                println!(
-                    "KNOWN seed {seed}: {} fails, measuring {:.3} (listed {:.3}, bound {}): {}",
-                    k.property, failure.measured, k.measured, k.bound, k.cause
-                );
-                continue;
-            }
+        let matching =
+            listed.filter(|k| k.property == failure.property && failure.measured <= k.bound);
+        if let Some(k) = matching {
+            known_line(&format!(
+                "KNOWN seed {seed}: {} fails, measuring {:.3} (listed {:.3}, bound {}): {}",
+                k.property, failure.measured, k.measured, k.bound, k.cause
+            ));
+            continue;
         }
         let original = scratch(&format!("seed_{seed}.map"));
         write(&original, &map);
