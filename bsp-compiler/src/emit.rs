@@ -9,7 +9,7 @@ use crate::planes::{PlaneId, PlaneSet};
 use crate::tree::{Tree, engine_contents, is_see_through};
 use crate::wad_lookup::WadSet;
 use crate::warnings::Warning;
-use crate::weld::{VertexWelder, fix_tjunctions, remove_degenerate_vertices};
+use crate::weld::{VertexWelder, fix_tjunctions};
 use quake_formats::bsp::{BspPlane, Face, Leaf, Model, Node, TexInfo, contents, texinfo_flags};
 use quake_formats::entities::{Entity, write_entities};
 use quake_formats::geom::{Bounds, Plane, Vec3};
@@ -181,8 +181,7 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
     let mut leaf_faces: HashMap<(usize, u32), Vec<u32>> = HashMap::new();
     let mut model_faces: Vec<(u32, u32)> = vec![(0, 0); input.models.len()];
     let mut phong = Vec::with_capacity(pending.len());
-    for (pf, mut poly) in pending.iter().zip(polygons) {
-        remove_degenerate_vertices(&mut poly, &welder.positions);
+    for (pf, poly) in pending.iter().zip(polygons) {
         if poly.len() < 3 {
             continue;
         }

@@ -46,66 +46,159 @@ impl VertexWelder {
     }
 }
 
+/// Passes of T-junction fixing before giving up on a polygon set that keeps changing.
+const MAX_TJUNCTION_PASSES: usize = 16;
+
 /// Insert into each polygon (vertex indices into `positions`) every vertex lying inside one of
-/// its edges. Returns how many vertices were inserted.
+/// its edges, then drop the degenerate parts that makes ([`remove_degenerate_vertices`]), and
+/// repeat until nothing changes: an insertion makes new, shorter edges that a third vertex of a
+/// knot of near-coincident ones (where several planes meet) may lie on. Polygons may be left with
+/// fewer than three vertices. Returns how many vertices were inserted.
 pub fn fix_tjunctions(positions: &[Vec3], polygons: &mut [Vec<u32>]) -> usize {
-    let cell = |p: Vec3| {
-        [
-            (p.x / GRID).floor() as i64,
-            (p.y / GRID).floor() as i64,
-            (p.z / GRID).floor() as i64,
-        ]
-    };
-    let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
-    for (i, &p) in positions.iter().enumerate() {
-        grid.entry(cell(p)).or_default().push(i as u32);
-    }
+    let mut grid = TJunctionGrid::new(positions);
     let mut inserted = 0;
-    let mut on_edge: Vec<(f64, u32)> = Vec::new();
+    for _ in 0..MAX_TJUNCTION_PASSES {
+        let collapsed = collapse_short_edges(positions, polygons);
+        // A vertex made one with another is no longer anywhere to insert.
+        for &v in &collapsed {
+            grid.remove(v);
+        }
+        let mut changed = !collapsed.is_empty();
+        for poly in polygons.iter_mut() {
+            let before = poly.clone();
+            let added = grid.insert_edge_vertices(poly);
+            if added == 0 {
+                continue;
+            }
+            remove_degenerate_vertices(poly, positions);
+            // A vertex inserted and then dropped again (a spike) is no change.
+            if *poly != before {
+                inserted += added;
+                changed = true;
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    inserted
+}
+
+/// Make the two ends of every polygon edge shorter than [`TJUNCTION_EPSILON`] one vertex (the
+/// lower-numbered one, when its position is that close to the other's). Such an edge is a knot
+/// of near-coincident vertices where several planes meet: each lies within the T-junction
+/// distance of the others' edges, so no insertion can fix them (a sliver triangle of three of
+/// them has each vertex on its opposite edge).
+/// Returns the vertices collapsed into others.
+fn collapse_short_edges(positions: &[Vec3], polygons: &mut [Vec<u32>]) -> Vec<u32> {
+    let mut same: HashMap<u32, u32> = HashMap::new();
+    let root = |same: &HashMap<u32, u32>, mut v: u32| {
+        while let Some(&r) = same.get(&v) {
+            v = r;
+        }
+        v
+    };
+    for poly in polygons.iter() {
+        for k in 0..poly.len() {
+            let (a, b) = (
+                root(&same, poly[k]),
+                root(&same, poly[(k + 1) % poly.len()]),
+            );
+            if a != b && positions[a as usize].near(positions[b as usize], TJUNCTION_EPSILON) {
+                same.insert(a.max(b), a.min(b));
+            }
+        }
+    }
+    if same.is_empty() {
+        return Vec::new();
+    }
     for poly in polygons.iter_mut() {
+        for v in poly.iter_mut() {
+            *v = root(&same, *v);
+        }
+        remove_degenerate_vertices(poly, positions);
+    }
+    same.into_keys().collect()
+}
+
+/// Vertices bucketed by position, for finding those near an edge.
+struct TJunctionGrid<'a> {
+    positions: &'a [Vec3],
+    cells: HashMap<[i64; 3], Vec<u32>>,
+}
+
+impl<'a> TJunctionGrid<'a> {
+    fn cell(p: Vec3) -> [i64; 3] {
+        let c = |v: f64| (v / GRID).floor() as i64;
+        [c(p.x), c(p.y), c(p.z)]
+    }
+
+    fn new(positions: &'a [Vec3]) -> Self {
+        let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+        for (i, &p) in positions.iter().enumerate() {
+            cells.entry(Self::cell(p)).or_default().push(i as u32);
+        }
+        Self { positions, cells }
+    }
+
+    fn remove(&mut self, v: u32) {
+        let cell = Self::cell(self.positions[v as usize]);
+        if let Some(ids) = self.cells.get_mut(&cell) {
+            ids.retain(|&id| id != v);
+        }
+    }
+
+    /// Insert into `poly` every vertex lying inside one of its edges; how many were inserted.
+    fn insert_edge_vertices(&self, poly: &mut Vec<u32>) -> usize {
+        let mut inserted = 0;
         let mut out = Vec::with_capacity(poly.len());
+        let mut on_edge: Vec<(f64, u32)> = Vec::new();
         for k in 0..poly.len() {
             let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
             out.push(a);
-            let (pa, pb) = (positions[a as usize], positions[b as usize]);
-            let d = pb - pa;
-            let len2 = d.dot(d);
-            if len2 < POINT_EPSILON * POINT_EPSILON {
-                continue;
-            }
-            let pad = Vec3::new(TJUNCTION_EPSILON, TJUNCTION_EPSILON, TJUNCTION_EPSILON);
-            let (lo, hi) = (cell(pa.min(pb) - pad), cell(pa.max(pb) + pad));
-            on_edge.clear();
-            for x in lo[0]..=hi[0] {
-                for y in lo[1]..=hi[1] {
-                    for z in lo[2]..=hi[2] {
-                        let Some(ids) = grid.get(&[x, y, z]) else {
-                            continue;
-                        };
-                        for &v in ids {
-                            if v == a || v == b {
-                                continue;
-                            }
-                            let pv = positions[v as usize];
-                            let t = (pv - pa).dot(d) / len2;
-                            let along = t * len2.sqrt();
-                            if along <= POINT_EPSILON || along >= len2.sqrt() - POINT_EPSILON {
-                                continue;
-                            }
-                            if (pa + d * t - pv).length() < TJUNCTION_EPSILON {
-                                on_edge.push((t, v));
-                            }
-                        }
-                    }
-                }
-            }
-            on_edge.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+            self.vertices_inside(a, b, &mut on_edge);
             inserted += on_edge.len();
             out.extend(on_edge.iter().map(|&(_, v)| v));
         }
         *poly = out;
+        inserted
     }
-    inserted
+
+    /// The vertices inside edge `a`→`b` (within [`TJUNCTION_EPSILON`] of it, more than
+    /// [`POINT_EPSILON`] from its ends), with their fraction along it, in order along it.
+    fn vertices_inside(&self, a: u32, b: u32, on_edge: &mut Vec<(f64, u32)>) {
+        on_edge.clear();
+        let (pa, pb) = (self.positions[a as usize], self.positions[b as usize]);
+        let d = pb - pa;
+        let len2 = d.dot(d);
+        if len2 < POINT_EPSILON * POINT_EPSILON {
+            return;
+        }
+        let len = len2.sqrt();
+        let pad = Vec3::new(TJUNCTION_EPSILON, TJUNCTION_EPSILON, TJUNCTION_EPSILON);
+        let (lo, hi) = (Self::cell(pa.min(pb) - pad), Self::cell(pa.max(pb) + pad));
+        for x in lo[0]..=hi[0] {
+            for y in lo[1]..=hi[1] {
+                for z in lo[2]..=hi[2] {
+                    for &v in self.cells.get(&[x, y, z]).into_iter().flatten() {
+                        if v == a || v == b {
+                            continue;
+                        }
+                        let pv = self.positions[v as usize];
+                        let t = (pv - pa).dot(d) / len2;
+                        let along = t * len;
+                        if along <= POINT_EPSILON || along >= len - POINT_EPSILON {
+                            continue;
+                        }
+                        if (pa + d * t - pv).length() < TJUNCTION_EPSILON {
+                            on_edge.push((t, v));
+                        }
+                    }
+                }
+            }
+        }
+        on_edge.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+    }
 }
 
 /// Drop the parts of a welded polygon that its own vertices make degenerate: repeats (`A A`,
