@@ -76,6 +76,19 @@ fn project_maps() -> &'static MapSet {
             bsp_options: &["--bsp2"],
             ..Case::new(repo().join("maps/demo.map"), wads())
         });
+        // LibreQuake's release light settings, with coloured bounce: a `.lit` the engines load.
+        cases.push(Case {
+            name: "demo_bounce".to_string(),
+            light_options: &[
+                "--extra4",
+                "--soft",
+                "--bounce",
+                "--dirt",
+                "--bouncecolorscale",
+                "1",
+            ],
+            ..Case::new(repo().join("maps/demo.map"), wads())
+        });
         cases.extend(
             maps_in(&repo().join("maps/hard"))
                 .into_iter()

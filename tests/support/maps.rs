@@ -19,6 +19,8 @@ pub struct Case {
     /// Where `slipgate bsp` looks for the map's WADs.
     pub wad_dirs: Vec<PathBuf>,
     pub bsp_options: &'static [&'static str],
+    /// Options for `slipgate light` (before the BSP).
+    pub light_options: &'static [&'static str],
     /// A compile failure is expected for some (`maps/hard/`): it skips the map, saying so,
     /// instead of failing.
     pub may_fail_to_compile: bool,
@@ -45,6 +47,7 @@ impl Case {
             map,
             wad_dirs,
             bsp_options: &[],
+            light_options: &[],
             may_fail_to_compile: false,
             empty_view: None,
             known_error: None,
@@ -155,7 +158,10 @@ fn compile(case: &Case, dir: &Path) -> Result<Compiled, NotCompiled> {
         &["vis", bsp_arg]
     };
     slipgate(vis).map_err(NotCompiled::Failed)?;
-    slipgate(&["light", bsp_arg]).map_err(NotCompiled::Failed)?;
+    let mut light_args = vec!["light"];
+    light_args.extend(case.light_options);
+    light_args.push(bsp_arg);
+    slipgate(&light_args).map_err(NotCompiled::Failed)?;
 
     let bytes = std::fs::read(&bsp).expect("read the BSP");
     let text = Bsp::read(&bytes)
