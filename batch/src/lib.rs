@@ -17,6 +17,7 @@ pub mod project;
 pub mod schedule;
 pub mod stages;
 pub mod summary;
+mod walk;
 
 use cache::Cache;
 use manifest::{Manifest, ManifestError, Shard};

@@ -113,8 +113,14 @@ pub struct Collected {
 /// Join the manifests found under `dirs` (searched recursively).
 pub fn collect(dirs: &[PathBuf]) -> Result<Collected, ManifestError> {
     let mut found = Vec::new();
+    let is_manifest = |path: &Path| {
+        path.file_name()
+            .map(|n| n.to_string_lossy())
+            .is_some_and(|n| n.starts_with("slipgate-manifest") && n.ends_with(".json"))
+    };
     for dir in dirs {
-        find_manifests(dir, &mut found)?;
+        crate::walk::files_under(dir, &is_manifest, &mut found)
+            .map_err(|(path, source)| ManifestError::Io { path, source })?;
     }
     found.sort();
     if found.is_empty() {
@@ -190,26 +196,6 @@ fn check_map(map: &MapOutcome, dir: &Path, manifest: &Path, collected: &mut Coll
                 .push(format!("{}: {}: {e}", map.map, path.display())),
         }
     }
-}
-
-fn find_manifests(dir: &Path, found: &mut Vec<PathBuf>) -> Result<(), ManifestError> {
-    let io = |source| ManifestError::Io {
-        path: dir.to_path_buf(),
-        source,
-    };
-    for entry in std::fs::read_dir(dir).map_err(io)? {
-        let path = entry.map_err(io)?.path();
-        let name = path
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        if path.is_dir() && !name.starts_with('.') {
-            find_manifests(&path, found)?;
-        } else if name.starts_with("slipgate-manifest") && name.ends_with(".json") {
-            found.push(path);
-        }
-    }
-    Ok(())
 }
 
 #[cfg(test)]

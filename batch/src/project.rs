@@ -197,8 +197,14 @@ impl Project {
     }
 
     fn from_folder(root: &Path) -> Result<Project, ProjectError> {
-        let mut names = Vec::new();
-        find_maps(root, root, &mut names)?;
+        let is_map = |path: &Path| {
+            path.extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("map"))
+        };
+        let mut paths = Vec::new();
+        crate::walk::files_under(root, &is_map, &mut paths)
+            .map_err(|(path, source)| ProjectError::Io { path, source })?;
+        let names = paths.iter().map(|p| relative_name(root, p)).collect();
         let maps = jobs(root, names, &MapOptions::default(), &BTreeMap::new());
         if maps.is_empty() {
             return Err(ProjectError::NoMaps {
@@ -275,32 +281,6 @@ fn glob_maps(file: &Path, root: &Path, pattern: &str) -> Result<Vec<String>, Pro
         }
     }
     Ok(names)
-}
-
-/// Every `.map` under `dir`, skipping hidden folders (the cache among them).
-fn find_maps(root: &Path, dir: &Path, names: &mut Vec<String>) -> Result<(), ProjectError> {
-    let io = |source| ProjectError::Io {
-        path: dir.to_path_buf(),
-        source,
-    };
-    for entry in std::fs::read_dir(dir).map_err(io)? {
-        let path = entry.map_err(io)?.path();
-        let hidden = path
-            .file_name()
-            .is_some_and(|n| n.to_string_lossy().starts_with('.'));
-        if hidden {
-            continue;
-        }
-        if path.is_dir() {
-            find_maps(root, &path, names)?;
-        } else if path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("map"))
-        {
-            names.push(relative_name(root, &path));
-        }
-    }
-    Ok(())
 }
 
 #[cfg(test)]

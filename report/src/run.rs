@@ -296,13 +296,8 @@ fn slipgate_command(
                 c.arg("--wad-dir").arg(dir);
             }
         }
-        Stage::Vis => {
-            copy(input, out)?;
-            copy(&input.with_extension("prt"), &out.with_extension("prt"))?;
-            c.arg(out);
-        }
-        Stage::Light => {
-            copy(input, out)?;
+        Stage::Vis | Stage::Light => {
+            copy_stage_input(setting.stage, input, out)?;
             c.arg(out);
         }
         Stage::View => {
@@ -349,14 +344,21 @@ fn ericw_command(
             c.arg(&map.source).arg(out);
         }
         _ => {
-            copy(input, out)?;
-            if setting.stage == Stage::Vis {
-                copy(&input.with_extension("prt"), &out.with_extension("prt"))?;
-            }
+            copy_stage_input(setting.stage, input, out)?;
             c.arg(out);
         }
     }
     Ok(c)
+}
+
+/// Vis and light rewrite their BSP in place, so each run works on its own copy of the input
+/// (vis with its portal file).
+fn copy_stage_input(stage: Stage, input: &Path, out: &Path) -> Result<(), ReportError> {
+    copy(input, out)?;
+    if stage == Stage::Vis {
+        copy(&input.with_extension("prt"), &out.with_extension("prt"))?;
+    }
+    Ok(())
 }
 
 /// Measures a finished step's output against its stage's reference.

@@ -11,9 +11,10 @@
 use bsp_compiler::{CompileOptions, MapSource, compile};
 use quake_formats::Bsp;
 use quake_formats::geom::Vec3;
+use quake_formats::rng::SplitMix64;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
-use vis::sample::{Hull0, SplitMix64, is_open};
+use vis::sample::{Hull0, is_open};
 use vis::{Pvs, VisMode, VisOptions, compute_vis, read_pvs};
 
 const PAIRS: usize = 1_000_000;

@@ -445,8 +445,8 @@ fn clip_in_place(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sample::SplitMix64;
     use quake_formats::geom::{Split, Winding};
+    use quake_formats::rng::SplitMix64;
 
     fn square() -> Vec<Vec3> {
         vec![

@@ -7,36 +7,8 @@ use crate::pvs::Pvs;
 use quake_formats::Bsp;
 use quake_formats::bsp::{Leaf, contents};
 use quake_formats::geom::{Plane, Vec3};
+use quake_formats::rng::SplitMix64;
 use rayon::prelude::*;
-
-/// A small, fast, seedable generator (SplitMix64); good enough for sampling, not for secrets.
-#[derive(Debug, Clone)]
-pub struct SplitMix64(u64);
-
-impl SplitMix64 {
-    pub fn new(seed: u64) -> SplitMix64 {
-        SplitMix64(seed)
-    }
-
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in `[0, 1)`.
-    pub fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    /// Uniform in `0..n` (`n > 0`).
-    pub fn below(&mut self, n: usize) -> usize {
-        debug_assert!(n > 0);
-        (self.next_u64() % n as u64) as usize
-    }
-}
 
 /// Whether sight passes through a leaf of these contents. Sky leaves are opaque: they lie inside
 /// sky brushes, and compilers write no portals into them.

@@ -3,11 +3,11 @@
 //! The same world also builds as a tiny BSP (an axis-aligned hull 0 tree), so sight lines can be
 //! traced through it.
 
-use crate::sample::SplitMix64;
 use quake_formats::Bsp;
 use quake_formats::bsp::{BspPlane, Leaf, Model, Node, contents};
 use quake_formats::geom::{Vec3, Winding};
 use quake_formats::prt::{PortalFile, PrtPortal};
+use quake_formats::rng::SplitMix64;
 
 /// A box of `size` cells of `cell` units; outside the box is solid.
 #[derive(Debug, Clone)]

@@ -82,31 +82,43 @@ impl Checker<'_> {
 /// Every problem found; with no [`Severity::Error`] the engines named in the rules load and play
 /// the file.
 pub fn validate(bsp: &Bsp) -> Vec<Problem> {
-    let mut c = Checker {
+    check_families(
         bsp,
-        problems: Vec::new(),
-    };
-    structure::check(&mut c);
-    trees::check(&mut c);
-    node_portals::check(&mut c);
-    surfaces::check(&mut c);
-    textures::check(&mut c);
-    counts::check(&mut c);
-    entities::check(&mut c);
-    c.problems
+        &[
+            structure::check,
+            trees::check,
+            node_portals::check,
+            surfaces::check,
+            textures::check,
+            counts::check,
+            entities::check,
+        ],
+    )
 }
 
 /// The rule families that hold every rule tools refuse ([`Rule::refused_by_tools`]): what the
 /// stage gate runs. The others (DarkPlaces' node portals, textures, entities) only concern
 /// engines, and the node-portal replay alone was 12-15% of a default light run.
 fn validate_for_tools(bsp: &Bsp) -> Vec<Problem> {
+    check_families(
+        bsp,
+        &[
+            structure::check,
+            trees::check,
+            surfaces::check,
+            counts::check,
+        ],
+    )
+}
+
+/// The problems `families` find, in their order.
+fn check_families(bsp: &Bsp, families: &[fn(&mut Checker)]) -> Vec<Problem> {
     let mut c = Checker {
         bsp,
         problems: Vec::new(),
     };
-    structure::check(&mut c);
-    trees::check(&mut c);
-    surfaces::check(&mut c);
-    counts::check(&mut c);
+    for check in families {
+        check(&mut c);
+    }
     c.problems
 }
