@@ -21,8 +21,6 @@ mod engines;
 mod maps;
 #[path = "support/corpus.rs"]
 mod support_corpus;
-#[path = "support/tga.rs"]
-mod tga;
 
 use engines::{Engine, Kind, Outcome};
 use maps::{Case, KnownError, MapSet, NotCompiled};
