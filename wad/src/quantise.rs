@@ -21,15 +21,19 @@ pub enum Class {
 pub struct Quantiser<'a> {
     palette: &'a Palette,
     transparent: Option<u8>,
-    plain: Vec<u8>,
-    bright: Vec<u8>,
+    /// The indices each class may take, with their colours.
+    plain: Vec<(u8, [f64; 3])>,
+    bright: Vec<(u8, [f64; 3])>,
 }
 
 impl<'a> Quantiser<'a> {
     pub fn new(palette: &'a Palette, kind: Kind) -> Quantiser<'a> {
         let transparent = kind.transparent_index();
-        let allowed = |range: std::ops::RangeInclusive<u8>| -> Vec<u8> {
-            range.filter(|&i| Some(i) != transparent).collect()
+        let allowed = |range: std::ops::RangeInclusive<u8>| -> Vec<(u8, [f64; 3])> {
+            range
+                .filter(|&i| Some(i) != transparent)
+                .map(|i| (i, palette.colors[i as usize].map(f64::from)))
+                .collect()
         };
         Quantiser {
             palette,
@@ -62,8 +66,8 @@ impl<'a> Quantiser<'a> {
             Class::Plain => &self.plain,
         };
         let mut best = (f64::INFINITY, 0);
-        for &i in indices {
-            let d = distance_squared(self.colour(i), rgb);
+        for &(i, colour) in indices {
+            let d = distance_squared(colour, rgb);
             if d < best.0 {
                 best = (d, i);
             }
@@ -120,7 +124,8 @@ impl<'a> Quantiser<'a> {
 }
 
 pub fn distance_squared(a: [f64; 3], b: [f64; 3]) -> f64 {
-    (0..3).map(|k| (a[k] - b[k]).powi(2)).sum()
+    let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
 }
 
 #[cfg(test)]
