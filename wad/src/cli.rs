@@ -157,7 +157,7 @@ fn summary(args: &BuildArgs, built: &Built, seconds: f64) {
         built.textures.len(),
         args.dir.display(),
         args.out.display(),
-        built.wad.write().len(),
+        std::fs::metadata(&args.out).map_or(0, |m| m.len()),
         count(&|t| t.resized()),
         count(&|t| t.fullbright_pixels > 0),
         count(&|t| t.transparent_pixels > 0),
