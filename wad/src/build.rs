@@ -11,9 +11,6 @@ use quake_formats::wad::{Wad, WadLump};
 use rayon::prelude::*;
 use std::path::PathBuf;
 
-/// Miptex bytes must stay within what engines and our reader accept.
-pub const MAX_SIDE: usize = 4096;
-
 #[derive(Debug, Clone)]
 pub struct BuildOptions {
     pub palette: Palette,
@@ -82,7 +79,7 @@ pub fn build(
     sources: &[Source],
     options: &BuildOptions,
     on_texture: &(dyn Fn(&str) + Sync),
-) -> Result<Built, crate::WadError> {
+) -> Built {
     let made: Vec<(MipTex, TextureReport)> = sources
         .par_iter()
         .map(|source| {
@@ -90,33 +87,21 @@ pub fn build(
             on_texture(&source.name);
             made
         })
-        .collect::<Result<_, _>>()?;
+        .collect();
     let (lumps, textures) = made
         .into_iter()
         .map(|(tex, report)| (WadLump::miptex(tex), report))
         .unzip();
-    Ok(Built {
+    Built {
         wad: Wad::new(lumps),
         textures,
-    })
+    }
 }
 
 /// One picture as a miptex, with its report.
-pub fn miptex(
-    source: &Source,
-    options: &BuildOptions,
-) -> Result<(MipTex, TextureReport), crate::WadError> {
+pub fn miptex(source: &Source, options: &BuildOptions) -> (MipTex, TextureReport) {
     let picture = &source.picture;
     let size = [rounded_side(picture.width), rounded_side(picture.height)];
-    if size.iter().any(|&side| side > MAX_SIDE) {
-        return Err(crate::WadError::Size {
-            path: source.path.clone(),
-            detail: format!(
-                "{}x{} is larger than {MAX_SIDE} on a side",
-                picture.width, picture.height
-            ),
-        });
-    }
     let mut level = if [picture.width, picture.height] == size {
         picture.clone()
     } else {
@@ -158,7 +143,7 @@ pub fn miptex(
         ignored_holes: source.ignored_holes,
         levels,
     };
-    Ok((tex, report))
+    (tex, report)
 }
 
 #[cfg(test)]
@@ -193,23 +178,12 @@ mod tests {
         let (tex, report) = miptex(
             &source("odd", 20, 8, |_, _| grey(128.0)),
             &BuildOptions::default(),
-        )
-        .expect("build");
+        );
         assert_eq!((tex.width, tex.height), (32, 16));
         assert!(report.resized());
         let mips = tex.mips.expect("pixels");
         let lens: Vec<usize> = mips.iter().map(Vec::len).collect();
         assert_eq!(lens, [512, 128, 32, 8]);
-        let too_big = miptex(
-            &source("big", 4097, 16, |_, _| grey(1.0)),
-            &BuildOptions::default(),
-        );
-        assert!(
-            too_big
-                .expect_err("too big")
-                .to_string()
-                .contains("big.png")
-        );
     }
 
     #[test]
@@ -228,8 +202,7 @@ mod tests {
                 dither,
                 ..BuildOptions::default()
             };
-            let (plain, report) =
-                miptex(&source("lamp", 16, 16, lamp(0.0)), &options).expect("build");
+            let (plain, report) = miptex(&source("lamp", 16, 16, lamp(0.0)), &options);
             assert!(
                 plain
                     .mips
@@ -239,8 +212,7 @@ mod tests {
                     .all(|&i| i < FIRST_FULLBRIGHT)
             );
             assert_eq!(report.fullbright_pixels, 0);
-            let (lit, report) =
-                miptex(&source("lamp", 16, 16, lamp(1.0)), &options).expect("build");
+            let (lit, report) = miptex(&source("lamp", 16, 16, lamp(1.0)), &options);
             assert!(
                 lit.mips
                     .expect("pixels")
@@ -263,7 +235,7 @@ mod tests {
             alpha: if x < 16 { 0.0 } else { 1.0 },
             glow: 1.0,
         });
-        let (tex, report) = miptex(&fence, &BuildOptions::default()).expect("build");
+        let (tex, report) = miptex(&fence, &BuildOptions::default());
         assert_eq!(report.transparent_pixels, 512);
         for (level, mip) in tex.mips.expect("pixels").iter().enumerate() {
             let width = 32 >> level;
@@ -283,7 +255,7 @@ mod tests {
             rgb: [40.0 + 3.0 * x as f64, 90.0, 30.0 + 2.0 * y as f64],
             ..Texel::OPAQUE_BLACK
         });
-        let built = build(&[gradient], &BuildOptions::default(), &|_| {}).expect("build");
+        let built = build(&[gradient], &BuildOptions::default(), &|_| {});
         for (level, e) in built.level_errors().iter().enumerate() {
             assert_eq!(e.dithered.pixels, 4096 >> (2 * level));
             assert!(e.dithered.block < e.nearest.block, "level {level}: {e:?}");

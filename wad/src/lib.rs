@@ -74,7 +74,7 @@ pub fn build_folder(
     on_texture: &(dyn Fn(&str) + Sync),
 ) -> Result<Built, WadError> {
     let sources = source::read_folder(dir)?;
-    let built = build(&sources, options, on_texture)?;
+    let built = build(&sources, options, on_texture);
     quake_formats::fsutil::write_atomic(out, &built.wad.write())?;
     Ok(built)
 }

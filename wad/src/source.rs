@@ -7,13 +7,16 @@
 //! colour; nowhere else does.
 
 use crate::WadError;
-use crate::picture::{Picture, Texel};
+use crate::picture::{Picture, Texel, rounded_side};
 use image::{ImageFormat, RgbaImage};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// Quake texture names are 16 bytes with a terminating NUL.
 pub const MAX_NAME_LEN: usize = 15;
+
+/// The largest side a texture may have once rounded up to 16: what our miptex reader accepts.
+pub const MAX_SIDE: usize = 4096;
 
 const GLOW_SUFFIX: &str = "_glow";
 
@@ -124,6 +127,20 @@ fn source(
     image: &RgbaImage,
     mask: Option<(PathBuf, RgbaImage)>,
 ) -> Result<Source, WadError> {
+    // Checked before the picture is made: a small file can claim a huge size.
+    if [image.width(), image.height()]
+        .iter()
+        .any(|&side| rounded_side(side as usize) > MAX_SIDE)
+    {
+        return Err(WadError::Size {
+            path,
+            detail: format!(
+                "{}x{} is larger than {MAX_SIDE} on a side",
+                image.width(),
+                image.height()
+            ),
+        });
+    }
     if let Some((mask_path, mask)) = &mask
         && mask.dimensions() != image.dimensions()
     {
@@ -324,6 +341,15 @@ mod tests {
         assert_eq!(
             (sources[1].ignored_holes, sources[1].picture.texels[0].alpha),
             (0, 0.0)
+        );
+    }
+
+    #[test]
+    fn a_side_over_4096_is_refused_naming_the_file() {
+        let err = from_files(vec![("big.png".into(), png(4097, 1, [0; 4]))]).expect_err("big");
+        assert!(
+            err.to_string().contains("big.png: 4097x1 is larger"),
+            "{err}"
         );
     }
 

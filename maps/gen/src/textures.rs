@@ -397,7 +397,7 @@ pub fn wad(pictures: &[(String, Vec<u8>)]) -> Result<Wad, WadError> {
         .map(|(name, bytes)| (Path::new(PICTURE_DIR).join(name), bytes.clone()))
         .collect();
     let sources = wad::source::from_files(files)?;
-    Ok(wad::build(&sources, &BuildOptions::default(), &|_| {})?.wad)
+    Ok(wad::build(&sources, &BuildOptions::default(), &|_| {}).wad)
 }
 
 #[cfg(test)]
