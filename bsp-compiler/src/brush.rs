@@ -328,7 +328,8 @@ impl Brush {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use quake_formats::geom::Vec3;
+    use glam::DVec3;
+    use quake_formats::geom::DVec3Ext;
 
     #[test]
     fn a_side_doubled_by_a_plane_a_millionth_of_a_radian_off_is_kept_once() {
@@ -336,10 +337,10 @@ pub(crate) mod tests {
         // are not one plane (`same_as`), yet each lies on the other over the cube. Found by
         // tests/generated_maps.rs, where a hull bevel doubled a nearly vertical face this way
         // and dropping both let the hull brush reach units further out.
-        let mut faces = box_planes(Vec3::ZERO, Vec3::new(64.0, 64.0, 64.0));
-        let n = Vec3::new(0.0, 1.0, 2e-6).normalized().expect("n");
+        let mut faces = box_planes(DVec3::ZERO, DVec3::new(64.0, 64.0, 64.0));
+        let n = DVec3::new(0.0, 1.0, 2e-6).normalized().expect("n");
         faces.push(BrushPlane {
-            plane: Plane::new(n, n.dot(Vec3::new(0.0, 64.0, 64.0))),
+            plane: Plane::new(n, n.dot(DVec3::new(0.0, 64.0, 64.0))),
             texinfo: Some(1),
         });
         let mut planes = PlaneSet::new();
@@ -356,10 +357,10 @@ pub(crate) mod tests {
     }
 
     /// The six outward planes of an axial box.
-    pub(crate) fn box_planes(mins: Vec3, maxs: Vec3) -> Vec<BrushPlane> {
+    pub(crate) fn box_planes(mins: DVec3, maxs: DVec3) -> Vec<BrushPlane> {
         let mut out = Vec::new();
         for axis in 0..3 {
-            let mut n = Vec3::ZERO;
+            let mut n = DVec3::ZERO;
             n[axis] = 1.0;
             out.push(BrushPlane {
                 plane: Plane::new(n, maxs[axis]),
@@ -374,7 +375,12 @@ pub(crate) mod tests {
     }
 
     /// An axial box brush of `contents` in entity 0.
-    pub(crate) fn box_brush(planes: &mut PlaneSet, mins: Vec3, maxs: Vec3, contents: i32) -> Brush {
+    pub(crate) fn box_brush(
+        planes: &mut PlaneSet,
+        mins: DVec3,
+        maxs: DVec3,
+        contents: i32,
+    ) -> Brush {
         Brush::from_planes(&box_planes(mins, maxs), planes, contents, 0).expect("box brush")
     }
 
@@ -382,8 +388,8 @@ pub(crate) mod tests {
     pub(crate) fn solid_cube(planes: &mut PlaneSet) -> Brush {
         box_brush(
             planes,
-            Vec3::ZERO,
-            Vec3::new(64.0, 64.0, 64.0),
+            DVec3::ZERO,
+            DVec3::new(64.0, 64.0, 64.0),
             quake_formats::bsp::contents::SOLID,
         )
     }
@@ -391,16 +397,16 @@ pub(crate) mod tests {
     #[test]
     fn keep_front_matches_clip_front() {
         let square = Winding::new(vec![
-            Vec3::new(0.0, 0.0, 0.0),
-            Vec3::new(0.0, 64.0, 0.0),
-            Vec3::new(64.0, 64.0, 0.0),
-            Vec3::new(64.0, 0.0, 0.0),
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(0.0, 64.0, 0.0),
+            DVec3::new(64.0, 64.0, 0.0),
+            DVec3::new(64.0, 0.0, 0.0),
         ]);
         for plane in [
-            Plane::new(Vec3::new(1.0, 0.0, 0.0), -8.0), // wholly in front
-            Plane::new(Vec3::new(1.0, 0.0, 0.0), 80.0), // wholly behind
-            Plane::new(Vec3::new(0.0, 0.0, 1.0), 0.0),  // on it
-            Plane::new(Vec3::new(-1.0, 0.0, 0.0), -32.0), // across
+            Plane::new(DVec3::new(1.0, 0.0, 0.0), -8.0), // wholly in front
+            Plane::new(DVec3::new(1.0, 0.0, 0.0), 80.0), // wholly behind
+            Plane::new(DVec3::new(0.0, 0.0, 1.0), 0.0),  // on it
+            Plane::new(DVec3::new(-1.0, 0.0, 0.0), -32.0), // across
         ] {
             assert_eq!(
                 keep_front(square.clone(), &plane),
@@ -414,7 +420,7 @@ pub(crate) mod tests {
     fn box_brush_has_six_sides_and_volume() {
         let mut planes = PlaneSet::new();
         let b = Brush::from_planes(
-            &box_planes(Vec3::new(0.0, 0.0, 0.0), Vec3::new(64.0, 32.0, 16.0)),
+            &box_planes(DVec3::new(0.0, 0.0, 0.0), DVec3::new(64.0, 32.0, 16.0)),
             &mut planes,
             -2,
             0,
@@ -432,7 +438,7 @@ pub(crate) mod tests {
     #[test]
     fn bad_brushes_are_reported() {
         let mut planes = PlaneSet::new();
-        let mut faces = box_planes(Vec3::ZERO, Vec3::new(8.0, 8.0, 8.0));
+        let mut faces = box_planes(DVec3::ZERO, DVec3::new(8.0, 8.0, 8.0));
         assert_eq!(
             Brush::from_planes(&faces[..3], &mut planes, -2, 0),
             Err(BrushError::TooFewPlanes(3))
@@ -443,8 +449,8 @@ pub(crate) mod tests {
             Err(BrushError::DuplicatePlane(0, 6))
         );
         // A slab with its top below its bottom has no volume.
-        let mut faces = box_planes(Vec3::ZERO, Vec3::new(8.0, 8.0, 8.0));
-        faces[4].plane = Plane::new(Vec3::new(0.0, 0.0, 1.0), -4.0);
+        let mut faces = box_planes(DVec3::ZERO, DVec3::new(8.0, 8.0, 8.0));
+        faces[4].plane = Plane::new(DVec3::new(0.0, 0.0, 1.0), -4.0);
         assert_eq!(
             Brush::from_planes(&faces, &mut planes, -2, 0),
             Err(BrushError::NoVolume)
@@ -457,8 +463,8 @@ pub(crate) mod tests {
     fn split_keeps_thin_parts_covered() {
         let mut planes = PlaneSet::new();
         let b = solid_cube(&mut planes);
-        let n = Vec3::new(1.0, 0.0, 1.0).normalized().expect("n");
-        let corner = Vec3::new(64.0, 32.0, 64.0);
+        let n = DVec3::new(1.0, 0.0, 1.0).normalized().expect("n");
+        let corner = DVec3::new(64.0, 32.0, 64.0);
         let (cut, flipped) = planes.insert(&Plane::new(n, n.dot(corner) - 0.02));
         assert!(!flipped);
         let (front, back) = b.clone().split(cut, &planes);
@@ -471,13 +477,13 @@ pub(crate) mod tests {
     fn split_conserves_volume_and_adds_cut_faces() {
         let mut planes = PlaneSet::new();
         let b = solid_cube(&mut planes);
-        let (cut, _) = planes.insert(&Plane::new(Vec3::new(0.6, 0.8, 0.0), 40.0));
+        let (cut, _) = planes.insert(&Plane::new(DVec3::new(0.6, 0.8, 0.0), 40.0));
         let (f, bk) = b.clone().split(cut, &planes);
         let (f, bk) = (f.expect("front"), bk.expect("back"));
         assert!((f.volume() + bk.volume() - b.volume()).abs() < 1e-6);
         assert!(f.sides.iter().any(|s| s.plane == cut && s.used));
         // An axial plane outside the brush leaves it whole.
-        let (out, _) = planes.insert(&Plane::new(Vec3::new(1.0, 0.0, 0.0), 100.0));
+        let (out, _) = planes.insert(&Plane::new(DVec3::new(1.0, 0.0, 0.0), 100.0));
         let (f, bk) = b.split(out, &planes);
         assert!(f.is_none() && bk.is_some());
     }

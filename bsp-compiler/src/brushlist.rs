@@ -62,16 +62,17 @@ pub fn brush_list_lump(models: &[Vec<ListedBrush>]) -> BspxLump {
             for v in b
                 .bounds
                 .mins
-                .to_f32()
+                .as_vec3()
+                .to_array()
                 .into_iter()
-                .chain(b.bounds.maxs.to_f32())
+                .chain(b.bounds.maxs.as_vec3().to_array())
             {
                 put(&v.to_le_bytes());
             }
             put(&b.contents.to_le_bytes());
             put(&(b.planes.len() as u16).to_le_bytes());
             for p in &b.planes {
-                for v in p.normal.to_f32() {
+                for v in p.normal.as_vec3().to_array() {
                     put(&v.to_le_bytes());
                 }
                 put(&(p.dist as f32).to_le_bytes());

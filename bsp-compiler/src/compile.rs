@@ -25,10 +25,11 @@ use crate::tree::{
 };
 use crate::wad_lookup::WadSet;
 use crate::warnings::Warning;
+use glam::DVec3;
 use quake_formats::bsp::contents;
 use quake_formats::bsp::phong::{self, FacePhong};
 use quake_formats::entities::Entity;
-use quake_formats::geom::{Bounds, Plane, Vec3};
+use quake_formats::geom::{Bounds, Plane};
 use quake_formats::prt::PortalFile;
 use quake_formats::{Bsp, BspVersion, FormatError};
 use rayon::prelude::*;
@@ -354,7 +355,7 @@ pub fn compile(
                 occupants.push(Occupant {
                     entity: index,
                     classname: class.to_string(),
-                    origin: Vec3::new(x, y, z),
+                    origin: DVec3::new(x, y, z),
                 });
             }
             continue;
@@ -374,7 +375,7 @@ pub fn compile(
             ent,
             index,
             brush_class,
-            origin.unwrap_or(Vec3::ZERO),
+            origin.unwrap_or(DVec3::ZERO),
             &mut planes,
             &mut table,
             &mut warnings,
@@ -629,7 +630,11 @@ pub(crate) fn lump_entities(map: &MapFile, omit: &[String]) -> Vec<Entity> {
 
 /// A submodel with an origin brush is built around that brush's centre, which becomes its
 /// "origin" (what rotating entities turn about); without one, around its origin key.
-fn submodel_origin(entities: &[MapEntity], ent: &MapEntity, planes: &mut PlaneSet) -> Option<Vec3> {
+fn submodel_origin(
+    entities: &[MapEntity],
+    ent: &MapEntity,
+    planes: &mut PlaneSet,
+) -> Option<DVec3> {
     origin_brush_centre(ent, planes).or_else(|| key_origin(entities, ent))
 }
 
@@ -722,7 +727,7 @@ fn is_origin_brush(mb: &MapBrush) -> bool {
 }
 
 /// The centre of the bounds of an entity's origin brushes, if it has any that can be built.
-fn origin_brush_centre(ent: &MapEntity, planes: &mut PlaneSet) -> Option<Vec3> {
+fn origin_brush_centre(ent: &MapEntity, planes: &mut PlaneSet) -> Option<DVec3> {
     let mut bounds = Bounds::EMPTY;
     for mb in ent.brushes.iter().filter(|mb| is_origin_brush(mb)) {
         let faces: Option<Vec<BrushPlane>> = mb
@@ -730,7 +735,7 @@ fn origin_brush_centre(ent: &MapEntity, planes: &mut PlaneSet) -> Option<Vec3> {
             .iter()
             .map(|f| {
                 Some(BrushPlane {
-                    plane: f.plane(Vec3::ZERO)?,
+                    plane: f.plane(DVec3::ZERO)?,
                     texinfo: None,
                 })
             })
@@ -766,7 +771,7 @@ fn merged_phong(ent: &MapEntity, index: usize, class: EntityBrushes) -> FacePhon
 /// entities the origin of the entity their `target` names (an `info_rotate`, the pivot), else
 /// the submodel's own `origin` key. Engines draw a model moved by its origin, so its brushes must
 /// be stored relative to it to appear where the mapper put them.
-fn key_origin(entities: &[MapEntity], ent: &MapEntity) -> Option<Vec3> {
+fn key_origin(entities: &[MapEntity], ent: &MapEntity) -> Option<DVec3> {
     let pivot = ent
         .entity
         .classname()
@@ -779,7 +784,7 @@ fn key_origin(entities: &[MapEntity], ent: &MapEntity) -> Option<Vec3> {
                 .find(|e| e.entity.get("targetname") == Some(target))
         });
     let [x, y, z] = pivot.unwrap_or(ent).entity.get_floats::<3>("origin")?;
-    Some(Vec3::new(x, y, z))
+    Some(DVec3::new(x, y, z))
 }
 
 /// Build one entity's brushes, in coordinates relative to `origin`, each with whether it is a
@@ -789,7 +794,7 @@ fn build_entity_brushes(
     ent: &MapEntity,
     entity: usize,
     class: EntityBrushes,
-    origin: Vec3,
+    origin: DVec3,
     planes: &mut PlaneSet,
     table: &mut TexInfoTable,
     warnings: &mut Vec<Warning>,
@@ -813,7 +818,7 @@ fn build_entity_brushes(
             // Engines draw the model moved by its origin: shift the texture to match.
             let mut vecs = f.projection.vecs(&plane);
             for row in &mut vecs {
-                row[3] += Vec3::new(row[0], row[1], row[2]).dot(origin);
+                row[3] += DVec3::new(row[0], row[1], row[2]).dot(origin);
             }
             let role = TextureRole::of(&f.texture);
             if role.is_drawn() && projection_squareness(&vecs, plane.normal) < MIN_SQUARENESS {
@@ -944,8 +949,8 @@ fn build_model(
     }
     if bounds.is_empty() {
         bounds = Bounds {
-            mins: Vec3::new(-1.0, -1.0, -1.0),
-            maxs: Vec3::new(1.0, 1.0, 1.0),
+            mins: DVec3::new(-1.0, -1.0, -1.0),
+            maxs: DVec3::new(1.0, 1.0, 1.0),
         };
     }
     let heuristic = Splitting {

@@ -8,7 +8,8 @@
 
 use crate::map::{MapFace, MapFile};
 use crate::texinfo::{Projection, base_axes};
-use quake_formats::geom::Vec3;
+use glam::DVec3;
+
 use std::fmt::Write;
 
 /// A `.map` dialect, by how faces give their texture projection.
@@ -87,7 +88,7 @@ fn write_face(out: &mut String, face: &MapFace, projection: &Projection) {
 
 /// `face`'s projection in format `to`, and whether it is exact.
 fn converted(face: &MapFace, to: MapFormat) -> (Projection, bool) {
-    let Some(plane) = face.plane(Vec3::ZERO) else {
+    let Some(plane) = face.plane(DVec3::ZERO) else {
         // No plane, no projection to speak of: the brush is reported as bad when compiled.
         return (face.projection, true);
     };
@@ -101,7 +102,7 @@ fn converted(face: &MapFace, to: MapFormat) -> (Projection, bool) {
 /// Each texinfo row as a unit axis and a scale (the row is axis / scale).
 fn to_valve(vecs: [[f64; 4]; 2]) -> Projection {
     let split = |row: [f64; 4]| {
-        let axis = Vec3::new(row[0], row[1], row[2]);
+        let axis = DVec3::new(row[0], row[1], row[2]);
         let len = axis.length();
         if len == 0.0 {
             return (row, 1.0);
@@ -124,9 +125,9 @@ const ROTATION_SNAP: f64 = 1e-6;
 /// The Quake projection nearest `vecs` on a face with `normal`: Quake turns the base axes about
 /// the two coordinates they use (see [`Projection::vecs`]), so only those components of `vecs`
 /// can be kept.
-fn to_quake(vecs: [[f64; 4]; 2], normal: Vec3) -> (Projection, bool) {
+fn to_quake(vecs: [[f64; 4]; 2], normal: DVec3) -> (Projection, bool) {
     let [s0, t0] = base_axes(normal);
-    let first_nonzero = |v: Vec3| (0..3).find(|&i| v[i] != 0.0).unwrap_or(2);
+    let first_nonzero = |v: DVec3| (0..3).find(|&i| v[i] != 0.0).unwrap_or(2);
     let (p, q) = (first_nonzero(s0), first_nonzero(t0));
     let (s_sign, t_sign) = (s0[p], t0[q]);
     let [r0, r1] = vecs;
@@ -165,7 +166,7 @@ mod tests {
         map.entities[0].brushes[0]
             .faces
             .iter()
-            .map(|f| f.projection.vecs(&f.plane(Vec3::ZERO).expect("plane")))
+            .map(|f| f.projection.vecs(&f.plane(DVec3::ZERO).expect("plane")))
             .collect()
     }
 

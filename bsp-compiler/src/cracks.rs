@@ -8,8 +8,10 @@
 //! would reject are skipped, never trusted.
 
 use crate::weld::{TJUNCTION_EPSILON, cell_and_neighbours};
+use glam::{DVec3, Vec3};
 use quake_formats::Bsp;
-use quake_formats::geom::{POINT_EPSILON, Vec3};
+use quake_formats::geom::DVec3Ext;
+use quake_formats::geom::POINT_EPSILON;
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 
 /// Cell size of the vertex search grid.
@@ -69,18 +71,18 @@ fn face_vertices(bsp: &Bsp, f: usize) -> Option<Vec<u32>> {
         .then_some(vs)
 }
 
-fn cell(p: Vec3) -> [i64; 3] {
+fn cell(p: DVec3) -> [i64; 3] {
     let c = |v: f64| (v / GRID).floor() as i64;
     [c(p.x), c(p.y), c(p.z)]
 }
 
 /// The grid cells within reach of segment `a..b`: those around points sampled along it.
-fn cells_along(a: Vec3, b: Vec3, out: &mut BTreeSet<[i64; 3]>) {
+fn cells_along(a: DVec3, b: DVec3, out: &mut BTreeSet<[i64; 3]>) {
     out.clear();
     let steps = ((b - a).length() / (GRID * 0.5)).ceil().max(1.0) as usize;
     for i in 0..=steps {
         out.extend(cell_and_neighbours(cell(
-            a.lerp(b, i as f64 / steps as f64),
+            a.lerp_monotonic(b, i as f64 / steps as f64),
         )));
     }
 }
@@ -99,7 +101,7 @@ pub fn find_cracks(bsp: &Bsp) -> CrackReport {
 }
 
 fn check_model(bsp: &Bsp, model: usize, faces: &[(usize, Vec<u32>)], report: &mut CrackReport) {
-    let pos = |v: u32| Vec3::from_f32(bsp.vertices[v as usize]);
+    let pos = |v: u32| Vec3::from(bsp.vertices[v as usize]).as_dvec3();
     let used: BTreeSet<u32> = faces
         .iter()
         .flat_map(|(_, vs)| vs.iter().copied())

@@ -10,13 +10,14 @@
 use crate::brush::{Brush, Side};
 use crate::planes::PlaneSet;
 use crate::tree::contents_priority;
-use quake_formats::geom::{Bounds, ON_EPSILON, PlaneSide, Split, Vec3, Winding};
+use glam::DVec3;
+use quake_formats::geom::{Bounds, ON_EPSILON, PlaneSide, Split, Winding};
 use rayon::prelude::*;
 
 /// Mark every side of `brushes` that lies wholly inside other brushes as buried. Returns how
 /// many.
 pub fn mark_hidden_sides(brushes: &mut [Brush], planes: &PlaneSet) -> usize {
-    let pad = Vec3::new(ON_EPSILON, ON_EPSILON, ON_EPSILON);
+    let pad = DVec3::new(ON_EPSILON, ON_EPSILON, ON_EPSILON);
     let padded: Vec<Bounds> = brushes
         .iter()
         .map(|b| Bounds {
@@ -100,7 +101,7 @@ fn clip_outside(
     w: Winding,
     brush: &Brush,
     planes: &PlaneSet,
-    facing: Vec3,
+    facing: DVec3,
     out: &mut Vec<Winding>,
 ) {
     let mut rest = w;
@@ -141,7 +142,7 @@ mod tests {
     use crate::brush::tests::box_planes;
     use quake_formats::bsp::contents;
 
-    fn cube(planes: &mut PlaneSet, mins: Vec3, maxs: Vec3, c: i32) -> Brush {
+    fn cube(planes: &mut PlaneSet, mins: DVec3, maxs: DVec3, c: i32) -> Brush {
         Brush::from_planes(&box_planes(mins, maxs), planes, c, 0).expect("brush")
     }
 
@@ -151,14 +152,14 @@ mod tests {
         let mut brushes = vec![
             cube(
                 &mut planes,
-                Vec3::ZERO,
-                Vec3::new(64.0, 64.0, 64.0),
+                DVec3::ZERO,
+                DVec3::new(64.0, 64.0, 64.0),
                 contents::SOLID,
             ),
             cube(
                 &mut planes,
-                Vec3::new(64.0, 0.0, 0.0),
-                Vec3::new(128.0, 64.0, 64.0),
+                DVec3::new(64.0, 0.0, 0.0),
+                DVec3::new(128.0, 64.0, 64.0),
                 contents::SOLID,
             ),
         ];
@@ -179,14 +180,14 @@ mod tests {
         let mut brushes = vec![
             cube(
                 &mut planes,
-                Vec3::ZERO,
-                Vec3::new(128.0, 128.0, 128.0),
+                DVec3::ZERO,
+                DVec3::new(128.0, 128.0, 128.0),
                 contents::WATER,
             ),
             cube(
                 &mut planes,
-                Vec3::new(32.0, 32.0, 32.0),
-                Vec3::new(64.0, 64.0, 64.0),
+                DVec3::new(32.0, 32.0, 32.0),
+                DVec3::new(64.0, 64.0, 64.0),
                 contents::SOLID,
             ),
         ];
@@ -194,14 +195,14 @@ mod tests {
         let mut brushes = vec![
             cube(
                 &mut planes,
-                Vec3::ZERO,
-                Vec3::new(128.0, 128.0, 128.0),
+                DVec3::ZERO,
+                DVec3::new(128.0, 128.0, 128.0),
                 contents::SOLID,
             ),
             cube(
                 &mut planes,
-                Vec3::new(32.0, 32.0, 32.0),
-                Vec3::new(64.0, 64.0, 64.0),
+                DVec3::new(32.0, 32.0, 32.0),
+                DVec3::new(64.0, 64.0, 64.0),
                 contents::WATER,
             ),
         ];
@@ -219,11 +220,11 @@ mod tests {
             ),
         ) {
             let mut planes = PlaneSet::new();
-            let boxes: Vec<(Vec3, Vec3)> = boxes
+            let boxes: Vec<(DVec3, DVec3)> = boxes
                 .iter()
                 .map(|&((x, y, z), (w, d, h))| {
-                    let lo = Vec3::new(x as f64, y as f64, z as f64) * 16.0;
-                    (lo, lo + Vec3::new(w as f64, d as f64, h as f64) * 16.0)
+                    let lo = DVec3::new(x as f64, y as f64, z as f64) * 16.0;
+                    (lo, lo + DVec3::new(w as f64, d as f64, h as f64) * 16.0)
                 })
                 .collect();
             let mut brushes: Vec<Brush> = boxes

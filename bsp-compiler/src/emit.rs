@@ -10,9 +10,10 @@ use crate::tree::{Tree, engine_contents, is_see_through};
 use crate::wad_lookup::WadSet;
 use crate::warnings::Warning;
 use crate::weld::{VertexWelder, fix_tjunctions};
+use glam::DVec3;
 use quake_formats::bsp::{BspPlane, Face, Leaf, Model, Node, TexInfo, contents, texinfo_flags};
 use quake_formats::entities::{Entity, write_entities};
-use quake_formats::geom::{Bounds, Plane, Vec3};
+use quake_formats::geom::{Bounds, Plane};
 use quake_formats::prt::{PortalFile, PrtPortal};
 use quake_formats::{Bsp, BspVersion};
 use std::collections::HashMap;
@@ -51,7 +52,7 @@ impl PlaneTable<'_> {
 
     fn push(&mut self, p: &Plane) -> u32 {
         self.planes.push(BspPlane {
-            normal: p.normal.to_f32(),
+            normal: p.normal.as_vec3().to_array(),
             dist: p.dist as f32,
             kind: p.quake_type(),
         });
@@ -167,7 +168,11 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
         .map(|f| std::mem::take(&mut f.vertices))
         .collect();
     let tjunction_vertices = fix_tjunctions(&welder.positions, &mut polygons);
-    bsp.vertices = welder.positions.iter().map(|p| p.to_f32()).collect();
+    bsp.vertices = welder
+        .positions
+        .iter()
+        .map(|p| p.as_vec3().to_array())
+        .collect();
     if bsp.vertices.is_empty() {
         // Edge 0 (below) names vertex 0, which must exist even in a world with no faces (one of
         // only clip, hint or liquid-less invisible brushes).
@@ -254,12 +259,12 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
         let (mut head, _) = w.node(0);
         if head < 0 {
             // Engines start at a node: give a one-leaf model a node with the leaf on both sides.
-            let plane = w.planes.push(&Plane::new(Vec3::new(0.0, 0.0, 1.0), 0.0));
+            let plane = w.planes.push(&Plane::new(DVec3::new(0.0, 0.0, 1.0), 0.0));
             w.bsp.nodes.push(Node {
                 plane,
                 children: [head, head],
-                mins: m.bounds.mins.to_f32(),
-                maxs: m.bounds.maxs.to_f32(),
+                mins: m.bounds.mins.as_vec3().to_array(),
+                maxs: m.bounds.maxs.as_vec3().to_array(),
                 first_face: 0,
                 num_faces: 0,
             });
@@ -273,8 +278,8 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
             clip_heads[hull] = emit_clipnodes(tree, &mut |id| planes.get(id), &mut bsp.clipnodes);
         }
         bsp.models.push(Model {
-            mins: m.bounds.mins.to_f32(),
-            maxs: m.bounds.maxs.to_f32(),
+            mins: m.bounds.mins.as_vec3().to_array(),
+            maxs: m.bounds.maxs.as_vec3().to_array(),
             origin: [0.0; 3],
             head_nodes: [head, clip_heads[0], clip_heads[1], 0],
             vis_leafs: (bsp.leafs.len() - leaves_before) as i32,
@@ -347,8 +352,8 @@ impl TreeWriter<'_, '_> {
             self.bsp.leafs.push(Leaf {
                 contents: engine_contents(node.contents),
                 vis_offset: -1,
-                mins: bounds.mins.to_f32(),
-                maxs: bounds.maxs.to_f32(),
+                mins: bounds.mins.as_vec3().to_array(),
+                maxs: bounds.maxs.as_vec3().to_array(),
                 first_marksurface: first,
                 num_marksurfaces: self.bsp.marksurfaces.len() as u32 - first,
                 ambient: [0; 4],
@@ -375,8 +380,8 @@ impl TreeWriter<'_, '_> {
         let bounds = fb.union(&bb);
         let out = &mut self.bsp.nodes[index];
         out.children = [front, back];
-        out.mins = bounds.mins.to_f32();
-        out.maxs = bounds.maxs.to_f32();
+        out.mins = bounds.mins.as_vec3().to_array();
+        out.maxs = bounds.maxs.as_vec3().to_array();
         (index as i32, bounds)
     }
 }

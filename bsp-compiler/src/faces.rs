@@ -9,10 +9,12 @@ use crate::tree::{
     Tree, TreeNode, VISBLOCKER, contents_priority, engine_contents, is_see_through,
     shows_faces_behind,
 };
+use glam::DVec3;
 use quake_formats::bsp::contents;
 use quake_formats::bsp::limits::MAX_SURFACE_EXTENT;
 use quake_formats::extents::LightmapExtents;
-use quake_formats::geom::{ON_EPSILON, POINT_EPSILON, Plane, Split, Vec3, Winding};
+use quake_formats::geom::DVec3Ext;
+use quake_formats::geom::{ON_EPSILON, POINT_EPSILON, Plane, Split, Winding};
 
 /// A face of one model, before vertices and edges are shared.
 #[derive(Debug, Clone, PartialEq)]
@@ -32,7 +34,7 @@ pub struct ModelFace {
 
 impl ModelFace {
     /// The normal of the side the face is seen from.
-    pub fn normal(&self, planes: &PlaneSet) -> Vec3 {
+    pub fn normal(&self, planes: &PlaneSet) -> DVec3 {
         let n = planes.get(self.plane).normal;
         if self.back { -n } else { n }
     }
@@ -67,8 +69,8 @@ pub const MIN_SQUARENESS: f64 = 0.1;
 /// How squarely a texture projects onto a face with unit `normal`: the |cosine| of the angle
 /// between it and the normal of the texture's s/t plane, 0 when the texture meets the face
 /// edge-on (floor axes on a wall) or an axis is zero.
-pub fn projection_squareness(vecs: &[[f64; 4]; 2], normal: Vec3) -> f64 {
-    let axis = |row: &[f64; 4]| Vec3::new(row[0], row[1], row[2]);
+pub fn projection_squareness(vecs: &[[f64; 4]; 2], normal: DVec3) -> f64 {
+    let axis = |row: &[f64; 4]| DVec3::new(row[0], row[1], row[2]);
     axis(&vecs[0])
         .cross(axis(&vecs[1]))
         .normalized()
@@ -118,7 +120,7 @@ impl TextureSearch<'_> {
     /// `owner`'s brushes have no textured side. The tree leaves out a side within the epsilon of
     /// a node plane or cutting off a sliver, so a leaf may have no side on its face; in a crack
     /// filled whole the wall's own side is in the next leaf.
-    fn texinfo(&self, owner: u32, plane: PlaneId, flipped: bool, center: Vec3) -> Option<u32> {
+    fn texinfo(&self, owner: u32, plane: PlaneId, flipped: bool, center: DVec3) -> Option<u32> {
         let leaf = &self.tree.nodes[owner as usize];
         let mut brushes: Vec<&Brush> = leaf
             .brushes
@@ -268,7 +270,7 @@ pub fn faces_from_portals(
 }
 
 /// The two polygons joined along a shared edge, if the result is convex.
-fn try_merge(a: &Winding, b: &Winding, normal: Vec3) -> Option<Winding> {
+fn try_merge(a: &Winding, b: &Winding, normal: DVec3) -> Option<Winding> {
     let (n, m) = (a.len(), b.len());
     let mut shared = None;
     'outer: for i in 0..n {
@@ -282,13 +284,13 @@ fn try_merge(a: &Winding, b: &Winding, normal: Vec3) -> Option<Winding> {
         }
     }
     let (i, j) = shared?;
-    let mut points: Vec<Vec3> = (1..=n).map(|k| a.points[(i + k) % n]).collect();
+    let mut points: Vec<DVec3> = (1..=n).map(|k| a.points[(i + k) % n]).collect();
     points.extend((2..m).map(|k| b.points[(j + k) % m]));
     simplify_convex(points, normal)
 }
 
 /// Drop collinear points; `None` if the polygon is not convex (clockwise about `normal`).
-fn simplify_convex(mut points: Vec<Vec3>, normal: Vec3) -> Option<Winding> {
+fn simplify_convex(mut points: Vec<DVec3>, normal: DVec3) -> Option<Winding> {
     let mut k = 0;
     while k < points.len() && points.len() >= 3 {
         let len = points.len();
@@ -371,7 +373,7 @@ fn f32_vecs(vecs: &[[f64; 4]; 2]) -> [[f32; 4]; 2] {
 
 /// Lightmap extents of a winding as engines will compute them from the written file.
 pub fn winding_extents(w: &Winding, vecs: &[[f64; 4]; 2]) -> LightmapExtents {
-    let points: Vec<[f32; 3]> = w.points.iter().map(|p| p.to_f32()).collect();
+    let points: Vec<[f32; 3]> = w.points.iter().map(|p| p.as_vec3().to_array()).collect();
     LightmapExtents::from_points(&points, &f32_vecs(vecs))
 }
 
@@ -417,7 +419,7 @@ pub fn cut_for_lightmaps(face: ModelFace, info: &FaceTexInfo, size: f64, out: &m
 /// grid rounding), or `None` when the winding is small enough.
 fn cut_once(w: &Winding, vecs: &[[f64; 4]; 2], size: f64) -> Option<(Winding, Winding)> {
     for row in vecs {
-        let axis = Vec3::new(row[0], row[1], row[2]);
+        let axis = DVec3::new(row[0], row[1], row[2]);
         let len = axis.length();
         if len == 0.0 {
             continue;
@@ -446,14 +448,14 @@ mod tests {
     fn square(x0: f64, y0: f64, size: f64) -> Winding {
         // Clockwise seen from +Z.
         Winding::new(vec![
-            Vec3::new(x0, y0, 0.0),
-            Vec3::new(x0, y0 + size, 0.0),
-            Vec3::new(x0 + size, y0 + size, 0.0),
-            Vec3::new(x0 + size, y0, 0.0),
+            DVec3::new(x0, y0, 0.0),
+            DVec3::new(x0, y0 + size, 0.0),
+            DVec3::new(x0 + size, y0 + size, 0.0),
+            DVec3::new(x0 + size, y0, 0.0),
         ])
     }
 
-    const UP: Vec3 = Vec3::new(0.0, 0.0, 1.0);
+    const UP: DVec3 = DVec3::new(0.0, 0.0, 1.0);
 
     #[test]
     fn adjacent_squares_merge_into_a_rectangle() {
@@ -466,10 +468,10 @@ mod tests {
     fn l_shapes_do_not_merge() {
         let big = square(0.0, 0.0, 64.0);
         let small = Winding::new(vec![
-            Vec3::new(64.0, 0.0, 0.0),
-            Vec3::new(64.0, 32.0, 0.0),
-            Vec3::new(96.0, 32.0, 0.0),
-            Vec3::new(96.0, 0.0, 0.0),
+            DVec3::new(64.0, 0.0, 0.0),
+            DVec3::new(64.0, 32.0, 0.0),
+            DVec3::new(96.0, 32.0, 0.0),
+            DVec3::new(96.0, 0.0, 0.0),
         ]);
         // They share only part of an edge: no common edge, no merge.
         assert!(try_merge(&big, &small, UP).is_none());
@@ -478,7 +480,7 @@ mod tests {
     #[test]
     fn squareness_of_projections() {
         let floor = [[1.0, 0.0, 0.0, 0.0], [0.0, -1.0, 0.0, 0.0]];
-        let wall = Vec3::new(0.0, -1.0, 0.0);
+        let wall = DVec3::new(0.0, -1.0, 0.0);
         assert_eq!(projection_squareness(&floor, UP), 1.0);
         assert_eq!(projection_squareness(&floor, -UP), 1.0);
         // Floor axes on a wall: the texture meets it edge-on.
@@ -488,7 +490,7 @@ mod tests {
         // Scale does not matter, only the angle.
         let scaled = [[0.25, 0.0, 0.0, 7.0], [0.0, -4.0, 0.0, 3.0]];
         assert_eq!(projection_squareness(&scaled, UP), 1.0);
-        let tilted = Vec3::new(0.0, 0.6, 0.8);
+        let tilted = DVec3::new(0.0, 0.6, 0.8);
         assert!((projection_squareness(&floor, tilted) - 0.8).abs() < 1e-12);
     }
 
@@ -521,10 +523,10 @@ mod tests {
     fn shrinking_one_piece_leaves_the_others_alone() {
         let vecs = [[1.0, 0.0, 0.0, 0.0], [0.0, -1.0, 0.0, 0.0]];
         let strip = Winding::new(vec![
-            Vec3::new(0.0, 0.0, 0.0),
-            Vec3::new(0.0, 16.0, 0.0),
-            Vec3::new(4000.0, 16.0, 0.0),
-            Vec3::new(4000.0, 0.0, 0.0),
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(0.0, 16.0, 0.0),
+            DVec3::new(4000.0, 16.0, 0.0),
+            DVec3::new(4000.0, 0.0, 0.0),
         ]);
         let alone = |w: &Winding, size: f64| {
             let mut out = Vec::new();

@@ -23,8 +23,10 @@ use crate::hulls::HULL_BOXES;
 use crate::map::{MapBrush, MapFile};
 use crate::texinfo::TextureRole;
 use crate::trace::{HullTrace, trace_hull};
+use glam::{DVec3, Vec3};
 use quake_formats::bsp::contents;
-use quake_formats::geom::{Bounds, ON_EPSILON, Plane, Vec3, Winding};
+use quake_formats::geom::DVec3Ext;
+use quake_formats::geom::{Bounds, ON_EPSILON, Plane, Winding};
 use quake_formats::rng::SplitMix64;
 use quake_formats::{Bsp, FormatError};
 
@@ -116,8 +118,8 @@ pub fn hull_agreement(
     let solids = world_hull_solids(map, mins, maxs);
     let world = &bsp.models[0];
     let space = Bounds {
-        mins: Vec3::from_f32(world.mins),
-        maxs: Vec3::from_f32(world.maxs),
+        mins: Vec3::from(world.mins).as_dvec3(),
+        maxs: Vec3::from(world.maxs).as_dvec3(),
     };
     let mut rng = SplitMix64::new(options.seed);
     let mut out = HullAgreement::default();
@@ -126,8 +128,14 @@ pub fn hull_agreement(
             break;
         };
         let end = start + random_direction(&mut rng) * rng.range(1.0, options.max_move);
-        let end = Vec3::from_f32(end.to_f32());
-        let hull = trace_hull(bsp, 0, options.hull, start.to_f32(), end.to_f32());
+        let end = end.as_vec3().as_dvec3();
+        let hull = trace_hull(
+            bsp,
+            0,
+            options.hull,
+            start.as_vec3().to_array(),
+            end.as_vec3().to_array(),
+        );
         let exact = sweep(&solids, start, end);
         let gap = compare(start, &hull, exact, &solids);
         out.traces += 1;
@@ -138,9 +146,9 @@ pub fn hull_agreement(
                 out.examples.push(HullDisagreement {
                     start: start.to_array(),
                     end: end.to_array(),
-                    hull_end: Vec3::from_f32(hull.end).to_array(),
+                    hull_end: Vec3::from(hull.end).as_dvec3().to_array(),
                     hull_start_solid: hull.start_solid,
-                    exact_end: start.lerp(end, exact).to_array(),
+                    exact_end: start.lerp_monotonic(end, exact).to_array(),
                     gap,
                 });
             }
@@ -150,12 +158,12 @@ pub fn hull_agreement(
 }
 
 /// How far the hull's stop is from what the brushes allow (see the module notes).
-fn compare(start: Vec3, hull: &HullTrace, exact: f64, solids: &[GrownBrush]) -> f64 {
+fn compare(start: DVec3, hull: &HullTrace, exact: f64, solids: &[GrownBrush]) -> f64 {
     if hull.start_solid || hull.all_solid {
         return clearance(solids, start);
     }
     let hull_fraction = f64::from(hull.fraction);
-    let hull_end = Vec3::from_f32(hull.end);
+    let hull_end = Vec3::from(hull.end).as_dvec3();
     if hull_fraction < exact {
         clearance(solids, hull_end).max(0.0)
     } else if hull_fraction > exact {
@@ -206,7 +214,7 @@ fn blocks_world_hulls(class: EntityBrushes, brush: &MapBrush) -> bool {
 }
 
 /// Every brush solid in the world's hulls, grown by the box `mins..maxs`.
-fn world_hull_solids(map: &MapFile, mins: Vec3, maxs: Vec3) -> Vec<GrownBrush> {
+fn world_hull_solids(map: &MapFile, mins: DVec3, maxs: DVec3) -> Vec<GrownBrush> {
     let mut out = Vec::new();
     for (index, entity) in map.entities.iter().enumerate() {
         let class = EntityBrushes::of(index, entity.entity.classname());
@@ -215,7 +223,7 @@ fn world_hull_solids(map: &MapFile, mins: Vec3, maxs: Vec3) -> Vec<GrownBrush> {
                 continue;
             }
             let planes: Option<Vec<Plane>> =
-                brush.faces.iter().map(|f| f.plane(Vec3::ZERO)).collect();
+                brush.faces.iter().map(|f| f.plane(DVec3::ZERO)).collect();
             if let Some(grown) = planes.and_then(|p| grow(&p, mins, maxs)) {
                 out.push(grown);
             }
@@ -226,7 +234,7 @@ fn world_hull_solids(map: &MapFile, mins: Vec3, maxs: Vec3) -> Vec<GrownBrush> {
 
 /// The convex brush bounded by `faces` (outward planes) grown by the box; `None` when the planes
 /// bound no volume (the compiler skips such brushes too).
-fn grow(faces: &[Plane], mins: Vec3, maxs: Vec3) -> Option<GrownBrush> {
+fn grow(faces: &[Plane], mins: DVec3, maxs: DVec3) -> Option<GrownBrush> {
     let windings: Vec<Winding> = faces
         .iter()
         .enumerate()
@@ -243,14 +251,14 @@ fn grow(faces: &[Plane], mins: Vec3, maxs: Vec3) -> Option<GrownBrush> {
     if windings.len() < 4 {
         return None;
     }
-    let points: Vec<Vec3> = windings.iter().flat_map(|w| w.points.clone()).collect();
+    let points: Vec<DVec3> = windings.iter().flat_map(|w| w.points.clone()).collect();
     let mut bounds = Bounds::EMPTY;
     for &p in &points {
         bounds.add_point(p);
     }
     let mut planes: Vec<Plane> = windings.iter().filter_map(Winding::plane).collect();
     for axis in 0..3 {
-        let mut n = Vec3::ZERO;
+        let mut n = DVec3::ZERO;
         n[axis] = 1.0;
         planes.push(Plane::new(n, bounds.maxs[axis]));
         planes.push(Plane::new(-n, -bounds.mins[axis]));
@@ -261,7 +269,7 @@ fn grow(faces: &[Plane], mins: Vec3, maxs: Vec3) -> Option<GrownBrush> {
                 continue;
             };
             for axis in 0..3 {
-                let mut a = Vec3::ZERO;
+                let mut a = DVec3::ZERO;
                 a[axis] = 1.0;
                 let Some(n) = edge.cross(a).normalized() else {
                     continue;
@@ -288,14 +296,14 @@ fn grow(faces: &[Plane], mins: Vec3, maxs: Vec3) -> Option<GrownBrush> {
 }
 
 /// The largest `n · p` over the box `mins..maxs`.
-fn support(n: Vec3, mins: Vec3, maxs: Vec3) -> f64 {
+fn support(n: DVec3, mins: DVec3, maxs: DVec3) -> f64 {
     (0..3).map(|i| (n[i] * mins[i]).max(n[i] * maxs[i])).sum()
 }
 
 impl GrownBrush {
     /// The part of the segment `a`→`b` strictly inside, as fractions of it; entering at 0 when
     /// `a` is inside.
-    fn inside(&self, a: Vec3, b: Vec3) -> Option<(f64, f64)> {
+    fn inside(&self, a: DVec3, b: DVec3) -> Option<(f64, f64)> {
         let (mut enter, mut leave) = (0.0f64, 1.0f64);
         for plane in &self.planes {
             let (da, db) = (plane.distance(a), plane.distance(b));
@@ -318,11 +326,11 @@ impl GrownBrush {
     /// How deep inside (behind its nearest plane) the segment `a`→`b` reaches; 0 when it stays
     /// out. Depth along the segment is concave (a minimum of linear functions), so a ternary
     /// search finds its peak.
-    fn depth_along(&self, a: Vec3, b: Vec3) -> f64 {
+    fn depth_along(&self, a: DVec3, b: DVec3) -> f64 {
         let Some((mut lo, mut hi)) = self.inside(a, b) else {
             return 0.0;
         };
-        let depth = |t: f64| -self.clearance(a.lerp(b, t));
+        let depth = |t: f64| -self.clearance(a.lerp_monotonic(b, t));
         for _ in 0..60 {
             let (m1, m2) = (lo + (hi - lo) / 3.0, hi - (hi - lo) / 3.0);
             if depth(m1) < depth(m2) {
@@ -336,7 +344,7 @@ impl GrownBrush {
 
     /// How far in front of its nearest plane `p` is (negative inside): at most the distance to
     /// the grown brush.
-    fn clearance(&self, p: Vec3) -> f64 {
+    fn clearance(&self, p: DVec3) -> f64 {
         self.planes
             .iter()
             .map(|plane| plane.distance(p))
@@ -345,7 +353,7 @@ impl GrownBrush {
 }
 
 /// The exact sweep: the fraction of the move `a`→`b` at which the box first touches a brush.
-fn sweep(solids: &[GrownBrush], a: Vec3, b: Vec3) -> f64 {
+fn sweep(solids: &[GrownBrush], a: DVec3, b: DVec3) -> f64 {
     let reach = Bounds {
         mins: a.min(b),
         maxs: a.max(b),
@@ -358,7 +366,7 @@ fn sweep(solids: &[GrownBrush], a: Vec3, b: Vec3) -> f64 {
 }
 
 /// The least clearance of `p` from any grown brush.
-fn clearance(solids: &[GrownBrush], p: Vec3) -> f64 {
+fn clearance(solids: &[GrownBrush], p: DVec3) -> f64 {
     solids
         .iter()
         .map(|s| s.clearance(p))
@@ -372,13 +380,13 @@ fn open_point(
     solids: &[GrownBrush],
     space: Bounds,
     rng: &mut SplitMix64,
-) -> Option<Vec3> {
+) -> Option<DVec3> {
     (0..TRIES_PER_TRACE).find_map(|_| {
-        let mut p = Vec3::ZERO;
+        let mut p = DVec3::ZERO;
         for i in 0..3 {
             p[i] = rng.range(space.mins[i], space.maxs[i]);
         }
-        let p = Vec3::from_f32(p.to_f32());
+        let p = p.as_vec3().as_dvec3();
         let open = matches!(
             hull0_contents(bsp, p),
             contents::EMPTY | contents::WATER | contents::SLIME | contents::LAVA
@@ -389,23 +397,23 @@ fn open_point(
 
 /// The contents of the world's hull 0 at `p` (the file passed the tools' gate, so the walk
 /// stays in bounds and ends).
-fn hull0_contents(bsp: &Bsp, p: Vec3) -> i32 {
+fn hull0_contents(bsp: &Bsp, p: DVec3) -> i32 {
     let mut node = bsp.models[0].head_nodes[0];
     while node >= 0 {
         let n = &bsp.nodes[node as usize];
         let plane = &bsp.planes[n.plane as usize];
-        let d = Vec3::from_f32(plane.normal).dot(p) - f64::from(plane.dist);
+        let d = Vec3::from(plane.normal).as_dvec3().dot(p) - f64::from(plane.dist);
         node = n.children[usize::from(d < 0.0)];
     }
     bsp.leafs[(-(node + 1)) as usize].contents
 }
 
 /// A direction uniform over the sphere.
-fn random_direction(rng: &mut SplitMix64) -> Vec3 {
+fn random_direction(rng: &mut SplitMix64) -> DVec3 {
     let z = rng.range(-1.0, 1.0);
     let angle = rng.range(0.0, std::f64::consts::TAU);
     let r = (1.0 - z * z).sqrt();
-    Vec3::new(r * angle.cos(), r * angle.sin(), z)
+    DVec3::new(r * angle.cos(), r * angle.sin(), z)
 }
 
 #[cfg(test)]
@@ -507,20 +515,20 @@ mod tests {
     #[test]
     fn grown_brushes_overlap_exactly_where_the_box_does() {
         // A wedge: a box cut by a 45-degree slope on its top front edge.
-        let n = Vec3::new(1.0, 0.0, 1.0).normalized().expect("n");
+        let n = DVec3::new(1.0, 0.0, 1.0).normalized().expect("n");
         let mut faces: Vec<Plane> = (0..3)
             .flat_map(|axis| {
-                let mut e = Vec3::ZERO;
+                let mut e = DVec3::ZERO;
                 e[axis] = 1.0;
                 [Plane::new(e, 64.0), Plane::new(-e, 0.0)]
             })
             .collect();
-        faces.push(Plane::new(n, n.dot(Vec3::new(64.0, 0.0, 32.0))));
+        faces.push(Plane::new(n, n.dot(DVec3::new(64.0, 0.0, 32.0))));
         let (mins, maxs) = HULL_BOXES[0];
         let grown = grow(&faces, mins, maxs).expect("grown");
         let mut rng = SplitMix64::new(3);
         for _ in 0..20000 {
-            let p = Vec3::new(
+            let p = DVec3::new(
                 rng.range(-40.0, 110.0),
                 rng.range(-40.0, 110.0),
                 rng.range(-70.0, 110.0),
@@ -537,23 +545,23 @@ mod tests {
 
     /// Whether the box at `p` overlaps the convex solid behind `faces`: a small linear program
     /// solved by brute force over the box's corners and the solid's vertices.
-    fn box_overlaps_wedge(p: Vec3, mins: Vec3, maxs: Vec3, faces: &[Plane]) -> bool {
+    fn box_overlaps_wedge(p: DVec3, mins: DVec3, maxs: DVec3, faces: &[Plane]) -> bool {
         // Separating axis test over the candidate axes of a box and a convex polytope: the
         // solid's normals, the box's axes and cross products of their edges (the wedge's edges
         // are along the axes and along the slope's edge, the y axis).
         let lo = p + mins;
         let hi = p + maxs;
-        let corners: Vec<Vec3> = (0..8)
+        let corners: Vec<DVec3> = (0..8)
             .map(|i| {
-                Vec3::new(
+                DVec3::new(
                     if i & 1 == 0 { lo.x } else { hi.x },
                     if i & 2 == 0 { lo.y } else { hi.y },
                     if i & 4 == 0 { lo.z } else { hi.z },
                 )
             })
             .collect();
-        let solid = grow(faces, Vec3::ZERO, Vec3::ZERO).expect("solid");
-        let vertices: Vec<Vec3> = faces
+        let solid = grow(faces, DVec3::ZERO, DVec3::ZERO).expect("solid");
+        let vertices: Vec<DVec3> = faces
             .iter()
             .enumerate()
             .filter_map(|(i, f)| {
@@ -568,12 +576,12 @@ mod tests {
             .flatten()
             .collect();
         let axes = solid.planes.iter().map(|pl| pl.normal).chain([
-            Vec3::new(1.0, 0.0, 0.0),
-            Vec3::new(0.0, 1.0, 0.0),
-            Vec3::new(0.0, 0.0, 1.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::new(0.0, 0.0, 1.0),
         ]);
         for axis in axes {
-            let project = |pts: &[Vec3]| {
+            let project = |pts: &[DVec3]| {
                 pts.iter()
                     .map(|q| q.dot(axis))
                     .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), d| {

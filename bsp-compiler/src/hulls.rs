@@ -4,13 +4,21 @@
 use crate::brush::{Brush, BrushPlane};
 use crate::planes::PlaneSet;
 use crate::tree::Tree;
+use glam::DVec3;
 use quake_formats::bsp::{ClipNode, contents};
-use quake_formats::geom::{ON_EPSILON, Plane, Vec3};
+use quake_formats::geom::DVec3Ext;
+use quake_formats::geom::{ON_EPSILON, Plane};
 
 /// The boxes of hull 1 (player) and hull 2 (shambler), as engines define them.
-pub const HULL_BOXES: [(Vec3, Vec3); 2] = [
-    (Vec3::new(-16.0, -16.0, -24.0), Vec3::new(16.0, 16.0, 32.0)),
-    (Vec3::new(-32.0, -32.0, -24.0), Vec3::new(32.0, 32.0, 64.0)),
+pub const HULL_BOXES: [(DVec3, DVec3); 2] = [
+    (
+        DVec3::new(-16.0, -16.0, -24.0),
+        DVec3::new(16.0, 16.0, 32.0),
+    ),
+    (
+        DVec3::new(-32.0, -32.0, -24.0),
+        DVec3::new(32.0, 32.0, 64.0),
+    ),
 ];
 
 fn push_unique(list: &mut Vec<Plane>, p: Plane) {
@@ -21,7 +29,12 @@ fn push_unique(list: &mut Vec<Plane>, p: Plane) {
 
 /// `brush` grown so that a point outside it is a box (`mins`..`maxs` around the point) clear
 /// of the original brush. Solid, untextured.
-pub fn expand_brush(brush: &Brush, planes: &mut PlaneSet, mins: Vec3, maxs: Vec3) -> Option<Brush> {
+pub fn expand_brush(
+    brush: &Brush,
+    planes: &mut PlaneSet,
+    mins: DVec3,
+    maxs: DVec3,
+) -> Option<Brush> {
     let mut list: Vec<Plane> = brush
         .sides
         .iter()
@@ -29,13 +42,13 @@ pub fn expand_brush(brush: &Brush, planes: &mut PlaneSet, mins: Vec3, maxs: Vec3
         .collect();
     // Axial bevels: the brush's bounding box.
     for axis in 0..3 {
-        let mut n = Vec3::ZERO;
+        let mut n = DVec3::ZERO;
         n[axis] = 1.0;
         push_unique(&mut list, Plane::new(n, brush.bounds.maxs[axis]));
         push_unique(&mut list, Plane::new(-n, -brush.bounds.mins[axis]));
     }
     // Edge bevels: planes through each edge and an axis that have the whole brush behind them.
-    let points: Vec<Vec3> = brush
+    let points: Vec<DVec3> = brush
         .sides
         .iter()
         .flat_map(|s| s.winding.points.iter().copied())
@@ -48,7 +61,7 @@ pub fn expand_brush(brush: &Brush, planes: &mut PlaneSet, mins: Vec3, maxs: Vec3
                 continue;
             };
             for axis in 0..3 {
-                let mut a = Vec3::ZERO;
+                let mut a = DVec3::ZERO;
                 a[axis] = 1.0;
                 let Some(n) = dir.cross(a).normalized() else {
                     continue;
@@ -165,8 +178,8 @@ mod tests {
         let b = solid_cube(&mut planes);
         let (mins, maxs) = HULL_BOXES[0];
         let g = expand_brush(&b, &mut planes, mins, maxs).expect("grown");
-        assert_eq!(g.bounds.mins, Vec3::new(-16.0, -16.0, -32.0));
-        assert_eq!(g.bounds.maxs, Vec3::new(80.0, 80.0, 88.0));
+        assert_eq!(g.bounds.mins, DVec3::new(-16.0, -16.0, -32.0));
+        assert_eq!(g.bounds.maxs, DVec3::new(80.0, 80.0, 88.0));
         assert_eq!(g.sides.len(), 6);
     }
 
@@ -210,7 +223,7 @@ mod tests {
         ];
         let point = |s: &str| {
             let v: Vec<f64> = s.split(' ').map(|c| c.parse().expect("number")).collect();
-            Vec3::new(v[0], v[1], v[2])
+            DVec3::new(v[0], v[1], v[2])
         };
         let faces: Vec<BrushPlane> = points
             .iter()
@@ -232,11 +245,11 @@ mod tests {
     #[test]
     fn wedge_gets_bevels() {
         let mut planes = PlaneSet::new();
-        let mut faces = box_planes(Vec3::ZERO, Vec3::new(64.0, 64.0, 64.0));
+        let mut faces = box_planes(DVec3::ZERO, DVec3::new(64.0, 64.0, 64.0));
         // Cut the top-front edge with a 45 degree slope.
-        let n = Vec3::new(1.0, 0.0, 1.0).normalized().expect("n");
+        let n = DVec3::new(1.0, 0.0, 1.0).normalized().expect("n");
         faces.push(BrushPlane {
-            plane: Plane::new(n, n.dot(Vec3::new(64.0, 0.0, 32.0))),
+            plane: Plane::new(n, n.dot(DVec3::new(64.0, 0.0, 32.0))),
             texinfo: Some(0),
         });
         let b = Brush::from_planes(&faces, &mut planes, contents::SOLID, 0).expect("wedge");
@@ -249,7 +262,7 @@ mod tests {
             .map(|s| g.outward(s, &planes))
             .find(|p| p.normal.near(n, 1e-9))
             .expect("slope");
-        let expected = n.dot(Vec3::new(64.0, 0.0, 32.0)) + (16.0 + 24.0) / 2f64.sqrt();
+        let expected = n.dot(DVec3::new(64.0, 0.0, 32.0)) + (16.0 + 24.0) / 2f64.sqrt();
         assert!((slope.dist - expected).abs() < 1e-6);
     }
 }

@@ -4,8 +4,9 @@
 //! geometry is not checked here (see [`crate::brush`]).
 
 use crate::texinfo::Projection;
+use glam::DVec3;
 use quake_formats::entities::Entity;
-use quake_formats::geom::{Plane, Vec3};
+use quake_formats::geom::Plane;
 use std::path::{Path, PathBuf};
 
 /// A syntax error in a `.map` file.
@@ -23,7 +24,7 @@ pub struct MapError {
 /// One brush face as written: three points, a texture name and its projection.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MapFace {
-    pub points: [Vec3; 3],
+    pub points: [DVec3; 3],
     pub texture: String,
     pub projection: Projection,
     pub line: usize,
@@ -32,7 +33,7 @@ pub struct MapFace {
 impl MapFace {
     /// The face's plane (outward facing) in coordinates relative to `origin`, snapped; `None`
     /// when the points are collinear.
-    pub fn plane(&self, origin: Vec3) -> Option<Plane> {
+    pub fn plane(&self, origin: DVec3) -> Option<Plane> {
         let [a, b, c] = self.points.map(|p| p - origin);
         Plane::from_points(a, b, c).map(|p| p.snapped())
     }
@@ -284,9 +285,9 @@ impl Parser<'_> {
         }
     }
 
-    fn point(&mut self) -> Result<Vec3, MapError> {
+    fn point(&mut self) -> Result<DVec3, MapError> {
         self.expect(b'(')?;
-        let p = Vec3::new(self.number()?, self.number()?, self.number()?);
+        let p = DVec3::new(self.number()?, self.number()?, self.number()?);
         self.expect(b')')?;
         Ok(p)
     }

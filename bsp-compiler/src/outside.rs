@@ -8,8 +8,9 @@ use crate::planes::PlaneSet;
 use crate::portals::Portals;
 use crate::tree::{Tree, TreeNode, engine_contents, is_opaque};
 use crate::warnings::Warning;
+use glam::DVec3;
 use quake_formats::bsp::contents;
-use quake_formats::geom::Vec3;
+
 use std::cmp::Ordering;
 use std::collections::{BinaryHeap, VecDeque};
 
@@ -18,7 +19,7 @@ use std::collections::{BinaryHeap, VecDeque};
 pub struct Occupant {
     pub entity: usize,
     pub classname: String,
-    pub origin: Vec3,
+    pub origin: DVec3,
 }
 
 /// A map open to the void.
@@ -26,9 +27,9 @@ pub struct Occupant {
 pub struct Leak {
     pub entity: usize,
     pub classname: String,
-    pub origin: Vec3,
+    pub origin: DVec3,
     /// From the entity through portal centres to the outside box (what the `.pts` file holds).
-    pub pointfile: Vec<Vec3>,
+    pub pointfile: Vec<DVec3>,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -147,10 +148,10 @@ fn path_to_outside(
     portals: &Portals,
     contents_of: &dyn Fn(u32) -> i32,
     start: u32,
-    origin: Vec3,
-) -> Vec<Vec3> {
+    origin: DVec3,
+) -> Vec<DVec3> {
     let n = portals.portals.len();
-    let centre: Vec<Vec3> = portals.portals.iter().map(|p| p.winding.center()).collect();
+    let centre: Vec<DVec3> = portals.portals.iter().map(|p| p.winding.center()).collect();
     let mut dist = vec![f64::INFINITY; n];
     let mut prev = vec![u32::MAX; n];
     let mut heap = BinaryHeap::new();

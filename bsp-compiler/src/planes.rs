@@ -83,24 +83,24 @@ impl PlaneSet {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use quake_formats::geom::Vec3;
+    use glam::DVec3;
 
     #[test]
     fn opposite_planes_share_an_id() {
         let mut set = PlaneSet::new();
-        let p = Plane::new(Vec3::new(0.0, 0.0, -1.0), -64.0);
+        let p = Plane::new(DVec3::new(0.0, 0.0, -1.0), -64.0);
         let (a, fa) = set.insert(&p);
         let (b, fb) = set.insert(&p.flipped());
         assert_eq!(a, b);
         assert!(fa && !fb);
-        assert_eq!(set.get(a).normal, Vec3::new(0.0, 0.0, 1.0));
+        assert_eq!(set.get(a).normal, DVec3::new(0.0, 0.0, 1.0));
         assert_eq!(set.get(a).dist, 64.0);
     }
 
     #[test]
     fn near_equal_distances_across_integer_boundaries_match() {
         let mut set = PlaneSet::new();
-        let n = Vec3::new(0.6, 0.8, 0.0);
+        let n = DVec3::new(0.6, 0.8, 0.0);
         let (a, _) = set.insert(&Plane::new(n, 15.99999999));
         let (b, _) = set.insert(&Plane::new(n, 16.0000001));
         assert_eq!(a, b);

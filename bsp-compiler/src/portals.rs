@@ -5,7 +5,8 @@
 use crate::brush::keep_front;
 use crate::planes::{PlaneId, PlaneSet};
 use crate::tree::{Tree, TreeNode};
-use quake_formats::geom::{Bounds, Plane, Split, Vec3, Winding};
+use glam::DVec3;
+use quake_formats::geom::{Bounds, Plane, Split, Winding};
 
 /// Space left between the map and the outside box.
 const OUTSIDE_MARGIN: f64 = 8.0;
@@ -138,11 +139,11 @@ impl Builder {
 
     /// The six portals to the outside leaf; returns their (inward-facing) planes.
     fn outside_box(&mut self, bounds: &Bounds, outside: u32) -> Vec<Plane> {
-        let mins = bounds.mins - Vec3::new(OUTSIDE_MARGIN, OUTSIDE_MARGIN, OUTSIDE_MARGIN);
-        let maxs = bounds.maxs + Vec3::new(OUTSIDE_MARGIN, OUTSIDE_MARGIN, OUTSIDE_MARGIN);
+        let mins = bounds.mins - DVec3::new(OUTSIDE_MARGIN, OUTSIDE_MARGIN, OUTSIDE_MARGIN);
+        let maxs = bounds.maxs + DVec3::new(OUTSIDE_MARGIN, OUTSIDE_MARGIN, OUTSIDE_MARGIN);
         let mut box_planes = Vec::new();
         for axis in 0..3 {
-            let mut n = Vec3::ZERO;
+            let mut n = DVec3::ZERO;
             n[axis] = 1.0;
             // Facing inwards, so the tree (node 0) is in front.
             box_planes.push(Plane::new(n, mins[axis]));
@@ -269,7 +270,10 @@ mod tests {
             .map(|&p| portals.portals[p as usize].winding.area())
             .sum();
         assert!((area - 6.0 * 64.0 * 64.0).abs() < 1e-6, "{area}");
-        assert_eq!(portals.leaf_bounds(solid).maxs, Vec3::new(64.0, 64.0, 64.0));
+        assert_eq!(
+            portals.leaf_bounds(solid).maxs,
+            DVec3::new(64.0, 64.0, 64.0)
+        );
         // Every portal's plane faces its first node.
         for p in &portals.portals {
             let own = p.winding.plane().expect("plane");
@@ -283,10 +287,13 @@ mod tests {
     fn portals_stay_within_their_nodes_regions() {
         let mut planes = PlaneSet::new();
         let boxes = [
-            (Vec3::new(0.0, 0.0, 0.0), Vec3::new(64.0, 64.0, 16.0)),
-            (Vec3::new(96.0, -32.0, 0.0), Vec3::new(128.0, 96.0, 128.0)),
-            (Vec3::new(-64.0, 80.0, 32.0), Vec3::new(200.0, 112.0, 48.0)),
-            (Vec3::new(16.0, 16.0, 64.0), Vec3::new(48.0, 48.0, 200.0)),
+            (DVec3::new(0.0, 0.0, 0.0), DVec3::new(64.0, 64.0, 16.0)),
+            (DVec3::new(96.0, -32.0, 0.0), DVec3::new(128.0, 96.0, 128.0)),
+            (
+                DVec3::new(-64.0, 80.0, 32.0),
+                DVec3::new(200.0, 112.0, 48.0),
+            ),
+            (DVec3::new(16.0, 16.0, 64.0), DVec3::new(48.0, 48.0, 200.0)),
         ];
         let brushes: Vec<Brush> = boxes
             .iter()

@@ -7,7 +7,8 @@
 
 use crate::map::{MapBrush, MapEntity, MapFace, MapFile, parse_map, read_map_text};
 use crate::texinfo::Projection;
-use quake_formats::geom::Vec3;
+use glam::{DAffine3, DMat3, DVec3};
+
 use std::path::{Path, PathBuf};
 
 pub const PREFAB_CLASSNAME: &str = "misc_external_map";
@@ -117,13 +118,13 @@ fn prefab_path(map: &Path, name: &str) -> PathBuf {
     }
 }
 
-/// `p -> linear * p + offset`, with the inverse transpose for texture axes.
+/// Where a prefab's points go, with the inverse transpose for texture axes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Transform {
-    linear: [Vec3; 3],
-    /// `linear`'s inverse transpose: texture axes map by it so that texels stay on the points.
-    axes: [Vec3; 3],
-    offset: Vec3,
+    place: DAffine3,
+    /// The linear part's inverse transpose: texture axes map by it so that texels stay on the
+    /// points.
+    axes: DMat3,
     /// The determinant is negative (a mirror): face point order flips with it.
     mirrors: bool,
 }
@@ -132,16 +133,6 @@ fn floats(text: &str) -> Option<Vec<f64>> {
     text.split_whitespace()
         .map(|w| w.parse::<f64>().ok().filter(|v| v.is_finite()))
         .collect()
-}
-
-/// Rows of `m * v` for matrices stored as rows.
-fn mul(m: &[Vec3; 3], v: Vec3) -> Vec3 {
-    Vec3::new(m[0].dot(v), m[1].dot(v), m[2].dot(v))
-}
-
-fn matmul(a: &[Vec3; 3], b: &[Vec3; 3]) -> [Vec3; 3] {
-    let col = |j: usize| Vec3::new(b[0][j], b[1][j], b[2][j]);
-    std::array::from_fn(|i| Vec3::new(a[i].dot(col(0)), a[i].dot(col(1)), a[i].dot(col(2))))
 }
 
 impl Transform {
@@ -162,9 +153,9 @@ impl Transform {
             (None, None) => [0.0; 3],
         };
         let scale = match key_floats(KEY_SCALE) {
-            None => Vec3::new(1.0, 1.0, 1.0),
-            Some((_, Some(v))) if v.len() == 1 => Vec3::new(v[0], v[0], v[0]),
-            Some((_, Some(v))) if v.len() == 3 => Vec3::new(v[0], v[1], v[2]),
+            None => DVec3::new(1.0, 1.0, 1.0),
+            Some((_, Some(v))) if v.len() == 1 => DVec3::new(v[0], v[0], v[0]),
+            Some((_, Some(v))) if v.len() == 3 => DVec3::new(v[0], v[1], v[2]),
             Some((text, _)) => {
                 return Err(format!(
                     "\"{KEY_SCALE}\" is {text:?}, not one number or three (x y z)"
@@ -175,32 +166,23 @@ impl Transform {
             return Err(format!("\"{KEY_SCALE}\" has a zero scale"));
         }
         let offset = match e.get_floats::<3>("origin") {
-            Some([x, y, z]) => Vec3::new(x, y, z),
+            Some([x, y, z]) => DVec3::new(x, y, z),
             None if e.get("origin").is_some() => {
                 return Err("\"origin\" is not three numbers".to_string());
             }
-            None => Vec3::ZERO,
+            None => DVec3::ZERO,
         };
         let rotation = rotation(pitch, yaw, roll);
-        let diagonal = |s: Vec3| {
-            [
-                Vec3::new(s.x, 0.0, 0.0),
-                Vec3::new(0.0, s.y, 0.0),
-                Vec3::new(0.0, 0.0, s.z),
-            ]
-        };
-        let inverse = Vec3::new(1.0 / scale.x, 1.0 / scale.y, 1.0 / scale.z);
         Ok(Transform {
-            linear: matmul(&rotation, &diagonal(scale)),
+            place: DAffine3::from_mat3_translation(rotation * DMat3::from_diagonal(scale), offset),
             // (R S)^-T = R^-T S^-T = R S^-1 for a rotation R and a diagonal S.
-            axes: matmul(&rotation, &diagonal(inverse)),
-            offset,
+            axes: rotation * DMat3::from_diagonal(scale.recip()),
             mirrors: scale.x * scale.y * scale.z < 0.0,
         })
     }
 
-    fn point(&self, p: Vec3) -> Vec3 {
-        mul(&self.linear, p) + self.offset
+    fn point(&self, p: DVec3) -> DVec3 {
+        self.place.transform_point3(p)
     }
 
     fn brush(&self, brush: MapBrush) -> MapBrush {
@@ -213,12 +195,17 @@ impl Transform {
     /// The face moved, its texture moved with it: written as explicit (Valve) axes, which every
     /// rotation keeps exact.
     fn face(&self, face: MapFace) -> MapFace {
-        let projection = match face.plane(Vec3::ZERO) {
+        let projection = match face.plane(DVec3::ZERO) {
             Some(plane) => {
                 let vecs = face.projection.vecs(&plane);
                 let [u, v] = vecs.map(|row| {
-                    let axis = mul(&self.axes, Vec3::new(row[0], row[1], row[2]));
-                    [axis.x, axis.y, axis.z, row[3] - axis.dot(self.offset)]
+                    let axis = self.axes * DVec3::new(row[0], row[1], row[2]);
+                    [
+                        axis.x,
+                        axis.y,
+                        axis.z,
+                        row[3] - axis.dot(self.place.translation),
+                    ]
                 });
                 Projection::Valve {
                     u,
@@ -240,46 +227,28 @@ impl Transform {
 
 /// Rotation by `roll` about +X, then `pitch` about +Y (positive pitch turns +X down), then
 /// `yaw` about +Z, in degrees.
-fn rotation(pitch: f64, yaw: f64, roll: f64) -> [Vec3; 3] {
-    let (sp, cp) = pitch.to_radians().sin_cos();
-    let (sy, cy) = yaw.to_radians().sin_cos();
-    let (sr, cr) = roll.to_radians().sin_cos();
-    let rz = [
-        Vec3::new(cy, -sy, 0.0),
-        Vec3::new(sy, cy, 0.0),
-        Vec3::new(0.0, 0.0, 1.0),
-    ];
-    let ry = [
-        Vec3::new(cp, 0.0, sp),
-        Vec3::new(0.0, 1.0, 0.0),
-        Vec3::new(-sp, 0.0, cp),
-    ];
-    let rx = [
-        Vec3::new(1.0, 0.0, 0.0),
-        Vec3::new(0.0, cr, -sr),
-        Vec3::new(0.0, sr, cr),
-    ];
-    snap(matmul(&rz, &matmul(&ry, &rx)))
+fn rotation(pitch: f64, yaw: f64, roll: f64) -> DMat3 {
+    snap(
+        DMat3::from_rotation_z(yaw.to_radians())
+            * (DMat3::from_rotation_y(pitch.to_radians())
+                * DMat3::from_rotation_x(roll.to_radians())),
+    )
 }
 
 /// Right angles give exact 0 and ±1, not 6e-17: brushes turned by them stay on the grid.
-fn snap(m: [Vec3; 3]) -> [Vec3; 3] {
-    m.map(|row| {
-        let mut row = row;
-        for i in 0..3 {
-            let r = row[i].round();
-            if (row[i] - r).abs() < 1e-12 {
-                row[i] = r;
-            }
-        }
-        row
-    })
+fn snap(m: DMat3) -> DMat3 {
+    let snapped = |x: f64| {
+        let r = x.round();
+        if (x - r).abs() < 1e-12 { r } else { x }
+    };
+    DMat3::from_cols_array(&m.to_cols_array().map(snapped))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use quake_formats::entities::Entity;
+    use quake_formats::geom::DVec3Ext;
 
     fn entity(pairs: &[(&str, &str)]) -> MapEntity {
         MapEntity {
@@ -303,13 +272,19 @@ mod tests {
         .expect("transform");
         // Facing +X, a yaw of 90 faces +Y.
         assert_eq!(
-            t.point(Vec3::new(1.0, 0.0, 0.0)),
-            Vec3::new(100.0, 1.0, 0.0)
+            t.point(DVec3::new(1.0, 0.0, 0.0)),
+            DVec3::new(100.0, 1.0, 0.0)
         );
         let t = Transform::of(&entity(&[("_external_map_angles", "90 0 0")])).expect("pitch");
-        assert_eq!(t.point(Vec3::new(1.0, 0.0, 0.0)), Vec3::new(0.0, 0.0, -1.0));
+        assert_eq!(
+            t.point(DVec3::new(1.0, 0.0, 0.0)),
+            DVec3::new(0.0, 0.0, -1.0)
+        );
         let t = Transform::of(&entity(&[("_external_map_scale", "2 -1 1")])).expect("scale");
-        assert_eq!(t.point(Vec3::new(1.0, 1.0, 1.0)), Vec3::new(2.0, -1.0, 1.0));
+        assert_eq!(
+            t.point(DVec3::new(1.0, 1.0, 1.0)),
+            DVec3::new(2.0, -1.0, 1.0)
+        );
         assert!(t.mirrors);
     }
 
@@ -328,9 +303,9 @@ mod tests {
     fn texture_axes_follow_the_points() {
         let face = MapFace {
             points: [
-                Vec3::new(0.0, 0.0, 64.0),
-                Vec3::new(0.0, 64.0, 64.0),
-                Vec3::new(64.0, 0.0, 64.0),
+                DVec3::new(0.0, 0.0, 64.0),
+                DVec3::new(0.0, 64.0, 64.0),
+                DVec3::new(64.0, 0.0, 64.0),
             ],
             texture: "t".into(),
             projection: Projection::Standard {
@@ -348,22 +323,23 @@ mod tests {
         .expect("transform");
         let before = face
             .projection
-            .vecs(&face.plane(Vec3::ZERO).expect("plane"));
+            .vecs(&face.plane(DVec3::ZERO).expect("plane"));
         let moved = t.face(face.clone());
         let after = moved
             .projection
-            .vecs(&moved.plane(Vec3::ZERO).expect("plane"));
-        let st =
-            |vecs: &[[f64; 4]; 2], p: Vec3| vecs.map(|r| Vec3::new(r[0], r[1], r[2]).dot(p) + r[3]);
-        for p in [Vec3::new(3.0, 5.0, 64.0), Vec3::new(-20.0, 7.0, 64.0)] {
+            .vecs(&moved.plane(DVec3::ZERO).expect("plane"));
+        let st = |vecs: &[[f64; 4]; 2], p: DVec3| {
+            vecs.map(|r| DVec3::new(r[0], r[1], r[2]).dot(p) + r[3])
+        };
+        for p in [DVec3::new(3.0, 5.0, 64.0), DVec3::new(-20.0, 7.0, 64.0)] {
             let [s0, t0] = st(&before, p);
             let [s1, t1] = st(&after, t.point(p));
             assert!((s0 - s1).abs() < 1e-9 && (t0 - t1).abs() < 1e-9);
         }
         // The mirrored face still faces out of its brush: normals map by the inverse transpose.
-        let n0 = face.plane(Vec3::ZERO).expect("plane").normal;
-        let expected = mul(&t.axes, n0).normalized().expect("normal");
-        let normal = moved.plane(Vec3::ZERO).expect("plane").normal;
+        let n0 = face.plane(DVec3::ZERO).expect("plane").normal;
+        let expected = (t.axes * n0).normalized().expect("normal");
+        let normal = moved.plane(DVec3::ZERO).expect("plane").normal;
         assert!(normal.dot(expected) > 0.999, "{normal:?} vs {expected:?}");
     }
 }

@@ -4,8 +4,9 @@
 //! between the children ("new portal was clipped away").
 
 use crate::brush::keep_front;
+use glam::DVec3;
 use quake_formats::bsp::DARKPLACES_PORTAL_EPSILON;
-use quake_formats::geom::{Bounds, ON_EPSILON, Plane, Split, Vec3, Winding};
+use quake_formats::geom::{Bounds, ON_EPSILON, Plane, Split, Winding};
 
 /// How far inside a region's faces a node plane's cross-section must reach: DarkPlaces' portal
 /// epsilon and a margin for the planes' rounding to `f32` (about 1/1000 unit at BSP29
@@ -42,11 +43,11 @@ pub(crate) struct Region {
 impl Region {
     /// The box `bounds` grown by `margin` on every side.
     pub(crate) fn around(bounds: &Bounds, margin: f64) -> Region {
-        let m = Vec3::new(margin, margin, margin);
+        let m = DVec3::new(margin, margin, margin);
         let (mins, maxs) = (bounds.mins - m, bounds.maxs + m);
         let mut planes = Vec::with_capacity(6);
         for axis in 0..3 {
-            let mut n = Vec3::ZERO;
+            let mut n = DVec3::ZERO;
             n[axis] = 1.0;
             planes.push(Plane::new(n, maxs[axis]));
             planes.push(Plane::new(-n, -mins[axis]));
@@ -139,7 +140,7 @@ impl Region {
         }
     }
 
-    fn points(&self) -> impl Iterator<Item = &Vec3> {
+    fn points(&self) -> impl Iterator<Item = &DVec3> {
         self.faces.iter().flat_map(|f| &f.winding.points)
     }
 
@@ -214,11 +215,12 @@ fn clip_inside(w: Winding, planes: &[Plane], own: &Plane) -> Option<Winding> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use quake_formats::geom::DVec3Ext;
 
-    fn box_region(maxs: Vec3) -> Region {
+    fn box_region(maxs: DVec3) -> Region {
         Region::around(
             &Bounds {
-                mins: Vec3::ZERO,
+                mins: DVec3::ZERO,
                 maxs,
             },
             0.0,
@@ -226,13 +228,13 @@ mod tests {
     }
 
     fn unit_box() -> Region {
-        box_region(Vec3::new(64.0, 64.0, 64.0))
+        box_region(DVec3::new(64.0, 64.0, 64.0))
     }
 
     /// The plane through (x, 0, `z0`) and (x, 64, `z1`) for every x.
     fn tilted(z0: f64, z1: f64) -> Plane {
-        let normal = Vec3::new(0.0, z0 - z1, 64.0).normalized().expect("unit");
-        Plane::new(normal, normal.dot(Vec3::new(0.0, 0.0, z0)))
+        let normal = DVec3::new(0.0, z0 - z1, 64.0).normalized().expect("unit");
+        Plane::new(normal, normal.dot(DVec3::new(0.0, 0.0, z0)))
     }
 
     #[test]
@@ -248,17 +250,17 @@ mod tests {
         assert_eq!(region.sliver(&wedge.flipped()), Sliver::Back);
         // Parallel to the top and as close: DarkPlaces would keep this one, but only a
         // cross-section with room inside every face is safe whatever order it clips in.
-        let slab = Plane::new(Vec3::new(0.0, 0.0, 1.0), 63.98);
+        let slab = Plane::new(DVec3::new(0.0, 0.0, 1.0), 63.98);
         assert!(region.split_cleanly(&slab).is_none());
         assert_eq!(region.sliver(&slab), Sliver::Front);
     }
 
     #[test]
     fn in_a_crack_there_is_no_side_to_give_the_sliver_to() {
-        let crack = box_region(Vec3::new(64.0, 0.5, 64.0));
-        let x = Plane::new(Vec3::new(1.0, 0.0, 0.0), 32.0);
+        let crack = box_region(DVec3::new(64.0, 0.5, 64.0));
+        let x = Plane::new(DVec3::new(1.0, 0.0, 0.0), 32.0);
         assert!(crack.split_cleanly(&x).is_some());
-        let y = Plane::new(Vec3::new(0.0, 1.0, 0.0), 0.02);
+        let y = Plane::new(DVec3::new(0.0, 1.0, 0.0), 0.02);
         assert!(crack.split_cleanly(&y).is_none());
         assert_eq!(crack.sliver(&y), Sliver::Crack);
     }
@@ -266,7 +268,7 @@ mod tests {
     #[test]
     fn planes_crossing_a_box_cut_it_and_others_do_not() {
         let region = unit_box();
-        let x = Vec3::new(1.0, 0.0, 0.0);
+        let x = DVec3::new(1.0, 0.0, 0.0);
         assert_eq!(region.sides_of(&Plane::new(x, 32.0)), (true, true));
         assert_eq!(region.sides_of(&Plane::new(x, 64.0)), (false, true));
         assert_eq!(region.sides_of(&Plane::new(x, 100.0)), (false, true));
@@ -275,8 +277,8 @@ mod tests {
 
     #[test]
     fn a_split_region_is_cut_where_the_plane_crossed() {
-        let diagonal = Plane::new(Vec3::new(1.0, 1.0, 0.0).normalized().expect("unit"), 0.0);
-        let x48 = Plane::new(Vec3::new(1.0, 0.0, 0.0), 48.0);
+        let diagonal = Plane::new(DVec3::new(1.0, 1.0, 0.0).normalized().expect("unit"), 0.0);
+        let x48 = Plane::new(DVec3::new(1.0, 0.0, 0.0), 48.0);
         let [front, back] = unit_box().split_cleanly(&x48).expect("clean");
         assert_eq!(front.bounds.mins.x, 48.0);
         assert_eq!(back.bounds.maxs.x, 48.0);

@@ -7,8 +7,9 @@ use crate::brush::keep_front;
 use crate::planes::{PlaneId, PlaneSet};
 use crate::portals::Portals;
 use crate::tree::{BuildNode, Splitting, Tree, best_splitter, flatten, mid_split};
+use glam::DVec3;
 use quake_formats::bsp::contents;
-use quake_formats::geom::{Bounds, Plane, Split, Vec3, Winding};
+use quake_formats::geom::{Bounds, Plane, Split, Winding};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Space left between the surfaces and the box bounding the root's region.
@@ -103,15 +104,15 @@ pub fn rebuild_from_surfaces(
     let root = if surfaces.is_empty() {
         // All one contents: whatever the old tree holds anywhere.
         BuildNode::Leaf {
-            contents: tree.nodes[tree.leaf_at(planes, Vec3::ZERO) as usize].contents,
+            contents: tree.nodes[tree.leaf_at(planes, DVec3::ZERO) as usize].contents,
             brushes: Vec::new(),
         }
     } else {
-        let m = Vec3::new(REGION_MARGIN, REGION_MARGIN, REGION_MARGIN);
+        let m = DVec3::new(REGION_MARGIN, REGION_MARGIN, REGION_MARGIN);
         let (mins, maxs) = (bounds.mins - m, bounds.maxs + m);
         let mut region = Vec::new();
         for axis in 0..3 {
-            let mut n = Vec3::ZERO;
+            let mut n = DVec3::ZERO;
             n[axis] = 1.0;
             region.push(Plane::new(n, mins[axis]));
             region.push(Plane::new(-n, -maxs[axis]));
@@ -291,8 +292,8 @@ impl Builder<'_> {
 }
 
 /// A point inside the convex region in front of all `planes`: the average of its vertices.
-fn inside_point(planes: &[Plane]) -> Option<Vec3> {
-    let mut sum = Vec3::ZERO;
+fn inside_point(planes: &[Plane]) -> Option<DVec3> {
+    let mut sum = DVec3::ZERO;
     let mut count = 0usize;
     for (i, plane) in planes.iter().enumerate() {
         // The region's face on this plane looks back into the region.
@@ -317,8 +318,9 @@ mod tests {
     use crate::brush::tests::box_planes;
     use crate::portals::make_portals;
     use crate::tree::{SplitHeuristic, build_tree};
+    use quake_formats::geom::DVec3Ext;
 
-    fn contents_at(tree: &Tree, planes: &PlaneSet, p: Vec3) -> i32 {
+    fn contents_at(tree: &Tree, planes: &PlaneSet, p: DVec3) -> i32 {
         tree.nodes[tree.leaf_at(planes, p) as usize].contents
     }
 
@@ -326,14 +328,14 @@ mod tests {
     fn inside_point_of_a_box() {
         let mut planes = Vec::new();
         for axis in 0..3 {
-            let mut n = Vec3::ZERO;
+            let mut n = DVec3::ZERO;
             n[axis] = 1.0;
             planes.push(Plane::new(n, 0.0));
             planes.push(Plane::new(-n, -10.0));
         }
         let p = inside_point(&planes).expect("point");
-        assert!(p.near(Vec3::new(5.0, 5.0, 5.0), 1e-9), "{p:?}");
-        planes.push(Plane::new(Vec3::new(1.0, 0.0, 0.0), 20.0));
+        assert!(p.near(DVec3::new(5.0, 5.0, 5.0), 1e-9), "{p:?}");
+        planes.push(Plane::new(DVec3::new(1.0, 0.0, 0.0), 20.0));
         assert!(inside_point(&planes).is_none());
     }
 
@@ -352,8 +354,8 @@ mod tests {
             .map(|(i, &(lo, hi))| {
                 Brush::from_planes(
                     &box_planes(
-                        Vec3::new(lo[0], lo[1], lo[2]),
-                        Vec3::new(hi[0], hi[1], hi[2]),
+                        DVec3::new(lo[0], lo[1], lo[2]),
+                        DVec3::new(hi[0], hi[1], hi[2]),
                     ),
                     &mut planes,
                     contents::SOLID,
@@ -371,7 +373,7 @@ mod tests {
         for x in (-24..=104).step_by(5) {
             for y in (-4..=90).step_by(5) {
                 for z in (-4..=110).step_by(5) {
-                    let p = Vec3::new(x as f64 + 0.5, y as f64 + 0.5, z as f64 + 0.5);
+                    let p = DVec3::new(x as f64 + 0.5, y as f64 + 0.5, z as f64 + 0.5);
                     assert_eq!(
                         contents_at(&rebuilt, &planes, p),
                         contents_at(&tree, &planes, p),

@@ -1,7 +1,8 @@
 //! Texture projections of both `.map` formats, and what a texture name means to the compiler.
 
+use glam::DVec3;
 use quake_formats::bsp::contents;
-use quake_formats::geom::{Plane, Vec3};
+use quake_formats::geom::Plane;
 
 /// How a face's texture is projected, as written in the `.map` file.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -21,42 +22,42 @@ pub enum Projection {
 }
 
 /// For each of the six base directions: the normal it matches, then the s and t axes.
-const BASE_AXES: [[Vec3; 3]; 6] = [
+const BASE_AXES: [[DVec3; 3]; 6] = [
     [
-        Vec3::new(0.0, 0.0, 1.0),
-        Vec3::new(1.0, 0.0, 0.0),
-        Vec3::new(0.0, -1.0, 0.0),
+        DVec3::new(0.0, 0.0, 1.0),
+        DVec3::new(1.0, 0.0, 0.0),
+        DVec3::new(0.0, -1.0, 0.0),
     ],
     [
-        Vec3::new(0.0, 0.0, -1.0),
-        Vec3::new(1.0, 0.0, 0.0),
-        Vec3::new(0.0, -1.0, 0.0),
+        DVec3::new(0.0, 0.0, -1.0),
+        DVec3::new(1.0, 0.0, 0.0),
+        DVec3::new(0.0, -1.0, 0.0),
     ],
     [
-        Vec3::new(1.0, 0.0, 0.0),
-        Vec3::new(0.0, 1.0, 0.0),
-        Vec3::new(0.0, 0.0, -1.0),
+        DVec3::new(1.0, 0.0, 0.0),
+        DVec3::new(0.0, 1.0, 0.0),
+        DVec3::new(0.0, 0.0, -1.0),
     ],
     [
-        Vec3::new(-1.0, 0.0, 0.0),
-        Vec3::new(0.0, 1.0, 0.0),
-        Vec3::new(0.0, 0.0, -1.0),
+        DVec3::new(-1.0, 0.0, 0.0),
+        DVec3::new(0.0, 1.0, 0.0),
+        DVec3::new(0.0, 0.0, -1.0),
     ],
     [
-        Vec3::new(0.0, 1.0, 0.0),
-        Vec3::new(1.0, 0.0, 0.0),
-        Vec3::new(0.0, 0.0, -1.0),
+        DVec3::new(0.0, 1.0, 0.0),
+        DVec3::new(1.0, 0.0, 0.0),
+        DVec3::new(0.0, 0.0, -1.0),
     ],
     [
-        Vec3::new(0.0, -1.0, 0.0),
-        Vec3::new(1.0, 0.0, 0.0),
-        Vec3::new(0.0, 0.0, -1.0),
+        DVec3::new(0.0, -1.0, 0.0),
+        DVec3::new(1.0, 0.0, 0.0),
+        DVec3::new(0.0, 0.0, -1.0),
     ],
 ];
 
 /// The s and t axes Quake projects a face with `normal` onto, before rotation and scale: those
 /// of the closest base direction (earlier entries win ties, as in Quake).
-pub fn base_axes(normal: Vec3) -> [Vec3; 2] {
+pub fn base_axes(normal: DVec3) -> [DVec3; 2] {
     let mut best = 0;
     let mut best_dot = 0.0;
     for (i, axes) in BASE_AXES.iter().enumerate() {
@@ -97,7 +98,7 @@ impl Projection {
                     270.0 => (-1.0, 0.0),
                     r => r.to_radians().sin_cos(),
                 };
-                let first_nonzero = |v: Vec3| (0..3).find(|&i| v[i] != 0.0).unwrap_or(2);
+                let first_nonzero = |v: DVec3| (0..3).find(|&i| v[i] != 0.0).unwrap_or(2);
                 let sv = first_nonzero(axes[0]);
                 let tv = first_nonzero(axes[1]);
                 for axis in &mut axes {
@@ -223,6 +224,7 @@ impl<'a> AnimationFrame<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use quake_formats::geom::DVec3Ext;
 
     #[test]
     fn animation_frames_from_names() {
@@ -245,41 +247,41 @@ mod tests {
         }
     }
 
-    fn plane(n: Vec3) -> Plane {
+    fn plane(n: DVec3) -> Plane {
         Plane::new(n, 0.0)
     }
 
     #[test]
     fn floor_uses_x_and_minus_y() {
-        let v = standard([0.0, 0.0], 0.0, [1.0, 1.0]).vecs(&plane(Vec3::new(0.0, 0.0, 1.0)));
+        let v = standard([0.0, 0.0], 0.0, [1.0, 1.0]).vecs(&plane(DVec3::new(0.0, 0.0, 1.0)));
         assert_eq!(v, [[1.0, 0.0, 0.0, 0.0], [0.0, -1.0, 0.0, 0.0]]);
     }
 
     #[test]
     fn walls_use_their_base_axes() {
-        let v = standard([0.0, 0.0], 0.0, [1.0, 1.0]).vecs(&plane(Vec3::new(-1.0, 0.0, 0.0)));
+        let v = standard([0.0, 0.0], 0.0, [1.0, 1.0]).vecs(&plane(DVec3::new(-1.0, 0.0, 0.0)));
         assert_eq!(v, [[0.0, 1.0, 0.0, 0.0], [0.0, 0.0, -1.0, 0.0]]);
-        let v = standard([0.0, 0.0], 0.0, [1.0, 1.0]).vecs(&plane(Vec3::new(0.0, 1.0, 0.0)));
+        let v = standard([0.0, 0.0], 0.0, [1.0, 1.0]).vecs(&plane(DVec3::new(0.0, 1.0, 0.0)));
         assert_eq!(v, [[1.0, 0.0, 0.0, 0.0], [0.0, 0.0, -1.0, 0.0]]);
     }
 
     #[test]
     fn rotation_scale_and_shift() {
         // e1m1's "SLIPBOTSD 0 0 90 -1 1" on an X wall.
-        let v = standard([0.0, 0.0], 90.0, [-1.0, 1.0]).vecs(&plane(Vec3::new(1.0, 0.0, 0.0)));
+        let v = standard([0.0, 0.0], 90.0, [-1.0, 1.0]).vecs(&plane(DVec3::new(1.0, 0.0, 0.0)));
         // s axis (0,1,0) rotated by 90 becomes (0,0,1); t axis (0,0,-1) becomes (0,1,0).
         assert_eq!(v[0], [0.0, 0.0, -1.0, 0.0]);
         assert_eq!(v[1], [0.0, 1.0, 0.0, 0.0]);
-        let v = standard([16.0, -8.0], 0.0, [2.0, 0.5]).vecs(&plane(Vec3::new(0.0, 0.0, 1.0)));
+        let v = standard([16.0, -8.0], 0.0, [2.0, 0.5]).vecs(&plane(DVec3::new(0.0, 0.0, 1.0)));
         assert_eq!(v, [[0.5, 0.0, 0.0, 16.0], [0.0, -2.0, 0.0, -8.0]]);
     }
 
     #[test]
     fn sloped_face_picks_the_closest_axis() {
-        let n = Vec3::new(0.6, 0.0, 0.8);
+        let n = DVec3::new(0.6, 0.0, 0.8);
         let v = standard([0.0, 0.0], 0.0, [1.0, 1.0]).vecs(&plane(n));
         assert_eq!(v[0], [1.0, 0.0, 0.0, 0.0]);
-        let n = Vec3::new(0.8, 0.0, 0.6);
+        let n = DVec3::new(0.8, 0.0, 0.6);
         let v = standard([0.0, 0.0], 0.0, [1.0, 1.0]).vecs(&plane(n));
         assert_eq!(v[0], [0.0, 1.0, 0.0, 0.0]);
     }
@@ -291,7 +293,7 @@ mod tests {
             v: [0.0, 0.0, -1.0, 4.0],
             scale: [0.5, 2.0],
         };
-        let v = p.vecs(&plane(Vec3::new(1.0, 0.0, 0.0)));
+        let v = p.vecs(&plane(DVec3::new(1.0, 0.0, 0.0)));
         assert_eq!(v, [[0.0, 2.0, 0.0, -16.0], [0.0, 0.0, -0.5, 4.0]]);
     }
 
@@ -322,7 +324,7 @@ mod tests {
             scale in (0.1f64..4.0, 0.1f64..4.0),
             negate in (proptest::bool::ANY, proptest::bool::ANY),
         ) {
-            let Some(normal) = Vec3::new(n.0, n.1, n.2).normalized() else {
+            let Some(normal) = DVec3::new(n.0, n.1, n.2).normalized() else {
                 return Ok(());
             };
             let scale = [
@@ -330,8 +332,8 @@ mod tests {
                 if negate.1 { -scale.1 } else { scale.1 },
             ];
             let v = standard([3.0, -7.0], rotation, scale).vecs(&plane(normal));
-            let s = Vec3::new(v[0][0], v[0][1], v[0][2]);
-            let t = Vec3::new(v[1][0], v[1][1], v[1][2]);
+            let s = DVec3::new(v[0][0], v[0][1], v[0][2]);
+            let t = DVec3::new(v[1][0], v[1][1], v[1][2]);
             // The area the plane's unit square covers in texture space: zero means two points
             // share texture coordinates.
             let covered = s.cross(t).dot(normal).abs();

@@ -6,8 +6,9 @@
 use crate::brush::{Brush, BrushKind};
 use crate::planes::{PlaneId, PlaneSet};
 use crate::region::{Region, Sliver};
+use glam::DVec3;
 use quake_formats::bsp::contents;
-use quake_formats::geom::{Bounds, Plane, Vec3};
+use quake_formats::geom::{Bounds, Plane};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -244,16 +245,16 @@ pub struct Tree {
 
 impl Tree {
     /// The leaf holding `p` (points on a plane go to the front, as in engines).
-    pub fn leaf_at(&self, planes: &PlaneSet, p: Vec3) -> u32 {
+    pub fn leaf_at(&self, planes: &PlaneSet, p: DVec3) -> u32 {
         self.descend(planes, p, TreeNode::is_leaf)
     }
 
     /// The structural leaf (vis cluster) holding `p`.
-    pub fn cluster_at(&self, planes: &PlaneSet, p: Vec3) -> u32 {
+    pub fn cluster_at(&self, planes: &PlaneSet, p: DVec3) -> u32 {
         self.descend(planes, p, |n| n.cluster.is_some())
     }
 
-    fn descend(&self, planes: &PlaneSet, p: Vec3, stop: impl Fn(&TreeNode) -> bool) -> u32 {
+    fn descend(&self, planes: &PlaneSet, p: DVec3, stop: impl Fn(&TreeNode) -> bool) -> u32 {
         let mut n = 0u32;
         while !stop(&self.nodes[n as usize]) {
             let Some(id) = self.nodes[n as usize].plane else {
@@ -432,8 +433,8 @@ impl Builder<'_> {
             .fold(Bounds::EMPTY, |acc, b| acc.union(&b.bounds));
         let bounds = if bounds.is_empty() {
             Bounds {
-                mins: Vec3::ZERO,
-                maxs: Vec3::ZERO,
+                mins: DVec3::ZERO,
+                maxs: DVec3::ZERO,
             }
         } else {
             bounds
@@ -692,25 +693,25 @@ mod tests {
         let mut planes = PlaneSet::new();
         let solid = box_brush(
             &mut planes,
-            Vec3::ZERO,
-            Vec3::new(64.0, 64.0, 64.0),
+            DVec3::ZERO,
+            DVec3::new(64.0, 64.0, 64.0),
             contents::SOLID,
         );
         let water = Brush::from_planes(
-            &box_planes(Vec3::new(32.0, 0.0, 0.0), Vec3::new(96.0, 64.0, 64.0)),
+            &box_planes(DVec3::new(32.0, 0.0, 0.0), DVec3::new(96.0, 64.0, 64.0)),
             &mut planes,
             contents::WATER,
             1,
         )
         .expect("water");
         let tree = build_tree(vec![water, solid], &planes, SplitHeuristic::Balanced, true);
-        let find = |p: Vec3| tree.nodes[tree.leaf_at(&planes, p) as usize].contents;
-        assert_eq!(find(Vec3::new(48.0, 32.0, 32.0)), contents::SOLID);
-        assert_eq!(find(Vec3::new(80.0, 32.0, 32.0)), contents::WATER);
-        assert_eq!(find(Vec3::new(200.0, 32.0, 32.0)), contents::EMPTY);
+        let find = |p: DVec3| tree.nodes[tree.leaf_at(&planes, p) as usize].contents;
+        assert_eq!(find(DVec3::new(48.0, 32.0, 32.0)), contents::SOLID);
+        assert_eq!(find(DVec3::new(80.0, 32.0, 32.0)), contents::WATER);
+        assert_eq!(find(DVec3::new(200.0, 32.0, 32.0)), contents::EMPTY);
     }
 
-    fn solid_box(planes: &mut PlaneSet, lo: Vec3, hi: Vec3) -> Brush {
+    fn solid_box(planes: &mut PlaneSet, lo: DVec3, hi: DVec3) -> Brush {
         Brush::from_planes(&box_planes(lo, hi), planes, contents::SOLID, 0).expect("box")
     }
 
@@ -724,8 +725,8 @@ mod tests {
                 let x = 128.0 * f64::from(i);
                 solid_box(
                     &mut planes,
-                    Vec3::new(x, 0.0, 0.0),
-                    Vec3::new(x + 64.0, 64.0, 64.0),
+                    DVec3::new(x, 0.0, 0.0),
+                    DVec3::new(x + 64.0, 64.0, 64.0),
                 )
             })
             .collect();
@@ -740,11 +741,11 @@ mod tests {
     fn hint_sides_split_first() {
         let mut planes = PlaneSet::new();
         let mut brushes = vec![
-            solid_box(&mut planes, Vec3::ZERO, Vec3::new(64.0, 64.0, 64.0)),
+            solid_box(&mut planes, DVec3::ZERO, DVec3::new(64.0, 64.0, 64.0)),
             solid_box(
                 &mut planes,
-                Vec3::new(128.0, 0.0, 0.0),
-                Vec3::new(192.0, 64.0, 64.0),
+                DVec3::new(128.0, 0.0, 0.0),
+                DVec3::new(192.0, 64.0, 64.0),
             ),
         ];
         let without = build_tree(
@@ -753,27 +754,27 @@ mod tests {
             SplitHeuristic::FewestSplits,
             false,
         );
-        let (hint_plane, _) = planes.insert(&Plane::new(Vec3::new(1.0, 0.0, 0.0), 100.0));
+        let (hint_plane, _) = planes.insert(&Plane::new(DVec3::new(1.0, 0.0, 0.0), 100.0));
         assert_ne!(without.nodes[0].plane, Some(hint_plane));
         let hint = hint_box(
             &mut planes,
-            Vec3::new(90.0, -8.0, -8.0),
-            Vec3::new(100.0, 72.0, 72.0),
+            DVec3::new(90.0, -8.0, -8.0),
+            DVec3::new(100.0, 72.0, 72.0),
             hint_plane,
         );
         brushes.push(hint);
         let tree = build_tree(brushes, &planes, SplitHeuristic::FewestSplits, false);
         assert_eq!(tree.nodes[0].plane, Some(hint_plane));
         // The hint brush is empty space: neither solid nor a plane of its skip faces.
-        let find = |p: Vec3| tree.nodes[tree.leaf_at(&planes, p) as usize].contents;
-        assert_eq!(find(Vec3::new(95.0, 32.0, 32.0)), contents::EMPTY);
-        let (skip_plane, _) = planes.insert(&Plane::new(Vec3::new(1.0, 0.0, 0.0), 90.0));
+        let find = |p: DVec3| tree.nodes[tree.leaf_at(&planes, p) as usize].contents;
+        assert_eq!(find(DVec3::new(95.0, 32.0, 32.0)), contents::EMPTY);
+        let (skip_plane, _) = planes.insert(&Plane::new(DVec3::new(1.0, 0.0, 0.0), 90.0));
         assert!(tree.nodes.iter().all(|n| n.plane != Some(skip_plane)));
     }
 
     /// An empty box brush of entity 2 whose face on `hint_plane` is a hint; its other faces are
     /// skip.
-    fn hint_box(planes: &mut PlaneSet, lo: Vec3, hi: Vec3, hint_plane: PlaneId) -> Brush {
+    fn hint_box(planes: &mut PlaneSet, lo: DVec3, hi: DVec3, hint_plane: PlaneId) -> Brush {
         let mut hint =
             Brush::from_planes(&box_planes(lo, hi), planes, contents::EMPTY, 2).expect("hint");
         hint.kind = BrushKind::Hint;
@@ -810,19 +811,19 @@ mod tests {
         // Reaches 0.05 above the hint plane z = 0: that part is too small to build.
         let post = solid_box(
             &mut planes,
-            Vec3::new(0.0, 0.0, -64.0),
-            Vec3::new(1.0, 1.0, 0.05),
+            DVec3::new(0.0, 0.0, -64.0),
+            DVec3::new(1.0, 1.0, 0.05),
         );
         let floor = solid_box(
             &mut planes,
-            Vec3::new(-64.0, -64.0, -80.0),
-            Vec3::new(64.0, 64.0, -64.0),
+            DVec3::new(-64.0, -64.0, -80.0),
+            DVec3::new(64.0, 64.0, -64.0),
         );
-        let (hint_plane, _) = planes.insert(&Plane::new(Vec3::new(0.0, 0.0, 1.0), 0.0));
+        let (hint_plane, _) = planes.insert(&Plane::new(DVec3::new(0.0, 0.0, 1.0), 0.0));
         let hint = hint_box(
             &mut planes,
-            Vec3::new(-64.0, -64.0, -8.0),
-            Vec3::new(64.0, 64.0, 0.0),
+            DVec3::new(-64.0, -64.0, -8.0),
+            DVec3::new(64.0, 64.0, 0.0),
             hint_plane,
         );
         let brushes = vec![post, floor, hint];
@@ -832,20 +833,20 @@ mod tests {
         let tree = build_tree(brushes, &planes, SplitHeuristic::FewestSplits, true);
         assert_eq!(tree.nodes[0].plane, Some(hint_plane));
         assert_planes_cut_their_regions(&tree, &planes, &bounds);
-        let find = |p: Vec3| tree.nodes[tree.leaf_at(&planes, p) as usize].contents;
-        assert_eq!(find(Vec3::new(0.5, 0.5, -32.0)), contents::SOLID);
-        assert_eq!(find(Vec3::new(0.5, 0.5, 8.0)), contents::EMPTY);
-        assert_eq!(find(Vec3::new(8.0, 0.5, -32.0)), contents::EMPTY);
+        let find = |p: DVec3| tree.nodes[tree.leaf_at(&planes, p) as usize].contents;
+        assert_eq!(find(DVec3::new(0.5, 0.5, -32.0)), contents::SOLID);
+        assert_eq!(find(DVec3::new(0.5, 0.5, 8.0)), contents::EMPTY);
+        assert_eq!(find(DVec3::new(8.0, 0.5, -32.0)), contents::EMPTY);
     }
 
     #[test]
     fn detail_splits_below_the_structural_leaves() {
         let mut planes = PlaneSet::new();
-        let wall = solid_box(&mut planes, Vec3::ZERO, Vec3::new(16.0, 256.0, 256.0));
+        let wall = solid_box(&mut planes, DVec3::ZERO, DVec3::new(16.0, 256.0, 256.0));
         let mut pillar = solid_box(
             &mut planes,
-            Vec3::new(100.0, 100.0, 0.0),
-            Vec3::new(132.0, 132.0, 256.0),
+            DVec3::new(100.0, 100.0, 0.0),
+            DVec3::new(132.0, 132.0, 256.0),
         );
         pillar.kind = BrushKind::Detail;
         let tree = build_tree(
@@ -864,12 +865,12 @@ mod tests {
             .filter(|&&i| !tree.nodes[i].is_leaf())
             .count();
         assert_eq!(split, 1);
-        let pillar_cluster = tree.cluster_at(&planes, Vec3::new(116.0, 116.0, 128.0));
+        let pillar_cluster = tree.cluster_at(&planes, DVec3::new(116.0, 116.0, 128.0));
         assert_eq!(
             tree.nodes[pillar_cluster as usize].cluster,
             Some(contents::EMPTY)
         );
-        let leaf = tree.leaf_at(&planes, Vec3::new(116.0, 116.0, 128.0));
+        let leaf = tree.leaf_at(&planes, DVec3::new(116.0, 116.0, 128.0));
         assert_eq!(tree.nodes[leaf as usize].contents, contents::SOLID);
         assert!(tree.leaves_below(pillar_cluster).contains(&leaf));
     }
@@ -886,11 +887,11 @@ mod tests {
             probes in proptest::collection::vec((-80i32..120, -80i32..120, -80i32..120), 40),
         ) {
             let mut planes = PlaneSet::new();
-            let boxes: Vec<(Vec3, Vec3)> = boxes
+            let boxes: Vec<(DVec3, DVec3)> = boxes
                 .iter()
                 .map(|&((x, y, z), (w, d, h))| {
-                    let lo = Vec3::new(x as f64, y as f64, z as f64) * 8.0;
-                    (lo, lo + Vec3::new(w as f64, d as f64, h as f64) * 8.0)
+                    let lo = DVec3::new(x as f64, y as f64, z as f64) * 8.0;
+                    (lo, lo + DVec3::new(w as f64, d as f64, h as f64) * 8.0)
                 })
                 .collect();
             let brushes: Vec<Brush> = boxes
@@ -906,7 +907,7 @@ mod tests {
             let tree = build_tree(brushes, &planes, SplitHeuristic::FewestSplits, true);
             for &(x, y, z) in &probes {
                 // Odd coordinates are never on a box plane (those are multiples of 8).
-                let p = Vec3::new(x as f64 + 0.5, y as f64 + 0.5, z as f64 + 0.5);
+                let p = DVec3::new(x as f64 + 0.5, y as f64 + 0.5, z as f64 + 0.5);
                 let inside = boxes.iter().any(|&(lo, hi)| Bounds { mins: lo, maxs: hi }.contains(p));
                 let leaf = tree.leaf_at(&planes, p) as usize;
                 let expected = if inside { contents::SOLID } else { contents::EMPTY };

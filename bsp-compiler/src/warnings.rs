@@ -1,6 +1,7 @@
 //! Things wrong with a map that the compiler works around.
 
-use quake_formats::geom::Vec3;
+use glam::DVec3;
+
 use std::path::PathBuf;
 
 #[derive(Debug, Clone, PartialEq)]
@@ -44,13 +45,13 @@ pub enum Warning {
     EntityInSolid {
         entity: usize,
         classname: String,
-        origin: Vec3,
+        origin: DVec3,
     },
     /// The map is open to the void.
     Leak {
         entity: usize,
         classname: String,
-        origin: Vec3,
+        origin: DVec3,
     },
     /// No point entity lies in open space, so the outside cannot be told from the inside.
     NoEntitiesToFlood,
@@ -67,7 +68,7 @@ pub enum Warning {
 
 impl std::fmt::Display for Warning {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let v = |p: &Vec3| format!("({} {} {})", p.x, p.y, p.z);
+        let v = |p: &DVec3| format!("({} {} {})", p.x, p.y, p.z);
         match self {
             Warning::BadBrush {
                 entity,

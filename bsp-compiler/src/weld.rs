@@ -1,7 +1,9 @@
 //! Shared vertices: welding equal points and inserting the vertices that lie on another face's
 //! edge (T-junctions), which would otherwise show as cracks.
 
-use quake_formats::geom::{POINT_EPSILON, Vec3};
+use glam::DVec3;
+use quake_formats::geom::DVec3Ext;
+use quake_formats::geom::POINT_EPSILON;
 use std::collections::HashMap;
 
 /// Distance from an edge within which a vertex counts as lying on it.
@@ -12,7 +14,7 @@ const GRID: f64 = 64.0;
 /// Points welded within [`POINT_EPSILON`], numbered in first-seen order.
 #[derive(Debug, Default)]
 pub struct VertexWelder {
-    pub positions: Vec<Vec3>,
+    pub positions: Vec<DVec3>,
     cells: HashMap<[i64; 3], Vec<u32>>,
 }
 
@@ -24,13 +26,13 @@ pub(crate) fn cell_and_neighbours([x, y, z]: [i64; 3]) -> impl Iterator<Item = [
 }
 
 impl VertexWelder {
-    fn cell(p: Vec3) -> [i64; 3] {
+    fn cell(p: DVec3) -> [i64; 3] {
         // Cells several epsilons wide; neighbours are searched, so the size only affects speed.
         let c = |v: f64| (v / (POINT_EPSILON * 16.0)).floor() as i64;
         [c(p.x), c(p.y), c(p.z)]
     }
 
-    pub fn weld(&mut self, p: Vec3) -> u32 {
+    pub fn weld(&mut self, p: DVec3) -> u32 {
         let cell = Self::cell(p);
         let found = cell_and_neighbours(cell)
             .filter_map(|c| self.cells.get(&c))
@@ -54,7 +56,7 @@ const MAX_TJUNCTION_PASSES: usize = 16;
 /// repeat until nothing changes: an insertion makes new, shorter edges that a third vertex of a
 /// knot of near-coincident ones (where several planes meet) may lie on. Polygons may be left with
 /// fewer than three vertices. Returns how many vertices were inserted.
-pub fn fix_tjunctions(positions: &[Vec3], polygons: &mut [Vec<u32>]) -> usize {
+pub fn fix_tjunctions(positions: &[DVec3], polygons: &mut [Vec<u32>]) -> usize {
     let mut grid = TJunctionGrid::new(positions);
     let mut inserted = 0;
     for _ in 0..MAX_TJUNCTION_PASSES {
@@ -90,7 +92,7 @@ pub fn fix_tjunctions(positions: &[Vec3], polygons: &mut [Vec<u32>]) -> usize {
 /// distance of the others' edges, so no insertion can fix them (a sliver triangle of three of
 /// them has each vertex on its opposite edge).
 /// Returns the vertices collapsed into others.
-fn collapse_short_edges(positions: &[Vec3], polygons: &mut [Vec<u32>]) -> Vec<u32> {
+fn collapse_short_edges(positions: &[DVec3], polygons: &mut [Vec<u32>]) -> Vec<u32> {
     let mut same: HashMap<u32, u32> = HashMap::new();
     let root = |same: &HashMap<u32, u32>, mut v: u32| {
         while let Some(&r) = same.get(&v) {
@@ -123,17 +125,17 @@ fn collapse_short_edges(positions: &[Vec3], polygons: &mut [Vec<u32>]) -> Vec<u3
 
 /// Vertices bucketed by position, for finding those near an edge.
 struct TJunctionGrid<'a> {
-    positions: &'a [Vec3],
+    positions: &'a [DVec3],
     cells: HashMap<[i64; 3], Vec<u32>>,
 }
 
 impl<'a> TJunctionGrid<'a> {
-    fn cell(p: Vec3) -> [i64; 3] {
+    fn cell(p: DVec3) -> [i64; 3] {
         let c = |v: f64| (v / GRID).floor() as i64;
         [c(p.x), c(p.y), c(p.z)]
     }
 
-    fn new(positions: &'a [Vec3]) -> Self {
+    fn new(positions: &'a [DVec3]) -> Self {
         let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
         for (i, &p) in positions.iter().enumerate() {
             cells.entry(Self::cell(p)).or_default().push(i as u32);
@@ -175,7 +177,7 @@ impl<'a> TJunctionGrid<'a> {
             return;
         }
         let len = len2.sqrt();
-        let pad = Vec3::new(TJUNCTION_EPSILON, TJUNCTION_EPSILON, TJUNCTION_EPSILON);
+        let pad = DVec3::new(TJUNCTION_EPSILON, TJUNCTION_EPSILON, TJUNCTION_EPSILON);
         let (lo, hi) = (Self::cell(pa.min(pb) - pad), Self::cell(pa.max(pb) + pad));
         for x in lo[0]..=hi[0] {
             for y in lo[1]..=hi[1] {
@@ -207,7 +209,7 @@ impl<'a> TJunctionGrid<'a> {
 /// its far edge and is inserted there) or a knot of near-coincident vertices inserted on each
 /// other's edges would use edges in both directions within one face: zero area that takes an
 /// edge's second use from the neighbour that needs it. May leave fewer than three vertices.
-pub fn remove_degenerate_vertices(poly: &mut Vec<u32>, positions: &[Vec3]) {
+pub fn remove_degenerate_vertices(poly: &mut Vec<u32>, positions: &[DVec3]) {
     loop {
         poly.dedup();
         while poly.len() > 1 && poly.first() == poly.last() {
@@ -231,9 +233,9 @@ pub fn remove_degenerate_vertices(poly: &mut Vec<u32>, positions: &[Vec3]) {
 }
 
 /// The area of a closed polygon of vertex indices.
-fn area(poly: &[u32], positions: &[Vec3]) -> f64 {
+fn area(poly: &[u32], positions: &[DVec3]) -> f64 {
     let point = |k: usize| positions[poly[k % poly.len()] as usize];
-    let twice = (0..poly.len()).fold(Vec3::ZERO, |sum, k| sum + point(k).cross(point(k + 1)));
+    let twice = (0..poly.len()).fold(DVec3::ZERO, |sum, k| sum + point(k).cross(point(k + 1)));
     twice.length() / 2.0
 }
 
@@ -244,9 +246,9 @@ mod tests {
     #[test]
     fn close_points_weld() {
         let mut w = VertexWelder::default();
-        let a = w.weld(Vec3::new(64.0, 0.0, 0.0));
-        let b = w.weld(Vec3::new(64.0 - POINT_EPSILON * 0.5, 0.0, 0.0));
-        let c = w.weld(Vec3::new(64.0 + POINT_EPSILON * 3.0, 0.0, 0.0));
+        let a = w.weld(DVec3::new(64.0, 0.0, 0.0));
+        let b = w.weld(DVec3::new(64.0 - POINT_EPSILON * 0.5, 0.0, 0.0));
+        let c = w.weld(DVec3::new(64.0 + POINT_EPSILON * 3.0, 0.0, 0.0));
         assert_eq!(a, b);
         assert_ne!(a, c);
     }
@@ -255,11 +257,11 @@ mod tests {
     fn vertex_on_an_edge_is_inserted() {
         // A big square next to two small ones: the small ones' shared corner lies on its edge.
         let positions = vec![
-            Vec3::new(0.0, 0.0, 0.0),
-            Vec3::new(0.0, 64.0, 0.0),
-            Vec3::new(64.0, 64.0, 0.0),
-            Vec3::new(64.0, 0.0, 0.0),
-            Vec3::new(64.0, 32.0, 0.0),
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(0.0, 64.0, 0.0),
+            DVec3::new(64.0, 64.0, 0.0),
+            DVec3::new(64.0, 0.0, 0.0),
+            DVec3::new(64.0, 32.0, 0.0),
         ];
         let mut polys = vec![vec![0, 1, 2, 3]];
         assert_eq!(fix_tjunctions(&positions, &mut polys), 1);
@@ -270,15 +272,15 @@ mod tests {
     fn repeats_spikes_and_knots_are_removed() {
         // A 64 unit square, a point out on its right, and a knot of points near one corner.
         let mut positions = vec![
-            Vec3::new(0.0, 0.0, 0.0),
-            Vec3::new(0.0, 64.0, 0.0),
-            Vec3::new(64.0, 64.0, 0.0),
-            Vec3::new(64.0, 0.0, 0.0),
-            Vec3::new(96.0, 32.0, 0.0),
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(0.0, 64.0, 0.0),
+            DVec3::new(64.0, 64.0, 0.0),
+            DVec3::new(64.0, 0.0, 0.0),
+            DVec3::new(96.0, 32.0, 0.0),
         ];
         positions.extend(
             [[0.01, 0.0], [0.01, 0.01], [0.0, 0.01]]
-                .map(|[x, y]| Vec3::new(64.0 + x, 64.0 + y, 0.0)),
+                .map(|[x, y]| DVec3::new(64.0 + x, 64.0 + y, 0.0)),
         );
         let cleaned = |mut poly: Vec<u32>| {
             remove_degenerate_vertices(&mut poly, &positions);

@@ -3,13 +3,14 @@
 mod common;
 
 use common::*;
+use glam::{DVec3, Vec3};
 
 use bsp_compiler::faces::{MIN_SQUARENESS, projection_squareness};
 use bsp_compiler::{CompileError, CompileOptions, CompileOutput, MapSource, Warning, compile};
 use quake_formats::bsp::limits::MAX_SURFACE_EXTENT;
 use quake_formats::bsp::{Rule, contents};
 use quake_formats::extents::LightmapExtents;
-use quake_formats::geom::Vec3;
+
 use quake_formats::miptex::MipTex;
 use quake_formats::prt::PortalFile;
 use quake_formats::wad::{Wad, WadLump};
@@ -79,7 +80,7 @@ fn assert_textures_project_squarely(bsp: &Bsp, name: &str) {
             .vecs
             .map(|row| row.map(f64::from));
         let [x, y, z] = face_normal(bsp, f).map(f64::from);
-        let square = projection_squareness(&vecs, Vec3::new(x, y, z));
+        let square = projection_squareness(&vecs, DVec3::new(x, y, z));
         assert!(
             square >= MIN_SQUARENESS,
             "{name}: face {i} (texinfo {}) meets its texture at squareness {square}",
@@ -234,7 +235,7 @@ fn leaking_room_writes_a_pointfile_to_the_void() {
     let out = compile_text(&room_map(true, ""));
     let leak = out.leak.as_ref().expect("leak");
     assert_eq!(leak.classname, "info_player_start");
-    assert_eq!(leak.pointfile[0], Vec3::new(-32.0, -32.0, -100.0));
+    assert_eq!(leak.pointfile[0], DVec3::new(-32.0, -32.0, -100.0));
     let last = *leak.pointfile.last().expect("points");
     assert!(
         [last.x, last.y, last.z].iter().any(|c| c.abs() > 144.0),
@@ -337,7 +338,7 @@ fn cluster_portals_face_their_first_cluster() {
         let c = p.winding.center();
         for (side, cluster) in [(1.0, p.leafs[0]), (-1.0, p.leafs[1])] {
             let probe = c + plane.normal * side;
-            let leaf = bsp.leaf_at(probe.to_f32()).expect("leaf");
+            let leaf = bsp.leaf_at(probe.as_vec3().to_array()).expect("leaf");
             assert_eq!(cluster_of_leaf(leaf), cluster as usize, "{probe:?}");
         }
     }
@@ -425,11 +426,11 @@ fn face_area_with_texture(bsp: &Bsp, name: &str) -> f64 {
         if !named {
             continue;
         }
-        let v: Vec<Vec3> = bsp
+        let v: Vec<DVec3> = bsp
             .face_vertices(f)
             .expect("vertices")
             .iter()
-            .map(|&p| Vec3::from_f32(p))
+            .map(|&p| Vec3::from(p).as_dvec3())
             .collect();
         area += quake_formats::geom::Winding::new(v).area();
     }

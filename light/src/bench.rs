@@ -2,6 +2,7 @@
 //! (sample points to the lights that survive culling, 16 neighbouring samples
 //! per packet), traced in a bare loop with no lighting arithmetic around it.
 
+use glam::Vec3;
 use std::time::Instant;
 
 use quake_formats::Bsp;
@@ -35,12 +36,12 @@ pub fn bare_occlusion(bsp: &Bsp, prep: &Prepared, gate: f64, max_rays: usize) ->
             }
             let range = light.range(gate);
             for p in &samples.points {
-                let d = light.origin - quake_formats::geom::Vec3::from_f32(*p);
+                let d = light.origin - Vec3::from(*p).as_dvec3();
                 let dist = d.length();
                 if dist > range || dist < 1e-3 {
                     continue;
                 }
-                rays.push((*p, (d / dist).to_f32(), dist as f32 - 0.1));
+                rays.push((*p, (d / dist).as_vec3().to_array(), dist as f32 - 0.1));
                 if rays.len() >= max_rays {
                     break 'faces;
                 }

@@ -17,9 +17,10 @@
 //! receivers is bilinear. Rays are keyed by face, luxel and pass, so results do not depend on
 //! threads.
 
+use glam::{DVec3, Vec3};
 use quake_formats::Bsp;
 use quake_formats::bsp::limits::LIGHTMAP_SCALE;
-use quake_formats::geom::Vec3;
+
 use quake_formats::palette::Palette;
 
 use crate::Quality;
@@ -184,9 +185,9 @@ pub fn point_key(face: usize, index: usize, pass: usize) -> u64 {
 /// shading normal (`_phong`; the face normal otherwise), and the key of its rays' jitter.
 #[derive(Debug, Clone, Copy)]
 pub struct GatherPoint {
-    pub point: Vec3,
-    pub flat: Vec3,
-    pub shading: Vec3,
+    pub point: DVec3,
+    pub flat: DVec3,
+    pub shading: DVec3,
     pub key: u64,
 }
 
@@ -201,11 +202,11 @@ pub struct Field<'a> {
 }
 
 /// The light of `face` at world point `q`, bilinear between luxel centres.
-fn light_at(face: &FaceGeom, luxels: &[[f32; 3]], q: Vec3) -> [f32; 3] {
+fn light_at(face: &FaceGeom, luxels: &[[f32; 3]], q: DVec3) -> [f32; 3] {
     let [w, h] = face.extents.luxel_size();
     let coord = |axis: usize, size: usize| {
         let v = face.vecs[axis];
-        let dir = Vec3::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2]));
+        let dir = DVec3::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2]));
         let st = dir.dot(q - face.origin) + f64::from(v[3]);
         let f = ((st - f64::from(face.extents.tex_mins[axis])) / f64::from(LIGHTMAP_SCALE))
             .clamp(0.0, size.saturating_sub(1) as f64);
@@ -252,7 +253,7 @@ impl Field<'_> {
         let [t0, t1] = tangent_basis(at.flat);
         let scale = self.kernel * std::f64::consts::PI / rays as f64;
         let mut packet = RayPacket16::new();
-        let mut dirs = [Vec3::ZERO; 16];
+        let mut dirs = [DVec3::ZERO; 16];
         for first in (0..rays).step_by(16) {
             packet.clear();
             let lanes = (rays - first).min(16);
@@ -264,7 +265,13 @@ impl Field<'_> {
                 let radius = u1.sqrt();
                 let (sin, cos) = (std::f64::consts::TAU * u2).sin_cos();
                 *dir = t0 * (radius * cos) + t1 * (radius * sin) + at.flat * (1.0 - u1).sqrt();
-                packet.set(lane, at.point.to_f32(), dir.to_f32(), 0.0, RAY_LENGTH);
+                packet.set(
+                    lane,
+                    at.point.as_vec3().to_array(),
+                    dir.as_vec3().to_array(),
+                    0.0,
+                    RAY_LENGTH,
+                );
             }
             counts.rays += lanes as u64;
             let hits = scene.first_faces16(&mut packet, model);
@@ -315,9 +322,9 @@ impl Field<'_> {
             for (gx, &x) in xs.iter().enumerate() {
                 let l = y * r.width + x;
                 let at = GatherPoint {
-                    point: Vec3::from_f32(r.points[l]),
+                    point: Vec3::from(r.points[l]).as_dvec3(),
                     flat: r.normal,
-                    shading: Vec3::from_f32(r.normals[l]),
+                    shading: Vec3::from(r.normals[l]).as_dvec3(),
                     key: point_key(r.face, l, pass),
                 };
                 let slot = gy * xs.len() + gx;
@@ -400,7 +407,7 @@ pub struct Receivers {
     pub width: usize,
     pub height: usize,
     /// The face's normal.
-    pub normal: Vec3,
+    pub normal: DVec3,
     pub points: Vec<[f32; 3]>,
     pub normals: Vec<[f32; 3]>,
 }
@@ -419,7 +426,9 @@ impl Receivers {
             height: samples.height,
             normal: samples.normal,
             points: indices.clone().map(|i| samples.points[i]).collect(),
-            normals: indices.map(|i| samples.normal_at(i).to_f32()).collect(),
+            normals: indices
+                .map(|i| samples.normal_at(i).as_vec3().to_array())
+                .collect(),
         }
     }
 }

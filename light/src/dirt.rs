@@ -3,7 +3,7 @@
 //! Lights that take dirt are scaled by [`crate::lights::DirtResponse::factor`]
 //! of this occlusion.
 
-use quake_formats::geom::Vec3;
+use glam::{DMat3, DVec3, Vec3};
 
 use crate::embree::RayPacket16;
 use crate::lights::{DirtMode, DirtSampling, tangent_basis};
@@ -24,12 +24,6 @@ fn cone_components(azimuth: f64, elevation: f64) -> [f64; 3] {
     [se * azimuth.cos(), se * azimuth.sin(), ce]
 }
 
-/// The direction with `components` in `basis`.
-fn in_basis(basis: [Vec3; 3], components: [f64; 3]) -> Vec3 {
-    let [u, v, n] = basis;
-    u * components[0] + v * components[1] + n * components[2]
-}
-
 /// The ordered pattern in the face's own terms (see [`ordered_directions`]):
 /// the same for every sample, so the sines and cosines are taken once.
 fn ordered_components(cone: f64) -> Vec<[f64; 3]> {
@@ -47,10 +41,10 @@ fn ordered_components(cone: f64) -> Vec<[f64; 3]> {
 
 /// The ordered pattern: rings at evenly spaced elevations, evenly spaced
 /// azimuths on each ring (elevations at the middle of their steps).
-fn ordered_directions(basis: [Vec3; 3], components: &[[f64; 3]]) -> Vec<[f32; 3]> {
+fn ordered_directions(basis: DMat3, components: &[[f64; 3]]) -> Vec<[f32; 3]> {
     components
         .iter()
-        .map(|&c| in_basis(basis, c).to_f32())
+        .map(|&c| (basis * DVec3::from(c)).as_vec3().to_array())
         .collect()
 }
 
@@ -79,13 +73,15 @@ fn unit_hash(key: u64) -> f64 {
 
 /// The random pattern for sample `sample` of face `face`: azimuth and
 /// elevation each uniform, as in the ordered pattern.
-fn random_directions(basis: [Vec3; 3], cone: f64, face: usize, sample: usize) -> Vec<[f32; 3]> {
+fn random_directions(basis: DMat3, cone: f64, face: usize, sample: usize) -> Vec<[f32; 3]> {
     let seed = ((face as u64) << 32 ^ sample as u64).wrapping_mul(RAYS_PER_SAMPLE as u64 * 2);
     (0..RAYS_PER_SAMPLE as u64)
         .map(|k| {
             let azimuth = std::f64::consts::TAU * unit_hash(seed + 2 * k);
             let elevation = cone * unit_hash(seed + 2 * k + 1);
-            in_basis(basis, cone_components(azimuth, elevation)).to_f32()
+            (basis * DVec3::from(cone_components(azimuth, elevation)))
+                .as_vec3()
+                .to_array()
         })
         .collect()
 }
@@ -94,11 +90,11 @@ fn random_directions(basis: [Vec3; 3], cone: f64, face: usize, sample: usize) ->
 /// else its mirror image in the face's plane. A `_phong` normal tilts the
 /// dirt cone, and rays it would send behind the flat face (into the face's
 /// own polygon, a facet the smooth surface does not have) go back out.
-fn in_front(d: [f32; 3], face_normal: Vec3) -> [f32; 3] {
-    let v = Vec3::from_f32(d);
+fn in_front(d: [f32; 3], face_normal: DVec3) -> [f32; 3] {
+    let v = Vec3::from(d).as_dvec3();
     let below = v.dot(face_normal);
     if below < 0.0 {
-        (v - face_normal * (2.0 * below)).to_f32()
+        (v - face_normal * (2.0 * below)).as_vec3().to_array()
     } else {
         d
     }
@@ -118,9 +114,9 @@ pub fn occlusion_at(
     scene: &TraceScene,
 ) -> (Vec<f32>, u64) {
     let cone = sampling.cone_degrees.to_radians();
-    let basis_of = |n: Vec3| {
+    let basis_of = |n: DVec3| {
         let [u, v] = tangent_basis(n);
-        [u, v, n]
+        DMat3::from_cols(u, v, n)
     };
     // Without per-sample normals every sample shares one ordered pattern.
     let flat_basis = basis_of(samples.normal);
@@ -132,7 +128,7 @@ pub fn occlusion_at(
             .collect()
     };
     let flat_ordered = in_front_all(ordered_directions(flat_basis, &ordered));
-    let shift = flat_basis[0] * RAY_START_SHIFT[0] + flat_basis[1] * RAY_START_SHIFT[1];
+    let shift = flat_basis.x_axis * RAY_START_SHIFT[0] + flat_basis.y_axis * RAY_START_SHIFT[1];
     let depth = sampling.depth as f32;
     let mut packet = RayPacket16::new();
     // Rays go in pattern order, each direction from every sample in turn, 16
@@ -143,7 +139,11 @@ pub fn occlusion_at(
     // directions). Each sample sums its rays in pattern order.
     let starts: Vec<[f32; 3]> = indices
         .iter()
-        .map(|&i| (Vec3::from_f32(samples.points[i]) + shift).to_f32())
+        .map(|&i| {
+            (Vec3::from(samples.points[i]).as_dvec3() + shift)
+                .as_vec3()
+                .to_array()
+        })
         .collect();
     let own: Vec<Vec<[f32; 3]>> = indices
         .iter()
@@ -204,23 +204,24 @@ mod tests {
 
     #[test]
     fn patterns_stay_inside_the_cone() {
-        let n = Vec3::new(0.0, 0.6, 0.8);
+        let n = DVec3::new(0.0, 0.6, 0.8);
         let [u, v] = tangent_basis(n);
+        let basis = DMat3::from_cols(u, v, n);
         let cone = 60f64.to_radians();
-        let ordered = ordered_directions([u, v, n], &ordered_components(cone));
-        let random = random_directions([u, v, n], cone, 3, 7);
+        let ordered = ordered_directions(basis, &ordered_components(cone));
+        let random = random_directions(basis, cone, 3, 7);
         assert_eq!(ordered.len(), RAYS_PER_SAMPLE);
         assert_eq!(random.len(), RAYS_PER_SAMPLE);
         for d in ordered.iter().chain(&random) {
-            let d = Vec3::from_f32(*d);
+            let d = Vec3::from(*d).as_dvec3();
             assert!((d.length() - 1.0).abs() < 1e-5);
             assert!(d.dot(n) >= cone.cos() - 1e-5, "{d:?}");
         }
         assert_eq!(
             random,
-            random_directions([u, v, n], cone, 3, 7),
+            random_directions(basis, cone, 3, 7),
             "deterministic"
         );
-        assert_ne!(random, random_directions([u, v, n], cone, 3, 8));
+        assert_ne!(random, random_directions(basis, cone, 3, 8));
     }
 }

@@ -1,10 +1,11 @@
 //! The faces of a BSP as geometry the light tool works with: world-space
 //! polygon, facing plane, texture projection and lightmap extents.
 
+use glam::{DVec3, Vec3};
 use quake_formats::Bsp;
 use quake_formats::bsp::texinfo_flags;
 use quake_formats::extents::LightmapExtents;
-use quake_formats::geom::{Plane, Vec3};
+use quake_formats::geom::Plane;
 
 use crate::LightError;
 
@@ -29,20 +30,20 @@ pub struct FaceGeom {
     pub kind: FaceKind,
     pub texture: String,
     /// Vertices in world space (the model's `origin` offset applied).
-    pub points: Vec<Vec3>,
+    pub points: Vec<DVec3>,
     /// The plane the face looks out of (the BSP plane flipped for back-side faces), world space.
     pub plane: Plane,
     /// Texture projection `s = vecs[0].xyz · p + vecs[0].w` in model space.
     pub vecs: [[f32; 4]; 2],
     /// Offset from model space to world space.
-    pub origin: Vec3,
+    pub origin: DVec3,
     pub extents: LightmapExtents,
 }
 
 impl FaceGeom {
     /// The mean of the vertices (inside the face: faces are convex).
-    pub fn centroid(&self) -> Vec3 {
-        let sum = self.points.iter().fold(Vec3::ZERO, |a, &p| a + p);
+    pub fn centroid(&self) -> DVec3 {
+        let sum = self.points.iter().fold(DVec3::ZERO, |a, &p| a + p);
         sum / self.points.len().max(1) as f64
     }
 }
@@ -53,7 +54,7 @@ impl FaceGeom {
 /// [`LightError::BadFace`] for a face whose indices run outside the file.
 pub fn face_geometry(
     bsp: &Bsp,
-    origin_of: impl Fn(usize) -> Vec3,
+    origin_of: impl Fn(usize) -> DVec3,
 ) -> Result<Vec<FaceGeom>, LightError> {
     let mut model_of = vec![0usize; bsp.faces.len()];
     for (m, model) in bsp.models.iter().enumerate() {
@@ -100,7 +101,7 @@ pub fn face_geometry(
             };
             let model = model_of[index];
             let origin = origin_of(model);
-            let mut plane = Plane::new(Vec3::from_f32(bp.normal), f64::from(bp.dist));
+            let mut plane = Plane::new(Vec3::from(bp.normal).as_dvec3(), f64::from(bp.dist));
             if face.side != 0 {
                 plane = plane.flipped();
             }
@@ -110,7 +111,10 @@ pub fn face_geometry(
                 model,
                 kind,
                 texture,
-                points: verts.iter().map(|&v| Vec3::from_f32(v) + origin).collect(),
+                points: verts
+                    .iter()
+                    .map(|&v| Vec3::from(v).as_dvec3() + origin)
+                    .collect(),
                 plane,
                 vecs: ti.vecs,
                 origin,

@@ -35,12 +35,13 @@ pub mod surface;
 pub mod trace;
 pub mod visibility;
 
+use glam::{DVec3, Vec3};
 use std::collections::HashMap;
 use std::time::Instant;
 
 use quake_formats::Bsp;
 use quake_formats::entities::{parse_entities, write_entities};
-use quake_formats::geom::{Bounds, Vec3};
+use quake_formats::geom::Bounds;
 use rayon::prelude::*;
 
 use crate::bounce::{BounceCounts, StyleLuxels};
@@ -202,7 +203,7 @@ pub struct Prepared {
     pub surface_lights: usize,
     pub entity_text: Option<String>,
     /// Per face: `_phong` corner normals, for faces of smoothed models.
-    pub phong: Vec<Option<Vec<Vec3>>>,
+    pub phong: Vec<Option<Vec<DVec3>>>,
 }
 
 impl Prepared {
@@ -256,7 +257,7 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
             .model_origins
             .get(&m)
             .copied()
-            .unwrap_or(Vec3::ZERO)
+            .unwrap_or(DVec3::ZERO)
     };
     let faces = face_geometry(bsp, origin_of)?;
     // Embree's own threads only build the BVH; rayon does the tracing.
@@ -398,7 +399,11 @@ fn trace_faces(
                 samples.normals = samples
                     .points
                     .iter()
-                    .map(|&p| phong::interpolate(geom, corners, Vec3::from_f32(p)).to_f32())
+                    .map(|&p| {
+                        phong::interpolate(geom, corners, Vec3::from(p).as_dvec3())
+                            .as_vec3()
+                            .to_array()
+                    })
                     .collect();
             }
             let rules = face_rules(&prep.lights, geom);

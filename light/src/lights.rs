@@ -6,11 +6,12 @@
 //! falloff); the range scale (`_range`, default 0.5) maps light units to
 //! lightmap bytes at the very end.
 
+use glam::DVec3;
+use quake_formats::geom::DVec3Ext;
 use std::collections::HashMap;
 
 use quake_formats::bsp::phong;
 use quake_formats::entities::Entity;
-use quake_formats::geom::Vec3;
 
 use crate::LightError;
 use crate::bounce::{BounceSettings, MAX_BOUNCE_PASSES};
@@ -72,7 +73,7 @@ impl Falloff {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Spot {
     /// Unit direction the light shines in.
-    pub dir: Vec3,
+    pub dir: DVec3,
     /// Cosine of half the outer cone angle: dimmer than this is dark.
     pub cos_outer: f64,
     /// Cosine of half the inner (`_softangle`) cone: full brightness inside.
@@ -82,7 +83,7 @@ pub struct Spot {
 impl Spot {
     /// A cone of full angle `angle` degrees (non-positive means the default
     /// 40) with an optional soft inner cone of `softangle` degrees.
-    pub fn new(dir: Vec3, angle: f64, softangle: f64) -> Spot {
+    pub fn new(dir: DVec3, angle: f64, softangle: f64) -> Spot {
         let angle = if angle > 0.0 {
             angle.min(360.0)
         } else {
@@ -104,7 +105,7 @@ impl Spot {
     /// Brightness factor for a point in unit direction `to_point` from the
     /// light: 1 inside the inner cone, 0 outside the outer one, linear in the
     /// cosine between them.
-    pub fn factor(&self, to_point: Vec3) -> f64 {
+    pub fn factor(&self, to_point: DVec3) -> f64 {
         let c = self.dir.dot(to_point);
         if c < self.cos_outer {
             0.0
@@ -179,14 +180,14 @@ impl Default for DirtSampling {
 /// A light at a point (an entity, or one copy of a `_surface` template).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PointLight {
-    pub origin: Vec3,
+    pub origin: DVec3,
     /// Brightness in light units; negative lights subtract.
     pub light: f64,
     /// Distance scale of the falloff: `wait` times the global `_dist`.
     pub atten: f64,
     pub falloff: Falloff,
     /// Per-channel colour, 1.0 = white.
-    pub color: Vec3,
+    pub color: DVec3,
     pub style: u8,
     pub spot: Option<Spot>,
     pub anglescale: f64,
@@ -237,7 +238,7 @@ impl PointLight {
     /// Brightness this light adds at a point `dist` away in unit direction
     /// `to_point` (from the light), on a surface whose normal makes cosine
     /// `cos_incidence` with the direction back to the light.
-    pub fn contribution(&self, dist: f64, to_point: Vec3, cos_incidence: f64) -> f64 {
+    pub fn contribution(&self, dist: f64, to_point: DVec3, cos_incidence: f64) -> f64 {
         let angle = if self.falloff == Falloff::LocalMin {
             f64::from(u8::from(cos_incidence > 0.0))
         } else {
@@ -258,10 +259,10 @@ impl PointLight {
 #[derive(Debug, Clone, PartialEq)]
 pub struct SunLight {
     /// Unit vector pointing towards the sun.
-    pub to_sun: Vec3,
+    pub to_sun: DVec3,
     /// Brightness this direction adds at full incidence.
     pub light: f64,
-    pub color: Vec3,
+    pub color: DVec3,
     pub style: u8,
     pub anglescale: f64,
     pub dirt: Option<DirtResponse>,
@@ -274,7 +275,7 @@ pub struct Minlight {
     pub level: f64,
     /// `--addmin`: the level is added to style 0 instead of being a floor.
     pub add: bool,
-    pub color: Vec3,
+    pub color: DVec3,
     pub dirt: Option<DirtResponse>,
     /// Faces with this texture get no minlight (`_minlight_exclude`).
     pub exclude_texture: Option<String>,
@@ -367,7 +368,7 @@ pub struct MapLights {
     /// Brush models (0 = world) with `_phong` smoothing, and their angle in degrees.
     pub phong: HashMap<usize, f64>,
     /// Offset of each brush model with an `origin` key (rotating entities).
-    pub model_origins: HashMap<usize, Vec3>,
+    pub model_origins: HashMap<usize, DVec3>,
     /// Lightmap bytes per light unit.
     pub rangescale: f64,
     pub gamma: f64,
@@ -387,7 +388,7 @@ impl MapLights {
 
     /// True if any light, sun or minlight is not white (a `.lit` is needed).
     pub fn is_coloured(&self) -> bool {
-        let grey = |c: &Vec3| c.x != c.y || c.y != c.z;
+        let grey = |c: &DVec3| c.x != c.y || c.y != c.z;
         self.points.iter().any(|l| grey(&l.color))
             || self.suns.iter().any(|s| grey(&s.color))
             || self.templates.iter().any(|t| grey(&t.light.color))
@@ -436,7 +437,7 @@ impl Keys<'_> {
         Ok(None)
     }
 
-    fn vec3(&self, key: &str) -> Result<Option<Vec3>, LightError> {
+    fn vec3(&self, key: &str) -> Result<Option<DVec3>, LightError> {
         match self.entity.get(key) {
             None => Ok(None),
             Some(v) if v.trim().is_empty() => Ok(None),
@@ -444,19 +445,19 @@ impl Keys<'_> {
                 .entity
                 .get_floats::<3>(key)
                 .filter(|f| f.iter().all(|c| c.is_finite()))
-                .map(|[x, y, z]| Some(Vec3::new(x, y, z)))
+                .map(|[x, y, z]| Some(DVec3::new(x, y, z)))
                 .ok_or_else(|| self.bad(key, "three numbers")),
         }
     }
 
     /// A colour in 0..255 or 0..1 notation, as 1.0 = full channel.
-    fn color_any(&self, keys: &[&str]) -> Result<Vec3, LightError> {
+    fn color_any(&self, keys: &[&str]) -> Result<DVec3, LightError> {
         for k in keys {
             if let Some(c) = self.vec3(k)? {
                 return Ok(normalize_color(c));
             }
         }
-        Ok(Vec3::new(1.0, 1.0, 1.0))
+        Ok(DVec3::new(1.0, 1.0, 1.0))
     }
 
     fn style(&self) -> Result<u8, LightError> {
@@ -470,7 +471,7 @@ impl Keys<'_> {
 
 /// ericw-tools' colour rule: components all within 0..1 are fractions,
 /// otherwise they are 0..255.
-pub fn normalize_color(c: Vec3) -> Vec3 {
+pub fn normalize_color(c: DVec3) -> DVec3 {
     if c.x <= 1.0 && c.y <= 1.0 && c.z <= 1.0 {
         c
     } else {
@@ -479,17 +480,17 @@ pub fn normalize_color(c: Vec3) -> Vec3 {
 }
 
 /// Unit vector of a "yaw pitch roll" triple (degrees; pitch 90 is up).
-pub fn mangle_to_vec(yaw: f64, pitch: f64) -> Vec3 {
+pub fn mangle_to_vec(yaw: f64, pitch: f64) -> DVec3 {
     let (y, p) = (yaw.to_radians(), pitch.to_radians());
-    Vec3::new(y.cos() * p.cos(), y.sin() * p.cos(), p.sin())
+    DVec3::new(y.cos() * p.cos(), y.sin() * p.cos(), p.sin())
 }
 
 /// Two unit vectors that make a right-handed orthonormal basis with unit `n`.
-pub fn tangent_basis(n: Vec3) -> [Vec3; 2] {
+pub fn tangent_basis(n: DVec3) -> [DVec3; 2] {
     let helper = if n.z.abs() < 0.9 {
-        Vec3::new(0.0, 0.0, 1.0)
+        DVec3::new(0.0, 0.0, 1.0)
     } else {
-        Vec3::new(1.0, 0.0, 0.0)
+        DVec3::new(1.0, 0.0, 0.0)
     };
     let u = helper.cross(n).normalized().unwrap_or(helper);
     [u, n.cross(u)]
@@ -498,7 +499,7 @@ pub fn tangent_basis(n: Vec3) -> [Vec3; 2] {
 /// `n` unit directions spread evenly (a Fibonacci spiral) over the cap of
 /// half-angle `half_angle_deg` around unit `center`; `[center]` for `n <= 1`
 /// or a zero cap. Deterministic.
-pub fn cap_directions(center: Vec3, half_angle_deg: f64, n: usize) -> Vec<Vec3> {
+pub fn cap_directions(center: DVec3, half_angle_deg: f64, n: usize) -> Vec<DVec3> {
     if n <= 1 || half_angle_deg <= 0.0 {
         return vec![center];
     }
@@ -517,7 +518,7 @@ pub fn cap_directions(center: Vec3, half_angle_deg: f64, n: usize) -> Vec<Vec3> 
 }
 
 /// Splits the light of `sun` evenly over `dirs` (its `to_sun` is replaced).
-fn suns_over(dirs: Vec<Vec3>, sun: &SunLight) -> Vec<SunLight> {
+fn suns_over(dirs: Vec<DVec3>, sun: &SunLight) -> Vec<SunLight> {
     let each = sun.light / dirs.len().max(1) as f64;
     dirs.into_iter()
         .map(|to_sun| SunLight {
@@ -541,8 +542,8 @@ fn dirt_if(switch: Option<f64>, global_on: bool, response: DirtResponse) -> Opti
 
 /// `count` points spread evenly through the ball of `radius` around
 /// `center` (deterministic: a Fibonacci spiral over shells of equal volume).
-pub fn ball_points(center: Vec3, radius: f64, count: usize) -> Vec<Vec3> {
-    let dirs = cap_directions(Vec3::new(0.0, 0.0, 1.0), 180.0, count);
+pub fn ball_points(center: DVec3, radius: f64, count: usize) -> Vec<DVec3> {
+    let dirs = cap_directions(DVec3::new(0.0, 0.0, 1.0), 180.0, count);
     dirs.into_iter()
         .enumerate()
         .map(|(i, d)| {
@@ -673,7 +674,7 @@ pub fn parse_lights(
         let mangle = wk
             .vec3("_sun_mangle")?
             .or(wk.vec3("_sunlight_mangle")?)
-            .unwrap_or(Vec3::new(0.0, -90.0, 0.0));
+            .unwrap_or(DVec3::new(0.0, -90.0, 0.0));
         let penumbra = wk.float("_sunlight_penumbra")?.unwrap_or(0.0);
         let to_sun = -mangle_to_vec(mangle.x, mangle.y);
         let template = SunLight {
@@ -693,7 +694,7 @@ pub fn parse_lights(
         ("_sunlight3", ["_sunlight3_color", "_sunlight_color3"], -1.0),
     ] {
         if let Some(dome) = wk.float(key)?.filter(|s| *s != 0.0) {
-            let up = Vec3::new(0.0, 0.0, up);
+            let up = DVec3::new(0.0, 0.0, up);
             let template = SunLight {
                 to_sun: up,
                 light: dome,
@@ -722,11 +723,11 @@ pub fn parse_lights(
         }
     }
 
-    let origins: HashMap<&str, Vec3> = entities
+    let origins: HashMap<&str, DVec3> = entities
         .iter()
         .filter_map(|e| {
             let [x, y, z] = e.get_floats::<3>("origin")?;
-            Some((e.get("targetname")?, Vec3::new(x, y, z)))
+            Some((e.get("targetname")?, DVec3::new(x, y, z)))
         })
         .collect();
 
@@ -769,7 +770,7 @@ pub fn parse_lights(
         if !e.classname().starts_with("light") || k.float("_nostaticlight")? == Some(1.0) {
             continue;
         }
-        let origin = k.vec3("origin")?.unwrap_or(Vec3::ZERO);
+        let origin = k.vec3("origin")?.unwrap_or(DVec3::ZERO);
         let light = match k.float("light")? {
             None => DEFAULT_LIGHT,
             Some(0.0) => DEFAULT_LIGHT,
@@ -790,7 +791,7 @@ pub fn parse_lights(
         let dirt = dirt_if(k.float("_dirt")?, global_dirt, response_of(&k)?);
         let deviance = k.float("_deviance")?.unwrap_or(0.0).max(0.0);
         if k.float("_sun")? == Some(1.0) {
-            let to_sun = -aim.unwrap_or(Vec3::new(0.0, 0.0, -1.0));
+            let to_sun = -aim.unwrap_or(DVec3::new(0.0, 0.0, -1.0));
             let template = SunLight {
                 to_sun,
                 light,
@@ -806,7 +807,7 @@ pub fn parse_lights(
         let mut dome = false;
         for (key, up) in [("_sunlight2", 1.0), ("_sunlight3", -1.0)] {
             if k.float(key)? == Some(1.0) {
-                let up = Vec3::new(0.0, 0.0, up);
+                let up = DVec3::new(0.0, 0.0, up);
                 let template = SunLight {
                     to_sun: up,
                     light,
@@ -966,11 +967,11 @@ mod tests {
 
     fn light(falloff: Falloff, value: f64, wait: f64) -> PointLight {
         PointLight {
-            origin: Vec3::ZERO,
+            origin: DVec3::ZERO,
             light: value,
             atten: wait,
             falloff,
-            color: Vec3::new(1.0, 1.0, 1.0),
+            color: DVec3::new(1.0, 1.0, 1.0),
             style: 0,
             spot: None,
             anglescale: 0.5,
@@ -1034,8 +1035,8 @@ mod tests {
         }
         // Local minlight has no angle term: any surface facing it gets the full value.
         let l = light(Falloff::LocalMin, 50.0, 1.0);
-        assert_eq!(l.contribution(10.0, Vec3::new(1.0, 0.0, 0.0), 0.01), 50.0);
-        assert_eq!(l.contribution(10.0, Vec3::new(1.0, 0.0, 0.0), -0.5), 0.0);
+        assert_eq!(l.contribution(10.0, DVec3::new(1.0, 0.0, 0.0), 0.01), 50.0);
+        assert_eq!(l.contribution(10.0, DVec3::new(1.0, 0.0, 0.0), -0.5), 0.0);
     }
 
     #[test]
@@ -1049,10 +1050,10 @@ mod tests {
 
     #[test]
     fn spotlight_cone_edges() {
-        let down = Vec3::new(0.0, 0.0, -1.0);
+        let down = DVec3::new(0.0, 0.0, -1.0);
         let at = |deg: f64| {
             let r = deg.to_radians();
-            Vec3::new(r.sin(), 0.0, -r.cos())
+            DVec3::new(r.sin(), 0.0, -r.cos())
         };
         // Default 40 degrees: 20 each side of the axis.
         let s = Spot::new(down, 0.0, 0.0);
@@ -1075,21 +1076,21 @@ mod tests {
     #[test]
     fn mangle_points_where_documented() {
         let v = mangle_to_vec(0.0, -90.0);
-        assert!(v.near(Vec3::new(0.0, 0.0, -1.0), 1e-12));
+        assert!(v.near(DVec3::new(0.0, 0.0, -1.0), 1e-12));
         let v = mangle_to_vec(90.0, 0.0);
-        assert!(v.near(Vec3::new(0.0, 1.0, 0.0), 1e-12));
+        assert!(v.near(DVec3::new(0.0, 1.0, 0.0), 1e-12));
     }
 
     #[test]
     fn cap_directions_stay_in_the_cap_and_are_unit() {
-        let c = Vec3::new(0.0, 0.6, 0.8);
+        let c = DVec3::new(0.0, 0.6, 0.8);
         let dirs = cap_directions(c, 10.0, 50);
         assert_eq!(dirs.len(), 50);
         for d in &dirs {
             assert!((d.length() - 1.0).abs() < 1e-9);
             assert!(d.dot(c) >= 10f64.to_radians().cos() - 1e-9);
         }
-        let hemi = cap_directions(Vec3::new(0.0, 0.0, 1.0), 90.0, 200);
+        let hemi = cap_directions(DVec3::new(0.0, 0.0, 1.0), 90.0, 200);
         let mean_z: f64 = hemi.iter().map(|d| d.z).sum::<f64>() / 200.0;
         assert!((mean_z - 0.5).abs() < 0.01, "uniform hemisphere: {mean_z}");
     }
@@ -1114,12 +1115,12 @@ mod tests {
         assert_eq!(p.falloff, Falloff::InverseSquare);
         assert_eq!(p.atten, 2.0);
         assert_eq!(p.light, DEFAULT_LIGHT);
-        assert_eq!(p.color, Vec3::new(1.0, 0.5, 0.5));
+        assert_eq!(p.color, DVec3::new(1.0, 0.5, 0.5));
         assert_eq!(lights.points[1].style, 32);
         assert_eq!(lights.points[2].style, 32, "same targetname, same style");
         assert_eq!(lights.points[3].style, 5, "explicit style kept");
         let spot = lights.points[4].spot.expect("spotlight");
-        assert!(spot.dir.near(Vec3::new(0.0, 0.0, -1.0), 1e-12));
+        assert!(spot.dir.near(DVec3::new(0.0, 0.0, -1.0), 1e-12));
         assert!(close(spot.cos_outer, 30f64.to_radians().cos()));
         assert_eq!(ents[2].get("style"), Some("32"));
         assert_eq!(ents[4].get("style"), Some("5"));
@@ -1127,7 +1128,7 @@ mod tests {
         assert_eq!(lights.templates.len(), 1);
         assert_eq!(lights.templates[0].texture, "sky4");
         assert_eq!(lights.suns.len(), 1, "no penumbra: one direction");
-        assert!(lights.suns[0].to_sun.near(Vec3::new(0.0, 0.0, 1.0), 1e-12));
+        assert!(lights.suns[0].to_sun.near(DVec3::new(0.0, 0.0, 1.0), 1e-12));
         assert!(close(lights.suns[0].color.y, 128.0 / 255.0));
         assert_eq!(lights.minlight[&0].level, 20.0);
         assert_eq!(lights.minlight[&1].level, 10.0);

@@ -8,10 +8,12 @@
 //! coordinates. Only the angle-of-incidence term uses them; shadows and
 //! culling keep the flat face.
 
+use glam::DVec3;
+use quake_formats::geom::DVec3Ext;
 use std::collections::HashMap;
 
 use quake_formats::bsp::phong::FacePhong;
-use quake_formats::geom::{Bounds, Vec3};
+use quake_formats::geom::Bounds;
 
 use crate::faces::{FaceGeom, FaceKind};
 
@@ -20,14 +22,14 @@ const TOUCH_EPSILON: f64 = 0.05;
 /// Grid cell size of the lookup of faces near a point.
 const CELL: f64 = 64.0;
 
-fn cell_of(p: Vec3) -> [i64; 3] {
+fn cell_of(p: DVec3) -> [i64; 3] {
     [p.x, p.y, p.z].map(|c| (c / CELL).floor() as i64)
 }
 
 /// The angle the polygon `points` spans at `p` if `p` is one of its corners,
 /// π if `p` lies on one of its edges, and 2π inside it; `None` if `p` is
 /// not on the polygon.
-fn angle_at(points: &[Vec3], normal: Vec3, plane_dist: f64, p: Vec3) -> Option<f64> {
+fn angle_at(points: &[DVec3], normal: DVec3, plane_dist: f64, p: DVec3) -> Option<f64> {
     if (normal.dot(p) - plane_dist).abs() > TOUCH_EPSILON {
         return None;
     }
@@ -113,8 +115,8 @@ pub fn groups(
 }
 
 /// Corner normals of every face in a phong group; `None` for the others.
-pub fn corner_normals(faces: &[FaceGeom], groups: &PhongGroups) -> Vec<Option<Vec<Vec3>>> {
-    let mut out: Vec<Option<Vec<Vec3>>> = vec![None; faces.len()];
+pub fn corner_normals(faces: &[FaceGeom], groups: &PhongGroups) -> Vec<Option<Vec<DVec3>>> {
+    let mut out: Vec<Option<Vec<DVec3>>> = vec![None; faces.len()];
     let mut members: Vec<Vec<&FaceGeom>> = vec![Vec::new(); groups.angles.len()];
     for f in faces {
         if let Some(Some(g)) = groups.of_face.get(f.index) {
@@ -128,7 +130,7 @@ pub fn corner_normals(faces: &[FaceGeom], groups: &PhongGroups) -> Vec<Option<Ve
             for &p in &f.points {
                 bounds.add_point(p);
             }
-            let margin = Vec3::new(1.0, 1.0, 1.0) * TOUCH_EPSILON;
+            let margin = DVec3::new(1.0, 1.0, 1.0) * TOUCH_EPSILON;
             let (lo, hi) = (cell_of(bounds.mins - margin), cell_of(bounds.maxs + margin));
             for x in lo[0]..=hi[0] {
                 for y in lo[1]..=hi[1] {
@@ -145,7 +147,7 @@ pub fn corner_normals(faces: &[FaceGeom], groups: &PhongGroups) -> Vec<Option<Ve
                 .points
                 .iter()
                 .map(|&p| {
-                    let mut sum = Vec3::ZERO;
+                    let mut sum = DVec3::ZERO;
                     for &m in grid.get(&cell_of(p)).into_iter().flatten() {
                         let g = members[m];
                         if g.plane.normal.dot(normal) < cos_limit - 1e-9 {
@@ -167,12 +169,12 @@ pub fn corner_normals(faces: &[FaceGeom], groups: &PhongGroups) -> Vec<Option<Ve
 /// The smooth normal at `p` (on or just off the face) from the face's
 /// `corners` normals, by mean value coordinates of `p` projected onto the
 /// face's plane (a point outside the face takes the nearest edge's blend).
-pub fn interpolate(face: &FaceGeom, corners: &[Vec3], p: Vec3) -> Vec3 {
+pub fn interpolate(face: &FaceGeom, corners: &[DVec3], p: DVec3) -> DVec3 {
     let n = face.plane.normal;
     let q = p - n * face.plane.distance(p);
     let pts = &face.points;
     let count = pts.len();
-    let spokes: Vec<Vec3> = pts.iter().map(|&v| v - q).collect();
+    let spokes: Vec<DVec3> = pts.iter().map(|&v| v - q).collect();
     let lengths: Vec<f64> = spokes.iter().map(|s| s.length()).collect();
     if let Some(i) = lengths.iter().position(|&r| r < 1e-6) {
         return corners[i];
@@ -194,7 +196,7 @@ pub fn interpolate(face: &FaceGeom, corners: &[Vec3], p: Vec3) -> Vec3 {
         }
         half_tan.push(cross / denom);
     }
-    let mut sum = Vec3::ZERO;
+    let mut sum = DVec3::ZERO;
     for i in 0..count {
         let w = (half_tan[(i + count - 1) % count] + half_tan[i]) / lengths[i];
         sum += corners[i] * w;
@@ -219,14 +221,14 @@ mod tests {
             texture: String::new(),
             // Clockwise seen from above (+z).
             points: vec![
-                Vec3::new(0.0, 0.0, 0.0),
-                Vec3::new(0.0, 10.0, 0.0),
-                Vec3::new(10.0, 10.0, 0.0),
-                Vec3::new(10.0, 0.0, 0.0),
+                DVec3::new(0.0, 0.0, 0.0),
+                DVec3::new(0.0, 10.0, 0.0),
+                DVec3::new(10.0, 10.0, 0.0),
+                DVec3::new(10.0, 0.0, 0.0),
             ],
-            plane: Plane::new(Vec3::new(0.0, 0.0, 1.0), 0.0),
+            plane: Plane::new(DVec3::new(0.0, 0.0, 1.0), 0.0),
             vecs: [[0.0; 4]; 2],
-            origin: Vec3::ZERO,
+            origin: DVec3::ZERO,
             extents: LightmapExtents::from_points(&[], &[[0.0; 4]; 2]),
         }
     }
@@ -234,15 +236,15 @@ mod tests {
     #[test]
     fn interpolation_hits_corners_edges_and_blends_inside() {
         let f = square();
-        let tilt = |x: f64| Vec3::new(x, 0.0, 1.0).normalized().expect("unit");
+        let tilt = |x: f64| DVec3::new(x, 0.0, 1.0).normalized().expect("unit");
         // Normals lean -x on the x = 0 side and +x on the x = 10 side.
         let corners = [tilt(-0.5), tilt(-0.5), tilt(0.5), tilt(0.5)];
-        assert!(interpolate(&f, &corners, Vec3::new(0.0, 0.0, 1.0)).near(corners[0], 1e-12));
-        let edge = interpolate(&f, &corners, Vec3::new(5.0, 10.0, 1.0));
-        assert!(edge.near(Vec3::new(0.0, 0.0, 1.0), 1e-9), "{edge:?}");
-        let mid = interpolate(&f, &corners, Vec3::new(5.0, 3.0, 0.0));
-        assert!(mid.near(Vec3::new(0.0, 0.0, 1.0), 1e-9), "{mid:?}");
-        let left = interpolate(&f, &corners, Vec3::new(2.0, 5.0, 0.0));
+        assert!(interpolate(&f, &corners, DVec3::new(0.0, 0.0, 1.0)).near(corners[0], 1e-12));
+        let edge = interpolate(&f, &corners, DVec3::new(5.0, 10.0, 1.0));
+        assert!(edge.near(DVec3::new(0.0, 0.0, 1.0), 1e-9), "{edge:?}");
+        let mid = interpolate(&f, &corners, DVec3::new(5.0, 3.0, 0.0));
+        assert!(mid.near(DVec3::new(0.0, 0.0, 1.0), 1e-9), "{mid:?}");
+        let left = interpolate(&f, &corners, DVec3::new(2.0, 5.0, 0.0));
         assert!(left.x < 0.0 && left.x > tilt(-0.5).x, "{left:?}");
     }
 

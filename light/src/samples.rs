@@ -13,11 +13,13 @@
 //! [`FaceSamples`] is kept as its own structure so later passes (bounce
 //! lighting) can reuse the same points.
 
+use glam::{DMat3, DVec3, Vec3};
 use quake_formats::Bsp;
 use quake_formats::bsp::contents;
 use quake_formats::bsp::limits::LIGHTMAP_SCALE;
 use quake_formats::extents::LightmapExtents;
-use quake_formats::geom::{Plane, Vec3, Winding};
+use quake_formats::geom::DVec3Ext;
+use quake_formats::geom::{Plane, Winding};
 
 use crate::embree::{RayPacket16, sys};
 use crate::faces::FaceGeom;
@@ -41,7 +43,7 @@ pub struct FaceSamples {
     /// Samples per luxel along each axis (1, 2, 4 or 16).
     pub per_axis: usize,
     /// The face's outward unit normal.
-    pub normal: Vec3,
+    pub normal: DVec3,
     /// Sample positions, luxel by luxel (row-major), `per_axis²` per luxel.
     pub points: Vec<[f32; 3]>,
     /// Per-sample shading normals (`_phong`), or empty: the face normal everywhere.
@@ -86,10 +88,10 @@ impl FaceSamples {
     }
 
     /// The normal the angle-of-incidence term uses at sample `i`.
-    pub fn normal_at(&self, i: usize) -> Vec3 {
+    pub fn normal_at(&self, i: usize) -> DVec3 {
         self.normals
             .get(i)
-            .map_or(self.normal, |&n| Vec3::from_f32(n))
+            .map_or(self.normal, |&n| Vec3::from(n).as_dvec3())
     }
 }
 
@@ -119,7 +121,8 @@ impl PlacementCounts {
 /// on the face plane with texture coordinates (s, t).
 #[derive(Debug, Clone)]
 struct TextureToWorld {
-    inverse: [Vec3; 3],
+    /// Columns: the world-space steps per unit of s, of t and of plane distance.
+    inverse: DMat3,
     s_offset: f64,
     t_offset: f64,
     plane_dist: f64,
@@ -127,27 +130,26 @@ struct TextureToWorld {
 
 impl TextureToWorld {
     fn new(face: &FaceGeom) -> Option<TextureToWorld> {
-        let axis = |v: [f32; 4]| Vec3::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2]));
+        let axis = |v: [f32; 4]| DVec3::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2]));
         let (s, t, n) = (axis(face.vecs[0]), axis(face.vecs[1]), face.plane.normal);
         let det = s.dot(t.cross(n));
         if det.abs() < 1e-9 {
             return None; // texture axes parallel to the plane
         }
-        // Rows of the inverse's transpose: columns of M^-1 are these / det.
+        // The columns of M^-1 are these cross products over det.
         let c0 = t.cross(n) / det;
         let c1 = n.cross(s) / det;
         let c2 = s.cross(t) / det;
         Some(TextureToWorld {
-            inverse: [c0, c1, c2],
+            inverse: DMat3::from_cols(c0, c1, c2),
             s_offset: f64::from(face.vecs[0][3]),
             t_offset: f64::from(face.vecs[1][3]),
             plane_dist: face.plane.dist - n.dot(face.origin),
         })
     }
 
-    fn point(&self, s: f64, t: f64) -> Vec3 {
-        let [c0, c1, c2] = self.inverse;
-        c0 * (s - self.s_offset) + c1 * (t - self.t_offset) + c2 * self.plane_dist
+    fn point(&self, s: f64, t: f64) -> DVec3 {
+        self.inverse * DVec3::new(s - self.s_offset, t - self.t_offset, self.plane_dist)
     }
 }
 
@@ -155,19 +157,19 @@ impl TextureToWorld {
 /// front of every edge's inward plane.
 #[derive(Debug, Clone)]
 pub struct FaceRegion {
-    points: Vec<Vec3>,
+    points: Vec<DVec3>,
     /// Per edge (from `points[i]` to the next): unit in-plane normal pointing inside.
-    inward: Vec<Vec3>,
+    inward: Vec<DVec3>,
 }
 
 impl FaceRegion {
-    fn from_points(points: Vec<Vec3>, normal: Vec3) -> FaceRegion {
-        let centre = points.iter().fold(Vec3::ZERO, |a, &p| a + p) / points.len().max(1) as f64;
+    fn from_points(points: Vec<DVec3>, normal: DVec3) -> FaceRegion {
+        let centre = points.iter().fold(DVec3::ZERO, |a, &p| a + p) / points.len().max(1) as f64;
         let inward = (0..points.len())
             .map(|i| {
                 let a = points[i];
                 let b = points[(i + 1) % points.len()];
-                let m = normal.cross(b - a).normalized().unwrap_or(Vec3::ZERO);
+                let m = normal.cross(b - a).normalized().unwrap_or(DVec3::ZERO);
                 if m.dot(centre - a) < 0.0 { -m } else { m }
             })
             .collect();
@@ -195,13 +197,13 @@ impl FaceRegion {
     }
 
     /// Mean of the corners (inside: the region is convex).
-    pub fn centre(&self) -> Vec3 {
-        self.points.iter().fold(Vec3::ZERO, |a, &p| a + p) / self.points.len().max(1) as f64
+    pub fn centre(&self) -> DVec3 {
+        self.points.iter().fold(DVec3::ZERO, |a, &p| a + p) / self.points.len().max(1) as f64
     }
 
     /// `p` (a point on the face's plane) if it is inside, else the nearest
     /// point of the region's outline.
-    pub fn nearest(&self, p: Vec3) -> Vec3 {
+    pub fn nearest(&self, p: DVec3) -> DVec3 {
         let outside = (0..self.points.len()).any(|i| self.inward[i].dot(p - self.points[i]) < 0.0);
         if !outside || self.points.is_empty() {
             return p;
@@ -236,8 +238,8 @@ impl FaceRegion {
 pub struct SurfaceMap {
     to_world: Option<TextureToWorld>,
     region: FaceRegion,
-    origin: Vec3,
-    lift: Vec3,
+    origin: DVec3,
+    lift: DVec3,
     extents: LightmapExtents,
     per_axis: usize,
     /// Half-diagonal of one sample's square, in world units.
@@ -249,7 +251,7 @@ impl SurfaceMap {
         let to_world = TextureToWorld::new(face);
         let step = f64::from(LIGHTMAP_SCALE) / per_axis as f64;
         let footprint_radius = to_world.as_ref().map_or(0.0, |m| {
-            (m.inverse[0].length() + m.inverse[1].length()) * step / 2.0
+            (m.inverse.x_axis.length() + m.inverse.y_axis.length()) * step / 2.0
         });
         SurfaceMap {
             to_world,
@@ -263,13 +265,13 @@ impl SurfaceMap {
     }
 
     /// The lifted centre of the face (inside it).
-    pub fn centre(&self) -> Vec3 {
+    pub fn centre(&self) -> DVec3 {
         self.region.centre() + self.lift
     }
 
     /// The lifted point for texture coordinates (s, t), and whether it had
     /// to move onto the face. Without a usable projection: the centre.
-    pub fn point(&self, s: f64, t: f64) -> (Vec3, bool) {
+    pub fn point(&self, s: f64, t: f64) -> (DVec3, bool) {
         let Some(m) = &self.to_world else {
             return (self.centre(), false);
         };
@@ -308,7 +310,7 @@ impl SurfaceMap {
 
     /// `n x n` points spread evenly over sample `i`'s square, each placed as
     /// a sample point would be (onto the face, lifted; not pulled back).
-    pub fn footprint_points(&self, i: usize, n: usize) -> impl Iterator<Item = Vec3> + '_ {
+    pub fn footprint_points(&self, i: usize, n: usize) -> impl Iterator<Item = DVec3> + '_ {
         let [s, t] = self.sample_st(i);
         let sub = self.sample_step() / n as f64;
         let first = -self.sample_step() / 2.0 + sub / 2.0;
@@ -333,7 +335,7 @@ pub fn face_samples(
     let centre = map.centre();
     let mut counts = PlacementCounts::default();
     let count = width * height * per_axis * per_axis;
-    let (on_face, clamped): (Vec<Vec3>, Vec<bool>) = (0..count)
+    let (on_face, clamped): (Vec<DVec3>, Vec<bool>) = (0..count)
         .map(|i| {
             let [s, t] = map.sample_st(i);
             map.point(s, t)
@@ -364,15 +366,15 @@ pub fn face_samples(
 /// onto `centre` if it is still in a solid world leaf. Also says which
 /// moved. The rays all leave the centre, so they go 16 to a coherent packet.
 fn into_open(
-    points: &[Vec3],
-    centre: Vec3,
+    points: &[DVec3],
+    centre: DVec3,
     check_leaf: bool,
     scene: &TraceScene,
     bsp: &Bsp,
     counts: &mut PlacementCounts,
 ) -> (Vec<[f32; 3]>, Vec<bool>) {
-    let c = centre.to_f32();
-    let mut out: Vec<[f32; 3]> = points.iter().map(|p| p.to_f32()).collect();
+    let c = centre.as_vec3().to_array();
+    let mut out: Vec<[f32; 3]> = points.iter().map(|p| p.as_vec3().to_array()).collect();
     let mut moved = vec![false; points.len()];
     let away: Vec<usize> = (0..points.len())
         .filter(|&i| (points[i] - centre).length() > 1e-3)
@@ -386,7 +388,7 @@ fn into_open(
             let d = points[i] - centre;
             let len = d.length();
             lens[lane] = len as f32;
-            dirs[lane] = (d / len).to_f32();
+            dirs[lane] = (d / len).as_vec3().to_array();
             packet.set(lane, c, dirs[lane], 0.0, len as f32 + WALL_CLEARANCE);
         }
         counts.rays += u64::from(packet.active_mask().count_ones());

@@ -39,7 +39,8 @@ struct Mesh {
 impl Mesh {
     fn add(&mut self, face: &FaceGeom) {
         let base = self.vertices.len() as u32;
-        self.vertices.extend(face.points.iter().map(|p| p.to_f32()));
+        self.vertices
+            .extend(face.points.iter().map(|p| p.as_vec3().to_array()));
         for i in 1..face.points.len() as u32 - 1 {
             self.triangles.push([base, base + i, base + i + 1]);
             self.faces.push(face.index as u32);

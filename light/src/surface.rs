@@ -2,7 +2,8 @@
 //! face with the named texture, one copy per piece of the face after cutting
 //! it on a grid of `spacing` units, placed `offset` units in front of it.
 
-use quake_formats::geom::{Plane, Split, Vec3, Winding};
+use glam::DVec3;
+use quake_formats::geom::{Plane, Split, Winding};
 
 use crate::faces::FaceGeom;
 use crate::lights::{PointLight, Spot, SurfaceTemplate};
@@ -22,7 +23,7 @@ fn subdivide(w: Winding, spacing: f64, out: &mut Vec<Winding>) {
         if cut <= lo + 1.0 || cut >= hi - 1.0 {
             cut = (lo + hi) / 2.0;
         }
-        let mut normal = Vec3::ZERO;
+        let mut normal = DVec3::ZERO;
         normal[axis] = 1.0;
         if let Split::Both { front, back } = w.split(&Plane::new(normal, cut)) {
             subdivide(front, spacing, out);
@@ -67,10 +68,10 @@ mod tests {
     #[test]
     fn a_300_unit_square_is_cut_on_the_128_grid() {
         let sq = Winding::new(vec![
-            Vec3::new(0.0, 0.0, 0.0),
-            Vec3::new(0.0, 300.0, 0.0),
-            Vec3::new(300.0, 300.0, 0.0),
-            Vec3::new(300.0, 0.0, 0.0),
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(0.0, 300.0, 0.0),
+            DVec3::new(300.0, 300.0, 0.0),
+            DVec3::new(300.0, 0.0, 0.0),
         ]);
         let mut pieces = Vec::new();
         subdivide(sq, 128.0, &mut pieces);

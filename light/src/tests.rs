@@ -1,10 +1,12 @@
 //! End-to-end tests on tiny synthetic BSPs (world model only, no BSP tree,
 //! no vis) and, when present, on the corpus maps.
 
+use glam::{DVec3, Vec3};
 use quake_formats::Bsp;
 use quake_formats::bsp::{BspPlane, Face, Model, TexInfo, texinfo_flags};
 use quake_formats::extents::LightmapExtents;
-use quake_formats::geom::Vec3;
+use quake_formats::geom::DVec3Ext;
+
 use quake_formats::miptex::{MipTex, TextureLump};
 
 use crate::faces::{FaceKind, face_geometry};
@@ -223,7 +225,7 @@ fn samples_behind_a_wall_are_pulled_back_and_do_not_bleed() {
     polys.extend(box_faces([100.0, -50.0, -50.0], [140.0, 150.0, 200.0]));
     let ents = "{ \"classname\" \"worldspawn\" }\n{ \"classname\" \"light\" \"origin\" \"180 50 40\" \"delay\" \"3\" }\n";
     let bsp = synthetic_bsp(&polys, ents);
-    let faces = face_geometry(&bsp, |_| Vec3::ZERO).expect("faces");
+    let faces = face_geometry(&bsp, |_| DVec3::ZERO).expect("faces");
     let device = crate::embree::Device::new(1).expect("device");
     let scene = TraceScene::build(&device, &faces, &[], &[]).expect("scene");
     let (samples, counts) = face_samples(&faces[0], 1, &scene, &bsp);
@@ -260,14 +262,14 @@ fn sample_points_invert_an_angled_projection() {
             [77.1, 0.0, 0.0],
         ],
         normal: {
-            let n = Vec3::new(0.0, -30.2, 90.7).normalized().expect("n");
-            n.to_f32()
+            let n = DVec3::new(0.0, -30.2, 90.7).normalized().expect("n");
+            n.as_vec3().to_array()
         },
         sky: false,
     };
     let mut bsp = synthetic_bsp(&[poly], "{ \"classname\" \"worldspawn\" }");
     bsp.texinfo[0].vecs = [[0.9, 0.1, 0.0, 5.5], [0.05, -0.7, -0.3, -3.25]];
-    let faces = face_geometry(&bsp, |_| Vec3::ZERO).expect("faces");
+    let faces = face_geometry(&bsp, |_| DVec3::ZERO).expect("faces");
     let device = crate::embree::Device::new(1).expect("device");
     let scene = TraceScene::build(&device, &faces, &[], &[]).expect("scene");
     let (samples, _) = face_samples(&faces[0], 1, &scene, &bsp);
@@ -279,10 +281,10 @@ fn sample_points_invert_an_angled_projection() {
     let mut exact = 0;
     for y in 0..samples.height {
         for x in 0..samples.width {
-            let p = Vec3::from_f32(samples.points[y * samples.width + x]) - n;
+            let p = Vec3::from(samples.points[y * samples.width + x]).as_dvec3() - n;
             assert!(faces[0].plane.distance(p).abs() < 1e-3);
             let st = ext.luxel_st(x, y);
-            let tex = |p: Vec3, axis: usize| {
+            let tex = |p: DVec3, axis: usize| {
                 let a = v[axis];
                 p.x * f64::from(a[0])
                     + p.y * f64::from(a[1])
@@ -679,7 +681,7 @@ fn edge_jumps(world_keys: &str) -> Vec<f64> {
         ..prep.trace_setup(&bsp, &light_reaches, 0.001, true, true)
     };
     // Value and position of every sample at mid height of each column face.
-    let rows: Vec<Vec<(Vec3, f64)>> = (1..=8)
+    let rows: Vec<Vec<(DVec3, f64)>> = (1..=8)
         .map(|f| {
             let geom = &prep.faces[f];
             let (mut samples, _) = face_samples(geom, 1, &prep.scene, &bsp);
@@ -687,7 +689,11 @@ fn edge_jumps(world_keys: &str) -> Vec<f64> {
                 samples.normals = samples
                     .points
                     .iter()
-                    .map(|&p| crate::phong::interpolate(geom, corners, Vec3::from_f32(p)).to_f32())
+                    .map(|&p| {
+                        crate::phong::interpolate(geom, corners, Vec3::from(p).as_dvec3())
+                            .as_vec3()
+                            .to_array()
+                    })
                     .collect();
             }
             let (light, _) =
@@ -696,7 +702,7 @@ fn edge_jumps(world_keys: &str) -> Vec<f64> {
                 .points
                 .iter()
                 .zip(&light.styles[0].1)
-                .map(|(&p, v)| (Vec3::from_f32(p), f64::from(v[0])))
+                .map(|(&p, v)| (Vec3::from(p).as_dvec3(), f64::from(v[0])))
                 .filter(|(p, _)| (p.z - 64.0).abs() <= 8.0)
                 .collect()
         })
@@ -709,8 +715,8 @@ fn edge_jumps(world_keys: &str) -> Vec<f64> {
         }
         // The shared corner's position at mid height.
         let ang = (k as f64 + 1.5) * std::f64::consts::TAU / 8.0;
-        let edge = Vec3::new(256.0 + 64.0 * ang.cos(), 256.0 + 64.0 * ang.sin(), 64.0);
-        let nearest = |row: &[(Vec3, f64)]| {
+        let edge = DVec3::new(256.0 + 64.0 * ang.cos(), 256.0 + 64.0 * ang.sin(), 64.0);
+        let nearest = |row: &[(DVec3, f64)]| {
             row.iter()
                 .min_by(|x, y| (x.0 - edge).length().total_cmp(&(y.0 - edge).length()))
                 .map(|x| x.1)
@@ -760,7 +766,7 @@ fn overhang_scene(model_keys: &str, sun: bool) -> Bsp {
 /// The grey style-0 value of the luxel of `face` at texture coordinates
 /// `(s, t)` (the luxel whose centre grid point is nearest).
 fn luxel_at(bsp: &Bsp, lighting: &crate::Lighting, face: usize, s: f64, t: f64) -> u8 {
-    let faces = face_geometry(bsp, |_| Vec3::ZERO).expect("faces");
+    let faces = face_geometry(bsp, |_| DVec3::ZERO).expect("faces");
     let mins = faces[face].extents.tex_mins;
     let m = lighting
         .lightmaps
@@ -840,7 +846,13 @@ fn dirt_cone_follows_the_phong_normal() {
         crate::dirt::occlusion_at(samples, &all, 0, &sampling, &prep.scene).0
     };
     let flat = occlusion(&samples);
-    let tilted = |x: f64| Vec3::new(x, 0.0, 1.0).normalized().expect("unit").to_f32();
+    let tilted = |x: f64| {
+        DVec3::new(x, 0.0, 1.0)
+            .normalized()
+            .expect("unit")
+            .as_vec3()
+            .to_array()
+    };
     // Normals leaning 45 degrees toward the wall, then away from it.
     samples.normals = vec![tilted(1.0); samples.points.len()];
     let toward = occlusion(&samples);
@@ -959,7 +971,7 @@ fn phong_on_func_detail_reaches_light_through_the_bsp() {
         prep.faces
             .iter()
             .filter(|f| f.plane.normal.z.abs() < 0.1)
-            .filter(|f| (f.centroid() - Vec3::new(0.0, 0.0, f.centroid().z)).length() < 60.0)
+            .filter(|f| (f.centroid() - DVec3::new(0.0, 0.0, f.centroid().z)).length() < 60.0)
             .map(|f| f.index)
             .collect()
     };

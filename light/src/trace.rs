@@ -2,8 +2,10 @@
 //! the face, traced in 16-ray packets (one light, 16 neighbouring samples:
 //! coherent rays), then averaged down to luxels.
 
+use glam::{DVec3, Vec3};
 use quake_formats::Bsp;
-use quake_formats::geom::{Bounds, Vec3};
+use quake_formats::geom::Bounds;
+use quake_formats::geom::DVec3Ext;
 
 use crate::dirt;
 use crate::embree::RayPacket16;
@@ -30,7 +32,7 @@ const CELL_PER_DISTANCE: f64 = 0.25;
 /// misses or sits on. `to_light` runs from the sample point to the light;
 /// `radius` is the square's half-diagonal; `max_cells` per axis gives the
 /// reference's 16x16 texel grid over a luxel.
-fn footprint_cells(to_light: Vec3, normal: Vec3, radius: f64, max_cells: usize) -> usize {
+fn footprint_cells(to_light: DVec3, normal: DVec3, radius: f64, max_cells: usize) -> usize {
     let height = to_light.dot(normal).abs();
     let across = (to_light.dot(to_light) - height * height).max(0.0).sqrt();
     let beyond = (across - radius).max(0.0);
@@ -44,7 +46,7 @@ fn footprint_cells(to_light: Vec3, normal: Vec3, radius: f64, max_cells: usize) 
 }
 
 /// What `light` adds at `p` on a surface with unit `normal`, unshadowed.
-fn unshadowed(light: &PointLight, p: Vec3, normal: Vec3) -> Option<(f64, Vec3, f64)> {
+fn unshadowed(light: &PointLight, p: DVec3, normal: DVec3) -> Option<(f64, DVec3, f64)> {
     let to_light = light.origin - p;
     let dist = to_light.length();
     let dir = to_light.normalized()?;
@@ -66,9 +68,9 @@ fn footprint_light(
 ) -> f64 {
     let normal = samples.normal_at(i);
     let model = setup.faces[samples.face].model;
-    let own = Vec3::from_f32(samples.points[i]);
-    let mut points: Vec<Vec3> = samples.map.footprint_points(i, cells).collect();
-    let at: Vec<[f32; 3]> = points.iter().map(|q| q.to_f32()).collect();
+    let own = Vec3::from(samples.points[i]).as_dvec3();
+    let mut points: Vec<DVec3> = samples.map.footprint_points(i, cells).collect();
+    let at: Vec<[f32; 3]> = points.iter().map(|q| q.as_vec3().to_array()).collect();
     for (q, solid) in points.iter_mut().zip(solid_points(setup.bsp, &at)) {
         if solid {
             *q = own;
@@ -84,7 +86,13 @@ fn footprint_light(
             };
             lane_value[lane] = value;
             let reach = (dist as f32 - LIGHT_CLEARANCE).max(0.0);
-            packet.set(lane, q.to_f32(), dir.to_f32(), 0.0, reach);
+            packet.set(
+                lane,
+                q.as_vec3().to_array(),
+                dir.as_vec3().to_array(),
+                0.0,
+                reach,
+            );
         }
         let active = packet.active_mask();
         counts.shadow_rays += u64::from(active.count_ones());
@@ -199,15 +207,15 @@ impl StyleBuffers {
     }
 }
 
-fn sub(a: Vec3, b: [f32; 3]) -> Vec3 {
-    a - Vec3::from_f32(b)
+fn sub(a: DVec3, b: [f32; 3]) -> DVec3 {
+    a - Vec3::from(b).as_dvec3()
 }
 
 /// Where a light is and how far it reaches, packed for the per-face cull
 /// (e1m1 tests about 950k face/light pairs).
 #[derive(Debug, Clone, Copy)]
 pub struct LightReach {
-    origin: Vec3,
+    origin: DVec3,
     /// Square of [`PointLight::range`] (infinite for lights that never fade).
     range_squared: f64,
 }
@@ -224,7 +232,7 @@ pub fn light_reaches(lights: &[PointLight], gate: f64) -> Vec<LightReach> {
 }
 
 /// Squared distance from `p` to the box `b` (0 inside).
-fn box_distance_squared(b: &Bounds, p: Vec3) -> f64 {
+fn box_distance_squared(b: &Bounds, p: DVec3) -> f64 {
     let mut d2 = 0.0;
     for axis in 0..3 {
         let excess = (b.mins[axis] - p[axis])
@@ -243,7 +251,7 @@ const SKY_BOX_MARGIN: f64 = 1.0;
 /// to a point `q` in it (the box `sky - samples`, a little wider): a sun
 /// ray from a sample can only meet that sky if its direction meets this box.
 fn sky_offsets(sky: &[Bounds], samples: &Bounds) -> Vec<Bounds> {
-    let margin = Vec3::new(SKY_BOX_MARGIN, SKY_BOX_MARGIN, SKY_BOX_MARGIN);
+    let margin = DVec3::new(SKY_BOX_MARGIN, SKY_BOX_MARGIN, SKY_BOX_MARGIN);
     sky.iter()
         .map(|b| Bounds {
             mins: b.mins - samples.maxs - margin,
@@ -253,7 +261,7 @@ fn sky_offsets(sky: &[Bounds], samples: &Bounds) -> Vec<Bounds> {
 }
 
 /// Whether the ray from the origin along `d` meets any of `boxes`.
-fn direction_meets_any(boxes: &[Bounds], d: Vec3) -> bool {
+fn direction_meets_any(boxes: &[Bounds], d: DVec3) -> bool {
     boxes.iter().any(|b| {
         let (mut near, mut far) = (0.0f64, f64::INFINITY);
         for axis in 0..3 {
@@ -869,7 +877,7 @@ pub fn trace_face(
     };
     let mut bounds = Bounds::EMPTY;
     for &p in &samples.points {
-        bounds.add_point(Vec3::from_f32(p));
+        bounds.add_point(Vec3::from(p).as_dvec3());
     }
     // Dirt is measured after the shadow rays, only where some light that
     // takes it arrives (half of e3m4's luxels are dark).
@@ -927,7 +935,7 @@ pub fn trace_face(
             let p = samples.points[i];
             let to_light = sub(light.origin, p);
             let dist = to_light.length();
-            let dir = (to_light / dist).to_f32();
+            let dir = (to_light / dist).as_vec3().to_array();
             (p, dir, (dist as f32 - LIGHT_CLEARANCE).max(0.0))
         };
         counts.shadow_rays +=
@@ -960,8 +968,8 @@ pub fn trace_face(
             {
                 continue;
             }
-            let dir = sun.to_sun.to_f32();
-            let sun_value = |normal: Vec3| {
+            let dir = sun.to_sun.as_vec3().to_array();
+            let sun_value = |normal: DVec3| {
                 let v = sun.light * angle_factor(normal.dot(sun.to_sun), sun.anglescale);
                 if v.abs() < setup.gate { 0.0 } else { v }
             };
@@ -1067,8 +1075,8 @@ mod tests {
 
     fn cube(mins: [f64; 3], maxs: [f64; 3]) -> Bounds {
         Bounds {
-            mins: Vec3::new(mins[0], mins[1], mins[2]),
-            maxs: Vec3::new(maxs[0], maxs[1], maxs[2]),
+            mins: DVec3::new(mins[0], mins[1], mins[2]),
+            maxs: DVec3::new(maxs[0], maxs[1], maxs[2]),
         }
     }
 
@@ -1098,12 +1106,12 @@ mod tests {
         let floor = cube([0.0, 0.0, 0.0], [64.0, 64.0, 0.0]);
         let skylight = cube([16.0, 16.0, 128.0], [48.0, 48.0, 128.0]);
         let offsets = sky_offsets(&[skylight], &floor);
-        let up = Vec3::new(0.0, 0.0, 1.0);
+        let up = DVec3::new(0.0, 0.0, 1.0);
         assert!(direction_meets_any(&offsets, up));
         // From the floor's corner (0, 0) to the skylight's far corner (48, 48).
-        let steepest_slant = Vec3::new(48.0, 48.0, 128.0).normalized().unwrap();
+        let steepest_slant = DVec3::new(48.0, 48.0, 128.0).normalized().unwrap();
         assert!(direction_meets_any(&offsets, steepest_slant));
-        let too_low = Vec3::new(1.0, 0.0, 0.5).normalized().unwrap();
+        let too_low = DVec3::new(1.0, 0.0, 0.5).normalized().unwrap();
         assert!(!direction_meets_any(&offsets, too_low));
         assert!(!direction_meets_any(&offsets, -up));
         assert!(!direction_meets_any(&[], up), "no sky in sight");

@@ -4,12 +4,13 @@
 //! face. Anything without vis data (no vis lump, a leaf without a row, a
 //! light in solid, a brush-model face) is treated as visible.
 
+use glam::DVec3;
 use std::collections::BTreeMap;
 
 use quake_formats::Bsp;
 use quake_formats::PvsRow;
 use quake_formats::bsp::contents;
-use quake_formats::geom::{Bounds, Vec3};
+use quake_formats::geom::Bounds;
 
 use crate::faces::{FaceGeom, FaceKind};
 
@@ -93,8 +94,8 @@ impl Visibility {
     }
 
     /// The world leaf containing `p`, unless it is solid (no culling then).
-    pub fn open_leaf_at(&self, bsp: &Bsp, p: Vec3) -> Option<u32> {
-        let leaf = bsp.leaf_at(p.to_f32())?;
+    pub fn open_leaf_at(&self, bsp: &Bsp, p: DVec3) -> Option<u32> {
+        let leaf = bsp.leaf_at(p.as_vec3().to_array())?;
         (self.leaf_contents.get(leaf) != Some(&contents::SOLID)).then_some(leaf as u32)
     }
 
@@ -180,9 +181,9 @@ mod tests {
             kind: FaceKind::Lit,
             texture: String::new(),
             points: Vec::new(),
-            plane: Plane::new(Vec3::new(0.0, 0.0, 1.0), 0.0),
+            plane: Plane::new(DVec3::new(0.0, 0.0, 1.0), 0.0),
             vecs: [[0.0; 4]; 2],
-            origin: Vec3::ZERO,
+            origin: DVec3::ZERO,
             extents: LightmapExtents::from_points(&[], &[[0.0; 4]; 2]),
         }
     }

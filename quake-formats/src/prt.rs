@@ -22,7 +22,8 @@
 //! ```
 
 use crate::error::{FormatError, Result};
-use crate::geom::{Vec3, Winding};
+use crate::geom::Winding;
+use glam::DVec3;
 
 /// A portal between two vis leaves.
 #[derive(Debug, Clone, PartialEq)]
@@ -206,7 +207,7 @@ fn parse_portal(line: usize, text: &str, num_ends: u32) -> Result<PrtPortal> {
     }
     let points = coords
         .chunks(3)
-        .map(|c| Vec3::new(c[0], c[1], c[2]))
+        .map(|c| DVec3::new(c[0], c[1], c[2]))
         .collect();
     Ok(PrtPortal {
         leafs: [a, b],
@@ -217,6 +218,7 @@ fn parse_portal(line: usize, text: &str, num_ends: u32) -> Result<PrtPortal> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geom::DVec3Ext;
 
     #[test]
     fn round_trip() {
@@ -225,9 +227,9 @@ mod tests {
             portals: vec![PrtPortal {
                 leafs: [0, 2],
                 winding: Winding::new(vec![
-                    Vec3::new(0.0, 0.0, 0.0),
-                    Vec3::new(0.0, 64.5, 0.0),
-                    Vec3::new(-1e-3, 64.0, 128.0),
+                    DVec3::new(0.0, 0.0, 0.0),
+                    DVec3::new(0.0, 64.5, 0.0),
+                    DVec3::new(-1e-3, 64.0, 128.0),
                 ]),
             }],
             clusters: None,

@@ -2,16 +2,16 @@
 //! which engines draw as a dotted trail (`pointfile` console command).
 
 use crate::error::{FormatError, Result};
-use crate::geom::Vec3;
+use glam::DVec3;
 
-pub fn write_pointfile(points: &[Vec3]) -> String {
+pub fn write_pointfile(points: &[DVec3]) -> String {
     points
         .iter()
         .map(|p| format!("{} {} {}\n", p.x as f32, p.y as f32, p.z as f32))
         .collect()
 }
 
-pub fn parse_pointfile(text: &str) -> Result<Vec<Vec3>> {
+pub fn parse_pointfile(text: &str) -> Result<Vec<DVec3>> {
     text.lines()
         .enumerate()
         .filter(|(_, l)| !l.trim().is_empty())
@@ -21,7 +21,7 @@ pub fn parse_pointfile(text: &str) -> Result<Vec<Vec3>> {
                 .filter_map(|f| f.parse().ok())
                 .collect();
             match v[..] {
-                [x, y, z] => Ok(Vec3::new(x, y, z)),
+                [x, y, z] => Ok(DVec3::new(x, y, z)),
                 _ => Err(FormatError::Syntax {
                     line: i + 1,
                     detail: format!("expected three numbers, found {l:?}"),
@@ -37,7 +37,7 @@ mod tests {
 
     #[test]
     fn round_trip() {
-        let pts = vec![Vec3::new(1.0, -2.5, 3.0), Vec3::new(4096.0, 0.0, 0.125)];
+        let pts = vec![DVec3::new(1.0, -2.5, 3.0), DVec3::new(4096.0, 0.0, 0.125)];
         assert_eq!(parse_pointfile(&write_pointfile(&pts)).expect("parse"), pts);
     }
 }

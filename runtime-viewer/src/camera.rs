@@ -4,14 +4,16 @@
 //! Axes: x forward at yaw 0, y left, z up; yaw turns counter-clockwise seen from above; positive
 //! pitch looks down. Pixel (i, j) covers [i, i+1) x [j, j+1); its centre is (i + 0.5, j + 0.5).
 
-use quake_formats::geom::{Plane, Vec3};
+use glam::DVec3;
+use quake_formats::geom::DVec3Ext;
+use quake_formats::geom::Plane;
 
 /// Anything nearer than this (map units along the view axis) is clipped away.
 pub const NEAR_CLIP: f64 = 0.5;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Camera {
-    pub origin: Vec3,
+    pub origin: DVec3,
     /// Pitch, yaw, roll in degrees.
     pub angles: [f64; 3],
     pub width: usize,
@@ -52,24 +54,24 @@ impl ScreenLinear {
 }
 
 /// Quake's forward, right and up vectors for pitch/yaw/roll in degrees.
-pub fn angle_vectors(angles: [f64; 3]) -> (Vec3, Vec3, Vec3) {
+pub fn angle_vectors(angles: [f64; 3]) -> (DVec3, DVec3, DVec3) {
     let [p, y, r] = angles.map(f64::to_radians);
     let (sp, cp) = p.sin_cos();
     let (sy, cy) = y.sin_cos();
     let (sr, cr) = r.sin_cos();
-    let forward = Vec3::new(cp * cy, cp * sy, -sp);
-    let right = Vec3::new(-sr * sp * cy + cr * sy, -sr * sp * sy - cr * cy, -sr * cp);
-    let up = Vec3::new(cr * sp * cy + sr * sy, cr * sp * sy - sr * cy, cr * cp);
+    let forward = DVec3::new(cp * cy, cp * sy, -sp);
+    let right = DVec3::new(-sr * sp * cy + cr * sy, -sr * sp * sy - cr * cy, -sr * cp);
+    let up = DVec3::new(cr * sp * cy + sr * sy, cr * sp * sy - sr * cy, cr * cp);
     (forward, right, up)
 }
 
 /// Everything derived from a camera for one frame.
 #[derive(Debug, Clone)]
 pub struct View {
-    pub origin: Vec3,
-    pub forward: Vec3,
-    pub right: Vec3,
-    pub up: Vec3,
+    pub origin: DVec3,
+    pub forward: DVec3,
+    pub right: DVec3,
+    pub up: DVec3,
     pub width: usize,
     pub height: usize,
     /// Pixels per unit of x/z (and y/z) at the screen centre.
@@ -87,7 +89,7 @@ impl Camera {
         let h = self.height as f64;
         let scale = (w / 2.0) / (self.fov_x.to_radians() / 2.0).tan();
         let center = (w / 2.0, h / 2.0);
-        let side = |n: Vec3| {
+        let side = |n: DVec3| {
             let n = n.normalized().unwrap_or(forward);
             Plane::new(n, n.dot(self.origin))
         };
@@ -116,13 +118,13 @@ impl Camera {
 
 impl View {
     /// The ray direction through screen point (x, y), with unit depth along `forward`.
-    pub fn ray(&self, x: f64, y: f64) -> Vec3 {
+    pub fn ray(&self, x: f64, y: f64) -> DVec3 {
         self.forward + self.right * ((x - self.center.0) / self.scale)
             - self.up * ((y - self.center.1) / self.scale)
     }
 
     /// `ray(x, y) · v` as a screen-linear form.
-    pub fn ray_dot(&self, v: Vec3) -> ScreenLinear {
+    pub fn ray_dot(&self, v: DVec3) -> ScreenLinear {
         let (r, u) = (self.right.dot(v) / self.scale, self.up.dot(v) / self.scale);
         ScreenLinear {
             c: self.forward.dot(v) - r * self.center.0 + u * self.center.1,
@@ -132,12 +134,12 @@ impl View {
     }
 
     /// Depth of `p` along the view axis.
-    pub fn depth(&self, p: Vec3) -> f64 {
+    pub fn depth(&self, p: DVec3) -> f64 {
         self.forward.dot(p - self.origin)
     }
 
     /// Screen position of a point in front of the eye.
-    pub fn project(&self, p: Vec3) -> (f64, f64) {
+    pub fn project(&self, p: DVec3) -> (f64, f64) {
         let d = p - self.origin;
         let z = self.forward.dot(d);
         (
@@ -159,7 +161,7 @@ mod tests {
 
     fn cam(angles: [f64; 3]) -> View {
         Camera {
-            origin: Vec3::new(10.0, 20.0, 30.0),
+            origin: DVec3::new(10.0, 20.0, 30.0),
             angles,
             width: 320,
             height: 200,
@@ -171,12 +173,12 @@ mod tests {
     #[test]
     fn quake_axes() {
         let (f, r, u) = angle_vectors([0.0, 0.0, 0.0]);
-        assert!(f.near(Vec3::new(1.0, 0.0, 0.0), 1e-12));
-        assert!(r.near(Vec3::new(0.0, -1.0, 0.0), 1e-12));
-        assert!(u.near(Vec3::new(0.0, 0.0, 1.0), 1e-12));
+        assert!(f.near(DVec3::new(1.0, 0.0, 0.0), 1e-12));
+        assert!(r.near(DVec3::new(0.0, -1.0, 0.0), 1e-12));
+        assert!(u.near(DVec3::new(0.0, 0.0, 1.0), 1e-12));
         let (f, _, _) = angle_vectors([0.0, 90.0, 0.0]);
         assert!(
-            f.near(Vec3::new(0.0, 1.0, 0.0), 1e-12),
+            f.near(DVec3::new(0.0, 1.0, 0.0), 1e-12),
             "yaw turns counter-clockwise"
         );
         let (f, _, _) = angle_vectors([30.0, 0.0, 0.0]);
@@ -213,7 +215,7 @@ mod tests {
     #[test]
     fn inverse_depth_is_linear_on_screen() {
         let v = cam([5.0, 20.0, 0.0]);
-        let plane = Plane::new(Vec3::new(1.0, 0.0, 0.0), 300.0);
+        let plane = Plane::new(DVec3::new(1.0, 0.0, 0.0), 300.0);
         let izi = v.inverse_depth(&plane).expect("not edge-on");
         for (x, y) in [(3.5, 7.5), (160.5, 100.5), (300.0, 190.0)] {
             let d = v.ray(x, y);

@@ -1,10 +1,10 @@
 //! `slipgate-view`: render a BSP to PNG, or fly through it and report frame rates.
 
+use glam::DVec3;
 use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::bail;
-use quake_formats::geom::Vec3;
 
 use crate::camera::Camera;
 use crate::image::write_png;
@@ -215,7 +215,7 @@ pub fn initial_camera(world: &World, args: &Args) -> anyhow::Result<Camera> {
     }
     let start = world.player_start();
     let origin = match (&args.pos, start) {
-        (Some(p), _) => Vec3::new(p[0], p[1], p[2]),
+        (Some(p), _) => DVec3::new(p[0], p[1], p[2]),
         (None, Some((o, _))) => o,
         (None, None) => bail!(
             "{}: no info_player_start (or other spawn spot); give --pos X Y Z",
@@ -274,7 +274,7 @@ fn run_bench(
         );
         let f = along.fract();
         let origin = if spots.len() > 1 {
-            spots[a].0.lerp(spots[b].0, f)
+            spots[a].0.lerp_monotonic(spots[b].0, f)
         } else {
             spots[0].0
         };

@@ -11,7 +11,8 @@
 //! first pixel whose centre is at or right of its edge. Two polygons sharing an edge compute it
 //! from the same projected endpoints in the same direction, so they meet without gaps or overlap.
 
-use quake_formats::geom::{Vec3, Winding};
+use glam::DVec3;
+use quake_formats::geom::Winding;
 
 use crate::camera::{ScreenLinear, View};
 
@@ -84,7 +85,7 @@ impl EdgeList {
     pub fn add_polygon(
         &mut self,
         view: &View,
-        points: &[Vec3],
+        points: &[DVec3],
         clip_flags: u8,
         surface: SpanSurface,
     ) -> bool {
@@ -291,7 +292,7 @@ mod tests {
 
     fn view() -> View {
         Camera {
-            origin: Vec3::ZERO,
+            origin: DVec3::ZERO,
             angles: [0.0; 3],
             width: 64,
             height: 48,
@@ -302,17 +303,17 @@ mod tests {
 
     /// A square facing the eye at distance `x`, spanning y in [y0, y1] and z in [z0, z1]
     /// (clockwise seen from the eye).
-    fn wall(x: f64, y0: f64, y1: f64, z0: f64, z1: f64) -> Vec<Vec3> {
+    fn wall(x: f64, y0: f64, y1: f64, z0: f64, z1: f64) -> Vec<DVec3> {
         vec![
-            Vec3::new(x, y1, z1),
-            Vec3::new(x, y0, z1),
-            Vec3::new(x, y0, z0),
-            Vec3::new(x, y1, z0),
+            DVec3::new(x, y1, z1),
+            DVec3::new(x, y0, z1),
+            DVec3::new(x, y0, z0),
+            DVec3::new(x, y1, z0),
         ]
     }
 
     fn surface(v: &View, face: u32, key: u32, x: f64) -> SpanSurface {
-        let plane = Plane::new(Vec3::new(-1.0, 0.0, 0.0), -x);
+        let plane = Plane::new(DVec3::new(-1.0, 0.0, 0.0), -x);
         SpanSurface {
             face,
             key,
@@ -453,8 +454,8 @@ mod tests {
             for (i, &(d, y0, dy, z0, dz)) in rects.iter().enumerate() {
                 let pts = wall(d, y0, y0 + dy, z0, z0 + dz);
                 list.add_polygon(&v, &pts, 0b1111, surface(&v, i as u32, keys[i], d));
-                let (xa, ya) = v.project(Vec3::new(d, y0 + dy, z0 + dz));
-                let (xb, yb) = v.project(Vec3::new(d, y0, z0));
+                let (xa, ya) = v.project(DVec3::new(d, y0 + dy, z0 + dz));
+                let (xb, yb) = v.project(DVec3::new(d, y0, z0));
                 screen_rects.push((xa, ya, xb, yb, keys[i], i as u32));
             }
             list.scan(64, 48);

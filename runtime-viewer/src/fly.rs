@@ -1,7 +1,8 @@
 //! Noclip flight for the interactive window: held keys and mouse movement turned into camera
 //! motion. Kept apart from the window itself so it is tested without a display.
 
-use quake_formats::geom::Vec3;
+use glam::DVec3;
+use quake_formats::geom::DVec3Ext;
 
 use crate::camera::{Camera, angle_vectors};
 
@@ -50,7 +51,7 @@ pub fn fly(camera: &mut Camera, input: &FlyInput, dt: f64) {
     camera.angles = [pitch, yaw, roll];
 
     let (forward, right, _) = angle_vectors(camera.angles);
-    let up = Vec3::new(0.0, 0.0, 1.0);
+    let up = DVec3::new(0.0, 0.0, 1.0);
     let wish = forward * axis(input.forward, input.back)
         + right * axis(input.right, input.left)
         + up * axis(input.up, input.down);
@@ -71,7 +72,7 @@ mod tests {
 
     fn camera() -> Camera {
         Camera {
-            origin: Vec3::new(10.0, 20.0, 30.0),
+            origin: DVec3::new(10.0, 20.0, 30.0),
             angles: [0.0, 90.0, 0.0],
             width: 64,
             height: 48,
@@ -89,7 +90,7 @@ mod tests {
         fly(&mut c, &input, 0.5);
         // Yaw 90 looks along +y.
         assert!(
-            c.origin.near(Vec3::new(10.0, 180.0, 30.0), 1e-9),
+            c.origin.near(DVec3::new(10.0, 180.0, 30.0), 1e-9),
             "{:?}",
             c.origin
         );
@@ -103,7 +104,7 @@ mod tests {
         fly(&mut c, &input, 1.0);
         let d = FLY_SPEED * FAST_FACTOR / 2f64.sqrt();
         assert!(
-            c.origin.near(Vec3::new(10.0 + d, 20.0, 30.0 + d), 1e-9),
+            c.origin.near(DVec3::new(10.0 + d, 20.0, 30.0 + d), 1e-9),
             "{:?}",
             c.origin
         );

@@ -160,12 +160,13 @@ pub fn for_each_segment<F: FnMut(Segment)>(
 mod tests {
     use super::*;
     use crate::camera::Camera;
+    use glam::DVec3;
     use quake_formats::extents::LightmapExtents;
-    use quake_formats::geom::{Plane, Vec3};
+    use quake_formats::geom::Plane;
 
     fn floor_view() -> (View, Surface) {
         let view = Camera {
-            origin: Vec3::new(0.0, 0.0, 50.0),
+            origin: DVec3::new(0.0, 0.0, 50.0),
             angles: [30.0, 10.0, 0.0],
             width: 128,
             height: 64,
@@ -173,11 +174,11 @@ mod tests {
         }
         .view();
         let surface = Surface {
-            plane: Plane::new(Vec3::new(0.0, 0.0, 1.0), 0.0),
+            plane: Plane::new(DVec3::new(0.0, 0.0, 1.0), 0.0),
             points: vec![],
-            s_axis: Vec3::new(1.0, 0.0, 0.0),
+            s_axis: DVec3::new(1.0, 0.0, 0.0),
             s_offset: 0.0,
-            t_axis: Vec3::new(0.0, -1.0, 0.0),
+            t_axis: DVec3::new(0.0, -1.0, 0.0),
             t_offset: 0.0,
             texture: 0,
             kind: crate::textures::TextureKind::Lit,

@@ -2,10 +2,10 @@
 //! same lit texels and mip choice as the fast renderer. Slow and simple on purpose: it defines
 //! what the fast renderer should draw. [`compare`] measures how far a frame is from it.
 
+use glam::DVec3;
 use std::collections::HashMap;
 
 use quake_formats::bsp::contents;
-use quake_formats::geom::Vec3;
 
 use crate::camera::{Camera, NEAR_CLIP, View};
 use crate::render::Frame;
@@ -70,7 +70,7 @@ struct Shader<'a> {
 impl Shader<'_> {
     /// The colour of `face` where the ray along `dir` meets it at `depth`; `None` for a hole
     /// in a fence.
-    fn color(&mut self, face: u32, dir: Vec3, depth: f64) -> Option<u32> {
+    fn color(&mut self, face: u32, dir: DVec3, depth: f64) -> Option<u32> {
         let world = self.world;
         let surface = world.surfaces[face as usize].as_ref()?;
         let tex = &world.textures[surface.texture];
@@ -105,7 +105,7 @@ impl Shader<'_> {
 }
 
 /// Depth at which the ray along `dir` meets the front of `s` inside its polygon.
-fn ray_hit(s: &Surface, view: &View, dir: Vec3) -> Option<f64> {
+fn ray_hit(s: &Surface, view: &View, dir: DVec3) -> Option<f64> {
     let eye = s.plane.distance(view.origin);
     let along = s.plane.normal.dot(dir);
     if eye <= 0.0 || along >= 0.0 {
@@ -116,7 +116,7 @@ fn ray_hit(s: &Surface, view: &View, dir: Vec3) -> Option<f64> {
 }
 
 /// The nearest opaque face along `dir` (depth-scaled: the point is `origin + dir * depth`).
-fn first_hit(world: &World, view: &View, dir: Vec3) -> Option<(u32, f64)> {
+fn first_hit(world: &World, view: &View, dir: DVec3) -> Option<(u32, f64)> {
     let world_hit = match world.root() {
         Some(root) => match trace(world, root, view.origin, dir, NEAR_CLIP, MAX_DEPTH) {
             Trace::Hit(f, d) => Some((f, d)),
@@ -145,7 +145,7 @@ fn first_hit(world: &World, view: &View, dir: Vec3) -> Option<(u32, f64)> {
 fn fence_hits(
     world: &World,
     view: &View,
-    dir: Vec3,
+    dir: DVec3,
     limit: Option<f64>,
     out: &mut Vec<(u32, f64)>,
 ) {
@@ -173,7 +173,7 @@ enum RayStep {
 
 /// Front-to-back along the ray: the first face hit, or the first solid leaf. An explicit stack
 /// keeps a degenerate, very deep tree from overflowing the thread's stack.
-fn trace(world: &World, root: i32, o: Vec3, dir: Vec3, t0: f64, t1: f64) -> Trace {
+fn trace(world: &World, root: i32, o: DVec3, dir: DVec3, t0: f64, t1: f64) -> Trace {
     let bsp = &world.bsp;
     let mut stack = vec![RayStep::Visit {
         child: root,
@@ -249,7 +249,7 @@ fn trace(world: &World, root: i32, o: Vec3, dir: Vec3, t0: f64, t1: f64) -> Trac
 }
 
 /// Whether `p` (on the surface's plane) lies inside its convex polygon, either winding.
-fn inside(s: &Surface, p: Vec3) -> bool {
+fn inside(s: &Surface, p: DVec3) -> bool {
     let n = s.points.len();
     let (mut pos, mut neg) = (false, false);
     for i in 0..n {

@@ -1,10 +1,10 @@
 //! One frame of the fast renderer: visibility, edges, spans, surfaces, raster.
 
+use glam::DVec3;
 use std::time::Instant;
 
 use crate::camera::{Camera, View};
 use crate::edges::{BACKGROUND, EdgeList, EdgeStats, SpanSurface};
-use quake_formats::geom::Vec3;
 
 use crate::raster::{TexMapping, draw_spans, for_each_segment};
 use crate::surface_cache::{CacheStats, LightStyles, SurfaceCache, TRANSPARENT, choose_mip};
@@ -104,7 +104,7 @@ fn candidate_polygon<'w>(
     world: &'w World,
     view: &View,
     c: &Candidate,
-) -> Option<(&'w Surface, &'w [Vec3], SpanSurface)> {
+) -> Option<(&'w Surface, &'w [DVec3], SpanSurface)> {
     let surface = world.surfaces.get(c.face as usize)?.as_ref()?;
     let points = match c.fragment {
         Some((leaf, i)) => &world.leaf_fragments[leaf as usize][i as usize].points,

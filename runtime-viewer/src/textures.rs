@@ -1,9 +1,9 @@
 //! Palettes and mip textures as the renderer uses them, plus the two special looks: sky and
 //! warped liquids.
 
+use glam::DVec3;
 use std::path::{Path, PathBuf};
 
-use quake_formats::geom::Vec3;
 use quake_formats::miptex::MipTex;
 use quake_formats::palette::{FIRST_FULLBRIGHT, Palette};
 
@@ -221,8 +221,8 @@ pub fn liquid_color(
 
 /// The sky's colour along view direction `dir`: the front layer (left half of the texture,
 /// index 0 transparent) over the back layer (right half), both projected onto a flattened dome.
-pub fn sky_color(tex: &Texture, palette: &PackedPalette, dir: Vec3) -> u32 {
-    let flat = Vec3::new(dir.x, dir.y, dir.z * 3.0);
+pub fn sky_color(tex: &Texture, palette: &PackedPalette, dir: DVec3) -> u32 {
+    let flat = DVec3::new(dir.x, dir.y, dir.z * 3.0);
     let len = flat.length().max(1e-9);
     let scale = 6.0 * 63.0 / len;
     let half = (tex.width / 2).max(1) as i32;

@@ -2,9 +2,10 @@
 //! nodes culled by the frustum, faces culled by facing, and a sort key per face from the order
 //! of the BSP walk (smaller keys are nearer).
 
+use glam::DVec3;
 use quake_formats::PvsRow;
 use quake_formats::bsp::contents;
-use quake_formats::geom::{ON_EPSILON, Vec3};
+use quake_formats::geom::ON_EPSILON;
 
 use crate::camera::View;
 use crate::world::World;
@@ -82,7 +83,7 @@ impl Visibility {
         out.clear();
         self.frame = self.frame.wrapping_add(1).max(1);
         let o = view.origin;
-        let camera_leaf = world.bsp.leaf_at(o.to_f32()).unwrap_or(0);
+        let camera_leaf = world.bsp.leaf_at(o.as_vec3().to_array()).unwrap_or(0);
         let pvs_leaves = self.mark_leaves(world, camera_leaf);
         let mut walk = Walk {
             world,
@@ -185,7 +186,7 @@ impl Visibility {
             }
             // The box corners furthest along and against the plane's normal.
             let corner = |toward: bool| {
-                Vec3::new(
+                DVec3::new(
                     pick((plane.normal.x >= 0.0) == toward, mins[0], maxs[0]),
                     pick((plane.normal.y >= 0.0) == toward, mins[1], maxs[1]),
                     pick((plane.normal.z >= 0.0) == toward, mins[2], maxs[2]),

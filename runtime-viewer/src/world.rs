@@ -2,13 +2,14 @@
 //! lightmap rectangles, textures, the palette, lightmaps as RGB, node/leaf parents, and brush
 //! models cut into the world's leaves so they sort with the world.
 
+use glam::{DVec3, Vec3};
 use std::path::Path;
 
 use quake_formats::Bsp;
 use quake_formats::bsp::{contents, limits::MAX_LIGHTMAPS, texinfo_flags};
 use quake_formats::entities::{Entity, parse_entities};
 use quake_formats::extents::LightmapExtents;
-use quake_formats::geom::{Plane, Split, Vec3, Winding};
+use quake_formats::geom::{Plane, Split, Winding};
 use quake_formats::palette::Palette;
 
 use crate::error::{Result, ViewerError};
@@ -22,11 +23,11 @@ pub const NO_STYLE: u8 = 255;
 pub struct Surface {
     /// The face's plane, facing the side it is seen from.
     pub plane: Plane,
-    pub points: Vec<Vec3>,
+    pub points: Vec<DVec3>,
     /// Texture coordinates: `s = s_axis · p + s_offset`, likewise t.
-    pub s_axis: Vec3,
+    pub s_axis: DVec3,
     pub s_offset: f64,
-    pub t_axis: Vec3,
+    pub t_axis: DVec3,
     pub t_offset: f64,
     pub texture: usize,
     pub kind: TextureKind,
@@ -37,7 +38,7 @@ pub struct Surface {
 }
 
 impl Surface {
-    pub fn st(&self, p: Vec3) -> (f64, f64) {
+    pub fn st(&self, p: DVec3) -> (f64, f64) {
         (
             self.s_axis.dot(p) + self.s_offset,
             self.t_axis.dot(p) + self.t_offset,
@@ -53,7 +54,7 @@ impl Surface {
 #[derive(Debug, Clone)]
 pub struct Fragment {
     pub face: u32,
-    pub points: Vec<Vec3>,
+    pub points: Vec<DVec3>,
 }
 
 /// Counts for the load summary.
@@ -153,9 +154,9 @@ impl World {
         };
 
         // Each drawn brush model's entity origin moves its faces.
-        let mut model_origin: Vec<Option<Vec3>> = vec![None; bsp.models.len()];
+        let mut model_origin: Vec<Option<DVec3>> = vec![None; bsp.models.len()];
         if let Some(slot) = model_origin.first_mut() {
-            *slot = Some(Vec3::ZERO);
+            *slot = Some(DVec3::ZERO);
         }
         for e in &entities {
             let Some(index) = e.get("model").and_then(|m| m.strip_prefix('*')) else {
@@ -170,10 +171,10 @@ impl World {
             }
             if let Some(slot) = model_origin.get_mut(index) {
                 let o = e.get_floats::<3>("origin").unwrap_or([0.0; 3]);
-                *slot = Some(Vec3::new(o[0], o[1], o[2]));
+                *slot = Some(DVec3::new(o[0], o[1], o[2]));
             }
         }
-        let mut face_origin: Vec<Option<(usize, Vec3)>> = vec![None; bsp.faces.len()];
+        let mut face_origin: Vec<Option<(usize, DVec3)>> = vec![None; bsp.faces.len()];
         for (m, (model, origin)) in bsp.models.iter().zip(&model_origin).enumerate() {
             let Some(origin) = origin else { continue };
             let first = model.first_face as usize;
@@ -185,7 +186,7 @@ impl World {
 
         let surfaces: Vec<Option<Surface>> = (0..bsp.faces.len())
             .map(|f| {
-                let origin = face_origin[f].map_or(Vec3::ZERO, |(_, o)| o);
+                let origin = face_origin[f].map_or(DVec3::ZERO, |(_, o)| o);
                 build_surface(&bsp, f, origin, &textures, fallback_texture, light.len())
             })
             .collect();
@@ -247,12 +248,12 @@ impl World {
     pub fn node_plane(&self, node: usize) -> Option<Plane> {
         let n = self.bsp.nodes.get(node)?;
         let p = self.bsp.planes.get(n.plane as usize)?;
-        Some(Plane::new(Vec3::from_f32(p.normal), p.dist as f64))
+        Some(Plane::new(Vec3::from(p.normal).as_dvec3(), p.dist as f64))
     }
 
     /// Where the player starts: `info_player_start` (else a deathmatch, coop or intermission
     /// spot), eye height 22 above its origin, and its yaw (`angle`, or `mangle`'s yaw).
-    pub fn player_start(&self) -> Option<(Vec3, f64)> {
+    pub fn player_start(&self) -> Option<(DVec3, f64)> {
         const SPOTS: [&str; 4] = [
             "info_player_start",
             "info_player_deathmatch",
@@ -271,12 +272,12 @@ impl World {
             } else {
                 22.0
             };
-            Some((Vec3::new(o[0], o[1], o[2] + eye), yaw))
+            Some((DVec3::new(o[0], o[1], o[2] + eye), yaw))
         })
     }
 
     /// Spawn and intermission spots in entity order, for a flythrough path.
-    pub fn spots(&self) -> Vec<(Vec3, f64)> {
+    pub fn spots(&self) -> Vec<(DVec3, f64)> {
         self.entities
             .iter()
             .filter(|e| {
@@ -285,7 +286,7 @@ impl World {
             .filter_map(|e| {
                 let o = e.get_floats::<3>("origin")?;
                 Some((
-                    Vec3::new(o[0], o[1], o[2] + 22.0),
+                    DVec3::new(o[0], o[1], o[2] + 22.0),
                     e.get_float("angle").unwrap_or(0.0),
                 ))
             })
@@ -296,7 +297,7 @@ impl World {
 fn build_surface(
     bsp: &Bsp,
     f: usize,
-    origin: Vec3,
+    origin: DVec3,
     textures: &[Texture],
     fallback_texture: usize,
     light_len: usize,
@@ -308,13 +309,13 @@ fn build_surface(
     }
     let ti = bsp.texinfo.get(face.texinfo as usize)?;
     let bp = bsp.planes.get(face.plane as usize)?;
-    let mut plane = Plane::new(Vec3::from_f32(bp.normal), bp.dist as f64);
+    let mut plane = Plane::new(Vec3::from(bp.normal).as_dvec3(), bp.dist as f64);
     if face.side != 0 {
         plane = plane.flipped();
     }
     plane.dist += plane.normal.dot(origin);
     let extents = LightmapExtents::from_points(&raw_points, &ti.vecs);
-    let axis = |v: [f32; 4]| Vec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
+    let axis = |v: [f32; 4]| DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
     let (s_axis, t_axis) = (axis(ti.vecs[0]), axis(ti.vecs[1]));
     let texture = if (ti.miptex as usize) < fallback_texture {
         ti.miptex as usize
@@ -331,7 +332,7 @@ fn build_surface(
         plane,
         points: raw_points
             .iter()
-            .map(|&p| Vec3::from_f32(p) + origin)
+            .map(|&p| Vec3::from(p).as_dvec3() + origin)
             .collect(),
         s_axis,
         s_offset: ti.vecs[0][3] as f64 - s_axis.dot(origin),
@@ -405,7 +406,7 @@ fn cut_into_leaves(bsp: &Bsp, face: u32, winding: Winding, out: &mut [Vec<Fragme
         let Some(p) = bsp.planes.get(node.plane as usize) else {
             continue;
         };
-        let plane = Plane::new(Vec3::from_f32(p.normal), p.dist as f64);
+        let plane = Plane::new(Vec3::from(p.normal).as_dvec3(), p.dist as f64);
         let [front, back] = node.children;
         match w.split(&plane) {
             Split::Front(w) => stack.push((front, w)),

@@ -1,9 +1,9 @@
 //! The viewer on the shared corpus BSPs: every map renders, and the fast renderer agrees with the
 //! reference ray caster. Skips (saying so) when the corpus is absent.
 
+use glam::DVec3;
 use std::path::{Path, PathBuf};
 
-use quake_formats::geom::Vec3;
 use runtime_viewer::reference::{Comparison, compare, render_reference};
 use runtime_viewer::render::NO_FACE;
 use runtime_viewer::{Camera, Frame, RenderOptions, Renderer, World};
@@ -31,7 +31,7 @@ fn load(corpus: &Path, map: &str) -> World {
     World::load(&corpus.join("public/bsp").join(map), Some(&palette)).expect(map)
 }
 
-fn camera(origin: Vec3, angles: [f64; 3], width: usize, height: usize) -> Camera {
+fn camera(origin: DVec3, angles: [f64; 3], width: usize, height: usize) -> Camera {
     Camera {
         origin,
         angles,
@@ -122,7 +122,7 @@ fn fences_are_see_through() {
     let Some(corpus) = corpus() else { return };
     let world = load(&corpus, "ericw-tools/q1_detail_fence2.bsp");
     assert!(!world.fence_faces.is_empty());
-    let cam = camera(Vec3::new(64.0, -200.0, 100.0), [10.0, 80.0, 0.0], 320, 200);
+    let cam = camera(DVec3::new(64.0, -200.0, 100.0), [10.0, 80.0, 0.0], 320, 200);
     let options = RenderOptions {
         span_step: 1,
         ..RenderOptions::default()

@@ -9,8 +9,9 @@
 //! both trees for the truth.
 
 use bsp_compiler::{CompileOptions, MapSource, compile};
+use glam::DVec3;
 use quake_formats::Bsp;
-use quake_formats::geom::Vec3;
+
 use quake_formats::rng::SplitMix64;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -37,7 +38,7 @@ impl Side {
     }
 
     /// The vis leaf (row index) holding `p`, when it is open.
-    fn open_leaf(&self, p: Vec3) -> Option<usize> {
+    fn open_leaf(&self, p: DVec3) -> Option<usize> {
         let leaf = self.hull.leaf_at(p);
         (leaf >= 1 && leaf <= self.pvs.num_leafs() && is_open(self.contents[leaf]))
             .then_some(leaf - 1)
@@ -112,12 +113,12 @@ fn main() {
             let ours = compute_vis(&out.portals, &options).expect("vis");
             let ours = Side::new(&out.bsp, ours.pvs);
             let world = &out.bsp.models[0];
-            let lo = Vec3::new(
+            let lo = DVec3::new(
                 world.mins[0] as f64,
                 world.mins[1] as f64,
                 world.mins[2] as f64,
             );
-            let hi = Vec3::new(
+            let hi = DVec3::new(
                 world.maxs[0] as f64,
                 world.maxs[1] as f64,
                 world.maxs[2] as f64,
@@ -153,10 +154,10 @@ fn main() {
 }
 
 /// `CHUNK` pairs of points open in both BSPs, drawn uniformly in the box `lo..hi`.
-fn sample_chunk(ours: &Side, theirs: &Side, lo: Vec3, hi: Vec3, chunk: u64) -> Counts {
+fn sample_chunk(ours: &Side, theirs: &Side, lo: DVec3, hi: DVec3, chunk: u64) -> Counts {
     let mut rng = SplitMix64::new(0x5eed ^ chunk.wrapping_mul(0x2545_f491_4f6c_dd1d));
     let mut point = || loop {
-        let mut p = Vec3::ZERO;
+        let mut p = DVec3::ZERO;
         for i in 0..3 {
             p[i] = lo[i] + rng.unit() * (hi[i] - lo[i]);
         }

@@ -3,9 +3,10 @@
 
 use crate::VisError;
 use crate::pvs::Pvs;
+use glam::Vec3;
 use quake_formats::Bsp;
 use quake_formats::bsp::contents;
-use quake_formats::geom::{Bounds, Vec3};
+use quake_formats::geom::Bounds;
 use rayon::prelude::*;
 
 /// Ambient channels in `Leaf::ambient` order.
@@ -70,8 +71,8 @@ fn box_distance(a: &Bounds, b: &Bounds) -> f64 {
 
 fn leaf_bounds(mins: [f32; 3], maxs: [f32; 3]) -> Bounds {
     let mut b = Bounds::EMPTY;
-    b.add_point(Vec3::from_f32(mins));
-    b.add_point(Vec3::from_f32(maxs));
+    b.add_point(Vec3::from(mins).as_dvec3());
+    b.add_point(Vec3::from(maxs).as_dvec3());
     b
 }
 
@@ -105,7 +106,7 @@ pub fn ambient_levels(bsp: &mut Bsp, pvs: &Pvs) -> Result<usize, VisError> {
                     let kind = ambient_of_texture(&tex.name())?;
                     let mut b = Bounds::EMPTY;
                     for v in bsp.face_vertices(face)? {
-                        b.add_point(Vec3::from_f32(v));
+                        b.add_point(Vec3::from(v).as_dvec3());
                     }
                     Some((kind, b))
                 }))

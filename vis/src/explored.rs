@@ -11,14 +11,16 @@
 //! of paths exponential in the depth down to a few per portal.
 
 use crate::bitset::WindowBits;
-use quake_formats::geom::{POINT_EPSILON, Vec3};
+use glam::DVec3;
+use quake_formats::geom::DVec3Ext;
+use quake_formats::geom::POINT_EPSILON;
 
 /// At most this many states are kept per portal; later ones are walked without being kept.
 const STATES_PER_PORTAL: usize = 4;
 
 struct State {
-    source: Vec<Vec3>,
-    pass: Vec<Vec3>,
+    source: Vec<DVec3>,
+    pass: Vec<DVec3>,
     might: WindowBits,
 }
 
@@ -45,11 +47,11 @@ impl Explored {
     pub fn covers(
         &self,
         portal: usize,
-        source: &[Vec3],
-        pass: &[Vec3],
+        source: &[DVec3],
+        pass: &[DVec3],
         might: &WindowBits,
-        source_normal: Vec3,
-        pass_normal: Vec3,
+        source_normal: DVec3,
+        pass_normal: DVec3,
     ) -> bool {
         self.states[portal].iter().any(|s| {
             convex_contains(&s.pass, pass, pass_normal)
@@ -59,7 +61,7 @@ impl Explored {
     }
 
     /// Remember a state about to be walked on from `portal`.
-    pub fn record(&mut self, portal: usize, source: &[Vec3], pass: &[Vec3], might: &WindowBits) {
+    pub fn record(&mut self, portal: usize, source: &[DVec3], pass: &[DVec3], might: &WindowBits) {
         let kept = &mut self.states[portal];
         if kept.len() >= STATES_PER_PORTAL {
             return;
@@ -83,12 +85,12 @@ impl Explored {
 
 /// Whether the convex winding `inner` lies inside the convex winding `outer` (both in one plane
 /// with normal `normal`), allowing [`POINT_EPSILON`].
-pub fn convex_contains(outer: &[Vec3], inner: &[Vec3], normal: Vec3) -> bool {
+pub fn convex_contains(outer: &[DVec3], inner: &[DVec3], normal: DVec3) -> bool {
     let n = outer.len();
     if n < 3 {
         return false;
     }
-    let center = outer.iter().fold(Vec3::ZERO, |a, &v| a + v) / n as f64;
+    let center = outer.iter().fold(DVec3::ZERO, |a, &v| a + v) / n as f64;
     (0..n).all(|i| {
         let a = outer[i];
         let Some(mut inward) = (outer[(i + 1) % n] - a).cross(normal).normalized() else {
@@ -106,16 +108,16 @@ mod tests {
     use super::*;
     use crate::bitset::BitSet;
 
-    fn square(size: f64, offset: f64) -> Vec<Vec3> {
+    fn square(size: f64, offset: f64) -> Vec<DVec3> {
         [(0.0, 0.0), (0.0, 1.0), (1.0, 1.0), (1.0, 0.0)]
             .iter()
-            .map(|&(x, y)| Vec3::new(offset + x * size, offset + y * size, 5.0))
+            .map(|&(x, y)| DVec3::new(offset + x * size, offset + y * size, 5.0))
             .collect()
     }
 
     #[test]
     fn containment_of_squares() {
-        let up = Vec3::new(0.0, 0.0, 1.0);
+        let up = DVec3::new(0.0, 0.0, 1.0);
         assert!(convex_contains(&square(64.0, 0.0), &square(32.0, 16.0), up));
         assert!(convex_contains(&square(64.0, 0.0), &square(64.0, 0.0), up));
         assert!(!convex_contains(
@@ -132,7 +134,7 @@ mod tests {
 
     #[test]
     fn a_state_covers_smaller_ones_with_a_smaller_bound() {
-        let up = Vec3::new(0.0, 0.0, 1.0);
+        let up = DVec3::new(0.0, 0.0, 1.0);
         let mut explored = Explored::default();
         explored.reset(3);
         let might = |members: &[usize]| {

@@ -35,7 +35,8 @@ use crate::bitset::{BitSet, WindowBits};
 use crate::explored::Explored;
 use crate::portals::{OneWayPortal, PortalGraph};
 use crate::schedule::FlowPlan;
-use quake_formats::geom::{ON_EPSILON, Plane, Vec3};
+use glam::DVec3;
+use quake_formats::geom::{ON_EPSILON, Plane};
 use std::sync::OnceLock;
 
 /// The shared inputs of every portal's flow.
@@ -63,8 +64,8 @@ impl FlowContext<'_> {
 
 /// One step of the walk: the state after passing through a portal (or the base, at the head).
 struct Frame {
-    source: Vec<Vec3>,
-    pass: Vec<Vec3>,
+    source: Vec<DVec3>,
+    pass: Vec<DVec3>,
     /// False at the head, where no portal has been passed yet.
     has_pass: bool,
     /// The plane of the portal passed (the base portal's at the head), facing onwards.
@@ -83,7 +84,7 @@ impl Frame {
             source: Vec::new(),
             pass: Vec::new(),
             has_pass: false,
-            plane: Plane::new(Vec3::ZERO, 0.0),
+            plane: Plane::new(DVec3::ZERO, 0.0),
             might: WindowBits::default(),
             separators: Vec::new(),
             separators_ready: false,
@@ -99,7 +100,7 @@ pub struct Workspace {
     /// Walks skipped because an explored state covered them.
     pub covered: u64,
     frames: Vec<Frame>,
-    scratch: Vec<Vec3>,
+    scratch: Vec<DVec3>,
     explored: Explored,
 }
 
@@ -281,8 +282,8 @@ impl Walk<'_> {
 /// the squared epsilon scaled by the normal's squared length: most are rejected, and this spares
 /// them the square root and divisions, the slowest part of the search.
 fn separating_planes(
-    a: &[Vec3],
-    b: &[Vec3],
+    a: &[DVec3],
+    b: &[DVec3],
     a_behind: bool,
     found: &mut impl FnMut(Plane) -> bool,
 ) -> bool {
@@ -350,7 +351,7 @@ fn separating_planes(
 /// Keep the part of `input` in front of `plane` in `out`; points within [`ON_EPSILON`] count as
 /// on the plane. False (and `out` unspecified) when no point lies in front: a winding lying in
 /// the plane is cut away too.
-pub fn clip_front(input: &[Vec3], plane: &Plane, out: &mut Vec<Vec3>) -> bool {
+pub fn clip_front(input: &[DVec3], plane: &Plane, out: &mut Vec<DVec3>) -> bool {
     out.clear();
     match cut(input, plane) {
         None => false,
@@ -367,7 +368,7 @@ pub fn clip_front(input: &[Vec3], plane: &Plane, out: &mut Vec<Vec3>) -> bool {
 
 /// How `plane` cuts `input`: `None` when no point lies in front (by more than [`ON_EPSILON`]),
 /// else whether any lies behind, so that clipping changes the winding.
-fn cut(input: &[Vec3], plane: &Plane) -> Option<bool> {
+fn cut(input: &[DVec3], plane: &Plane) -> Option<bool> {
     let mut front = false;
     let mut back = false;
     for &p in input {
@@ -379,7 +380,7 @@ fn cut(input: &[Vec3], plane: &Plane) -> Option<bool> {
 }
 
 /// Append to `out` the part of `input` in front of `plane`, which [`cut`] found to cut it.
-fn split_front(input: &[Vec3], plane: &Plane, out: &mut Vec<Vec3>) {
+fn split_front(input: &[DVec3], plane: &Plane, out: &mut Vec<DVec3>) {
     // Distances are computed again rather than kept: cheaper than a buffer for small windings.
     let n = input.len();
     let mut d = plane.distance(input[0]);
@@ -391,7 +392,7 @@ fn split_front(input: &[Vec3], plane: &Plane, out: &mut Vec<Vec3>) {
             out.push(p);
         }
         if d.abs() > ON_EPSILON && dn.abs() > ON_EPSILON && (dn > 0.0) != (d > 0.0) {
-            let mut mid = p.lerp(input[j], d / (d - dn));
+            let mut mid = p.lerp_monotonic(input[j], d / (d - dn));
             // Keep axial coordinates exact so axial splits do not drift.
             for axis in 0..3 {
                 if plane.normal[axis] == 1.0 {
@@ -408,7 +409,7 @@ fn split_front(input: &[Vec3], plane: &Plane, out: &mut Vec<Vec3>) {
 
 /// [`clip_front`] of `input`, a part of `bound`'s winding: a bounding sphere wholly on one side
 /// of the plane decides without testing the points.
-fn clip_within(input: &[Vec3], bound: &OneWayPortal, plane: &Plane, out: &mut Vec<Vec3>) -> bool {
+fn clip_within(input: &[DVec3], bound: &OneWayPortal, plane: &Plane, out: &mut Vec<DVec3>) -> bool {
     match bound.sphere_side(plane) {
         Some(true) => {
             out.clear();
@@ -422,10 +423,10 @@ fn clip_within(input: &[Vec3], bound: &OneWayPortal, plane: &Plane, out: &mut Ve
 
 /// [`clip_within`] replacing `winding`, with `scratch` as the other buffer.
 fn clip_in_place(
-    winding: &mut Vec<Vec3>,
+    winding: &mut Vec<DVec3>,
     bound: &OneWayPortal,
     plane: &Plane,
-    scratch: &mut Vec<Vec3>,
+    scratch: &mut Vec<DVec3>,
 ) -> bool {
     match bound.sphere_side(plane) {
         Some(kept) => kept,
@@ -445,21 +446,22 @@ fn clip_in_place(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use quake_formats::geom::DVec3Ext;
     use quake_formats::geom::{Split, Winding};
     use quake_formats::rng::SplitMix64;
 
-    fn square() -> Vec<Vec3> {
+    fn square() -> Vec<DVec3> {
         vec![
-            Vec3::new(0.0, 0.0, 0.0),
-            Vec3::new(0.0, 64.0, 0.0),
-            Vec3::new(64.0, 64.0, 0.0),
-            Vec3::new(64.0, 0.0, 0.0),
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(0.0, 64.0, 0.0),
+            DVec3::new(64.0, 64.0, 0.0),
+            DVec3::new(64.0, 0.0, 0.0),
         ]
     }
 
     #[test]
     fn clip_matches_the_shared_winding_split() {
-        let plane = Plane::new(Vec3::new(0.6, 0.8, 0.0), 30.0);
+        let plane = Plane::new(DVec3::new(0.6, 0.8, 0.0), 30.0);
         let mut out = Vec::new();
         assert!(clip_front(&square(), &plane, &mut out));
         let Split::Both { front, .. } = Winding::new(square()).split(&plane) else {
@@ -471,16 +473,16 @@ mod tests {
     #[test]
     fn clip_drops_windings_behind_or_in_the_plane() {
         let mut out = Vec::new();
-        let up = Plane::new(Vec3::new(0.0, 0.0, 1.0), 0.0);
+        let up = Plane::new(DVec3::new(0.0, 0.0, 1.0), 0.0);
         assert!(!clip_front(&square(), &up, &mut out));
         assert!(!clip_front(
             &square(),
-            &Plane::new(Vec3::new(1.0, 0.0, 0.0), 64.0),
+            &Plane::new(DVec3::new(1.0, 0.0, 0.0), 64.0),
             &mut out
         ));
         assert!(clip_front(
             &square(),
-            &Plane::new(Vec3::new(1.0, 0.0, 0.0), -1.0),
+            &Plane::new(DVec3::new(1.0, 0.0, 0.0), -1.0),
             &mut out
         ));
         assert_eq!(out, square());
@@ -491,9 +493,9 @@ mod tests {
         // Source at z=0, pass at z=64 shifted by 32 in x: the separators keep what lies
         // beyond the pass within the sheared prism.
         let source = square();
-        let pass: Vec<Vec3> = square()
+        let pass: Vec<DVec3> = square()
             .iter()
-            .map(|&v| v + Vec3::new(32.0, 0.0, 64.0))
+            .map(|&v| v + DVec3::new(32.0, 0.0, 64.0))
             .collect();
         let mut planes = Vec::new();
         separating_planes(&source, &pass, true, &mut |p| {
@@ -506,21 +508,21 @@ mod tests {
             assert!(pass.iter().all(|&v| plane.distance(v) >= -ON_EPSILON));
         }
         // A point at z=128 straight along the shear is kept; one far to the side is cut.
-        let inside = Vec3::new(96.0, 32.0, 128.0);
-        let outside = Vec3::new(-64.0, 32.0, 128.0);
+        let inside = DVec3::new(96.0, 32.0, 128.0);
+        let outside = DVec3::new(-64.0, 32.0, 128.0);
         assert!(planes.iter().all(|p| p.distance(inside) >= -ON_EPSILON));
         assert!(planes.iter().any(|p| p.distance(outside) < -ON_EPSILON));
     }
 
     /// A regular polygon of 3 to 8 points, axial or on a random plane, somewhere in a map.
-    fn random_winding(rng: &mut SplitMix64) -> Vec<Vec3> {
+    fn random_winding(rng: &mut SplitMix64) -> Vec<DVec3> {
         let sides = 3 + rng.below(6);
         let mut coordinate = || rng.unit() * 2.0 - 1.0;
-        let center = Vec3::new(coordinate(), coordinate(), coordinate()) * 1024.0;
-        let axis = Vec3::new(coordinate(), coordinate(), coordinate());
-        let (u, v) = match axis.cross(Vec3::new(0.0, 0.0, 1.0)).normalized() {
+        let center = DVec3::new(coordinate(), coordinate(), coordinate()) * 1024.0;
+        let axis = DVec3::new(coordinate(), coordinate(), coordinate());
+        let (u, v) = match axis.cross(DVec3::new(0.0, 0.0, 1.0)).normalized() {
             Some(u) if coordinate() > 0.0 => (u, axis.cross(u).normalized().unwrap_or(u)),
-            _ => (Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0)),
+            _ => (DVec3::new(1.0, 0.0, 0.0), DVec3::new(0.0, 1.0, 0.0)),
         };
         let radius = 8.0 + (coordinate() + 1.0) * 64.0;
         (0..sides)
@@ -533,7 +535,7 @@ mod tests {
 
     /// The search with every candidate's normal normalized, as classic vis does it: the
     /// reference the scaled comparisons of [`separating_planes`] must agree with.
-    fn separating_planes_normalized(a: &[Vec3], b: &[Vec3], a_behind: bool) -> Vec<Plane> {
+    fn separating_planes_normalized(a: &[DVec3], b: &[DVec3], a_behind: bool) -> Vec<Plane> {
         let mut out = Vec::new();
         let n = a.len();
         for i in 0..n {
@@ -574,7 +576,7 @@ mod tests {
             let mut b = random_winding(&mut rng);
             if rng.below(4) == 0 {
                 // Parallel edges: near-ties between candidates, as axial maps are full of.
-                b = a.iter().map(|&v| v + Vec3::new(16.0, 0.0, 96.0)).collect();
+                b = a.iter().map(|&v| v + DVec3::new(16.0, 0.0, 96.0)).collect();
             }
             for a_behind in [true, false] {
                 let mut planes = Vec::new();
@@ -599,7 +601,7 @@ mod tests {
                 continue;
             };
             let portal = OneWayPortal::new(winding.clone(), plane, 0, 1);
-            let normal = Vec3::new(rng.unit() - 0.5, rng.unit() - 0.5, rng.unit() - 0.5);
+            let normal = DVec3::new(rng.unit() - 0.5, rng.unit() - 0.5, rng.unit() - 0.5);
             let Some(normal) = normal.normalized() else {
                 continue;
             };

@@ -9,30 +9,31 @@
 //! into the leaf it leads to: whatever is seen through it lies in front of it.
 
 use crate::VisError;
-use quake_formats::geom::{ON_EPSILON, POINT_EPSILON, Plane, Vec3};
+use glam::DVec3;
+use quake_formats::geom::{ON_EPSILON, POINT_EPSILON, Plane};
 use quake_formats::prt::PortalFile;
 
 /// A portal seen from one side: looking from `from_cluster` through `winding` into `to_cluster`.
 #[derive(Debug, Clone)]
 pub struct OneWayPortal {
-    pub winding: Vec<Vec3>,
+    pub winding: Vec<DVec3>,
     /// Faces into `to_cluster`.
     pub plane: Plane,
     pub from_cluster: u32,
     pub to_cluster: u32,
     /// A sphere holding the winding, for quick plane tests.
-    pub center: Vec3,
+    pub center: DVec3,
     pub radius: f64,
 }
 
 impl OneWayPortal {
     pub(crate) fn new(
-        winding: Vec<Vec3>,
+        winding: Vec<DVec3>,
         plane: Plane,
         from_cluster: u32,
         to_cluster: u32,
     ) -> OneWayPortal {
-        let center = winding.iter().fold(Vec3::ZERO, |a, &v| a + v) / winding.len().max(1) as f64;
+        let center = winding.iter().fold(DVec3::ZERO, |a, &v| a + v) / winding.len().max(1) as f64;
         let radius = winding
             .iter()
             .map(|&v| (v - center).length())

@@ -4,9 +4,10 @@
 
 use crate::VisError;
 use crate::pvs::Pvs;
+use glam::DVec3;
 use quake_formats::Bsp;
 use quake_formats::bsp::{Leaf, contents};
-use quake_formats::geom::{Plane, Vec3};
+use quake_formats::geom::Plane;
 use quake_formats::rng::SplitMix64;
 use rayon::prelude::*;
 
@@ -50,7 +51,7 @@ impl Hull0 {
                         return Err(bad(format!("node {i} has child {c} outside the tree")));
                     }
                 }
-                let normal = Vec3::new(p.normal[0] as f64, p.normal[1] as f64, p.normal[2] as f64);
+                let normal = DVec3::new(p.normal[0] as f64, p.normal[1] as f64, p.normal[2] as f64);
                 Ok((Plane::new(normal, p.dist as f64), n.children))
             })
             .collect::<Result<Vec<_>, VisError>>()?;
@@ -88,7 +89,7 @@ impl Hull0 {
         Ok(())
     }
 
-    pub fn leaf_at(&self, p: Vec3) -> usize {
+    pub fn leaf_at(&self, p: DVec3) -> usize {
         let mut n = self.head;
         while n >= 0 {
             let (plane, children) = &self.nodes[n as usize];
@@ -98,11 +99,11 @@ impl Hull0 {
     }
 
     /// True when the segment from `a` to `b` passes only through open leaves.
-    pub fn segment_is_open(&self, a: Vec3, b: Vec3) -> bool {
+    pub fn segment_is_open(&self, a: DVec3, b: DVec3) -> bool {
         self.open_below(self.head, a, b)
     }
 
-    fn open_below(&self, node: i32, a: Vec3, b: Vec3) -> bool {
+    fn open_below(&self, node: i32, a: DVec3, b: DVec3) -> bool {
         if node < 0 {
             return is_open(self.leaf_contents[(-(node + 1)) as usize]);
         }
@@ -115,7 +116,7 @@ impl Hull0 {
         if da < 0.0 && db < 0.0 {
             return self.open_below(children[1], a, b);
         }
-        let mid = a.lerp(b, da / (da - db));
+        let mid = a.lerp_monotonic(b, da / (da - db));
         let near = usize::from(da < 0.0);
         self.open_below(children[near], a, mid) && self.open_below(children[1 - near], mid, b)
     }
@@ -208,7 +209,7 @@ pub fn sample_visibility(
 
 /// A point in a random open leaf: a random point of the leaf's box that the tree places in that
 /// leaf (the box may reach into neighbours). Leaves where that keeps failing are redrawn.
-fn random_point(bsp: &Bsp, hull: &Hull0, open: &[usize], rng: &mut SplitMix64) -> (Vec3, usize) {
+fn random_point(bsp: &Bsp, hull: &Hull0, open: &[usize], rng: &mut SplitMix64) -> (DVec3, usize) {
     loop {
         let leaf = open[rng.below(open.len())];
         for _ in 0..32 {
@@ -220,8 +221,8 @@ fn random_point(bsp: &Bsp, hull: &Hull0, open: &[usize], rng: &mut SplitMix64) -
     }
 }
 
-fn point_in_box(leaf: &Leaf, rng: &mut SplitMix64) -> Vec3 {
-    let mut p = Vec3::ZERO;
+fn point_in_box(leaf: &Leaf, rng: &mut SplitMix64) -> DVec3 {
+    let mut p = DVec3::ZERO;
     for i in 0..3 {
         p[i] = leaf.mins[i] as f64 + rng.unit() * (leaf.maxs[i] - leaf.mins[i]) as f64;
     }

@@ -3,9 +3,10 @@
 //! The same world also builds as a tiny BSP (an axis-aligned hull 0 tree), so sight lines can be
 //! traced through it.
 
+use glam::DVec3;
 use quake_formats::Bsp;
 use quake_formats::bsp::{BspPlane, Leaf, Model, Node, contents};
-use quake_formats::geom::{Vec3, Winding};
+use quake_formats::geom::Winding;
 use quake_formats::prt::{PortalFile, PrtPortal};
 use quake_formats::rng::SplitMix64;
 
@@ -112,8 +113,8 @@ impl VoxelWorld {
         leaf
     }
 
-    fn corner(&self, c: [usize; 3]) -> Vec3 {
-        Vec3::new(
+    fn corner(&self, c: [usize; 3]) -> DVec3 {
+        DVec3::new(
             c[0] as f64 * self.cell,
             c[1] as f64 * self.cell,
             c[2] as f64 * self.cell,
@@ -134,9 +135,9 @@ impl VoxelWorld {
                 }
                 let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
                 let origin = self.corner(n);
-                let mut du = Vec3::ZERO;
+                let mut du = DVec3::ZERO;
                 du[u] = self.cell;
-                let mut dv = Vec3::ZERO;
+                let mut dv = DVec3::ZERO;
                 dv[v] = self.cell;
                 let mut winding =
                     Winding::new(vec![origin, origin + du, origin + du + dv, origin + dv]);
@@ -203,8 +204,8 @@ impl VoxelWorld {
         let mut bsp = Bsp::default();
         bsp.leafs.push(Leaf::SHARED_SOLID);
         for c in self.open_cells() {
-            let lo = self.corner(c).to_f32();
-            let hi = self.corner(c.map(|x| x + 1)).to_f32();
+            let lo = self.corner(c).as_vec3().to_array();
+            let hi = self.corner(c.map(|x| x + 1)).as_vec3().to_array();
             bsp.leafs.push(Leaf {
                 contents: contents::EMPTY,
                 vis_offset: -1,
@@ -216,7 +217,7 @@ impl VoxelWorld {
             });
         }
         let head = self.build_tree(&mut bsp, &self.leaf_numbers(), [0; 3], self.size);
-        let hi = self.corner(self.size).to_f32();
+        let hi = self.corner(self.size).as_vec3().to_array();
         bsp.models.push(Model {
             mins: [0.0; 3],
             maxs: hi,
@@ -253,8 +254,8 @@ impl VoxelWorld {
         bsp.nodes.push(Node {
             plane: (bsp.planes.len() - 1) as u32,
             children: [0, 0],
-            mins: self.corner(lo).to_f32(),
-            maxs: self.corner(hi).to_f32(),
+            mins: self.corner(lo).as_vec3().to_array(),
+            maxs: self.corner(hi).as_vec3().to_array(),
             first_face: 0,
             num_faces: 0,
         });

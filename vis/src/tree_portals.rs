@@ -8,8 +8,9 @@
 use crate::VisError;
 use crate::lump::world_vis_leafs;
 use crate::sample::is_open;
+use glam::{DVec3, Vec3};
 use quake_formats::Bsp;
-use quake_formats::geom::{Plane, Vec3, Winding};
+use quake_formats::geom::{Plane, Winding};
 use quake_formats::prt::{PortalFile, PrtPortal};
 
 struct Tree<'a> {
@@ -28,7 +29,7 @@ pub fn portals_from_bsp(bsp: &Bsp) -> Result<PortalFile, VisError> {
     let planes = bsp
         .planes
         .iter()
-        .map(|p| Plane::new(Vec3::from_f32(p.normal), p.dist as f64))
+        .map(|p| Plane::new(Vec3::from(p.normal).as_dvec3(), p.dist as f64))
         .collect();
     let tree = Tree {
         bsp,
@@ -38,7 +39,7 @@ pub fn portals_from_bsp(bsp: &Bsp) -> Result<PortalFile, VisError> {
     // The world's box, a little larger, bounds every node region.
     let mut bounds = Vec::new();
     for axis in 0..3 {
-        let mut normal = Vec3::ZERO;
+        let mut normal = DVec3::ZERO;
         normal[axis] = 1.0;
         bounds.push(Plane::new(normal, world.mins[axis] as f64 - 64.0));
         bounds.push(Plane::new(-normal, -(world.maxs[axis] as f64 + 64.0)));

@@ -6,6 +6,7 @@
 use super::{BounceCounts, Field, GatherPoint, StyleLuxels, point_key};
 use crate::samples::FaceSamples;
 use crate::scene::TraceScene;
+use glam::Vec3;
 
 /// Strata along each axis of the unit square mapped onto the hemisphere.
 const STRATA: usize = 4;
@@ -24,7 +25,7 @@ pub fn gather(
     let mut out: StyleLuxels = Vec::new();
     for (i, &point) in samples.points.iter().enumerate() {
         let at = GatherPoint {
-            point: quake_formats::geom::Vec3::from_f32(point),
+            point: Vec3::from(point).as_dvec3(),
             flat: samples.normal,
             shading: samples.normal_at(i),
             key: point_key(samples.face, i, pass),

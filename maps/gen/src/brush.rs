@@ -1,20 +1,21 @@
 //! A small model of a `.map` file (entities, brushes, faces) and its text writer, in the standard
 //! Quake format or Valve 220.
 
-use quake_formats::geom::{Bounds, Plane, Vec3};
+use glam::DVec3;
+use quake_formats::geom::{Bounds, Plane};
 
 /// One brush face: three points on its plane, listed so that `(p1 - p2) x (p3 - p2)` points out
 /// of the brush (the `.map` convention [`Plane::from_points`] follows).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Face {
-    pub points: [Vec3; 3],
+    pub points: [DVec3; 3],
     pub texture: String,
 }
 
 impl Face {
-    pub fn new(points: [Vec3; 3], texture: &str) -> Face {
+    pub fn new(points: [DVec3; 3], texture: &str) -> Face {
         Face {
-            points: points.map(|p| Vec3::new(snap(p.x), snap(p.y), snap(p.z))),
+            points: points.map(|p| DVec3::new(snap(p.x), snap(p.y), snap(p.z))),
             texture: texture.to_string(),
         }
     }
@@ -47,7 +48,7 @@ impl Brush {
     /// A six-sided brush from the corners of a (transformed) box: corner `i` has the high X when
     /// bit 0 of `i` is set, high Y for bit 1, high Z for bit 2. The corners of each side must be
     /// coplanar and the transform orientation-preserving (a rotation, shear or translation).
-    pub fn hexahedron(corners: [Vec3; 8], textures: SixTextures) -> Brush {
+    pub fn hexahedron(corners: [DVec3; 8], textures: SixTextures) -> Brush {
         let mut faces = Vec::with_capacity(6);
         for axis in 0..3 {
             let (i, j) = ((axis + 1) % 3, (axis + 2) % 3);
@@ -66,7 +67,7 @@ impl Brush {
 }
 
 /// The eight corners of a box in [`Brush::hexahedron`]'s order.
-pub fn box_corners(b: Bounds) -> [Vec3; 8] {
+pub fn box_corners(b: Bounds) -> [DVec3; 8] {
     std::array::from_fn(|i| {
         let pick = |bit: usize, axis: usize| {
             if i & bit != 0 {
@@ -75,15 +76,15 @@ pub fn box_corners(b: Bounds) -> [Vec3; 8] {
                 b.mins[axis]
             }
         };
-        Vec3::new(pick(1, 0), pick(2, 1), pick(4, 2))
+        DVec3::new(pick(1, 0), pick(2, 1), pick(4, 2))
     })
 }
 
 /// A box from its low and high corners.
 pub fn aabb(lo: [f64; 3], hi: [f64; 3]) -> Bounds {
     Bounds {
-        mins: Vec3::new(lo[0], lo[1], lo[2]),
-        maxs: Vec3::new(hi[0], hi[1], hi[2]),
+        mins: DVec3::new(lo[0], lo[1], lo[2]),
+        maxs: DVec3::new(hi[0], hi[1], hi[2]),
     }
 }
 
@@ -218,7 +219,7 @@ const BASE_AXES: [Axes; 3] = [
     ([1, 0, 0], [0, 0, -1]),
 ];
 
-fn texture_axes(normal: Vec3) -> Axes {
+fn texture_axes(normal: DVec3) -> Axes {
     // Ties go to the floor axes first, as in Quake.
     let mut best = 2;
     for axis in [0, 1] {
@@ -232,14 +233,14 @@ fn texture_axes(normal: Vec3) -> Axes {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use quake_formats::geom::Vec3;
+    use quake_formats::geom::DVec3Ext;
 
     fn faces_point_out(brush: &Brush) -> bool {
         let center = brush
             .faces
             .iter()
             .flat_map(|f| f.points)
-            .fold(Vec3::ZERO, |acc, p| acc + p)
+            .fold(DVec3::ZERO, |acc, p| acc + p)
             / 18.0;
         brush.faces.iter().all(|f| {
             let plane = f.plane().expect("non-degenerate face");
@@ -252,7 +253,7 @@ mod tests {
         let b = aabb([-16.0, 8.0, 0.0], [48.0, 72.0, 128.0]);
         let brush = Brush::cuboid(b, "brick1");
         assert!(faces_point_out(&brush));
-        let normals: Vec<Vec3> = brush
+        let normals: Vec<DVec3> = brush
             .faces
             .iter()
             .map(|f| f.plane().expect("plane").normal)
@@ -266,7 +267,10 @@ mod tests {
             [0.0, 0.0, 1.0],
         ];
         for (n, e) in normals.iter().zip(expected) {
-            assert!(n.near(Vec3::new(e[0], e[1], e[2]), 1e-12), "{n:?} != {e:?}");
+            assert!(
+                n.near(DVec3::new(e[0], e[1], e[2]), 1e-12),
+                "{n:?} != {e:?}"
+            );
         }
     }
 
@@ -275,9 +279,9 @@ mod tests {
         // id's e1m1.map writes the -X side of a box spanning x 448..512 like this.
         let id = Face::new(
             [
-                Vec3::new(448.0, -320.0, 64.0),
-                Vec3::new(448.0, -384.0, 64.0),
-                Vec3::new(448.0, -384.0, 0.0),
+                DVec3::new(448.0, -320.0, 64.0),
+                DVec3::new(448.0, -384.0, 64.0),
+                DVec3::new(448.0, -384.0, 0.0),
             ],
             "x",
         );

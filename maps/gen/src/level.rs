@@ -87,8 +87,8 @@ impl Level {
 
 fn grow(b: Bounds, by: f64) -> Bounds {
     Bounds {
-        mins: b.mins - quake_formats::geom::Vec3::new(by, by, by),
-        maxs: b.maxs + quake_formats::geom::Vec3::new(by, by, by),
+        mins: b.mins - glam::DVec3::new(by, by, by),
+        maxs: b.maxs + glam::DVec3::new(by, by, by),
     }
 }
 

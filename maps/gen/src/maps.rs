@@ -3,7 +3,8 @@
 
 use crate::brush::{Brush, Map, MapEntity, MapFormat, aabb, box_corners};
 use crate::level::{Level, Surfaces};
-use quake_formats::geom::{Bounds, Vec3};
+use glam::DVec3;
+use quake_formats::geom::Bounds;
 
 /// One generated map: where it goes, what it is for, and whether every brush in it is meant to be
 /// a valid convex solid (`broken.map` is not).
@@ -171,12 +172,12 @@ pub fn demo() -> Map {
 }
 
 /// Rotation of the XY plane by an angle given as (cos, sin).
-fn rotate_z(p: Vec3, (c, s): (f64, f64)) -> Vec3 {
-    Vec3::new(c * p.x - s * p.y, s * p.x + c * p.y, p.z)
+fn rotate_z(p: DVec3, (c, s): (f64, f64)) -> DVec3 {
+    DVec3::new(c * p.x - s * p.y, s * p.x + c * p.y, p.z)
 }
 
-fn rotate_x(p: Vec3, (c, s): (f64, f64)) -> Vec3 {
-    Vec3::new(p.x, c * p.y - s * p.z, s * p.y + c * p.z)
+fn rotate_x(p: DVec3, (c, s): (f64, f64)) -> DVec3 {
+    DVec3::new(p.x, c * p.y - s * p.z, s * p.y + c * p.z)
 }
 
 const DEG45: (f64, f64) = (
@@ -189,9 +190,9 @@ fn deg30() -> (f64, f64) {
 }
 
 /// A box of half-size `half` centred on the origin, transformed by `f`, then moved to `centre`.
-fn transformed_box(half: [f64; 3], centre: [f64; 3], f: impl Fn(Vec3) -> Vec3) -> [Vec3; 8] {
+fn transformed_box(half: [f64; 3], centre: [f64; 3], f: impl Fn(DVec3) -> DVec3) -> [DVec3; 8] {
     let neg = half.map(|h| -h);
-    box_corners(b(neg, half)).map(|p| f(p) + Vec3::new(centre[0], centre[1], centre[2]))
+    box_corners(b(neg, half)).map(|p| f(p) + DVec3::new(centre[0], centre[1], centre[2]))
 }
 
 pub fn demo220() -> Map {
@@ -293,7 +294,7 @@ fn near_parallel() -> Map {
 }
 
 fn offgrid() -> Map {
-    let tilt = |p: Vec3| rotate_x(rotate_z(p, deg30()), DEG45);
+    let tilt = |p: DVec3| rotate_x(rotate_z(p, deg30()), DEG45);
     hard_case(
         &[
             "Off-grid and rotated brushes: non-integer plane points (4 decimals) and boxes",

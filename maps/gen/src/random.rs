@@ -11,7 +11,8 @@
 use crate::brush::{Brush, Map, MapEntity, MapFormat, aabb, box_corners};
 use crate::level::{Level, Surfaces};
 use crate::maps::WAD_NAME;
-use quake_formats::geom::{Bounds, Vec3};
+use glam::DVec3;
+use quake_formats::geom::Bounds;
 use quake_formats::rng::SplitMix64;
 
 /// What to generate.
@@ -67,7 +68,7 @@ struct Room {
 }
 
 impl Room {
-    fn centre(&self) -> Vec3 {
+    fn centre(&self) -> DVec3 {
         self.air.center()
     }
 }
@@ -151,7 +152,7 @@ fn corridor(rng: &mut SplitMix64, a: &Room, b: &Room) -> Bounds {
 /// A random rotation (about Z, sometimes tilted about X as well) of a shear, built from
 /// normalised random vectors (square roots are exact everywhere, unlike sines), so every
 /// platform makes the same map.
-fn random_transform(rng: &mut SplitMix64) -> impl Fn(Vec3) -> Vec3 + use<> {
+fn random_transform(rng: &mut SplitMix64) -> impl Fn(DVec3) -> DVec3 + use<> {
     let mut unit_pair = || loop {
         let (a, b) = (rng.range(-1.0, 1.0), rng.range(-1.0, 1.0));
         let len = (a * a + b * b).sqrt();
@@ -168,14 +169,14 @@ fn random_transform(rng: &mut SplitMix64) -> impl Fn(Vec3) -> Vec3 + use<> {
     } else {
         0.0
     };
-    move |p: Vec3| {
-        let p = Vec3::new(p.x + shear * p.z, p.y, p.z);
-        let p = Vec3::new(p.x, cx * p.y - sx * p.z, sx * p.y + cx * p.z);
-        Vec3::new(cz * p.x - sz * p.y, sz * p.x + cz * p.y, p.z)
+    move |p: DVec3| {
+        let p = DVec3::new(p.x + shear * p.z, p.y, p.z);
+        let p = DVec3::new(p.x, cx * p.y - sx * p.z, sx * p.y + cx * p.z);
+        DVec3::new(cz * p.x - sz * p.y, sz * p.x + cz * p.y, p.z)
     }
 }
 
-fn bounds_of(points: &[Vec3]) -> Bounds {
+fn bounds_of(points: &[DVec3]) -> Bounds {
     let mut b = Bounds::EMPTY;
     for &p in points {
         b.add_point(p);
@@ -203,7 +204,7 @@ fn object(rng: &mut SplitMix64, space: Bounds) -> Option<Brush> {
         box_corners(aabb(half.map(|h| -h), half)).map(f)
     };
     let extent = bounds_of(&corners);
-    let mut offset = Vec3::ZERO;
+    let mut offset = DVec3::ZERO;
     for i in 0..3 {
         let (lo, hi) = (
             space.mins[i] - extent.mins[i],

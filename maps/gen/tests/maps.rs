@@ -1,9 +1,10 @@
 //! Every generated map is well-formed: its textures are in the WAD, its brushes are convex solids
 //! with outward-facing planes, its entities sit in open space, and only `leak.map` leaks.
 
+use glam::DVec3;
 use mapgen::brush::{Brush, Map};
 use mapgen::maps::{self, MapFile};
-use quake_formats::geom::{Bounds, Plane, Vec3, Winding};
+use quake_formats::geom::{Bounds, Plane, Winding};
 use quake_formats::wad::Wad;
 
 /// The faces of a brush as windings (each plane's huge square clipped behind every other plane),
@@ -61,8 +62,8 @@ fn every_brush_of_the_valid_maps_is_a_convex_solid_with_outward_planes() {
                 assert_eq!(faces.len(), 6, "{at}");
                 assert!(faces.iter().all(|w| w.len() == 4), "{at}: not a hexahedron");
                 assert!(volume(&faces) > 0.1, "{at}: volume {}", volume(&faces));
-                let points: Vec<Vec3> = faces.iter().flat_map(|w| w.points.clone()).collect();
-                let centre = points.iter().fold(Vec3::ZERO, |a, &p| a + p) / points.len() as f64;
+                let points: Vec<DVec3> = faces.iter().flat_map(|w| w.points.clone()).collect();
+                let centre = points.iter().fold(DVec3::ZERO, |a, &p| a + p) / points.len() as f64;
                 for (face, w) in brush.faces.iter().zip(&faces) {
                     let plane = face.plane().expect("checked");
                     assert!(plane.distance(centre) < 0.0, "{at}: a plane faces inwards");

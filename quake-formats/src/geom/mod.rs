@@ -1,4 +1,4 @@
-//! Geometry in `f64`: vectors, planes, convex windings and the one epsilon policy every tool uses.
+//! Geometry in `f64` on glam's `DVec3`: bounds, planes, convex windings and the one epsilon policy every tool uses.
 //!
 //! # Epsilon policy
 //!
@@ -24,12 +24,14 @@
 //! (`light/src/samples.rs`, `SHARED_WALK_MARGIN`), and how far outside an edge a reference-render
 //! ray hit still counts (`runtime-viewer/src/reference.rs`).
 
+mod bounds;
+mod direction;
 mod plane;
-mod vec3;
 mod winding;
 
+pub use bounds::Bounds;
+pub use direction::DVec3Ext;
 pub use plane::{Plane, PlaneSide};
-pub use vec3::{Bounds, Vec3};
 pub use winding::{Split, Winding};
 
 /// Distance within which a point lies on a plane.

@@ -1,9 +1,11 @@
-use super::{DIST_EPSILON, NORMAL_EPSILON, ON_EPSILON, Vec3};
+use super::{DIST_EPSILON, NORMAL_EPSILON, ON_EPSILON};
+use crate::geom::DVec3Ext;
+use glam::DVec3;
 
 /// A plane `normal · p = dist` with a unit normal; the front side is where the normal points.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Plane {
-    pub normal: Vec3,
+    pub normal: DVec3,
     pub dist: f64,
 }
 
@@ -30,18 +32,18 @@ impl PlaneSide {
 }
 
 impl Plane {
-    pub fn new(normal: Vec3, dist: f64) -> Self {
+    pub fn new(normal: DVec3, dist: f64) -> Self {
         Plane { normal, dist }
     }
 
     /// The plane through three points, facing so that `a, b, c` wind clockwise seen from the
     /// front (Quake's `.map` convention). `None` when the points are collinear.
-    pub fn from_points(a: Vec3, b: Vec3, c: Vec3) -> Option<Plane> {
+    pub fn from_points(a: DVec3, b: DVec3, c: DVec3) -> Option<Plane> {
         let normal = (a - b).cross(c - b).normalized()?;
         Some(Plane::new(normal, normal.dot(b)))
     }
 
-    pub fn distance(&self, p: Vec3) -> f64 {
+    pub fn distance(&self, p: DVec3) -> f64 {
         self.normal.dot(p) - self.dist
     }
 
@@ -49,7 +51,7 @@ impl Plane {
         Plane::new(-self.normal, -self.dist)
     }
 
-    pub fn side_of_point(&self, p: Vec3) -> PlaneSide {
+    pub fn side_of_point(&self, p: DVec3) -> PlaneSide {
         PlaneSide::of_distance(self.distance(p))
     }
 
@@ -88,7 +90,7 @@ impl Plane {
         let mut normal = self.normal;
         for i in 0..3 {
             if (normal[i].abs() - 1.0).abs() < NORMAL_EPSILON {
-                normal = Vec3::ZERO;
+                normal = DVec3::ZERO;
                 normal[i] = self.normal[i].signum();
                 break;
             }
@@ -113,21 +115,21 @@ mod tests {
     fn from_points_follows_quake_winding() {
         // A floor at z=0 listed as in .map files: normal points up.
         let p = Plane::from_points(
-            Vec3::new(0.0, 0.0, 0.0),
-            Vec3::new(0.0, 1.0, 0.0),
-            Vec3::new(1.0, 0.0, 0.0),
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
         )
         .expect("plane");
-        assert!(p.normal.near(Vec3::new(0.0, 0.0, 1.0), 1e-12));
+        assert!(p.normal.near(DVec3::new(0.0, 0.0, 1.0), 1e-12));
         assert_eq!(p.dist, 0.0);
         assert_eq!(p.quake_type(), 2);
     }
 
     #[test]
     fn collinear_points_have_no_plane() {
-        let a = Vec3::new(0.0, 0.0, 0.0);
+        let a = DVec3::new(0.0, 0.0, 0.0);
         assert!(
-            Plane::from_points(a, Vec3::new(1.0, 1.0, 1.0), Vec3::new(2.0, 2.0, 2.0)).is_none()
+            Plane::from_points(a, DVec3::new(1.0, 1.0, 1.0), DVec3::new(2.0, 2.0, 2.0)).is_none()
         );
     }
 }

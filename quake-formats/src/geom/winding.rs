@@ -1,10 +1,12 @@
-use super::{Bounds, MAX_WORLD_COORD, ON_EPSILON, Plane, PlaneSide, Vec3};
+use super::{Bounds, MAX_WORLD_COORD, ON_EPSILON, Plane, PlaneSide};
+use crate::geom::DVec3Ext;
+use glam::DVec3;
 
 /// A convex polygon, its points in clockwise order seen from the front of its plane (Quake's
 /// convention, matching [`Plane::from_points`]).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Winding {
-    pub points: Vec<Vec3>,
+    pub points: Vec<DVec3>,
 }
 
 /// The result of splitting a winding by a plane.
@@ -24,7 +26,7 @@ pub enum Split {
 }
 
 impl Winding {
-    pub fn new(points: Vec<Vec3>) -> Self {
+    pub fn new(points: Vec<DVec3>) -> Self {
         Winding { points }
     }
 
@@ -36,13 +38,13 @@ impl Winding {
         let ay = n.y.abs();
         let az = n.z.abs();
         let up = if az >= ax && az >= ay {
-            Vec3::new(1.0, 0.0, 0.0)
+            DVec3::new(1.0, 0.0, 0.0)
         } else {
-            Vec3::new(0.0, 0.0, 1.0)
+            DVec3::new(0.0, 0.0, 1.0)
         };
         let up = (up - n * up.dot(n))
             .normalized()
-            .unwrap_or(Vec3::new(0.0, 1.0, 0.0));
+            .unwrap_or(DVec3::new(0.0, 1.0, 0.0));
         let right = up.cross(n);
         let origin = n * plane.dist;
         let size = MAX_WORLD_COORD * 4.0;
@@ -72,13 +74,13 @@ impl Winding {
         b
     }
 
-    pub fn center(&self) -> Vec3 {
-        let sum = self.points.iter().fold(Vec3::ZERO, |acc, &p| acc + p);
+    pub fn center(&self) -> DVec3 {
+        let sum = self.points.iter().fold(DVec3::ZERO, |acc, &p| acc + p);
         sum / self.points.len().max(1) as f64
     }
 
     pub fn area(&self) -> f64 {
-        let mut total = Vec3::ZERO;
+        let mut total = DVec3::ZERO;
         for i in 2..self.points.len() {
             let d1 = self.points[i - 1] - self.points[0];
             let d2 = self.points[i] - self.points[0];
@@ -94,7 +96,7 @@ impl Winding {
             return None;
         }
         // Newell's method: robust for slightly non-planar or near-degenerate polygons.
-        let mut normal = Vec3::ZERO;
+        let mut normal = DVec3::ZERO;
         for i in 0..n {
             let a = self.points[i];
             let b = self.points[(i + 1) % n];
@@ -170,7 +172,7 @@ impl Winding {
             }
             let q = self.points[j];
             let t = dists[i] / (dists[i] - dists[j]);
-            let mut mid = p.lerp(q, t);
+            let mut mid = p.lerp_monotonic(q, t);
             // Keep axial coordinates exact so splits by axial planes do not drift.
             for axis in 0..3 {
                 if plane.normal[axis] == 1.0 {
@@ -224,23 +226,23 @@ mod tests {
     fn square(z: f64) -> Winding {
         // Clockwise seen from +Z.
         Winding::new(vec![
-            Vec3::new(0.0, 0.0, z),
-            Vec3::new(0.0, 64.0, z),
-            Vec3::new(64.0, 64.0, z),
-            Vec3::new(64.0, 0.0, z),
+            DVec3::new(0.0, 0.0, z),
+            DVec3::new(0.0, 64.0, z),
+            DVec3::new(64.0, 64.0, z),
+            DVec3::new(64.0, 0.0, z),
         ])
     }
 
     #[test]
     fn plane_of_clockwise_square_faces_up() {
         let p = square(8.0).plane().expect("plane");
-        assert!(p.normal.near(Vec3::new(0.0, 0.0, 1.0), 1e-12));
+        assert!(p.normal.near(DVec3::new(0.0, 0.0, 1.0), 1e-12));
         assert!((p.dist - 8.0).abs() < 1e-12);
     }
 
     #[test]
     fn base_winding_lies_on_plane_and_faces_it() {
-        let plane = Plane::new(Vec3::new(0.6, 0.0, 0.8), 100.0);
+        let plane = Plane::new(DVec3::new(0.6, 0.0, 0.8), 100.0);
         let w = Winding::base_for_plane(&plane);
         for p in &w.points {
             assert!(plane.distance(*p).abs() < 1e-6);
@@ -251,7 +253,7 @@ mod tests {
 
     #[test]
     fn split_square_in_half() {
-        let plane = Plane::new(Vec3::new(1.0, 0.0, 0.0), 16.0);
+        let plane = Plane::new(DVec3::new(1.0, 0.0, 0.0), 16.0);
         match square(0.0).split(&plane) {
             Split::Both { front, back } => {
                 assert!((front.area() - 48.0 * 64.0).abs() < 1e-9);
@@ -264,7 +266,7 @@ mod tests {
     proptest! {
         #[test]
         fn split_preserves_area(nx in -1.0f64..1.0, ny in -1.0f64..1.0, nz in -1.0f64..1.0, d in -80.0f64..80.0) {
-            let Some(normal) = Vec3::new(nx, ny, nz).normalized() else { return Ok(()); };
+            let Some(normal) = DVec3::new(nx, ny, nz).normalized() else { return Ok(()); };
             let w = square(3.0);
             let plane = Plane::new(normal, d);
             let total = w.area();
