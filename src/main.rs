@@ -43,6 +43,8 @@ enum Command {
     Report(report::ReportArgs),
     /// Build many maps (a project file or a folder): cached, in parallel, optionally in shards
     Batch(batch::cli::Args),
+    /// Texture WADs: build one from a folder of PNG/TGA pictures, list one, extract its pictures
+    Wad(wad::cli::Args),
 }
 
 fn main() -> ExitCode {
@@ -69,6 +71,7 @@ fn run(command: Command) -> Result<ExitCode> {
         Command::Convert(args) => inspect::convert(&args).map(|()| ExitCode::SUCCESS),
         Command::Report(args) => report::report(&args).map(|()| ExitCode::SUCCESS),
         Command::Batch(args) => batch::cli::run(&args),
+        Command::Wad(args) => wad::cli::run(&args).map(|()| ExitCode::SUCCESS),
     }
 }
 

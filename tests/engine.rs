@@ -15,14 +15,16 @@
 //! skip independently with a `SKIPPED:` line when absent.
 #![cfg(unix)]
 
+// Only its `slipgate`: this test keeps its own scratch directory.
+#[allow(dead_code)]
+#[path = "support/command.rs"]
+mod command;
 #[path = "support/engines.rs"]
 mod engines;
 #[path = "support/maps.rs"]
 mod maps;
 #[path = "support/corpus.rs"]
 mod support_corpus;
-#[path = "support/tga.rs"]
-mod tga;
 
 use engines::{Engine, Kind, Outcome};
 use maps::{Case, KnownError, MapSet, NotCompiled};
@@ -305,6 +307,39 @@ fn darkplaces_plays_the_corpus_maps() {
     if let (Some(engine), Some(set)) = (Engine::find(Kind::DarkPlaces, scratch()), corpus_maps()) {
         play_all(&engine, set);
     }
+}
+
+/// The demo map compiled against a WAD that `slipgate wad build` makes here from the committed
+/// pictures (`maps/textures`: sky holes, a glow mask, liquids), played in QuakeSpasm.
+#[test]
+fn quakespasm_plays_a_map_with_a_wad_built_from_pictures() {
+    let Some(engine) = Engine::find(Kind::QuakeSpasm, scratch()) else {
+        return;
+    };
+    static SET: OnceLock<MapSet> = OnceLock::new();
+    let set = SET.get_or_init(|| {
+        let dir = scratch().join("wad_from_pictures");
+        std::fs::create_dir_all(&dir).expect("scratch dir");
+        let wad = dir.join("slipgate.wad");
+        let pictures = repo().join("maps/textures");
+        let out = command::slipgate(&[
+            "wad",
+            "build",
+            maps::path_str(&pictures),
+            maps::path_str(&wad),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let case = Case {
+            name: "demo_wad_from_pictures".to_string(),
+            ..Case::new(repo().join("maps/demo.map"), vec![dir.clone()])
+        };
+        MapSet::new(vec![case], dir)
+    });
+    play_all(&engine, set);
 }
 
 /// The check itself: a BSP from another compiler passes both servers, and one with a marksurface

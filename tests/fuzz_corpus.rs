@@ -71,3 +71,8 @@ fn entities_corpus() {
 fn stages_corpus() {
     replay("stages", entries::stages);
 }
+
+#[test]
+fn pictures_corpus() {
+    replay("pictures", entries::pictures);
+}

@@ -64,6 +64,38 @@ pub fn wad(data: &[u8]) {
     quake_formats::wad::Wad::read(&wad.write()).expect("a WAD that was read rewrites readably");
 }
 
+/// Pixels the fuzzer lets a picture have; larger ones are refused only past 4096 on a side (with
+/// its unit test), and building them would only be slow.
+const FUZZ_PICTURE_PIXELS: u64 = 1 << 16;
+
+/// The WAD builder on one picture: the bytes as a PNG and as a TGA `{` texture (so holes count)
+/// with themselves as its glow mask; a WAD that builds reads back with that one texture.
+pub fn pictures(data: &[u8]) {
+    for (format, ext) in [
+        (image::ImageFormat::Png, "png"),
+        (image::ImageFormat::Tga, "tga"),
+    ] {
+        let reader = image::ImageReader::with_format(std::io::Cursor::new(data), format);
+        match reader.into_dimensions() {
+            Ok((w, h)) if u64::from(w) * u64::from(h) <= FUZZ_PICTURE_PIXELS => {}
+            _ => continue,
+        }
+        let files = vec![
+            (format!("{{fuzz.{ext}").into(), data.to_vec()),
+            (format!("{{fuzz_glow.{ext}").into(), data.to_vec()),
+        ];
+        let Ok(sources) = wad::source::from_files(files) else {
+            continue;
+        };
+        let built = wad::build(&sources, &wad::BuildOptions::default(), &|_| {});
+        let read = quake_formats::wad::Wad::read(&built.wad.write()).expect("a built WAD reads");
+        assert!(
+            read.find_miptex("{fuzz").is_some(),
+            "the texture is in the WAD"
+        );
+    }
+}
+
 /// What the fuzzer lets base vis spend on its sets; past it vis's own limit
 /// ([`vis::MAX_SET_BYTES`], with its unit test) is what refuses, and a run that large would only
 /// be slow.

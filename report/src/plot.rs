@@ -74,13 +74,21 @@ pub fn draw_all(report: &Report, out_dir: &Path) -> Result<Vec<PlotFile>, Report
             path: png.clone(),
             what,
         };
+        let mut pixels = vec![0u8; SIZE.0 as usize * SIZE.1 as usize * 3];
         draw(
-            BitMapBackend::new(&png, SIZE).into_drawing_area(),
+            BitMapBackend::with_buffer(&mut pixels, SIZE).into_drawing_area(),
             stage,
             &series,
             labels,
         )
         .map_err(failed)?;
+        let png_bytes = encode_png(pixels).map_err(failed)?;
+        quake_formats::fsutil::write_atomic(&png, &png_bytes).map_err(|source| {
+            ReportError::Format {
+                path: png.clone(),
+                source,
+            }
+        })?;
         let mut svg_text = String::new();
         draw(
             SVGBackend::with_string(&mut svg_text, SIZE).into_drawing_area(),
@@ -104,6 +112,17 @@ pub fn draw_all(report: &Report, out_dir: &Path) -> Result<Vec<PlotFile>, Report
         });
     }
     Ok(files)
+}
+
+/// A drawn plot as PNG bytes, through `image` like every other picture Slipgate writes.
+fn encode_png(pixels: Vec<u8>) -> Result<Vec<u8>, String> {
+    let picture = image::RgbImage::from_raw(SIZE.0, SIZE.1, pixels)
+        .ok_or_else(|| "the plot's pixel buffer is not its size".to_string())?;
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    picture
+        .write_to(&mut bytes, image::ImageFormat::Png)
+        .map_err(|e| e.to_string())?;
+    Ok(bytes.into_inner())
 }
 
 /// The stage's points with a finite, positive time and a finite error, by map and tool.

@@ -15,7 +15,7 @@ pub enum ViewerError {
     #[error("{path}: writing PNG: {error}")]
     Png {
         path: PathBuf,
-        error: png::EncodingError,
+        error: ::image::ImageError,
     },
     /// The interactive window could not be opened or updated (no display, for instance).
     #[error("window: {0}")]

@@ -6,20 +6,22 @@ use crate::error::{Result, ViewerError};
 use crate::render::Frame;
 
 /// Encode a frame as an 8-bit RGB PNG.
-pub fn encode_png(frame: &Frame) -> Result<Vec<u8>, png::EncodingError> {
-    let mut out = Vec::new();
-    let mut encoder = png::Encoder::new(&mut out, frame.width as u32, frame.height as u32);
-    encoder.set_color(png::ColorType::Rgb);
-    encoder.set_depth(png::BitDepth::Eight);
-    let mut writer = encoder.write_header()?;
+pub fn encode_png(frame: &Frame) -> Result<Vec<u8>, ::image::ImageError> {
     let rgb: Vec<u8> = frame
         .pixels
         .iter()
         .flat_map(|&c| crate::textures::unpack(c))
         .collect();
-    writer.write_image_data(&rgb)?;
-    writer.finish()?;
-    Ok(out)
+    let mut out = std::io::Cursor::new(Vec::new());
+    ::image::write_buffer_with_format(
+        &mut out,
+        &rgb,
+        frame.width as u32,
+        frame.height as u32,
+        ::image::ExtendedColorType::Rgb8,
+        ::image::ImageFormat::Png,
+    )?;
+    Ok(out.into_inner())
 }
 
 /// Write `frame` to `path` as PNG, atomically.

@@ -21,8 +21,7 @@
 //! or a timeout; the engine is stopped early once it printed a fatal error.
 
 use crate::maps::{Compiled, path_str};
-use crate::tga;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashSet};
 use std::fs::File;
 use std::os::unix::fs::{MetadataExt, symlink};
 use std::os::unix::process::{CommandExt, ExitStatusExt};
@@ -387,20 +386,19 @@ impl Engine {
 /// Read the screenshot: [`SCREEN`]'s size and at least `min_colours` colours. `Ok` holds it and
 /// its colour count.
 fn check_screenshot(shot: PathBuf, min_colours: usize) -> Result<(PathBuf, usize), String> {
-    let image = std::fs::read(&shot)
-        .map_err(|e| e.to_string())
-        .and_then(|bytes| tga::read(&bytes))
-        .map_err(|e| format!("screenshot {}: {e}", shot.display()))?;
-    let (width, height) = (SCREEN.0 as usize, SCREEN.1 as usize);
-    if (image.width, image.height) != (width, height) {
+    let image = image::open(&shot)
+        .map_err(|e| format!("screenshot {}: {e}", shot.display()))?
+        .into_rgb8();
+    let (width, height) = (SCREEN.0, SCREEN.1);
+    if image.dimensions() != (width, height) {
         return Err(format!(
             "screenshot {} is {}x{}, not {width}x{height}",
             shot.display(),
-            image.width,
-            image.height
+            image.width(),
+            image.height()
         ));
     }
-    let colours = image.colours();
+    let colours = image.pixels().collect::<HashSet<_>>().len();
     if colours < min_colours {
         return Err(format!(
             "screenshot {} is blank: {colours} colours",

@@ -1,12 +1,16 @@
-//! Procedural textures quantised to Slipgate's own palette, packed into a WAD2.
+//! Procedural textures as PNG pictures (`maps/textures/`), and the WAD2 the `slipgate-wad` crate
+//! builds from them.
 //!
 //! Everything is deterministic: a seeded SplitMix64 drives tileable value noise, and only
-//! arithmetic whose IEEE results are exact everywhere is used (no `sin`/`exp`), so the WAD's
-//! bytes are the same on every machine.
+//! arithmetic whose IEEE results are exact everywhere is used (no `sin`/`exp`), here and in the
+//! WAD builder, so the pictures' and the WAD's bytes are the same on every machine.
 
-use quake_formats::miptex::MipTex;
-use quake_formats::palette::{FIRST_FULLBRIGHT, Palette};
-use quake_formats::wad::{Wad, WadLump};
+use image::DynamicImage;
+use quake_formats::wad::Wad;
+use std::path::Path;
+use wad::WadError;
+use wad::build::BuildOptions;
+use wad::extract::encode_png;
 
 /// SplitMix64: tiny, fast and good enough for texture noise.
 #[derive(Debug, Clone)]
@@ -82,20 +86,26 @@ impl Fractal {
     }
 }
 
-/// An RGB image (0..255 per channel) with a "glow" weight per pixel: pixels that glow are
-/// quantised to the fullbright colours.
+/// What a pixel asks of the WAD builder besides its colour.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Look {
+    Plain,
+    /// Drawn with a fullbright colour: white in the texture's `_glow` mask.
+    Glow,
+    /// Transparent (alpha 0): the holes of a sky's front layer.
+    Hole,
+}
+
+/// An RGB picture (0..255 per channel) with a [`Look`] per pixel.
 #[derive(Debug, Clone)]
 pub struct Image {
     pub width: usize,
     pub height: usize,
-    pixels: Vec<([f64; 3], f64)>,
+    pixels: Vec<([f64; 3], Look)>,
 }
 
-const NO_GLOW: f64 = 0.0;
-const GLOW: f64 = 1.0;
-
 impl Image {
-    fn from_fn(width: usize, height: usize, f: impl Fn(usize, usize) -> ([f64; 3], f64)) -> Image {
+    fn from_fn(width: usize, height: usize, f: impl Fn(usize, usize) -> ([f64; 3], Look)) -> Image {
         let pixels = (0..height)
             .flat_map(|y| (0..width).map(move |x| (x, y)))
             .map(|(x, y)| f(x, y))
@@ -107,61 +117,38 @@ impl Image {
         }
     }
 
-    /// Half size, each pixel the average of a 2x2 block (colour and glow alike).
-    fn half(&self) -> Image {
-        Image::from_fn(self.width / 2, self.height / 2, |x, y| {
-            let mut rgb = [0.0; 3];
-            let mut glow = 0.0;
-            for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-                let (c, g) = self.pixels[(2 * y + dy) * self.width + 2 * x + dx];
-                for k in 0..3 {
-                    rgb[k] += c[k] / 4.0;
-                }
-                glow += g / 4.0;
-            }
-            (rgb, glow)
+    fn map<P: image::Pixel>(
+        &self,
+        f: impl Fn([f64; 3], Look) -> P,
+    ) -> image::ImageBuffer<P, Vec<P::Subpixel>> {
+        image::ImageBuffer::from_fn(self.width as u32, self.height as u32, |x, y| {
+            let (rgb, look) = self.pixels[y as usize * self.width + x as usize];
+            f(rgb, look)
         })
     }
 
-    fn quantise(&self, palette: &Palette) -> Vec<u8> {
-        self.pixels
-            .iter()
-            .map(|&(rgb, glow)| {
-                let rgb = rgb.map(|c| c.round().clamp(0.0, 255.0) as u8);
-                if glow >= 0.5 {
-                    nearest_fullbright(palette, rgb)
-                } else if rgb == [0, 0, 0] {
-                    // Pure black is index 0: the transparent colour of a sky's front layer.
-                    0
-                } else {
-                    palette.nearest(rgb)
-                }
-            })
-            .collect()
+    /// The picture as the WAD builder reads it: RGBA when it has holes, RGB otherwise.
+    pub fn picture(&self) -> DynamicImage {
+        let rgb = |c: [f64; 3]| c.map(|v| v.round().clamp(0.0, 255.0) as u8);
+        if self.pixels.iter().any(|&(_, look)| look == Look::Hole) {
+            DynamicImage::ImageRgba8(self.map(|c, look| {
+                let [r, g, b] = rgb(c);
+                image::Rgba([r, g, b, if look == Look::Hole { 0 } else { 255 }])
+            }))
+        } else {
+            DynamicImage::ImageRgb8(self.map(|c, _| image::Rgb(rgb(c))))
+        }
     }
 
-    /// The four mip levels: box-filtered in RGB, each quantised on its own.
-    pub fn to_miptex(&self, name: &str, palette: &Palette) -> MipTex {
-        let mut level = self.clone();
-        let mips = std::array::from_fn(|i| {
-            if i > 0 {
-                level = level.half();
-            }
-            level.quantise(palette)
-        });
-        MipTex::new(name, self.width as u32, self.height as u32, mips)
+    /// The `_glow` mask: white where the pixel glows. `None` when none does.
+    pub fn glow_mask(&self) -> Option<DynamicImage> {
+        let glows = |look: Look| look == Look::Glow;
+        self.pixels.iter().any(|&(_, look)| glows(look)).then(|| {
+            DynamicImage::ImageLuma8(
+                self.map(|_, look| image::Luma([if glows(look) { 255 } else { 0 }])),
+            )
+        })
     }
-}
-
-fn nearest_fullbright(palette: &Palette, rgb: [u8; 3]) -> u8 {
-    let distance = |i: usize| -> i32 {
-        (0..3)
-            .map(|k| (palette.colors[i][k] as i32 - rgb[k] as i32).pow(2))
-            .sum()
-    };
-    (FIRST_FULLBRIGHT as usize..256)
-        .min_by_key(|&i| distance(i))
-        .unwrap_or(FIRST_FULLBRIGHT as usize) as u8
 }
 
 fn shade(rgb: [f64; 3], factor: f64) -> [f64; 3] {
@@ -197,12 +184,12 @@ fn brick(n: &Fractal, rng: &mut Rng) -> Image {
         let shifted = x + 16 * (row % 2);
         let grain = n.at(x as f64 / 64.0, y as f64 / 64.0);
         if y % 16 < 2 || shifted % 32 < 2 {
-            return (shade([112.0, 106.0, 98.0], 0.7 + 0.5 * grain), NO_GLOW);
+            return (shade([112.0, 106.0, 98.0], 0.7 + 0.5 * grain), Look::Plain);
         }
         let tone = tones[row * 4 + (shifted / 32) % 4];
         (
             shade([150.0, 72.0, 52.0], tone * (0.75 + 0.5 * grain)),
-            NO_GLOW,
+            Look::Plain,
         )
     })
 }
@@ -214,7 +201,7 @@ fn stone_floor(n: &Fractal, rng: &mut Rng) -> Image {
         let tile = tones[(y / 32) * 2 + x / 32];
         let edge = bevel(x % 32, y % 32, 32, 32, 2);
         let rgb = shade([120.0, 114.0, 102.0], tile * edge * (0.65 + 0.7 * grain));
-        (rgb, NO_GLOW)
+        (rgb, Look::Plain)
     })
 }
 
@@ -225,13 +212,13 @@ fn wood(n: &Fractal, rng: &mut Rng) -> Image {
     Image::from_fn(64, 64, |x, y| {
         let (tone, joint) = planks[y / 16];
         if y % 16 == 0 || x == joint {
-            return ([58.0, 38.0, 22.0], NO_GLOW);
+            return ([58.0, 38.0, 22.0], Look::Plain);
         }
         let warp = n.at(x as f64 / 64.0, y as f64 / 64.0);
         let grain = to_line(y as f64 + 6.0 * warp, 4.0) / 2.0;
         (
             shade([138.0, 94.0, 54.0], tone * (0.75 + 0.3 * grain)),
-            NO_GLOW,
+            Look::Plain,
         )
     })
 }
@@ -248,7 +235,7 @@ fn metal_panel(n: &Fractal) -> Image {
         let light = if rivet { 1.4 } else { bevel(x, y, 64, 64, 3) };
         (
             shade([96.0, 100.0, 118.0], light * (0.85 + 0.3 * grain)),
-            NO_GLOW,
+            Look::Plain,
         )
     })
 }
@@ -262,12 +249,12 @@ fn door(n: &Fractal) -> Image {
             let light = bevel(x, y % 124, 64, 124, 1);
             return (
                 shade([92.0, 96.0, 108.0], light * (0.85 + 0.3 * grain)),
-                NO_GLOW,
+                Look::Plain,
             );
         }
         let seam = (x - 4) % 14 == 0;
         let tone = if seam { 0.45 } else { 0.8 + 0.3 * grain };
-        (shade([128.0, 86.0, 48.0], tone), NO_GLOW)
+        (shade([128.0, 86.0, 48.0], tone), Look::Plain)
     })
 }
 
@@ -278,7 +265,7 @@ fn trim(n: &Fractal) -> Image {
         let light = if notch { 0.55 } else { bevel(x, y, 64, 16, 2) };
         (
             shade([150.0, 128.0, 84.0], light * (0.85 + 0.3 * grain)),
-            NO_GLOW,
+            Look::Plain,
         )
     })
 }
@@ -287,11 +274,17 @@ fn light_fixture() -> Image {
     Image::from_fn(32, 32, |x, y| {
         let inner = (6..26).contains(&x) && (6..26).contains(&y);
         if !inner {
-            return (shade([90.0, 90.0, 96.0], bevel(x, y, 32, 32, 2)), NO_GLOW);
+            return (
+                shade([90.0, 90.0, 96.0], bevel(x, y, 32, 32, 2)),
+                Look::Plain,
+            );
         }
         // Brightest in the middle of the lamp.
         let d = to_line(x as f64 - 16.0, 64.0).max(to_line(y as f64 - 16.0, 64.0)) / 10.0;
-        (mix([255.0, 250.0, 215.0], [240.0, 200.0, 140.0], d), GLOW)
+        (
+            mix([255.0, 250.0, 215.0], [240.0, 200.0, 140.0], d),
+            Look::Glow,
+        )
     })
 }
 
@@ -303,16 +296,16 @@ fn sky(n: &Fractal, clouds: &Fractal) -> Image {
         if x >= 128 {
             return (
                 mix([28.0, 22.0, 70.0], [90.0, 60.0, 130.0], n.at(u, v)),
-                NO_GLOW,
+                Look::Plain,
             );
         }
         let density = clouds.at(u, v);
         if density < 0.55 {
-            return ([0.0; 3], NO_GLOW);
+            return ([0.0; 3], Look::Hole);
         }
         (
             mix([120.0, 120.0, 160.0], [220.0, 215.0, 235.0], density),
-            NO_GLOW,
+            Look::Plain,
         )
     })
 }
@@ -321,7 +314,7 @@ fn liquid(n: &Fractal, dark: [f64; 3], bright: [f64; 3]) -> Image {
     Image::from_fn(64, 64, |x, y| {
         let t = n.at(x as f64 / 64.0, y as f64 / 64.0);
         let ripple = to_line(8.0 * t, 1.0) * 2.0;
-        (mix(dark, bright, 0.6 * t + 0.4 * ripple), NO_GLOW)
+        (mix(dark, bright, 0.6 * t + 0.4 * ripple), Look::Plain)
     })
 }
 
@@ -333,7 +326,7 @@ fn tool(base: [f64; 3], pattern: fn(usize, usize) -> bool) -> Image {
         } else {
             base
         };
-        (rgb, NO_GLOW)
+        (rgb, Look::Plain)
     })
 }
 
@@ -379,19 +372,38 @@ pub fn images() -> Vec<(&'static str, Image)> {
     ]
 }
 
-/// The texture WAD, quantised to `Palette::slipgate()`.
-pub fn wad() -> Wad {
-    let palette = Palette::slipgate();
-    let lumps = images()
-        .into_iter()
-        .map(|(name, image)| WadLump::miptex(image.to_miptex(name, &palette)))
+/// Where the pictures go, relative to the maps directory.
+pub const PICTURE_DIR: &str = "textures";
+
+/// Every picture file of `textures/`: `(file name, PNG bytes)`, each texture's picture and, for
+/// the glowing ones, its `_glow` mask.
+pub fn picture_files() -> Result<Vec<(String, Vec<u8>)>, image::ImageError> {
+    let mut files = Vec::new();
+    for (name, image) in images() {
+        let stem = wad::source::file_stem(name);
+        files.push((format!("{stem}.png"), encode_png(&image.picture())?));
+        if let Some(mask) = image.glow_mask() {
+            files.push((format!("{stem}_glow.png"), encode_png(&mask)?));
+        }
+    }
+    Ok(files)
+}
+
+/// The texture WAD, built from [`picture_files`] exactly as `slipgate wad build maps/textures
+/// maps/slipgate.wad` builds it (Slipgate's palette, dithered).
+pub fn wad(pictures: &[(String, Vec<u8>)]) -> Result<Wad, WadError> {
+    let files = pictures
+        .iter()
+        .map(|(name, bytes)| (Path::new(PICTURE_DIR).join(name), bytes.clone()))
         .collect();
-    Wad::new(lumps)
+    let sources = wad::source::from_files(files)?;
+    Ok(wad::build(&sources, &BuildOptions::default(), &|_| {}).wad)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use quake_formats::palette::FIRST_FULLBRIGHT;
 
     #[test]
     fn rng_is_deterministic_and_uniformish() {
@@ -413,30 +425,28 @@ mod tests {
         }
     }
 
+    fn built_wad() -> Wad {
+        wad(&picture_files().expect("PNGs encode")).expect("the WAD builds")
+    }
+
     #[test]
     fn only_the_light_fixture_uses_fullbright_colours() {
+        let wad = built_wad();
         for (name, image) in images() {
-            let tex = image.to_miptex(name, &Palette::slipgate());
+            let tex = wad.find_miptex(name).expect("every picture is in the WAD");
+            assert_eq!(
+                (tex.width, tex.height),
+                (image.width as u32, image.height as u32)
+            );
             let mips = tex.mips.expect("pixels");
             let bright = mips[0].iter().any(|&i| i >= FIRST_FULLBRIGHT);
             assert_eq!(bright, name == "light1", "{name}");
-            for (level, m) in mips.iter().enumerate() {
-                assert_eq!(m.len(), MipTex::mip_len(tex.width, tex.height, level));
-            }
-            assert!(
-                tex.width.is_multiple_of(16) && tex.height.is_multiple_of(16),
-                "{name}"
-            );
         }
     }
 
     #[test]
     fn sky_front_layer_has_transparent_holes_and_the_back_has_none() {
-        let (_, sky) = images()
-            .into_iter()
-            .find(|(n, _)| *n == "sky1")
-            .expect("sky");
-        let tex = sky.to_miptex("sky1", &Palette::slipgate());
+        let tex = built_wad().find_miptex("sky1").expect("sky");
         let pixels = &tex.mips.expect("pixels")[0];
         let (front, back): (Vec<_>, Vec<_>) = pixels
             .chunks(256)
@@ -445,5 +455,13 @@ mod tests {
         let holes = front.concat().iter().filter(|&&i| i == 0).count();
         assert!(holes > 1000 && holes < 128 * 128 - 1000, "{holes} holes");
         assert!(!back.concat().contains(&0));
+    }
+
+    #[test]
+    fn liquids_are_written_with_a_hash_and_read_back_with_a_star() {
+        let files = picture_files().expect("PNGs encode");
+        let names: Vec<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
+        assert!(names.contains(&"#water1.png") && names.contains(&"light1_glow.png"));
+        assert!(built_wad().find_miptex("*water1").is_some());
     }
 }

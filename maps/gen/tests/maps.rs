@@ -91,7 +91,8 @@ fn broken_map_has_exactly_four_bad_brushes_at_its_end() {
 
 #[test]
 fn the_wad_reads_back_and_has_every_texture_the_maps_use() {
-    let bytes = mapgen::textures::wad().write();
+    let pictures = mapgen::textures::picture_files().expect("pictures");
+    let bytes = mapgen::textures::wad(&pictures).expect("WAD").write();
     let wad = Wad::read(&bytes).expect("WAD reads back");
     assert_eq!(wad.write(), bytes);
     for m in maps::all() {
