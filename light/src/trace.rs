@@ -233,14 +233,10 @@ pub fn light_reaches(lights: &[PointLight], gate: f64) -> Vec<LightReach> {
 
 /// Squared distance from `p` to the box `b` (0 inside).
 fn box_distance_squared(b: &Bounds, p: DVec3) -> f64 {
-    let mut d2 = 0.0;
-    for axis in 0..3 {
-        let excess = (b.mins[axis] - p[axis])
-            .max(p[axis] - b.maxs[axis])
-            .max(0.0);
-        d2 += excess * excess;
-    }
-    d2
+    (b.mins - p)
+        .max(p - b.maxs)
+        .max(DVec3::ZERO)
+        .length_squared()
 }
 
 /// Sky faces closer to a box's edge than this still count as reachable
@@ -262,10 +258,13 @@ fn sky_offsets(sky: &[Bounds], samples: &Bounds) -> Vec<Bounds> {
 
 /// Whether the ray from the origin along `d` meets any of `boxes`.
 fn direction_meets_any(boxes: &[Bounds], d: DVec3) -> bool {
+    // Arrays, not DVec3 indexing: glam's Index has a panic arm, which this hot loop pays for.
+    let d = d.to_array();
     boxes.iter().any(|b| {
         let (mut near, mut far) = (0.0f64, f64::INFINITY);
+        let (mins, maxs) = (b.mins.to_array(), b.maxs.to_array());
         for axis in 0..3 {
-            let (lo, hi) = (b.mins[axis], b.maxs[axis]);
+            let (lo, hi) = (mins[axis], maxs[axis]);
             if d[axis] == 0.0 {
                 if lo > 0.0 || hi < 0.0 {
                     return false;
