@@ -300,3 +300,126 @@ fn a_stage_killed_at_any_moment_leaves_the_old_outputs_or_the_new_ones() {
         }
     }
 }
+
+/// Why `lit` would colour `bsp` wrongly, if it would: engines check only its header and size (3
+/// bytes a luxel after an 8-byte header), so a `.lit` from another run of the same size passes
+/// them; its grey (the rounded mean of each luxel's colour, as `slipgate light` writes the lump)
+/// gives it away.
+fn lit_mismatch(bsp: &Bsp, lit: &[u8]) -> Option<String> {
+    let rgb = match quake_formats::lit::read_lit(lit, bsp.lighting.len()) {
+        Ok(rgb) => rgb,
+        Err(e) => return Some(e.to_string()),
+    };
+    let off = rgb
+        .chunks_exact(3)
+        .zip(&bsp.lighting)
+        .filter(|(c, grey)| {
+            (c.iter().map(|&b| u16::from(b)).sum::<u16>() + 1) / 3 != u16::from(**grey)
+        })
+        .count();
+    (off > 0).then(|| {
+        format!(
+            "{off} of {} luxels' grey differs from the lump",
+            rgb.len() / 3
+        )
+    })
+}
+
+/// Where a killed `slipgate light` left the pair.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+enum Left {
+    OldPair,
+    OldBspAlone,
+    NewBspAlone,
+    NewPair,
+}
+
+/// Checks what a kill left beside the BSP against the pair before (`before`) and after
+/// (`done`) the run: a whole, valid BSP, and beside it its own `.lit` or none.
+fn check_left_pair(bsp: &Path, before: &Outputs, done: &Outputs, what: &str) -> Left {
+    let now = outputs(bsp);
+    let old = if now.bsp == before.bsp {
+        true
+    } else {
+        assert!(now.bsp == done.bsp, "{what}: a partial .bsp");
+        false
+    };
+    let read = Bsp::read(&now.bsp).unwrap_or_else(|e| panic!("{what}: {e}"));
+    let errors: Vec<_> = quake_formats::validate(&read)
+        .into_iter()
+        .filter(|p| p.severity == quake_formats::Severity::Error)
+        .collect();
+    assert!(errors.is_empty(), "{what}: {errors:?}");
+    let Some(lit) = &now.lit else {
+        return if old {
+            Left::OldBspAlone
+        } else {
+            Left::NewBspAlone
+        };
+    };
+    if let Some(mismatch) = lit_mismatch(&read, lit) {
+        panic!("{what}: the .lit beside the BSP is another run's: {mismatch}");
+    }
+    let own = if old { &before.lit } else { &done.lit };
+    assert!(own.as_ref() == Some(lit), "{what}: a .lit from neither run");
+    if old { Left::OldPair } else { Left::NewPair }
+}
+
+#[test]
+fn light_killed_at_any_moment_leaves_a_bsp_with_its_own_lit_or_none() {
+    const KILLS: usize = 50;
+    // The demo map's coloured lights write a .lit; each relight below replaces it with one of
+    // the same size but other colours, with none, or with a smaller one.
+    let bsp = compile("demo.map", "pair");
+    let b = bsp.to_str().expect("utf8");
+    let before = outputs(&bsp);
+    assert!(before.lit.is_some(), "the demo map's light writes a .lit");
+    let mut flips = Flips(1313);
+    let mut left = std::collections::BTreeMap::new();
+    for extra in [
+        &["--range", "0.3"][..],
+        &["--nolit"],
+        &["--face-stride", "2"],
+    ] {
+        let args: Vec<&str> = ["light", b].iter().chain(extra).copied().collect();
+        let start = Instant::now();
+        let out = command::slipgate(&args);
+        let seconds = start.elapsed().as_secs_f64();
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let done = outputs(&bsp);
+        assert!(done.lit != before.lit, "{args:?} leaves the .lit as it was");
+        // Half the kills anywhere in the run; the other half where the kills so far saw the
+        // files change (the latest that left the old BSP to the earliest that left the new),
+        // widened by a millisecond each way since runs start and end with some jitter.
+        let (mut old_until, mut new_from) = (0.0_f64, seconds * 1.2);
+        for kill in 0..KILLS {
+            restore(&bsp, &before);
+            let delay = if kill < KILLS / 2 {
+                seconds * 1.2 * flips.below(1000) as f64 / 1000.0
+            } else {
+                let (lo, hi) = (
+                    old_until.min(new_from) - 1e-3,
+                    old_until.max(new_from) + 1e-3,
+                );
+                (lo + (hi - lo) * flips.below(1000) as f64 / 1000.0).max(0.0)
+            };
+            kill_after(&args, Duration::from_secs_f64(delay));
+            let what = format!("{args:?} killed after {delay:.4} s (kill {kill})");
+            let outcome = check_left_pair(&bsp, &before, &done, &what);
+            if outcome <= Left::OldBspAlone {
+                old_until = old_until.max(delay);
+            } else {
+                new_from = new_from.min(delay);
+            }
+            *left.entry((extra[0], outcome)).or_insert(0) += 1;
+        }
+    }
+    eprintln!(
+        "light killed {} times; what each kill left: {left:?}",
+        3 * KILLS
+    );
+}

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use quake_formats::Bsp;
-use quake_formats::fsutil::{read_file, write_atomic};
+use quake_formats::fsutil::{Staged, read_file, write_atomic};
 
 use quake_formats::palette::Palette;
 
@@ -365,8 +365,7 @@ fn run_with_current_threads(args: &Args) -> anyhow::Result<()> {
     let lit = crate::apply_lighting(&mut bsp, &lighting);
     let lit = args.lit_to_write(&bsp, lit);
     let out = args.output.as_ref().unwrap_or(path);
-    write_atomic(out, &bsp.write()?)?;
-    write_or_remove_lit(&lit_path(out), lit)?;
+    place_lit_pair(out, &bsp.write()?, lit)?;
     if let Some(stats_path) = &args.stats {
         let mut json = serde_json::to_value(&lighting.stats)?;
         if let serde_json::Value::Object(map) = &mut json {
@@ -378,20 +377,60 @@ fn run_with_current_threads(args: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Writes the `.lit`, or removes one left from an earlier run: engines would load a stale `.lit`
-/// over the new lightmaps.
-fn write_or_remove_lit(lit_file: &Path, lit: Option<Vec<u8>>) -> anyhow::Result<()> {
-    match lit {
-        Some(bytes) => write_atomic(lit_file, &bytes)?,
-        None if lit_file.exists() => {
-            std::fs::remove_file(lit_file)
-                .with_context(|| format!("removing stale {}", lit_file.display()))?;
-            eprintln!(
-                "light: removed {} (left from an earlier run; no .lit is wanted now)",
-                lit_file.display()
-            );
+/// One step of putting a lit BSP and its `.lit` in place.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum PairStep {
+    RemoveOldLit,
+    PlaceBsp,
+    PlaceLit,
+}
+
+/// Engines take a `.lit` whose size is three times the BSP's lighting lump (QuakeSpasm and
+/// DarkPlaces check only that; older engines not even that), so an old `.lit` beside the new BSP
+/// would paint the old light's colours over it. The old `.lit` goes before the new BSP arrives and
+/// the new one after: a kill between any two steps leaves a BSP with its own `.lit` or with none.
+const PAIR_ORDER: [PairStep; 3] = [
+    PairStep::RemoveOldLit,
+    PairStep::PlaceBsp,
+    PairStep::PlaceLit,
+];
+
+/// Puts the lit BSP at `out` and its `.lit` (or none) beside it in [`PAIR_ORDER`], after both are
+/// written in full under temporary names (failing to write either leaves the old pair untouched).
+fn place_lit_pair(out: &Path, bsp: &[u8], lit: Option<Vec<u8>>) -> anyhow::Result<()> {
+    let lit_file = lit_path(out);
+    let mut staged_bsp = Some(Staged::write(out, bsp)?);
+    let mut staged_lit = lit
+        .map(|bytes| Staged::write(&lit_file, &bytes))
+        .transpose()?;
+    for step in PAIR_ORDER {
+        let staged = match step {
+            PairStep::RemoveOldLit => {
+                remove_old_lit(&lit_file, staged_lit.is_none())?;
+                None
+            }
+            PairStep::PlaceBsp => staged_bsp.take(),
+            PairStep::PlaceLit => staged_lit.take(),
+        };
+        if let Some(staged) = staged {
+            staged.commit()?;
         }
-        None => {}
+    }
+    Ok(())
+}
+
+/// Removes a `.lit` left from an earlier run, saying so when no new one replaces it.
+fn remove_old_lit(lit_file: &Path, none_wanted: bool) -> anyhow::Result<()> {
+    if !lit_file.exists() {
+        return Ok(());
+    }
+    std::fs::remove_file(lit_file)
+        .with_context(|| format!("removing stale {}", lit_file.display()))?;
+    if none_wanted {
+        eprintln!(
+            "light: removed {} (left from an earlier run; no .lit is wanted now)",
+            lit_file.display()
+        );
     }
     Ok(())
 }
@@ -417,6 +456,64 @@ mod tests {
 
     fn strings(a: &[&str]) -> Vec<String> {
         a.iter().map(|s| s.to_string()).collect()
+    }
+
+    /// Which run wrote a file of the pair.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    enum Run {
+        Old,
+        New,
+    }
+
+    #[test]
+    fn every_moment_of_the_pair_order_shows_a_bsp_with_its_own_lit_or_none() {
+        for had_lit in [false, true] {
+            for wants_lit in [false, true] {
+                let mut bsp = Run::Old;
+                let mut lit = had_lit.then_some(Run::Old);
+                let what = format!("old .lit: {had_lit}, new .lit: {wants_lit}");
+                for step in PAIR_ORDER {
+                    match step {
+                        PairStep::RemoveOldLit => lit = None,
+                        PairStep::PlaceBsp => bsp = Run::New,
+                        PairStep::PlaceLit if wants_lit => lit = Some(Run::New),
+                        PairStep::PlaceLit => {}
+                    }
+                    assert!(
+                        lit.is_none_or(|lit| lit == bsp),
+                        "{what}: a kill after {step:?} leaves a {bsp:?} BSP beside a {lit:?} .lit"
+                    );
+                }
+                assert_eq!(
+                    (bsp, lit),
+                    (Run::New, wants_lit.then_some(Run::New)),
+                    "{what}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn placing_a_pair_replaces_or_removes_the_old_lit_and_leaves_no_temporaries() {
+        let dir = std::env::temp_dir().join(format!("slipgate-light-pair-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        let bsp = dir.join("map.bsp");
+        let lit = lit_path(&bsp);
+        std::fs::write(&bsp, b"old bsp").expect("write");
+        std::fs::write(&lit, b"old lit").expect("write");
+        place_lit_pair(&bsp, b"new bsp", Some(b"new lit".to_vec())).expect("place");
+        assert_eq!(std::fs::read(&bsp).expect("bsp"), b"new bsp");
+        assert_eq!(std::fs::read(&lit).expect("lit"), b"new lit");
+        place_lit_pair(&bsp, b"grey bsp", None).expect("place");
+        assert_eq!(std::fs::read(&bsp).expect("bsp"), b"grey bsp");
+        assert!(!lit.exists(), "the old .lit outlived a run that wants none");
+        let mut names: Vec<_> = std::fs::read_dir(&dir)
+            .expect("list")
+            .map(|e| e.expect("entry").file_name())
+            .collect();
+        names.sort();
+        assert_eq!(names, ["map.bsp"], "temporaries left behind");
+        std::fs::remove_dir_all(&dir).expect("clean up");
     }
 
     #[test]
