@@ -5,7 +5,7 @@
 use crate::brush::{Brush, Map, aabb};
 use crate::level::{Level, Surfaces};
 use crate::maps::{light, player_start, standard, worldspawn};
-use crate::textures::Rng;
+use quake_formats::rng::SplitMix64;
 
 /// The seed of the committed `open/open.map`.
 pub const SEED: u64 = 16;
@@ -93,28 +93,27 @@ pub fn open_map(seed: u64) -> Map {
 
 /// The cells of the field: about one in eight a room (2x2 cells), the rest mostly pillars.
 fn layout(seed: u64) -> Vec<Cell> {
-    let mut rng = Rng::new(seed);
+    let mut rng = SplitMix64::new(seed);
     let mut cells = vec![Cell::Empty; CELLS * CELLS];
-    let below = |rng: &mut Rng, n: u64| (rng.next_u64() % n) as usize;
     for i in 0..cells.len() {
         let (cx, cy) = (i % CELLS, i / CELLS);
         if cells[i] != Cell::Empty {
             continue;
         }
-        let roll = below(&mut rng, 16);
+        let roll = rng.below(16);
         // Rooms keep one cell of field between them and the outer wall.
         let room_fits = cx > 0 && cy > 0 && cx + 2 < CELLS && cy + 2 < CELLS;
         let free = |j: usize| cells.get(j) == Some(&Cell::Empty);
         if roll < 2 && room_fits && [i + 1, i + CELLS, i + CELLS + 1].into_iter().all(free) {
             cells[i] = Cell::Room {
-                door_side: below(&mut rng, 4),
+                door_side: rng.below(4),
             };
             for j in [i + 1, i + CELLS, i + CELLS + 1] {
                 cells[j] = Cell::Taken;
             }
         } else if roll < 11 {
-            let half = 16.0 * (1 + below(&mut rng, 4)) as f64;
-            let height = 64.0 * (1 + below(&mut rng, 8)) as f64;
+            let half = 16.0 * (1 + rng.below(4)) as f64;
+            let height = 64.0 * (1 + rng.below(8)) as f64;
             cells[i] = Cell::Pillar { half, height };
         }
     }

@@ -6,34 +6,12 @@
 //! WAD builder, so the pictures' and the WAD's bytes are the same on every machine.
 
 use image::DynamicImage;
+use quake_formats::rng::SplitMix64;
 use quake_formats::wad::Wad;
 use std::path::Path;
 use wad::WadError;
 use wad::build::BuildOptions;
 use wad::extract::encode_png;
-
-/// SplitMix64: tiny, fast and good enough for texture noise.
-#[derive(Debug, Clone)]
-pub struct Rng(u64);
-
-impl Rng {
-    pub fn new(seed: u64) -> Rng {
-        Rng(seed)
-    }
-
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [0, 1).
-    pub fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
 
 /// Value noise on a grid of `cells` x `cells` that wraps around, so textures tile.
 struct Noise {
@@ -42,7 +20,7 @@ struct Noise {
 }
 
 impl Noise {
-    fn new(rng: &mut Rng, cells: usize) -> Noise {
+    fn new(rng: &mut SplitMix64, cells: usize) -> Noise {
         Noise {
             cells,
             values: (0..cells * cells).map(|_| rng.unit()).collect(),
@@ -71,7 +49,7 @@ struct Fractal(Vec<Noise>);
 
 impl Fractal {
     fn new(seed: u64) -> Fractal {
-        let mut rng = Rng::new(seed);
+        let mut rng = SplitMix64::new(seed);
         Fractal([4, 8, 16, 32].map(|c| Noise::new(&mut rng, c)).into())
     }
 
@@ -177,7 +155,7 @@ fn bevel(x: usize, y: usize, w: usize, h: usize, width: usize) -> f64 {
     }
 }
 
-fn brick(n: &Fractal, rng: &mut Rng) -> Image {
+fn brick(n: &Fractal, rng: &mut SplitMix64) -> Image {
     let tones: Vec<f64> = (0..16).map(|_| 0.8 + 0.35 * rng.unit()).collect();
     Image::from_fn(64, 64, |x, y| {
         let row = y / 16;
@@ -194,7 +172,7 @@ fn brick(n: &Fractal, rng: &mut Rng) -> Image {
     })
 }
 
-fn stone_floor(n: &Fractal, rng: &mut Rng) -> Image {
+fn stone_floor(n: &Fractal, rng: &mut SplitMix64) -> Image {
     let tones: Vec<f64> = (0..4).map(|_| 0.85 + 0.3 * rng.unit()).collect();
     Image::from_fn(64, 64, |x, y| {
         let grain = n.at(x as f64 / 64.0, y as f64 / 64.0);
@@ -205,7 +183,7 @@ fn stone_floor(n: &Fractal, rng: &mut Rng) -> Image {
     })
 }
 
-fn wood(n: &Fractal, rng: &mut Rng) -> Image {
+fn wood(n: &Fractal, rng: &mut SplitMix64) -> Image {
     let planks: Vec<(f64, usize)> = (0..4)
         .map(|_| (0.8 + 0.35 * rng.unit(), (rng.unit() * 64.0) as usize))
         .collect();
@@ -332,9 +310,9 @@ fn tool(base: [f64; 3], pattern: fn(usize, usize) -> bool) -> Image {
 
 /// Every texture of `slipgate.wad`, in the WAD's order.
 pub fn images() -> Vec<(&'static str, Image)> {
-    let mut rng = Rng::new(0x5119_6A7E);
+    let mut rng = SplitMix64::new(0x5119_6A7E);
     let mut noise = || Fractal::new(rng.next_u64());
-    let mut tones = Rng::new(0x7E27_u64);
+    let mut tones = SplitMix64::new(0x7E27_u64);
     vec![
         ("brick1", brick(&noise(), &mut tones)),
         ("floor1", stone_floor(&noise(), &mut tones)),
@@ -404,16 +382,6 @@ pub fn wad(pictures: &[(String, Vec<u8>)]) -> Result<Wad, WadError> {
 mod tests {
     use super::*;
     use quake_formats::palette::FIRST_FULLBRIGHT;
-
-    #[test]
-    fn rng_is_deterministic_and_uniformish() {
-        let mut a = Rng::new(7);
-        let mut b = Rng::new(7);
-        let xs: Vec<f64> = (0..1000).map(|_| a.unit()).collect();
-        assert!(xs.iter().all(|&x| x == b.unit() && (0.0..1.0).contains(&x)));
-        let mean = xs.iter().sum::<f64>() / xs.len() as f64;
-        assert!((mean - 0.5).abs() < 0.05, "mean {mean}");
-    }
 
     #[test]
     fn noise_tiles_and_stays_in_range() {
