@@ -134,8 +134,16 @@ pub fn extract(wad: &Wad, dir: &Path, palette: &Palette) -> Result<Extracted, Wa
         source,
     })?;
     let mut done = Extracted::default();
+    let mut seen = std::collections::HashSet::new();
     for lump in &wad.lumps {
         let name = lump.name();
+        // Compilers take the first texture of a name; a later one would overwrite its picture.
+        if lump.kind == lump_type::MIPTEX && !seen.insert(name.to_ascii_lowercase()) {
+            done.skipped.push(format!(
+                "{name}: a second texture of this name (compilers use the first)"
+            ));
+            continue;
+        }
         let Some(tex) = miptex_of(wad, lump) else {
             done.skipped
                 .push(format!("{name}: {} lump", lump_kind(lump.kind)));
@@ -185,6 +193,22 @@ mod tests {
     fn tex(name: &str, pixels: Vec<u8>) -> MipTex {
         let mips = [pixels, vec![0; 64], vec![0; 16], vec![0; 4]];
         MipTex::new(name, 16, 16, mips)
+    }
+
+    #[test]
+    fn a_second_texture_of_a_name_is_skipped_not_written_over_the_first() {
+        let palette = Palette::slipgate();
+        let wad = Wad::new(vec![
+            quake_formats::wad::WadLump::miptex(tex("wall", vec![10; 256])),
+            quake_formats::wad::WadLump::miptex(tex("WALL", vec![20; 256])),
+        ]);
+        let dir = std::env::temp_dir().join(format!("slipgate-extract-dup-{}", std::process::id()));
+        let done = extract(&wad, &dir, &palette).expect("extract");
+        assert_eq!(done.written.len(), 1);
+        assert_eq!(done.skipped.len(), 1, "{:?}", done.skipped);
+        let written = image::open(&done.written[0]).expect("png").to_rgb8();
+        assert_eq!(written.get_pixel(0, 0).0, palette.colors[10]);
+        std::fs::remove_dir_all(&dir).expect("clean up");
     }
 
     #[test]
