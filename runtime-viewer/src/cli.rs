@@ -94,6 +94,9 @@ fn parse_size(s: &str) -> Result<(usize, usize), String> {
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let start = Instant::now();
     let world = World::load(&args.map, args.palette.as_deref())?;
+    if let Some(why) = &world.stats.ignored_lit {
+        eprintln!("warning: {why}; drawing the BSP's own light in grey, as engines do");
+    }
     let load_time = start.elapsed().as_secs_f64();
     let camera = initial_camera(&world, args)?;
     let mut renderer = Renderer::new(&world, args.render_options());

@@ -67,6 +67,8 @@ pub struct LoadStats {
     pub brush_models_drawn: usize,
     pub brush_model_fragments: usize,
     pub coloured_light: bool,
+    /// Why a `.lit` beside the BSP was not used (engines then draw the BSP's own light, grey).
+    pub ignored_lit: Option<String>,
 }
 
 #[derive(Debug)]
@@ -101,20 +103,24 @@ impl World {
         let data = quake_formats::fsutil::read_file(path).map_err(format(path))?;
         let bsp = Bsp::read(&data).map_err(format(path))?;
         let lit_path = path.with_extension("lit");
-        let lit = if lit_path.is_file() {
+        // As QuakeSpasm and DarkPlaces do, a `.lit` that is not this BSP's is ignored, not fatal.
+        let (lit, ignored_lit) = if lit_path.is_file() {
             let data = quake_formats::fsutil::read_file(&lit_path).map_err(format(&lit_path))?;
-            Some(
-                quake_formats::lit::read_lit(&data, bsp.lighting.len())
-                    .map_err(format(&lit_path))?,
-            )
+            match quake_formats::lit::read_lit(&data, bsp.lighting.len()) {
+                Ok(rgb) => (Some(rgb), None),
+                Err(e) => (None, Some(format!("{}: {e}", lit_path.display()))),
+            }
         } else {
-            None
+            (None, None)
         };
         let (palette, source) = find_palette(path, palette)?;
-        World::new(bsp, &palette, source, lit).map_err(|detail| ViewerError::BadMap {
-            path: path.to_path_buf(),
-            detail,
-        })
+        let mut world =
+            World::new(bsp, &palette, source, lit).map_err(|detail| ViewerError::BadMap {
+                path: path.to_path_buf(),
+                detail,
+            })?;
+        world.stats.ignored_lit = ignored_lit;
+        Ok(world)
     }
 
     /// Build from parts; `lit` is the RGB data of a `.lit` file matching `bsp.lighting`.
@@ -420,5 +426,31 @@ fn cut_into_leaves(bsp: &Bsp, face: u32, winding: Winding, out: &mut [Vec<Fragme
                 stack.push((back, b));
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_lit_of_another_bsp_is_ignored_as_engines_do_not_fatal() {
+        let dir = std::env::temp_dir().join(format!("slipgate-view-lit-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        let bsp_path = dir.join("room.bsp");
+        let bsp = crate::test_room::room_bsp(0);
+        std::fs::write(&bsp_path, bsp.write().expect("room writes")).expect("write bsp");
+        // One luxel too many: a .lit written for another BSP.
+        let rgb = vec![200u8; 3 * (bsp.lighting.len() + 1)];
+        std::fs::write(dir.join("room.lit"), quake_formats::lit::write_lit(&rgb)).expect("lit");
+        let world = World::load(&bsp_path, None).expect("loads without the .lit");
+        assert!(!world.stats.coloured_light);
+        assert!(world.stats.ignored_lit.is_some());
+        // The matching size is used.
+        let rgb = vec![200u8; 3 * bsp.lighting.len()];
+        std::fs::write(dir.join("room.lit"), quake_formats::lit::write_lit(&rgb)).expect("lit");
+        let world = World::load(&bsp_path, None).expect("loads with the .lit");
+        assert!(world.stats.coloured_light && world.stats.ignored_lit.is_none());
+        std::fs::remove_dir_all(&dir).expect("clean up");
     }
 }
