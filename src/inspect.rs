@@ -58,6 +58,7 @@ fn info_file(file: &Path) -> Result<ExitCode> {
     print_counts(&bsp);
     let problems = validate(&bsp);
     print_problems(&problems);
+    print_lit_beside(file, &bsp)?;
     let errors = problems
         .iter()
         .filter(|p| p.severity == Severity::Error)
@@ -106,6 +107,38 @@ fn print_counts(bsp: &Bsp) {
         entities.len(),
         bsp.models.len()
     );
+}
+
+/// Whether a `.lit` beside the BSP is the one engines would pair with it and the light it holds.
+fn print_lit_beside(file: &Path, bsp: &Bsp) -> Result<()> {
+    let path = file.with_extension("lit");
+    if !path.is_file() {
+        return Ok(());
+    }
+    let data = read_file(&path)?;
+    let rgb = match quake_formats::lit::read_lit(&data, bsp.lighting.len()) {
+        Ok(rgb) => rgb,
+        Err(e) => {
+            println!("warning: {}: {e}; engines ignore it", path.display());
+            return Ok(());
+        }
+    };
+    let luxels = bsp.lighting.len();
+    let far = quake_formats::lit::grey_disagreements(&rgb, &bsp.lighting);
+    if luxels > 0 && far as f64 / luxels as f64 > quake_formats::lit::LIT_MISMATCH_SHARE {
+        println!(
+            "warning: {}: {far} of {luxels} luxels' grey is more than {} from the lighting lump: \
+             the colours of another light run (engines will draw them); light the BSP again",
+            path.display(),
+            quake_formats::lit::LIT_GREY_TOLERANCE
+        );
+    } else {
+        println!(
+            "{}: {luxels} luxels of colour, grey agrees with the lighting lump",
+            path.display()
+        );
+    }
+    Ok(())
 }
 
 /// Every problem, at most [`SHOWN_PER_RULE`] per rule, then a count per rule.

@@ -215,3 +215,36 @@ fn a_world_without_brushes_is_an_error_and_writes_nothing() {
         }
     }
 }
+
+#[test]
+fn info_says_whether_the_lit_beside_a_bsp_is_its_own() {
+    let Some(bsp) = corpus("public/bsp/librequake/start.bsp") else {
+        return;
+    };
+    let copy = scratch("lit-check.bsp");
+    std::fs::copy(bsp, &copy).expect("copy");
+    let lighting = quake_formats::Bsp::read(&std::fs::read(&copy).expect("read"))
+        .expect("corpus BSP reads")
+        .lighting;
+    let lit = copy.with_extension("lit");
+    let info = || {
+        String::from_utf8_lossy(&slipgate(&["info", copy.to_str().expect("utf8")]).stdout)
+            .into_owned()
+    };
+    let own: Vec<u8> = lighting.iter().flat_map(|&g| [g, g, g]).collect();
+    std::fs::write(&lit, quake_formats::lit::write_lit(&own)).expect("write");
+    assert!(
+        info().contains("grey agrees with the lighting lump"),
+        "{}",
+        info()
+    );
+    let foreign: Vec<u8> = lighting.iter().flat_map(|&g| [255 - g; 3]).collect();
+    std::fs::write(&lit, quake_formats::lit::write_lit(&foreign)).expect("write");
+    assert!(
+        info().contains("the colours of another light run"),
+        "{}",
+        info()
+    );
+    std::fs::write(&lit, quake_formats::lit::write_lit(&own[3..])).expect("write");
+    assert!(info().contains("engines ignore it"), "{}", info());
+}
