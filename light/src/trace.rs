@@ -13,7 +13,7 @@ use crate::faces::FaceGeom;
 use crate::lights::{
     DirtMode, DirtResponse, DirtSampling, Falloff, Minlight, PointLight, SunLight, angle_factor,
 };
-use crate::samples::{FaceSamples, solid_points};
+use crate::samples::{FaceSamples, WalkStart, solid_points_from};
 use crate::scene::TraceScene;
 use crate::visibility::Visibility;
 
@@ -72,6 +72,9 @@ struct Footprints {
     lit: Vec<bool>,
     points: Vec<DVec3>,
     at: Vec<[f32; 3]>,
+    /// Where the face's points part ways in the world BSP, found at the
+    /// first footprint (the inner None: the BSP has no world model).
+    walk_start: Option<Option<WalkStart>>,
 }
 
 impl Footprints {
@@ -97,7 +100,15 @@ impl Footprints {
         self.at.clear();
         self.at
             .extend(self.points.iter().map(|q| q.as_vec3().to_array()));
-        for (q, solid) in self.points.iter_mut().zip(solid_points(bsp, &self.at)) {
+        let start = self.walk_start.get_or_insert_with(|| {
+            let (lo, hi) = samples.map.bounds();
+            WalkStart::for_box(bsp, lo, hi)
+        });
+        let solid = match start {
+            Some(start) => solid_points_from(bsp, start, &self.at),
+            None => vec![false; self.at.len()],
+        };
+        for (q, solid) in self.points.iter_mut().zip(solid) {
             if solid {
                 *q = own;
             }
