@@ -160,6 +160,8 @@ pub struct FaceRegion {
     points: Vec<DVec3>,
     /// Per edge (from `points[i]` to the next): unit in-plane normal pointing inside.
     inward: Vec<DVec3>,
+    /// Per edge: the step from `points[i]` to the next and its squared length.
+    edges: Vec<(DVec3, f64)>,
 }
 
 impl FaceRegion {
@@ -173,7 +175,17 @@ impl FaceRegion {
                 if m.dot(centre - a) < 0.0 { -m } else { m }
             })
             .collect();
-        FaceRegion { points, inward }
+        let edges = (0..points.len())
+            .map(|i| {
+                let ab = points[(i + 1) % points.len()] - points[i];
+                (ab, ab.dot(ab))
+            })
+            .collect();
+        FaceRegion {
+            points,
+            inward,
+            edges,
+        }
     }
 
     /// The face's polygon shrunk by [`FACE_INSET`] (halved until the face
@@ -204,16 +216,13 @@ impl FaceRegion {
     /// `p` (a point on the face's plane) if it is inside, else the nearest
     /// point of the region's outline.
     pub fn nearest(&self, p: DVec3) -> DVec3 {
-        let outside = (0..self.points.len()).any(|i| self.inward[i].dot(p - self.points[i]) < 0.0);
+        let outside = (self.points.iter().zip(&self.inward)).any(|(&a, m)| m.dot(p - a) < 0.0);
         if !outside || self.points.is_empty() {
             return p;
         }
         let mut best = self.points[0];
         let mut best_d2 = f64::INFINITY;
-        for i in 0..self.points.len() {
-            let a = self.points[i];
-            let ab = self.points[(i + 1) % self.points.len()] - a;
-            let len2 = ab.dot(ab);
+        for (&a, &(ab, len2)) in self.points.iter().zip(&self.edges) {
             let t = if len2 > 0.0 {
                 ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
             } else {
