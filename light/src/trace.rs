@@ -53,6 +53,9 @@ fn unshadowed(light: &PointLight, p: DVec3, normal: DVec3) -> Option<(f64, DVec3
     Some((light.contribution(dist, -dir, normal.dot(dir)), dir, dist))
 }
 
+/// A ray's origin, direction and length.
+type ShadowRay = ([f32; 3], [f32; 3], f32);
+
 /// Adaptive supersampling of close lights: a sample so close to a light
 /// that its value changes a lot across the sample's square takes the mean
 /// of what the light adds over `cells x cells` points spread across it,
@@ -67,9 +70,14 @@ struct Footprints {
     /// Per point: what the light adds unshadowed (0 at the light itself).
     values: Vec<f64>,
     /// Per point: its shadow ray (origin, direction, length), if it has one.
-    rays: Vec<Option<([f32; 3], [f32; 3], f32)>>,
+    rays: Vec<Option<ShadowRay>>,
     /// Per point: its shadow ray got through.
     lit: Vec<bool>,
+    /// Per sample (sized at the face's first footprint): the cell count and
+    /// range in `points` of its placed points (inside solid: moved onto the
+    /// sample), so a sample close to several lights with the same cell
+    /// count (the copies of a surface light) places its points once.
+    placed: Vec<Option<(usize, std::ops::Range<usize>)>>,
     points: Vec<DVec3>,
     at: Vec<[f32; 3]>,
     /// Where the face's points part ways in the world BSP, found at the
@@ -84,7 +92,37 @@ impl Footprints {
         self.rays.clear();
     }
 
-    /// Places sample `i`'s `cells x cells` points and their rays to `light`.
+    /// Places sample `i`'s `cells x cells` points at the end of `points`.
+    fn place(
+        &mut self,
+        bsp: &Bsp,
+        samples: &FaceSamples,
+        i: usize,
+        cells: usize,
+    ) -> std::ops::Range<usize> {
+        let own = Vec3::from(samples.points[i]).as_dvec3();
+        let first = self.points.len();
+        self.points.extend(samples.map.footprint_points(i, cells));
+        self.at.clear();
+        self.at
+            .extend(self.points[first..].iter().map(|q| q.as_vec3().to_array()));
+        let start = self.walk_start.get_or_insert_with(|| {
+            let (lo, hi) = samples.map.bounds();
+            WalkStart::for_box(bsp, lo, hi)
+        });
+        let solid = match start {
+            Some(start) => solid_points_from(bsp, start, &self.at),
+            None => vec![false; self.at.len()],
+        };
+        for (q, solid) in self.points[first..].iter_mut().zip(solid) {
+            if solid {
+                *q = own;
+            }
+        }
+        first..self.points.len()
+    }
+
+    /// Adds sample `i`'s `cells x cells` points and their rays to `light`.
     fn add(
         &mut self,
         bsp: &Bsp,
@@ -94,27 +132,19 @@ impl Footprints {
         light: &PointLight,
     ) {
         let normal = samples.normal_at(i);
-        let own = Vec3::from(samples.points[i]).as_dvec3();
-        self.points.clear();
-        self.points.extend(samples.map.footprint_points(i, cells));
-        self.at.clear();
-        self.at
-            .extend(self.points.iter().map(|q| q.as_vec3().to_array()));
-        let start = self.walk_start.get_or_insert_with(|| {
-            let (lo, hi) = samples.map.bounds();
-            WalkStart::for_box(bsp, lo, hi)
-        });
-        let solid = match start {
-            Some(start) => solid_points_from(bsp, start, &self.at),
-            None => vec![false; self.at.len()],
-        };
-        for (q, solid) in self.points.iter_mut().zip(solid) {
-            if solid {
-                *q = own;
-            }
+        if self.placed.is_empty() {
+            self.placed.resize(samples.points.len(), None);
         }
+        let placed = match &self.placed[i] {
+            Some((c, placed)) if *c == cells => placed.clone(),
+            _ => {
+                let placed = self.place(bsp, samples, i, cells);
+                self.placed[i] = Some((cells, placed.clone()));
+                placed
+            }
+        };
         let first = self.values.len();
-        for &q in &self.points {
+        for &q in &self.points[placed] {
             let Some((value, dir, dist)) = unshadowed(light, q, normal) else {
                 self.values.push(0.0);
                 self.rays.push(None);
