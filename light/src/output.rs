@@ -73,7 +73,15 @@ pub fn to_bytes(c: [f32; 3], finish: &Finish) -> [u8; 3] {
     if max > 255.0 {
         v = v.map(|x| x * 255.0 / max);
     }
-    v.map(|x| x.round().clamp(0.0, 255.0) as u8)
+    v.map(|x| round_non_negative(x).clamp(0.0, 255.0) as u8)
+}
+
+/// `x.round()` for `x` in 0..2^32 (NaN gives 0, as `round` then `as u8` do): `f64::round`
+/// is a software routine on baseline x86-64, and this runs for every channel of every luxel.
+/// `x - t` is exact there, so halves round up as `round` rounds them.
+fn round_non_negative(x: f64) -> f64 {
+    let t = f64::from(x as u32);
+    if x - t >= 0.5 { t + 1.0 } else { t }
 }
 
 /// Finishes one face. Returns the lightmap and how many styles were dropped
@@ -155,6 +163,19 @@ mod tests {
         assert_eq!(to_bytes([300.0, 300.0, 300.0], &PLAIN), [150; 3]);
         assert_eq!(to_bytes([-20.0, 0.0, 1.0], &PLAIN), [0, 0, 1]);
         assert_eq!(to_bytes([1020.0, 510.0, 0.0], &PLAIN), [255, 128, 0]);
+    }
+
+    #[test]
+    fn non_negative_rounding_matches_round() {
+        let halves = (0..600).map(|k| f64::from(k) / 2.0);
+        let near_halves = (0..600).flat_map(|k| {
+            let h = f64::from(k) + 0.5;
+            [h.next_down(), h.next_up()]
+        });
+        for x in halves.chain(near_halves).chain([0.0, 254.9999, 1e9]) {
+            assert_eq!(round_non_negative(x), x.round(), "{x}");
+        }
+        assert_eq!(round_non_negative(f64::NAN) as u8, f64::NAN.round() as u8);
     }
 
     #[test]

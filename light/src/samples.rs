@@ -160,6 +160,8 @@ pub struct FaceRegion {
     points: Vec<DVec3>,
     /// Per edge (from `points[i]` to the next): unit in-plane normal pointing inside.
     inward: Vec<DVec3>,
+    /// Per edge: the step from `points[i]` to the next and its squared length.
+    edges: Vec<(DVec3, f64)>,
 }
 
 impl FaceRegion {
@@ -173,7 +175,17 @@ impl FaceRegion {
                 if m.dot(centre - a) < 0.0 { -m } else { m }
             })
             .collect();
-        FaceRegion { points, inward }
+        let edges = (0..points.len())
+            .map(|i| {
+                let ab = points[(i + 1) % points.len()] - points[i];
+                (ab, ab.dot(ab))
+            })
+            .collect();
+        FaceRegion {
+            points,
+            inward,
+            edges,
+        }
     }
 
     /// The face's polygon shrunk by [`FACE_INSET`] (halved until the face
@@ -204,16 +216,13 @@ impl FaceRegion {
     /// `p` (a point on the face's plane) if it is inside, else the nearest
     /// point of the region's outline.
     pub fn nearest(&self, p: DVec3) -> DVec3 {
-        let outside = (0..self.points.len()).any(|i| self.inward[i].dot(p - self.points[i]) < 0.0);
+        let outside = (self.points.iter().zip(&self.inward)).any(|(&a, m)| m.dot(p - a) < 0.0);
         if !outside || self.points.is_empty() {
             return p;
         }
         let mut best = self.points[0];
         let mut best_d2 = f64::INFINITY;
-        for i in 0..self.points.len() {
-            let a = self.points[i];
-            let ab = self.points[(i + 1) % self.points.len()] - a;
-            let len2 = ab.dot(ab);
+        for (&a, &(ab, len2)) in self.points.iter().zip(&self.edges) {
             let t = if len2 > 0.0 {
                 ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
             } else {
@@ -278,6 +287,21 @@ impl SurfaceMap {
         let on_plane = m.point(s, t) + self.origin;
         let on_face = self.region.nearest(on_plane);
         (on_face + self.lift, on_face != on_plane)
+    }
+
+    /// A box holding every point [`SurfaceMap::point`] gives (a little
+    /// wider, for rounding), in single precision.
+    pub fn bounds(&self) -> ([f32; 3], [f32; 3]) {
+        const SLACK: f64 = 0.01;
+        let (mut lo, mut hi) = (self.centre(), self.centre());
+        for &p in &self.region.points {
+            lo = lo.min(p + self.lift);
+            hi = hi.max(p + self.lift);
+        }
+        (
+            (lo - SLACK).as_vec3().to_array(),
+            (hi + SLACK).as_vec3().to_array(),
+        )
     }
 
     /// Texels along each axis one sample stands for.
@@ -426,18 +450,63 @@ fn into_open(
 /// per-point test, so the shared walk ends in the leaf `Bsp::leaf_at` finds.
 const SHARED_WALK_MARGIN: f32 = 0.1;
 
+/// A node of the world BSP where the shared walk of [`solid_points`]
+/// arrives for every point inside a box: walks of points inside that box
+/// (the close-light footprints of one face) start there instead of at the
+/// root, and end where they would have. A box inside another one is on one
+/// side of every plane the bigger box is on one side of (the near and far
+/// sums are monotonic in the box corners, rounding included).
+#[derive(Debug, Clone, Copy)]
+pub struct WalkStart {
+    node: i32,
+    lo: [f32; 3],
+    hi: [f32; 3],
+}
+
+impl WalkStart {
+    /// The root, for points anywhere (None: the BSP has no world model).
+    pub fn root(bsp: &Bsp) -> Option<WalkStart> {
+        let &node = bsp.models.first()?.head_nodes.first()?;
+        let (lo, hi) = ([f32::NEG_INFINITY; 3], [f32::INFINITY; 3]);
+        Some(WalkStart { node, lo, hi })
+    }
+
+    /// Where points inside `lo..hi` part ways.
+    pub fn for_box(bsp: &Bsp, lo: [f32; 3], hi: [f32; 3]) -> Option<WalkStart> {
+        let root = WalkStart::root(bsp)?;
+        Some(WalkStart {
+            node: shared_walk(bsp, root.node, lo, hi),
+            lo,
+            hi,
+        })
+    }
+
+    fn contains(&self, lo: [f32; 3], hi: [f32; 3]) -> bool {
+        (0..3).all(|a| self.lo[a] <= lo[a] && hi[a] <= self.hi[a])
+    }
+}
+
 /// Whether each of `points` is in a solid world leaf. The points share the
 /// walk from the root down to the first node whose plane passes between
 /// them, so a cluster (a face's samples, a luxel's square) costs about one
 /// walk instead of one each.
 pub fn solid_points(bsp: &Bsp, points: &[[f32; 3]]) -> Vec<bool> {
+    match WalkStart::root(bsp) {
+        Some(root) => solid_points_from(bsp, &root, points),
+        None => vec![false; points.len()],
+    }
+}
+
+/// [`solid_points`], with the walk starting at `start` when it holds all
+/// of `points` (else at the root).
+pub fn solid_points_from(bsp: &Bsp, start: &WalkStart, points: &[[f32; 3]]) -> Vec<bool> {
     let solid = |leaf: Option<usize>| {
         leaf.and_then(|l| bsp.leafs.get(l))
             .is_some_and(|l| l.contents == contents::SOLID)
     };
-    let Some(&root) = bsp.models.first().and_then(|m| m.head_nodes.first()) else {
-        return vec![false; points.len()];
-    };
+    if points.is_empty() {
+        return Vec::new();
+    }
     let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
     for p in points {
         for a in 0..3 {
@@ -445,9 +514,29 @@ pub fn solid_points(bsp: &Bsp, points: &[[f32; 3]]) -> Vec<bool> {
             hi[a] = hi[a].max(p[a]);
         }
     }
-    let mut node = root;
+    let from = if start.contains(lo, hi) {
+        start.node
+    } else {
+        match WalkStart::root(bsp) {
+            Some(root) => root.node,
+            None => return vec![false; points.len()],
+        }
+    };
+    let node = shared_walk(bsp, from, lo, hi);
+    if node < 0 {
+        return vec![solid(bsp.leaf_from(node, [0.0; 3])); points.len()];
+    }
+    points
+        .iter()
+        .map(|&p| solid(bsp.leaf_from(node, p)))
+        .collect()
+}
+
+/// From `node` down, the first node whose plane passes between the corners
+/// of `lo..hi` (with [`SHARED_WALK_MARGIN`]), or the leaf the box is in.
+fn shared_walk(bsp: &Bsp, mut node: i32, lo: [f32; 3], hi: [f32; 3]) -> i32 {
     let mut steps = 0;
-    while node >= 0 && steps <= bsp.nodes.len() && !points.is_empty() {
+    while node >= 0 && steps <= bsp.nodes.len() {
         let Some(n) = bsp.nodes.get(node as usize) else {
             break;
         };
@@ -469,11 +558,5 @@ pub fn solid_points(bsp: &Bsp, points: &[[f32; 3]]) -> Vec<bool> {
         };
         steps += 1;
     }
-    if node < 0 {
-        return vec![solid(bsp.leaf_from(node, [0.0; 3])); points.len()];
-    }
-    points
-        .iter()
-        .map(|&p| solid(bsp.leaf_from(node, p)))
-        .collect()
+    node
 }

@@ -1209,6 +1209,22 @@ fn shared_leaf_walk_agrees_with_walking_each_point() {
                 expected,
                 "cluster at {cx} {cz}"
             );
+            // A walk started where a box around the cluster parts ways,
+            // and one whose start box misses the cluster (from the root).
+            for (lo, hi) in [
+                (
+                    [cx as f32 - 1.0, -90.0, -170.0],
+                    [cx as f32 + 16.0, 90.0, 170.0],
+                ),
+                ([500.0; 3], [600.0; 3]),
+            ] {
+                let start = crate::samples::WalkStart::for_box(&bsp, lo, hi).expect("world model");
+                assert_eq!(
+                    crate::samples::solid_points_from(&bsp, &start, &cluster),
+                    expected,
+                    "cluster at {cx} {cz} from the node of {lo:?}..{hi:?}"
+                );
+            }
         }
     }
     assert!(solid_seen > 0, "some clusters reach into solid");

@@ -13,7 +13,7 @@ use crate::faces::FaceGeom;
 use crate::lights::{
     DirtMode, DirtResponse, DirtSampling, Falloff, Minlight, PointLight, SunLight, angle_factor,
 };
-use crate::samples::{FaceSamples, solid_points};
+use crate::samples::{FaceSamples, WalkStart, solid_points_from};
 use crate::scene::TraceScene;
 use crate::visibility::Visibility;
 
@@ -53,56 +53,157 @@ fn unshadowed(light: &PointLight, p: DVec3, normal: DVec3) -> Option<(f64, DVec3
     Some((light.contribution(dist, -dir, normal.dot(dir)), dir, dist))
 }
 
-/// Adaptive supersampling of one close light: the mean of what `light` adds
-/// over `cells x cells` points spread across sample `i`'s square, each with
-/// its own shadow ray. A point that lands inside solid (the square reaching
-/// into a fixture on the wall) counts as the sample point itself.
-fn footprint_light(
-    setup: &TraceSetup,
-    samples: &FaceSamples,
-    i: usize,
-    cells: usize,
-    light: &PointLight,
-    packet: &mut RayPacket16,
-    counts: &mut TraceCounts,
-) -> f64 {
-    let normal = samples.normal_at(i);
-    let model = setup.faces[samples.face].model;
-    let own = Vec3::from(samples.points[i]).as_dvec3();
-    let mut points: Vec<DVec3> = samples.map.footprint_points(i, cells).collect();
-    let at: Vec<[f32; 3]> = points.iter().map(|q| q.as_vec3().to_array()).collect();
-    for (q, solid) in points.iter_mut().zip(solid_points(setup.bsp, &at)) {
-        if solid {
-            *q = own;
-        }
+/// A ray's origin, direction and length.
+type ShadowRay = ([f32; 3], [f32; 3], f32);
+
+/// Adaptive supersampling of close lights: a sample so close to a light
+/// that its value changes a lot across the sample's square takes the mean
+/// of what the light adds over `cells x cells` points spread across it,
+/// each with its own shadow ray. A point that lands inside solid (the square
+/// reaching into a fixture on the wall) counts as the sample point itself.
+/// The points of all of one light's footprints on a face share packets
+/// (most footprints have fewer than 16 points).
+#[derive(Debug, Default)]
+struct Footprints {
+    /// Per footprint: its sample and its range in `values` and `lit`.
+    spans: Vec<(usize, std::ops::Range<usize>)>,
+    /// Per point: what the light adds unshadowed (0 at the light itself).
+    values: Vec<f64>,
+    /// Per point: its shadow ray (origin, direction, length), if it has one.
+    rays: Vec<Option<ShadowRay>>,
+    /// Per point: its shadow ray got through.
+    lit: Vec<bool>,
+    /// Per sample (sized at the face's first footprint): the cell count and
+    /// range in `points` of its placed points (inside solid: moved onto the
+    /// sample), so a sample close to several lights with the same cell
+    /// count (the copies of a surface light) places its points once.
+    placed: Vec<Option<(usize, std::ops::Range<usize>)>>,
+    points: Vec<DVec3>,
+    at: Vec<[f32; 3]>,
+    /// Where the face's points part ways in the world BSP, found at the
+    /// first footprint (the inner None: the BSP has no world model).
+    walk_start: Option<Option<WalkStart>>,
+}
+
+impl Footprints {
+    fn clear(&mut self) {
+        self.spans.clear();
+        self.values.clear();
+        self.rays.clear();
     }
-    let mut lane_value = [0.0f64; 16];
-    let mut sum = 0.0;
-    for chunk in points.chunks(16) {
-        packet.clear();
-        for (lane, &q) in chunk.iter().enumerate() {
+
+    /// Places sample `i`'s `cells x cells` points at the end of `points`.
+    fn place(
+        &mut self,
+        bsp: &Bsp,
+        samples: &FaceSamples,
+        i: usize,
+        cells: usize,
+    ) -> std::ops::Range<usize> {
+        let own = Vec3::from(samples.points[i]).as_dvec3();
+        let first = self.points.len();
+        self.points.extend(samples.map.footprint_points(i, cells));
+        self.at.clear();
+        self.at
+            .extend(self.points[first..].iter().map(|q| q.as_vec3().to_array()));
+        let start = self.walk_start.get_or_insert_with(|| {
+            let (lo, hi) = samples.map.bounds();
+            WalkStart::for_box(bsp, lo, hi)
+        });
+        let solid = match start {
+            Some(start) => solid_points_from(bsp, start, &self.at),
+            None => vec![false; self.at.len()],
+        };
+        for (q, solid) in self.points[first..].iter_mut().zip(solid) {
+            if solid {
+                *q = own;
+            }
+        }
+        first..self.points.len()
+    }
+
+    /// Adds sample `i`'s `cells x cells` points and their rays to `light`.
+    fn add(
+        &mut self,
+        bsp: &Bsp,
+        samples: &FaceSamples,
+        i: usize,
+        cells: usize,
+        light: &PointLight,
+    ) {
+        let normal = samples.normal_at(i);
+        if self.placed.is_empty() {
+            self.placed.resize(samples.points.len(), None);
+        }
+        let placed = match &self.placed[i] {
+            Some((c, placed)) if *c == cells => placed.clone(),
+            _ => {
+                let placed = self.place(bsp, samples, i, cells);
+                self.placed[i] = Some((cells, placed.clone()));
+                placed
+            }
+        };
+        let first = self.values.len();
+        for &q in &self.points[placed] {
             let Some((value, dir, dist)) = unshadowed(light, q, normal) else {
+                self.values.push(0.0);
+                self.rays.push(None);
                 continue;
             };
-            lane_value[lane] = value;
             let reach = (dist as f32 - LIGHT_CLEARANCE).max(0.0);
-            packet.set(
-                lane,
+            self.values.push(value);
+            self.rays.push(Some((
                 q.as_vec3().to_array(),
                 dir.as_vec3().to_array(),
-                0.0,
                 reach,
-            );
+            )));
         }
-        let active = packet.active_mask();
-        counts.shadow_rays += u64::from(active.count_ones());
-        let lit = active & !setup.scene.occluded16(packet, model);
-        sum += (0..16)
-            .filter(|l| lit & (1 << l) != 0)
-            .map(|l| lane_value[l])
-            .sum::<f64>();
+        self.spans.push((i, first..self.values.len()));
     }
-    sum / points.len() as f64
+
+    /// Traces every point's ray, 16 to a packet; returns the rays cast.
+    fn trace(&mut self, scene: &TraceScene, model: usize, packet: &mut RayPacket16) -> u64 {
+        self.lit.clear();
+        self.lit.resize(self.values.len(), false);
+        let with_ray: Vec<usize> = (0..self.rays.len())
+            .filter(|&k| self.rays[k].is_some())
+            .collect();
+        let mut rays = 0;
+        for chunk in with_ray.chunks(16) {
+            packet.clear();
+            for (lane, &k) in chunk.iter().enumerate() {
+                if let Some((org, dir, reach)) = self.rays[k] {
+                    packet.set(lane, org, dir, 0.0, reach);
+                }
+            }
+            let active = packet.active_mask();
+            rays += u64::from(active.count_ones());
+            let lit = active & !scene.occluded16(packet, model);
+            for (lane, &k) in chunk.iter().enumerate() {
+                self.lit[k] = lit & (1 << lane) != 0;
+            }
+        }
+        rays
+    }
+
+    /// Per footprint in the order added: its sample and mean value. Sums
+    /// go 16 points at a time, as one footprint's own packets would.
+    fn means(&self) -> impl Iterator<Item = (usize, f64)> + '_ {
+        self.spans.iter().map(|(i, span)| {
+            let values = &self.values[span.clone()];
+            let lit = &self.lit[span.clone()];
+            let mut sum = 0.0;
+            for (v, l) in values.chunks(16).zip(lit.chunks(16)) {
+                sum += v
+                    .iter()
+                    .zip(l)
+                    .filter(|(_, l)| **l)
+                    .map(|(v, _)| *v)
+                    .sum::<f64>();
+            }
+            (*i, sum / values.len() as f64)
+        })
+    }
 }
 
 /// Everything shared by all faces while tracing.
@@ -901,6 +1002,7 @@ pub fn trace_face(
     let max_cells = 16 / samples.per_axis.min(16);
     // Samples so close to the current light that it is averaged over their squares.
     let mut near: Vec<(usize, usize)> = Vec::new();
+    let mut footprints = Footprints::default();
     for (li, light) in lights.iter().enumerate() {
         counts.pairs += 1;
         let reach = &setup.light_reaches[li];
@@ -948,9 +1050,15 @@ pub fn trace_face(
                 arrivals.push(Arrival::new(source, i, v, dirty, true));
             }
         }
-        for &(i, cells) in &near {
-            let v = footprint_light(setup, samples, i, cells, light, &mut packet, &mut counts);
-            arrivals.push(Arrival::new(source, i, v, dirty, false));
+        if !near.is_empty() {
+            footprints.clear();
+            for &(i, cells) in &near {
+                footprints.add(setup.bsp, samples, i, cells, light);
+            }
+            counts.shadow_rays += footprints.trace(setup.scene, face.model, &mut packet);
+            for (i, v) in footprints.means() {
+                arrivals.push(Arrival::new(source, i, v, dirty, false));
+            }
         }
     }
 
