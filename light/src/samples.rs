@@ -292,15 +292,14 @@ impl SurfaceMap {
     /// A box holding every point [`SurfaceMap::point`] gives (a little
     /// wider, for rounding), in single precision.
     pub fn bounds(&self) -> ([f32; 3], [f32; 3]) {
-        const SLACK: f64 = 0.01;
         let (mut lo, mut hi) = (self.centre(), self.centre());
         for &p in &self.region.points {
             lo = lo.min(p + self.lift);
             hi = hi.max(p + self.lift);
         }
         (
-            (lo - SLACK).as_vec3().to_array(),
-            (hi + SLACK).as_vec3().to_array(),
+            (lo - FOOTPRINT_BOX_SLACK).as_vec3().to_array(),
+            (hi + FOOTPRINT_BOX_SLACK).as_vec3().to_array(),
         )
     }
 
@@ -449,6 +448,10 @@ fn into_open(
 /// every point to go down one side: far above the f32 rounding of the
 /// per-point test, so the shared walk ends in the leaf `Bsp::leaf_at` finds.
 const SHARED_WALK_MARGIN: f32 = 0.1;
+
+/// How much wider than its points a face's box of close-light footprint points is (units): the
+/// points are rounded to f32 after the box is taken.
+const FOOTPRINT_BOX_SLACK: f64 = 0.01;
 
 /// A node of the world BSP where the shared walk of [`solid_points`]
 /// arrives for every point inside a box: walks of points inside that box

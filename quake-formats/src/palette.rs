@@ -75,20 +75,6 @@ impl Palette {
         }
         Palette { colors }
     }
-
-    /// The index of the nearest non-fullbright colour (squared RGB distance).
-    pub fn nearest(&self, rgb: [u8; 3]) -> u8 {
-        let mut best = (u32::MAX, 0u8);
-        for (i, c) in self.colors[..FIRST_FULLBRIGHT as usize].iter().enumerate() {
-            let d: u32 = (0..3)
-                .map(|k| (c[k] as i32 - rgb[k] as i32).pow(2) as u32)
-                .sum();
-            if d < best.0 {
-                best = (d, i as u8);
-            }
-        }
-        best.1
-    }
 }
 
 #[cfg(test)]
@@ -96,11 +82,9 @@ mod tests {
     use super::*;
 
     #[test]
-    fn round_trip_and_nearest() {
+    fn round_trip() {
         let p = Palette::slipgate();
         assert_eq!(Palette::from_bytes(&p.to_bytes()).expect("768 bytes"), p);
-        let white = p.nearest([255, 255, 255]);
-        assert_eq!(white, 15);
         assert!(Palette::from_bytes(&[0; 767]).is_err());
     }
 }

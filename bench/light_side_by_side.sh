@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# Default-quality light, ours against ericw-tools' (../shared/anchors/ericw-tools), on copies of
+# the same BSPs, interleaved, ROUNDS rounds (default 3): prints wall, user and system seconds per
+# run; take the best of each. light/README.md's "Direct light, side by side" tables come from this.
+# Usage: bench/light_side_by_side.sh MAP.bsp...   (vised BSPs; nothing is written beside them)
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+anchor="$root/../shared/anchors/ericw-tools/bin/light"
+[ -x "$anchor" ] || { echo "SKIPPED: $anchor not found" >&2; exit 0; }
+cargo build --release --manifest-path "$root/Cargo.toml" -p slipgate >/dev/null
+ours="${CARGO_TARGET_DIR:-$root/target}/release/slipgate"
+work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
+timed() { /usr/bin/time -f "%e %U %S" "$@" 2>&1 >/dev/null | tail -1; }
+for round in $(seq "${ROUNDS:-3}"); do
+  for bsp in "$@"; do
+    name=$(basename "$bsp" .bsp)
+    cp "$bsp" "$work/ours.bsp"; cp "$bsp" "$work/ericw.bsp"
+    echo "$round $name ours  $(timed "$ours" light "$work/ours.bsp")"
+    echo "$round $name ericw $(timed "$anchor" "$work/ericw.bsp")"
+  done
+done
