@@ -623,8 +623,16 @@ pub struct Hit {
 
 /// Embree requires `0 <= tnear <= tfar` and finite origin/direction;
 /// anything else is treated as an empty segment that hits nothing.
+/// Embree's `FLT_LARGE`: a ray whose origin or direction has a component larger than this fails
+/// its traversal's validity assertion (an abort, not an error), though it is finite.
+const LARGEST_RAY_COMPONENT: f32 = 1.844e18;
+
 fn ray_ok(org: [f32; 3], dir: [f32; 3], tnear: f32, tfar: f32) -> bool {
-    org.iter().chain(&dir).all(|c| c.is_finite()) && tnear >= 0.0 && tnear <= tfar
+    org.iter()
+        .chain(&dir)
+        .all(|c| c.abs() <= LARGEST_RAY_COMPONENT)
+        && tnear >= 0.0
+        && tnear <= tfar
 }
 
 fn make_ray(org: [f32; 3], dir: [f32; 3], tnear: f32, tfar: f32) -> sys::RTCRay {
@@ -820,12 +828,20 @@ impl RayPacket16 {
     /// Loads a ray into `lane` and activates it (an invalid segment, see
     /// [`Scene::occluded`], leaves the lane inactive). Panics if `lane >= 16`.
     pub fn set(&mut self, lane: usize, org: [f32; 3], dir: [f32; 3], tnear: f32, tfar: f32) {
+        let ok = ray_ok(org, dir, tnear, tfar);
+        // Embree checks the rays of inactive lanes too (its 16-wide calls on 8-wide kernels
+        // abort on one past its largest coordinate), so a refused ray is not left in the packet.
+        let (org, dir, tnear, tfar) = if ok {
+            (org, dir, tnear, tfar)
+        } else {
+            ([0.0; 3], [0.0, 0.0, 1.0], 0.0, -1.0)
+        };
         let r = &mut self.rays;
         [r.org_x[lane], r.org_y[lane], r.org_z[lane]] = org;
         [r.dir_x[lane], r.dir_y[lane], r.dir_z[lane]] = dir;
         r.tnear[lane] = tnear;
         r.tfar[lane] = tfar;
-        self.valid.0[lane] = if ray_ok(org, dir, tnear, tfar) { -1 } else { 0 };
+        self.valid.0[lane] = if ok { -1 } else { 0 };
     }
 
     /// The far end of `lane`'s segment: after [`Scene::first_hit_geom16`],
@@ -1007,6 +1023,28 @@ mod tests {
                 .intersect([9.0, 9.0, -1.0], [0.0, 0.0, 1.0], 0.0, 100.0)
                 .is_none()
         );
+    }
+
+    /// A fuzzed BSP with a vertex at 1e19 made Embree abort on its own validity assertion: finite
+    /// rays past its largest coordinate must stay on our side, in a packet's inactive lanes too.
+    #[test]
+    fn rays_past_embrees_largest_coordinate_hit_nothing() {
+        let (scene, _, _) = quad_scene(false);
+        let up = [0.0, 0.0, 1.0];
+        let far_away = [0.5, 1.0e19, -1.0];
+        assert!(scene.intersect(far_away, up, 0.0, 10.0).is_none());
+        assert!(!scene.occluded(far_away, up, 0.0, 10.0));
+        assert!(!scene.occluded([0.5, 0.5, -1.0], [0.0, 0.0, 1.0e19], 0.0, 10.0));
+        let mut packet = RayPacket16::new();
+        packet.set(0, far_away, up, 0.0, 10.0);
+        packet.set(1, [0.5, 0.5, -1.0], up, 0.0, 10.0);
+        assert_eq!(packet.active_mask(), 0b10);
+        for coherent in [true, false] {
+            let hits = scene.first_hit_geom16(&mut packet.clone(), coherent);
+            assert_eq!(hits[0], sys::RTC_INVALID_GEOMETRY_ID);
+            assert_ne!(hits[1], sys::RTC_INVALID_GEOMETRY_ID);
+            assert_eq!(scene.occluded16(&mut packet.clone(), coherent), 0b10);
+        }
     }
 
     #[test]
