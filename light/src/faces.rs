@@ -1,6 +1,7 @@
 //! The faces of a BSP as geometry the light tool works with: world-space
 //! polygon, facing plane, texture projection and lightmap extents.
 
+use rayon::prelude::*;
 use glam::{DVec3, Vec3};
 use quake_formats::Bsp;
 use quake_formats::bsp::texinfo_flags;
@@ -54,7 +55,7 @@ impl FaceGeom {
 /// [`LightError::BadFace`] for a face whose indices run outside the file.
 pub fn face_geometry(
     bsp: &Bsp,
-    origin_of: impl Fn(usize) -> DVec3,
+    origin_of: impl Fn(usize) -> DVec3 + Sync,
 ) -> Result<Vec<FaceGeom>, LightError> {
     let mut model_of = vec![0usize; bsp.faces.len()];
     for (m, model) in bsp.models.iter().enumerate() {
@@ -64,8 +65,9 @@ pub fn face_geometry(
             *slot = m;
         }
     }
-    bsp.faces
-        .iter()
+    let faces: Vec<Result<FaceGeom, LightError>> = bsp
+        .faces
+        .par_iter()
         .enumerate()
         .map(|(index, face)| {
             let bad = |detail: &str| LightError::BadFace {
@@ -121,5 +123,7 @@ pub fn face_geometry(
                 extents: LightmapExtents::from_points(&verts, &ti.vecs),
             })
         })
-        .collect()
+        .collect();
+    // The first bad face in file order, whichever thread found it.
+    faces.into_iter().collect()
 }

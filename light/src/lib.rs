@@ -51,7 +51,9 @@ use crate::lights::{GlobalOverrides, parse_lights};
 use crate::output::{FaceLightmap, Finish, finish_face};
 use crate::samples::{FaceSamples, PlacementCounts, face_samples};
 use crate::scene::TraceScene;
-use crate::trace::{FaceLight, FaceRules, SampleLight, TraceCounts, TraceSetup, trace_face};
+use crate::trace::{
+    FaceLight, FaceRules, SampleLight, TraceCounts, TraceScratch, TraceSetup, trace_face,
+};
 use crate::visibility::Visibility;
 
 /// Everything that can stop lighting a map.
@@ -392,7 +394,7 @@ fn trace_faces(
     let styled = prep.lights.bounce.styled;
     faces
         .par_iter()
-        .map(|&f| {
+        .map_init(TraceScratch::default, |reuse, &f| {
             let geom = &prep.faces[f];
             let (mut samples, placement) = face_samples(geom, per_axis, &prep.scene, bsp);
             if let Some(corners) = &prep.phong[f] {
@@ -407,7 +409,7 @@ fn trace_faces(
                     .collect();
             }
             let rules = face_rules(&prep.lights, geom);
-            let (light, counts) = trace_face(setup, &samples, &rules);
+            let (light, counts) = trace_face(setup, &samples, &rules, reuse);
             bar.inc(1);
             let reflected =
                 (keep.bouncing && keep.reflectance[f].is_some()).then(|| light.reflected(styled));
@@ -573,7 +575,7 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
     let trace_done = Instant::now();
 
     let mut bounce_counts = BounceCounts::default();
-    let mut bounced = if bouncing && reference {
+    let bounced = if bouncing && reference {
         // The reference's emitters: every face's direct light at --extra4.
         let fine = prep.trace_setup(bsp, &light_reaches, options.gate, true, true);
         let keep = Keep {
@@ -622,18 +624,21 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
         fullbright,
         ..Stats::default()
     };
-    let mut faces = Vec::new();
-    for t in traced {
+    for t in &traced {
         placement.add(&t.placement);
         counts.add(&t.counts);
-        let Some(light) = t.light else {
-            continue;
-        };
-        stats.samples += t.sample_count;
-        let light = light.finish(bounced.get_mut(t.face).map_or(&[][..], |b| &b[..]));
-        stats.luxels += (light.width * light.height) as u64;
-        faces.push(light);
+        if t.light.is_some() {
+            stats.samples += t.sample_count;
+        }
     }
+    let faces: Vec<FaceLight> = traced
+        .into_par_iter()
+        .filter_map(|t| {
+            let bounce = bounced.get(t.face).map_or(&[][..], |b| &b[..]);
+            Some(t.light?.finish(bounce))
+        })
+        .collect();
+    stats.luxels = faces.iter().map(|l| (l.width * l.height) as u64).sum();
     stats.faces_lit = faces.len();
     if bouncing {
         // Bounced light takes the reflecting texture's colour.
