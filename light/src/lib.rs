@@ -690,15 +690,12 @@ pub fn finish_lighting(raw: &RawLighting, soft_radius: usize) -> Lighting {
         soft_radius,
     };
     let mut stats = raw.stats.clone();
-    let lightmaps = raw
+    let (lightmaps, dropped): (Vec<_>, Vec<usize>) = raw
         .faces
-        .iter()
-        .map(|light| {
-            let (map, dropped) = finish_face(light, &finish);
-            stats.faces_with_dropped_styles += u64::from(dropped > 0);
-            map
-        })
-        .collect();
+        .par_iter()
+        .map(|light| finish_face(light, &finish))
+        .unzip();
+    stats.faces_with_dropped_styles += dropped.iter().filter(|&&d| d > 0).count() as u64;
     stats.seconds_total += start.elapsed().as_secs_f64();
     Lighting {
         lightmaps,
