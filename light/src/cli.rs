@@ -178,12 +178,10 @@ fn lit_path(bsp: &Path) -> PathBuf {
 /// folders above it; `None`: Slipgate's own.
 fn find_palette(args: &Args) -> anyhow::Result<Option<Palette>> {
     let dir = args.bsp.parent().unwrap_or(Path::new("."));
-    let found = args.palette.clone().or_else(|| {
-        dir.ancestors()
-            .take(4)
-            .map(|a| a.join("gfx").join("palette.lmp"))
-            .find(|p| p.is_file())
-    });
+    let found = args
+        .palette
+        .clone()
+        .or_else(|| quake_formats::palette::find_game_palette(dir));
     found
         .map(|path| {
             let data = read_file(&path)?;

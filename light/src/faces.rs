@@ -1,12 +1,12 @@
 //! The faces of a BSP as geometry the light tool works with: world-space
 //! polygon, facing plane, texture projection and lightmap extents.
 
-use rayon::prelude::*;
 use glam::{DVec3, Vec3};
 use quake_formats::Bsp;
 use quake_formats::bsp::texinfo_flags;
 use quake_formats::extents::LightmapExtents;
 use quake_formats::geom::Plane;
+use rayon::prelude::*;
 
 use crate::LightError;
 

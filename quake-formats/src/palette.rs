@@ -1,6 +1,20 @@
 //! The 768-byte palette (256 RGB colours) that indexes every texture pixel.
 
 use crate::error::{FormatError, Result};
+use std::path::{Path, PathBuf};
+
+/// How many folders above a file's own the game palette is looked for.
+const PALETTE_SEARCH_DEPTH: usize = 3;
+
+/// `gfx/palette.lmp` in `dir` or the nearest of its parents (up to three) that has one: Quake
+/// keeps maps and WADs in `id1/maps/` and the palette in `id1/gfx/`, and engines draw every
+/// texture through that palette.
+pub fn find_game_palette(dir: &Path) -> Option<PathBuf> {
+    dir.ancestors()
+        .take(PALETTE_SEARCH_DEPTH + 1)
+        .map(|a| a.join("gfx").join("palette.lmp"))
+        .find(|p| p.is_file())
+}
 
 /// Palette indices from here up are "fullbright": drawn unlit by engines.
 pub const FIRST_FULLBRIGHT: u8 = 224;
@@ -86,5 +100,31 @@ mod tests {
         let p = Palette::slipgate();
         assert_eq!(Palette::from_bytes(&p.to_bytes()).expect("768 bytes"), p);
         assert!(Palette::from_bytes(&[0; 767]).is_err());
+    }
+}
+
+#[cfg(test)]
+mod search_tests {
+    use super::*;
+
+    #[test]
+    fn the_game_palette_is_found_in_the_nearest_parent_with_one() {
+        let root = std::env::temp_dir().join(format!("slipgate-palette-{}", std::process::id()));
+        let maps = root.join("game").join("id1").join("maps");
+        std::fs::create_dir_all(&maps).expect("folders");
+        assert_eq!(find_game_palette(&maps), None);
+        let gfx = root.join("game").join("id1").join("gfx");
+        std::fs::create_dir_all(&gfx).expect("gfx");
+        std::fs::write(gfx.join("palette.lmp"), [0u8; 768]).expect("palette");
+        assert_eq!(find_game_palette(&maps), Some(gfx.join("palette.lmp")));
+        // No more than three folders up.
+        let deep = maps.join("a").join("b").join("c");
+        std::fs::create_dir_all(&deep).expect("deep");
+        assert_eq!(find_game_palette(&deep), None);
+        assert_eq!(
+            find_game_palette(&maps.join("a").join("b")),
+            Some(gfx.join("palette.lmp"))
+        );
+        let _ = std::fs::remove_dir_all(&root);
     }
 }

@@ -30,13 +30,10 @@ pub fn find_palette(map: &Path, explicit: Option<&Path>) -> Result<(Palette, Pal
         return read(path);
     }
     let dir = map.parent().unwrap_or(Path::new("."));
-    for ancestor in dir.ancestors().take(4) {
-        let candidate = ancestor.join("gfx").join("palette.lmp");
-        if candidate.is_file() {
-            return read(&candidate);
-        }
+    match quake_formats::palette::find_game_palette(dir) {
+        Some(found) => read(&found),
+        None => Ok((Palette::slipgate(), PaletteSource::Builtin)),
     }
-    Ok((Palette::slipgate(), PaletteSource::Builtin))
 }
 
 /// How a surface is drawn, decided by its texture name and texinfo flags.

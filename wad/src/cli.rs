@@ -15,8 +15,10 @@ characters; a leading # stands for *, as in #water1.png for *water1). Sides that
 multiples of 16 are stretched up to the next multiple with bilinear filtering (wrapping at the \
 edges, since textures tile), with a warning.
 
-Colours are quantised to the palette (Slipgate's own unless --palette names a 768-byte \
-palette.lmp). Fullbright colours (indices 224-255, drawn unlit) are used only where a glow mask \
+Colours are quantised to the game's palette: --palette FILE.lmp (768 bytes), else \
+gfx/palette.lmp in the WAD's folder or up to three folders above it (a WAD written to \
+id1/maps/ finds id1/gfx/palette.lmp, the palette engines draw it with), else Slipgate's own. \
+Fullbright colours (indices 224-255, drawn unlit) are used only where a glow mask \
 NAME_glow.png beside NAME.png is bright (a channel of at least 128), and there only. In { \
 textures pixels with alpha under 128 become index 255, and no other pixel does; in sky textures \
 they become index 0, the front layer's transparent colour, and no other pixel does.
@@ -49,7 +51,7 @@ pub struct BuildArgs {
     pub dir: PathBuf,
     /// The WAD to write
     pub out: PathBuf,
-    /// A 768-byte palette (palette.lmp) instead of Slipgate's own
+    /// A 768-byte palette (palette.lmp); default: gfx/palette.lmp near OUT, else Slipgate's own
     #[arg(long, value_name = "FILE.lmp")]
     pub palette: Option<PathBuf>,
     /// Quantise each pixel to its nearest colour instead of diffusing the error
@@ -65,7 +67,7 @@ pub struct ExtractArgs {
     pub wad: PathBuf,
     /// Folder to write the pictures into (created if missing)
     pub dir: PathBuf,
-    /// A 768-byte palette (palette.lmp) instead of Slipgate's own
+    /// A 768-byte palette (palette.lmp); default: gfx/palette.lmp near WAD, else Slipgate's own
     #[arg(long, value_name = "FILE.lmp")]
     pub palette: Option<PathBuf>,
 }
@@ -78,12 +80,27 @@ pub fn run(args: &Args) -> Result<()> {
     }
 }
 
-fn palette(path: Option<&Path>) -> Result<Palette> {
-    let Some(path) = path else {
-        return Ok(Palette::slipgate());
+/// `--palette FILE`, else the game's `gfx/palette.lmp` near `wad` (see
+/// [`quake_formats::palette::find_game_palette`]), else Slipgate's own; and the file it came from.
+fn palette(explicit: Option<&Path>, wad: &Path) -> Result<(Palette, Option<PathBuf>)> {
+    let dir = wad.parent().unwrap_or(Path::new("."));
+    let Some(path) = explicit
+        .map(Path::to_path_buf)
+        .or_else(|| quake_formats::palette::find_game_palette(dir))
+    else {
+        return Ok((Palette::slipgate(), None));
     };
-    let bytes = read_file(path)?;
-    Palette::from_bytes(&bytes).with_context(|| format!("{}", path.display()))
+    let bytes = read_file(&path)?;
+    let palette = Palette::from_bytes(&bytes).with_context(|| format!("{}", path.display()))?;
+    Ok((palette, Some(path)))
+}
+
+/// How the summary names the palette used.
+fn palette_name(path: Option<&Path>) -> String {
+    path.map_or_else(
+        || "Slipgate's own palette (no --palette, no gfx/palette.lmp near the WAD)".to_string(),
+        |p| format!("palette {}", p.display()),
+    )
 }
 
 fn progress_bar() -> indicatif::ProgressBar {
@@ -99,8 +116,9 @@ fn progress_bar() -> indicatif::ProgressBar {
 
 fn run_build(args: &BuildArgs) -> Result<()> {
     let started = Instant::now();
+    let (palette, palette_path) = palette(args.palette.as_deref(), &args.out)?;
     let options = BuildOptions {
-        palette: palette(args.palette.as_deref())?,
+        palette,
         dither: !args.no_dither,
     };
     let bar = progress_bar();
@@ -108,13 +126,13 @@ fn run_build(args: &BuildArgs) -> Result<()> {
     bar.finish_and_clear();
     let seconds = started.elapsed().as_secs_f64();
     warn(&built);
-    summary(args, &built, seconds);
+    summary(args, &built, palette_path.as_deref(), seconds);
     if let Some(path) = &args.stats {
         let json = serde_json::json!({
             "dir": args.dir,
             "wad": args.out,
             "dither": options.dither,
-            "palette": args.palette,
+            "palette": palette_path,
             "textures": built.textures,
             "levels": built.level_errors(),
             "seconds": seconds,
@@ -147,7 +165,7 @@ fn warn(built: &Built) {
     }
 }
 
-fn summary(args: &BuildArgs, built: &Built, seconds: f64) {
+fn summary(args: &BuildArgs, built: &Built, palette: Option<&Path>, seconds: f64) {
     let count = |f: &dyn Fn(&crate::build::TextureReport) -> bool| {
         built.textures.iter().filter(|t| f(t)).count()
     };
@@ -167,6 +185,7 @@ fn summary(args: &BuildArgs, built: &Built, seconds: f64) {
             "dithered"
         }
     );
+    eprintln!("  {}", palette_name(palette));
     eprint!("{}", error_table(&built.level_errors()));
     eprintln!("  time: {seconds:.2} s");
 }
@@ -206,7 +225,9 @@ fn run_list(path: &Path) -> Result<()> {
 fn run_extract(args: &ExtractArgs) -> Result<()> {
     let started = Instant::now();
     let wad = read_wad(&args.wad)?;
-    let done = extract(&wad, &args.dir, &palette(args.palette.as_deref())?)?;
+    let (palette, palette_path) = palette(args.palette.as_deref(), &args.wad)?;
+    let done = extract(&wad, &args.dir, &palette)?;
+    eprintln!("{}", palette_name(palette_path.as_deref()));
     for why in &done.skipped {
         eprintln!("note: skipped {why}");
     }
@@ -218,4 +239,34 @@ fn run_extract(args: &ExtractArgs) -> Result<()> {
         started.elapsed().as_secs_f64()
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A WAD written into a game's `maps/` folder is quantised to that game's palette, which
+    /// engines draw it with, not to Slipgate's.
+    #[test]
+    fn a_wad_beside_a_game_takes_its_palette() {
+        let root =
+            std::env::temp_dir().join(format!("slipgate-wad-palette-{}", std::process::id()));
+        let (maps, gfx) = (root.join("id1").join("maps"), root.join("id1").join("gfx"));
+        std::fs::create_dir_all(&maps).expect("maps");
+        std::fs::create_dir_all(&gfx).expect("gfx");
+        let mut game = [0u8; 768];
+        game[3..6].copy_from_slice(&[200, 10, 10]);
+        std::fs::write(gfx.join("palette.lmp"), game).expect("palette");
+        let wad = maps.join("textures.wad");
+        let (found, path) = palette(None, &wad).expect("found");
+        assert_eq!(path, Some(gfx.join("palette.lmp")));
+        assert_eq!(found.colors[1], [200, 10, 10]);
+        // --palette wins; elsewhere it is Slipgate's own.
+        let (_, path) =
+            palette(Some(&gfx.join("palette.lmp")), &root.join("x.wad")).expect("explicit");
+        assert_eq!(path, Some(gfx.join("palette.lmp")));
+        let (own, path) = palette(None, &std::env::temp_dir().join("lone.wad")).expect("own");
+        assert_eq!((own, path), (Palette::slipgate(), None));
+        let _ = std::fs::remove_dir_all(&root);
+    }
 }
