@@ -24,19 +24,20 @@ fn cone_components(azimuth: f64, elevation: f64) -> [f64; 3] {
     [se * azimuth.cos(), se * azimuth.sin(), ce]
 }
 
+/// One cone's ordered pattern: each ray's components along a face's `u`, `v` and `n`.
+pub type ConePattern = [[f64; 3]; RAYS_PER_SAMPLE];
+
 /// The ordered pattern in the face's own terms (see [`ordered_directions`]):
-/// the same for every sample, so the sines and cosines are taken once.
-fn ordered_components(cone: f64) -> Vec<[f64; 3]> {
+/// the same for every sample and face, so the sines and cosines are taken
+/// once a run ([`crate::lights::DirtSampling::new`]).
+pub fn ordered_components(cone: f64) -> ConePattern {
     let azimuth_step = std::f64::consts::TAU / AZIMUTH_STEPS as f64;
     let elevation_step = cone / ELEVATION_STEPS as f64;
-    (0..AZIMUTH_STEPS)
-        .flat_map(|a| {
-            (0..ELEVATION_STEPS).map(move |e| {
-                let elevation = elevation_step * (e as f64 + 0.5);
-                cone_components(azimuth_step * a as f64, elevation)
-            })
-        })
-        .collect()
+    std::array::from_fn(|k| {
+        let (a, e) = (k / ELEVATION_STEPS, k % ELEVATION_STEPS);
+        let elevation = elevation_step * (e as f64 + 0.5);
+        cone_components(azimuth_step * a as f64, elevation)
+    })
 }
 
 /// The ordered pattern: rings at evenly spaced elevations, evenly spaced
@@ -113,21 +114,21 @@ pub fn occlusion_at(
     sampling: &DirtSampling,
     scene: &TraceScene,
 ) -> (Vec<f32>, u64) {
-    let cone = sampling.cone_degrees.to_radians();
+    let cone = sampling.cone_degrees().to_radians();
     let basis_of = |n: DVec3| {
         let [u, v] = tangent_basis(n);
         DMat3::from_cols(u, v, n)
     };
     // Without per-sample normals every sample shares one ordered pattern.
     let flat_basis = basis_of(samples.normal);
-    let ordered = ordered_components(cone);
+    let ordered = sampling.ordered();
     // Each pattern is turned in front of the face once, not per ray.
     let in_front_all = |dirs: Vec<[f32; 3]>| -> Vec<[f32; 3]> {
         dirs.into_iter()
             .map(|d| in_front(d, samples.normal))
             .collect()
     };
-    let flat_ordered = in_front_all(ordered_directions(flat_basis, &ordered));
+    let flat_ordered = in_front_all(ordered_directions(flat_basis, ordered));
     let shift = flat_basis.x_axis * RAY_START_SHIFT[0] + flat_basis.y_axis * RAY_START_SHIFT[1];
     let depth = sampling.depth as f32;
     let mut packet = RayPacket16::new();
@@ -150,7 +151,7 @@ pub fn occlusion_at(
         .map(|&i| match sampling.mode {
             DirtMode::Ordered if samples.normals.is_empty() => Vec::new(),
             DirtMode::Ordered => {
-                in_front_all(ordered_directions(basis_of(samples.normal_at(i)), &ordered))
+                in_front_all(ordered_directions(basis_of(samples.normal_at(i)), ordered))
             }
             DirtMode::Random => in_front_all(random_directions(
                 basis_of(samples.normal_at(i)),
