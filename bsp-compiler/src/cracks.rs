@@ -3,9 +3,9 @@
 //!
 //! Within each model it reports T-junctions (a face vertex on the open interior of another face's
 //! edge), directed edges used by more than two faces and not as often as their reverse, and
-//! distinct vertex indices at the same position. Faces of every kind count (sky, liquids, fences): engines draw them all, so a
-//! T-junction between water and a wall shows as a crack like any other. Indices the validator
-//! would reject are skipped, never trusted.
+//! distinct vertex indices at the same position. Faces of every kind count (sky, liquids,
+//! fences): engines draw them all, so a T-junction between water and a wall shows as a crack like
+//! any other. Indices the validator would reject are skipped, never trusted.
 
 use crate::weld::{TJUNCTION_EPSILON, cell_and_neighbours};
 use glam::{DVec3, Vec3};

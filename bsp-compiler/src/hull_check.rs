@@ -5,9 +5,9 @@
 //! The exact side grows each brush that blocks the world's hulls by the hull's box in `f64`: its
 //! own planes plus every bevel (the bounding box's axial planes, and planes along an edge and an
 //! axis that touch the brush at that edge with the whole brush behind them), each pushed out by
-//! the box's support along its normal. Those are all the facets of the brush's Minkowski sum with the box, so a point is
-//! inside the grown brush exactly when the box there overlaps the brush, and a segment clipped
-//! against the planes gives the exact first contact.
+//! the box's support along its normal. Those are all the facets of the brush's Minkowski sum
+//! with the box, so a point is inside the grown brush exactly when the box there overlaps the
+//! brush, and a segment clipped against the planes gives the exact first contact.
 //!
 //! Moves start at random points of the world's open space (hull 0 open there, and the box at
 //! least [`START_CLEARANCE`] from every brush), go a random direction and length, and are traced

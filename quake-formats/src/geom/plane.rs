@@ -105,8 +105,8 @@ impl Plane {
     }
 
     /// Snap an axial normal ([`Plane::axial`]) onto its axis, turning the plane about `on` (a
-    /// point on it, so the plane moves nowhere near `on`), and round a distance near an integer,
-    /// so that planes written from integer brush points compare equal.
+    /// point on it, which stays on it: the plane moves least where it matters), and round a
+    /// distance near an integer, so that planes written from integer brush points compare equal.
     pub fn snapped(&self, on: DVec3) -> Plane {
         let normal = Plane::snap_normal(self.normal);
         let mut dist = if normal == self.normal {
