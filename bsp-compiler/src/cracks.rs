@@ -2,10 +2,10 @@
 //! engine's rasteriser can leave pixel gaps between them.
 //!
 //! Within each model it reports T-junctions (a face vertex on the open interior of another face's
-//! edge), directed edges used by more than two faces, and distinct vertex indices at the same
-//! position. Faces of every kind count (sky, liquids, fences): engines draw them all, so a
-//! T-junction between water and a wall shows as a crack like any other. Indices the validator
-//! would reject are skipped, never trusted.
+//! edge), directed edges used by more than two faces and not as often as their reverse, and
+//! distinct vertex indices at the same position. Faces of every kind count (sky, liquids,
+//! fences): engines draw them all, so a T-junction between water and a wall shows as a crack like
+//! any other. Indices the validator would reject are skipped, never trusted.
 
 use crate::weld::{TJUNCTION_EPSILON, cell_and_neighbours};
 use glam::{DVec3, Vec3};
@@ -32,7 +32,8 @@ pub struct TJunction {
 #[derive(Debug, Default, Clone, PartialEq)]
 pub struct CrackReport {
     pub tjunctions: Vec<TJunction>,
-    /// `(model, [from, to], faces)`: a directed edge used by more than two faces.
+    /// `(model, [from, to], faces)`: a directed edge used by more than two faces, and by more
+    /// or fewer than its reverse.
     pub overused_edges: Vec<(usize, [u32; 2], usize)>,
     /// `(model, a, b)`: two vertex indices used by one model within [`POINT_EPSILON`].
     pub duplicate_vertices: Vec<(usize, u32, u32)>,
@@ -155,12 +156,18 @@ fn check_model(bsp: &Bsp, model: usize, faces: &[(usize, Vec<u32>)], report: &mu
             }
         }
     }
-    report.overused_edges.extend(
-        directed
-            .into_iter()
-            .filter(|&(_, n)| n > 2)
-            .map(|(e, n)| (model, e, n)),
-    );
+    // Around an edge, each open sector (air, liquid) is bounded by two faces that run along the
+    // edge opposite ways, and a two-sided liquid surface gives two sectors a face each: an edge
+    // where more than two open sectors meet (a brush's edge lying on a liquid surface: three)
+    // is used more than twice each way. Only an edge used more often one way than the other
+    // has a face without its neighbour.
+    let reverse_uses = |[a, b]: [u32; 2]| directed.get(&[b, a]).copied().unwrap_or(0);
+    let overused: Vec<_> = directed
+        .iter()
+        .filter(|&(&e, &n)| n > 2 && n != reverse_uses(e))
+        .map(|(&e, &n)| (model, e, n))
+        .collect();
+    report.overused_edges.extend(overused);
 }
 
 #[cfg(test)]
@@ -237,6 +244,39 @@ mod tests {
 
         let bsp = bsp_of(&vertices, &[&[0, 1, 2], &[0, 1, 3], &[0, 1, 5]]);
         assert_eq!(find_cracks(&bsp).overused_edges, vec![(0, [0, 1], 3)]);
+    }
+
+    #[test]
+    fn an_edge_where_three_open_sectors_meet_is_no_crack() {
+        // A wedge's edge lying on a two-sided water surface (generated seed 1012): the water's
+        // top and bottom on both sides of the edge and the wedge's two faces all end there,
+        // three faces running along the edge each way. Every vertex is shared: no crack.
+        let vertices = [
+            [0.0, 0.0, 0.0],
+            [64.0, 0.0, 0.0],
+            [64.0, -32.0, 0.0],
+            [0.0, -32.0, 0.0],
+            [64.0, 32.0, 0.0],
+            [0.0, 32.0, 0.0],
+            [64.0, -16.0, 16.0],
+            [0.0, -16.0, 16.0],
+            [64.0, 16.0, 16.0],
+            [0.0, 16.0, 16.0],
+        ];
+        let water_top = [&[0, 1, 2, 3][..], &[1, 0, 5, 4]];
+        let water_bottom = [&[3, 2, 1, 0][..], &[4, 5, 0, 1]];
+        let wedge = [&[0, 1, 6, 7][..], &[1, 0, 9, 8]];
+        let loops: Vec<&[u32]> = water_top
+            .into_iter()
+            .chain(water_bottom)
+            .chain(wedge)
+            .collect();
+        let report = find_cracks(&bsp_of(&vertices, &loops));
+        assert!(report.is_empty(), "{}", report.summary());
+
+        // Without one of the water's top faces the edge is used more one way than the other.
+        let report = find_cracks(&bsp_of(&vertices, &loops[1..]));
+        assert_eq!(report.overused_edges, vec![(0, [1, 0], 3)]);
     }
 
     #[test]

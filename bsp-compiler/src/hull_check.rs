@@ -3,11 +3,11 @@
 //! exactly through the solid brushes stops.
 //!
 //! The exact side grows each brush that blocks the world's hulls by the hull's box in `f64`: its
-//! own planes plus every bevel (the bounding box's axial planes, and planes through an edge and
-//! an axis that have the whole brush behind them), each pushed out by the box's support along
-//! its normal. Those are all the facets of the brush's Minkowski sum with the box, so a point is
-//! inside the grown brush exactly when the box there overlaps the brush, and a segment clipped
-//! against the planes gives the exact first contact.
+//! own planes plus every bevel (the bounding box's axial planes, and planes along an edge and an
+//! axis that touch the brush at that edge with the whole brush behind them), each pushed out by
+//! the box's support along its normal. Those are all the facets of the brush's Minkowski sum
+//! with the box, so a point is inside the grown brush exactly when the box there overlaps the
+//! brush, and a segment clipped against the planes gives the exact first contact.
 //!
 //! Moves start at random points of the world's open space (hull 0 open there, and the box at
 //! least [`START_CLEARANCE`] from every brush), go a random direction and length, and are traced
@@ -19,7 +19,7 @@
 //! brush's edge without touching it, as engines do.
 
 use crate::compile::EntityBrushes;
-use crate::hulls::HULL_BOXES;
+use crate::hulls::{HULL_BOXES, supporting_plane};
 use crate::map::{MapBrush, MapFile};
 use crate::texinfo::TextureRole;
 use crate::trace::{HullTrace, trace_hull};
@@ -275,8 +275,8 @@ fn grow(faces: &[Plane], mins: DVec3, maxs: DVec3) -> Option<GrownBrush> {
                     continue;
                 };
                 for n in [n, -n] {
-                    let bevel = Plane::new(n, n.dot(p));
-                    if points.iter().all(|&v| bevel.distance(v) <= ON_EPSILON) {
+                    let bevel = supporting_plane(n, &points);
+                    if bevel.distance(p) >= -ON_EPSILON {
                         planes.push(bevel);
                     }
                 }

@@ -31,11 +31,11 @@ pub struct MapFace {
 }
 
 impl MapFace {
-    /// The face's plane (outward facing) in coordinates relative to `origin`, snapped; `None`
-    /// when the points are collinear.
+    /// The face's plane (outward facing) in coordinates relative to `origin`, snapped about
+    /// its three points' centre; `None` when the points are collinear.
     pub fn plane(&self, origin: DVec3) -> Option<Plane> {
         let [a, b, c] = self.points.map(|p| p - origin);
-        Plane::from_points(a, b, c).map(|p| p.snapped())
+        Plane::from_points(a, b, c).map(|p| p.snapped((a + b + c) / 3.0))
     }
 }
 

@@ -9,7 +9,10 @@
 //!   classifying or splitting windings, so slivers thinner than this are not created.
 //! - [`NORMAL_EPSILON`] and [`DIST_EPSILON`]: two planes are the *same* plane when their normals
 //!   differ by less than `NORMAL_EPSILON` per component and their distances by less than
-//!   `DIST_EPSILON`. Used when planes are deduplicated.
+//!   `DIST_EPSILON`. Used when planes are deduplicated. A normal is *axial* when it is the same
+//!   as an axis's by that test (`Plane::axial`): snapped onto the axis, turning its plane about a
+//!   point on it (`Plane::snapped`), and written with an axial plane type, which engines test by
+//!   that one coordinate.
 //! - [`POINT_EPSILON`]: two vertices closer than this per component are the same vertex (welding,
 //!   shared edges, T-junction detection).
 //!

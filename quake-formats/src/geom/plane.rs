@@ -60,9 +60,29 @@ impl Plane {
         self.normal.near(o.normal, NORMAL_EPSILON) && (self.dist - o.dist).abs() < DIST_EPSILON
     }
 
-    /// The axis (0, 1, 2) the normal is exactly aligned with, if any.
+    /// The axis (0, 1, 2) the normal lies along, within [`NORMAL_EPSILON`] per component: the
+    /// same normal as the axis's, as [`Plane::same_as`] compares them. (A test on the axis
+    /// component alone, `1 - |n_i| < NORMAL_EPSILON`, would take normals up to 1.4e-3 rad off the
+    /// axis, and engines evaluate an axial plane by that one coordinate: such a plane would
+    /// turn about the origin, 0.14 units at 100 units out.)
     pub fn axial(&self) -> Option<usize> {
-        (0..3).find(|&i| (self.normal[i].abs() - 1.0).abs() < NORMAL_EPSILON)
+        (0..3).find(|&i| {
+            let mut axis = DVec3::ZERO;
+            axis[i] = self.normal[i].signum();
+            self.normal.near(axis, NORMAL_EPSILON)
+        })
+    }
+
+    /// `normal` moved onto the axis it lies along ([`Plane::axial`]), or unchanged.
+    pub fn snap_normal(normal: DVec3) -> DVec3 {
+        match Plane::new(normal, 0.0).axial() {
+            Some(i) => {
+                let mut axis = DVec3::ZERO;
+                axis[i] = normal[i].signum();
+                axis
+            }
+            None => normal,
+        }
     }
 
     /// Quake's plane type: 0..2 axial X/Y/Z, 3..5 mostly X/Y/Z.
@@ -84,18 +104,16 @@ impl Plane {
         }
     }
 
-    /// Snap near-axial normals to the axis and round distances near integers, so that planes
-    /// written from integer brush points compare equal. Returns the snapped plane.
-    pub fn snapped(&self) -> Plane {
-        let mut normal = self.normal;
-        for i in 0..3 {
-            if (normal[i].abs() - 1.0).abs() < NORMAL_EPSILON {
-                normal = DVec3::ZERO;
-                normal[i] = self.normal[i].signum();
-                break;
-            }
-        }
-        let mut dist = self.dist;
+    /// Snap an axial normal ([`Plane::axial`]) onto its axis, turning the plane about `on` (a
+    /// point on it, which stays on it: the plane moves least where it matters), and round a
+    /// distance near an integer, so that planes written from integer brush points compare equal.
+    pub fn snapped(&self, on: DVec3) -> Plane {
+        let normal = Plane::snap_normal(self.normal);
+        let mut dist = if normal == self.normal {
+            self.dist
+        } else {
+            normal.dot(on)
+        };
         if (dist - dist.round()).abs() < DIST_EPSILON {
             dist = dist.round();
         }
@@ -123,6 +141,37 @@ mod tests {
         assert!(p.normal.near(DVec3::new(0.0, 0.0, 1.0), 1e-12));
         assert_eq!(p.dist, 0.0);
         assert_eq!(p.quake_type(), 2);
+    }
+
+    #[test]
+    fn a_normal_a_thousandth_of_a_radian_off_an_axis_is_not_axial() {
+        // The edge bevel of a sheared block (generated seed 1007): 0.136 units of lean over
+        // 210.8 of height. Taken as axial, snapping and the engines' one-coordinate test of an
+        // axial plane flattened it onto the block's axial bevel, and the player hull stopped up
+        // to 0.165 units short of the block.
+        let n = DVec3::new(0.0, -210.7974, 0.1364).normalized().expect("n");
+        assert!(
+            (1.0 - n.y.abs()) < NORMAL_EPSILON,
+            "the axis component alone looks axial"
+        );
+        let bevel = Plane::new(n, n.dot(DVec3::new(183.1036, 148.8576, 0.0)));
+        assert_eq!(bevel.axial(), None);
+        assert_eq!(bevel.quake_type(), 4);
+        assert_eq!(bevel.snapped(DVec3::new(183.1036, 148.8576, 0.0)), bevel);
+    }
+
+    #[test]
+    fn snapping_turns_the_plane_about_the_given_point() {
+        // A wall 5e-7 rad off the x axis is axial; snapped, it turns about the point given (on
+        // its face, 10000 units out): keeping its distance would move it 0.005 units there.
+        let n = DVec3::new(1.0, 5e-7, 0.0).normalized().expect("n");
+        let on = DVec3::new(64.0, 10000.0, 0.0);
+        let wall = Plane::new(n, n.dot(on));
+        assert_eq!(wall.axial(), Some(0));
+        let snapped = wall.snapped(on);
+        assert_eq!(snapped.normal, DVec3::X);
+        assert_eq!(snapped.dist, 64.0);
+        assert_eq!(snapped.quake_type(), 0);
     }
 
     #[test]
