@@ -86,8 +86,8 @@ pub fn render(report: &Report, plots: &[PlotFile]) -> String {
 fn stage_note(report: &Report, stage: Stage) -> String {
     match stage {
         Stage::Bsp => "Counts of the written BSP (portals from its `.prt`); cracks from \
-                       `bsp_compiler::cracks` (T-junctions, edges used by more than two faces and not as often as their reverse, \
-                       duplicate vertices); hull agreement from `bsp_compiler::hull_check`: \
+                       `bsp_compiler::cracks` (T-junctions, edges used by more than two faces \
+                       and not as often as their reverse, duplicate vertices); hull agreement from `bsp_compiler::hull_check`: \
                        player-box moves traced through clip hull 1 and swept exactly through the \
                        map's brushes, counted when their stops are more than 0.1 units apart \
                        (a hull that agrees stops the engine's 1/32 short)."
