@@ -2,7 +2,9 @@
 # Default-quality light, ours against ericw-tools' (../shared/anchors/ericw-tools), on copies of
 # the same BSPs, interleaved, ROUNDS rounds (default 3): prints wall, user and system seconds per
 # run; take the best of each. light/README.md's "Direct light, side by side" tables come from this.
-# Usage: bench/light_side_by_side.sh MAP.bsp...   (vised BSPs; nothing is written beside them)
+# Usage: [ROUNDS=3] [OURS="--bounce"] [ERICW="-bounce"] bench/light_side_by_side.sh MAP.bsp...
+# (vised BSPs; nothing is written beside them). OURS and ERICW are each tool's options for the
+# same settings, e.g. OURS="--extra4 --soft --bounce --dirt" ERICW="-extra4 -soft -bounce -dirt".
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 anchor="$root/../shared/anchors/ericw-tools/bin/light"
@@ -15,7 +17,9 @@ for round in $(seq "${ROUNDS:-3}"); do
   for bsp in "$@"; do
     name=$(basename "$bsp" .bsp)
     cp "$bsp" "$work/ours.bsp"; cp "$bsp" "$work/ericw.bsp"
-    echo "$round $name ours  $(timed "$ours" light "$work/ours.bsp")"
-    echo "$round $name ericw $(timed "$anchor" "$work/ericw.bsp")"
+    # shellcheck disable=SC2086 # the option strings are split on purpose
+    echo "$round $name ours  $(timed "$ours" light ${OURS:-} "$work/ours.bsp")"
+    # shellcheck disable=SC2086
+    echo "$round $name ericw $(timed "$anchor" ${ERICW:-} "$work/ericw.bsp")"
   done
 done
