@@ -739,6 +739,26 @@ fn phong_smooths_a_column_without_facet_bands() {
     assert!(smooth.iter().all(|&j| j < 8.0), "{smooth:?}");
 }
 
+/// Culling is exact: on a `_phong` column, the faces just past the light's terminator have the
+/// light behind their flat plane but in front of their smoothed corner normals, and they were
+/// culled by that plane (e3m4: 228 faces, up to 41 levels darker than without culling).
+#[test]
+fn culling_leaves_phong_faces_lit_from_behind_their_plane() {
+    let bsp = column_scene("\"_phong\" \"1\"");
+    let culled = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
+    let everything = compute_lighting(
+        &bsp,
+        &Options {
+            no_cull: true,
+            ..options(Quality::Default)
+        },
+    )
+    .expect("light");
+    let e = crate::compare(&culled, &everything);
+    assert!(e.luxels > 0);
+    assert_eq!(e.max, 0, "{e:?}");
+}
+
 /// Floor 0..256 (world) and brush model *1: a pedestal (x, y 96..160, up to
 /// z 64) under a wider slab (32..224, z 64..80), keyed `model_keys`. Light
 /// comes from high up on the +x side, from a constant light or (`sun`) a sun
@@ -1363,7 +1383,11 @@ fn fast_bounce_converges_to_the_reference_at_every_luxel_with_more_rays() {
     let rms_error = |strata: usize| {
         let mut fast = options(Quality::Extra4);
         fast.overrides.bounce = Some(1);
-        fast.bounce_density = Some(crate::bounce::Density { stride: 1, strata });
+        fast.bounce_density = Some(crate::bounce::Density {
+            stride: 1,
+            strata,
+            widen_last: false,
+        });
         let b = bounce_part(&bsp, &fast);
         assert_eq!(b.len(), reference.len());
         let sum: f64 = b

@@ -1026,8 +1026,11 @@ pub fn trace_face(
     for (li, light) in lights.iter().enumerate() {
         counts.pairs += 1;
         let reach = &setup.light_reaches[li];
+        // A light behind the plane of a `_phong` face can still be in front of the smoothed
+        // normals of some of its samples: only flat faces are culled by their plane.
+        let behind = samples.normals.is_empty() && face.plane.distance(reach.origin) <= 0.0;
         if setup.cull
-            && (face.plane.distance(reach.origin) <= 0.0
+            && (behind
                 || box_distance_squared(&bounds, reach.origin) > reach.range_squared
                 || !setup.vis.may_reach(setup.light_leafs[li], face.index))
         {
