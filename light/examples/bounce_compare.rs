@@ -27,6 +27,7 @@ fn parse_density(arg: &str) -> Option<Density> {
     Some(Density {
         stride: stride.parse().ok().filter(|&s| s > 0)?,
         strata: strata.parse().ok().filter(|&s| s > 0)?,
+        widen_last: false,
     })
 }
 

@@ -21,8 +21,9 @@ fn main() -> anyhow::Result<()> {
         &lightmaps_in(&reference, &faces),
     );
     println!(
-        "RMSE {:.3}, max {} levels over {} luxels ({} differ by more than 8)",
-        e.rmse, e.max, e.luxels, e.over_8
+        "RMSE {:.3}, max {} levels over {} luxels ({} differ by more than 8, {} by more than 2; \
+         {} black where the reference is not, {} where it is above 2)",
+        e.rmse, e.max, e.luxels, e.over_8, e.over_2, e.black, e.black_over_2
     );
     Ok(())
 }

@@ -753,6 +753,9 @@ pub struct ErrorStats {
     pub over_8: u64,
     /// Luxels that differ by more than 2 levels.
     pub over_2: u64,
+    /// Luxels black (0) here where the reference is not, and where it is above 2 levels.
+    pub black: u64,
+    pub black_over_2: u64,
 }
 
 /// Compares grey lightmaps face by face and style by style (a style only one
@@ -783,6 +786,8 @@ pub fn compare(a: &Lighting, reference: &Lighting) -> ErrorStats {
                 e.max = e.max.max(d);
                 e.over_8 += u64::from(d > 8);
                 e.over_2 += u64::from(d > 2);
+                e.black += u64::from(*x == 0 && *y > 0);
+                e.black_over_2 += u64::from(*x == 0 && *y > 2);
             }
         }
     }
