@@ -402,6 +402,7 @@ impl MapLights {
             || self.suns.iter().any(|s| s.dirt.is_some())
             || self.templates.iter().any(|t| t.light.dirt.is_some())
             || self.minlight.values().any(|m| m.dirt.is_some())
+            || (self.bounce.is_on() && self.bounce.dirt.is_some())
     }
 
     /// True if any light, sun or minlight is not white (a `.lit` is needed).
@@ -1201,6 +1202,20 @@ mod tests {
         assert!(close(global.factor(0.25), 1.0 - 1.5 * 0.5));
         assert_eq!(global.factor(0.0), 1.0);
         assert_eq!(global.factor(1.0), 0.0);
+    }
+
+    #[test]
+    fn bounce_keeps_dirt_when_every_light_opts_out() {
+        // Regression: dirt was only traced for lights, so bounce lost its dirt here.
+        let text = r#"
+{ "classname" "worldspawn" "_dirt" "1" "_bounce" "1" }
+{ "classname" "light" "origin" "0 0 0" "_dirt" "-1" }
+"#;
+        let mut ents = parse_entities(text).expect("parse");
+        let lights = parse_lights(&mut ents, &GlobalOverrides::default()).expect("lights");
+        assert_eq!(lights.points[0].dirt, None);
+        assert!(lights.bounce.dirt.is_some());
+        assert!(lights.uses_dirt());
     }
 
     #[test]

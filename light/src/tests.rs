@@ -1039,6 +1039,22 @@ fn phong_on_func_detail_reaches_light_through_the_bsp() {
 /// Every lit face's luxels (style 0) and the rays cast, at `per_axis`
 /// samples per luxel axis, with adaptive supersampling on or off.
 fn traced_faces(bsp: &Bsp, per_axis: usize, adaptive: bool) -> (Vec<Vec<[f32; 3]>>, u64) {
+    let rules = crate::trace::FaceRules {
+        dirt: true,
+        ..Default::default()
+    };
+    lit_faces(bsp, per_axis, adaptive, &rules, 0.0)
+}
+
+/// As [`traced_faces`], with `rules` and `bounce` light units of bounced light added to every
+/// luxel (darkened by dirt when `rules` says so).
+fn lit_faces(
+    bsp: &Bsp,
+    per_axis: usize,
+    adaptive: bool,
+    rules: &crate::trace::FaceRules,
+    bounce: f32,
+) -> (Vec<Vec<[f32; 3]>>, u64) {
     let prep = crate::prepare(bsp, &Options::default()).expect("prepare");
     let light_reaches = crate::trace::light_reaches(&prep.point_lights, 0.001);
     let setup = prep.trace_setup(bsp, &light_reaches, 0.001, true, adaptive);
@@ -1049,12 +1065,11 @@ fn traced_faces(bsp: &Bsp, per_axis: usize, adaptive: bool) -> (Vec<Vec<[f32; 3]
         .filter(|f| f.kind == FaceKind::Lit)
         .map(|geom| {
             let (samples, _) = face_samples(geom, per_axis, &prep.scene, bsp);
-            let rules = crate::trace::FaceRules {
-                dirt: true,
-                ..Default::default()
-            };
-            let (light, counts) = crate::trace::light_face(&setup, &samples, &rules);
+            let mut scratch = crate::trace::TraceScratch::default();
+            let (raw, counts) = crate::trace::trace_face(&setup, &samples, rules, &mut scratch);
             rays += counts.rays();
+            let bounced = [(0, vec![[bounce; 3]; samples.width * samples.height])];
+            let light = raw.finish(if bounce > 0.0 { &bounced } else { &[] });
             light.styles[0].1.clone()
         })
         .collect();
@@ -1104,6 +1119,40 @@ fn adaptive_dirt_stays_close_to_measuring_every_sample() {
         // weight (200 / 48 = 4.2 units): a ray that came out differently fails.
         assert!(worst <= 3.0, "{per_axis}: {worst}");
         assert!(adaptive_rays < full_rays, "{adaptive_rays} >= {full_rays}");
+    }
+}
+
+/// Where only bounced light takes dirt (here the light has `_dirt -1`), a supersampled sample's
+/// occlusion is the bilinear mean of its luxel's corners, edges included: 24 % fewer dirt rays
+/// on e3m4's release settings, RMSE 0.486 -> 0.488 against the reference. Without
+/// supersampling a fine cell is two luxels wide, and the same rule was 12 % off at this wall's
+/// foot (2 % at 4x4), so there it keeps the usual rule and gives the same bytes.
+#[test]
+fn dirt_that_only_bounce_takes_is_interpolated_and_stays_close() {
+    let bsp = corner_scene("\"_dirt\" \"1\" \"_bounce\" \"1\"", "\"_dirt\" \"-1\"");
+    let rules = crate::trace::FaceRules {
+        dirt: true,
+        bounce_dirt: Some(crate::lights::DirtResponse {
+            scale: 1.0,
+            gain: 1.0,
+        }),
+        ..Default::default()
+    };
+    for per_axis in [1, 4] {
+        let (full, full_rays) = lit_faces(&bsp, per_axis, false, &rules, 100.0);
+        let (adaptive, adaptive_rays) = lit_faces(&bsp, per_axis, true, &rules, 100.0);
+        let worst = full
+            .iter()
+            .flatten()
+            .zip(adaptive.iter().flatten())
+            .map(|(a, b)| (a[0] - b[0]).abs())
+            .fold(0.0f32, f32::max);
+        // 100 units of bounce: at most 2.5 % off (4x4: 2.0 light units; 1x1, the usual rule: 1.2).
+        assert!(worst <= 2.5, "{per_axis}: {worst}");
+        assert!(
+            adaptive_rays * 2 < full_rays,
+            "{adaptive_rays} of {full_rays}"
+        );
     }
 }
 

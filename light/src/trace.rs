@@ -447,7 +447,10 @@ const DIRT_COARSE_CELLS: usize = 2;
 /// does one whose fine corners the coarse cell predicts to within as much.
 /// The others (corners, edges of objects) are measured. Only samples marked
 /// in `needed` get a value (the rest 0); a needed sample's value does not
-/// depend on which others are needed.
+/// depend on which others are needed. When supersampling (a fine cell is one
+/// luxel), a sample needed only for bounced light ([`DirtNeed::Bounce`]) takes
+/// the bilinear mean of its fine cell whatever its corners' spread, moved or
+/// not (measured only when a corner is pulled).
 fn face_occlusion(
     setup: &TraceSetup,
     samples: &FaceSamples,
@@ -455,7 +458,7 @@ fn face_occlusion(
     sampling: &DirtSampling,
     adaptive: bool,
     first_at: &[usize],
-    needed: &[bool],
+    needed: &[DirtNeed],
 ) -> (Vec<f32>, u64) {
     let n = samples.points.len();
     // Ordered dirt rays depend only on the point: samples at one point share them.
@@ -487,11 +490,12 @@ fn face_occlusion(
         }
     };
     if !adaptive {
-        let mut all: Vec<usize> = (0..n).filter(|&i| needed[i]).collect();
+        let mut all: Vec<usize> = (0..n).filter(|&i| needed[i] != DirtNeed::No).collect();
         measure_into(&mut known, &mut all);
         return (known.into_iter().map(|v| v.unwrap_or(0.0)).collect(), rays);
     }
     let axis = samples.per_axis;
+    let supersampled = axis > 1;
     let stride = axis.max(2);
     let smooth = if axis > 1 {
         DIRT_SMOOTH_SUPERSAMPLED
@@ -509,10 +513,10 @@ fn face_occlusion(
     for gy in 0..gh {
         for gx in 0..gw {
             let i = index((gx, gy));
-            if !needed[i] {
+            if needed[i] == DirtNeed::No {
                 continue;
             }
-            if samples.moved[i] {
+            if samples.moved[i] && !(needed[i] == DirtNeed::Bounce && supersampled) {
                 batch.push(i);
             } else {
                 pending.push((gx, gy));
@@ -558,6 +562,10 @@ fn face_occlusion(
             if known[index(at)].is_some() {
                 return false;
             }
+            let bounce_only = needed[index(at)] == DirtNeed::Bounce && supersampled;
+            if bounce_only && outer.is_none() {
+                return true; // the fine cell's corners are measured next
+            }
             let Some((value, spread)) = bilinear(&known, grid, at) else {
                 return true;
             };
@@ -574,7 +582,7 @@ fn face_occlusion(
                     matches!((measured, predicted), (Some(m), Some((p, _))) if (m - p).abs() <= smooth)
                 })
             };
-            if spread > smooth && !linear() {
+            if !bounce_only && spread > smooth && !linear() {
                 return true;
             }
             interpolated.push((index(at), value));
@@ -587,6 +595,16 @@ fn face_occlusion(
         known[i] = Some(v);
     }
     (known.into_iter().map(|v| v.unwrap_or(0.0)).collect(), rays)
+}
+
+/// Why a sample's dirt occlusion is wanted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum DirtNeed {
+    No,
+    /// Only bounced light (which is smooth and faint where no light reaches) takes it.
+    Bounce,
+    /// A light, sun or minlight that takes dirt reaches the sample.
+    Light,
 }
 
 /// Dirt factors per sample, computed once per distinct [`DirtResponse`]
@@ -1131,11 +1149,16 @@ pub fn trace_face(
 
     let occlusion = match dirt_sampling {
         Some(sampling) => {
-            let everywhere =
-                rules.minlight.is_some_and(|m| m.dirt.is_some()) || rules.bounce_dirt.is_some();
+            let everywhere = if rules.minlight.is_some_and(|m| m.dirt.is_some()) {
+                DirtNeed::Light
+            } else if rules.bounce_dirt.is_some() {
+                DirtNeed::Bounce
+            } else {
+                DirtNeed::No
+            };
             let mut needed = vec![everywhere; n];
             for a in arrivals.iter().filter(|a| a.dirty) {
-                needed[a.sample as usize] = true;
+                needed[a.sample as usize] = DirtNeed::Light;
             }
             let (values, rays) = face_occlusion(
                 setup,
