@@ -3,7 +3,8 @@
 //! (default and `--extra4`) and with `--reference --bounce`, and reads ericw-tools' lightmaps of
 //! the same faces from ERICW_LIT.bsp (its `light -bounce` of the same BSP); errors are in grey
 //! levels. Each `GRIDxSTRATA` (for example `4x8`) also runs both modes with the fast bounce's
-//! receivers every GRID luxels casting STRATA² rays each.
+//! receivers every GRID luxels casting STRATA² rays each; a trailing `s` (`2x6s`) smooths the
+//! receivers as the default mode does.
 
 use light::bounce::Density;
 use light::{Lighting, Options, Quality, compare, compute_lighting, lightmaps_in};
@@ -21,13 +22,18 @@ fn report(name: &str, a: &Lighting, reference: &Lighting) {
     );
 }
 
-/// `GRIDxSTRATA` as a density.
+/// `GRIDxSTRATA` or `GRIDxSTRATAs` as a density.
 fn parse_density(arg: &str) -> Option<Density> {
     let (stride, strata) = arg.split_once('x')?;
+    let (strata, smooth) = match strata.strip_suffix('s') {
+        Some(s) => (s, true),
+        None => (strata, false),
+    };
     Some(Density {
         stride: stride.parse().ok().filter(|&s| s > 0)?,
         strata: strata.parse().ok().filter(|&s| s > 0)?,
         widen_last: false,
+        smooth,
     })
 }
 

@@ -1436,6 +1436,7 @@ fn fast_bounce_converges_to_the_reference_at_every_luxel_with_more_rays() {
             stride: 1,
             strata,
             widen_last: false,
+            smooth: false,
         });
         let b = bounce_part(&bsp, &fast);
         assert_eq!(b.len(), reference.len());
