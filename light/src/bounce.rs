@@ -280,74 +280,102 @@ fn light_at(face: &FaceGeom, luxels: &[[f32; 3]], q: DVec3) -> [f32; 3] {
 const RAY_LENGTH: f32 = 65536.0;
 
 impl Field<'_> {
-    /// Adds the light `at` receives into slot `i` of `out` (`n` slots per style): `strata²`
-    /// cosine-distributed rays around the face normal, one per cell of a stratified grid
-    /// jittered by `at.key`. A ray that first meets the front of a reflecting face at `q`
-    /// brings `π · kernel · ρ E(q) · min(1, d²/128²)` (times the shading/flat cosine ratio),
-    /// over the number of rays: the model's integral with `dA = d² dω / cos θq`.
-    #[allow(clippy::too_many_arguments)]
-    pub fn gather_at(
+    /// Adds the light each of `points` receives into its slot of `out` (`n` slots per style):
+    /// `strata²` cosine-distributed rays around the point's face normal, one per cell of a
+    /// stratified grid jittered by the point's key. A ray that first meets the front of a
+    /// reflecting face at `q` brings `π · kernel · ρ E(q) · min(1, d²/128²)` (times the
+    /// shading/flat cosine ratio), over the number of rays: the model's integral with
+    /// `dA = d² dω / cos θq`. Rays go 16 to a packet whichever point they leave (a point's
+    /// rays need not fill whole packets); each slot takes its rays in order, so the result
+    /// does not depend on how they were packed.
+    pub fn gather(
         &self,
         scene: &TraceScene,
         model: usize,
-        at: &GatherPoint,
+        points: &[(GatherPoint, usize)],
         strata: usize,
         out: &mut StyleLuxels,
         n: usize,
-        i: usize,
         counts: &mut BounceCounts,
     ) {
         let rays = strata * strata;
-        let [t0, t1] = tangent_basis(at.flat);
         let scale = self.kernel * std::f64::consts::PI / rays as f64;
         let mut packet = RayPacket16::new();
-        let mut dirs = [DVec3::ZERO; 16];
-        for first in (0..rays).step_by(16) {
-            packet.clear();
-            let lanes = (rays - first).min(16);
-            for (lane, dir) in dirs.iter_mut().enumerate().take(lanes) {
-                let r = first + lane;
+        // Per lane: its direction and the point it leaves.
+        let mut lanes: Vec<(DVec3, usize)> = Vec::with_capacity(16);
+        let all = points.iter().enumerate().flat_map(|(k, (at, _))| {
+            let [t0, t1] = tangent_basis(at.flat);
+            (0..rays).map(move |r| {
                 let (j1, j2) = jitter(at.key.wrapping_add(r as u64));
                 let u1 = ((r / strata) as f64 + j1) / strata as f64;
                 let u2 = ((r % strata) as f64 + j2) / strata as f64;
                 let radius = u1.sqrt();
                 let (sin, cos) = sin_cos_turns(u2);
-                *dir = t0 * (radius * cos) + t1 * (radius * sin) + at.flat * (1.0 - u1).sqrt();
-                packet.set(
-                    lane,
-                    at.point.as_vec3().to_array(),
-                    dir.as_vec3().to_array(),
-                    0.0,
-                    RAY_LENGTH,
-                );
+                let dir = t0 * (radius * cos) + t1 * (radius * sin) + at.flat * (1.0 - u1).sqrt();
+                (dir, k)
+            })
+        });
+        for (dir, k) in all {
+            packet.set(
+                lanes.len(),
+                points[k].0.point.as_vec3().to_array(),
+                dir.as_vec3().to_array(),
+                0.0,
+                RAY_LENGTH,
+            );
+            lanes.push((dir, k));
+            if lanes.len() == 16 {
+                self.take_hits(scene, model, &mut packet, &lanes, points, scale, out, n);
+                counts.rays += 16;
+                packet.clear();
+                lanes.clear();
             }
-            counts.rays += lanes as u64;
-            let hits = scene.first_faces16(&mut packet, model);
-            for (lane, hit) in hits.iter().enumerate().take(lanes) {
-                let Some((f, t)) = *hit else {
-                    continue;
-                };
-                let (Some(face), Some(Some(rho)), Some(Some(light))) = (
-                    self.faces.get(f),
-                    self.reflectance.get(f),
-                    self.light.get(f),
-                ) else {
-                    continue;
-                };
-                let dir = dirs[lane];
-                let cos_flat = at.flat.dot(dir);
-                if face.plane.normal.dot(dir) >= 0.0 || cos_flat <= 0.0 {
-                    continue; // the back of a face, or a grazing ray
-                }
-                let cos_shading = at.shading.dot(dir).max(0.0);
-                let near = (f64::from(t) / HOTSPOT_CLAMP).min(1.0);
-                let weight = scale * cos_shading / cos_flat * near * near;
-                let q = at.point + dir * f64::from(t);
-                for (style, luxels) in light {
-                    let e = light_at(face, luxels, q);
-                    let flux = std::array::from_fn(|k| e[k] * rho[k]);
-                    add_light(out, n, &[*style], &[flux], i, weight);
-                }
+        }
+        if !lanes.is_empty() {
+            self.take_hits(scene, model, &mut packet, &lanes, points, scale, out, n);
+            counts.rays += lanes.len() as u64;
+        }
+    }
+
+    /// Traces `packet` (its lanes leaving `points` in the directions of `lanes`) and adds what
+    /// each ray brings to its point's slot of `out`.
+    #[allow(clippy::too_many_arguments)]
+    fn take_hits(
+        &self,
+        scene: &TraceScene,
+        model: usize,
+        packet: &mut RayPacket16,
+        lanes: &[(DVec3, usize)],
+        points: &[(GatherPoint, usize)],
+        scale: f64,
+        out: &mut StyleLuxels,
+        n: usize,
+    ) {
+        let hits = scene.first_faces16(packet, model);
+        for (&(dir, k), hit) in lanes.iter().zip(hits) {
+            let Some((f, t)) = hit else {
+                continue;
+            };
+            let (Some(face), Some(Some(rho)), Some(Some(light))) = (
+                self.faces.get(f),
+                self.reflectance.get(f),
+                self.light.get(f),
+            ) else {
+                continue;
+            };
+            let (at, slot) = &points[k];
+            let cos_flat = at.flat.dot(dir);
+            if face.plane.normal.dot(dir) >= 0.0 || cos_flat <= 0.0 {
+                continue; // the back of a face, or a grazing ray
+            }
+            let cos_shading = at.shading.dot(dir).max(0.0);
+            let near = (f64::from(t) / HOTSPOT_CLAMP).min(1.0);
+            let weight = scale * cos_shading / cos_flat * near * near;
+            let q = at.point + dir * f64::from(t);
+            for (style, luxels) in light {
+                let e = light_at(face, luxels, q);
+                let flux = std::array::from_fn(|c| e[c] * rho[c]);
+                add_light(out, n, &[*style], &[flux], *slot, weight);
             }
         }
     }
@@ -371,7 +399,7 @@ impl Field<'_> {
         };
         let (xs, ys) = (axis(r.width), axis(r.height));
         let cells = xs.len() * ys.len();
-        let mut at_grid: StyleLuxels = Vec::new();
+        let mut points = Vec::with_capacity(cells);
         for (gy, &y) in ys.iter().enumerate() {
             for (gx, &x) in xs.iter().enumerate() {
                 let l = y * r.width + x;
@@ -381,19 +409,19 @@ impl Field<'_> {
                     shading: Vec3::from(r.normals[l]).as_dvec3(),
                     key: point_key(r.face, l, pass),
                 };
-                let slot = gy * xs.len() + gx;
-                self.gather_at(
-                    scene,
-                    r.model,
-                    &at,
-                    density.strata,
-                    &mut at_grid,
-                    cells,
-                    slot,
-                    counts,
-                );
+                points.push((at, gy * xs.len() + gx));
             }
         }
+        let mut at_grid: StyleLuxels = Vec::new();
+        self.gather(
+            scene,
+            r.model,
+            &points,
+            density.strata,
+            &mut at_grid,
+            cells,
+            counts,
+        );
         if density.smooth {
             smooth_receivers(&mut at_grid, xs.len(), ys.len());
         }

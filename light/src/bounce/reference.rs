@@ -1,5 +1,5 @@
 //! The slow exact bounce of `--reference`: at every sample, the fast method's hemisphere
-//! gathering ([`Field::gather_at`]) with [`STRATA`]² rays, read from every face's `--extra4`
+//! gathering ([`Field::gather`]) with [`STRATA`]² rays, read from every face's `--extra4`
 //! direct light. With 256 samples per luxel that is 4096 rays per luxel, none skipped and
 //! nothing interpolated.
 
@@ -22,15 +22,21 @@ pub fn gather(
     counts: &mut BounceCounts,
 ) -> StyleLuxels {
     let n = samples.points.len();
+    let points: Vec<(GatherPoint, usize)> = samples
+        .points
+        .iter()
+        .enumerate()
+        .map(|(i, &point)| {
+            let at = GatherPoint {
+                point: Vec3::from(point).as_dvec3(),
+                flat: samples.normal,
+                shading: samples.normal_at(i),
+                key: point_key(samples.face, i, pass),
+            };
+            (at, i)
+        })
+        .collect();
     let mut out: StyleLuxels = Vec::new();
-    for (i, &point) in samples.points.iter().enumerate() {
-        let at = GatherPoint {
-            point: Vec3::from(point).as_dvec3(),
-            flat: samples.normal,
-            shading: samples.normal_at(i),
-            key: point_key(samples.face, i, pass),
-        };
-        field.gather_at(scene, model, &at, STRATA, &mut out, n, i, counts);
-    }
+    field.gather(scene, model, &points, STRATA, &mut out, n, counts);
     out
 }
