@@ -280,7 +280,7 @@ fn light_at(face: &FaceGeom, luxels: &[[f32; 3]], q: DVec3) -> [f32; 3] {
 const RAY_LENGTH: f32 = 65536.0;
 
 impl Field<'_> {
-    /// Adds the light each of `points` receives into its slot of `out` (`n` slots per style):
+    /// The light each of `points` receives, in its slot (of `n` per style):
     /// `strata²` cosine-distributed rays around the point's face normal, one per cell of a
     /// stratified grid jittered by the point's key. A ray that first meets the front of a
     /// reflecting face at `q` brings `π · kernel · ρ E(q) · min(1, d²/128²)` (times the
@@ -294,10 +294,10 @@ impl Field<'_> {
         model: usize,
         points: &[(GatherPoint, usize)],
         strata: usize,
-        out: &mut StyleLuxels,
         n: usize,
         counts: &mut BounceCounts,
-    ) {
+    ) -> StyleLuxels {
+        let mut out = StyleLuxels::new();
         let rays = strata * strata;
         let scale = self.kernel * std::f64::consts::PI / rays as f64;
         let mut packet = RayPacket16::new();
@@ -325,16 +325,35 @@ impl Field<'_> {
             );
             lanes.push((dir, k));
             if lanes.len() == 16 {
-                self.take_hits(scene, model, &mut packet, &lanes, points, scale, out, n);
+                self.take_hits(
+                    scene,
+                    model,
+                    &mut packet,
+                    &lanes,
+                    points,
+                    scale,
+                    &mut out,
+                    n,
+                );
                 counts.rays += 16;
                 packet.clear();
                 lanes.clear();
             }
         }
         if !lanes.is_empty() {
-            self.take_hits(scene, model, &mut packet, &lanes, points, scale, out, n);
+            self.take_hits(
+                scene,
+                model,
+                &mut packet,
+                &lanes,
+                points,
+                scale,
+                &mut out,
+                n,
+            );
             counts.rays += lanes.len() as u64;
         }
+        out
     }
 
     /// Traces `packet` (its lanes leaving `points` in the directions of `lanes`) and adds what
@@ -412,16 +431,7 @@ impl Field<'_> {
                 points.push((at, gy * xs.len() + gx));
             }
         }
-        let mut at_grid: StyleLuxels = Vec::new();
-        self.gather(
-            scene,
-            r.model,
-            &points,
-            density.strata,
-            &mut at_grid,
-            cells,
-            counts,
-        );
+        let mut at_grid = self.gather(scene, r.model, &points, density.strata, cells, counts);
         if density.smooth {
             smooth_receivers(&mut at_grid, xs.len(), ys.len());
         }

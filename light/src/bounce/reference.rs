@@ -36,7 +36,5 @@ pub fn gather(
             (at, i)
         })
         .collect();
-    let mut out: StyleLuxels = Vec::new();
-    field.gather(scene, model, &points, STRATA, &mut out, n, counts);
-    out
+    field.gather(scene, model, &points, STRATA, n, counts)
 }
