@@ -1113,11 +1113,12 @@ fn adaptive_dirt_stays_close_to_measuring_every_sample() {
             .fold(0.0f32, f32::max);
         // Samples measured in both runs cast the same rays and agree exactly
         // (no ray here meets an edge: see the next test), so this is the
-        // interpolation error alone: 2.1 light units at 1×1 and 0.2 at 4×4,
-        // the same with Embree's SSE2, SSE4.2, AVX and AVX2 kernels. The bound,
-        // 1.5 grey levels of this 200 light, is below one dirt ray's whole
-        // weight (200 / 48 = 4.2 units): a ray that came out differently fails.
-        assert!(worst <= 3.0, "{per_axis}: {worst}");
+        // interpolation error alone: 3.3 light units at 1×1 (2.1 when
+        // `DIRT_SMOOTH` was 0.05) and 0.2 at 4×4, the same with Embree's SSE2,
+        // SSE4.2, AVX and AVX2 kernels. The bound, 2 grey levels of this 200
+        // light, is below one dirt ray's whole weight (200 / 48 = 4.2 units):
+        // a ray that came out differently fails.
+        assert!(worst <= 4.0, "{per_axis}: {worst}");
         assert!(adaptive_rays < full_rays, "{adaptive_rays} >= {full_rays}");
     }
 }

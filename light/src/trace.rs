@@ -389,8 +389,10 @@ fn direction_meets_any(boxes: &[Bounds], d: DVec3) -> bool {
 }
 
 /// Occlusion may be interpolated between grid points that differ by at
-/// most this much (a light's dirt factor then moves by about as much).
-const DIRT_SMOOTH: f32 = 0.05;
+/// most this much (a light's dirt factor then moves by about as much). 0.05
+/// cast 14 % more dirt rays on e3m4 (default mode) for an RMSE against the
+/// reference 0.005 lower.
+const DIRT_SMOOTH: f32 = 0.1;
 
 /// [`DIRT_SMOOTH`] when supersampling, whose error against the reference is
 /// small enough for 0.05 to show: e3m4's `--extra4` RMSE is 0.395 with this
@@ -440,11 +442,15 @@ const DIRT_COARSE_CELLS: usize = 2;
 /// [`DIRT_COARSE_CELLS`] fine cells wide, then on the fine grid (every
 /// `stride`-th sample along each axis of the face's sample grid: one per
 /// luxel when supersampling, every other luxel otherwise), both with the
-/// face's last row and column; and at every moved sample. A sample whose
-/// cell's four corners (none of them pulled, see [`FaceSamples::pulled`])
-/// differ by at most [`DIRT_SMOOTH`] (or [`DIRT_SMOOTH_SUPERSAMPLED`]) takes
-/// their bilinear mean, first in the coarse cell, else in the fine one; so
-/// does one whose fine corners the coarse cell predicts to within as much.
+/// face's last row and column; and at every sample off the grid: pulled ones
+/// ([`FaceSamples::pulled`]), and when supersampling every moved one (a
+/// luxel's sub-samples are close together; in the default mode a sample moved
+/// onto the face from past its edge stays beside its grid position and is
+/// interpolated like the others: 18 % fewer dirt rays on e3m4, RMSE against
+/// the reference +0.02). A sample whose cell's four corners (none of them
+/// pulled) differ by at most [`DIRT_SMOOTH`] (or [`DIRT_SMOOTH_SUPERSAMPLED`])
+/// takes their bilinear mean, first in the coarse cell, else in the fine one;
+/// so does one whose fine corners the coarse cell predicts to within as much.
 /// The others (corners, edges of objects) are measured. Only samples marked
 /// in `needed` get a value (the rest 0); a needed sample's value does not
 /// depend on which others are needed. When supersampling (a fine cell is one
@@ -516,7 +522,12 @@ fn face_occlusion(
             if needed[i] == DirtNeed::No {
                 continue;
             }
-            if samples.moved[i] && !(needed[i] == DirtNeed::Bounce && supersampled) {
+            let off_grid = if supersampled {
+                samples.moved[i]
+            } else {
+                samples.pulled[i]
+            };
+            if off_grid && !(needed[i] == DirtNeed::Bounce && supersampled) {
                 batch.push(i);
             } else {
                 pending.push((gx, gy));
