@@ -101,17 +101,35 @@ fn in_front(d: [f32; 3], face_normal: DVec3) -> [f32; 3] {
     }
 }
 
+/// Which of its dirt rays a sample casts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DirtRays {
+    /// All [`RAYS_PER_SAMPLE`].
+    All,
+    /// Every other azimuth (all elevations): for samples only bounced light
+    /// takes dirt at, which is faint and smooth.
+    Half,
+}
+
+impl DirtRays {
+    /// Whether ray `k` of the pattern (azimuth-major) is cast.
+    fn casts(self, k: usize) -> bool {
+        self == DirtRays::All || (k / ELEVATION_STEPS).is_multiple_of(2)
+    }
+}
+
 /// Occlusion of the samples `indices` of `samples` (a face of brush model
-/// `model`), in that order: the mean over the dirt rays, cast in a cone
-/// around the sample's shading normal (the `_phong` one where the face has
-/// them), of `1 - hit distance / depth` (0 for a ray that reaches no opaque
-/// surface within `depth`; sky does not occlude). Returns the values and the
-/// number of rays cast.
+/// `model`), in that order: the mean over the dirt rays (`rays` of them),
+/// cast in a cone around the sample's shading normal (the `_phong` one where
+/// the face has them), of `1 - hit distance / depth` (0 for a ray that
+/// reaches no opaque surface within `depth`; sky does not occlude). Returns
+/// the values and the number of rays cast.
 pub fn occlusion_at(
     samples: &FaceSamples,
     indices: &[usize],
     model: usize,
     sampling: &DirtSampling,
+    rays: DirtRays,
     scene: &TraceScene,
 ) -> (Vec<f32>, u64) {
     let cone = sampling.cone_degrees().to_radians();
@@ -125,7 +143,9 @@ pub fn occlusion_at(
     // Each pattern is turned in front of the face once, not per ray.
     let in_front_all = |dirs: Vec<[f32; 3]>| -> Vec<[f32; 3]> {
         dirs.into_iter()
-            .map(|d| in_front(d, samples.normal))
+            .enumerate()
+            .filter(|&(k, _)| rays.casts(k))
+            .map(|(_, d)| in_front(d, samples.normal))
             .collect()
     };
     let flat_ordered = in_front_all(ordered_directions(flat_basis, ordered));
@@ -169,7 +189,8 @@ pub fn occlusion_at(
         }
     };
     let n = indices.len();
-    let total = n * RAYS_PER_SAMPLE;
+    let per_sample = flat_ordered.len();
+    let total = n * per_sample;
     let mut gathered = vec![0.0f32; n];
     // Direction and sample of the next ray.
     let (mut k, mut s) = (0, 0);
@@ -192,10 +213,7 @@ pub fn occlusion_at(
             }
         }
     }
-    let values = gathered
-        .iter()
-        .map(|g| g / RAYS_PER_SAMPLE as f32)
-        .collect();
+    let values = gathered.iter().map(|g| g / per_sample as f32).collect();
     (values, total as u64)
 }
 

@@ -863,7 +863,15 @@ fn dirt_cone_follows_the_phong_normal() {
     let sampling = crate::lights::DirtSampling::default();
     let occlusion = |samples: &crate::samples::FaceSamples| {
         let all: Vec<usize> = (0..samples.points.len()).collect();
-        crate::dirt::occlusion_at(samples, &all, 0, &sampling, &prep.scene).0
+        crate::dirt::occlusion_at(
+            samples,
+            &all,
+            0,
+            &sampling,
+            crate::dirt::DirtRays::All,
+            &prep.scene,
+        )
+        .0
     };
     let flat = occlusion(&samples);
     let tilted = |x: f64| {
@@ -1127,7 +1135,10 @@ fn adaptive_dirt_stays_close_to_measuring_every_sample() {
 /// occlusion is the bilinear mean of its luxel's corners, edges included: 24 % fewer dirt rays
 /// on e3m4's release settings, RMSE 0.486 -> 0.488 against the reference. Without
 /// supersampling a fine cell is two luxels wide, and the same rule was 12 % off at this wall's
-/// foot (2 % at 4x4), so there it keeps the usual rule and gives the same bytes.
+/// foot (2 % at 4x4), so there it keeps the usual rule. Samples measured for bounce alone cast
+/// half the dirt rays (`dirt::DirtRays::Half`): 6 % off at this wall's foot in both modes (the
+/// 8-azimuth pattern against 16), for 21 % fewer dirt rays on e3m4 `--bounce` (RMSE 2.696 ->
+/// 2.697) and 12 % on e3m4's and retrojam1's release settings (RMSE unchanged or lower).
 #[test]
 fn dirt_that_only_bounce_takes_is_interpolated_and_stays_close() {
     let bsp = corner_scene("\"_dirt\" \"1\" \"_bounce\" \"1\"", "\"_dirt\" \"-1\"");
@@ -1148,8 +1159,9 @@ fn dirt_that_only_bounce_takes_is_interpolated_and_stays_close() {
             .zip(adaptive.iter().flatten())
             .map(|(a, b)| (a[0] - b[0]).abs())
             .fold(0.0f32, f32::max);
-        // 100 units of bounce: at most 2.5 % off (4x4: 2.0 light units; 1x1, the usual rule: 1.2).
-        assert!(worst <= 2.5, "{per_axis}: {worst}");
+        // 100 units of bounce: at most 7 % off (6.1 light units at both densities; 2.0 and 1.2
+        // with every ray), the same with each of Embree's kernels.
+        assert!(worst <= 7.0, "{per_axis}: {worst}");
         assert!(
             adaptive_rays * 2 < full_rays,
             "{adaptive_rays} of {full_rays}"
@@ -1181,6 +1193,7 @@ fn dirt_occlusion_does_not_depend_on_the_rays_traced_beside_it() {
                         indices,
                         geom.model,
                         &prep.lights.dirt,
+                        crate::dirt::DirtRays::All,
                         &prep.scene,
                     )
                     .0

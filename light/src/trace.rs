@@ -7,7 +7,7 @@ use quake_formats::Bsp;
 use quake_formats::geom::Bounds;
 use quake_formats::geom::DVec3Ext;
 
-use crate::dirt;
+use crate::dirt::{self, DirtRays};
 use crate::embree::RayPacket16;
 use crate::faces::FaceGeom;
 use crate::lights::{
@@ -469,14 +469,15 @@ fn face_occlusion(
     let n = samples.points.len();
     // Ordered dirt rays depend only on the point: samples at one point share them.
     let same_rays = sampling.mode == DirtMode::Ordered;
-    let measure = |indices: &[usize]| {
+    let measure = |indices: &[usize], which: DirtRays| {
         if !same_rays {
-            return dirt::occlusion_at(samples, indices, model, sampling, setup.scene);
+            return dirt::occlusion_at(samples, indices, model, sampling, which, setup.scene);
         }
         let mut unique: Vec<usize> = indices.iter().map(|&i| first_at[i]).collect();
         unique.sort_unstable();
         unique.dedup();
-        let (values, rays) = dirt::occlusion_at(samples, &unique, model, sampling, setup.scene);
+        let (values, rays) =
+            dirt::occlusion_at(samples, &unique, model, sampling, which, setup.scene);
         let value_of = |i: usize| {
             unique
                 .binary_search(&first_at[i])
@@ -489,10 +490,19 @@ fn face_occlusion(
     let mut measure_into = |known: &mut Vec<Option<f32>>, indices: &mut Vec<usize>| {
         indices.sort_unstable();
         indices.dedup();
-        let (values, r) = measure(indices);
-        rays += r;
-        for (&i, v) in indices.iter().zip(values) {
-            known[i] = Some(v);
+        // Samples only bounced light takes dirt at cast half the rays (the adaptive modes).
+        let (half, all): (Vec<usize>, Vec<usize>) = indices
+            .iter()
+            .partition(|&&i| adaptive && needed[i] == DirtNeed::Bounce);
+        for (group, which) in [(all, DirtRays::All), (half, DirtRays::Half)] {
+            if group.is_empty() {
+                continue;
+            }
+            let (values, r) = measure(&group, which);
+            rays += r;
+            for (&i, v) in group.iter().zip(values) {
+                known[i] = Some(v);
+            }
         }
     };
     if !adaptive {
