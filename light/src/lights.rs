@@ -284,6 +284,8 @@ pub struct SunLight {
     pub style: u8,
     pub anglescale: f64,
     pub dirt: Option<DirtResponse>,
+    /// How many directions its sun or dome is spread over (1: a sun without a penumbra).
+    pub directions: usize,
 }
 
 /// A minimum light level: no luxel of style 0 ends up darker than this
@@ -539,10 +541,12 @@ pub fn cap_directions(center: DVec3, half_angle_deg: f64, n: usize) -> Vec<DVec3
 /// Splits the light of `sun` evenly over `dirs` (its `to_sun` is replaced).
 fn suns_over(dirs: Vec<DVec3>, sun: &SunLight) -> Vec<SunLight> {
     let each = sun.light / dirs.len().max(1) as f64;
+    let directions = dirs.len();
     dirs.into_iter()
         .map(|to_sun| SunLight {
             to_sun,
             light: each,
+            directions,
             ..sun.clone()
         })
         .collect()
@@ -703,6 +707,7 @@ pub fn parse_lights(
             style: 0,
             anglescale: global_anglescale,
             dirt: dirt_if(wk.float("_sunlight_dirt")?, global_dirt, global_response),
+            directions: 1,
         };
         let dirs = cap_directions(to_sun, penumbra, sunsamples);
         out.suns.extend(suns_over(dirs, &template));
@@ -721,6 +726,7 @@ pub fn parse_lights(
                 style: 0,
                 anglescale: global_anglescale,
                 dirt: dome_dirt,
+                directions: 1,
             };
             out.suns
                 .extend(suns_over(cap_directions(up, 90.0, sunsamples), &template));
@@ -818,6 +824,7 @@ pub fn parse_lights(
                 style,
                 anglescale,
                 dirt,
+                directions: 1,
             };
             let dirs = cap_directions(to_sun, deviance, sunsamples);
             out.suns.extend(suns_over(dirs, &template));
@@ -834,6 +841,7 @@ pub fn parse_lights(
                     style,
                     anglescale,
                     dirt,
+                    directions: 1,
                 };
                 out.suns
                     .extend(suns_over(cap_directions(up, 90.0, sunsamples), &template));

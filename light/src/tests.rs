@@ -1231,6 +1231,28 @@ fn demo_bsp_with_sun() -> Bsp {
     bsp
 }
 
+/// In the default mode the dome's directions (each carrying 1/100 of it) are probed every
+/// other luxel and filled in where a cell's probes agree (`VisibilityScratch::trace_probed`):
+/// on e3m4 40 % fewer sun rays, RMSE against the reference unchanged to three places. The
+/// single sun (one direction) is traced at every luxel as before.
+#[test]
+fn probed_sky_dome_stays_close_to_tracing_every_luxel() {
+    let bsp = demo_bsp_with_sun();
+    let (full, full_rays) = traced_faces(&bsp, 1, false);
+    let (probed, probed_rays) = traced_faces(&bsp, 1, true);
+    let worst = full
+        .iter()
+        .flatten()
+        .zip(probed.iter().flatten())
+        .map(|(a, b)| (a[0] - b[0]).abs())
+        .fold(0.0f32, f32::max);
+    // The dome is 60 light units over 100 directions: the worst luxel (0.56) lost or gained
+    // one direction; a bound of two allows for another CPU's kernel breaking a tie otherwise.
+    assert!(worst <= 1.2, "{worst}");
+    // 0.69 M rays instead of 1.18 M here (shadow and dirt rays included).
+    assert!(probed_rays < full_rays, "{probed_rays} >= {full_rays}");
+}
+
 #[test]
 fn output_does_not_depend_on_the_thread_count() {
     // Faces are lit in parallel: nothing a face's result rests on (its packets,

@@ -399,10 +399,10 @@ const DIRT_SMOOTH: f32 = 0.1;
 /// and 0.399 with 0.05 (the default mode gains nothing from it).
 const DIRT_SMOOTH_SUPERSAMPLED: f32 = 0.01;
 
-/// A grid of points where dirt is measured, over a face's grid of samples
-/// (`gw × gh` positions): every `stride`-th position along each axis, and
-/// the last row and column, so every position lies in a cell.
-struct DirtGrid {
+/// A grid of points where dirt is measured or sunlight probed, over a face's
+/// grid of samples (`gw × gh` positions): every `stride`-th position along
+/// each axis, and the last row and column, so every position lies in a cell.
+struct SampleGrid {
     xs: Vec<usize>,
     ys: Vec<usize>,
     /// Per position along each axis: the grid lines before and after it
@@ -411,11 +411,11 @@ struct DirtGrid {
     cy: Vec<(usize, usize, f32)>,
 }
 
-impl DirtGrid {
-    fn new(gw: usize, gh: usize, stride: usize) -> DirtGrid {
+impl SampleGrid {
+    fn new(gw: usize, gh: usize, stride: usize) -> SampleGrid {
         let xs = crate::bounce::grid(gw, stride);
         let ys = crate::bounce::grid(gh, stride);
-        DirtGrid {
+        SampleGrid {
             cx: crate::bounce::cell_of(&xs),
             cy: crate::bounce::cell_of(&ys),
             xs,
@@ -432,6 +432,13 @@ impl DirtGrid {
         ([(x0, y0), (x1, y0), (x0, y1), (x1, y1)], fx, fy)
     }
 }
+
+/// Luxels between sunlight probes ([`VisibilityScratch::trace_probed`]).
+const SUN_PROBE_STRIDE: usize = 2;
+
+/// Suns and domes spread over at least this many directions are probed in
+/// the default mode ([`VisibilityScratch::trace_probed`]).
+const SUN_PROBE_DIRECTIONS: usize = 16;
 
 /// Coarse dirt cells are this many fine cells wide: occlusion is first
 /// measured on the coarse grid, and cells whose corners differ are refined.
@@ -549,7 +556,7 @@ fn face_occlusion(
     // needed sample's value must not depend on which others are needed) and
     // none was pulled (possibly far from its grid position; a sample moved
     // onto the face from past its edge stays beside it).
-    let bilinear = |known: &[Option<f32>], grid: &DirtGrid, (gx, gy): (usize, usize)| {
+    let bilinear = |known: &[Option<f32>], grid: &SampleGrid, (gx, gy): (usize, usize)| {
         let (corners, fx, fy) = grid.cell(gx, gy);
         let values = corners.map(|c| {
             let c = index(c);
@@ -563,8 +570,8 @@ fn face_occlusion(
         let spread = a.max(b).max(c).max(d) - a.min(b).min(c).min(d);
         Some((top + (bottom - top) * fy, spread))
     };
-    let coarse = DirtGrid::new(gw, gh, stride * DIRT_COARSE_CELLS);
-    let fine = DirtGrid::new(gw, gh, stride);
+    let coarse = SampleGrid::new(gw, gh, stride * DIRT_COARSE_CELLS);
+    let fine = SampleGrid::new(gw, gh, stride);
     for (grid, outer) in [(&coarse, None), (&fine, Some(&coarse))] {
         // The corners of the cells of the samples still pending (a sample on
         // the grid is its own first corner), then what they let us interpolate.
@@ -769,6 +776,62 @@ impl VisibilityScratch {
                 } else {
                     self.todo.push(i);
                 }
+            }
+        }
+        rays += self.cast(&ray, packet, &mut reaches);
+        rays
+    }
+
+    /// [`VisibilityScratch::trace`] for one of many directions of a sun or
+    /// dome, one sample per luxel (the default mode): probes first, at the
+    /// positions of `grid` (every [`SUN_PROBE_STRIDE`]-th luxel along each axis
+    /// and the last row and column); a luxel between them that was not pulled
+    /// back ([`FaceSamples::pulled`]) takes the answer of its cell's probes
+    /// when all of them got through or all were blocked; the others are
+    /// traced. A shadow narrower than the cell can slip between the probes,
+    /// but each direction carries at most 1 / [`SUN_PROBE_DIRECTIONS`] of its
+    /// source's light.
+    fn trace_probed(
+        &mut self,
+        samples: &FaceSamples,
+        grid: &SampleGrid,
+        value: &[f64],
+        ray: impl Fn(usize) -> ([f32; 3], [f32; 3], f32),
+        packet: &mut RayPacket16,
+        mut reaches: impl FnMut(&mut RayPacket16) -> u16,
+    ) -> u64 {
+        debug_assert_eq!(samples.per_axis, 1);
+        let n = value.len();
+        self.lit.clear();
+        self.lit.resize(n, false);
+        self.traced.clear();
+        self.traced.resize(n, false);
+        self.todo.clear();
+        let w = samples.width;
+        let probe = |i: usize| value[i] != 0.0 && !samples.pulled[i];
+        for &y in &grid.ys {
+            self.todo.extend(
+                grid.xs
+                    .iter()
+                    .map(|&x| y * w + x)
+                    .filter(|&i| value[i] != 0.0),
+            );
+        }
+        let mut rays = self.cast(&ray, packet, &mut reaches);
+        self.todo.clear();
+        for i in (0..n).filter(|&i| value[i] != 0.0) {
+            let (corners, _, _) = grid.cell(i % w, i / w);
+            if corners[0] == (i % w, i / w) {
+                continue; // a probe
+            }
+            let corners = corners.map(|(x, y)| y * w + x);
+            let agreed = !samples.pulled[i]
+                && corners.iter().all(|&c| probe(c))
+                && corners.iter().all(|&c| self.lit[c] == self.lit[corners[0]]);
+            if agreed {
+                self.lit[i] = self.lit[corners[0]];
+            } else {
+                self.todo.push(i);
             }
         }
         rays += self.cast(&ray, packet, &mut reaches);
@@ -1130,6 +1193,8 @@ pub fn trace_face(
             .then(|| setup.vis.visible_sky_bounds(face.index))
             .flatten()
             .map(|sky| sky_offsets(&sky, &bounds));
+        let sun_probes = (setup.adaptive && samples.per_axis == 1)
+            .then(|| SampleGrid::new(samples.width, samples.height, SUN_PROBE_STRIDE));
         for (si, sun) in suns.iter().enumerate() {
             if sky_offsets
                 .as_ref()
@@ -1155,10 +1220,13 @@ pub fn trace_face(
                 }
             }
             let ray = |i: usize| (samples.points[i], dir, setup.sun_distance);
-            counts.sun_rays +=
-                scratch.trace(samples, setup.adaptive, value, ray, &mut packet, |p| {
-                    setup.scene.sees_sky16(p, face.model)
-                });
+            let reaches = |p: &mut RayPacket16| setup.scene.sees_sky16(p, face.model);
+            counts.sun_rays += match &sun_probes {
+                Some(grid) if sun.directions >= SUN_PROBE_DIRECTIONS => {
+                    scratch.trace_probed(samples, grid, value, ray, &mut packet, reaches)
+                }
+                _ => scratch.trace(samples, setup.adaptive, value, ray, &mut packet, reaches),
+            };
             let dirty = takes_dirt(sun.dirt);
             for (i, &v) in value.iter().enumerate() {
                 if scratch.lit[i] {
@@ -1257,7 +1325,7 @@ mod tests {
     #[test]
     fn dirt_grid_cells_reach_the_last_row_and_column() {
         // 6 × 3 positions, stride 2: lines at x 0, 2, 4, 5 and y 0, 2.
-        let grid = DirtGrid::new(6, 3, 2);
+        let grid = SampleGrid::new(6, 3, 2);
         assert_eq!(
             grid.cell(0, 0),
             ([(0, 0), (2, 0), (0, 2), (2, 2)], 0.0, 0.0)
