@@ -1065,6 +1065,8 @@ pub struct TraceScratch {
     value: Vec<f64>,
     /// Samples so close to the current light that it is averaged over their squares.
     near: Vec<(usize, usize)>,
+    /// Per sample: the direction and length of its shadow ray to the current light.
+    to_light: Vec<([f32; 3], f32)>,
     footprints: Footprints,
     visibility: VisibilityScratch,
 }
@@ -1115,6 +1117,7 @@ pub fn trace_face(
         arrivals,
         value,
         near,
+        to_light: shadow_rays,
         footprints,
         visibility: scratch,
     } = reuse;
@@ -1125,6 +1128,11 @@ pub fn trace_face(
     footprints.start_face();
     let radius = samples.map.footprint_radius();
     let max_cells = 16 / samples.per_axis.min(16);
+    // A light at least this far from a sample point is one cell away from its square
+    // ([`footprint_cells`]' nearest distance is at least the point's distance less `radius`);
+    // the margin covers rounding.
+    let surely_far = radius * (1.0 + 1.0 / CELL_PER_DISTANCE) * (1.0 + 1e-9) + 1e-9;
+    shadow_rays.resize(n, ([0.0; 3], 0.0));
     for (li, light) in lights.iter().enumerate() {
         counts.pairs += 1;
         let reach = &setup.light_reaches[li];
@@ -1143,26 +1151,36 @@ pub fn trace_face(
         for (i, &p) in samples.points.iter().enumerate() {
             value[i] = 0.0;
             let to_light = sub(light.origin, p);
-            let Some(dir) = to_light.normalized() else {
+            // One square root per sample and light (as `normalized` divides, with its limit).
+            let dist = to_light.length();
+            if dist <= 1e-12 {
                 continue;
+            }
+            let dir = to_light / dist;
+            let cells = if dist >= surely_far {
+                1
+            } else {
+                footprint_cells(to_light, samples.normal, radius, max_cells)
             };
-            let cells = footprint_cells(to_light, samples.normal, radius, max_cells);
             if cells > 1 {
                 // Traced on its own below, point by point over the square.
                 near.push((i, cells));
                 continue;
             }
-            let v = light.contribution(to_light.length(), -dir, samples.normal_at(i).dot(dir));
+            // Kept whatever the value: a sample whose `_phong` normal turns from the light may
+            // be the first at a point whose others need the ray.
+            shadow_rays[i] = (
+                dir.as_vec3().to_array(),
+                (dist as f32 - LIGHT_CLEARANCE).max(0.0),
+            );
+            let v = light.contribution(dist, -dir, samples.normal_at(i).dot(dir));
             if v.abs() >= setup.gate {
                 value[i] = v;
             }
         }
         let ray = |i: usize| {
-            let p = samples.points[i];
-            let to_light = sub(light.origin, p);
-            let dist = to_light.length();
-            let dir = (to_light / dist).as_vec3().to_array();
-            (p, dir, (dist as f32 - LIGHT_CLEARANCE).max(0.0))
+            let (dir, length) = shadow_rays[i];
+            (samples.points[i], dir, length)
         };
         counts.shadow_rays +=
             scratch.trace(samples, setup.adaptive, value, ray, &mut packet, |p| {
