@@ -1044,6 +1044,15 @@ fn phong_on_func_detail_reaches_light_through_the_bsp() {
     compute_lighting(&smooth, &options(Quality::Default)).expect("light");
 }
 
+/// The largest difference in red between the luxels of two lightings of the same faces.
+fn worst_red_difference(a: &[Vec<[f32; 3]>], b: &[Vec<[f32; 3]>]) -> f32 {
+    a.iter()
+        .flatten()
+        .zip(b.iter().flatten())
+        .map(|(x, y)| (x[0] - y[0]).abs())
+        .fold(0.0f32, f32::max)
+}
+
 /// Every lit face's luxels (style 0) and the rays cast, at `per_axis`
 /// samples per luxel axis, with adaptive supersampling on or off.
 fn traced_faces(bsp: &Bsp, per_axis: usize, adaptive: bool) -> (Vec<Vec<[f32; 3]>>, u64) {
@@ -1113,12 +1122,7 @@ fn adaptive_dirt_stays_close_to_measuring_every_sample() {
     for per_axis in [1, 4] {
         let (full, full_rays) = traced_faces(&bsp, per_axis, false);
         let (adaptive, adaptive_rays) = traced_faces(&bsp, per_axis, true);
-        let worst = full
-            .iter()
-            .flatten()
-            .zip(adaptive.iter().flatten())
-            .map(|(a, b)| (a[0] - b[0]).abs())
-            .fold(0.0f32, f32::max);
+        let worst = worst_red_difference(&full, &adaptive);
         // Samples measured in both runs cast the same rays and agree exactly
         // (no ray here meets an edge: see the next test), so this is the
         // interpolation error alone: 3.3 light units at 1×1 (2.1 when
@@ -1153,12 +1157,7 @@ fn dirt_that_only_bounce_takes_is_interpolated_and_stays_close() {
     for per_axis in [1, 4] {
         let (full, full_rays) = lit_faces(&bsp, per_axis, false, &rules, 100.0);
         let (adaptive, adaptive_rays) = lit_faces(&bsp, per_axis, true, &rules, 100.0);
-        let worst = full
-            .iter()
-            .flatten()
-            .zip(adaptive.iter().flatten())
-            .map(|(a, b)| (a[0] - b[0]).abs())
-            .fold(0.0f32, f32::max);
+        let worst = worst_red_difference(&full, &adaptive);
         // 100 units of bounce: at most 7 % off (6.1 light units at both densities; 2.0 and 1.2
         // with every ray), the same with each of Embree's kernels.
         assert!(worst <= 7.0, "{per_axis}: {worst}");
@@ -1240,12 +1239,7 @@ fn probed_sky_dome_stays_close_to_tracing_every_luxel() {
     let bsp = demo_bsp_with_sun();
     let (full, full_rays) = traced_faces(&bsp, 1, false);
     let (probed, probed_rays) = traced_faces(&bsp, 1, true);
-    let worst = full
-        .iter()
-        .flatten()
-        .zip(probed.iter().flatten())
-        .map(|(a, b)| (a[0] - b[0]).abs())
-        .fold(0.0f32, f32::max);
+    let worst = worst_red_difference(&full, &probed);
     // The dome is 60 light units over 100 directions: the worst luxel (0.56) lost or gained
     // one direction; a bound of two allows for another CPU's kernel breaking a tie otherwise.
     assert!(worst <= 1.2, "{worst}");

@@ -45,6 +45,18 @@ fn footprint_cells(to_light: DVec3, normal: DVec3, radius: f64, max_cells: usize
     (cells.ceil() as usize).clamp(1, max_cells)
 }
 
+/// Relative and absolute margin by which a light must lie beyond
+/// [`far_from_every_square`] before [`footprint_cells`] is skipped: covers the
+/// rounding of `footprint_cells`' own sums.
+const FOOTPRINT_FAR_MARGIN: f64 = 1e-9;
+
+/// Distance from a sample point beyond which a light is one cell away from the
+/// sample's square of half-diagonal `radius`: [`footprint_cells`]' nearest
+/// distance is at least the point's distance less `radius`.
+fn far_from_every_square(radius: f64) -> f64 {
+    radius * (1.0 + 1.0 / CELL_PER_DISTANCE) * (1.0 + FOOTPRINT_FAR_MARGIN) + FOOTPRINT_FAR_MARGIN
+}
+
 /// What `light` adds at `p` on a surface with unit `normal`, unshadowed.
 fn unshadowed(light: &PointLight, p: DVec3, normal: DVec3) -> Option<(f64, DVec3, f64)> {
     let to_light = light.origin - p;
@@ -704,6 +716,15 @@ impl VisibilityScratch {
         self.first_at = first_at;
     }
 
+    /// Clears what the last light left for a face of `n` samples.
+    fn start_light(&mut self, n: usize) {
+        self.lit.clear();
+        self.lit.resize(n, false);
+        self.traced.clear();
+        self.traced.resize(n, false);
+        self.todo.clear();
+    }
+
     /// Fills `lit` for every sample with a non-zero `value`; returns the
     /// rays cast. `ray(i)` is sample `i`'s (origin, direction, length) and
     /// `reaches` the lanes of a packet whose rays get through.
@@ -725,11 +746,7 @@ impl VisibilityScratch {
         mut reaches: impl FnMut(&mut RayPacket16) -> u16,
     ) -> u64 {
         let n = value.len();
-        self.lit.clear();
-        self.lit.resize(n, false);
-        self.traced.clear();
-        self.traced.resize(n, false);
-        self.todo.clear();
+        self.start_light(n);
         let per = samples.per_luxel();
         if !adaptive || per == 1 {
             self.todo.extend((0..n).filter(|&i| value[i] != 0.0));
@@ -802,11 +819,7 @@ impl VisibilityScratch {
     ) -> u64 {
         debug_assert_eq!(samples.per_axis, 1);
         let n = value.len();
-        self.lit.clear();
-        self.lit.resize(n, false);
-        self.traced.clear();
-        self.traced.resize(n, false);
-        self.todo.clear();
+        self.start_light(n);
         let w = samples.width;
         let probe = |i: usize| value[i] != 0.0 && !samples.pulled[i];
         for &y in &grid.ys {
@@ -1128,10 +1141,7 @@ pub fn trace_face(
     footprints.start_face();
     let radius = samples.map.footprint_radius();
     let max_cells = 16 / samples.per_axis.min(16);
-    // A light at least this far from a sample point is one cell away from its square
-    // ([`footprint_cells`]' nearest distance is at least the point's distance less `radius`);
-    // the margin covers rounding.
-    let surely_far = radius * (1.0 + 1.0 / CELL_PER_DISTANCE) * (1.0 + 1e-9) + 1e-9;
+    let surely_far = far_from_every_square(radius);
     shadow_rays.resize(n, ([0.0; 3], 0.0));
     for (li, light) in lights.iter().enumerate() {
         counts.pairs += 1;
@@ -1151,12 +1161,10 @@ pub fn trace_face(
         for (i, &p) in samples.points.iter().enumerate() {
             value[i] = 0.0;
             let to_light = sub(light.origin, p);
-            // One square root per sample and light (as `normalized` divides, with its limit).
-            let dist = to_light.length();
-            if dist <= 1e-12 {
+            // One square root per sample and light.
+            let Some((dist, dir)) = to_light.length_and_direction() else {
                 continue;
-            }
-            let dir = to_light / dist;
+            };
             let cells = if dist >= surely_far {
                 1
             } else {
@@ -1337,6 +1345,26 @@ mod tests {
         Bounds {
             mins: DVec3::new(mins[0], mins[1], mins[2]),
             maxs: DVec3::new(maxs[0], maxs[1], maxs[2]),
+        }
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn lights_past_the_far_distance_are_one_cell_away(
+            radius in 0.01f64..64.0,
+            beyond in 0.0f64..4.0,
+            theta in 0.0f64..std::f64::consts::PI,
+            phi in 0.0f64..std::f64::consts::TAU,
+        ) {
+            let dist = far_from_every_square(radius) * (1.0 + beyond);
+            let dir = DVec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
+            let to_light = dir * dist;
+            proptest::prop_assert_eq!(
+                footprint_cells(to_light, DVec3::Z, radius, 16),
+                1,
+                "{:?}",
+                to_light
+            );
         }
     }
 

@@ -9,6 +9,8 @@ use glam::DVec3;
 pub trait DVec3Ext {
     /// The unit vector in this direction, or `None` for a (near) zero vector.
     fn normalized(self) -> Option<DVec3>;
+    /// The length and [`DVec3Ext::normalized`] direction, from one square root.
+    fn length_and_direction(self) -> Option<(f64, DVec3)>;
     /// True when every component differs by less than `eps`.
     fn near(self, o: DVec3, eps: f64) -> bool;
 }
@@ -16,8 +18,13 @@ pub trait DVec3Ext {
 impl DVec3Ext for DVec3 {
     #[inline]
     fn normalized(self) -> Option<DVec3> {
+        self.length_and_direction().map(|(_, d)| d)
+    }
+
+    #[inline]
+    fn length_and_direction(self) -> Option<(f64, DVec3)> {
         let len = self.length();
-        (len > 1e-12).then(|| self / len)
+        (len > 1e-12).then(|| (len, self / len))
     }
 
     #[inline]
