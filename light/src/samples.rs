@@ -214,15 +214,16 @@ impl FaceRegion {
     }
 
     /// `p` (a point on the face's plane) if it is inside, else the nearest
-    /// point of the region's outline.
+    /// point of the region's outline. Only edges `p` is outside of can hold
+    /// that point (or end in it): the region is convex.
     pub fn nearest(&self, p: DVec3) -> DVec3 {
-        let outside = (self.points.iter().zip(&self.inward)).any(|(&a, m)| m.dot(p - a) < 0.0);
-        if !outside || self.points.is_empty() {
-            return p;
-        }
-        let mut best = self.points[0];
+        let mut best = p;
         let mut best_d2 = f64::INFINITY;
-        for (&a, &(ab, len2)) in self.points.iter().zip(&self.edges) {
+        let edges = self.points.iter().zip(&self.inward).zip(&self.edges);
+        for ((&a, m), &(ab, len2)) in edges {
+            if m.dot(p - a) >= 0.0 {
+                continue;
+            }
             let t = if len2 > 0.0 {
                 ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
             } else {
@@ -562,4 +563,53 @@ fn shared_walk(bsp: &Bsp, mut node: i32, lo: [f32; 3], hi: [f32; 3]) -> i32 {
         steps += 1;
     }
     node
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The nearest point of any edge of `region` to `p`, every edge looked at.
+    fn nearest_of_every_edge(region: &FaceRegion, p: DVec3) -> DVec3 {
+        let n = region.points.len();
+        (0..n)
+            .map(|i| {
+                let (a, b) = (region.points[i], region.points[(i + 1) % n]);
+                let ab = b - a;
+                a + ab * ((p - a).dot(ab) / ab.dot(ab)).clamp(0.0, 1.0)
+            })
+            .min_by(|q, r| (p - *q).length().total_cmp(&(p - *r).length()))
+            .unwrap_or(p)
+    }
+
+    proptest! {
+        /// Looking only at the edges a point is outside of finds the same nearest point.
+        #[test]
+        fn nearest_looks_only_at_edges_the_point_is_outside_of(
+            mut angles in proptest::collection::vec(0.0f64..std::f64::consts::TAU, 3..9),
+            radius in 1.0f64..500.0,
+            x in -800.0f64..800.0,
+            y in -800.0f64..800.0,
+        ) {
+            angles.sort_by(f64::total_cmp);
+            angles.dedup_by(|a, b| (*a - *b).abs() < 0.05);
+            prop_assume!(angles.len() >= 3);
+            // A convex polygon on the plane z = 64: points on a circle, in order.
+            let points: Vec<DVec3> = angles
+                .iter()
+                .map(|a| DVec3::new(radius * a.cos(), radius * a.sin(), 64.0))
+                .collect();
+            let region = FaceRegion::from_points(points, DVec3::Z);
+            let p = DVec3::new(x, y, 64.0);
+            let inside = (region.points.iter().zip(&region.inward)).all(|(&a, m)| m.dot(p - a) >= 0.0);
+            let got = region.nearest(p);
+            if inside {
+                prop_assert_eq!(got, p);
+            } else {
+                let want = nearest_of_every_edge(&region, p);
+                prop_assert!(((p - got).length() - (p - want).length()).abs() < 1e-9);
+            }
+        }
+    }
 }
