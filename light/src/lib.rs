@@ -410,7 +410,10 @@ fn trace_faces(
             }
             let rules = face_rules(&prep.lights, geom);
             let (light, counts) = trace_face(setup, &samples, &rules, reuse);
-            bar.inc(1);
+            // A hidden bar still takes its lock per call (0.7 % of e1m1's instructions).
+            if !bar.is_hidden() {
+                bar.inc(1);
+            }
             let reflected =
                 (keep.bouncing && keep.reflectance[f].is_some()).then(|| light.reflected(styled));
             Traced {
