@@ -132,10 +132,31 @@ impl Winding {
         }
     }
 
+    /// Each point's distance from `plane` and its side ([`ON_EPSILON`] thick).
+    fn sides_of(&self, plane: &Plane) -> (Vec<f64>, Vec<PlaneSide>) {
+        let dists: Vec<f64> = self.points.iter().map(|&p| plane.distance(p)).collect();
+        let sides = dists.iter().map(|&d| PlaneSide::of_distance(d)).collect();
+        (dists, sides)
+    }
+
+    /// Where the edge from point `i` to point `j` (on opposite sides) crosses `plane`.
+    fn crossing(&self, plane: &Plane, dists: &[f64], i: usize, j: usize) -> DVec3 {
+        let t = dists[i] / (dists[i] - dists[j]);
+        let mut mid = self.points[i].lerp_monotonic(self.points[j], t);
+        // Keep axial coordinates exact so splits by axial planes do not drift.
+        for axis in 0..3 {
+            if plane.normal[axis] == 1.0 {
+                mid[axis] = plane.dist;
+            } else if plane.normal[axis] == -1.0 {
+                mid[axis] = -plane.dist;
+            }
+        }
+        mid
+    }
+
     /// Split by `plane`; points within [`ON_EPSILON`] of it count as on it.
     pub fn split(&self, plane: &Plane) -> Split {
-        let dists: Vec<f64> = self.points.iter().map(|&p| plane.distance(p)).collect();
-        let sides: Vec<PlaneSide> = dists.iter().map(|&d| PlaneSide::of_distance(d)).collect();
+        let (dists, sides) = self.sides_of(plane);
         let has_front = sides.contains(&PlaneSide::Front);
         let has_back = sides.contains(&PlaneSide::Back);
         match (has_front, has_back) {
@@ -170,17 +191,7 @@ impl Winding {
             if sides[j] == PlaneSide::On || sides[j] == sides[i] {
                 continue;
             }
-            let q = self.points[j];
-            let t = dists[i] / (dists[i] - dists[j]);
-            let mut mid = p.lerp_monotonic(q, t);
-            // Keep axial coordinates exact so splits by axial planes do not drift.
-            for axis in 0..3 {
-                if plane.normal[axis] == 1.0 {
-                    mid[axis] = plane.dist;
-                } else if plane.normal[axis] == -1.0 {
-                    mid[axis] = -plane.dist;
-                }
-            }
+            let mid = self.crossing(plane, &dists, i, j);
             front.push(mid);
             back.push(mid);
         }
@@ -190,14 +201,31 @@ impl Winding {
         }
     }
 
-    /// The part in front of `plane` (on-plane windings are kept when `keep_on` is set).
+    /// The part in front of `plane` (on-plane windings are kept when `keep_on` is set): the
+    /// front of [`Winding::split`], without building the back.
     pub fn clip_front(&self, plane: &Plane, keep_on: bool) -> Option<Winding> {
-        match self.split(plane) {
-            Split::Front(w) => Some(w),
-            Split::Both { front, .. } => Some(front),
-            Split::On { winding, .. } if keep_on => Some(winding),
-            _ => None,
+        let (dists, sides) = self.sides_of(plane);
+        let has_front = sides.contains(&PlaneSide::Front);
+        let has_back = sides.contains(&PlaneSide::Back);
+        match (has_front, has_back) {
+            (false, false) => return keep_on.then(|| self.clone()),
+            (true, false) => return Some(self.clone()),
+            (false, true) => return None,
+            (true, true) => {}
         }
+        let n = self.points.len();
+        let mut front = Vec::with_capacity(n + 2);
+        for i in 0..n {
+            if sides[i] != PlaneSide::Back {
+                front.push(self.points[i]);
+            }
+            let j = (i + 1) % n;
+            if sides[i] == PlaneSide::On || sides[j] == PlaneSide::On || sides[j] == sides[i] {
+                continue;
+            }
+            front.push(self.crossing(plane, &dists, i, j));
+        }
+        Some(Winding::new(front))
     }
 
     /// True when the winding is too small to matter: fewer than three points, or every edge
@@ -264,6 +292,22 @@ mod tests {
     }
 
     proptest! {
+        /// Clipping gives exactly the front that splitting does (it only skips the back).
+        #[test]
+        fn clip_front_is_the_front_of_split(
+            nx in -1.0f64..1.0, ny in -1.0f64..1.0, nz in -1.0f64..1.0,
+            d in -80.0f64..80.0, z in -4.0f64..4.0, keep_on in proptest::bool::ANY,
+        ) {
+            let Some(normal) = DVec3::new(nx, ny, nz).normalized() else { return Ok(()); };
+            let (w, plane) = (square(z), Plane::new(normal, d));
+            let front = match w.split(&plane) {
+                Split::Both { front, .. } | Split::Front(front) => Some(front),
+                Split::On { winding, .. } => keep_on.then_some(winding),
+                Split::Back(_) => None,
+            };
+            prop_assert_eq!(w.clip_front(&plane, keep_on).map(|w| w.points), front.map(|w| w.points));
+        }
+
         #[test]
         fn split_preserves_area(nx in -1.0f64..1.0, ny in -1.0f64..1.0, nz in -1.0f64..1.0, d in -80.0f64..80.0) {
             let Some(normal) = DVec3::new(nx, ny, nz).normalized() else { return Ok(()); };
