@@ -952,6 +952,52 @@ impl Arrival {
     }
 }
 
+/// Where a face's arrivals go. With dirt measured they wait (dirt is measured
+/// after the shadow rays, only where some light that takes it arrives); without,
+/// they go straight into the sums, in the same order and so to the same sums
+/// (a gated arrival is above the gate already: nothing darkens it).
+#[derive(Debug, Default)]
+struct Arrivals {
+    waiting: Vec<Arrival>,
+    wait: bool,
+}
+
+impl Arrivals {
+    fn start_face(&mut self, wait: bool) {
+        self.waiting.clear();
+        self.wait = wait;
+    }
+
+    fn add(&mut self, a: Arrival, lights: &[PointLight], suns: &[SunLight], out: &mut SampleLight) {
+        if self.wait {
+            self.waiting.push(a);
+        } else {
+            settle(&a, a.value, lights, suns, out);
+        }
+    }
+}
+
+/// Adds arrival `a` to `out` at `value` (its value after dirt).
+fn settle(
+    a: &Arrival,
+    value: f64,
+    lights: &[PointLight],
+    suns: &[SunLight],
+    out: &mut SampleLight,
+) {
+    let i = a.sample as usize;
+    match a.source {
+        Source::Light(li) => deposit(&lights[li], value, i, out),
+        Source::Sun(si) => {
+            let sun = &suns[si];
+            let slot = &mut out.sums.get(sun.style)[i];
+            for (o, c) in slot.iter_mut().zip(sun.color.to_array()) {
+                *o += (value * c) as f32;
+            }
+        }
+    }
+}
+
 /// Adds `value` of `light` (its colour) to sample `i`, or for a local
 /// minlight raises the sample's floor to it. Light of a `_bounce 0` light
 /// is also kept in `no_bounce`, so it can be taken out of what reflects.
@@ -1103,7 +1149,7 @@ pub fn light_face(
 /// and growing them per face cost about 3 % of e1m1's instructions.
 #[derive(Debug, Default)]
 pub struct TraceScratch {
-    arrivals: Vec<Arrival>,
+    arrivals: Arrivals,
     value: Vec<f64>,
     /// Samples so close to the current light that it is averaged over their squares.
     near: Vec<(usize, usize)>,
@@ -1164,7 +1210,7 @@ pub fn trace_face(
         visibility: scratch,
     } = reuse;
     scratch.start_face(samples.first_at_same_point());
-    arrivals.clear();
+    arrivals.start_face(dirt_sampling.is_some());
     value.clear();
     value.resize(n, 0.0);
     footprints.start_face();
@@ -1227,7 +1273,12 @@ pub fn trace_face(
         let dirty = takes_dirt(light.dirt);
         for (i, &v) in value.iter().enumerate() {
             if scratch.lit[i] {
-                arrivals.push(Arrival::new(source, i, v, dirty, true));
+                arrivals.add(
+                    Arrival::new(source, i, v, dirty, true),
+                    lights,
+                    suns,
+                    &mut out,
+                );
             }
         }
         if !near.is_empty() {
@@ -1237,7 +1288,12 @@ pub fn trace_face(
             }
             counts.shadow_rays += footprints.trace(setup.scene, face.model, &mut packet);
             for (i, v) in footprints.means() {
-                arrivals.push(Arrival::new(source, i, v, dirty, false));
+                arrivals.add(
+                    Arrival::new(source, i, v, dirty, false),
+                    lights,
+                    suns,
+                    &mut out,
+                );
             }
         }
     }
@@ -1285,7 +1341,8 @@ pub fn trace_face(
             let dirty = takes_dirt(sun.dirt);
             for (i, &v) in value.iter().enumerate() {
                 if scratch.lit[i] {
-                    arrivals.push(Arrival::new(Source::Sun(si), i, v, dirty, true));
+                    let a = Arrival::new(Source::Sun(si), i, v, dirty, true);
+                    arrivals.add(a, lights, suns, &mut out);
                 }
             }
         }
@@ -1301,7 +1358,7 @@ pub fn trace_face(
                 DirtNeed::No
             };
             let mut needed = vec![everywhere; n];
-            for a in arrivals.iter().filter(|a| a.dirty) {
+            for a in arrivals.waiting.iter().filter(|a| a.dirty) {
                 needed[a.sample as usize] = DirtNeed::Light;
             }
             let (values, rays) = face_occlusion(
@@ -1321,7 +1378,7 @@ pub fn trace_face(
     let mut dirt_factors = DirtFactors::new(&occlusion, n);
     // In the order they were found, so sums come out the same as adding
     // each light as it is traced.
-    for a in arrivals.iter() {
+    for a in arrivals.waiting.iter() {
         let i = a.sample as usize;
         let response = match a.source {
             Source::Light(li) => lights[li].dirt,
@@ -1331,16 +1388,7 @@ pub fn trace_face(
         if a.gated && v.abs() < setup.gate {
             continue;
         }
-        match a.source {
-            Source::Light(li) => deposit(&lights[li], v, i, &mut out),
-            Source::Sun(si) => {
-                let sun = &suns[si];
-                let slot = &mut out.sums.get(sun.style)[i];
-                for (o, c) in slot.iter_mut().zip(sun.color.to_array()) {
-                    *o += (v * c) as f32;
-                }
-            }
-        }
+        settle(a, v, lights, suns, &mut out);
     }
 
     if let Some(m) = rules.minlight {
