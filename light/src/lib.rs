@@ -221,7 +221,7 @@ impl Prepared {
     pub fn trace_setup<'a>(
         &'a self,
         bsp: &'a Bsp,
-        light_reaches: &'a [trace::LightReach],
+        light_reaches: &'a trace::LightReaches,
         gate: f64,
         cull: bool,
         adaptive: bool,

@@ -266,7 +266,7 @@ pub struct TraceSetup<'a> {
     /// World leaf of each light (None: in solid or outside; no PVS culling).
     pub light_leafs: &'a [Option<u32>],
     /// Each light's cut-off, from [`light_reaches`] with `gate`.
-    pub light_reaches: &'a [LightReach],
+    pub light_reaches: &'a LightReaches,
     pub suns: &'a [SunLight],
     /// Skip lights that cannot reach a face (range, plane side, PVS, sky PVS).
     pub cull: bool,
@@ -370,15 +370,148 @@ pub struct LightReach {
     range_squared: f64,
 }
 
+/// Every light's [`LightReach`], and which lights may reach a box: a grid of
+/// cubes, each listing the lights whose reach (the box around its sphere)
+/// touches it, so a face looks at the lights near it instead of at all of them
+/// (e1m1: 198 lights, 1 % of face-light pairs within reach).
+pub struct LightReaches {
+    each: Vec<LightReach>,
+    /// The grid's lowest corner and its cube's side.
+    min: DVec3,
+    cube: f64,
+    dims: [usize; 3],
+    /// Per cube (x fastest): the lights reaching into it, in ascending order.
+    cubes: Vec<Vec<u32>>,
+    /// Lights that never fade, or reach more than [`MAX_CUBES_PER_LIGHT`] cubes: near every box.
+    everywhere: Vec<u32>,
+}
+
+/// Cubes of the [`LightReaches`] grid along its longest side (fewer when they
+/// would be smaller than [`MIN_CUBE`]).
+const CUBES_ALONG: f64 = 64.0;
+
+/// Smallest cube side of the [`LightReaches`] grid, in map units.
+const MIN_CUBE: f64 = 128.0;
+
+/// A light reaching more cubes than this is listed as near every box instead.
+const MAX_CUBES_PER_LIGHT: usize = 4096;
+
 /// Each light's [`LightReach`] at contribution cut-off `gate`.
-pub fn light_reaches(lights: &[PointLight], gate: f64) -> Vec<LightReach> {
-    lights
-        .iter()
-        .map(|l| LightReach {
-            origin: l.origin,
-            range_squared: l.range(gate).powi(2),
-        })
-        .collect()
+pub fn light_reaches(lights: &[PointLight], gate: f64) -> LightReaches {
+    LightReaches::new(
+        lights
+            .iter()
+            .map(|l| LightReach {
+                origin: l.origin,
+                range_squared: l.range(gate).powi(2),
+            })
+            .collect(),
+    )
+}
+
+impl LightReaches {
+    fn new(each: Vec<LightReach>) -> LightReaches {
+        let reach_box = |r: &LightReach| {
+            let radius = DVec3::splat(r.range_squared.sqrt());
+            (r.origin - radius, r.origin + radius)
+        };
+        let finite = |r: &LightReach| r.range_squared.is_finite();
+        let (mut min, mut max) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+        for r in each.iter().filter(|r| finite(r)) {
+            let (lo, hi) = reach_box(r);
+            (min, max) = (min.min(lo), max.max(hi));
+        }
+        let extent = (max - min).max_element();
+        let cube = if extent.is_finite() {
+            (extent / CUBES_ALONG).max(MIN_CUBE)
+        } else {
+            MIN_CUBE
+        };
+        let along = |a: f64| ((a / cube).ceil() as usize).max(1);
+        let dims = if extent.is_finite() {
+            [
+                along(max.x - min.x),
+                along(max.y - min.y),
+                along(max.z - min.z),
+            ]
+        } else {
+            [1, 1, 1]
+        };
+        let mut grid = LightReaches {
+            each: Vec::new(),
+            min,
+            cube,
+            dims,
+            cubes: vec![Vec::new(); dims[0] * dims[1] * dims[2]],
+            everywhere: Vec::new(),
+        };
+        for (li, r) in each.iter().enumerate() {
+            let (lo, hi) = reach_box(r);
+            // Every finite reach box lies inside the grid.
+            match grid.cube_range(lo, hi).filter(|_| finite(r)) {
+                Some(range)
+                    if range.iter().map(|a| a.len()).product::<usize>() <= MAX_CUBES_PER_LIGHT =>
+                {
+                    grid.for_each_cube(&range, |cube| cube.push(li as u32));
+                }
+                _ => grid.everywhere.push(li as u32),
+            }
+        }
+        grid.each = each;
+        grid
+    }
+
+    /// The cubes `lo..hi` overlaps, per axis; None when it misses the grid.
+    fn cube_range(&self, lo: DVec3, hi: DVec3) -> Option<[std::ops::Range<usize>; 3]> {
+        let mut out = [0..0, 0..0, 0..0];
+        for a in 0..3 {
+            let first = ((lo[a] - self.min[a]) / self.cube).floor();
+            let last = ((hi[a] - self.min[a]) / self.cube).floor();
+            if last < 0.0 || first >= self.dims[a] as f64 || first.is_nan() || last.is_nan() {
+                return None;
+            }
+            out[a] = first.max(0.0) as usize..(last as usize).min(self.dims[a] - 1) + 1;
+        }
+        Some(out)
+    }
+
+    fn for_each_cube(
+        &mut self,
+        range: &[std::ops::Range<usize>; 3],
+        mut f: impl FnMut(&mut Vec<u32>),
+    ) {
+        for z in range[2].clone() {
+            for y in range[1].clone() {
+                for x in range[0].clone() {
+                    f(&mut self.cubes[(z * self.dims[1] + y) * self.dims[0] + x]);
+                }
+            }
+        }
+    }
+
+    /// Into `out`, in ascending order: every light whose reach may touch `b`.
+    fn near(&self, b: &Bounds, out: &mut Vec<u32>) {
+        out.clear();
+        out.extend(&self.everywhere);
+        if let Some(range) = self.cube_range(b.mins, b.maxs) {
+            for z in range[2].clone() {
+                for y in range[1].clone() {
+                    for x in range[0].clone() {
+                        out.extend(&self.cubes[(z * self.dims[1] + y) * self.dims[0] + x]);
+                    }
+                }
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+    }
+}
+
+impl std::ops::Index<usize> for LightReaches {
+    type Output = LightReach;
+    fn index(&self, li: usize) -> &LightReach {
+        &self.each[li]
+    }
 }
 
 /// Squared distance from `p` to the box `b` (0 inside).
@@ -1155,6 +1288,8 @@ pub struct TraceScratch {
     near: Vec<(usize, usize)>,
     /// Per sample: the direction and length of its shadow ray to the current light.
     to_light: Vec<([f32; 3], f32)>,
+    /// The lights that may reach the face ([`LightReaches::near`]).
+    near_lights: Vec<u32>,
     footprints: Footprints,
     visibility: VisibilityScratch,
 }
@@ -1206,6 +1341,7 @@ pub fn trace_face(
         value,
         near,
         to_light: shadow_rays,
+        near_lights,
         footprints,
         visibility: scratch,
     } = reuse;
@@ -1218,8 +1354,17 @@ pub fn trace_face(
     let footprint = FootprintRule::for_samples(samples.per_axis);
     let surely_far = footprint.surely_far(radius);
     shadow_rays.resize(n, ([0.0; 3], 0.0));
-    for (li, light) in lights.iter().enumerate() {
-        counts.pairs += 1;
+    // Only the lights whose reach may touch the samples' box (all of them without culling).
+    near_lights.clear();
+    if setup.cull && !lights.is_empty() {
+        setup.light_reaches.near(&bounds, near_lights);
+    } else {
+        near_lights.extend(0..lights.len() as u32);
+    }
+    counts.pairs += lights.len() as u64;
+    counts.pairs_culled += (lights.len() - near_lights.len()) as u64;
+    for li in near_lights.iter().map(|&li| li as usize) {
+        let light = &lights[li];
         let reach = &setup.light_reaches[li];
         // A light behind the plane of a `_phong` face can still be in front of the smoothed
         // normals of some of its samples: only flat faces are culled by their plane.
@@ -1426,6 +1571,41 @@ mod tests {
     }
 
     proptest::proptest! {
+        /// The grid finds every light within reach of a box (it may find more).
+        #[test]
+        fn light_grid_finds_every_light_within_reach(
+            lights in proptest::collection::vec(
+                ((-3000.0f64..3000.0, -3000.0f64..3000.0, -500.0f64..500.0), 0.0f64..2000.0, 0u8..8),
+                1..40,
+            ),
+            corner in (-3500.0f64..3500.0, -3500.0f64..3500.0, -900.0f64..900.0),
+            size in (0.0f64..600.0, 0.0f64..600.0, 0.0f64..600.0),
+        ) {
+            let each: Vec<LightReach> = lights
+                .iter()
+                .map(|&((x, y, z), range, kind)| LightReach {
+                    origin: DVec3::new(x, y, z),
+                    // Some never fade; some reach nothing.
+                    range_squared: match kind {
+                        0 => f64::INFINITY,
+                        1 => 0.0,
+                        _ => range * range,
+                    },
+                })
+                .collect();
+            let reaches = LightReaches::new(each);
+            let mins = DVec3::new(corner.0, corner.1, corner.2);
+            let b = Bounds { mins, maxs: mins + DVec3::new(size.0, size.1, size.2) };
+            let mut near = Vec::new();
+            reaches.near(&b, &mut near);
+            proptest::prop_assert!(near.windows(2).all(|w| w[0] < w[1]));
+            for (li, r) in reaches.each.iter().enumerate() {
+                if box_distance_squared(&b, r.origin) <= r.range_squared {
+                    proptest::prop_assert!(near.contains(&(li as u32)), "light {} missed", li);
+                }
+            }
+        }
+
         #[test]
         fn lights_past_the_far_distance_are_one_cell_away(
             radius in 0.01f64..64.0,
