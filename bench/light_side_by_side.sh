@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Default-quality light, ours against ericw-tools' (../shared/anchors/ericw-tools), on copies of
 # the same BSPs, interleaved, ROUNDS rounds (default 3): prints wall, user and system seconds per
-# run; take the best of each. light/README.md's "Direct light, side by side" tables come from this.
+# run; take the best (or median) of each, and the median of the paired rounds' ratios.
+# light/README.md's "Direct light, side by side" tables come from this.
 # Usage: [ROUNDS=3] [OURS="--bounce"] [ERICW="-bounce"] bench/light_side_by_side.sh MAP.bsp...
 # (vised BSPs; nothing is written beside them). OURS and ERICW are each tool's options for the
 # same settings, e.g. OURS="--extra4 --soft --bounce --dirt" ERICW="-extra4 -soft -bounce -dirt".
@@ -12,7 +13,8 @@ anchor="$root/../shared/anchors/ericw-tools/bin/light"
 cargo build --release --manifest-path "$root/Cargo.toml" -p slipgate >/dev/null
 ours="${CARGO_TARGET_DIR:-$root/target}/release/slipgate"
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
-timed() { /usr/bin/time -f "%e %U %S" "$@" 2>&1 >/dev/null | tail -1; }
+# Milliseconds matter: a default-quality e1m1 run takes a tenth of a second.
+timed() { local TIMEFORMAT='%3R %3U %3S'; { time "$@" >/dev/null 2>&1; } 2>&1; }
 for round in $(seq "${ROUNDS:-3}"); do
   for bsp in "$@"; do
     name=$(basename "$bsp" .bsp)

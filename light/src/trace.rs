@@ -237,7 +237,7 @@ impl Footprints {
 
     /// Per footprint in the order added: its sample and mean value. Sums
     /// go 16 points at a time, as one footprint's own packets would.
-    fn means(&self) -> impl Iterator<Item = (usize, f64)> + '_ {
+    fn means(&self) -> impl Iterator<Item = (usize, f64)> + Clone + '_ {
         self.spans.iter().map(|(i, span)| {
             let values = &self.values[span.clone()];
             let lit = &self.lit[span.clone()];
@@ -1108,6 +1108,24 @@ impl Arrivals {
             settle(&a, a.value, lights, suns, out);
         }
     }
+
+    /// [`Arrivals::add`] for light `li` arriving at each `(sample, value)` of `arrived`, in
+    /// one go when nothing waits.
+    fn add_light(
+        &mut self,
+        li: usize,
+        light: &PointLight,
+        arrived: impl Iterator<Item = (usize, f64)> + Clone,
+        (dirty, gated): (bool, bool),
+        out: &mut SampleLight,
+    ) {
+        if self.wait {
+            self.waiting
+                .extend(arrived.map(|(i, v)| Arrival::new(Source::Light(li), i, v, dirty, gated)));
+        } else {
+            deposit(light, arrived, out);
+        }
+    }
 }
 
 /// Adds arrival `a` to `out` at `value` (its value after dirt).
@@ -1120,7 +1138,7 @@ fn settle(
 ) {
     let i = a.sample as usize;
     match a.source {
-        Source::Light(li) => deposit(&lights[li], value, i, out),
+        Source::Light(li) => deposit(&lights[li], std::iter::once((i, value)), out),
         Source::Sun(si) => {
             let sun = &suns[si];
             let slot = &mut out.sums.get(sun.style)[i];
@@ -1131,29 +1149,37 @@ fn settle(
     }
 }
 
-/// Adds `value` of `light` (its colour) to sample `i`, or for a local
-/// minlight raises the sample's floor to it. Light of a `_bounce 0` light
-/// is also kept in `no_bounce`, so it can be taken out of what reflects.
-fn deposit(light: &PointLight, value: f64, i: usize, out: &mut SampleLight) {
+/// Adds `value` of `light` (its colour) to sample `i` for each `(i, value)`
+/// of `arrived`, or for a local minlight raises the sample's floor to it.
+/// Light of a `_bounce 0` light is also kept in `no_bounce`, so it can be
+/// taken out of what reflects.
+fn deposit(
+    light: &PointLight,
+    arrived: impl Iterator<Item = (usize, f64)> + Clone,
+    out: &mut SampleLight,
+) {
     let local_min = light.falloff == Falloff::LocalMin;
+    let color = light.color.to_array();
     let target = if local_min {
         &mut out.floors
     } else {
         &mut out.sums
     };
-    let slot = &mut target.get(light.style)[i];
-    for (o, c) in slot.iter_mut().zip(light.color.to_array()) {
-        let add = (value * c) as f32;
-        *o = if local_min { o.max(add) } else { *o + add };
+    let buffer = target.get(light.style);
+    for (i, value) in arrived.clone() {
+        for (o, c) in buffer[i].iter_mut().zip(color) {
+            let add = (value * c) as f32;
+            *o = if local_min { o.max(add) } else { *o + add };
+        }
     }
     if !local_min && !light.bounce {
         let len = out.sums.len;
         let kept = out.no_bounce.get_or_insert_with(|| StyleBuffers::new(len));
-        for (o, c) in kept.get(light.style)[i]
-            .iter_mut()
-            .zip(light.color.to_array())
-        {
-            *o += (value * c) as f32;
+        let buffer = kept.get(light.style);
+        for (i, value) in arrived {
+            for (o, c) in buffer[i].iter_mut().zip(color) {
+                *o += (value * c) as f32;
+            }
         }
     }
 }
@@ -1414,32 +1440,17 @@ pub fn trace_face(
             scratch.trace(samples, setup.adaptive, value, ray, &mut packet, |p| {
                 !setup.scene.occluded16(p, face.model)
             });
-        let source = Source::Light(li);
         let dirty = takes_dirt(light.dirt);
-        for (i, &v) in value.iter().enumerate() {
-            if scratch.lit[i] {
-                arrivals.add(
-                    Arrival::new(source, i, v, dirty, true),
-                    lights,
-                    suns,
-                    &mut out,
-                );
-            }
-        }
+        let lit = &scratch.lit;
+        let arrived = (0..n).filter(|&i| lit[i]).map(|i| (i, value[i]));
+        arrivals.add_light(li, light, arrived, (dirty, true), &mut out);
         if !near.is_empty() {
             footprints.clear();
             for &(i, cells) in near.iter() {
                 footprints.add(setup.bsp, samples, i, cells, light);
             }
             counts.shadow_rays += footprints.trace(setup.scene, face.model, &mut packet);
-            for (i, v) in footprints.means() {
-                arrivals.add(
-                    Arrival::new(source, i, v, dirty, false),
-                    lights,
-                    suns,
-                    &mut out,
-                );
-            }
+            arrivals.add_light(li, light, footprints.means(), (dirty, false), &mut out);
         }
     }
 
