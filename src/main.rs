@@ -10,7 +10,8 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 // Every stage allocates small per-face buffers on rayon's threads and frees them elsewhere; glibc's
-// malloc was 8 % of light's instructions on id e1m1 and its frees from other threads contend.
+// malloc and free were 8 % of light's time on id e1m1 (perf) and its frees from other threads
+// contend.
 // mimalloc: e1m1 light 9 % less wall time (paired, interleaved), bsp e3m4 13 % less CPU time, the
 // same output bytes (light/README.md, "Direct light, side by side").
 #[global_allocator]

@@ -28,8 +28,9 @@ const CELL_PER_DISTANCE: f64 = 0.25;
 
 /// [`CELL_PER_DISTANCE`] in the default mode (one sample per luxel), whose
 /// error against the reference is dominated by that one sample: a quarter cast
-/// 33 % more shadow rays on ericw-tools' e1m1 for an RMSE 0.09 lower there and
-/// on retrojam1, and 0.08 higher on e3m4 (light/README.md, "Close lights").
+/// 33 % more shadow rays on ericw-tools' BSP of e1m1, for an RMSE 0.09 lower on
+/// our BSPs of e1m1 and retrojam1 and 0.08 higher on e3m4 (light/README.md,
+/// "Close lights").
 const CELL_PER_DISTANCE_ONE_SAMPLE: f64 = 1.0;
 
 /// How finely a light's unshadowed brightness is averaged over a sample's
@@ -452,7 +453,9 @@ impl LightReaches {
                 Some(range)
                     if range.iter().map(|a| a.len()).product::<usize>() <= MAX_CUBES_PER_LIGHT =>
                 {
-                    grid.for_each_cube(&range, |cube| cube.push(li as u32));
+                    for c in grid.cubes_in(range) {
+                        grid.cubes[c].push(li as u32);
+                    }
                 }
                 _ => grid.everywhere.push(li as u32),
             }
@@ -475,18 +478,15 @@ impl LightReaches {
         Some(out)
     }
 
-    fn for_each_cube(
-        &mut self,
-        range: &[std::ops::Range<usize>; 3],
-        mut f: impl FnMut(&mut Vec<u32>),
-    ) {
-        for z in range[2].clone() {
-            for y in range[1].clone() {
-                for x in range[0].clone() {
-                    f(&mut self.cubes[(z * self.dims[1] + y) * self.dims[0] + x]);
-                }
-            }
-        }
+    /// The index in `cubes` of every cube of `range` (x fastest).
+    fn cubes_in(&self, range: [std::ops::Range<usize>; 3]) -> impl Iterator<Item = usize> + use<> {
+        let [xs, ys, zs] = range;
+        let [dx, dy, _] = self.dims;
+        zs.flat_map(move |z| {
+            let xs = xs.clone();
+            ys.clone()
+                .flat_map(move |y| xs.clone().map(move |x| (z * dy + y) * dx + x))
+        })
     }
 
     /// Into `out`, in ascending order: every light whose reach may touch `b`.
@@ -494,12 +494,8 @@ impl LightReaches {
         out.clear();
         out.extend(&self.everywhere);
         if let Some(range) = self.cube_range(b.mins, b.maxs) {
-            for z in range[2].clone() {
-                for y in range[1].clone() {
-                    for x in range[0].clone() {
-                        out.extend(&self.cubes[(z * self.dims[1] + y) * self.dims[0] + x]);
-                    }
-                }
+            for c in self.cubes_in(range) {
+                out.extend(&self.cubes[c]);
             }
         }
         out.sort_unstable();
