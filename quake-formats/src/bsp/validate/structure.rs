@@ -4,7 +4,15 @@ use super::{Checker, Rule};
 use crate::bsp::BspVersion;
 
 impl Checker<'_> {
-    fn index(&mut self, lump: &'static str, index: usize, field: &str, value: u64, len: usize) {
+    /// `field` names the value in a problem's detail; it is formatted only for a problem.
+    fn index(
+        &mut self,
+        lump: &'static str,
+        index: usize,
+        field: impl std::fmt::Display,
+        value: u64,
+        len: usize,
+    ) {
         if value >= len as u64 {
             let detail = format!("{field} {value} is out of range (0..{len})");
             self.report(Rule::IndexRange, lump, index, detail);
@@ -37,12 +45,12 @@ impl Checker<'_> {
     fn node_ref(&mut self, lump: &'static str, index: usize, role: &str, child: i32) {
         let bsp = self.bsp;
         if child >= 0 {
-            let field = format!("{role} node");
-            self.index(lump, index, &field, child as u64, bsp.nodes.len());
+            let field = format_args!("{role} node");
+            self.index(lump, index, field, child as u64, bsp.nodes.len());
         } else {
             let leaf = (-(child as i64 + 1)) as u64;
-            let field = format!("{role} leaf");
-            self.index(lump, index, &field, leaf, bsp.leafs.len());
+            let field = format_args!("{role} leaf");
+            self.index(lump, index, field, leaf, bsp.leafs.len());
         }
     }
 
@@ -50,8 +58,8 @@ impl Checker<'_> {
     fn clip_ref(&mut self, lump: &'static str, index: usize, role: &str, child: i32) {
         if child >= 0 {
             let len = self.bsp.clipnodes.len();
-            let field = format!("{role} clip node");
-            self.index(lump, index, &field, child as u64, len);
+            let field = format_args!("{role} clip node");
+            self.index(lump, index, field, child as u64, len);
         } else if child < -15 {
             let detail = format!("{role} contents {child} is not a contents value");
             self.report(Rule::ContentsValue, lump, index, detail);

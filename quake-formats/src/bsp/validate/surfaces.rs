@@ -33,18 +33,21 @@ fn check_extents(c: &mut Checker, i: usize, f: &Face, tex: &TexInfo, ext: &Light
     let lightmapped_by_darkplaces = !special || f.light_offset != -1;
     let widest = ext.extents[0].max(ext.extents[1]);
     let luxels = ext.luxel_size();
-    let detail = format!(
-        "spans {}x{} texels ({}x{} luxels){}",
-        ext.extents[0],
-        ext.extents[1],
-        luxels[0],
-        luxels[1],
-        if special { ", TEX_SPECIAL" } else { "" }
-    );
+    // Formatted only for a problem: every face passes here.
+    let detail = || {
+        format!(
+            "spans {}x{} texels ({}x{} luxels){}",
+            ext.extents[0],
+            ext.extents[1],
+            luxels[0],
+            luxels[1],
+            if special { ", TEX_SPECIAL" } else { "" }
+        )
+    };
     if (!special && widest > QUAKESPASM_MAX_SURFACE_EXTENT)
         || (lightmapped_by_darkplaces && luxels[0].max(luxels[1]) > DARKPLACES_MAX_LIGHTMAP_SIZE)
     {
-        c.report(Rule::SurfaceExtents, "faces", i, detail);
+        c.report(Rule::SurfaceExtents, "faces", i, detail());
     } else if !special && widest > MAX_SURFACE_EXTENT {
         let which = if widest > GLQUAKE_MAX_SURFACE_EXTENT {
             "WinQuake and GLQuake"
@@ -55,7 +58,7 @@ fn check_extents(c: &mut Checker, i: usize, f: &Face, tex: &TexInfo, ext: &Light
             Rule::SurfaceExtentsVanilla,
             "faces",
             i,
-            format!("{detail}: {which} refuse it"),
+            format!("{}: {which} refuse it", detail()),
         );
     }
 }
