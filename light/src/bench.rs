@@ -25,7 +25,7 @@ pub struct BareOcclusion {
 }
 
 /// Collects up to `max_rays` shadow rays (default sampling, plane-side and
-/// range culling) and times tracing them with `rtcOccluded16` on all threads.
+/// range culling) and times tracing them in 16-ray packets on all threads.
 pub fn bare_occlusion(bsp: &Bsp, prep: &Prepared, gate: f64, max_rays: usize) -> BareOcclusion {
     let mut rays: Vec<Ray> = Vec::new();
     'faces: for face in prep.faces.iter().filter(|f| f.kind == FaceKind::Lit) {

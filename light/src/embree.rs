@@ -123,47 +123,62 @@ pub mod sys {
         pub hit: RTCHit,
     }
 
+    /// `struct RTCRay8` (`K = 8`, which C aligns to 32 bytes) and `struct RTCRay16` (`K = 16`):
+    /// one array of `K` lanes per field. 64-byte alignment serves both.
     #[repr(C, align(64))]
     #[derive(Debug, Clone, Copy)]
-    pub struct RTCRay16 {
-        pub org_x: [f32; 16],
-        pub org_y: [f32; 16],
-        pub org_z: [f32; 16],
-        pub tnear: [f32; 16],
-        pub dir_x: [f32; 16],
-        pub dir_y: [f32; 16],
-        pub dir_z: [f32; 16],
-        pub time: [f32; 16],
-        pub tfar: [f32; 16],
-        pub mask: [c_uint; 16],
-        pub id: [c_uint; 16],
-        pub flags: [c_uint; 16],
+    pub struct RTCRayK<const K: usize> {
+        pub org_x: [f32; K],
+        pub org_y: [f32; K],
+        pub org_z: [f32; K],
+        pub tnear: [f32; K],
+        pub dir_x: [f32; K],
+        pub dir_y: [f32; K],
+        pub dir_z: [f32; K],
+        pub time: [f32; K],
+        pub tfar: [f32; K],
+        pub mask: [c_uint; K],
+        pub id: [c_uint; K],
+        pub flags: [c_uint; K],
     }
 
+    /// `struct RTCHit8` / `struct RTCHit16`, as [`RTCRayK`].
     #[repr(C, align(64))]
     #[derive(Debug, Clone, Copy)]
-    pub struct RTCHit16 {
-        pub Ng_x: [f32; 16],
-        pub Ng_y: [f32; 16],
-        pub Ng_z: [f32; 16],
-        pub u: [f32; 16],
-        pub v: [f32; 16],
-        pub primID: [c_uint; 16],
-        pub geomID: [c_uint; 16],
-        pub instID: [[c_uint; 16]; RTC_MAX_INSTANCE_LEVEL_COUNT],
+    pub struct RTCHitK<const K: usize> {
+        pub Ng_x: [f32; K],
+        pub Ng_y: [f32; K],
+        pub Ng_z: [f32; K],
+        pub u: [f32; K],
+        pub v: [f32; K],
+        pub primID: [c_uint; K],
+        pub geomID: [c_uint; K],
+        pub instID: [[c_uint; K]; RTC_MAX_INSTANCE_LEVEL_COUNT],
     }
 
+    /// `struct RTCRayHit8` / `struct RTCRayHit16`.
     #[repr(C)]
     #[derive(Debug, Clone, Copy)]
-    pub struct RTCRayHit16 {
-        pub ray: RTCRay16,
-        pub hit: RTCHit16,
+    pub struct RTCRayHitK<const K: usize> {
+        pub ray: RTCRayK<K>,
+        pub hit: RTCHitK<K>,
     }
+
+    pub type RTCRay8 = RTCRayK<8>;
+    pub type RTCHit8 = RTCHitK<8>;
+    pub type RTCRayHit8 = RTCRayHitK<8>;
+    pub type RTCRay16 = RTCRayK<16>;
+    pub type RTCHit16 = RTCHitK<16>;
+    pub type RTCRayHit16 = RTCRayHitK<16>;
+
+    pub type RTCDeviceProperty = c_uint;
+    pub const RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED: RTCDeviceProperty = 34;
 
     unsafe extern "C" {
         pub fn rtcNewDevice(config: *const c_char) -> RTCDevice;
         pub fn rtcReleaseDevice(device: RTCDevice);
         pub fn rtcGetDeviceError(device: RTCDevice) -> RTCError;
+        pub fn rtcGetDeviceProperty(device: RTCDevice, prop: RTCDeviceProperty) -> isize;
         pub fn rtcSetDeviceErrorFunction(
             device: RTCDevice,
             error: RTCErrorFunction,
@@ -206,6 +221,18 @@ pub mod sys {
             scene: RTCScene,
             context: *mut RTCIntersectContext,
             rayhit: *mut RTCRayHit16,
+        );
+        pub fn rtcOccluded8(
+            valid: *const c_int,
+            scene: RTCScene,
+            context: *mut RTCIntersectContext,
+            ray: *mut RTCRay8,
+        );
+        pub fn rtcIntersect8(
+            valid: *const c_int,
+            scene: RTCScene,
+            context: *mut RTCIntersectContext,
+            rayhit: *mut RTCRayHit8,
         );
     }
 }
@@ -259,6 +286,9 @@ impl std::error::Error for EmbreeError {}
 /// Owns the device handle plus the slot the error callback writes into.
 struct DeviceInner {
     raw: sys::RTCDevice,
+    /// Whether the kernels Embree chose trace 16-wide packets natively (AVX-512); without
+    /// them, its 16-wide calls go through its ray-stream filter, which regathers every packet.
+    native16: bool,
     // Boxed so the address handed to Embree as `userPtr` never moves.
     last_message: Box<Mutex<Option<String>>>,
 }
@@ -387,8 +417,13 @@ impl Device {
                 message: None,
             });
         }
+        // SAFETY: `raw` is a live device.
+        let native16 = unsafe {
+            sys::rtcGetDeviceProperty(raw, sys::RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED)
+        } != 0;
         let inner = DeviceInner {
             raw,
+            native16,
             last_message: Box::new(Mutex::new(None)),
         };
         let user_ptr = std::ptr::from_ref::<Mutex<Option<String>>>(&inner.last_message).cast_mut();
@@ -719,15 +754,25 @@ impl Scene {
             return 0;
         }
         let mut ctx = context(coherent);
-        // SAFETY: committed live scene; the valid mask and ray packet are both
-        // 64-byte aligned by their types and fully initialised.
-        unsafe {
-            sys::rtcOccluded16(
-                packet.valid.0.as_ptr(),
-                self.handle.raw,
-                &raw mut ctx,
-                &raw mut packet.rayhit.ray,
-            );
+        if self.handle.device.native16 {
+            // SAFETY: committed live scene; the valid mask and ray packet are both
+            // 64-byte aligned by their types and fully initialised.
+            unsafe {
+                sys::rtcOccluded16(
+                    packet.valid.0.as_ptr(),
+                    self.handle.raw,
+                    &raw mut ctx,
+                    &raw mut packet.rayhit.ray,
+                );
+            }
+        } else {
+            packet.by_halves(|valid, rayhit| {
+                // SAFETY: as above, for a packet of 8 (aligned to 64 bytes, more than the 32
+                // Embree asks of one).
+                unsafe {
+                    sys::rtcOccluded8(valid, self.handle.raw, &raw mut ctx, &raw mut rayhit.ray);
+                }
+            });
         }
         (0..16)
             .filter(|&i| packet.valid.0[i] != 0 && packet.rayhit.ray.tfar[i] == f32::NEG_INFINITY)
@@ -754,15 +799,22 @@ impl Scene {
         hit.geomID = [sys::RTC_INVALID_GEOMETRY_ID; 16];
         hit.instID = [[sys::RTC_INVALID_GEOMETRY_ID; 16]; sys::RTC_MAX_INSTANCE_LEVEL_COUNT];
         let mut ctx = context(coherent);
-        // SAFETY: committed live scene; the valid mask and ray-hit packet are both 64-byte
-        // aligned by their types and fully initialised (geomID invalid).
-        unsafe {
-            sys::rtcIntersect16(
-                packet.valid.0.as_ptr(),
-                self.handle.raw,
-                &raw mut ctx,
-                &raw mut packet.rayhit,
-            );
+        if self.handle.device.native16 {
+            // SAFETY: committed live scene; the valid mask and ray-hit packet are both 64-byte
+            // aligned by their types and fully initialised (geomID invalid).
+            unsafe {
+                sys::rtcIntersect16(
+                    packet.valid.0.as_ptr(),
+                    self.handle.raw,
+                    &raw mut ctx,
+                    &raw mut packet.rayhit,
+                );
+            }
+        } else {
+            packet.by_halves(|valid, rayhit| {
+                // SAFETY: as above, for a packet of 8.
+                unsafe { sys::rtcIntersect8(valid, self.handle.raw, &raw mut ctx, rayhit) };
+            });
         }
         let hit = &packet.rayhit.hit;
         for (i, id) in ids.iter_mut().enumerate() {
@@ -878,6 +930,80 @@ impl RayPacket16 {
             .filter(|&i| self.valid.0[i] != 0)
             .fold(0, |m, i| m | (1 << i))
     }
+
+    /// Hands each half of the packet that has an active lane to `trace` as a packet of 8
+    /// (valid mask and rays with their hit records), and copies back what it wrote.
+    fn by_halves(&mut self, mut trace: impl FnMut(*const i32, &mut sys::RTCRayHit8)) {
+        for first in [0, 8] {
+            let lanes = first..first + 8;
+            if self.valid.0[lanes.clone()].iter().all(|&v| v == 0) {
+                continue;
+            }
+            let mut valid = ValidMask8([0; 8]);
+            valid.0.copy_from_slice(&self.valid.0[lanes]);
+            let mut half = sys::RTCRayHit8 {
+                ray: lanes_of(&self.rayhit.ray, first),
+                hit: hit_lanes_of(&self.rayhit.hit, first),
+            };
+            trace(valid.0.as_ptr(), &mut half);
+            self.rayhit.ray.tfar[first..first + 8].copy_from_slice(&half.ray.tfar);
+            put_hit_lanes(&mut self.rayhit.hit, first, &half.hit);
+        }
+    }
+}
+
+#[repr(C, align(64))]
+struct ValidMask8([i32; 8]);
+
+/// Lanes `first..first + 8` of a 16-wide packet's rays.
+fn lanes_of(ray: &sys::RTCRay16, first: usize) -> sys::RTCRay8 {
+    let take = |a: &[f32; 16]| -> [f32; 8] { std::array::from_fn(|i| a[first + i]) };
+    let take_u = |a: &[u32; 16]| -> [u32; 8] { std::array::from_fn(|i| a[first + i]) };
+    sys::RTCRay8 {
+        org_x: take(&ray.org_x),
+        org_y: take(&ray.org_y),
+        org_z: take(&ray.org_z),
+        tnear: take(&ray.tnear),
+        dir_x: take(&ray.dir_x),
+        dir_y: take(&ray.dir_y),
+        dir_z: take(&ray.dir_z),
+        time: take(&ray.time),
+        tfar: take(&ray.tfar),
+        mask: take_u(&ray.mask),
+        id: take_u(&ray.id),
+        flags: take_u(&ray.flags),
+    }
+}
+
+/// Lanes `first..first + 8` of a 16-wide packet's hit records.
+fn hit_lanes_of(hit: &sys::RTCHit16, first: usize) -> sys::RTCHit8 {
+    let take = |a: &[f32; 16]| -> [f32; 8] { std::array::from_fn(|i| a[first + i]) };
+    let take_u = |a: &[u32; 16]| -> [u32; 8] { std::array::from_fn(|i| a[first + i]) };
+    sys::RTCHit8 {
+        Ng_x: take(&hit.Ng_x),
+        Ng_y: take(&hit.Ng_y),
+        Ng_z: take(&hit.Ng_z),
+        u: take(&hit.u),
+        v: take(&hit.v),
+        primID: take_u(&hit.primID),
+        geomID: take_u(&hit.geomID),
+        instID: hit.instID.map(|level| take_u(&level)),
+    }
+}
+
+/// Writes a packet of 8's hit records back into lanes `first..first + 8`.
+fn put_hit_lanes(hit: &mut sys::RTCHit16, first: usize, half: &sys::RTCHit8) {
+    let lanes = first..first + 8;
+    hit.Ng_x[lanes.clone()].copy_from_slice(&half.Ng_x);
+    hit.Ng_y[lanes.clone()].copy_from_slice(&half.Ng_y);
+    hit.Ng_z[lanes.clone()].copy_from_slice(&half.Ng_z);
+    hit.u[lanes.clone()].copy_from_slice(&half.u);
+    hit.v[lanes.clone()].copy_from_slice(&half.v);
+    hit.primID[lanes.clone()].copy_from_slice(&half.primID);
+    hit.geomID[lanes.clone()].copy_from_slice(&half.geomID);
+    for (level, half_level) in hit.instID.iter_mut().zip(&half.instID) {
+        level[lanes.clone()].copy_from_slice(half_level);
+    }
 }
 
 #[cfg(test)]
@@ -925,6 +1051,17 @@ mod tests {
             (1280, 64)
         );
         assert_eq!(offset_of!(RTCRayHit16, hit), 768);
+
+        // C aligns the packets of 8 to 32 bytes; ours are aligned to 64, with the same layout.
+        assert_eq!(size_of::<RTCRay8>(), 384);
+        assert_eq!(offset_of!(RTCRay8, dir_x), 128);
+        assert_eq!(offset_of!(RTCRay8, tfar), 256);
+        assert_eq!(size_of::<RTCHit8>(), 256);
+        assert_eq!(offset_of!(RTCHit8, geomID), 192);
+        assert_eq!(
+            (size_of::<RTCRayHit8>(), offset_of!(RTCRayHit8, hit)),
+            (640, 384)
+        );
 
         assert_eq!(
             (
@@ -1078,9 +1215,8 @@ mod tests {
         }
     }
 
-    #[test]
-    fn occluded16_matches_occluded() {
-        // Axis-aligned box [-1, 1]^3 as 12 triangles.
+    /// Axis-aligned box [-1, 1]^3 as 12 triangles, on `device`.
+    fn box_scene(device: &Device) -> Scene {
         let verts: Vec<[f32; 3]> = (0..8)
             .map(|i| {
                 [
@@ -1102,36 +1238,87 @@ mod tests {
             .iter()
             .flat_map(|f| [[f[0], f[1], f[2]], [f[0], f[2], f[3]]])
             .collect();
-        let mut b = SceneBuilder::new(&device()).expect("scene");
+        let mut b = SceneBuilder::new(device).expect("scene");
         b.add_triangle_mesh(&verts, &tris).expect("box");
-        let scene = b.commit().expect("commit");
+        b.commit().expect("commit")
+    }
 
-        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
-        let (mut hits, mut misses) = (0, 0);
-        for round in 0..200 {
-            let mut packet = RayPacket16::new();
-            let mut expected = 0u16;
-            for lane in 0..16 {
-                // Leave some lanes inactive to exercise the valid mask.
-                if (round + lane) % 7 == 0 {
-                    continue;
-                }
-                let org = rng.v(4.0);
-                let dir = rng.v(1.0);
-                let tfar = rng.f() * 8.0;
-                packet.set(lane, org, dir, 0.0, tfar);
-                if scene.occluded(org, dir, 0.0, tfar) {
-                    expected |= 1 << lane;
+    /// The machine's own kernels, and SSE2 kernels, which take 16-wide packets by halves.
+    fn devices_native_and_by_halves() -> [Device; 2] {
+        let sse2 = Device::with_options(1, "isa=sse2").expect("SSE2 device");
+        assert!(!sse2.inner.native16);
+        [device(), sse2]
+    }
+
+    /// Random rays around the box, some lanes left inactive to exercise the valid mask: the
+    /// packet and the `(org, dir, tfar)` of each active lane.
+    fn random_packet(rng: &mut Rng, round: usize) -> (RayPacket16, [Option<RandomRay>; 16]) {
+        let mut packet = RayPacket16::new();
+        let mut rays = [None; 16];
+        for (lane, ray) in rays.iter_mut().enumerate() {
+            if (round + lane).is_multiple_of(7) {
+                continue;
+            }
+            let (org, dir, tfar) = (rng.v(4.0), rng.v(1.0), rng.f() * 8.0);
+            packet.set(lane, org, dir, 0.0, tfar);
+            *ray = Some((org, dir, tfar));
+        }
+        (packet, rays)
+    }
+
+    type RandomRay = ([f32; 3], [f32; 3], f32);
+
+    #[test]
+    fn occluded16_matches_occluded() {
+        for device in devices_native_and_by_halves() {
+            let scene = box_scene(&device);
+            let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+            let (mut hits, mut misses) = (0, 0);
+            for round in 0..200 {
+                let (mut packet, rays) = random_packet(&mut rng, round);
+                let expected = (0..16)
+                    .filter(|&lane| {
+                        rays[lane]
+                            .is_some_and(|(org, dir, tfar)| scene.occluded(org, dir, 0.0, tfar))
+                    })
+                    .fold(0u16, |m, lane| m | 1 << lane);
+                let got = scene.occluded16(&mut packet, round % 2 == 0);
+                assert_eq!(got, expected, "round {round}");
+                assert_eq!(got & !packet.active_mask(), 0);
+                hits += expected.count_ones();
+                misses += packet.active_mask().count_ones() - expected.count_ones();
+            }
+            // Make sure the random rays actually exercise both outcomes.
+            assert!(hits > 100 && misses > 100, "hits {hits} misses {misses}");
+        }
+    }
+
+    #[test]
+    fn first_hits16_match_intersect() {
+        for device in devices_native_and_by_halves() {
+            let scene = box_scene(&device);
+            let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+            let mut hits = 0;
+            for round in 0..200 {
+                let (mut packet, rays) = random_packet(&mut rng, round);
+                let got = scene.first_hits16(&mut packet, round % 2 == 0);
+                for (lane, ray) in rays.iter().enumerate() {
+                    let expected =
+                        ray.and_then(|(org, dir, tfar)| scene.intersect(org, dir, 0.0, tfar));
+                    match expected {
+                        Some(hit) => {
+                            hits += 1;
+                            assert_eq!(got[lane], (hit.geom_id, hit.prim_id), "round {round}");
+                            // Packet and single-ray kernels may round differently.
+                            let dt = (packet.tfar(lane) - hit.t).abs();
+                            assert!(dt <= 1e-5 * hit.t.max(1.0), "round {round} lane {lane}");
+                        }
+                        None => assert_eq!(got[lane].0, sys::RTC_INVALID_GEOMETRY_ID),
+                    }
                 }
             }
-            let got = scene.occluded16(&mut packet, round % 2 == 0);
-            assert_eq!(got, expected, "round {round}");
-            assert_eq!(got & !packet.active_mask(), 0);
-            hits += expected.count_ones();
-            misses += packet.active_mask().count_ones() - expected.count_ones();
+            assert!(hits > 100, "hits {hits}");
         }
-        // Make sure the random rays actually exercise both outcomes.
-        assert!(hits > 100 && misses > 100, "hits {hits} misses {misses}");
     }
 
     #[test]
