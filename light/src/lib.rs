@@ -360,10 +360,11 @@ struct Traced {
     face: usize,
     /// Its light per sample (faces whose lightmap is wanted).
     light: Option<SampleLight>,
-    /// Its sample points (kept for the reference's bounce gathering).
-    samples: Option<FaceSamples>,
+    /// Its sample points (kept for the reference's bounce gathering). Boxed, as `receivers`:
+    /// most runs keep neither, and every face's record is in one large vector.
+    samples: Option<Box<FaceSamples>>,
     /// Where it receives bounced light (when bouncing).
-    receivers: Option<bounce::Receivers>,
+    receivers: Option<Box<bounce::Receivers>>,
     /// The light it reflects (when bouncing and the face reflects).
     reflected: Option<StyleLuxels>,
     placement: PlacementCounts,
@@ -421,12 +422,12 @@ fn trace_faces(
                 light: keep.wanted[f].then_some(light),
                 receivers: keep
                     .bouncing
-                    .then(|| bounce::Receivers::new(&samples, geom)),
+                    .then(|| Box::new(bounce::Receivers::new(&samples, geom))),
                 reflected,
                 placement,
                 counts,
                 sample_count: samples.points.len() as u64,
-                samples: (keep.samples && keep.wanted[f]).then_some(samples),
+                samples: (keep.samples && keep.wanted[f]).then(|| Box::new(samples)),
             }
         })
         .collect()
@@ -464,7 +465,7 @@ fn bounce_light(
         if reference {
             let gathered: Vec<(usize, StyleLuxels, BounceCounts)> = traced
                 .par_iter()
-                .filter_map(|t| Some((t.face, t.samples.as_ref()?)))
+                .filter_map(|t| Some((t.face, &**t.samples.as_ref()?)))
                 .map(|(face, samples)| {
                     let mut c = BounceCounts::default();
                     let model = prep.faces[face].model;
@@ -495,7 +496,7 @@ fn bounce_light(
             .collect();
         let gathered: Vec<(usize, StyleLuxels, BounceCounts)> = receiving
             .par_iter()
-            .filter_map(|t| Some((t.face, t.receivers.as_ref()?)))
+            .filter_map(|t| Some((t.face, &**t.receivers.as_ref()?)))
             .map(|(face, r)| {
                 let mut c = BounceCounts::default();
                 let b = emitting.gather_face(&prep.scene, r, pass, density, &mut c);
@@ -634,11 +635,14 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
             stats.samples += t.sample_count;
         }
     }
-    let faces: Vec<FaceLight> = traced
+    // Gathered first so the parallel collect knows its length (a vector grown in steps
+    // takes fresh pages at each).
+    let lit: Vec<SampleLight> = traced.into_iter().filter_map(|t| t.light).collect();
+    let faces: Vec<FaceLight> = lit
         .into_par_iter()
-        .filter_map(|t| {
-            let bounce = bounced.get(t.face).map_or(&[][..], |b| &b[..]);
-            Some(t.light?.finish(bounce))
+        .map(|light| {
+            let bounce = bounced.get(light.face).map_or(&[][..], |b| &b[..]);
+            light.finish(bounce)
         })
         .collect();
     stats.luxels = faces.iter().map(|l| (l.width * l.height) as u64).sum();

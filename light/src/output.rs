@@ -127,8 +127,10 @@ pub fn finish_face(light: &FaceLight, finish: &Finish) -> (FaceLightmap, usize) 
 /// Replaces the lighting lump with `maps` (faces not listed get no
 /// lightmap) and returns the `.lit` RGB payload matching it.
 pub fn write_lighting(bsp: &mut Bsp, maps: &[FaceLightmap]) -> Vec<u8> {
-    let mut grey = Vec::new();
-    let mut rgb = Vec::new();
+    // Sized up front: growing them copied into fresh pages, which the kernel zeroes first.
+    let bytes: usize = maps.iter().flat_map(|m| &m.grey).map(Vec::len).sum();
+    let mut grey = Vec::with_capacity(bytes);
+    let mut rgb = Vec::with_capacity(3 * bytes);
     for f in &mut bsp.faces {
         f.styles = [NO_STYLE; 4];
         f.light_offset = -1;

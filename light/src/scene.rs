@@ -37,6 +37,21 @@ struct Mesh {
 }
 
 impl Mesh {
+    /// An empty mesh with room for `faces` without growing: its buffers are the largest the
+    /// light tool builds, and each growth of one is a copy into fresh pages.
+    fn with_room_for<'a>(faces: impl Iterator<Item = &'a FaceGeom>) -> Mesh {
+        let (mut vertices, mut triangles) = (0, 0);
+        for f in faces {
+            vertices += f.points.len();
+            triangles += f.points.len().saturating_sub(2);
+        }
+        Mesh {
+            vertices: Vec::with_capacity(vertices),
+            triangles: Vec::with_capacity(triangles),
+            faces: Vec::with_capacity(triangles),
+        }
+    }
+
     fn add(&mut self, face: &FaceGeom) {
         let base = self.vertices.len() as u32;
         self.vertices
@@ -62,13 +77,14 @@ impl TraceScene {
         shadow_models: &[usize],
         self_shadow_models: &[usize],
     ) -> Result<TraceScene, LightError> {
-        let mut opaque = Mesh::default();
+        let casts = |f: &FaceGeom| f.model == 0 || shadow_models.contains(&f.model);
+        let mut opaque =
+            Mesh::with_room_for(faces.iter().filter(|f| f.kind == FaceKind::Lit && casts(f)));
         let mut sky = Mesh::default();
         let mut own_meshes: HashMap<usize, Mesh> = HashMap::new();
         for f in faces {
-            let casts = f.model == 0 || shadow_models.contains(&f.model);
             match f.kind {
-                FaceKind::Lit if casts => opaque.add(f),
+                FaceKind::Lit if casts(f) => opaque.add(f),
                 FaceKind::Lit if self_shadow_models.contains(&f.model) => {
                     own_meshes.entry(f.model).or_default().add(f);
                 }

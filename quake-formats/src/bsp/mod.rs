@@ -18,6 +18,8 @@ pub use validate::{
     check_usable, check_usable_for, darkplaces_divide, validate,
 };
 
+use std::borrow::Cow;
+
 use crate::bytes::{PutLe, Reader};
 use crate::error::{FormatError, Result};
 use crate::layout::{Layout, place};
@@ -227,24 +229,27 @@ impl Bsp {
         if v == BspVersion::Bsp29 {
             self.check_bsp29_limits()?;
         }
-        let mut lumps: [Vec<u8>; 15] = Default::default();
-        lumps[0] = self.entities.clone();
-        lumps[1] = write_records(&self.planes, v)?;
-        lumps[2] = self.textures.encode();
-        lumps[3] = write_records(&self.vertices, v)?;
-        lumps[4] = self.visibility.clone();
-        lumps[5] = write_records(&self.nodes, v)?;
-        lumps[6] = write_records(&self.texinfo, v)?;
-        lumps[7] = write_records(&self.faces, v)?;
-        lumps[8] = self.lighting.clone();
-        lumps[9] = write_records(&self.clipnodes, v)?;
-        lumps[10] = write_records(&self.leafs, v)?;
-        lumps[11] = write_records(&self.marksurfaces, v)?;
-        lumps[12] = write_records(&self.edges, v)?;
-        lumps[13] = write_records(&self.surfedges, v)?;
-        lumps[14] = write_records(&self.models, v)?;
+        // Lumps held as bytes already are borrowed, not copied.
+        let owned = |bytes: Vec<u8>| Cow::Owned(bytes);
+        let lumps: [Cow<[u8]>; 15] = [
+            Cow::Borrowed(&self.entities),
+            owned(write_records(&self.planes, v)?),
+            owned(self.textures.encode()),
+            owned(write_records(&self.vertices, v)?),
+            Cow::Borrowed(&self.visibility),
+            owned(write_records(&self.nodes, v)?),
+            owned(write_records(&self.texinfo, v)?),
+            owned(write_records(&self.faces, v)?),
+            Cow::Borrowed(&self.lighting),
+            owned(write_records(&self.clipnodes, v)?),
+            owned(write_records(&self.leafs, v)?),
+            owned(write_records(&self.marksurfaces, v)?),
+            owned(write_records(&self.edges, v)?),
+            owned(write_records(&self.surfedges, v)?),
+            owned(write_records(&self.models, v)?),
+        ];
 
-        let mut segments: Vec<&[u8]> = FILE_ORDER.iter().map(|&i| lumps[i].as_slice()).collect();
+        let mut segments: Vec<&[u8]> = FILE_ORDER.iter().map(|&i| &*lumps[i]).collect();
         let bspx_dir_len = if self.bspx.is_empty() {
             0
         } else {
