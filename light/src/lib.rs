@@ -249,8 +249,14 @@ impl Prepared {
 /// # Errors
 /// Bad entities or faces, or an Embree failure.
 pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
-    quake_formats::bsp::check_usable_for(bsp, quake_formats::bsp::TreeUse::IfPresent)
-        .map_err(LightError::Unusable)?;
+    // Starting Embree (its device and thread pool) takes as long as the check: both at once.
+    // Embree's own threads only build the BVH; rayon does the tracing.
+    let (usable, device) = rayon::join(
+        || quake_formats::bsp::check_usable_for(bsp, quake_formats::bsp::TreeUse::IfPresent),
+        || Device::new(rayon::current_num_threads()),
+    );
+    usable.map_err(LightError::Unusable)?;
+    let device = device?;
     let mut entities = parse_entities(&bsp.entity_text())?;
     let map_lights = parse_lights(&mut entities, &options.overrides)?;
     let entity_text = (!map_lights.switchable_styles.is_empty()).then(|| write_entities(&entities));
@@ -262,8 +268,6 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
             .unwrap_or(DVec3::ZERO)
     };
     let faces = face_geometry(bsp, origin_of)?;
-    // Embree's own threads only build the BVH; rayon does the tracing.
-    let device = Device::new(rayon::current_num_threads())?;
     let scene = TraceScene::build(
         &device,
         &faces,
@@ -724,13 +728,11 @@ pub fn compute_lighting(bsp: &Bsp, options: &Options) -> Result<Lighting, LightE
 /// Writes `lighting` into `bsp` (lighting lump, face styles and offsets,
 /// entity styles) and returns the `.lit` file bytes when the map is coloured.
 pub fn apply_lighting(bsp: &mut Bsp, lighting: &Lighting) -> Option<Vec<u8>> {
-    let rgb = output::write_lighting(bsp, &lighting.lightmaps);
+    let rgb = output::write_lighting(bsp, &lighting.lightmaps, lighting.coloured);
     if let Some(text) = &lighting.entity_text {
         bsp.set_entity_text(text);
     }
-    lighting
-        .coloured
-        .then(|| quake_formats::lit::write_lit(&rgb))
+    rgb.map(|rgb| quake_formats::lit::write_lit(&rgb))
 }
 
 /// `--onlyents`: gives switchable lights their styles in the entity lump (the lump `slipgate bsp

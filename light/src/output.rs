@@ -124,13 +124,13 @@ pub fn finish_face(light: &FaceLight, finish: &Finish) -> (FaceLightmap, usize) 
     )
 }
 
-/// Replaces the lighting lump with `maps` (faces not listed get no
-/// lightmap) and returns the `.lit` RGB payload matching it.
-pub fn write_lighting(bsp: &mut Bsp, maps: &[FaceLightmap]) -> Vec<u8> {
+/// Replaces the lighting lump with `maps` (faces not listed get no lightmap) and, when
+/// `coloured`, returns the `.lit` RGB payload matching it (white light needs none).
+pub fn write_lighting(bsp: &mut Bsp, maps: &[FaceLightmap], coloured: bool) -> Option<Vec<u8>> {
     // Sized up front: growing them copied into fresh pages, which the kernel zeroes first.
     let bytes: usize = maps.iter().flat_map(|m| &m.grey).map(Vec::len).sum();
     let mut grey = Vec::with_capacity(bytes);
-    let mut rgb = Vec::with_capacity(3 * bytes);
+    let mut rgb = Vec::with_capacity(if coloured { 3 * bytes } else { 0 });
     for f in &mut bsp.faces {
         f.styles = [NO_STYLE; 4];
         f.light_offset = -1;
@@ -143,11 +143,13 @@ pub fn write_lighting(bsp: &mut Bsp, maps: &[FaceLightmap]) -> Vec<u8> {
         }
         for (g, c) in m.grey.iter().zip(&m.rgb) {
             grey.extend_from_slice(g);
-            rgb.extend(c.iter().flatten());
+            if coloured {
+                rgb.extend(c.iter().flatten());
+            }
         }
     }
     bsp.lighting = grey;
-    rgb
+    coloured.then_some(rgb)
 }
 
 #[cfg(test)]
