@@ -72,19 +72,7 @@ impl FaceSamples {
     /// there is none): points moved onto the face often land together, on
     /// an edge or a corner, and need their rays traced only once.
     pub fn first_at_same_point(&self) -> Vec<usize> {
-        let mut first: Vec<usize> = (0..self.points.len()).collect();
-        // Points on the texture grid are all distinct: only moved ones can meet.
-        let mut moved: Vec<([u32; 3], usize)> = (0..self.points.len())
-            .filter(|&i| self.moved.get(i).copied().unwrap_or(true))
-            .map(|i| (self.points[i].map(f32::to_bits), i))
-            .collect();
-        moved.sort_unstable();
-        for pair in moved.windows(2) {
-            if pair[0].0 == pair[1].0 {
-                first[pair[1].1] = first[pair[0].1];
-            }
-        }
-        first
+        first_at_same_point(&self.points, &self.moved)
     }
 
     /// The normal the angle-of-incidence term uses at sample `i`.
@@ -93,6 +81,31 @@ impl FaceSamples {
             .get(i)
             .map_or(self.normal, |&n| Vec3::from(n).as_dvec3())
     }
+}
+
+/// Per point, the first of `points` at exactly the same place (itself when there is none).
+/// Points on the texture grid are all distinct: only moved ones (`moved[i]`, true past its
+/// end) can meet.
+fn first_at_same_point(points: &[[f32; 3]], moved: &[bool]) -> Vec<usize> {
+    let mut first: Vec<usize> = (0..points.len()).collect();
+    debug_assert!(u32::try_from(points.len()).is_ok());
+    // One integer per point, its coordinates' bits above its index, sorts in the order of
+    // (point, index) with one comparison each.
+    let mut keys: Vec<u128> = (0..points.len())
+        .filter(|&i| moved.get(i).copied().unwrap_or(true))
+        .map(|i| {
+            let [x, y, z] = points[i].map(|c| u128::from(c.to_bits()));
+            x << 96 | y << 64 | z << 32 | i as u128
+        })
+        .collect();
+    keys.sort_unstable();
+    let index = |key: u128| (key & u128::from(u32::MAX)) as usize;
+    for pair in keys.windows(2) {
+        if pair[0] >> 32 == pair[1] >> 32 {
+            first[index(pair[1])] = first[index(pair[0])];
+        }
+    }
+    first
 }
 
 /// Counts from placing sample points.
@@ -609,6 +622,33 @@ mod tests {
             } else {
                 let want = nearest_of_every_edge(&region, p);
                 prop_assert!(((p - got).length() - (p - want).length()).abs() < 1e-9);
+            }
+        }
+
+        /// Each moved point's first twin is the lowest-numbered moved point at exactly its place;
+        /// points that did not move keep their own.
+        #[test]
+        fn first_at_same_point_finds_the_first_moved_twin(
+            cells in proptest::collection::vec((0u8..4, 0u8..4, any::<bool>()), 0..60),
+            moved_len_cut in 0usize..8,
+        ) {
+            // Few distinct places so twins are common; -0.0 and 0.0 are different bits.
+            let points: Vec<[f32; 3]> = cells
+                .iter()
+                .map(|&(a, b, neg)| [f32::from(a), if neg { -0.0 } else { 0.0 }, f32::from(b)])
+                .collect();
+            let mut moved: Vec<bool> = cells.iter().map(|&(a, b, _)| (a + b) % 3 != 0).collect();
+            moved.truncate(moved.len().saturating_sub(moved_len_cut));
+            let is_moved = |i: usize| moved.get(i).copied().unwrap_or(true);
+            let bits = |p: &[f32; 3]| p.map(f32::to_bits);
+            let got = first_at_same_point(&points, &moved);
+            for (i, p) in points.iter().enumerate() {
+                let want = if is_moved(i) {
+                    (0..=i).find(|&j| is_moved(j) && bits(&points[j]) == bits(p)).unwrap_or(i)
+                } else {
+                    i
+                };
+                prop_assert_eq!(got[i], want, "point {}", i);
             }
         }
     }
