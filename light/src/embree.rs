@@ -941,13 +941,13 @@ impl RayPacket16 {
             }
             let mut valid = ValidMask8([0; 8]);
             valid.0.copy_from_slice(&self.valid.0[lanes]);
-            let mut half = sys::RTCRayHit8 {
+            let mut packet8 = sys::RTCRayHit8 {
                 ray: lanes_of(&self.rayhit.ray, first),
                 hit: hit_lanes_of(&self.rayhit.hit, first),
             };
-            trace(valid.0.as_ptr(), &mut half);
-            self.rayhit.ray.tfar[first..first + 8].copy_from_slice(&half.ray.tfar);
-            put_hit_lanes(&mut self.rayhit.hit, first, &half.hit);
+            trace(valid.0.as_ptr(), &mut packet8);
+            self.rayhit.ray.tfar[first..first + 8].copy_from_slice(&packet8.ray.tfar);
+            put_hit_lanes(&mut self.rayhit.hit, first, &packet8.hit);
         }
     }
 }
@@ -955,54 +955,57 @@ impl RayPacket16 {
 #[repr(C, align(64))]
 struct ValidMask8([i32; 8]);
 
+/// Lanes `first..first + 8` of one field of a 16-wide packet.
+fn half<T: Copy>(lanes: &[T; 16], first: usize) -> [T; 8] {
+    std::array::from_fn(|i| lanes[first + i])
+}
+
 /// Lanes `first..first + 8` of a 16-wide packet's rays.
 fn lanes_of(ray: &sys::RTCRay16, first: usize) -> sys::RTCRay8 {
-    let take = |a: &[f32; 16]| -> [f32; 8] { std::array::from_fn(|i| a[first + i]) };
-    let take_u = |a: &[u32; 16]| -> [u32; 8] { std::array::from_fn(|i| a[first + i]) };
     sys::RTCRay8 {
-        org_x: take(&ray.org_x),
-        org_y: take(&ray.org_y),
-        org_z: take(&ray.org_z),
-        tnear: take(&ray.tnear),
-        dir_x: take(&ray.dir_x),
-        dir_y: take(&ray.dir_y),
-        dir_z: take(&ray.dir_z),
-        time: take(&ray.time),
-        tfar: take(&ray.tfar),
-        mask: take_u(&ray.mask),
-        id: take_u(&ray.id),
-        flags: take_u(&ray.flags),
+        org_x: half(&ray.org_x, first),
+        org_y: half(&ray.org_y, first),
+        org_z: half(&ray.org_z, first),
+        tnear: half(&ray.tnear, first),
+        dir_x: half(&ray.dir_x, first),
+        dir_y: half(&ray.dir_y, first),
+        dir_z: half(&ray.dir_z, first),
+        time: half(&ray.time, first),
+        tfar: half(&ray.tfar, first),
+        mask: half(&ray.mask, first),
+        id: half(&ray.id, first),
+        flags: half(&ray.flags, first),
     }
 }
 
 /// Lanes `first..first + 8` of a 16-wide packet's hit records.
 fn hit_lanes_of(hit: &sys::RTCHit16, first: usize) -> sys::RTCHit8 {
-    let take = |a: &[f32; 16]| -> [f32; 8] { std::array::from_fn(|i| a[first + i]) };
-    let take_u = |a: &[u32; 16]| -> [u32; 8] { std::array::from_fn(|i| a[first + i]) };
     sys::RTCHit8 {
-        Ng_x: take(&hit.Ng_x),
-        Ng_y: take(&hit.Ng_y),
-        Ng_z: take(&hit.Ng_z),
-        u: take(&hit.u),
-        v: take(&hit.v),
-        primID: take_u(&hit.primID),
-        geomID: take_u(&hit.geomID),
-        instID: hit.instID.map(|level| take_u(&level)),
+        Ng_x: half(&hit.Ng_x, first),
+        Ng_y: half(&hit.Ng_y, first),
+        Ng_z: half(&hit.Ng_z, first),
+        u: half(&hit.u, first),
+        v: half(&hit.v, first),
+        primID: half(&hit.primID, first),
+        geomID: half(&hit.geomID, first),
+        instID: hit.instID.map(|level| half(&level, first)),
     }
 }
 
 /// Writes a packet of 8's hit records back into lanes `first..first + 8`.
-fn put_hit_lanes(hit: &mut sys::RTCHit16, first: usize, half: &sys::RTCHit8) {
-    let lanes = first..first + 8;
-    hit.Ng_x[lanes.clone()].copy_from_slice(&half.Ng_x);
-    hit.Ng_y[lanes.clone()].copy_from_slice(&half.Ng_y);
-    hit.Ng_z[lanes.clone()].copy_from_slice(&half.Ng_z);
-    hit.u[lanes.clone()].copy_from_slice(&half.u);
-    hit.v[lanes.clone()].copy_from_slice(&half.v);
-    hit.primID[lanes.clone()].copy_from_slice(&half.primID);
-    hit.geomID[lanes.clone()].copy_from_slice(&half.geomID);
-    for (level, half_level) in hit.instID.iter_mut().zip(&half.instID) {
-        level[lanes.clone()].copy_from_slice(half_level);
+fn put_hit_lanes(hit: &mut sys::RTCHit16, first: usize, from: &sys::RTCHit8) {
+    fn put<T: Copy>(lanes: &mut [T; 16], first: usize, from: &[T; 8]) {
+        lanes[first..first + 8].copy_from_slice(from);
+    }
+    put(&mut hit.Ng_x, first, &from.Ng_x);
+    put(&mut hit.Ng_y, first, &from.Ng_y);
+    put(&mut hit.Ng_z, first, &from.Ng_z);
+    put(&mut hit.u, first, &from.u);
+    put(&mut hit.v, first, &from.v);
+    put(&mut hit.primID, first, &from.primID);
+    put(&mut hit.geomID, first, &from.geomID);
+    for (level, from_level) in hit.instID.iter_mut().zip(&from.instID) {
+        put(level, first, from_level);
     }
 }
 

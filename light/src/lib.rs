@@ -639,9 +639,10 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
             stats.samples += t.sample_count;
         }
     }
-    // Gathered first so the parallel collect knows its length (a vector grown in steps
-    // takes fresh pages at each).
-    let lit: Vec<SampleLight> = traced.into_iter().filter_map(|t| t.light).collect();
+    // Gathered first, into room for all, so no vector here grows in steps (each step takes
+    // fresh pages) and the parallel collect knows its length.
+    let mut lit: Vec<SampleLight> = Vec::with_capacity(traced.len());
+    lit.extend(traced.into_iter().filter_map(|t| t.light));
     let faces: Vec<FaceLight> = lit
         .into_par_iter()
         .map(|light| {

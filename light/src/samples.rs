@@ -88,6 +88,8 @@ impl FaceSamples {
 /// end) can meet.
 fn first_at_same_point(points: &[[f32; 3]], moved: &[bool]) -> Vec<usize> {
     let mut first: Vec<usize> = (0..points.len()).collect();
+    // A face has at most a few million samples (its extents pass the stage gate; 16x16 per
+    // luxel at most), so an index fits in the key's low 32 bits.
     debug_assert!(u32::try_from(points.len()).is_ok());
     // One integer per point, its coordinates' bits above its index, sorts in the order of
     // (point, index) with one comparison each.
