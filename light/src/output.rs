@@ -1,6 +1,8 @@
 //! From light units to the bytes engines read: the `--soft` filter, range scale, gamma, clamping, and the lighting lump (plus the
 //! `.lit` colour data) with each face's `styles` and `light_offset`.
 
+use std::borrow::Cow;
+
 use quake_formats::Bsp;
 use quake_formats::bsp::limits::MAX_LIGHTMAPS;
 
@@ -31,16 +33,17 @@ pub struct Finish {
     pub soft_radius: usize,
 }
 
-/// Averages each luxel with its neighbours within `radius` (staying inside the face's grid).
+/// Averages each luxel with its neighbours within `radius` (staying inside the face's grid;
+/// radius 0 borrows the luxels as they are).
 pub fn soft_filter(
     luxels: &[[f32; 3]],
     width: usize,
     height: usize,
     radius: usize,
-) -> Vec<[f32; 3]> {
+) -> Cow<'_, [[f32; 3]]> {
     debug_assert_eq!(luxels.len(), width * height);
     if radius == 0 {
-        return luxels.to_vec();
+        return Cow::Borrowed(luxels);
     }
     let mut out = Vec::with_capacity(luxels.len());
     for y in 0..height {
@@ -59,7 +62,7 @@ pub fn soft_filter(
             out.push(acc.map(|a| a / count));
         }
     }
-    out
+    Cow::Owned(out)
 }
 
 /// Light units to bytes: scale, gamma, then scale all channels down together
@@ -189,7 +192,7 @@ mod tests {
         let f = soft_filter(&l, 3, 3, 1);
         assert_eq!(f[4], [1.0; 3]);
         assert_eq!(f[0], [9.0 / 4.0; 3], "corner averages 4 luxels");
-        assert_eq!(soft_filter(&l, 3, 3, 0), l);
+        assert_eq!(soft_filter(&l, 3, 3, 0)[..], l[..]);
     }
 
     #[test]

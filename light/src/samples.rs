@@ -93,13 +93,16 @@ fn first_at_same_point(points: &[[f32; 3]], moved: &[bool]) -> Vec<usize> {
     debug_assert!(u32::try_from(points.len()).is_ok());
     // One integer per point, its coordinates' bits above its index, sorts in the order of
     // (point, index) with one comparison each.
-    let mut keys: Vec<u128> = (0..points.len())
-        .filter(|&i| moved.get(i).copied().unwrap_or(true))
-        .map(|i| {
-            let [x, y, z] = points[i].map(|c| u128::from(c.to_bits()));
-            x << 96 | y << 64 | z << 32 | i as u128
-        })
-        .collect();
+    // With room for all (most are moved): a filtered collect would grow in steps.
+    let mut keys: Vec<u128> = Vec::with_capacity(points.len());
+    keys.extend(
+        (0..points.len())
+            .filter(|&i| moved.get(i).copied().unwrap_or(true))
+            .map(|i| {
+                let [x, y, z] = points[i].map(|c| u128::from(c.to_bits()));
+                x << 96 | y << 64 | z << 32 | i as u128
+            }),
+    );
     keys.sort_unstable();
     let index = |key: u128| (key & u128::from(u32::MAX)) as usize;
     for pair in keys.windows(2) {

@@ -1198,8 +1198,12 @@ pub struct SampleLight {
     bounce_dirt: Vec<f32>,
 }
 
-/// Luxel means of per-sample values, `per` samples to a luxel.
-fn luxel_means(values: &[[f32; 3]], per: usize) -> Vec<[f32; 3]> {
+/// Luxel means of per-sample values, `per` samples to a luxel (one sample to a luxel, as in
+/// the default mode: the values themselves, not copied).
+fn luxel_means(values: Vec<[f32; 3]>, per: usize) -> Vec<[f32; 3]> {
+    if per == 1 {
+        return values;
+    }
     values
         .chunks(per)
         .map(|c| {
@@ -1235,7 +1239,7 @@ impl SampleLight {
                 }
             }
             if values.iter().any(|v| v.iter().any(|&c| c > 0.0)) {
-                out.push((*style, luxel_means(&values, self.per_luxel)));
+                out.push((*style, luxel_means(values, self.per_luxel)));
             }
         }
         out
@@ -1279,7 +1283,7 @@ impl SampleLight {
             .sums
             .styles
             .into_iter()
-            .map(|(style, values)| (style, luxel_means(&values, per)))
+            .map(|(style, values)| (style, luxel_means(values, per)))
             .collect();
         FaceLight {
             face: self.face,

@@ -1,6 +1,7 @@
 use super::{Bounds, MAX_WORLD_COORD, ON_EPSILON, Plane, PlaneSide};
 use crate::geom::DVec3Ext;
 use glam::DVec3;
+use smallvec::SmallVec;
 
 /// A convex polygon, its points in clockwise order seen from the front of its plane (Quake's
 /// convention, matching [`Plane::from_points`]).
@@ -23,6 +24,15 @@ pub enum Split {
         front: Winding,
         back: Winding,
     },
+}
+
+/// A winding's points against a plane ([`Winding::classify`]). Inline up to 16 points: most
+/// windings are that small, and splitting and clipping run in the compiler's and light's
+/// inner loops.
+struct Classified {
+    dists: SmallVec<[f64; 16]>,
+    sides: SmallVec<[PlaneSide; 16]>,
+    whole: PlaneSide,
 }
 
 impl Winding {
@@ -132,11 +142,26 @@ impl Winding {
         }
     }
 
-    /// Each point's distance from `plane` and its side ([`ON_EPSILON`] thick).
-    fn sides_of(&self, plane: &Plane) -> (Vec<f64>, Vec<PlaneSide>) {
-        let dists: Vec<f64> = self.points.iter().map(|&p| plane.distance(p)).collect();
-        let sides = dists.iter().map(|&d| PlaneSide::of_distance(d)).collect();
-        (dists, sides)
+    /// Each point's distance from `plane` and its side ([`ON_EPSILON`] thick), and where the
+    /// whole winding lies: [`PlaneSide::Cross`] when it has points on both sides.
+    fn classify(&self, plane: &Plane) -> Classified {
+        let dists: SmallVec<[f64; 16]> = self.points.iter().map(|&p| plane.distance(p)).collect();
+        let sides: SmallVec<[PlaneSide; 16]> =
+            dists.iter().map(|&d| PlaneSide::of_distance(d)).collect();
+        let whole = match (
+            sides.contains(&PlaneSide::Front),
+            sides.contains(&PlaneSide::Back),
+        ) {
+            (true, true) => PlaneSide::Cross,
+            (true, false) => PlaneSide::Front,
+            (false, true) => PlaneSide::Back,
+            (false, false) => PlaneSide::On,
+        };
+        Classified {
+            dists,
+            sides,
+            whole,
+        }
     }
 
     /// Where the edge from point `i` to point `j` (on opposite sides) crosses `plane`.
@@ -156,11 +181,13 @@ impl Winding {
 
     /// Split by `plane`; points within [`ON_EPSILON`] of it count as on it.
     pub fn split(&self, plane: &Plane) -> Split {
-        let (dists, sides) = self.sides_of(plane);
-        let has_front = sides.contains(&PlaneSide::Front);
-        let has_back = sides.contains(&PlaneSide::Back);
-        match (has_front, has_back) {
-            (false, false) => {
+        let Classified {
+            dists,
+            sides,
+            whole,
+        } = self.classify(plane);
+        match whole {
+            PlaneSide::On => {
                 let facing_front = self
                     .plane()
                     .is_some_and(|own| own.normal.dot(plane.normal) > 0.0);
@@ -169,9 +196,9 @@ impl Winding {
                     facing_front,
                 };
             }
-            (true, false) => return Split::Front(self.clone()),
-            (false, true) => return Split::Back(self.clone()),
-            (true, true) => {}
+            PlaneSide::Front => return Split::Front(self.clone()),
+            PlaneSide::Back => return Split::Back(self.clone()),
+            PlaneSide::Cross => {}
         }
         let n = self.points.len();
         let mut front = Vec::with_capacity(n + 2);
@@ -204,14 +231,16 @@ impl Winding {
     /// The part in front of `plane` (on-plane windings are kept when `keep_on` is set): the
     /// front of [`Winding::split`], without building the back.
     pub fn clip_front(&self, plane: &Plane, keep_on: bool) -> Option<Winding> {
-        let (dists, sides) = self.sides_of(plane);
-        let has_front = sides.contains(&PlaneSide::Front);
-        let has_back = sides.contains(&PlaneSide::Back);
-        match (has_front, has_back) {
-            (false, false) => return keep_on.then(|| self.clone()),
-            (true, false) => return Some(self.clone()),
-            (false, true) => return None,
-            (true, true) => {}
+        let Classified {
+            dists,
+            sides,
+            whole,
+        } = self.classify(plane);
+        match whole {
+            PlaneSide::On => return keep_on.then(|| self.clone()),
+            PlaneSide::Front => return Some(self.clone()),
+            PlaneSide::Back => return None,
+            PlaneSide::Cross => {}
         }
         let n = self.points.len();
         let mut front = Vec::with_capacity(n + 2);
