@@ -700,6 +700,7 @@ pub fn finish_lighting(raw: &RawLighting, soft_radius: usize) -> Lighting {
         rangescale: raw.rangescale,
         gamma: raw.gamma,
         soft_radius,
+        rgb: raw.coloured,
     };
     let mut stats = raw.stats.clone();
     let (lightmaps, dropped): (Vec<_>, Vec<usize>) = raw

@@ -21,6 +21,7 @@ pub struct FaceLightmap {
     pub styles: Vec<u8>,
     /// One byte per luxel per style: the mean of the RGB channels.
     pub grey: Vec<Vec<u8>>,
+    /// The channels themselves, per style, when [`Finish::rgb`] asks for them (else empty).
     pub rgb: Vec<Vec<[u8; 3]>>,
 }
 
@@ -31,6 +32,8 @@ pub struct Finish {
     pub gamma: f64,
     /// `--soft` box filter radius in luxels (0 = off).
     pub soft_radius: usize,
+    /// Keep each luxel's RGB bytes, not only their mean: the light is coloured (for a `.lit`).
+    pub rgb: bool,
 }
 
 /// Averages each luxel with its neighbours within `radius` (staying inside the face's grid;
@@ -87,44 +90,67 @@ fn round_non_negative(x: f64) -> f64 {
     if x - t >= 0.5 { t + 1.0 } else { t }
 }
 
+/// One style's lightmap of a face: its style, grey and (when kept) RGB bytes, and the sum of
+/// its channel bytes (0: dark all over).
+struct StyleMap {
+    style: u8,
+    grey: Vec<u8>,
+    rgb: Vec<[u8; 3]>,
+    energy: u64,
+}
+
+/// The mean of a luxel's channels, rounded.
+fn grey_of(c: [u8; 3]) -> u8 {
+    ((u16::from(c[0]) + u16::from(c[1]) + u16::from(c[2]) + 1) / 3) as u8
+}
+
 /// Finishes one face. Returns the lightmap and how many styles were dropped
 /// for exceeding four.
 pub fn finish_face(light: &FaceLight, finish: &Finish) -> (FaceLightmap, usize) {
     let (w, h) = (light.width, light.height);
-    let mut maps: Vec<(u8, Vec<[u8; 3]>, u64)> = Vec::new();
+    let mut maps: Vec<StyleMap> = Vec::with_capacity(light.styles.len());
     for (style, luxels) in &light.styles {
-        let style = *style;
         let filtered = soft_filter(luxels, w, h, finish.soft_radius);
-        let rgb: Vec<[u8; 3]> = filtered.iter().map(|&c| to_bytes(c, finish)).collect();
-        let energy: u64 = rgb.iter().flatten().map(|&b| u64::from(b)).sum();
+        // One pass, into buffers sized once: this runs for every luxel of the map.
+        let mut map = StyleMap {
+            style: *style,
+            grey: Vec::with_capacity(filtered.len()),
+            rgb: Vec::with_capacity(if finish.rgb { filtered.len() } else { 0 }),
+            energy: 0,
+        };
+        for &c in filtered.iter() {
+            let bytes = to_bytes(c, finish);
+            map.energy += bytes.iter().map(|&b| u64::from(b)).sum::<u64>();
+            map.grey.push(grey_of(bytes));
+            if finish.rgb {
+                map.rgb.push(bytes);
+            }
+        }
         // Style 0 is always written (a face without a lightmap renders fullbright).
-        if style == 0 || energy > 0 {
-            maps.push((style, rgb, energy));
+        if map.style == 0 || map.energy > 0 {
+            maps.push(map);
         }
     }
     // Style 0 stays first; the brightest of the others fill the remaining slots.
-    maps[1..].sort_by_key(|m| std::cmp::Reverse(m.2));
+    maps[1..].sort_by_key(|m| std::cmp::Reverse(m.energy));
     let dropped = maps.len().saturating_sub(MAX_LIGHTMAPS);
     maps.truncate(MAX_LIGHTMAPS);
-    let grey = maps
-        .iter()
-        .map(|(_, rgb, _)| {
-            rgb.iter()
-                .map(|c| ((u16::from(c[0]) + u16::from(c[1]) + u16::from(c[2]) + 1) / 3) as u8)
-                .collect()
-        })
-        .collect();
-    (
-        FaceLightmap {
-            face: light.face,
-            width: w,
-            height: h,
-            styles: maps.iter().map(|m| m.0).collect(),
-            grey,
-            rgb: maps.into_iter().map(|m| m.1).collect(),
-        },
-        dropped,
-    )
+    let mut lightmap = FaceLightmap {
+        face: light.face,
+        width: w,
+        height: h,
+        styles: Vec::with_capacity(maps.len()),
+        grey: Vec::with_capacity(maps.len()),
+        rgb: Vec::with_capacity(if finish.rgb { maps.len() } else { 0 }),
+    };
+    for map in maps {
+        lightmap.styles.push(map.style);
+        lightmap.grey.push(map.grey);
+        if finish.rgb {
+            lightmap.rgb.push(map.rgb);
+        }
+    }
+    (lightmap, dropped)
 }
 
 /// Replaces the lighting lump with `maps` (faces not listed get no lightmap) and, when
@@ -144,9 +170,11 @@ pub fn write_lighting(bsp: &mut Bsp, maps: &[FaceLightmap], coloured: bool) -> O
         for (slot, &s) in m.styles.iter().enumerate() {
             face.styles[slot] = s;
         }
-        for (g, c) in m.grey.iter().zip(&m.rgb) {
+        for g in &m.grey {
             grey.extend_from_slice(g);
-            if coloured {
+        }
+        if coloured {
+            for c in &m.rgb {
                 rgb.extend(c.iter().flatten());
             }
         }
@@ -163,6 +191,7 @@ mod tests {
         rangescale: 0.5,
         gamma: 1.0,
         soft_radius: 0,
+        rgb: true,
     };
 
     #[test]
@@ -229,5 +258,36 @@ mod tests {
         let (out, _) = finish_face(&light, &PLAIN);
         assert_eq!(out.rgb[0], vec![[20, 10, 10]]);
         assert_eq!(out.grey[0], vec![13]);
+    }
+
+    #[test]
+    fn white_light_keeps_only_grey_and_writes_the_same_lump() {
+        let light = FaceLight {
+            face: 0,
+            width: 2,
+            height: 1,
+            styles: vec![(0, vec![[40.0; 3], [90.0; 3]]), (5, vec![[8.0; 3]; 2])],
+        };
+        let (with_rgb, _) = finish_face(&light, &PLAIN);
+        let grey_only = Finish {
+            rgb: false,
+            ..PLAIN
+        };
+        let (without, _) = finish_face(&light, &grey_only);
+        assert!(without.rgb.is_empty());
+        assert_eq!(without.grey, with_rgb.grey);
+        let mut bsp = Bsp::default();
+        bsp.faces.push(quake_formats::bsp::Face {
+            plane: 0,
+            side: 0,
+            first_edge: 0,
+            num_edges: 0,
+            texinfo: 0,
+            styles: [NO_STYLE; 4],
+            light_offset: -1,
+        });
+        assert_eq!(write_lighting(&mut bsp, &[without], false), None);
+        assert_eq!(bsp.lighting, vec![20, 45, 4, 4]);
+        assert_eq!(bsp.faces[0].styles, [0, 5, NO_STYLE, NO_STYLE]);
     }
 }

@@ -31,7 +31,6 @@ pub enum Split {
 /// inner loops.
 struct Classified {
     dists: SmallVec<[f64; 16]>,
-    sides: SmallVec<[PlaneSide; 16]>,
     whole: PlaneSide,
 }
 
@@ -142,26 +141,27 @@ impl Winding {
         }
     }
 
-    /// Each point's distance from `plane` and its side ([`ON_EPSILON`] thick), and where the
-    /// whole winding lies: [`PlaneSide::Cross`] when it has points on both sides.
+    /// Each point's distance from `plane`, and where the whole winding lies ([`ON_EPSILON`]
+    /// thick): [`PlaneSide::Cross`] when it has points on both sides.
     fn classify(&self, plane: &Plane) -> Classified {
-        let dists: SmallVec<[f64; 16]> = self.points.iter().map(|&p| plane.distance(p)).collect();
-        let sides: SmallVec<[PlaneSide; 16]> =
-            dists.iter().map(|&d| PlaneSide::of_distance(d)).collect();
-        let whole = match (
-            sides.contains(&PlaneSide::Front),
-            sides.contains(&PlaneSide::Back),
-        ) {
+        let mut dists = SmallVec::new();
+        let (mut front, mut back) = (false, false);
+        for &p in &self.points {
+            let d = plane.distance(p);
+            match PlaneSide::of_distance(d) {
+                PlaneSide::Front => front = true,
+                PlaneSide::Back => back = true,
+                _ => {}
+            }
+            dists.push(d);
+        }
+        let whole = match (front, back) {
             (true, true) => PlaneSide::Cross,
             (true, false) => PlaneSide::Front,
             (false, true) => PlaneSide::Back,
             (false, false) => PlaneSide::On,
         };
-        Classified {
-            dists,
-            sides,
-            whole,
-        }
+        Classified { dists, whole }
     }
 
     /// Where the edge from point `i` to point `j` (on opposite sides) crosses `plane`.
@@ -181,11 +181,7 @@ impl Winding {
 
     /// Split by `plane`; points within [`ON_EPSILON`] of it count as on it.
     pub fn split(&self, plane: &Plane) -> Split {
-        let Classified {
-            dists,
-            sides,
-            whole,
-        } = self.classify(plane);
+        let Classified { dists, whole } = self.classify(plane);
         match whole {
             PlaneSide::On => {
                 let facing_front = self
@@ -201,11 +197,12 @@ impl Winding {
             PlaneSide::Cross => {}
         }
         let n = self.points.len();
+        let side = |i: usize| PlaneSide::of_distance(dists[i]);
         let mut front = Vec::with_capacity(n + 2);
         let mut back = Vec::with_capacity(n + 2);
         for i in 0..n {
             let p = self.points[i];
-            match sides[i] {
+            match side(i) {
                 PlaneSide::On => {
                     front.push(p);
                     back.push(p);
@@ -215,7 +212,7 @@ impl Winding {
                 _ => back.push(p),
             }
             let j = (i + 1) % n;
-            if sides[j] == PlaneSide::On || sides[j] == sides[i] {
+            if side(j) == PlaneSide::On || side(j) == side(i) {
                 continue;
             }
             let mid = self.crossing(plane, &dists, i, j);
@@ -231,11 +228,7 @@ impl Winding {
     /// The part in front of `plane` (on-plane windings are kept when `keep_on` is set): the
     /// front of [`Winding::split`], without building the back.
     pub fn clip_front(&self, plane: &Plane, keep_on: bool) -> Option<Winding> {
-        let Classified {
-            dists,
-            sides,
-            whole,
-        } = self.classify(plane);
+        let Classified { dists, whole } = self.classify(plane);
         match whole {
             PlaneSide::On => return keep_on.then(|| self.clone()),
             PlaneSide::Front => return Some(self.clone()),
@@ -243,13 +236,14 @@ impl Winding {
             PlaneSide::Cross => {}
         }
         let n = self.points.len();
+        let side = |i: usize| PlaneSide::of_distance(dists[i]);
         let mut front = Vec::with_capacity(n + 2);
         for i in 0..n {
-            if sides[i] != PlaneSide::Back {
+            if side(i) != PlaneSide::Back {
                 front.push(self.points[i]);
             }
             let j = (i + 1) % n;
-            if sides[i] == PlaneSide::On || sides[j] == PlaneSide::On || sides[j] == sides[i] {
+            if side(i) == PlaneSide::On || side(j) == PlaneSide::On || side(j) == side(i) {
                 continue;
             }
             front.push(self.crossing(plane, &dists, i, j));
