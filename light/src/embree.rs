@@ -766,12 +766,10 @@ impl Scene {
                 );
             }
         } else {
-            packet.by_halves(|valid, rayhit| {
+            packet.rays_by_halves(|valid, ray| {
                 // SAFETY: as above, for a packet of 8 (aligned to 64 bytes, more than the 32
                 // Embree asks of one).
-                unsafe {
-                    sys::rtcOccluded8(valid, self.handle.raw, &raw mut ctx, &raw mut rayhit.ray);
-                }
+                unsafe { sys::rtcOccluded8(valid, self.handle.raw, &raw mut ctx, ray) };
             });
         }
         (0..16)
@@ -931,16 +929,24 @@ impl RayPacket16 {
             .fold(0, |m, i| m | (1 << i))
     }
 
+    /// The valid mask of lanes `first..first + 8` as a packet of 8, unless none is active.
+    #[inline]
+    fn valid_half(&self, first: usize) -> Option<ValidMask8> {
+        let lanes = &self.valid.0[first..first + 8];
+        lanes.iter().any(|&v| v != 0).then(|| {
+            let mut valid = ValidMask8([0; 8]);
+            valid.0.copy_from_slice(lanes);
+            valid
+        })
+    }
+
     /// Hands each half of the packet that has an active lane to `trace` as a packet of 8
     /// (valid mask and rays with their hit records), and copies back what it wrote.
     fn by_halves(&mut self, mut trace: impl FnMut(*const i32, &mut sys::RTCRayHit8)) {
         for first in [0, 8] {
-            let lanes = first..first + 8;
-            if self.valid.0[lanes.clone()].iter().all(|&v| v == 0) {
+            let Some(valid) = self.valid_half(first) else {
                 continue;
-            }
-            let mut valid = ValidMask8([0; 8]);
-            valid.0.copy_from_slice(&self.valid.0[lanes]);
+            };
             let mut packet8 = sys::RTCRayHit8 {
                 ray: lanes_of(&self.rayhit.ray, first),
                 hit: hit_lanes_of(&self.rayhit.hit, first),
@@ -948,6 +954,19 @@ impl RayPacket16 {
             trace(valid.0.as_ptr(), &mut packet8);
             self.rayhit.ray.tfar[first..first + 8].copy_from_slice(&packet8.ray.tfar);
             put_hit_lanes(&mut self.rayhit.hit, first, &packet8.hit);
+        }
+    }
+
+    /// [`RayPacket16::by_halves`] for occlusion, which reads and writes only the rays (their
+    /// `tfar`): the hit records stay where they are.
+    fn rays_by_halves(&mut self, mut trace: impl FnMut(*const i32, &mut sys::RTCRay8)) {
+        for first in [0, 8] {
+            let Some(valid) = self.valid_half(first) else {
+                continue;
+            };
+            let mut ray8 = lanes_of(&self.rayhit.ray, first);
+            trace(valid.0.as_ptr(), &mut ray8);
+            self.rayhit.ray.tfar[first..first + 8].copy_from_slice(&ray8.tfar);
         }
     }
 }
