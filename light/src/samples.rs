@@ -92,8 +92,8 @@ fn first_at_same_point(points: &[[f32; 3]], moved: &[bool]) -> Vec<usize> {
     // luxel at most), so an index fits in the key's low 32 bits.
     debug_assert!(u32::try_from(points.len()).is_ok());
     // One integer per point, its coordinates' bits above its index, sorts in the order of
-    // (point, index) with one comparison each.
-    // With room for all (most are moved): a filtered collect would grow in steps.
+    // (point, index) with one comparison each. Room for all (most are moved): a filtered
+    // collect would grow in steps.
     let mut keys: Vec<u128> = Vec::with_capacity(points.len());
     keys.extend(
         (0..points.len())

@@ -449,7 +449,7 @@ impl LightReaches {
         for (li, r) in each.iter().enumerate() {
             let (lo, hi) = reach_box(r);
             // Every finite reach box lies inside the grid.
-            match grid.cube_range(lo, hi).filter(|_| finite(r)) {
+            match finite(r).then(|| grid.cube_range(lo, hi)).flatten() {
                 Some(range)
                     if range.iter().map(|a| a.len()).product::<usize>() <= MAX_CUBES_PER_LIGHT =>
                 {

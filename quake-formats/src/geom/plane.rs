@@ -29,6 +29,16 @@ impl PlaneSide {
             PlaneSide::On
         }
     }
+
+    /// The side of a set of points, from whether any is in front and any behind.
+    pub fn of_both(front: bool, back: bool) -> PlaneSide {
+        match (front, back) {
+            (true, true) => PlaneSide::Cross,
+            (true, false) => PlaneSide::Front,
+            (false, true) => PlaneSide::Back,
+            (false, false) => PlaneSide::On,
+        }
+    }
 }
 
 impl Plane {
