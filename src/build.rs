@@ -147,12 +147,18 @@ fn run_stages(args: &BuildArgs, bsp: &Path, scratch: &Path) -> Result<Vec<StageR
     argv.extend(extra_args(args.bsp_opts.as_deref()));
     stages.push(run_stage("bsp", argv, scratch, bsp_compiler::cli::run)?);
 
-    let mut argv: Vec<OsString> = vec![bsp.into()];
-    if args.fast {
-        argv.push("--fast".into());
+    // A leaking map has no .prt unless the bsp options asked for one (--keepprt).
+    let leaked = stages[0].stats.pointer("/leaked") == Some(&Value::Bool(true));
+    if leaked && !bsp.with_extension("prt").exists() {
+        eprintln!("== vis skipped: the map leaks, and vis needs a sealed map (see the pointfile)");
+    } else {
+        let mut argv: Vec<OsString> = vec![bsp.into()];
+        if args.fast {
+            argv.push("--fast".into());
+        }
+        argv.extend(extra_args(args.vis_opts.as_deref()));
+        stages.push(run_stage("vis", argv, scratch, vis::cli::run)?);
     }
-    argv.extend(extra_args(args.vis_opts.as_deref()));
-    stages.push(run_stage("vis", argv, scratch, vis::cli::run)?);
 
     let mut argv: Vec<OsString> = vec![bsp.into()];
     for (on, flag) in [

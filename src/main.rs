@@ -95,6 +95,7 @@ mod tests {
             "-leaktest",
             "-notex",
             "-nofill",
+            "-keepprt",
             "-noclip",
             "-omitdetail",
             "-nosubdivide",
@@ -112,7 +113,8 @@ mod tests {
             panic!("not the bsp command");
         };
         let options = bsp.compile_options();
-        assert!(bsp.leaktest && !options.texture_data && !options.fill && !options.clip_hulls);
+        assert!(bsp.leaktest && bsp.keepprt);
+        assert!(!options.texture_data && !options.fill && !options.clip_hulls);
         assert_eq!(options.omit, ["func_detail"]);
         assert_eq!((options.subdivide, options.max_node_size), (0.0, 512.0));
         assert!(options.brush_list && bsp.onlyents);

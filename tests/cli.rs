@@ -248,3 +248,45 @@ fn info_says_whether_the_lit_beside_a_bsp_is_its_own() {
     std::fs::write(&lit, quake_formats::lit::write_lit(&own[3..])).expect("write");
     assert!(info().contains("engines ignore it"), "{}", info());
 }
+
+/// A leaking map gets its pointfile and no `.prt` (an old one is removed), so vis never flows
+/// through the void; `--keepprt` writes it anyway, and vis then refuses it, saying the map
+/// leaks. Once the map seals, the old pointfile goes.
+#[test]
+fn a_leak_writes_a_pointfile_and_no_portal_file_and_vis_refuses_the_void() {
+    let dir = scratch("leak-outputs");
+    std::fs::create_dir_all(&dir).expect("dir");
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let map = dir.join("pinhole.map");
+    std::fs::copy(repo.join("maps/hard/pinhole.map"), &map).expect("copy");
+    let (prt, pts) = (map.with_extension("prt"), map.with_extension("pts"));
+    std::fs::write(&prt, "an old portal file").expect("write");
+    let map_arg = map.to_str().expect("utf8");
+
+    let out = slipgate(&["bsp", map_arg]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("LEAK: entity 1 (info_player_start, line 92)"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("brush 7 of entity 0 (line 73, brick1)"),
+        "{stderr}"
+    );
+    assert!(pts.exists() && !prt.exists(), "{stderr}");
+
+    let out = slipgate(&["bsp", "-keepprt", map_arg]);
+    assert!(out.status.success() && prt.exists());
+    let bsp = map.with_extension("bsp");
+    let out = slipgate(&["vis", bsp.to_str().expect("utf8")]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("the map leaks"), "{stderr}");
+
+    // Sealed: the same room without its pinhole brushes' gap.
+    std::fs::copy(repo.join("maps/leak/sealed.map"), &map).expect("copy");
+    let out = slipgate(&["bsp", map_arg]);
+    assert!(out.status.success());
+    assert!(prt.exists() && !pts.exists());
+}

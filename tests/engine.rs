@@ -309,6 +309,63 @@ fn darkplaces_plays_the_corpus_maps() {
     }
 }
 
+/// Frames of walking forward, at Quake's 200 units a second: long enough for the sealing
+/// corridors' 1024 units, with room to spare.
+const WALK_FRAMES: usize = 70;
+/// The inside of the sealing corridors (`maps/hard/seal_*.map`) along x, and their floor.
+const CORRIDOR_X: [f32; 2] = [0.0, 1024.0];
+const CORRIDOR_FLOOR: f32 = 0.0;
+
+/// The sealing hard cases (`maps/hard/seal_*.map`) are corridors a player walks end to end in
+/// QuakeSpasm: from the start at the west end, the walk must reach the east wall and end
+/// standing on the floor (a corridor whose hulls let the player out, or stop it short, fails).
+#[test]
+fn quakespasm_players_walk_the_sealing_corridors_end_to_end() {
+    let Some(engine) = Engine::find(Kind::QuakeSpasm, scratch()) else {
+        return;
+    };
+    if !engine.has_client() {
+        eprintln!("SKIPPED: QuakeSpasm's client (or xvfb-run) is absent: the walks need it");
+        return;
+    }
+    let set = project_maps();
+    let mut failures = Vec::new();
+    let corridors: Vec<usize> = (0..set.len())
+        .filter(|&i| set.name(i).starts_with("seal_"))
+        .collect();
+    assert!(!corridors.is_empty(), "no maps/hard/seal_*.map");
+    for index in corridors {
+        let map = match set.get(index) {
+            Ok(map) => map,
+            Err(e) => {
+                failures.push(format!(
+                    "{}: not compiled: {}",
+                    set.name(index),
+                    match e {
+                        NotCompiled::Skipped(w) | NotCompiled::Failed(w) => w,
+                    }
+                ));
+                continue;
+            }
+        };
+        match engine.walk(map, WALK_FRAMES) {
+            // The player's box is 32 wide: its centre stops 16 short of the east wall, and
+            // stands 24 above the floor.
+            Ok([x, _, z])
+                if x > CORRIDOR_X[1] - 24.0 && (z - CORRIDOR_FLOOR - 24.0).abs() < 1.0 =>
+            {
+                eprintln!("quakespasm walk {}: reached x {x}, z {z}", map.name);
+            }
+            Ok(origin) => failures.push(format!(
+                "{}: the walk east from x {} ended at {origin:?}",
+                map.name, CORRIDOR_X[0]
+            )),
+            Err(e) => failures.push(format!("{}: {e}", map.name)),
+        }
+    }
+    assert!(failures.is_empty(), "\n{}", failures.join("\n"));
+}
+
 /// The demo map compiled against a WAD that `slipgate wad build` makes here from the committed
 /// pictures (`maps/textures`: sky holes, a glow mask, liquids), played in QuakeSpasm.
 #[test]

@@ -302,12 +302,7 @@ fn compile_map(
         }
         write_atomic(&pts, text.as_bytes()).map_err(|e| e.to_string())?;
         return Err(format!(
-            "the map leaks (entity {}, {} at {} {} {}, reaches the void); pointfile {}",
-            leak.entity,
-            leak.classname,
-            leak.origin.x,
-            leak.origin.y,
-            leak.origin.z,
+            "the map leaks: {leak}; pointfile {}",
             pts.display()
         ));
     }

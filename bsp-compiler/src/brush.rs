@@ -84,8 +84,6 @@ pub struct BrushPlane {
 pub enum BrushError {
     #[error("has {0} planes, fewer than 4")]
     TooFewPlanes(usize),
-    #[error("face {0} has collinear points")]
-    NoPlane(usize),
     #[error("faces {0} and {1} lie on the same plane")]
     DuplicatePlane(usize, usize),
     #[error("faces {0} and {1} face each other on one plane: no volume")]

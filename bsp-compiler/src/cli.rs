@@ -48,6 +48,10 @@ pub struct Args {
     /// for)
     #[arg(long)]
     pub nofill: bool,
+    /// Write the .prt even when the map leaks (vis then works through the void as well, slowly;
+    /// without it, a leaking map gets no .prt and an old one is removed)
+    #[arg(long)]
+    pub keepprt: bool,
     /// Build no clip hulls: players and monsters collide with nothing but point-sized hull 0
     /// (for engines that collide with brushes, with --wrbrushes)
     #[arg(long)]
@@ -194,6 +198,17 @@ fn progress_bar() -> Progress {
     })
 }
 
+/// Remove a file an earlier compile left that no longer belongs to the map (a pointfile once it
+/// seals, a portal file once it leaks).
+fn remove_stale(path: &Path) -> Result<()> {
+    match std::fs::remove_file(path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            Err(e).with_context(|| format!("removing the old {}", path.display()))
+        }
+        _ => Ok(()),
+    }
+}
+
 pub fn run(args: &Args) -> Result<()> {
     let source = MapSource::read(&args.input)?;
     let bsp_path = args
@@ -207,31 +222,27 @@ pub fn run(args: &Args) -> Result<()> {
         return convert(&source, format);
     }
     let out = compile(&source, &args.compile_options())?;
+    let pts_path = bsp_path.with_extension("pts");
+    let prt_path = bsp_path.with_extension("prt");
     if args.leaktest
         && let Some(leak) = &out.leak
     {
-        let pts_path = bsp_path.with_extension("pts");
         write_atomic(&pts_path, write_pointfile(&leak.pointfile).as_bytes())?;
         anyhow::bail!(
-            "--leaktest: the map leaks (entity {}, {} at {} {} {}, reaches the void); nothing \
-             written but the pointfile {}",
-            leak.entity,
-            leak.classname,
-            leak.origin.x,
-            leak.origin.y,
-            leak.origin.z,
+            "--leaktest: the map leaks: {leak}; nothing written but the pointfile {}",
             pts_path.display()
         );
     }
     let bytes = out.bsp.write().context("encoding the BSP")?;
     write_atomic(&bsp_path, &bytes)?;
-    write_atomic(
-        &bsp_path.with_extension("prt"),
-        out.portals.write().as_bytes(),
-    )?;
-    let pts_path = bsp_path.with_extension("pts");
-    if let Some(leak) = &out.leak {
-        write_atomic(&pts_path, write_pointfile(&leak.pointfile).as_bytes())?;
+    if out.leak.is_none() || args.keepprt {
+        write_atomic(&prt_path, out.portals.write().as_bytes())?;
+    } else {
+        remove_stale(&prt_path)?;
+    }
+    match &out.leak {
+        Some(leak) => write_atomic(&pts_path, write_pointfile(&leak.pointfile).as_bytes())?,
+        None => remove_stale(&pts_path)?,
     }
 
     // Repeated warnings of one kind are summarised after a few.
@@ -282,10 +293,18 @@ pub fn run(args: &Args) -> Result<()> {
         println!("  {phase:<28} {secs:8.3} s");
     }
     println!("wrote {} ({})", bsp_path.display(), s.version);
-    if out.leak.is_some() {
+    if let Some(leak) = &out.leak {
+        let prt = if args.keepprt {
+            format!("{} written anyway (--keepprt)", prt_path.display())
+        } else {
+            "no .prt written: vis needs a sealed map".to_string()
+        };
         eprintln!(
-            "LEAK: the map is open to the void; pointfile written to {}",
-            pts_path.display()
+            "LEAK: the map is open to the void; the pointfile {} ({} points) leads from entity {} \
+             to the void (load it in the editor); {prt}",
+            pts_path.display(),
+            leak.pointfile.len(),
+            leak.entity,
         );
     }
     if let Some(path) = &args.stats {

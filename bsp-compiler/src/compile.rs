@@ -12,24 +12,24 @@ use crate::faces::{
 use crate::hulls::{HULL_BOXES, expand_brush};
 use crate::lightmap_grid::{LightmapGridStats, agree_on_lightmap_grid};
 use crate::map::{MapBrush, MapEntity, MapError, MapFile, parse_map, read_map_text};
-use crate::outside::{FillOutcome, Leak, Occupant, fill_outside};
+use crate::outside::{FillOutcome, LeakReport, MapBrushRef, Occupant, OnPlane, fill_outside};
 use crate::planes::PlaneSet;
 use crate::portals::{Portals, make_cluster_portals, make_portals};
 use crate::prefab::{PrefabError, expand_prefabs};
 use crate::progress::Progress;
 use crate::surface_tree::rebuild_from_surfaces;
-use crate::texinfo::{Projection, TextureRole};
+use crate::texinfo::{self, FaceContents, Projection, TextureRole};
 use crate::tree::{
     DETAIL_WALL, FENCE, ILLUSIONARY, MID_SPLIT_SIZE, SplitHeuristic, Splitting, Tree, VISBLOCKER,
     build_clip_hull_tree, build_tree, engine_contents,
 };
 use crate::wad_lookup::WadSet;
-use crate::warnings::Warning;
+use crate::warnings::{DroppedFace, Warning};
 use glam::DVec3;
 use quake_formats::bsp::contents;
 use quake_formats::bsp::phong::{self, FacePhong};
 use quake_formats::entities::Entity;
-use quake_formats::geom::{Bounds, Plane};
+use quake_formats::geom::{Bounds, POINT_EPSILON, Plane};
 use quake_formats::prt::PortalFile;
 use quake_formats::{Bsp, BspVersion, FormatError};
 use rayon::prelude::*;
@@ -171,7 +171,7 @@ pub struct CompileStats {
 pub struct CompileOutput {
     pub bsp: Bsp,
     pub portals: PortalFile,
-    pub leak: Option<Leak>,
+    pub leak: Option<LeakReport>,
     pub warnings: Vec<Warning>,
     pub stats: CompileStats,
 }
@@ -339,6 +339,16 @@ pub fn compile(
     let mut models: Vec<ModelInput> = vec![ModelInput::new(0)];
     let entities = lump_entities(&map, &options.omit);
     let mut occupants = Vec::new();
+    // Each entity's first brush in one numbering of every map brush (`Brush::source`).
+    let first_source: Vec<u32> = map
+        .entities
+        .iter()
+        .scan(0u32, |next, e| {
+            let first = *next;
+            *next += e.brushes.len() as u32;
+            Some(first)
+        })
+        .collect();
     let mut skipped_hint = 0;
     // Per model, when `brush_list` asks for them.
     let mut listed: Vec<Vec<ListedBrush>> = Vec::new();
@@ -351,13 +361,7 @@ pub fn compile(
             continue;
         }
         if index > 0 && ent.brushes.is_empty() {
-            if let Some([x, y, z]) = ent.entity.get_floats::<3>("origin") {
-                occupants.push(Occupant {
-                    entity: index,
-                    classname: class.to_string(),
-                    origin: DVec3::new(x, y, z),
-                });
-            }
+            occupants.extend(occupant(ent, index));
             continue;
         }
         let brush_class = EntityBrushes::of(index, class);
@@ -371,15 +375,16 @@ pub fn compile(
         } else {
             0
         };
-        let (built, bad, hints) = build_entity_brushes(
-            ent,
-            index,
-            brush_class,
-            origin.unwrap_or(DVec3::ZERO),
-            &mut planes,
-            &mut table,
-            &mut warnings,
-        );
+        let mut cx = EntityContext {
+            entity: index,
+            first_source: first_source[index],
+            class: brush_class,
+            origin: origin.unwrap_or(DVec3::ZERO),
+            phong: merged_phong(ent, index, brush_class),
+            table: &mut table,
+            warnings: &mut warnings,
+        };
+        let (built, bad, hints) = cx.build_brushes(ent, &mut planes);
         stats.brushes += ent.brushes.len();
         stats.bad_brushes += bad;
         skipped_hint += hints;
@@ -468,12 +473,12 @@ pub fn compile(
         fs.after_merge += out.face_stats.after_merge;
         match &out.fill {
             Some(FillOutcome::Leaked(l)) => {
-                warnings.push(Warning::Leak {
-                    entity: l.entity,
-                    classname: l.classname.clone(),
-                    origin: l.origin,
-                });
-                leak = Some(l.clone());
+                let report = l.report(
+                    |source| map_brush(&map, &first_source, source),
+                    |texinfo| table.names[table.infos[texinfo as usize].texture as usize].clone(),
+                );
+                warnings.push(Warning::Leak(report.clone()));
+                leak = Some(report);
             }
             Some(FillOutcome::NoOccupants) => warnings.push(Warning::NoEntitiesToFlood),
             Some(FillOutcome::Sealed { filled }) => stats.filled_leaves = *filled,
@@ -787,34 +792,93 @@ fn key_origin(entities: &[MapEntity], ent: &MapEntity) -> Option<DVec3> {
     Some(DVec3::new(x, y, z))
 }
 
-/// Build one entity's brushes, in coordinates relative to `origin`, each with whether it is a
-/// clip brush; origin brushes are left out. Returns the brushes, the number of bad brushes and
-/// the number of hint brushes skipped (outside the world).
-fn build_entity_brushes(
-    ent: &MapEntity,
+/// The point entity `ent` (number `index`) as an occupant of open space for the flood: not
+/// when it has no origin, stands at the map's origin (where ericw-tools skips it, taking it for
+/// a brush entity), or is marked `_nofill` (or `_lightgrid_hint`) to stand in the void.
+fn occupant(ent: &MapEntity, index: usize) -> Option<Occupant> {
+    let [x, y, z] = ent.entity.get_floats::<3>("origin")?;
+    let origin = DVec3::new(x, y, z);
+    let marked = |key| ent.entity.get_float(key).is_some_and(|v| v != 0.0);
+    if origin.abs().max_element() < POINT_EPSILON || marked("_nofill") || marked("_lightgrid_hint")
+    {
+        return None;
+    }
+    Some(Occupant {
+        entity: index,
+        classname: ent.entity.classname().to_string(),
+        origin,
+        line: ent.line,
+    })
+}
+
+/// The map brush numbered `source` by the numbering of every map brush whose entities start at
+/// `first_source`.
+fn map_brush(map: &MapFile, first_source: &[u32], source: u32) -> Option<MapBrushRef> {
+    let entity = first_source
+        .partition_point(|&first| first <= source)
+        .checked_sub(1)?;
+    let brush = (source - first_source[entity]) as usize;
+    Some(MapBrushRef {
+        entity,
+        brush,
+        line: map.entities[entity].brushes.get(brush)?.line,
+    })
+}
+
+/// The faces of a map brush as the compiler takes them: each face's plane (relative to the
+/// entity's origin) and texinfo, with its texture's role and its line.
+struct BrushFaces {
+    planes: Vec<BrushPlane>,
+    roles: Vec<TextureRole>,
+    lines: Vec<usize>,
+    /// Faces of the map brush left out (warned about).
+    dropped: usize,
+}
+
+/// What an entity's brushes go through to become [`Brush`]es.
+struct EntityContext<'a> {
     entity: usize,
+    /// The [`Brush::source`] of the entity's first brush.
+    first_source: u32,
     class: EntityBrushes,
     origin: DVec3,
-    planes: &mut PlaneSet,
-    table: &mut TexInfoTable,
-    warnings: &mut Vec<Warning>,
-) -> (Vec<(Brush, bool)>, usize, usize) {
-    let mut out = Vec::new();
-    let (mut bad, mut hints) = (0, 0);
-    let phong = merged_phong(ent, entity, class);
-    let mirror_inside = ent.entity.get_float("_mirrorinside").map(|v| v != 0.0);
-    for (bi, mb) in ent.brushes.iter().enumerate() {
-        if is_origin_brush(mb) {
-            continue;
-        }
-        let mut faces = Vec::with_capacity(mb.faces.len());
-        let mut roles = Vec::with_capacity(mb.faces.len());
-        let mut failure = None;
-        for (fi, f) in mb.faces.iter().enumerate() {
-            let Some(plane) = f.plane(origin) else {
-                failure = Some(crate::brush::BrushError::NoPlane(fi).to_string());
-                break;
+    phong: FacePhong,
+    table: &'a mut TexInfoTable,
+    warnings: &'a mut Vec<Warning>,
+}
+
+impl EntityContext<'_> {
+    /// The faces of map brush number `bi`. As in id's and ericw-tools' compilers, a face whose
+    /// three points are collinear (no plane) and a face on a plane an earlier face of the brush
+    /// already lies on (either way round; id's dm2 has one) are dropped with a warning naming
+    /// the face's line, and the brush is built from the rest.
+    fn faces(&mut self, mb: &MapBrush, bi: usize) -> BrushFaces {
+        let (entity, origin) = (self.entity, self.origin);
+        let mut out = BrushFaces {
+            planes: Vec::with_capacity(mb.faces.len()),
+            roles: Vec::with_capacity(mb.faces.len()),
+            lines: Vec::with_capacity(mb.faces.len()),
+            dropped: 0,
+        };
+        for f in &mb.faces {
+            let dropped = |reason| Warning::DroppedFace {
+                entity,
+                brush: bi,
+                line: f.line,
+                reason,
             };
+            let Some(plane) = f.plane(origin) else {
+                self.warnings.push(dropped(DroppedFace::NoPlane));
+                out.dropped += 1;
+                continue;
+            };
+            let on_plane =
+                |b: &BrushPlane| b.plane.same_as(&plane) || b.plane.same_as(&plane.flipped());
+            if out.planes.iter().any(on_plane) {
+                self.warnings.push(dropped(DroppedFace::RepeatedPlane));
+                out.dropped += 1;
+                continue;
+            }
             // Engines draw the model moved by its origin: shift the texture to match.
             let mut vecs = f.projection.vecs(&plane);
             for row in &mut vecs {
@@ -822,80 +886,115 @@ fn build_entity_brushes(
             }
             let role = TextureRole::of(&f.texture);
             if role.is_drawn() && projection_squareness(&vecs, plane.normal) < MIN_SQUARENESS {
-                warnings.push(Warning::DegenerateTextureAxes {
+                self.warnings.push(Warning::DegenerateTextureAxes {
                     entity,
                     brush: bi,
                     line: f.line,
                     texture: f.texture.clone(),
                 });
             }
-            let texinfo = table.intern(&f.texture, vecs, phong);
-            roles.push(role);
-            faces.push(BrushPlane {
+            let texinfo = self.table.intern(&f.texture, vecs, self.phong);
+            out.roles.push(role);
+            out.lines.push(f.line);
+            out.planes.push(BrushPlane {
                 plane,
                 texinfo: Some(texinfo),
             });
         }
-        let hint = roles
-            .iter()
-            .any(|r| matches!(r, TextureRole::Hint | TextureRole::HintSkip));
-        if hint && class == EntityBrushes::Submodel {
-            hints += 1;
-            continue;
-        }
-        let clip = roles.contains(&TextureRole::Clip);
-        let brush_contents = match class {
-            _ if hint => contents::EMPTY,
-            EntityBrushes::Submodel => contents::SOLID,
-            EntityBrushes::Fence => FENCE,
-            EntityBrushes::DetailWall => DETAIL_WALL,
-            EntityBrushes::Illusionary => ILLUSIONARY,
-            EntityBrushes::VisBlocker => VISBLOCKER,
-            EntityBrushes::World | EntityBrushes::Detail => {
-                if roles.contains(&TextureRole::Sky) {
-                    contents::SKY
-                } else if let Some(c) = roles.iter().find_map(|r| match r {
-                    TextureRole::Liquid(c) => Some(*c),
-                    _ => None,
-                }) {
-                    c
-                } else {
-                    contents::SOLID
-                }
-            }
-        };
-        let built = match failure {
-            Some(reason) => Err(reason),
-            None => Brush::from_planes(&faces, planes, brush_contents, bi as u32)
-                .map_err(|e| e.to_string()),
-        };
-        match built {
-            Ok(mut b) => {
-                if hint {
-                    b.kind = BrushKind::Hint;
-                    // Only the hint faces split; the others (skip, hintskip) are ignored.
-                    for s in &mut b.sides {
-                        let role = s.texinfo.map(|t| table.infos[t as usize].role);
-                        s.buried |= role != Some(TextureRole::Hint);
-                    }
-                } else {
-                    b.kind = class.kind();
-                }
-                b.mirror_inside = mirror_inside;
-                out.push((b, clip));
-            }
-            Err(reason) => {
-                bad += 1;
-                warnings.push(Warning::BadBrush {
-                    entity,
-                    brush: bi,
-                    line: mb.line,
-                    reason,
-                });
-            }
-        }
+        out
     }
-    (out, bad, hints)
+
+    /// The contents of a (non-hint) brush of these faces. The texture decides first, as in
+    /// ericw-tools: a sky or liquid brush stays one in any detail entity (sky seals the map
+    /// wherever it is); only solid brushes take their entity's contents. The brush's first face
+    /// that gives contents decides them; a later one giving others is warned about.
+    fn contents(&mut self, faces: &BrushFaces, bi: usize) -> (i32, FaceContents) {
+        let (textured, conflict) = texinfo::brush_contents(&faces.roles);
+        if let Some(i) = conflict {
+            self.warnings.push(Warning::MixedContents {
+                entity: self.entity,
+                brush: bi,
+                line: faces.lines[i],
+                used: textured,
+            });
+        }
+        let contents = match (self.class, textured) {
+            (EntityBrushes::Submodel, _) => contents::SOLID,
+            (EntityBrushes::VisBlocker, _) => VISBLOCKER,
+            (_, FaceContents::Sky) => contents::SKY,
+            (_, FaceContents::Liquid(c)) => c,
+            (EntityBrushes::Fence, _) => FENCE,
+            (EntityBrushes::DetailWall, _) => DETAIL_WALL,
+            (EntityBrushes::Illusionary, _) => ILLUSIONARY,
+            (EntityBrushes::World | EntityBrushes::Detail, _) => contents::SOLID,
+        };
+        (contents, textured)
+    }
+
+    /// Build the entity's brushes, in coordinates relative to its origin, each with whether it
+    /// is a clip brush; origin brushes are left out. Brush `i` gets the source `first_source +
+    /// i`. Returns the brushes, the number of bad brushes and the number of hint brushes skipped
+    /// (outside the world).
+    fn build_brushes(
+        &mut self,
+        ent: &MapEntity,
+        planes: &mut PlaneSet,
+    ) -> (Vec<(Brush, bool)>, usize, usize) {
+        let mut out = Vec::new();
+        let (mut bad, mut hints) = (0, 0);
+        let mirror_inside = ent.entity.get_float("_mirrorinside").map(|v| v != 0.0);
+        for (bi, mb) in ent.brushes.iter().enumerate() {
+            if is_origin_brush(mb) {
+                continue;
+            }
+            let faces = self.faces(mb, bi);
+            let hint = faces
+                .roles
+                .iter()
+                .any(|r| matches!(r, TextureRole::Hint | TextureRole::HintSkip));
+            if hint && self.class == EntityBrushes::Submodel {
+                hints += 1;
+                continue;
+            }
+            let (brush_contents, textured) = if hint {
+                (contents::EMPTY, FaceContents::Solid)
+            } else {
+                self.contents(&faces, bi)
+            };
+            let source = self.first_source + bi as u32;
+            match Brush::from_planes(&faces.planes, planes, brush_contents, source) {
+                Ok(mut b) => {
+                    if hint {
+                        b.kind = BrushKind::Hint;
+                        // Only the hint faces split; the others (skip, hintskip) are ignored.
+                        for s in &mut b.sides {
+                            let role = s.texinfo.map(|t| self.table.infos[t as usize].role);
+                            s.buried |= role != Some(TextureRole::Hint);
+                        }
+                    } else if brush_contents == contents::SKY {
+                        b.kind = BrushKind::Structural;
+                    } else {
+                        b.kind = self.class.kind();
+                    }
+                    b.mirror_inside = mirror_inside;
+                    out.push((b, textured == FaceContents::Clip));
+                }
+                Err(e) => {
+                    bad += 1;
+                    self.warnings.push(Warning::BadBrush {
+                        entity: self.entity,
+                        brush: bi,
+                        line: mb.line,
+                        reason: match faces.dropped {
+                            0 => e.to_string(),
+                            n => format!("{e} once {n} unusable faces are dropped"),
+                        },
+                    });
+                }
+            }
+        }
+        (out, bad, hints)
+    }
 }
 
 /// A built brush as the `BRUSHLIST` lump stores it: clip brushes collide as solid; brushes
@@ -925,9 +1024,14 @@ fn fill_hull(
     let portals = make_portals(tree, planes, bounds);
     // Entities near walls are inside the grown brushes; that is expected, not worth a warning.
     let mut ignored = Vec::new();
-    if let FillOutcome::Sealed { .. } =
-        fill_outside(tree, planes, &portals, occupants, &mut ignored)
-    {
+    if let FillOutcome::Sealed { .. } = fill_outside(
+        tree,
+        planes,
+        &portals,
+        occupants,
+        OnPlane::Open,
+        &mut ignored,
+    ) {
         *tree = rebuild_from_surfaces(tree, &portals, planes, heuristic);
     }
 }
@@ -1011,7 +1115,14 @@ fn build_model(
     let is_world = m.entity == 0;
     let fill = (is_world && options.fill).then(|| {
         let flood = cluster_portals.as_ref().unwrap_or(&portals);
-        fill_outside(&mut tree, planes, flood, occupants, &mut warnings)
+        fill_outside(
+            &mut tree,
+            planes,
+            flood,
+            occupants,
+            OnPlane::Sealing,
+            &mut warnings,
+        )
     });
     timings[2] = t.elapsed().as_secs_f64();
 

@@ -2,7 +2,9 @@
 //! map leaks (report it with a path to the void), otherwise every flooded leaf becomes solid.
 //!
 //! The flood runs over the structural leaves (vis clusters) with their structural contents:
-//! detail brushes never seal a map, as in ericw-tools.
+//! detail brushes never seal a map, as in ericw-tools. An entity lying on a brush face (within
+//! `ON_EPSILON` of a node plane, between a sealing cluster and an open one) is placed on the
+//! sealing side in hull 0 ([`OnPlane`]): a light set on the outer face of a ceiling does not leak.
 
 use crate::planes::PlaneSet;
 use crate::portals::Portals;
@@ -20,16 +22,127 @@ pub struct Occupant {
     pub entity: usize,
     pub classname: String,
     pub origin: DVec3,
+    /// The line of the `.map` where the entity starts.
+    pub line: usize,
 }
 
-/// A map open to the void.
+/// A map open to the void: the first entity the flood from outside reaches, and how.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Leak {
+    pub occupant: Occupant,
+    /// From the entity through portal centres to the outside box (what the `.pts` file holds).
+    pub pointfile: Vec<DVec3>,
+    /// The sealing brush faces beside the last place the path passes any (nearest first, at most
+    /// [`EXIT_FACES`]): where it leaves the map, and where the mapper looks for the hole. Empty
+    /// when the entity stands beyond every brush.
+    pub exit: Vec<ExitFace>,
+    /// The entity stands beyond the box around every brush of the map: it is what to move.
+    pub beyond_brushes: bool,
+}
+
+/// How many brush faces a leak names.
+pub const EXIT_FACES: usize = 3;
+
+/// A brush face beside a leak's path.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExitFace {
+    /// [`crate::brush::Brush::source`] of the brush.
+    pub brush: u32,
+    /// The face's texinfo (`None` for a face the compiler made).
+    pub texinfo: Option<u32>,
+    /// The centre of the part of the face the path's leaf touches.
+    pub point: DVec3,
+}
+
+/// A map brush: its entity, its number within the entity and its line, as a mapper finds it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct MapBrushRef {
+    pub entity: usize,
+    pub brush: usize,
+    pub line: usize,
+}
+
+/// A leak as the mapper reads it: the entity, the path, and the brush faces where it leaves.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LeakReport {
     pub entity: usize,
     pub classname: String,
     pub origin: DVec3,
-    /// From the entity through portal centres to the outside box (what the `.pts` file holds).
+    /// The entity's line in the `.map`.
+    pub line: usize,
+    /// What the `.pts` file holds.
     pub pointfile: Vec<DVec3>,
+    /// The brush faces beside the path where it leaves the map, nearest first, with textures.
+    pub exit: Vec<(MapBrushRef, String, DVec3)>,
+    /// The entity stands beyond the box around every brush of the map.
+    pub beyond_brushes: bool,
+}
+
+impl Leak {
+    /// The leak named for the mapper: `brush` finds a [`crate::brush::Brush::source`]'s map
+    /// brush, `texture` a texinfo's texture name.
+    pub fn report(
+        &self,
+        brush: impl Fn(u32) -> Option<MapBrushRef>,
+        texture: impl Fn(u32) -> String,
+    ) -> LeakReport {
+        let o = &self.occupant;
+        LeakReport {
+            entity: o.entity,
+            classname: o.classname.clone(),
+            origin: o.origin,
+            line: o.line,
+            pointfile: self.pointfile.clone(),
+            exit: self
+                .exit
+                .iter()
+                .filter_map(|f| {
+                    let name = f.texinfo.map(&texture).unwrap_or_default();
+                    Some((brush(f.brush)?, name, f.point))
+                })
+                .collect(),
+            beyond_brushes: self.beyond_brushes,
+        }
+    }
+}
+
+impl std::fmt::Display for LeakReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let v = |p: &DVec3| format!("({} {} {})", round(p.x), round(p.y), round(p.z));
+        write!(
+            f,
+            "entity {} ({}, line {}) at {} reaches the void",
+            self.entity,
+            self.classname,
+            self.line,
+            v(&self.origin)
+        )?;
+        if self.beyond_brushes {
+            write!(f, "; it stands outside every brush of the map")?;
+        }
+        for (i, (b, texture, point)) in self.exit.iter().enumerate() {
+            let lead = if i == 0 {
+                "; the path leaves the map past"
+            } else {
+                ","
+            };
+            write!(
+                f,
+                "{lead} brush {} of entity {} (line {}, {texture}) near {}",
+                b.brush,
+                b.entity,
+                b.line,
+                v(point)
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// A coordinate to a tenth of a unit, without a trailing `.0`.
+fn round(x: f64) -> f64 {
+    // Adding 0.0 turns -0.0 into 0.0.
+    (x * 10.0).round() / 10.0 + 0.0
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -43,6 +156,46 @@ pub enum FillOutcome {
     NoOccupants,
 }
 
+/// Which side an entity lying on a node plane (within [`quake_formats::geom::ON_EPSILON`]) is
+/// placed on, when one side seals the map and the other is open.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OnPlane {
+    /// The sealing side: hull 0, where an entity standing exactly on a brush face of the map's
+    /// outside (a light on a ceiling's top) must not leak.
+    Sealing,
+    /// The open side: the clip hulls, where brushes are grown and an entity near a wall often
+    /// touches one; there an occupant only keeps a hull from being filled.
+    Open,
+}
+
+/// Where a point entity sits for the flood.
+enum Placement {
+    /// In open space: the flood must not reach this cluster.
+    Open(u32),
+    /// On a face between open space and a sealing brush, placed on the sealing side.
+    OnSealingFace,
+    /// Inside sealing brushes.
+    Sealed,
+}
+
+fn place(
+    tree: &Tree,
+    planes: &PlaneSet,
+    origin: DVec3,
+    on_plane: OnPlane,
+    contents_of: impl Fn(u32) -> i32,
+) -> Placement {
+    let clusters = tree.clusters_touching(planes, origin);
+    let sealing = |c: &u32| is_opaque(contents_of(*c));
+    match clusters.iter().find(|c| !sealing(c)) {
+        None => Placement::Sealed,
+        Some(_) if on_plane == OnPlane::Sealing && clusters.iter().any(sealing) => {
+            Placement::OnSealingFace
+        }
+        Some(&c) => Placement::Open(c),
+    }
+}
+
 /// Flood `tree` from the outside and fill it unless an occupant is reached. `portals` are its
 /// cluster portals ([`crate::portals::make_cluster_portals`]).
 pub fn fill_outside(
@@ -50,24 +203,35 @@ pub fn fill_outside(
     planes: &PlaneSet,
     portals: &Portals,
     occupants: &[Occupant],
+    on_plane: OnPlane,
     warnings: &mut Vec<Warning>,
 ) -> FillOutcome {
     let leaf_count = portals.leaf_portals.len();
     let mut occupant_of: Vec<Option<usize>> = vec![None; leaf_count];
     let cluster_contents = |node: &TreeNode| node.cluster.unwrap_or(node.contents);
     for (i, o) in occupants.iter().enumerate() {
-        let cluster = tree.cluster_at(planes, o.origin) as usize;
-        let leaf = &tree.nodes[tree.leaf_at(planes, o.origin) as usize];
-        let sealed_in = is_opaque(cluster_contents(&tree.nodes[cluster]));
-        if sealed_in || engine_contents(leaf.contents) == contents::SOLID {
+        let placement = place(tree, planes, o.origin, on_plane, |c| {
+            cluster_contents(&tree.nodes[c as usize])
+        });
+        let in_solid = match placement {
+            Placement::Sealed => true,
+            Placement::OnSealingFace => false,
+            // Inside detail brushes, which do not seal: it still marks open space.
+            Placement::Open(_) => tree
+                .leaves_touching(planes, o.origin)
+                .iter()
+                .all(|&l| engine_contents(tree.nodes[l as usize].contents) == contents::SOLID),
+        };
+        if in_solid {
             warnings.push(Warning::EntityInSolid {
                 entity: o.entity,
                 classname: o.classname.clone(),
                 origin: o.origin,
+                line: o.line,
             });
         }
-        if !sealed_in && occupant_of[cluster].is_none() {
-            occupant_of[cluster] = Some(i);
+        if let Placement::Open(cluster) = placement {
+            occupant_of[cluster as usize].get_or_insert(i);
         }
     }
     if occupant_of.iter().all(Option::is_none) {
@@ -97,14 +261,26 @@ pub fn fill_outside(
         .filter_map(|l| occupant_of[l].map(|o| (o, l as u32)))
         .min();
     if let Some((o, leaf)) = leaking {
-        let o = &occupants[o];
-        let mut pointfile = vec![o.origin];
-        pointfile.extend(path_to_outside(portals, &contents_of, leaf, o.origin));
+        let occupant = occupants[o].clone();
+        let path = path_to_outside(portals, &contents_of, leaf, occupant.origin);
+        let mut pointfile = vec![occupant.origin];
+        pointfile.extend(
+            path.iter()
+                .map(|&p| portals.portals[p as usize].winding.center()),
+        );
+        let beyond_brushes = !portals
+            .leaf_bounds(portals.outside)
+            .contains(occupant.origin);
+        let exit = if beyond_brushes {
+            Vec::new()
+        } else {
+            exit_faces(tree, portals, &contents_of, leaf, &path, occupant.origin)
+        };
         return FillOutcome::Leaked(Leak {
-            entity: o.entity,
-            classname: o.classname.clone(),
-            origin: o.origin,
+            occupant,
             pointfile,
+            exit,
+            beyond_brushes,
         });
     }
     let mut filled = 0;
@@ -143,13 +319,14 @@ impl PartialOrd for Visit {
     }
 }
 
-/// The shortest path through portal centres from `origin` in `start` to the outside box.
+/// The shortest path through portal centres from `origin` in `start` to the outside box: the
+/// portals it passes, the last one on the box.
 fn path_to_outside(
     portals: &Portals,
     contents_of: &dyn Fn(u32) -> i32,
     start: u32,
     origin: DVec3,
-) -> Vec<DVec3> {
+) -> Vec<u32> {
     let n = portals.portals.len();
     let centre: Vec<DVec3> = portals.portals.iter().map(|p| p.winding.center()).collect();
     let mut dist = vec![f64::INFINITY; n];
@@ -171,7 +348,7 @@ fn path_to_outside(
             let mut path = Vec::new();
             let mut p = portal;
             while p != u32::MAX {
-                path.push(centre[p as usize]);
+                path.push(p);
                 p = prev[p as usize];
             }
             path.reverse();
@@ -195,4 +372,70 @@ fn path_to_outside(
         }
     }
     Vec::new()
+}
+
+/// The sealing faces a leak's path passes last. The path runs from the entity's cluster `start`
+/// through the portals of `path` to the outside box; the last cluster on it that borders sealing
+/// brushes lies just outside the hole (the box is a margin away from every brush), and the faces
+/// it touches nearest to where the path entered it frame the hole.
+fn exit_faces(
+    tree: &Tree,
+    portals: &Portals,
+    contents_of: &dyn Fn(u32) -> i32,
+    start: u32,
+    path: &[u32],
+    origin: DVec3,
+) -> Vec<ExitFace> {
+    // Each cluster on the path, with the point the path enters it by.
+    let mut visited = vec![(start, origin)];
+    let mut cluster = start;
+    for &p in path {
+        cluster = portals.other(p, cluster);
+        visited.push((cluster, portals.portals[p as usize].winding.center()));
+    }
+    for &(cluster, entry) in visited.iter().rev() {
+        if cluster == portals.outside {
+            continue;
+        }
+        let mut faces: Vec<ExitFace> = portals.leaf_portals[cluster as usize]
+            .iter()
+            .filter(|&&p| is_opaque(contents_of(portals.other(p, cluster))))
+            .filter_map(|&p| sealing_face(tree, portals, p, portals.other(p, cluster)))
+            .collect();
+        if faces.is_empty() {
+            continue;
+        }
+        faces.sort_by(|a, b| {
+            let (da, db) = ((a.point - entry).length(), (b.point - entry).length());
+            da.total_cmp(&db).then(a.brush.cmp(&b.brush))
+        });
+        let mut named: Vec<ExitFace> = Vec::new();
+        for f in faces {
+            if named.len() < EXIT_FACES && !named.iter().any(|n| n.brush == f.brush) {
+                named.push(f);
+            }
+        }
+        return named;
+    }
+    Vec::new()
+}
+
+/// The face of a brush in the sealing cluster `solid` that portal `p` lies on: among the brush
+/// fragments filling the cluster's leaves, the textured side on the portal's plane nearest to it.
+fn sealing_face(tree: &Tree, portals: &Portals, p: u32, solid: u32) -> Option<ExitFace> {
+    let portal = &portals.portals[p as usize];
+    let plane = portal.plane_id?;
+    let point = portal.winding.center();
+    tree.leaves_below(solid)
+        .into_iter()
+        .flat_map(|leaf| &tree.nodes[leaf as usize].brushes)
+        .flat_map(|b| b.sides.iter().map(move |s| (b, s)))
+        .filter(|(_, s)| s.plane == plane && s.texinfo.is_some())
+        .map(|(b, s)| (b, s, (s.winding.center() - point).length()))
+        .min_by(|a, b| a.2.total_cmp(&b.2))
+        .map(|(b, s, _)| ExitFace {
+            brush: b.source,
+            texinfo: s.texinfo,
+            point,
+        })
 }

@@ -185,6 +185,61 @@ impl TextureRole {
     }
 }
 
+/// What a face's texture makes of its brush.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FaceContents {
+    /// Any other texture, `skip` and `trigger` included: the brush is solid.
+    Solid,
+    Sky,
+    Liquid(i32),
+    /// `clip`: the brush only exists in the clip hulls.
+    Clip,
+}
+
+impl FaceContents {
+    /// The contents a face of `role` gives its brush; `None` for faces that give none (hint,
+    /// hintskip, origin).
+    pub fn of(role: TextureRole) -> Option<FaceContents> {
+        match role {
+            TextureRole::Sky => Some(FaceContents::Sky),
+            TextureRole::Liquid(c) => Some(FaceContents::Liquid(c)),
+            TextureRole::Clip => Some(FaceContents::Clip),
+            TextureRole::Hint | TextureRole::HintSkip | TextureRole::Origin => None,
+            TextureRole::Normal | TextureRole::Skip | TextureRole::Trigger => {
+                Some(FaceContents::Solid)
+            }
+        }
+    }
+}
+
+impl std::fmt::Display for FaceContents {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            FaceContents::Solid => "solid",
+            FaceContents::Sky => "sky",
+            FaceContents::Liquid(contents::LAVA) => "lava",
+            FaceContents::Liquid(contents::SLIME) => "slime",
+            FaceContents::Liquid(_) => "water",
+            FaceContents::Clip => "clip",
+        })
+    }
+}
+
+/// A brush's contents from its faces' textures, as id's and ericw-tools' compilers decide them:
+/// the first face that gives any decides (solid when none does). When a later face gives other
+/// contents, that face's index comes too, for a warning.
+pub fn brush_contents(roles: &[TextureRole]) -> (FaceContents, Option<usize>) {
+    let mut faces = roles
+        .iter()
+        .enumerate()
+        .filter_map(|(i, &r)| Some((i, FaceContents::of(r)?)));
+    let Some((_, first)) = faces.next() else {
+        return (FaceContents::Solid, None);
+    };
+    let conflict = faces.find(|&(_, c)| c != first).map(|(i, _)| i);
+    (first, conflict)
+}
+
 /// A frame of an animated texture: `+`, the frame, then the name all frames of the animation
 /// share. Frames `0`-`9` are the main cycle, `a`-`j` the alternate one engines show on an
 /// entity whose frame is 1 (a pressed button).
@@ -225,6 +280,44 @@ impl<'a> AnimationFrame<'a> {
 mod tests {
     use super::*;
     use quake_formats::geom::DVec3Ext;
+
+    #[test]
+    fn a_brushs_first_face_that_gives_contents_decides_them() {
+        let role = |names: &[&str]| names.iter().map(|n| TextureRole::of(n)).collect::<Vec<_>>();
+        let sky = FaceContents::Sky;
+        assert_eq!(
+            brush_contents(&role(&["sky1", "sky1", "sky1"])),
+            (sky, None)
+        );
+        assert_eq!(
+            brush_contents(&role(&["sky1", "brick", "sky1"])),
+            (sky, Some(1))
+        );
+        assert_eq!(
+            brush_contents(&role(&["brick", "sky1", "sky1"])),
+            (FaceContents::Solid, Some(1))
+        );
+        // skip is solid: first, it makes a water brush solid (ericw-tools does too).
+        let water = FaceContents::Liquid(contents::WATER);
+        assert_eq!(
+            brush_contents(&role(&["skip", "*water1", "*water1"])),
+            (FaceContents::Solid, Some(1))
+        );
+        assert_eq!(
+            brush_contents(&role(&["*water1", "*water1", "skip"])),
+            (water, Some(2))
+        );
+        // Hint faces give none; a brush of them alone is solid (and a hint brush elsewhere).
+        assert_eq!(brush_contents(&role(&["hint", "*water1"])), (water, None));
+        assert_eq!(
+            brush_contents(&role(&["hint", "hintskip"])),
+            (FaceContents::Solid, None)
+        );
+        assert_eq!(
+            brush_contents(&role(&["clip", "brick"])),
+            (FaceContents::Clip, Some(1))
+        );
+    }
 
     #[test]
     fn animation_frames_from_names() {

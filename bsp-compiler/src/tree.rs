@@ -8,7 +8,7 @@ use crate::planes::{PlaneId, PlaneSet};
 use crate::region::{Region, Sliver};
 use glam::DVec3;
 use quake_formats::bsp::contents;
-use quake_formats::geom::{Bounds, Plane};
+use quake_formats::geom::{Bounds, ON_EPSILON, Plane};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -246,24 +246,46 @@ pub struct Tree {
 impl Tree {
     /// The leaf holding `p` (points on a plane go to the front, as in engines).
     pub fn leaf_at(&self, planes: &PlaneSet, p: DVec3) -> u32 {
-        self.descend(planes, p, TreeNode::is_leaf)
-    }
-
-    /// The structural leaf (vis cluster) holding `p`.
-    pub fn cluster_at(&self, planes: &PlaneSet, p: DVec3) -> u32 {
-        self.descend(planes, p, |n| n.cluster.is_some())
-    }
-
-    fn descend(&self, planes: &PlaneSet, p: DVec3, stop: impl Fn(&TreeNode) -> bool) -> u32 {
         let mut n = 0u32;
-        while !stop(&self.nodes[n as usize]) {
-            let Some(id) = self.nodes[n as usize].plane else {
-                break;
-            };
+        while let Some(id) = self.nodes[n as usize].plane {
             let d = planes.get(id).distance(p);
             n = self.nodes[n as usize].children[usize::from(d < 0.0)];
         }
         n
+    }
+
+    /// The structural leaves (vis clusters) whose regions hold `p` or lie within [`ON_EPSILON`]
+    /// of it, front sides first: one, unless `p` lies on node planes (a brush face, an edge, a
+    /// corner), where it touches the clusters on every side.
+    pub fn clusters_touching(&self, planes: &PlaneSet, p: DVec3) -> Vec<u32> {
+        self.touching(planes, p, |n| n.cluster.is_some())
+    }
+
+    /// The leaves whose regions hold `p` or lie within [`ON_EPSILON`] of it, as
+    /// [`Tree::clusters_touching`].
+    pub fn leaves_touching(&self, planes: &PlaneSet, p: DVec3) -> Vec<u32> {
+        self.touching(planes, p, TreeNode::is_leaf)
+    }
+
+    fn touching(&self, planes: &PlaneSet, p: DVec3, stop: impl Fn(&TreeNode) -> bool) -> Vec<u32> {
+        let mut found = Vec::new();
+        let mut stack = vec![0u32];
+        while let Some(n) = stack.pop() {
+            let node = &self.nodes[n as usize];
+            let Some(id) = node.plane.filter(|_| !stop(node)) else {
+                found.push(n);
+                continue;
+            };
+            // Pushed back first, so the front side is searched (and listed) first.
+            let d = planes.get(id).distance(p);
+            if d < ON_EPSILON {
+                stack.push(node.children[1]);
+            }
+            if d > -ON_EPSILON {
+                stack.push(node.children[0]);
+            }
+        }
+        found
     }
 
     /// The leaves at or below node `n`, in pre-order.
@@ -865,7 +887,7 @@ mod tests {
             .filter(|&&i| !tree.nodes[i].is_leaf())
             .count();
         assert_eq!(split, 1);
-        let pillar_cluster = tree.cluster_at(&planes, DVec3::new(116.0, 116.0, 128.0));
+        let pillar_cluster = tree.clusters_touching(&planes, DVec3::new(116.0, 116.0, 128.0))[0];
         assert_eq!(
             tree.nodes[pillar_cluster as usize].cluster,
             Some(contents::EMPTY)
@@ -912,6 +934,25 @@ mod tests {
                 let leaf = tree.leaf_at(&planes, p) as usize;
                 let expected = if inside { contents::SOLID } else { contents::EMPTY };
                 proptest::prop_assert_eq!(tree.nodes[leaf].contents, expected, "{:?}", p);
+                // Half a unit from every plane: the one leaf it is in, and only that.
+                proptest::prop_assert_eq!(tree.leaves_touching(&planes, p), vec![leaf as u32]);
+            }
+            // A point on the middle of a box's top face touches that box's solid leaf, and an
+            // empty one unless boxes fill every octant around it (the boxes' planes are a grid
+            // there, so the octants tell which leaves lie within ON_EPSILON).
+            let in_a_box = |p: DVec3| {
+                boxes.iter().any(|&(lo, hi)| Bounds { mins: lo, maxs: hi }.contains(p))
+            };
+            for &(lo, hi) in &boxes {
+                let top = DVec3::new((lo.x + hi.x) / 2.0, (lo.y + hi.y) / 2.0, hi.z);
+                let touched = tree.leaves_touching(&planes, top);
+                let solid = |l: &u32| tree.nodes[*l as usize].contents == contents::SOLID;
+                proptest::prop_assert!(touched.iter().any(solid), "{:?}", top);
+                let filled = (0..8).all(|octant| {
+                    let sign = |bit: i32| if octant & bit == 0 { -1.0 } else { 1.0 };
+                    in_a_box(top + DVec3::new(sign(1), sign(2), sign(4)) * (ON_EPSILON / 2.0))
+                });
+                proptest::prop_assert_eq!(touched.iter().all(solid), filled, "{:?}", top);
             }
         }
     }

@@ -1,5 +1,7 @@
 //! Things wrong with a map that the compiler works around.
 
+use crate::outside::LeakReport;
+use crate::texinfo::FaceContents;
 use glam::DVec3;
 
 use std::path::PathBuf;
@@ -12,6 +14,22 @@ pub enum Warning {
         brush: usize,
         line: usize,
         reason: String,
+    },
+    /// A brush face that cannot be used: it is dropped and the brush built from the others.
+    DroppedFace {
+        entity: usize,
+        brush: usize,
+        line: usize,
+        reason: DroppedFace,
+    },
+    /// A brush whose faces' textures give different contents (sky and solid, say): the first
+    /// face's are used, as in id's and ericw-tools' compilers. `line` is the first face that
+    /// differs.
+    MixedContents {
+        entity: usize,
+        brush: usize,
+        line: usize,
+        used: FaceContents,
     },
     MissingWad {
         name: String,
@@ -46,13 +64,11 @@ pub enum Warning {
         entity: usize,
         classname: String,
         origin: DVec3,
+        /// The entity's line in the `.map`.
+        line: usize,
     },
     /// The map is open to the void.
-    Leak {
-        entity: usize,
-        classname: String,
-        origin: DVec3,
-    },
+    Leak(LeakReport),
     /// No point entity lies in open space, so the outside cannot be told from the inside.
     NoEntitiesToFlood,
     /// A brush entity with no usable brushes.
@@ -64,6 +80,15 @@ pub enum Warning {
     Unsupported {
         what: String,
     },
+}
+
+/// Why a brush face is dropped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DroppedFace {
+    /// Its three points are collinear.
+    NoPlane,
+    /// An earlier face of the brush lies on its plane (facing either way).
+    RepeatedPlane,
 }
 
 impl std::fmt::Display for Warning {
@@ -78,6 +103,32 @@ impl std::fmt::Display for Warning {
             } => write!(
                 f,
                 "line {line}: entity {entity}, brush {brush}: {reason}; brush skipped"
+            ),
+            Warning::DroppedFace {
+                entity,
+                brush,
+                line,
+                reason,
+            } => {
+                let why = match reason {
+                    DroppedFace::NoPlane => "the face's three points lie on one line",
+                    DroppedFace::RepeatedPlane => {
+                        "the face lies on the plane of an earlier face of the brush"
+                    }
+                };
+                write!(
+                    f,
+                    "line {line}: entity {entity}, brush {brush}: {why}; face dropped"
+                )
+            }
+            Warning::MixedContents {
+                entity,
+                brush,
+                line,
+                used,
+            } => write!(
+                f,
+                "line {line}: entity {entity}, brush {brush}: this face's texture gives other contents than the brush's first face; the brush is {used}"
             ),
             Warning::MissingWad { name } => write!(f, "WAD {name} not found in the search path"),
             Warning::UnreadableWad { path, reason } => {
@@ -110,19 +161,15 @@ impl std::fmt::Display for Warning {
                 entity,
                 classname,
                 origin,
+                line,
             } => write!(
                 f,
-                "entity {entity} ({classname}) at {} is inside a solid brush",
+                "line {line}: entity {entity} ({classname}) at {} is inside a solid brush",
                 v(origin)
             ),
-            Warning::Leak {
-                entity,
-                classname,
-                origin,
-            } => write!(
+            Warning::Leak(report) => write!(
                 f,
-                "LEAK: entity {entity} ({classname}) at {} can reach the void; outside not removed, see the .pts pointfile",
-                v(origin)
+                "LEAK: {report}; the outside is not filled, see the .pts pointfile"
             ),
             Warning::NoEntitiesToFlood => {
                 write!(f, "no point entity in open space: outside filling skipped")

@@ -306,6 +306,34 @@ impl Engine {
         Ok(run.outcome(game_time, Some(shot), Some(colours)))
     }
 
+    /// Where the player stands after walking forward from the player start for `frames` frames
+    /// in QuakeSpasm's client (god mode, so nothing stops the walk but the map).
+    pub fn walk(&self, map: &Compiled, frames: usize) -> Result<[f32; 3], String> {
+        assert!(self.kind == Kind::QuakeSpasm, "walks are QuakeSpasm's");
+        let xvfb = self.xvfb.as_ref().expect("xvfb-run");
+        let game = Game::new(self, map, "walk");
+        let script = format!(
+            "{}noexit 1\nmap {}\n{}god\n+forward\n{}-forward\n{}edict 1\n\
+             echo slipgate: walked\nquit\n",
+            self.frame_settings(false),
+            map.name,
+            waits(SIGNON_FRAMES),
+            waits(frames),
+            waits(2)
+        );
+        game.write_script(&script);
+        let env = [
+            ("LP_NUM_THREADS", "0"),
+            ("MESA_SHADER_CACHE_DISABLE", "true"),
+        ];
+        let run = game.run(xvfb, &self.client_args(&game), &env, CLIENT_TIMEOUT);
+        game.clear_user_dir();
+        run.check(&["godmode ON", "slipgate: walked"])?;
+        let origin = player_origin(&run.output).map_err(|e| run.fail(&e))?;
+        game.clean_up();
+        Ok(origin)
+    }
+
     /// The client's script: load the map, wait for the player, [`play_script`], report.
     fn write_client_scripts(&self, game: &Game, map: &Compiled) {
         let mut script = self.frame_settings(false);
@@ -492,6 +520,23 @@ impl PlayerReport {
             }
         }
     }
+}
+
+/// The player's origin as QuakeSpasm's `edict 1` prints it (`origin  '  64.0  64.0  24.0'`).
+fn player_origin(output: &str) -> Result<[f32; 3], String> {
+    let missing = || "the player's origin was not printed".to_string();
+    let fields = output.split("EDICT 1:").nth(1).ok_or_else(missing)?;
+    let line = fields
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("origin"))
+        .ok_or_else(missing)?;
+    let numbers: Vec<f32> = line
+        .trim()
+        .trim_matches('\'')
+        .split_whitespace()
+        .map(|w| w.parse().map_err(|_| missing()))
+        .collect::<Result<_, _>>()?;
+    numbers.try_into().map_err(|_| missing())
 }
 
 /// The server's game time as DarkPlaces' `prvm_global server time` prints it.
@@ -888,5 +933,12 @@ mod tests {
         assert_eq!((player.health, player.rockets), (100.0, 96.0));
         assert_eq!(game_time(darkplaces), Some(11.1));
         assert!(PlayerReport::parse(Kind::QuakeSpasm, "no edicts").is_err());
+    }
+
+    #[test]
+    fn quakespasm_prints_the_players_origin_as_a_quoted_vector() {
+        let output = "EDICT 1:\nmodelindex 4.0\norigin        ' 991.9  64.0  24.0'\n";
+        assert_eq!(player_origin(output), Ok([991.9, 64.0, 24.0]));
+        assert!(player_origin("EDICT 1:\nhealth 100.0\n").is_err());
     }
 }

@@ -148,16 +148,12 @@ fn compile(case: &Case, dir: &Path) -> Result<Compiled, NotCompiled> {
         }
     })?;
     // Full vis, as a mapper ships a map: the release build does it in seconds on every corpus
-    // map. A leaking map (its pointfile written) has no outside to leave out: its portals reach
-    // the whole void and full vis would run for many minutes, so it gets the fast pass, which
-    // still writes a real visibility lump.
+    // map. A leaking map (its pointfile written) gets no portal file and no vis: engines draw
+    // it whole.
     let leaked = bsp.with_extension("pts").exists();
-    let vis: &[&str] = if leaked {
-        &["vis", "--fast", bsp_arg]
-    } else {
-        &["vis", bsp_arg]
-    };
-    slipgate(vis).map_err(NotCompiled::Failed)?;
+    if !leaked {
+        slipgate(&["vis", bsp_arg]).map_err(NotCompiled::Failed)?;
+    }
     let mut light_args = vec!["light"];
     light_args.extend(case.light_options);
     light_args.push(bsp_arg);
@@ -178,7 +174,7 @@ fn compile(case: &Case, dir: &Path) -> Result<Compiled, NotCompiled> {
         bsp,
         lit,
         start,
-        vis: if leaked { "fast (leaks)" } else { "full" },
+        vis: if leaked { "none (leaks)" } else { "full" },
         seconds: started.elapsed().as_secs_f64(),
         empty_view: case.empty_view,
         known_error: case.known_error,

@@ -97,6 +97,8 @@ impl Inputs {
     fn read(args: &Args) -> Result<Inputs> {
         let bsp_name = args.bsp.display();
         let bsp = Bsp::read(&read_file(&args.bsp)?).with_context(|| format!("{bsp_name}"))?;
+        // Before the portal file: a leaking map has none, and this says why.
+        crate::check_sealed(&bsp).with_context(|| format!("{bsp_name}"))?;
         let prt_path = args
             .prt
             .clone()

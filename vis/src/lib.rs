@@ -23,7 +23,7 @@ pub mod tree_portals;
 
 pub use bitset::BitSet;
 pub use clusters::Clusters;
-pub use lump::{LumpStats, check_portals_match, read_pvs, write_vis};
+pub use lump::{LumpStats, check_portals_match, check_sealed, read_pvs, write_vis};
 pub use portals::PortalGraph;
 pub use pvs::Pvs;
 pub use schedule::{FlowPlan, Grouping, Shard};
@@ -44,6 +44,12 @@ pub enum VisError {
          leaves: the .prt file does not belong to this BSP (compile the map again)"
     )]
     LeafCountMismatch { prt_leafs: usize, vis_leafs: usize },
+    #[error(
+        "the map leaks: leaf {leaf} reaches past the world's brushes into the void outside the \
+         map, which vis would have to work through; fix the leak (the compiler's .pts pointfile \
+         leads to it) and compile again"
+    )]
+    Void { leaf: usize },
     #[error("the BSP has no models, so no world model to compute visibility for")]
     NoWorldModel,
     #[error("the world model claims {vis_leafs} vis leaves but the BSP has {leafs} leaves")]

@@ -5,6 +5,7 @@ use crate::bitset::BitSet;
 use crate::pvs::Pvs;
 use quake_formats::Bsp;
 use quake_formats::PvsRow;
+use quake_formats::bsp::contents;
 use quake_formats::visrle::compress_row;
 use std::collections::HashMap;
 
@@ -48,7 +49,49 @@ pub fn check_portals_match(bsp: &Bsp, prt_leafs: usize) -> Result<(), VisError> 
             vis_leafs,
         });
     }
-    Ok(())
+    check_sealed(bsp)
+}
+
+/// Refuse a BSP whose world keeps the void of a leaking map: the portals of such a map reach
+/// the whole void, and flowing through them is wasted work.
+pub fn check_sealed(bsp: &Bsp) -> Result<(), VisError> {
+    match void_leaf(bsp, world_vis_leafs(bsp)?) {
+        Some(leaf) => Err(VisError::Void { leaf }),
+        None => Ok(()),
+    }
+}
+
+/// How far past the world model's bounds a leaf must reach to be the void: more than the
+/// rounding of BSP29's whole-unit leaf bounds, less than the margin compilers leave between a
+/// map and the box around it.
+const VOID_REACH: f32 = 2.0;
+
+/// An open world leaf of a leaking map's void, which compilers keep when they do not fill the
+/// outside: open leaves reach past the world model's bounds on all six sides. A sealed map's
+/// open leaves lie inside its brushes, but for a few that some compilers leave unfilled at the
+/// edge of the map (ericw-tools keeps a leaf whose face also touches open space).
+fn void_leaf(bsp: &Bsp, vis_leafs: usize) -> Option<usize> {
+    let world = bsp.models.first()?;
+    let mut beyond: [Option<usize>; 6] = [None; 6];
+    for i in 1..=vis_leafs {
+        let leaf = &bsp.leafs[i];
+        if leaf.contents == contents::SOLID {
+            continue;
+        }
+        for a in 0..3 {
+            if leaf.mins[a] < world.mins[a] - VOID_REACH {
+                beyond[2 * a].get_or_insert(i);
+            }
+            if leaf.maxs[a] > world.maxs[a] + VOID_REACH {
+                beyond[2 * a + 1].get_or_insert(i);
+            }
+        }
+    }
+    beyond
+        .iter()
+        .all(Option::is_some)
+        .then_some(beyond[0])
+        .flatten()
 }
 
 /// Store `pvs` in `bsp`: the visibility lump and the vis offset of every leaf. Leaf 0 and the

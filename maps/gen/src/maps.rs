@@ -419,12 +419,16 @@ fn broken() -> Map {
     );
     let first_bad = map.entities[0].brushes.len() - 4;
     map.comment = vec![
-        "Broken brushes: the compiler must report and skip them, and compile the rest.".into(),
+        "Broken brushes: the compiler must report them, drop their unusable faces, skip what".into(),
+        "cannot be built, and compile the rest.".into(),
         format!(
-            "Worldspawn brushes {first_bad}..{}: only 3 planes; a duplicate plane (the +Z face twice);",
+            "Worldspawn brushes {first_bad}..{}: only 3 planes; a duplicate plane (the +Z face twice:",
             first_bad + 3
         ),
-        "opposite planes at x 300 (no volume); a face with collinear points.".into(),
+        "the repeat is dropped, the brush kept); opposite planes at x 300 (no volume: the later face"
+            .into(),
+        "is dropped, leaving the brush open); a face with collinear points (dropped, leaving it open)."
+            .into(),
     ];
     map
 }
@@ -545,7 +549,7 @@ pub fn all() -> Vec<MapFile> {
         ),
         MapFile {
             path: "hard/broken.map",
-            purpose: "Hard case: 4 invalid brushes (3 planes, duplicate plane, no volume, collinear points) to report and skip; the rest compiles.",
+            purpose: "Hard case: 4 invalid brushes (3 planes, duplicate plane, no volume, collinear points) to report: unusable faces dropped, what cannot be built skipped; the rest compiles.",
             map: broken(),
             all_brushes_valid: false,
         },
