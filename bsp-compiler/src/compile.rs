@@ -16,7 +16,6 @@ use crate::outside::{FillOutcome, LeakReport, MapBrushRef, Occupant, OnPlane, fi
 use crate::planes::PlaneSet;
 use crate::portals::{Portals, make_cluster_portals, make_portals};
 use crate::prefab::{PrefabError, expand_prefabs};
-use crate::progress::Progress;
 use crate::surface_tree::rebuild_from_surfaces;
 use crate::texinfo::{self, FaceContents, Projection, TextureRole};
 use crate::tree::{
@@ -30,6 +29,7 @@ use quake_formats::bsp::contents;
 use quake_formats::bsp::phong::{self, FacePhong};
 use quake_formats::entities::Entity;
 use quake_formats::geom::{Bounds, POINT_EPSILON, Plane};
+use quake_formats::progress::Progress;
 use quake_formats::prt::PortalFile;
 use quake_formats::{Bsp, BspVersion, FormatError};
 use rayon::prelude::*;

@@ -29,7 +29,6 @@ pub mod outside;
 pub mod planes;
 pub mod portals;
 pub mod prefab;
-pub mod progress;
 mod region;
 pub mod surface_tree;
 pub mod texinfo;
@@ -44,6 +43,6 @@ pub use compile::{
     wad_search_dirs,
 };
 pub use outside::Leak;
-pub use progress::{Progress, ProgressEvent};
+pub use quake_formats::progress::{Progress, ProgressEvent};
 pub use tree::SplitHeuristic;
 pub use warnings::Warning;

@@ -5,7 +5,7 @@
 //! [`palette`], [`entities`], [`prt`] (portal files), [`pts`] (pointfiles), [`lit`] (coloured
 //! lightmaps), [`visrle`] (PVS row compression), [`extents`] (lightmap extents of a face) and
 //! [`geom`] (f64 vectors, planes, windings and the epsilon policy); [`rng`] is the seeded
-//! generator the tools sample with.
+//! generator the tools sample with, and [`progress`] the one way every stage reports progress.
 
 pub mod bsp;
 mod bytes;
@@ -18,6 +18,7 @@ mod layout;
 pub mod lit;
 pub mod miptex;
 pub mod palette;
+pub mod progress;
 pub mod prt;
 pub mod pts;
 pub mod rng;

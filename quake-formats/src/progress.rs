@@ -1,4 +1,5 @@
-//! Progress of the long phases, reported to whoever shows it (the CLI draws a bar).
+//! Progress of a stage's long phases, reported to whoever shows it: every stage takes a
+//! [`Progress`], and the command lines draw it as a bar.
 
 use std::sync::Arc;
 
@@ -33,26 +34,34 @@ impl Progress {
         Progress(Some(Arc::new(sink)))
     }
 
+    /// Whether anyone receives the reports (work only worth doing to report can be skipped).
+    pub fn is_reported(&self) -> bool {
+        self.0.is_some()
+    }
+
     fn send(&self, event: ProgressEvent) {
         if let Some(sink) = &self.0 {
             sink(event);
         }
     }
 
-    pub(crate) fn start(&self, phase: &'static str, total: usize) {
+    /// A phase starts with `total` units of work.
+    pub fn start(&self, phase: &'static str, total: usize) {
         self.send(ProgressEvent::Start {
             phase,
             total: total as u64,
         });
     }
 
-    pub(crate) fn advance(&self, n: usize) {
+    /// `n` more units of the current phase are done.
+    pub fn advance(&self, n: usize) {
         if n > 0 {
             self.send(ProgressEvent::Advance(n as u64));
         }
     }
 
-    pub(crate) fn finish(&self) {
+    /// The current phase is over.
+    pub fn finish(&self) {
         self.send(ProgressEvent::Finish);
     }
 }
