@@ -2,9 +2,10 @@
 //! faces, nodes, leaves (leaf 0 is the shared solid leaf), clip nodes and models; and the
 //! world's portals into a PRT1 file (PRT2 when it has detail).
 
-use crate::compile::{MapTexInfo, ModelOutput};
 use crate::faces::ModelFace;
+use crate::gather::MapTexInfo;
 use crate::hulls::emit_clipnodes;
+use crate::model::ModelOutput;
 use crate::planes::{PlaneId, PlaneSet};
 use crate::tree::{Tree, engine_contents, is_see_through};
 use crate::wad_lookup::WadSet;

@@ -18,7 +18,7 @@
 //! (1/32) short of a brush; it may also stop where its path passes within that epsilon of a
 //! brush's edge without touching it, as engines do.
 
-use crate::compile::EntityBrushes;
+use crate::gather::EntityBrushes;
 use crate::hulls::{HULL_BOXES, supporting_plane};
 use crate::map::{MapBrush, MapFile};
 use crate::texinfo::TextureRole;

@@ -20,11 +20,15 @@ pub mod cracks;
 pub mod csg;
 mod emit;
 pub mod faces;
+mod gather;
 pub mod hull_check;
 pub mod hulls;
+pub mod leak;
 pub mod lightmap_grid;
 pub mod map;
+mod model;
 pub mod onlyents;
+mod options;
 pub mod outside;
 pub mod planes;
 pub mod portals;
@@ -38,10 +42,9 @@ pub mod wad_lookup;
 pub mod warnings;
 pub mod weld;
 
-pub use compile::{
-    CompileError, CompileOptions, CompileOutput, CompileStats, MapSource, MapTexInfo, compile,
-    wad_search_dirs,
-};
+pub use compile::{CompileError, CompileOutput, CompileStats, MapSource, compile, wad_search_dirs};
+pub use gather::MapTexInfo;
+pub use options::CompileOptions;
 pub use outside::Leak;
 pub use quake_formats::progress::{Progress, ProgressEvent};
 pub use tree::SplitHeuristic;

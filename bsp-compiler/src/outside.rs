@@ -6,6 +6,7 @@
 //! `ON_EPSILON` of a node plane, between a sealing cluster and an open one) is placed on the
 //! sealing side in hull 0 ([`OnPlane`]): a light set on the outer face of a ceiling does not leak.
 
+use crate::leak::{LeakReport, MapBrushRef};
 use crate::planes::PlaneSet;
 use crate::portals::Portals;
 use crate::tree::{Tree, TreeNode, engine_contents, is_opaque};
@@ -54,30 +55,6 @@ pub struct ExitFace {
     pub point: DVec3,
 }
 
-/// A map brush: its entity, its number within the entity and its line, as a mapper finds it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct MapBrushRef {
-    pub entity: usize,
-    pub brush: usize,
-    pub line: usize,
-}
-
-/// A leak as the mapper reads it: the entity, the path, and the brush faces where it leaves.
-#[derive(Debug, Clone, PartialEq)]
-pub struct LeakReport {
-    pub entity: usize,
-    pub classname: String,
-    pub origin: DVec3,
-    /// The entity's line in the `.map`.
-    pub line: usize,
-    /// What the `.pts` file holds.
-    pub pointfile: Vec<DVec3>,
-    /// The brush faces beside the path where it leaves the map, nearest first, with textures.
-    pub exit: Vec<(MapBrushRef, String, DVec3)>,
-    /// The entity stands beyond the box around every brush of the map.
-    pub beyond_brushes: bool,
-}
-
 impl Leak {
     /// The leak named for the mapper: `brush` finds a [`crate::brush::Brush::source`]'s map
     /// brush, `texture` a texinfo's texture name.
@@ -104,45 +81,6 @@ impl Leak {
             beyond_brushes: self.beyond_brushes,
         }
     }
-}
-
-impl std::fmt::Display for LeakReport {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let v = |p: &DVec3| format!("({} {} {})", round(p.x), round(p.y), round(p.z));
-        write!(
-            f,
-            "entity {} ({}, line {}) at {} reaches the void",
-            self.entity,
-            self.classname,
-            self.line,
-            v(&self.origin)
-        )?;
-        if self.beyond_brushes {
-            write!(f, "; it stands outside every brush of the map")?;
-        }
-        for (i, (b, texture, point)) in self.exit.iter().enumerate() {
-            let lead = if i == 0 {
-                "; the path leaves the map past"
-            } else {
-                ","
-            };
-            write!(
-                f,
-                "{lead} brush {} of entity {} (line {}, {texture}) near {}",
-                b.brush,
-                b.entity,
-                b.line,
-                v(point)
-            )?;
-        }
-        Ok(())
-    }
-}
-
-/// A coordinate to a tenth of a unit, without a trailing `.0`.
-fn round(x: f64) -> f64 {
-    // Adding 0.0 turns -0.0 into 0.0.
-    (x * 10.0).round() / 10.0 + 0.0
 }
 
 #[derive(Debug, Clone, PartialEq)]

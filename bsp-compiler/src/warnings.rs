@@ -1,6 +1,6 @@
 //! Things wrong with a map that the compiler works around.
 
-use crate::outside::LeakReport;
+use crate::leak::LeakReport;
 use crate::texinfo::FaceContents;
 use glam::DVec3;
 

@@ -1,0 +1,604 @@
+//! From the map's entities to each model's brushes, the first step of a compile.
+//!
+//! Worldspawn and the entities merged into it (`func_group`, `func_detail*`,
+//! `func_illusionary_visblocker`) make model 0; every other brush entity a model of its own, built
+//! around its origin. Each map brush becomes a convex [`Brush`] of the contents its textures and
+//! its entity give it ([`EntityContext`]), and, when it collides, a grown copy for each clip hull.
+//! Point entities become the occupants the outside fill floods from.
+
+use crate::brush::{Brush, BrushKind, BrushPlane};
+use crate::brushlist::ListedBrush;
+use crate::faces::{MIN_SQUARENESS, projection_squareness};
+use crate::hulls::{HULL_BOXES, expand_brush};
+use crate::leak::MapBrushRef;
+use crate::map::{MapBrush, MapEntity, MapFile};
+use crate::options::CompileOptions;
+use crate::outside::Occupant;
+use crate::planes::PlaneSet;
+use crate::texinfo::{self, FaceContents, TextureRole};
+use crate::tree::{DETAIL_WALL, FENCE, ILLUSIONARY, VISBLOCKER, engine_contents};
+use crate::warnings::{DroppedFace, Warning};
+use glam::DVec3;
+use quake_formats::bsp::contents;
+use quake_formats::bsp::phong::{self, FacePhong};
+use quake_formats::geom::{Bounds, POINT_EPSILON};
+use std::collections::HashMap;
+
+/// Each model's brushes, with what the rest of the compile needs to name them.
+pub(crate) struct Gathered {
+    pub models: Vec<ModelInput>,
+    pub planes: PlaneSet,
+    pub table: TexInfoTable,
+    /// The world's point entities, for the outside fill.
+    pub occupants: Vec<Occupant>,
+    /// Per model, when `brush_list` asks for them.
+    pub listed: Vec<Vec<ListedBrush>>,
+    /// Each entity's first brush in one numbering of every map brush ([`Brush::source`]).
+    pub first_source: Vec<u32>,
+    /// Map brushes read, and those that could not be built.
+    pub brushes: usize,
+    pub bad_brushes: usize,
+}
+
+/// Build every entity's brushes (leaving out the classnames `options.omit` names).
+pub(crate) fn gather(
+    map: &MapFile,
+    options: &CompileOptions,
+    warnings: &mut Vec<Warning>,
+) -> Gathered {
+    let mut g = Gathered {
+        models: vec![ModelInput::new(0)],
+        planes: PlaneSet::new(),
+        table: TexInfoTable::default(),
+        occupants: Vec::new(),
+        listed: Vec::new(),
+        first_source: map
+            .entities
+            .iter()
+            .scan(0u32, |next, e| {
+                let first = *next;
+                *next += e.brushes.len() as u32;
+                Some(first)
+            })
+            .collect(),
+        brushes: 0,
+        bad_brushes: 0,
+    };
+    let mut skipped_hint = 0;
+    let progress = &options.progress;
+    progress.start("brushes", map.entities.len());
+    for (index, ent) in map.entities.iter().enumerate() {
+        progress.advance(1);
+        let class = ent.entity.classname();
+        if index > 0 && options.omit.iter().any(|c| c == class) {
+            continue;
+        }
+        if index > 0 && ent.brushes.is_empty() {
+            g.occupants.extend(occupant(ent, index));
+            continue;
+        }
+        let brush_class = EntityBrushes::of(index, class);
+        let origin = match brush_class {
+            EntityBrushes::Submodel => submodel_origin(&map.entities, ent, &mut g.planes),
+            _ => None,
+        };
+        let model = if brush_class == EntityBrushes::Submodel {
+            g.models.push(ModelInput::new(index));
+            g.models.len() - 1
+        } else {
+            0
+        };
+        let mut cx = EntityContext {
+            entity: index,
+            first_source: g.first_source[index],
+            class: brush_class,
+            origin: origin.unwrap_or(DVec3::ZERO),
+            phong: merged_phong(ent, index, brush_class),
+            table: &mut g.table,
+            warnings,
+        };
+        let (built, bad, hints) = cx.build_brushes(ent, &mut g.planes);
+        g.brushes += ent.brushes.len();
+        g.bad_brushes += bad;
+        skipped_hint += hints;
+        g.add(model, built, options);
+    }
+    progress.finish();
+    if skipped_hint > 0 {
+        warnings.push(Warning::Unsupported {
+            what: format!("{skipped_hint} hint brushes in brush entities are ignored"),
+        });
+    }
+    g
+}
+
+impl Gathered {
+    /// Add the brushes `built` (each with whether it is a clip brush) to model `model`, grown
+    /// for each clip hull when they collide; clip brushes exist only grown.
+    fn add(&mut self, model: usize, built: Vec<(Brush, bool)>, options: &CompileOptions) {
+        if options.brush_list {
+            self.listed.resize_with(self.models.len(), Vec::new);
+            self.listed[model].extend(
+                built
+                    .iter()
+                    .filter_map(|(b, clip)| listed_brush(b, *clip, &self.planes)),
+            );
+        }
+        let m = &mut self.models[model];
+        for (brush, clip) in built {
+            let collides = matches!(
+                engine_contents(brush.contents),
+                contents::SOLID | contents::SKY
+            );
+            for (hull, (mins, maxs)) in HULL_BOXES.iter().enumerate() {
+                if options.clip_hulls
+                    && (collides || clip)
+                    && let Some(g) = expand_brush(&brush, &mut self.planes, *mins, *maxs)
+                {
+                    m.hull_brushes[hull].push(g);
+                }
+            }
+            if clip {
+                m.clip_bounds = m.clip_bounds.union(&brush.bounds);
+            } else {
+                m.brushes.push(brush);
+            }
+        }
+    }
+}
+
+/// The map brush numbered `source` ([`Brush::source`]) of `map`, whose entities' first brushes
+/// are numbered `first_source`.
+pub(crate) fn map_brush(map: &MapFile, first_source: &[u32], source: u32) -> Option<MapBrushRef> {
+    let entity = first_source
+        .partition_point(|&first| first <= source)
+        .checked_sub(1)?;
+    let brush = (source - first_source[entity]) as usize;
+    Some(MapBrushRef {
+        entity,
+        brush,
+        line: map.entities[entity].brushes.get(brush)?.line,
+    })
+}
+
+/// A map texinfo: projection vectors and texture.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MapTexInfo {
+    pub vecs: [[f64; 4]; 2],
+    /// Index into the texture name list.
+    pub texture: u32,
+    pub role: TextureRole,
+    /// The `_phong` group of the world-merged entity the face came from.
+    pub phong: FacePhong,
+}
+
+/// One model's brushes before tree building.
+pub(crate) struct ModelInput {
+    pub entity: usize,
+    pub brushes: Vec<Brush>,
+    /// Grown brushes of hulls 1 and 2.
+    pub hull_brushes: [Vec<Brush>; 2],
+    /// Bounds of the clip brushes, which only exist grown in the hulls.
+    pub clip_bounds: Bounds,
+}
+
+impl ModelInput {
+    /// Brushes of all three trees: the unit of model building progress.
+    pub fn work(&self) -> usize {
+        self.brushes.len() + self.hull_brushes[0].len() + self.hull_brushes[1].len()
+    }
+
+    fn new(entity: usize) -> ModelInput {
+        ModelInput {
+            entity,
+            brushes: Vec::new(),
+            hull_brushes: [Vec::new(), Vec::new()],
+            clip_bounds: Bounds::EMPTY,
+        }
+    }
+}
+
+/// How an entity's brushes enter the compile.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum EntityBrushes {
+    /// Worldspawn and `func_group`.
+    World,
+    /// `func_detail`: world brushes that do not split the vis structure.
+    Detail,
+    /// `func_detail_wall`: detail that leaves the faces it touches whole.
+    DetailWall,
+    /// `func_detail_fence`: detail with see-through (fence) textures.
+    Fence,
+    /// `func_detail_illusionary`: drawn detail without collision.
+    Illusionary,
+    /// `func_illusionary_visblocker`: drawn, walked through, and closed to vis.
+    VisBlocker,
+    /// A brush entity of its own.
+    Submodel,
+}
+
+impl EntityBrushes {
+    pub(crate) fn of(index: usize, classname: &str) -> EntityBrushes {
+        match classname {
+            _ if index == 0 => EntityBrushes::World,
+            "func_group" => EntityBrushes::World,
+            "func_detail" => EntityBrushes::Detail,
+            "func_detail_wall" => EntityBrushes::DetailWall,
+            "func_detail_fence" => EntityBrushes::Fence,
+            "func_detail_illusionary" => EntityBrushes::Illusionary,
+            "func_illusionary_visblocker" => EntityBrushes::VisBlocker,
+            _ => EntityBrushes::Submodel,
+        }
+    }
+
+    fn kind(self) -> BrushKind {
+        match self {
+            EntityBrushes::World | EntityBrushes::Submodel | EntityBrushes::VisBlocker => {
+                BrushKind::Structural
+            }
+            _ => BrushKind::Detail,
+        }
+    }
+}
+
+/// Texture names and texinfos, interned in first-use order.
+#[derive(Default)]
+pub(crate) struct TexInfoTable {
+    pub names: Vec<String>,
+    name_index: HashMap<String, u32>,
+    pub infos: Vec<MapTexInfo>,
+    info_index: HashMap<([u64; 8], u32, u32), u32>,
+}
+
+impl TexInfoTable {
+    /// The texinfo of `name` projected by `vecs` on a face of `phong`'s group
+    /// (faces of different groups never share one, so they never merge).
+    pub fn intern(&mut self, name: &str, vecs: [[f64; 4]; 2], phong: FacePhong) -> u32 {
+        let key = name.to_ascii_lowercase();
+        let texture = match self.name_index.get(&key) {
+            Some(&i) => i,
+            None => {
+                let i = self.names.len() as u32;
+                self.names.push(name.to_string());
+                self.name_index.insert(key, i);
+                i
+            }
+        };
+        let bits: [u64; 8] = std::array::from_fn(|i| (vecs[i / 4][i % 4] as f32).to_bits() as u64);
+        if let Some(&i) = self.info_index.get(&(bits, texture, phong.group)) {
+            return i;
+        }
+        let i = self.infos.len() as u32;
+        self.infos.push(MapTexInfo {
+            vecs,
+            texture,
+            role: TextureRole::of(name),
+            phong,
+        });
+        self.info_index.insert((bits, texture, phong.group), i);
+        i
+    }
+}
+
+/// A submodel with an origin brush is built around that brush's centre, which becomes its
+/// "origin" (what rotating entities turn about); without one, around its origin key.
+pub(crate) fn submodel_origin(
+    entities: &[MapEntity],
+    ent: &MapEntity,
+    planes: &mut PlaneSet,
+) -> Option<DVec3> {
+    origin_brush_centre(ent, planes).or_else(|| key_origin(entities, ent))
+}
+
+fn is_origin_brush(mb: &MapBrush) -> bool {
+    mb.faces
+        .iter()
+        .any(|f| TextureRole::of(&f.texture) == TextureRole::Origin)
+}
+
+/// The centre of the bounds of an entity's origin brushes, if it has any that can be built.
+fn origin_brush_centre(ent: &MapEntity, planes: &mut PlaneSet) -> Option<DVec3> {
+    let mut bounds = Bounds::EMPTY;
+    for mb in ent.brushes.iter().filter(|mb| is_origin_brush(mb)) {
+        let faces: Option<Vec<BrushPlane>> = mb
+            .faces
+            .iter()
+            .map(|f| {
+                Some(BrushPlane {
+                    plane: f.plane(DVec3::ZERO)?,
+                    texinfo: None,
+                })
+            })
+            .collect();
+        if let Some(b) = faces.and_then(|f| Brush::from_planes(&f, planes, contents::SOLID, 0).ok())
+        {
+            bounds = bounds.union(&b.bounds);
+        }
+    }
+    (!bounds.is_empty()).then(|| bounds.center())
+}
+
+/// The `_phong` group of entity `index` if it is merged into the world (its
+/// faces could not be told apart from the world's otherwise): its entity
+/// index as group id. Worldspawn and brush models get none here; light reads
+/// their own keys.
+fn merged_phong(ent: &MapEntity, index: usize, class: EntityBrushes) -> FacePhong {
+    let merged = index != 0 && class != EntityBrushes::Submodel;
+    let angle = phong::angle_from_keys(
+        ent.entity.get_float("_phong"),
+        ent.entity.get_float("_phong_angle"),
+    );
+    match angle.filter(|_| merged) {
+        Some(angle) => FacePhong {
+            group: index as u32,
+            angle: angle as f32,
+        },
+        None => FacePhong::default(),
+    }
+}
+
+/// The origin a submodel without origin brushes is built around: for Hipnotic's `rotate_*`
+/// entities the origin of the entity their `target` names (an `info_rotate`, the pivot), else
+/// the submodel's own `origin` key. Engines draw a model moved by its origin, so its brushes must
+/// be stored relative to it to appear where the mapper put them.
+fn key_origin(entities: &[MapEntity], ent: &MapEntity) -> Option<DVec3> {
+    let pivot = ent
+        .entity
+        .classname()
+        .starts_with("rotate_")
+        .then(|| ent.entity.get("target"))
+        .flatten()
+        .and_then(|target| {
+            entities
+                .iter()
+                .find(|e| e.entity.get("targetname") == Some(target))
+        });
+    let [x, y, z] = pivot.unwrap_or(ent).entity.get_floats::<3>("origin")?;
+    Some(DVec3::new(x, y, z))
+}
+
+/// The point entity `ent` (number `index`) as an occupant of open space for the flood: not
+/// when it has no origin, stands at the map's origin (where ericw-tools skips it, taking it for
+/// a brush entity), or is marked `_nofill` (or `_lightgrid_hint`) to stand in the void.
+fn occupant(ent: &MapEntity, index: usize) -> Option<Occupant> {
+    let [x, y, z] = ent.entity.get_floats::<3>("origin")?;
+    let origin = DVec3::new(x, y, z);
+    let marked = |key| ent.entity.get_float(key).is_some_and(|v| v != 0.0);
+    if origin.abs().max_element() < POINT_EPSILON || marked("_nofill") || marked("_lightgrid_hint")
+    {
+        return None;
+    }
+    Some(Occupant {
+        entity: index,
+        classname: ent.entity.classname().to_string(),
+        origin,
+        line: ent.line,
+    })
+}
+
+/// The faces of a map brush as the compiler takes them: each face's plane (relative to the
+/// entity's origin) and texinfo, with its texture's role and its line.
+struct BrushFaces {
+    planes: Vec<BrushPlane>,
+    roles: Vec<TextureRole>,
+    lines: Vec<usize>,
+    /// Faces of the map brush left out (warned about).
+    dropped: usize,
+}
+
+/// What an entity's brushes go through to become [`Brush`]es.
+struct EntityContext<'a> {
+    entity: usize,
+    /// The [`Brush::source`] of the entity's first brush.
+    first_source: u32,
+    class: EntityBrushes,
+    origin: DVec3,
+    phong: FacePhong,
+    table: &'a mut TexInfoTable,
+    warnings: &'a mut Vec<Warning>,
+}
+
+impl EntityContext<'_> {
+    /// The faces of map brush number `bi`. As in id's and ericw-tools' compilers, a face whose
+    /// three points are collinear (no plane) and a face on a plane an earlier face of the brush
+    /// already lies on (either way round; id's dm2 has one) are dropped with a warning naming
+    /// the face's line, and the brush is built from the rest.
+    fn faces(&mut self, mb: &MapBrush, bi: usize) -> BrushFaces {
+        let (entity, origin) = (self.entity, self.origin);
+        let mut out = BrushFaces {
+            planes: Vec::with_capacity(mb.faces.len()),
+            roles: Vec::with_capacity(mb.faces.len()),
+            lines: Vec::with_capacity(mb.faces.len()),
+            dropped: 0,
+        };
+        for f in &mb.faces {
+            let dropped = |reason| Warning::DroppedFace {
+                entity,
+                brush: bi,
+                line: f.line,
+                reason,
+            };
+            let Some(plane) = f.plane(origin) else {
+                self.warnings.push(dropped(DroppedFace::NoPlane));
+                out.dropped += 1;
+                continue;
+            };
+            let on_plane =
+                |b: &BrushPlane| b.plane.same_as(&plane) || b.plane.same_as(&plane.flipped());
+            if out.planes.iter().any(on_plane) {
+                self.warnings.push(dropped(DroppedFace::RepeatedPlane));
+                out.dropped += 1;
+                continue;
+            }
+            // Engines draw the model moved by its origin: shift the texture to match.
+            let mut vecs = f.projection.vecs(&plane);
+            for row in &mut vecs {
+                row[3] += DVec3::new(row[0], row[1], row[2]).dot(origin);
+            }
+            let role = TextureRole::of(&f.texture);
+            if role.is_drawn() && projection_squareness(&vecs, plane.normal) < MIN_SQUARENESS {
+                self.warnings.push(Warning::DegenerateTextureAxes {
+                    entity,
+                    brush: bi,
+                    line: f.line,
+                    texture: f.texture.clone(),
+                });
+            }
+            let texinfo = self.table.intern(&f.texture, vecs, self.phong);
+            out.roles.push(role);
+            out.lines.push(f.line);
+            out.planes.push(BrushPlane {
+                plane,
+                texinfo: Some(texinfo),
+            });
+        }
+        out
+    }
+
+    /// The contents of a (non-hint) brush of these faces. The texture decides first, as in
+    /// ericw-tools: a sky or liquid brush stays one in any detail entity (sky seals the map
+    /// wherever it is); only solid brushes take their entity's contents. The brush's first face
+    /// that gives contents decides them; a later one giving others is warned about.
+    fn contents(&mut self, faces: &BrushFaces, bi: usize) -> (i32, FaceContents) {
+        let (textured, conflict) = texinfo::brush_contents(&faces.roles);
+        if let Some(i) = conflict {
+            self.warnings.push(Warning::MixedContents {
+                entity: self.entity,
+                brush: bi,
+                line: faces.lines[i],
+                used: textured,
+            });
+        }
+        let contents = match (self.class, textured) {
+            (EntityBrushes::Submodel, _) => contents::SOLID,
+            (EntityBrushes::VisBlocker, _) => VISBLOCKER,
+            (_, FaceContents::Sky) => contents::SKY,
+            (_, FaceContents::Liquid(c)) => c,
+            (EntityBrushes::Fence, _) => FENCE,
+            (EntityBrushes::DetailWall, _) => DETAIL_WALL,
+            (EntityBrushes::Illusionary, _) => ILLUSIONARY,
+            (EntityBrushes::World | EntityBrushes::Detail, _) => contents::SOLID,
+        };
+        (contents, textured)
+    }
+
+    /// Build the entity's brushes, in coordinates relative to its origin, each with whether it
+    /// is a clip brush; origin brushes are left out. Brush `i` gets the source `first_source +
+    /// i`. Returns the brushes, the number of bad brushes and the number of hint brushes skipped
+    /// (outside the world).
+    fn build_brushes(
+        &mut self,
+        ent: &MapEntity,
+        planes: &mut PlaneSet,
+    ) -> (Vec<(Brush, bool)>, usize, usize) {
+        let mut out = Vec::new();
+        let (mut bad, mut hints) = (0, 0);
+        let mirror_inside = ent.entity.get_float("_mirrorinside").map(|v| v != 0.0);
+        for (bi, mb) in ent.brushes.iter().enumerate() {
+            if is_origin_brush(mb) {
+                continue;
+            }
+            let faces = self.faces(mb, bi);
+            let hint = faces
+                .roles
+                .iter()
+                .any(|r| matches!(r, TextureRole::Hint | TextureRole::HintSkip));
+            if hint && self.class == EntityBrushes::Submodel {
+                hints += 1;
+                continue;
+            }
+            let (brush_contents, textured) = if hint {
+                (contents::EMPTY, FaceContents::Solid)
+            } else {
+                self.contents(&faces, bi)
+            };
+            let source = self.first_source + bi as u32;
+            match Brush::from_planes(&faces.planes, planes, brush_contents, source) {
+                Ok(mut b) => {
+                    if hint {
+                        b.kind = BrushKind::Hint;
+                        // Only the hint faces split; the others (skip, hintskip) are ignored.
+                        for s in &mut b.sides {
+                            let role = s.texinfo.map(|t| self.table.infos[t as usize].role);
+                            s.buried |= role != Some(TextureRole::Hint);
+                        }
+                    } else if brush_contents == contents::SKY {
+                        b.kind = BrushKind::Structural;
+                    } else {
+                        b.kind = self.class.kind();
+                    }
+                    b.mirror_inside = mirror_inside;
+                    out.push((b, textured == FaceContents::Clip));
+                }
+                Err(e) => {
+                    bad += 1;
+                    self.warnings.push(Warning::BadBrush {
+                        entity: self.entity,
+                        brush: bi,
+                        line: mb.line,
+                        reason: match faces.dropped {
+                            0 => e.to_string(),
+                            n => format!("{e} once {n} unusable faces are dropped"),
+                        },
+                    });
+                }
+            }
+        }
+        (out, bad, hints)
+    }
+}
+
+/// A built brush as the `BRUSHLIST` lump stores it: clip brushes collide as solid; brushes
+/// nothing collides with (hint, illusionary) are left out.
+fn listed_brush(brush: &Brush, clip: bool, planes: &PlaneSet) -> Option<ListedBrush> {
+    let contents = match engine_contents(brush.contents) {
+        _ if clip => contents::SOLID,
+        _ if brush.kind == BrushKind::Hint => return None,
+        contents::EMPTY => return None,
+        c => c,
+    };
+    Some(ListedBrush::of(brush, contents, planes))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::map::parse_map;
+    use std::path::Path;
+
+    #[test]
+    fn phong_groups_only_for_entities_merged_into_the_world() {
+        let text = "{ \"classname\" \"worldspawn\" \"_phong\" \"1\" }\n\
+                    { \"classname\" \"func_detail\" \"_phong\" \"1\" }\n\
+                    { \"classname\" \"func_group\" \"_phong_angle\" \"30\" }\n\
+                    { \"classname\" \"func_wall\" \"_phong\" \"1\" }\n\
+                    { \"classname\" \"func_detail_wall\" }\n";
+        let map = parse_map(Path::new("phong.map"), text).expect("parse");
+        let got: Vec<FacePhong> = map
+            .entities
+            .iter()
+            .enumerate()
+            .map(|(i, e)| merged_phong(e, i, EntityBrushes::of(i, e.entity.classname())))
+            .collect();
+        let group = |group, angle| FacePhong { group, angle };
+        let none = FacePhong::default();
+        // Worldspawn and brush models keep their keys for light to read.
+        assert_eq!(got, vec![none, group(1, 89.0), group(2, 30.0), none, none]);
+    }
+
+    #[test]
+    fn faces_of_different_phong_groups_get_different_texinfos() {
+        let mut table = TexInfoTable::default();
+        let vecs = [[1.0, 0.0, 0.0, 0.0], [0.0, -1.0, 0.0, 0.0]];
+        let grouped = FacePhong {
+            group: 3,
+            angle: 89.0,
+        };
+        let plain = table.intern("wall", vecs, FacePhong::default());
+        let a = table.intern("wall", vecs, grouped);
+        assert_ne!(plain, a);
+        assert_eq!(table.intern("wall", vecs, grouped), a);
+        assert_eq!(table.infos[a as usize].phong, grouped);
+        assert_eq!(table.names.len(), 1, "one texture either way");
+    }
+}

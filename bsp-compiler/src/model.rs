@@ -1,0 +1,224 @@
+//! One model from its brushes to its trees and faces: the world and every brush entity go
+//! through this on their own (in parallel).
+//!
+//! CSG marks the brush sides other brushes bury; the drawing tree (hull 0) and the two clip hull
+//! trees are built at once; hull 0 is portalised (and, when detail split its structural leaves,
+//! portalised again by clusters); the world's outside is flooded from its point entities and
+//! filled, and then so are its clip hulls; faces are made where leaf contents change, merged,
+//! and cut where their lightmaps would grow too large.
+
+use crate::csg::mark_hidden_sides;
+use crate::faces::{
+    FaceStats, FaceTexInfo, MIN_SQUARENESS, ModelFace, cut_for_lightmaps, faces_from_portals,
+    merge_faces, projection_squareness,
+};
+use crate::gather::ModelInput;
+use crate::options::CompileOptions;
+use crate::outside::{FillOutcome, Occupant, OnPlane, fill_outside};
+use crate::planes::PlaneSet;
+use crate::portals::{Portals, make_cluster_portals, make_portals};
+use crate::surface_tree::rebuild_from_surfaces;
+use crate::tree::{Splitting, Tree, build_clip_hull_tree, build_tree};
+use crate::warnings::Warning;
+use glam::DVec3;
+use quake_formats::geom::Bounds;
+use std::time::Instant;
+
+/// Progress units [`build_model`] reports per brush of [`ModelInput::work`]: one for its CSG,
+/// one for its tree, one for filling and faces.
+pub(crate) const MODEL_WORK_PER_BRUSH: usize = 3;
+
+/// The phases [`ModelOutput::timings`] times, in its order.
+pub(crate) const MODEL_PHASES: [&str; 6] = ["tree", "portals", "outside", "faces", "hulls", "csg"];
+
+/// One model's trees and faces.
+pub(crate) struct ModelOutput {
+    pub tree: Tree,
+    pub portals: Portals,
+    /// Portals between the structural leaves, when detail split some of them.
+    pub cluster_portals: Option<Portals>,
+    pub faces: Vec<ModelFace>,
+    pub hulls: [Tree; 2],
+    pub bounds: Bounds,
+    pub fill: Option<FillOutcome>,
+    pub face_stats: FaceStats,
+    /// Seconds spent in each of [`MODEL_PHASES`].
+    pub timings: [f64; 6],
+}
+
+/// Build model `m`. `occupants` are the world's point entities (none for brush entities).
+pub(crate) fn build_model(
+    m: ModelInput,
+    planes: &PlaneSet,
+    texinfos: &[FaceTexInfo],
+    options: &CompileOptions,
+    occupants: &[Occupant],
+) -> (ModelOutput, Vec<Warning>) {
+    let mut warnings = Vec::new();
+    let mut timings = [0.0; 6];
+    let bounds = model_bounds(&m);
+    let splitting = Splitting {
+        heuristic: options.heuristic,
+        max_node_size: options.max_node_size,
+    };
+    let progress = &options.progress;
+    let t = Instant::now();
+    let mut brushes = m.brushes;
+    let [mut h1, mut h2] = m.hull_brushes;
+    let counts = [brushes.len(), h1.len(), h2.len()];
+    for list in [&mut brushes, &mut h1, &mut h2] {
+        mark_hidden_sides(list, planes);
+        progress.advance(list.len());
+    }
+    let hull_bounds = [&h1, &h2].map(|list| {
+        list.iter()
+            .fold(Bounds::EMPTY, |acc, b| acc.union(&b.bounds))
+    });
+    timings[5] = t.elapsed().as_secs_f64();
+    let ((mut tree, tree_time), (mut hulls, hull_time)) = rayon::join(
+        || {
+            let t = Instant::now();
+            let tree = build_tree(brushes, planes, splitting, true);
+            progress.advance(counts[0]);
+            (tree, t.elapsed().as_secs_f64())
+        },
+        || {
+            let t = Instant::now();
+            let (a, b) = rayon::join(
+                || build_clip_hull_tree(h1, planes, splitting),
+                || build_clip_hull_tree(h2, planes, splitting),
+            );
+            progress.advance(counts[1] + counts[2]);
+            ([a, b], t.elapsed().as_secs_f64())
+        },
+    );
+    timings[0] = tree_time;
+    timings[4] = hull_time;
+
+    let t = Instant::now();
+    let portals = make_portals(&tree, planes, &bounds);
+    let cluster_portals = tree
+        .nodes
+        .iter()
+        .any(|n| n.cluster.is_some() && !n.is_leaf())
+        .then(|| make_cluster_portals(&tree, planes, &bounds));
+    timings[1] = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let is_world = m.entity == 0;
+    let fill = (is_world && options.fill).then(|| {
+        let flood = cluster_portals.as_ref().unwrap_or(&portals);
+        fill_outside(
+            &mut tree,
+            planes,
+            flood,
+            occupants,
+            OnPlane::Sealing,
+            &mut warnings,
+        )
+    });
+    timings[2] = t.elapsed().as_secs_f64();
+
+    // A sealed world's clip hulls are sealed too (grown brushes only close gaps further): fill
+    // their outsides as well, so it collapses into one solid leaf instead of many clip nodes.
+    let t = Instant::now();
+    if matches!(fill, Some(FillOutcome::Sealed { .. })) {
+        let [h1, h2] = &mut hulls;
+        rayon::join(
+            || fill_hull(h1, planes, &hull_bounds[0], occupants, splitting),
+            || fill_hull(h2, planes, &hull_bounds[1], occupants, splitting),
+        );
+    }
+    progress.advance(counts[1] + counts[2]);
+    timings[4] += t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let (faces, face_stats) = model_faces(&tree, &portals, planes, texinfos, options.subdivide);
+    timings[3] = t.elapsed().as_secs_f64();
+    progress.advance(counts[0]);
+
+    (
+        ModelOutput {
+            tree,
+            portals,
+            cluster_portals,
+            faces,
+            hulls,
+            bounds,
+            fill,
+            face_stats,
+            timings,
+        },
+        warnings,
+    )
+}
+
+/// The bounds engines size a model by (a door's travel, its trigger field): its map brushes,
+/// clip brushes included, not the grown ones; a unit box around the origin for an empty model.
+fn model_bounds(m: &ModelInput) -> Bounds {
+    let bounds = m
+        .brushes
+        .iter()
+        .fold(m.clip_bounds, |acc, b| acc.union(&b.bounds));
+    if bounds.is_empty() {
+        Bounds {
+            mins: DVec3::new(-1.0, -1.0, -1.0),
+            maxs: DVec3::new(1.0, 1.0, 1.0),
+        }
+    } else {
+        bounds
+    }
+}
+
+/// Fill the outside of a clip hull's tree, flooding from the world's point entities, and
+/// rebuild it from what is left.
+fn fill_hull(
+    tree: &mut Tree,
+    planes: &PlaneSet,
+    bounds: &Bounds,
+    occupants: &[Occupant],
+    splitting: Splitting,
+) {
+    if bounds.is_empty() {
+        return;
+    }
+    let portals = make_portals(tree, planes, bounds);
+    // Entities near walls are inside the grown brushes; that is expected, not worth a warning.
+    let mut ignored = Vec::new();
+    if let FillOutcome::Sealed { .. } = fill_outside(
+        tree,
+        planes,
+        &portals,
+        occupants,
+        OnPlane::Open,
+        &mut ignored,
+    ) {
+        *tree = rebuild_from_surfaces(tree, &portals, planes, splitting);
+    }
+}
+
+/// The faces of hull 0: made on the portals where leaf contents change, merged, and cut for
+/// their lightmaps (a face whose texture meets it edge-on waits until it has a projection of its
+/// own: see `square_up_projections` in the compile).
+fn model_faces(
+    tree: &Tree,
+    portals: &Portals,
+    planes: &PlaneSet,
+    texinfos: &[FaceTexInfo],
+    subdivide: f64,
+) -> (Vec<ModelFace>, FaceStats) {
+    let mut stats = FaceStats::default();
+    let raw = faces_from_portals(tree, portals, planes, texinfos, &mut stats);
+    let merged = merge_faces(raw, |f| *planes.get(f.plane));
+    stats.after_merge = merged.len();
+    let mut faces = Vec::with_capacity(merged.len());
+    for f in merged {
+        let info = &texinfos[f.texinfo as usize];
+        if projection_squareness(&info.vecs, f.normal(planes)) < MIN_SQUARENESS {
+            faces.push(f);
+        } else {
+            cut_for_lightmaps(f, info, subdivide, &mut faces);
+        }
+    }
+    (faces, stats)
+}

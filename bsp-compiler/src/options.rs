@@ -1,0 +1,48 @@
+//! What a compile is asked to do.
+
+use crate::tree::{MID_SPLIT_SIZE, SplitHeuristic};
+use quake_formats::progress::Progress;
+use std::path::PathBuf;
+
+#[derive(Debug, Clone)]
+pub struct CompileOptions {
+    /// Write BSP2 even when BSP29 would do.
+    pub bsp2: bool,
+    /// Directories searched for WADs (the map's own directory is searched last).
+    pub wad_dirs: Vec<PathBuf>,
+    pub heuristic: SplitHeuristic,
+    /// Nodes spanning more than this are cut near their middle first (0: never).
+    pub max_node_size: f64,
+    /// Largest span of a lit face in texels before it is cut (0: never cut).
+    pub subdivide: f64,
+    /// Fill the void outside the map (off keeps it, for debugging; leaks are not looked for).
+    pub fill: bool,
+    /// Build clip hulls 1 and 2 (off: every model is empty to them).
+    pub clip_hulls: bool,
+    /// Classnames whose brushes are left out of the compile (`--omitdetail` and its kin).
+    pub omit: Vec<String>,
+    /// Write texture pixels (off: names and sizes only, for engines that have the textures).
+    pub texture_data: bool,
+    /// Write the BSPX `BRUSHLIST` lump (see [`crate::brushlist`]).
+    pub brush_list: bool,
+    /// Where the long phases report their progress.
+    pub progress: Progress,
+}
+
+impl Default for CompileOptions {
+    fn default() -> Self {
+        CompileOptions {
+            bsp2: false,
+            wad_dirs: Vec::new(),
+            heuristic: SplitHeuristic::default(),
+            max_node_size: MID_SPLIT_SIZE,
+            subdivide: 240.0,
+            fill: true,
+            clip_hulls: true,
+            omit: Vec::new(),
+            texture_data: true,
+            brush_list: false,
+            progress: Progress::default(),
+        }
+    }
+}
