@@ -4,15 +4,12 @@ use crate::convert::{MapFormat, convert_map};
 use crate::map::parse_map;
 use crate::onlyents::replace_entities;
 use crate::tree::MID_SPLIT_SIZE;
-use crate::{CompileOptions, MapSource, Progress, ProgressEvent, SplitHeuristic, compile};
+use crate::{CompileOptions, MapSource, SplitHeuristic, compile};
 use anyhow::{Context, Result};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use quake_formats::Bsp;
 use quake_formats::fsutil::write_atomic;
 use quake_formats::pts::write_pointfile;
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 
 #[derive(clap::Args, Debug, Clone)]
 pub struct Args {
@@ -117,7 +114,7 @@ impl Args {
             omit,
             texture_data: !self.notex,
             brush_list: self.wrbrushes,
-            progress: progress_bar(),
+            progress: quake_formats::progress::terminal(),
         }
     }
 }
@@ -161,41 +158,6 @@ fn only_entities(source: &MapSource, args: &Args, bsp_path: &Path) -> Result<()>
         bsp_path.display()
     );
     Ok(())
-}
-
-/// A progress bar on stderr for each long phase, when stderr is a terminal.
-fn progress_bar() -> Progress {
-    if !std::io::stderr().is_terminal() {
-        return Progress::default();
-    }
-    let current: Mutex<Option<ProgressBar>> = Mutex::new(None);
-    Progress::new(move |event| {
-        let Ok(mut current) = current.lock() else {
-            return;
-        };
-        match event {
-            ProgressEvent::Start { phase, total } => {
-                let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
-                if let Ok(style) =
-                    ProgressStyle::with_template("{msg:>8} {bar:40} {pos}/{len} {elapsed}")
-                {
-                    bar.set_style(style);
-                }
-                bar.set_message(phase);
-                *current = Some(bar);
-            }
-            ProgressEvent::Advance(n) => {
-                if let Some(bar) = current.as_ref() {
-                    bar.inc(n);
-                }
-            }
-            ProgressEvent::Finish => {
-                if let Some(bar) = current.take() {
-                    bar.finish_and_clear();
-                }
-            }
-        }
-    })
 }
 
 /// Remove a file an earlier compile left that no longer belongs to the map (a pointfile once it

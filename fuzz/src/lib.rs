@@ -110,7 +110,6 @@ pub fn prt(data: &[u8]) {
     let options = vis::VisOptions {
         mode: vis::VisMode::Fast,
         threads: Some(1),
-        progress: false,
         ..Default::default()
     };
     let bytes = vis::set_bytes(&prt);
@@ -173,7 +172,6 @@ fn run_vis(bsp: &mut Bsp) {
     let options = vis::VisOptions {
         mode: vis::VisMode::Fast,
         threads: Some(1),
-        progress: false,
         ..Default::default()
     };
     let Ok(result) = vis::compute_vis(&prt, &options) else {

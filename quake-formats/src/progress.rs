@@ -65,3 +65,42 @@ impl Progress {
         self.send(ProgressEvent::Finish);
     }
 }
+
+/// Progress drawn on stderr, one bar per phase, when stderr is a terminal (nowhere otherwise).
+#[cfg(feature = "terminal")]
+pub fn terminal() -> Progress {
+    use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+    use std::io::IsTerminal;
+    use std::sync::Mutex;
+    if !std::io::stderr().is_terminal() {
+        return Progress::default();
+    }
+    let current: Mutex<Option<ProgressBar>> = Mutex::new(None);
+    Progress::new(move |event| {
+        let Ok(mut current) = current.lock() else {
+            return;
+        };
+        match event {
+            ProgressEvent::Start { phase, total } => {
+                let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
+                if let Ok(style) =
+                    ProgressStyle::with_template("{msg:>8} {bar:40} {pos}/{len} {elapsed}")
+                {
+                    bar.set_style(style);
+                }
+                bar.set_message(phase);
+                *current = Some(bar);
+            }
+            ProgressEvent::Advance(n) => {
+                if let Some(bar) = current.as_ref() {
+                    bar.inc(n);
+                }
+            }
+            ProgressEvent::Finish => {
+                if let Some(bar) = current.take() {
+                    bar.finish_and_clear();
+                }
+            }
+        }
+    })
+}

@@ -55,7 +55,7 @@ fn main() {
         let options = VisOptions {
             mode,
             threads: None,
-            progress: true,
+            progress: quake_formats::progress::terminal(),
             ..Default::default()
         };
         let start = Instant::now();

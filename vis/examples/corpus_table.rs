@@ -52,7 +52,6 @@ fn main() {
             let options = VisOptions {
                 mode,
                 threads: None,
-                progress: false,
                 ..Default::default()
             };
             // Best of `RUNS`: the machine is shared, and every run gives the same sets.

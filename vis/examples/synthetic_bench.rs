@@ -22,7 +22,6 @@ fn main() {
         let options = VisOptions {
             mode,
             threads: None,
-            progress: false,
             ..Default::default()
         };
         let start = Instant::now();

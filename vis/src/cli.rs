@@ -2,8 +2,9 @@
 //! shard's part of the full flow (`--shard K/N`), joined later by `--merge`.
 
 use crate::saved::{InputsHash, SavedFlows, SavedKind};
+use crate::shards;
 use crate::{BitSet, Checkpoint, KnownFlows, SaveFlows, Shard, VisMode, VisOptions};
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use quake_formats::Bsp;
 use quake_formats::fsutil::{read_file, write_atomic};
 use quake_formats::prt::PortalFile;
@@ -61,20 +62,14 @@ pub fn run(args: &Args) -> Result<()> {
     let result = if args.merge {
         merge(args, &inputs)?
     } else {
-        let options = VisOptions {
-            mode: if args.fast {
-                VisMode::Fast
-            } else {
-                VisMode::Full { level: args.level }
-            },
-            threads: args.threads,
-            progress: true,
-            ..Default::default()
-        };
-        let state_path = saved_path(&args.bsp, "vis.state");
-        let known = resume_state(args, &inputs, Shard::WHOLE, &state_path)?;
+        let options = options(args);
+        let state_path = shards::state_path(&args.bsp);
+        let known = resume(args, &inputs, Shard::WHOLE, &state_path)?;
         let save = |results: Vec<(usize, &BitSet)>| {
-            save_state(&inputs, Shard::WHOLE, &state_path, results);
+            save_state(
+                &state_path,
+                shards::state_bytes(inputs.hash, Shard::WHOLE, results),
+            );
         };
         let checkpoint = checkpoint(args, &save);
         let result = crate::compute_vis_resuming(&inputs.prt, &options, known, checkpoint.as_ref())
@@ -83,6 +78,19 @@ pub fn run(args: &Args) -> Result<()> {
         result
     };
     finish(args, inputs, result, total)
+}
+
+fn options(args: &Args) -> VisOptions {
+    VisOptions {
+        mode: if args.fast {
+            VisMode::Fast
+        } else {
+            VisMode::Full { level: args.level }
+        },
+        threads: args.threads,
+        progress: quake_formats::progress::terminal(),
+        ..Default::default()
+    }
 }
 
 /// The BSP and portal file every mode reads, checked against each other.
@@ -119,16 +127,6 @@ impl Inputs {
     }
 }
 
-/// `MAP.<suffix>` beside the BSP.
-fn saved_path(bsp: &Path, suffix: &str) -> PathBuf {
-    bsp.with_extension(suffix)
-}
-
-/// Where shard `shard`'s partial goes by default: `MAP.vis.K-of-N`.
-pub fn partial_path(bsp: &Path, shard: Shard) -> PathBuf {
-    saved_path(bsp, &format!("vis.{}-of-{}", shard.index + 1, shard.count))
-}
-
 fn checkpoint<'a>(args: &Args, save: &'a SaveFlows<'a>) -> Option<Checkpoint<'a>> {
     (args.save_interval > 0.0 && !args.fast).then(|| Checkpoint {
         every: Duration::from_secs_f64(args.save_interval),
@@ -136,9 +134,8 @@ fn checkpoint<'a>(args: &Args, save: &'a SaveFlows<'a>) -> Option<Checkpoint<'a>
     })
 }
 
-/// The results a saved state holds, when `--resume` asks for them; a state of other inputs or
-/// another shard is refused.
-fn resume_state(args: &Args, inputs: &Inputs, shard: Shard, path: &Path) -> Result<KnownFlows> {
+/// The results the saved state at `path` holds, when `--resume` asks for them.
+fn resume(args: &Args, inputs: &Inputs, shard: Shard, path: &Path) -> Result<KnownFlows> {
     if !args.resume || args.fast {
         return Ok(Vec::new());
     }
@@ -149,40 +146,20 @@ fn resume_state(args: &Args, inputs: &Inputs, shard: Shard, path: &Path) -> Resu
         );
         return Ok(Vec::new());
     }
-    let name = path.display();
-    let state = SavedFlows::read(&read_file(path)?, SavedKind::State)
-        .with_context(|| format!("{name}: cannot resume from it (delete it to start over)"))?;
-    if state.inputs != inputs.hash || state.shard != shard {
-        bail!(
-            "{name}: saved from other inputs (inputs {}, shard {}; this run has inputs {}, shard \
-             {shard}): the map, its portal file or --level changed; delete it to start over",
-            state.inputs,
-            state.shard,
-            inputs.hash
-        );
-    }
-    let mut known: KnownFlows = vec![None; state.portals];
-    let count = state.results.len();
-    for (p, set) in state.results {
-        known[p] = Some(set);
-    }
+    let known = shards::resume_from(path, &read_file(path)?, inputs.hash, shard)
+        .context("cannot resume from it (delete it to start over)")?;
     eprintln!(
-        "resuming from {name}: {count} of {} portal flows done",
-        state.portals
+        "resuming from {}: {} of {} portal flows done",
+        path.display(),
+        known.iter().flatten().count(),
+        known.len()
     );
     Ok(known)
 }
 
 /// Write the state atomically; a failure only warns, the run goes on.
-fn save_state(inputs: &Inputs, shard: Shard, path: &Path, results: Vec<(usize, &BitSet)>) {
-    let state = SavedFlows {
-        kind: SavedKind::State,
-        inputs: inputs.hash,
-        shard,
-        portals: results.first().map_or(0, |(_, s)| s.len()),
-        results: results.into_iter().map(|(p, s)| (p, s.clone())).collect(),
-    };
-    if let Err(e) = write_atomic(path, &state.write()) {
+fn save_state(path: &Path, bytes: Vec<u8>) {
+    if let Err(e) = write_atomic(path, &bytes) {
         eprintln!("warning: could not save the vis state: {e}");
     }
 }
@@ -200,18 +177,19 @@ fn run_shard(args: &Args, inputs: &Inputs, shard: Shard) -> Result<()> {
         .partial
         .first()
         .cloned()
-        .unwrap_or_else(|| partial_path(&args.bsp, shard));
-    let mut state_name = out.clone().into_os_string();
-    state_name.push(".state");
-    let state_path = PathBuf::from(state_name);
-    let known = resume_state(args, inputs, shard, &state_path)?;
-    let save = |results: Vec<(usize, &BitSet)>| save_state(inputs, shard, &state_path, results);
+        .unwrap_or_else(|| shards::partial_path(&args.bsp, shard));
+    let state_path = shards::shard_state_path(&out);
+    let known = resume(args, inputs, shard, &state_path)?;
+    let save = |results: Vec<(usize, &BitSet)>| {
+        save_state(
+            &state_path,
+            shards::state_bytes(inputs.hash, shard, results),
+        );
+    };
     let checkpoint = checkpoint(args, &save);
     let flows = crate::compute_shard(
         &inputs.prt,
-        args.level,
-        args.threads,
-        crate::Grouping::Auto,
+        &options(args),
         shard,
         known,
         checkpoint.as_ref(),
@@ -241,122 +219,21 @@ fn run_shard(args: &Args, inputs: &Inputs, shard: Shard) -> Result<()> {
 /// Read every shard's partial file and join their flows into the sets of one whole run.
 fn merge(args: &Args, inputs: &Inputs) -> Result<crate::VisResult> {
     let paths = if args.partial.is_empty() {
-        find_partials(&args.bsp)?
+        shards::find_partials(&args.bsp).with_context(|| format!("{}", args.bsp.display()))?
     } else {
         args.partial.clone()
     };
-    if paths.is_empty() {
-        bail!(
-            "no partial files {} beside {}: run `vis --shard K/N` for every shard first",
-            saved_path(&args.bsp, "vis.K-of-N").display(),
-            args.bsp.display()
-        );
-    }
-    let mut partials: Vec<(PathBuf, SavedFlows)> = Vec::new();
-    for path in paths {
-        let partial = SavedFlows::read(&read_file(&path)?, SavedKind::Partial)
-            .with_context(|| format!("{}", path.display()))?;
-        if partial.inputs != inputs.hash {
-            bail!(
-                "{}: computed from other inputs (inputs {}; {} with --level {} has {}): the \
-                 partial belongs to another map, portal file or level",
-                path.display(),
-                partial.inputs,
-                args.bsp.display(),
-                args.level,
-                inputs.hash
-            );
-        }
-        partials.push((path, partial));
-    }
-    check_shards(&partials)?;
-    let portals = partials[0].1.portals;
-    let mut flows: Vec<Option<BitSet>> = vec![None; portals];
-    for (path, partial) in partials {
-        for (p, set) in partial.results {
-            if flows[p].replace(set).is_some() {
-                bail!("{}: portal {p} is in two partials", path.display());
-            }
-        }
-    }
-    let flows: Vec<BitSet> = flows
+    let files = paths
         .into_iter()
-        .enumerate()
-        .map(|(p, f)| f.with_context(|| format!("no partial holds portal {p}")))
-        .collect::<Result<_>>()?;
-    crate::vis_from_flows(&inputs.prt, &flows)
-        .with_context(|| format!("{}", inputs.prt_path.display()))
-}
-
-/// Every shard of one count exactly once.
-fn check_shards(partials: &[(PathBuf, SavedFlows)]) -> Result<()> {
-    let (first_path, first) = &partials[0];
-    let count = first.shard.count;
-    let mut by_shard: Vec<Option<&Path>> = vec![None; count];
-    for (path, partial) in partials {
-        let shard = partial.shard;
-        if shard.count != count {
-            bail!(
-                "{} is shard {shard} but {} is shard {}: the partials come from runs with \
-                 different shard counts",
-                path.display(),
-                first_path.display(),
-                first.shard
-            );
-        }
-        if let Some(other) = by_shard[shard.index].replace(path) {
-            bail!(
-                "shard {shard} given twice: {} and {}",
-                other.display(),
-                path.display()
-            );
-        }
-    }
-    let missing: Vec<String> = (0..count)
-        .filter(|&i| by_shard[i].is_none())
-        .map(|index| Shard { index, count }.to_string())
-        .collect();
-    if !missing.is_empty() {
-        let found: Vec<String> = partials
-            .iter()
-            .map(|(p, _)| p.display().to_string())
-            .collect();
-        bail!(
-            "missing the partial of shard {}; found only {}",
-            missing.join(", "),
-            found.join(", ")
-        );
-    }
-    Ok(())
-}
-
-/// Every `MAP.vis.K-of-N` beside the BSP, sorted by name.
-fn find_partials(bsp: &Path) -> Result<Vec<PathBuf>> {
-    let dir = match bsp.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let stem = bsp
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let prefix = format!("{stem}.vis.");
-    let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
-    let mut found = Vec::new();
-    for entry in std::fs::read_dir(dir).with_context(|| format!("{}", dir.display()))? {
-        let path = entry?.path();
-        let name = path.file_name().map(|n| n.to_string_lossy().into_owned());
-        let is_partial = name
-            .as_deref()
-            .and_then(|n| n.strip_prefix(&prefix))
-            .and_then(|rest| rest.split_once("-of-"))
-            .is_some_and(|(k, n)| digits(k) && digits(n));
-        if is_partial {
-            found.push(path);
-        }
-    }
-    found.sort();
-    Ok(found)
+        .map(|path| Ok((path.clone(), read_file(&path)?)))
+        .collect::<Result<Vec<_>>>()?;
+    shards::merge_partials(&inputs.prt, files, inputs.hash).with_context(|| {
+        format!(
+            "joining the partials of {} (--level {})",
+            args.bsp.display(),
+            args.level
+        )
+    })
 }
 
 /// Write the sets into the BSP and report.

@@ -18,6 +18,7 @@ pub mod pvs;
 pub mod sample;
 pub mod saved;
 pub mod schedule;
+pub mod shards;
 pub mod synthetic;
 pub mod tree_portals;
 
@@ -28,10 +29,9 @@ pub use portals::PortalGraph;
 pub use pvs::Pvs;
 pub use schedule::{FlowPlan, Grouping, Shard};
 
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use quake_formats::progress::Progress;
 use quake_formats::prt::PortalFile;
 use rayon::prelude::*;
-use std::io::IsTerminal;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Mutex, OnceLock};
 use std::time::{Duration, Instant};
@@ -50,6 +50,8 @@ pub enum VisError {
          leads to it) and compile again"
     )]
     Void { leaf: usize },
+    #[error("a shard runs a share of the full flow; base vis (fast) has none")]
+    FastShard,
     #[error("the BSP has no models, so no world model to compute visibility for")]
     NoWorldModel,
     #[error("the world model claims {vis_leafs} vis leaves but the BSP has {leafs} leaves")]
@@ -115,8 +117,8 @@ pub struct VisOptions {
     pub mode: VisMode,
     /// Worker threads; `None` uses every core.
     pub threads: Option<usize>,
-    /// Show a progress bar on stderr (only drawn when stderr is a terminal).
-    pub progress: bool,
+    /// Where the full flow reports its progress (one unit per one-way portal flow).
+    pub progress: Progress,
     /// Whether the full flow is planned in groups for shards ([`FlowPlan`]).
     pub grouping: Grouping,
 }
@@ -126,7 +128,7 @@ impl Default for VisOptions {
         VisOptions {
             mode: VisMode::Full { level: 4 },
             threads: None,
-            progress: false,
+            progress: Progress::default(),
             grouping: Grouping::Auto,
         }
     }
@@ -203,7 +205,7 @@ pub fn compute_vis_resuming(
                     mightsee: &mightsee,
                     plan: &plan,
                     level,
-                    progress: options.progress,
+                    progress: &options.progress,
                     wanted: &wanted,
                     checkpoint,
                 };
@@ -236,19 +238,21 @@ pub struct ShardFlows {
     pub flow_seconds: f64,
 }
 
-/// Run the full flow (at `level`) of `shard`'s share of the portals: the shared ones and the
-/// shard's final groups. [`vis_from_flows`] turns the results of all
-/// shards into the same sets [`compute_vis`] gives.
+/// Run the full flow of `shard`'s share of the portals: the shared ones and the shard's final
+/// groups ([`VisOptions::mode`] gives the level; fast mode has no flow to share).
+/// [`vis_from_flows`] turns the results of all shards into the same sets [`compute_vis`] gives.
 pub fn compute_shard(
     prt: &PortalFile,
-    level: u8,
-    threads: Option<usize>,
-    grouping: Grouping,
+    options: &VisOptions,
     shard: Shard,
     known: KnownFlows,
     checkpoint: Option<&Checkpoint>,
 ) -> Result<ShardFlows, VisError> {
-    let setup = Setup::new(prt, threads)?;
+    let VisMode::Full { level } = options.mode else {
+        return Err(VisError::FastShard);
+    };
+    let grouping = options.grouping;
+    let setup = Setup::new(prt, options.threads)?;
     Ok(setup.pool.install(|| {
         let (mightsee, base_seconds) = base_vis(&setup.graph);
         let start = Instant::now();
@@ -259,7 +263,7 @@ pub fn compute_shard(
             mightsee: &mightsee,
             plan: &plan,
             level,
-            progress: false,
+            progress: &options.progress,
             wanted: &wanted,
             checkpoint,
         };
@@ -397,7 +401,7 @@ struct FlowJob<'a> {
     mightsee: &'a [BitSet],
     plan: &'a FlowPlan,
     level: u8,
-    progress: bool,
+    progress: &'a Progress,
     /// By portal: whether to run its flow (a shard skips the other shards' groups).
     wanted: &'a [bool],
     checkpoint: Option<&'a Checkpoint<'a>>,
@@ -408,16 +412,14 @@ struct FlowJob<'a> {
 /// portals not wanted, or whose worker panicked).
 fn full_flow(job: &FlowJob, known: KnownFlows) -> Vec<Option<BitSet>> {
     let n = job.graph.portals.len();
-    let bar = progress_bar(
-        job.wanted.iter().filter(|&&w| w).count() as u64,
-        job.progress,
-    );
+    let bar = job.progress;
+    bar.start("flow", job.wanted.iter().filter(|&&w| w).count());
     // The plan decides which results a flow may use, so known ones can all go in at once.
     let results: Vec<OnceLock<BitSet>> = (0..n).map(|_| OnceLock::new()).collect();
     for (p, set) in known.into_iter().enumerate().take(n) {
         if let Some(set) = set.filter(|s| job.wanted[p] && s.len() == n) {
             let _ = results[p].set(set);
-            bar.inc(1);
+            bar.advance(1);
         }
     }
     let workspaces: Vec<Mutex<flow::Workspace>> = (0..rayon::current_num_threads())
@@ -456,7 +458,7 @@ fn full_flow(job: &FlowJob, known: KnownFlows) -> Vec<Option<BitSet>> {
                     break;
                 };
                 let _ = results[todo[i]].set(flow::portal_flow(&ctx, todo[i], &mut ws));
-                bar.inc(1);
+                bar.advance(1);
                 if let Some(saver) = &saver {
                     saver.save_if_due(|| {
                         let finished = results.iter().enumerate();
@@ -468,7 +470,7 @@ fn full_flow(job: &FlowJob, known: KnownFlows) -> Vec<Option<BitSet>> {
             }
         });
     }
-    bar.finish_and_clear();
+    bar.finish();
     results.into_iter().map(OnceLock::into_inner).collect()
 }
 
@@ -494,20 +496,6 @@ impl Saver<'_> {
         }
         self.busy.store(false, Ordering::Release);
     }
-}
-
-/// A bar with a time estimate on stderr, or a hidden one when stderr is not a terminal.
-pub fn progress_bar(len: u64, enabled: bool) -> ProgressBar {
-    if !enabled || !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
-    if let Ok(style) =
-        ProgressStyle::with_template("{elapsed_precise} [{wide_bar}] {percent}% eta {eta}")
-    {
-        bar.set_style(style);
-    }
-    bar
 }
 
 #[cfg(test)]
@@ -538,13 +526,16 @@ mod tests {
             ..VisOptions::default()
         };
         let whole = compute_vis(&prt, &grouped).expect("vis");
+        let two_threads_grouped = VisOptions {
+            threads: Some(2),
+            ..grouped
+        };
         for count in [1, 2, 3, 16, 17] {
             let mut flows: Vec<Option<BitSet>> = Vec::new();
             for index in 0..count {
                 let shard = Shard { index, count };
-                let part =
-                    compute_shard(&prt, 4, Some(2), Grouping::Always, shard, Vec::new(), None)
-                        .expect("shard");
+                let part = compute_shard(&prt, &two_threads_grouped, shard, Vec::new(), None)
+                    .expect("shard");
                 flows.resize(part.portals, None);
                 for (p, set) in part.results {
                     assert!(flows[p].replace(set).is_none(), "portal {p} twice");

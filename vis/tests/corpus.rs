@@ -64,7 +64,6 @@ fn our_vis_on_start_is_never_too_small_and_no_larger_than_the_stored_one() {
     let options = vis::VisOptions {
         mode: vis::VisMode::Full { level: 2 },
         threads: None,
-        progress: false,
         ..Default::default()
     };
     let ours = vis::compute_vis(&prt, &options).expect("vis").pvs;

@@ -43,7 +43,6 @@ fn check_map(corpus: &Path, rel: &str, pairs: usize) {
         let options = VisOptions {
             mode,
             threads: None,
-            progress: false,
             ..Default::default()
         };
         let result = compute_vis(&prt, &options).expect("vis");

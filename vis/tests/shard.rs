@@ -5,7 +5,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 use vis::Shard;
-use vis::cli::{Args, partial_path, run};
+use vis::cli::{Args, run};
+use vis::shards::partial_path;
 use vis::synthetic::VoxelWorld;
 
 fn temp_dir(name: &str) -> PathBuf {

@@ -12,7 +12,6 @@ fn run(prt: &PortalFile, mode: VisMode) -> Pvs {
     let options = VisOptions {
         mode,
         threads: Some(2),
-        progress: false,
         ..Default::default()
     };
     compute_vis(prt, &options).expect("vis").pvs
@@ -310,7 +309,6 @@ fn the_pvs_does_not_depend_on_the_thread_count() {
         let options = VisOptions {
             mode: FULL,
             threads: Some(threads),
-            progress: false,
             ..Default::default()
         };
         compute_vis(&prt, &options).expect("vis").pvs
