@@ -5,8 +5,8 @@ mod inspect;
 mod report;
 
 use anyhow::Result;
-use batch::options::normalise_single_dash;
 use clap::{Parser, Subcommand};
+use quake_formats::cli::normalise_single_dash;
 use std::process::ExitCode;
 
 // Every stage allocates small per-face buffers on rayon's threads and frees them elsewhere; glibc's
@@ -20,7 +20,7 @@ static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 #[derive(Parser, Debug)]
 #[command(
     name = "slipgate",
-    version,
+    version = concat!(env!("CARGO_PKG_VERSION"), " (", env!("SLIPGATE_COMMIT"), ")"),
     about = "Compile Quake .map files to BSP (qbsp, vis, light) and preview them",
     long_about = "Compile Quake .map files to BSP29/BSP2 (qbsp, vis, light) and preview them with a \
                   software renderer.\n\nericw-tools' single-dash spellings (-bsp2, -fast, -extra4, \

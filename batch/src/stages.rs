@@ -26,7 +26,7 @@ use crate::project::MapJob;
 use bsp_compiler::map::{MapFile, parse_map};
 use bsp_compiler::prefab::expand_prefabs;
 use bsp_compiler::wad_lookup::WadSet;
-use bsp_compiler::{CompileOptions, MapSource, Progress, compile, wad_search_dirs};
+use bsp_compiler::{CompileOptions, MapSource, Progress, compile, wad_search};
 use quake_formats::Bsp;
 use quake_formats::fsutil::write_atomic;
 use quake_formats::prt::PortalFile;
@@ -271,7 +271,7 @@ fn bsp_stage(
     }
     let mut options = args.compile_options();
     options.progress = Progress::default();
-    for dir in &mut options.wad_dirs {
+    for dir in options.wad_dirs.iter_mut().chain(&mut options.xwad_dirs) {
         *dir = ctx.project_root.join(&*dir);
     }
     let mut key = key_with_options(ctx, "bsp", &words);
@@ -373,12 +373,10 @@ fn wads_used(
     map: &MapFile,
     options: &CompileOptions,
 ) -> Result<Vec<(PathBuf, Vec<u8>)>, String> {
-    let key = map
-        .entities
-        .first()
-        .and_then(|e| e.entity.get("wad"))
-        .unwrap_or("");
-    let wads = WadSet::load(key, &wad_search_dirs(source, options), &mut Vec::new());
+    let Some(world) = map.entities.first() else {
+        return Ok(Vec::new());
+    };
+    let wads = WadSet::load(&world.entity, &wad_search(source, options), &mut Vec::new());
     wads.paths()
         .map(|path| {
             let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
@@ -444,7 +442,7 @@ fn ents_stage(
         .field("map", source.text.as_bytes());
     cached_stage(ctx, "ents", key.finish(), runs, || {
         let mut bsp = read_bsp(&blob(ctx, "vis", visible, "bsp").map_err(|f| f.message)?)?;
-        bsp_compiler::onlyents::replace_entities(source, &args.compile_options().omit, &mut bsp)
+        bsp_compiler::onlyents::replace_entities(source, &args.compile_options(), &mut bsp)
             .map_err(|e| e.to_string())?;
         let entities =
             quake_formats::entities::parse_entities(&bsp.entity_text()).map_or(0, |e| e.len());

@@ -20,10 +20,16 @@ pub struct Args {
     /// Write BSP2 (BSP29 is used unless a limit is exceeded)
     #[arg(long)]
     pub bsp2: bool,
-    /// A directory to search for the WADs named by worldspawn (repeatable; the map's own
-    /// directory is searched last)
-    #[arg(long = "wad-dir", value_name = "DIR")]
+    /// A directory to search for the WADs worldspawn names (repeatable; ericw-tools spells it
+    /// -wadpath). A WAD named with a path is looked for with that path joined onto each
+    /// directory, then by its file name alone; the map's own directory and the working
+    /// directory are searched last
+    #[arg(long = "wad-dir", visible_alias = "wadpath", value_name = "DIR")]
     pub wad_dirs: Vec<PathBuf>,
+    /// Like --wad-dir, but the textures of WADs found there are not embedded: only their names
+    /// and sizes, for engines that load them from the WAD (-xwadpath)
+    #[arg(long = "xwadpath", value_name = "DIR")]
+    pub xwad_dirs: Vec<PathBuf>,
     /// How node planes are chosen: fewest-splits or balanced
     #[arg(long, default_value = "fewest-splits")]
     pub heuristic: SplitHeuristic,
@@ -69,6 +75,11 @@ pub struct Args {
     /// Leave out func_detail_fence brushes
     #[arg(long)]
     pub omitdetailfence: bool,
+    /// Keep editor-only keys (TrenchBroom's _tb_textures, _tb_layer...) in the entity lump; by
+    /// default they are left out, as they mean nothing to engines and _tb_textures can crash
+    /// vanilla clients
+    #[arg(long)]
+    pub keep_editor_keys: bool,
     /// Write the BSPX BRUSHLIST lump: every model's brushes, for engines and importers that
     /// collide with brushes (FTE, bevy_trenchbroom)
     #[arg(long, alias = "bspx")]
@@ -102,6 +113,7 @@ impl Args {
         CompileOptions {
             bsp2: self.bsp2,
             wad_dirs: self.wad_dirs.clone(),
+            xwad_dirs: self.xwad_dirs.clone(),
             heuristic: self.heuristic,
             max_node_size: self.maxnodesize,
             subdivide: if self.nosubdivide {
@@ -114,6 +126,7 @@ impl Args {
             omit,
             texture_data: !self.notex,
             brush_list: self.wrbrushes,
+            keep_editor_keys: self.keep_editor_keys,
             progress: quake_formats::progress::terminal(),
         }
     }
@@ -150,7 +163,7 @@ fn only_entities(source: &MapSource, args: &Args, bsp_path: &Path) -> Result<()>
     let bytes = std::fs::read(bsp_path)
         .with_context(|| format!("--onlyents: reading {}", bsp_path.display()))?;
     let mut bsp = Bsp::read(&bytes).with_context(|| format!("reading {}", bsp_path.display()))?;
-    replace_entities(source, &args.compile_options().omit, &mut bsp)?;
+    replace_entities(source, &args.compile_options(), &mut bsp)?;
     write_atomic(bsp_path, &bsp.write().context("encoding the BSP")?)?;
     println!(
         "wrote the entities of {} into {}",

@@ -3,6 +3,7 @@
 //! ([`crate::model`], the models in parallel), then emit the BSP and the portal file.
 
 use crate::brushlist::brush_list_lump;
+use crate::editor::{OmittedLayer, omitted_layers, without_editor_keys};
 use crate::emit::{EmitInput, emit};
 use crate::faces::{
     FaceStats, FaceTexInfo, MIN_SQUARENESS, cut_for_lightmaps, projection_squareness,
@@ -20,7 +21,7 @@ use crate::planes::PlaneSet;
 use crate::prefab::{PrefabError, expand_prefabs};
 use crate::texinfo::Projection;
 use crate::tree::SplitHeuristic;
-use crate::wad_lookup::WadSet;
+use crate::wad_lookup::{WadSearch, WadSet};
 use crate::warnings::Warning;
 use quake_formats::entities::Entity;
 use quake_formats::geom::Plane;
@@ -145,6 +146,8 @@ pub fn compile(
     timings.push(("parse".to_string(), t.elapsed().as_secs_f64()));
 
     let t = Instant::now();
+    let (left_out, layers) = entities_left_out(&map, options);
+    warnings.extend(layers.into_iter().map(Warning::OmittedLayer));
     let Gathered {
         models,
         planes,
@@ -154,7 +157,7 @@ pub fn compile(
         first_source,
         brushes,
         bad_brushes,
-    } = gather(&map, options, &mut warnings);
+    } = gather(&map, &left_out, options, &mut warnings);
     (stats.brushes, stats.bad_brushes) = (brushes, bad_brushes);
     require_world_brushes(source, &map.entities, &models[0], &warnings)?;
     warn_empty_brush_entities(&map, &models, &mut warnings);
@@ -197,8 +200,8 @@ pub fn compile(
 
     let t = Instant::now();
     let wads = WadSet::load(
-        map.entities[0].entity.get("wad").unwrap_or(""),
-        &wad_search_dirs(source, options),
+        &map.entities[0].entity,
+        &wad_search(source, options),
         &mut warnings,
     );
     let version = if options.bsp2 {
@@ -212,7 +215,7 @@ pub fn compile(
         texinfos: &table.infos,
         texture_names: &table.names,
         wads: &wads,
-        entities: &lump_entities(&map, &options.omit),
+        entities: &lump_entities(&map, &left_out, options),
         version,
         warnings: &mut warnings,
     });
@@ -331,18 +334,40 @@ impl CompileStats {
     }
 }
 
-/// The folders searched, in order, for the WADs a map names: `options.wad_dirs`, then the map's
-/// own folder.
-pub fn wad_search_dirs(source: &MapSource, options: &CompileOptions) -> Vec<PathBuf> {
-    let mut search = options.wad_dirs.clone();
-    if let Some(dir) = source.path.parent() {
-        search.push(if dir.as_os_str().is_empty() {
-            PathBuf::from(".")
-        } else {
-            dir.to_path_buf()
-        });
+/// Where the compile of `source` looks for the WADs its map names: the `wad_dirs`, the
+/// `xwad_dirs` (not embedded), the map's own folder, then the working directory; `MAP.wad`
+/// beside the map when worldspawn names none.
+pub fn wad_search(source: &MapSource, options: &CompileOptions) -> WadSearch {
+    let map_dir = source.path.parent().unwrap_or(Path::new(""));
+    let mut folders: Vec<(PathBuf, bool)> = options
+        .wad_dirs
+        .iter()
+        .map(|d| (d.clone(), true))
+        .chain(options.xwad_dirs.iter().map(|d| (d.clone(), false)))
+        .collect();
+    if !map_dir.as_os_str().is_empty() {
+        folders.push((map_dir.to_path_buf(), true));
     }
-    search
+    folders.push((PathBuf::new(), true));
+    WadSearch {
+        folders,
+        beside_map: source.path.with_extension("wad"),
+    }
+}
+
+/// The entities of `map` the compile leaves out (worldspawn never): those of the classes
+/// `options.omit` names and those in editor layers marked to be omitted from export, with those
+/// layers.
+pub(crate) fn entities_left_out(
+    map: &MapFile,
+    options: &CompileOptions,
+) -> (Vec<bool>, Vec<OmittedLayer>) {
+    let (mut left_out, layers) = omitted_layers(map);
+    for (index, ent) in map.entities.iter().enumerate().skip(1) {
+        let class = ent.entity.classname();
+        left_out[index] |= options.omit.iter().any(|c| c == class);
+    }
+    (left_out, layers)
 }
 
 /// Parse a map, its prefabs expanded; the first entity must be worldspawn.
@@ -362,26 +387,35 @@ pub(crate) fn read_map(source: &MapSource) -> Result<MapFile, CompileError> {
     Ok(map)
 }
 
-/// The entity lump's entities for `map` (leaving out the classes in `omit`): worldspawn, the
-/// point entities, and each brush entity not merged into the world, numbered `*1`, `*2`... in
+/// The entity lump's entities for `map` (leaving out those `left_out` marks, and editor keys
+/// unless `options` keeps them): worldspawn, the point entities, and each brush entity not
+/// merged into the world, numbered `*1`, `*2`... in
 /// order, with the origin its brushes are built around. Merged entities (`func_group`,
 /// `func_detail*`, brushless ones too: they have no spawn function in any game) are left out.
-pub(crate) fn lump_entities(map: &MapFile, omit: &[String]) -> Vec<Entity> {
+pub(crate) fn lump_entities(
+    map: &MapFile,
+    left_out: &[bool],
+    options: &CompileOptions,
+) -> Vec<Entity> {
     let mut planes = PlaneSet::new();
     let mut models = 0;
     let mut out = Vec::new();
+    let kept = |e: &Entity| match options.keep_editor_keys {
+        true => e.clone(),
+        false => without_editor_keys(e),
+    };
     for (index, ent) in map.entities.iter().enumerate() {
-        let class = ent.entity.classname();
-        if index > 0 && omit.iter().any(|c| c == class) {
+        if left_out[index] {
             continue;
         }
+        let class = ent.entity.classname();
         if index == 0 || EntityBrushes::of(index, class) != EntityBrushes::Submodel {
             if index == 0 {
-                out.push(ent.entity.clone());
+                out.push(kept(&ent.entity));
             }
             continue;
         }
-        let mut e = ent.entity.clone();
+        let mut e = kept(&ent.entity);
         if !ent.brushes.is_empty() {
             models += 1;
             e.set("model", format!("*{models}"));

@@ -40,9 +40,10 @@ pub(crate) struct Gathered {
     pub bad_brushes: usize,
 }
 
-/// Build every entity's brushes (leaving out the classnames `options.omit` names).
+/// Build every entity's brushes, but for those `left_out` marks.
 pub(crate) fn gather(
     map: &MapFile,
+    left_out: &[bool],
     options: &CompileOptions,
     warnings: &mut Vec<Warning>,
 ) -> Gathered {
@@ -69,10 +70,10 @@ pub(crate) fn gather(
     progress.start("brushes", map.entities.len());
     for (index, ent) in map.entities.iter().enumerate() {
         progress.advance(1);
-        let class = ent.entity.classname();
-        if index > 0 && options.omit.iter().any(|c| c == class) {
+        if left_out[index] {
             continue;
         }
+        let class = ent.entity.classname();
         if index > 0 && ent.brushes.is_empty() {
             g.occupants.extend(occupant(ent, index));
             continue;

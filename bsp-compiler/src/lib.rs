@@ -18,6 +18,7 @@ mod compile;
 pub mod convert;
 pub mod cracks;
 pub mod csg;
+pub mod editor;
 mod emit;
 pub mod faces;
 mod gather;
@@ -42,7 +43,7 @@ pub mod wad_lookup;
 pub mod warnings;
 pub mod weld;
 
-pub use compile::{CompileError, CompileOutput, CompileStats, MapSource, compile, wad_search_dirs};
+pub use compile::{CompileError, CompileOutput, CompileStats, MapSource, compile, wad_search};
 pub use gather::MapTexInfo;
 pub use options::CompileOptions;
 pub use outside::Leak;

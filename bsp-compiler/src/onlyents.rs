@@ -4,7 +4,8 @@
 //! The brush entities must still match the BSP's models one for one: the entity lump names
 //! models `*1`, `*2`... in order, and a changed count would point entities at the wrong model.
 
-use crate::compile::{CompileError, MapSource, lump_entities, read_map};
+use crate::compile::{CompileError, MapSource, entities_left_out, lump_entities, read_map};
+use crate::options::CompileOptions;
 use quake_formats::Bsp;
 use quake_formats::entities::{Entity, parse_entities, write_entities};
 
@@ -32,15 +33,16 @@ fn model_classes(entities: &[Entity]) -> Vec<String> {
         .collect()
 }
 
-/// Replace `bsp`'s entity lump with the entities of `source` (classes in `omit` left out, as
-/// the compile that made it would).
+/// Replace `bsp`'s entity lump with the entities of `source` as a compile with `options` would
+/// write them.
 pub fn replace_entities(
     source: &MapSource,
-    omit: &[String],
+    options: &CompileOptions,
     bsp: &mut Bsp,
 ) -> Result<(), OnlyEntsError> {
     let map = read_map(source)?;
-    let entities = lump_entities(&map, omit);
+    let (left_out, _) = entities_left_out(&map, options);
+    let entities = lump_entities(&map, &left_out, options);
     let submodels = bsp.models.len().saturating_sub(1);
     let new = model_classes(&entities);
     if new.len() != submodels {

@@ -8,8 +8,12 @@ use std::path::PathBuf;
 pub struct CompileOptions {
     /// Write BSP2 even when BSP29 would do.
     pub bsp2: bool,
-    /// Directories searched for WADs (the map's own directory is searched last).
+    /// Directories searched for WADs (then `xwad_dirs`, the map's own directory and the working
+    /// directory; see [`crate::wad_lookup::WadSearch`]).
     pub wad_dirs: Vec<PathBuf>,
+    /// Directories searched for WADs whose textures are not embedded: only their names and
+    /// sizes go into the BSP, for engines that load them from elsewhere (`-xwadpath`).
+    pub xwad_dirs: Vec<PathBuf>,
     pub heuristic: SplitHeuristic,
     /// Nodes spanning more than this are cut near their middle first (0: never).
     pub max_node_size: f64,
@@ -25,6 +29,8 @@ pub struct CompileOptions {
     pub texture_data: bool,
     /// Write the BSPX `BRUSHLIST` lump (see [`crate::brushlist`]).
     pub brush_list: bool,
+    /// Keep editor-only keys (TrenchBroom's `_tb_*`) in the entity lump ([`crate::editor`]).
+    pub keep_editor_keys: bool,
     /// Where the long phases report their progress.
     pub progress: Progress,
 }
@@ -34,6 +40,7 @@ impl Default for CompileOptions {
         CompileOptions {
             bsp2: false,
             wad_dirs: Vec::new(),
+            xwad_dirs: Vec::new(),
             heuristic: SplitHeuristic::default(),
             max_node_size: MID_SPLIT_SIZE,
             subdivide: 240.0,
@@ -42,6 +49,7 @@ impl Default for CompileOptions {
             omit: Vec::new(),
             texture_data: true,
             brush_list: false,
+            keep_editor_keys: false,
             progress: Progress::default(),
         }
     }

@@ -3,7 +3,9 @@
 
 use crate::texinfo::{AnimationFrame, TextureRole};
 use crate::warnings::Warning;
+use quake_formats::entities::Entity;
 use quake_formats::miptex::MipTex;
+use quake_formats::string_to_name16;
 use quake_formats::wad::Wad;
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
@@ -11,52 +13,119 @@ use std::path::{Path, PathBuf};
 /// The WADs a map's worldspawn names, as far as they were found.
 #[derive(Debug, Default)]
 pub struct WadSet {
-    wads: Vec<(PathBuf, Wad)>,
+    wads: Vec<FoundWad>,
 }
 
-/// The file names listed in a `"wad"` key (`;`-separated, paths in any style).
-pub fn wad_file_names(key: &str) -> Vec<String> {
+#[derive(Debug)]
+struct FoundWad {
+    path: PathBuf,
+    wad: Wad,
+    /// Whether its textures' pixels go into the BSP (not for `-xwadpath` folders).
+    embed: bool,
+}
+
+/// Where a compile looks for the WADs a map names, in order (see [`WadSearch::candidates`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct WadSearch {
+    /// Folders, each with whether the textures of WADs found there are embedded: the
+    /// `--wad-dir` (`-wadpath`) folders, the `-xwadpath` ones (read for sizes only), the map's
+    /// own folder, and the working directory (an empty path).
+    pub folders: Vec<(PathBuf, bool)>,
+    /// The WAD read when worldspawn names none: `MAP.wad` beside the map.
+    pub beside_map: PathBuf,
+}
+
+/// The WAD names worldspawn's `wad` (or `_wad`) key lists (`;`-separated, paths in any style,
+/// `\` read as `/`).
+pub fn wad_names(worldspawn: &Entity) -> Vec<String> {
+    let key = ["wad", "_wad"]
+        .iter()
+        .find_map(|k| worldspawn.get(k).filter(|v| !v.trim().is_empty()))
+        .unwrap_or("");
     key.split(';')
         .map(str::trim)
         .filter(|s| !s.is_empty())
-        .map(|s| s.rsplit(['/', '\\']).next().unwrap_or(s).to_string())
+        .map(|s| s.replace('\\', "/"))
         .collect()
 }
 
+impl WadSearch {
+    /// The paths tried for the WAD `name`, in order, each with whether its textures are
+    /// embedded: an absolute path as written; a relative one, folders and all, joined onto each
+    /// folder; then the file name alone in each folder. (A name with a Windows drive, `C:/...`,
+    /// is only looked for by its file name.)
+    pub fn candidates(&self, name: &str) -> Vec<(PathBuf, bool)> {
+        let path = Path::new(name);
+        let drive = name.len() > 1 && name.as_bytes()[1] == b':';
+        let mut out: Vec<(PathBuf, bool)> = Vec::new();
+        if path.is_absolute() {
+            out.push((path.to_path_buf(), true));
+        } else if !drive {
+            out.extend(
+                self.folders
+                    .iter()
+                    .map(|(dir, embed)| (dir.join(path), *embed)),
+            );
+        }
+        if let Some(file) = path.file_name().filter(|f| Path::new(f) != path) {
+            out.extend(
+                self.folders
+                    .iter()
+                    .map(|(dir, embed)| (dir.join(file), *embed)),
+            );
+        }
+        let mut seen = HashSet::new();
+        out.retain(|(p, _)| seen.insert(p.clone()));
+        out
+    }
+}
+
 impl WadSet {
-    /// Load each WAD named in `wad_key`, searching `search_dirs` in order by file name.
-    pub fn load(wad_key: &str, search_dirs: &[PathBuf], warnings: &mut Vec<Warning>) -> WadSet {
+    /// Load each WAD worldspawn names (`MAP.wad` beside the map when it names none), looking for
+    /// each as [`WadSearch::candidates`] says; a WAD not found is a warning naming where it was
+    /// looked for.
+    pub fn load(worldspawn: &Entity, search: &WadSearch, warnings: &mut Vec<Warning>) -> WadSet {
+        let mut names = wad_names(worldspawn);
+        let beside_map = names.is_empty() && search.beside_map.is_file();
+        if beside_map {
+            names.push(search.beside_map.to_string_lossy().into_owned());
+        }
         let mut wads = Vec::new();
-        for name in wad_file_names(wad_key) {
-            let found = search_dirs
-                .iter()
-                .map(|d| d.join(&name))
-                .find(|p| p.is_file());
-            let Some(path) = found else {
-                warnings.push(Warning::MissingWad { name });
+        for name in names {
+            let candidates = search.candidates(&name);
+            let Some((path, embed)) = candidates.iter().find(|(p, _)| p.is_file()).cloned() else {
+                warnings.push(Warning::MissingWad {
+                    name,
+                    looked: candidates.into_iter().map(|(p, _)| p).collect(),
+                });
                 continue;
             };
             match std::fs::read(&path)
                 .map_err(|e| e.to_string())
                 .and_then(|b| Wad::read(&b).map_err(|e| e.to_string()))
             {
-                Ok(wad) => wads.push((path, wad)),
+                Ok(wad) => wads.push(FoundWad { path, wad, embed }),
                 Err(reason) => warnings.push(Warning::UnreadableWad { path, reason }),
             }
         }
         WadSet { wads }
     }
 
+    /// The files the WADs were read from.
     pub fn paths(&self) -> impl Iterator<Item = &Path> {
-        self.wads.iter().map(|(p, _)| p.as_path())
+        self.wads.iter().map(|w| w.path.as_path())
     }
 
-    /// The texture from the first WAD holding it with pixels.
+    /// The texture from the first WAD holding it with pixels, without them when that WAD's
+    /// textures are not embedded (`-xwadpath`).
     fn find(&self, name: &str) -> Option<MipTex> {
-        self.wads
-            .iter()
-            .find_map(|(_, w)| w.find_miptex(name))
-            .filter(|t| t.mips.is_some())
+        self.wads.iter().find_map(|w| {
+            let mut t = w.wad.find_miptex(name).filter(|t| t.mips.is_some())?;
+            if !w.embed {
+                t.mips = None;
+            }
+            Some(t)
+        })
     }
 
     /// The texture lump for the textures faces use (`used`, in the order texinfos refer to
@@ -100,7 +169,13 @@ impl WadSet {
                     mips: Some(mips),
                     ..
                 }) => MipTex::new(&name, width, height, mips),
-                _ => {
+                Some(MipTex { width, height, .. }) => MipTex {
+                    raw_name: string_to_name16(&name),
+                    width,
+                    height,
+                    mips: None,
+                },
+                None => {
                     let size = AnimationFrame::of(&name)
                         .and_then(|f| frame_sizes.get(f.base).copied())
                         .unwrap_or_else(|| placeholder_size(&name));
@@ -206,21 +281,81 @@ mod tests {
     use quake_formats::wad::WadLump;
 
     #[test]
-    fn wad_key_is_split_into_file_names() {
-        assert_eq!(
-            wad_file_names("gfx/base.wad; C:\\quake\\id1\\x.wad;;/abs/lq_dev.wad"),
-            vec!["base.wad", "x.wad", "lq_dev.wad"]
+    fn the_wad_key_lists_paths_as_written() {
+        let mut world = Entity::default();
+        world.set(
+            "wad",
+            "gfx/base.wad; C:\\quake\\id1\\x.wad;;/abs/lq_dev.wad",
         );
+        assert_eq!(
+            wad_names(&world),
+            vec!["gfx/base.wad", "C:/quake/id1/x.wad", "/abs/lq_dev.wad"]
+        );
+        let mut world = Entity::default();
+        world.set("_wad", "a.wad");
+        assert_eq!(wad_names(&world), vec!["a.wad"]);
     }
 
-    /// A set holding one WAD of `(name, size)` textures.
+    #[test]
+    fn wads_are_looked_for_by_path_then_by_file_name() {
+        let search = WadSearch {
+            folders: vec![
+                (PathBuf::from("/wads"), true),
+                (PathBuf::from("/ext"), false),
+                (PathBuf::new(), true),
+            ],
+            beside_map: PathBuf::from("/maps/m.wad"),
+        };
+        let paths = |name| -> Vec<(String, bool)> {
+            search
+                .candidates(name)
+                .into_iter()
+                .map(|(p, e)| (p.display().to_string(), e))
+                .collect()
+        };
+        let s = |p: &str, e| (p.to_string(), e);
+        assert_eq!(
+            paths("gfx/base.wad"),
+            [
+                s("/wads/gfx/base.wad", true),
+                s("/ext/gfx/base.wad", false),
+                s("gfx/base.wad", true),
+                s("/wads/base.wad", true),
+                s("/ext/base.wad", false),
+                s("base.wad", true),
+            ]
+        );
+        assert_eq!(
+            paths("/abs/q.wad"),
+            [
+                s("/abs/q.wad", true),
+                s("/wads/q.wad", true),
+                s("/ext/q.wad", false),
+                s("q.wad", true),
+            ]
+        );
+        assert_eq!(
+            paths("C:/quake/x.wad"),
+            [
+                s("/wads/x.wad", true),
+                s("/ext/x.wad", false),
+                s("x.wad", true)
+            ]
+        );
+        assert_eq!(paths("plain.wad").len(), 3);
+    }
+
     fn wad_set(textures: &[(&str, u32)]) -> WadSet {
         let lumps = textures
             .iter()
             .map(|&(name, size)| WadLump::miptex(placeholder(name, (size, size))))
             .collect();
         WadSet {
-            wads: vec![(PathBuf::from("test.wad"), Wad::new(lumps))],
+            wads: vec![FoundWad {
+                path: PathBuf::from("test.wad"),
+                wad: Wad::new(lumps),
+                embed: true,
+            }],
         }
     }
 
@@ -231,7 +366,13 @@ mod tests {
     #[test]
     fn missing_wad_and_texture_give_placeholders() {
         let mut warnings = Vec::new();
-        let set = WadSet::load("nope.wad", &[PathBuf::from("/nonexistent")], &mut warnings);
+        let mut world = Entity::default();
+        world.set("wad", "nope.wad");
+        let search = WadSearch {
+            folders: vec![(PathBuf::from("/nonexistent"), true)],
+            beside_map: PathBuf::from("/nonexistent/m.wad"),
+        };
+        let set = WadSet::load(&world, &search, &mut warnings);
         let lump = set.texture_lump(&["SKY4"], &mut warnings);
         let t = &lump[0];
         assert_eq!((t.width, t.height), (256, 128));

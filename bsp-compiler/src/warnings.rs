@@ -1,5 +1,6 @@
 //! Things wrong with a map that the compiler works around.
 
+use crate::editor::OmittedLayer;
 use crate::leak::LeakReport;
 use crate::texinfo::FaceContents;
 use glam::DVec3;
@@ -31,8 +32,12 @@ pub enum Warning {
         line: usize,
         used: FaceContents,
     },
+    /// A WAD worldspawn names that is nowhere it was looked for (`looked`, in order).
+    /// An editor layer marked "Omit From Export": left out with everything in it.
+    OmittedLayer(OmittedLayer),
     MissingWad {
         name: String,
+        looked: Vec<PathBuf>,
     },
     UnreadableWad {
         path: PathBuf,
@@ -130,7 +135,21 @@ impl std::fmt::Display for Warning {
                 f,
                 "line {line}: entity {entity}, brush {brush}: this face's texture gives other contents than the brush's first face; the brush is {used}"
             ),
-            Warning::MissingWad { name } => write!(f, "WAD {name} not found in the search path"),
+            Warning::OmittedLayer(layer) => write!(
+                f,
+                "note: layer {:?} (entity {}) is marked Omit From Export: left out with the {} entities in it",
+                layer.name, layer.entity, layer.entities
+            ),
+            Warning::MissingWad { name, looked } => {
+                let looked: Vec<String> = looked
+                    .iter()
+                    .map(|p| match p.is_relative() {
+                        true => format!("{} in the working directory", p.display()),
+                        false => p.display().to_string(),
+                    })
+                    .collect();
+                write!(f, "WAD {name} not found; looked for {}", looked.join(", "))
+            }
             Warning::UnreadableWad { path, reason } => {
                 write!(f, "{}: not a usable WAD: {reason}", path.display())
             }

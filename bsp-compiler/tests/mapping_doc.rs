@@ -100,7 +100,7 @@ fn every_key_the_stages_read_is_documented() {
     let read = read_by_code();
     // The collector finds what it should: a key of each kind of accessor.
     for known in [
-        "wad",
+        "targetname",
         "_external_map_scale",
         "_sunlight2",
         "_mincolor",

@@ -9,6 +9,8 @@
 
 pub mod bsp;
 mod bytes;
+#[cfg(feature = "cli")]
+pub mod cli;
 pub mod entities;
 pub mod error;
 pub mod extents;

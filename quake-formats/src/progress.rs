@@ -67,7 +67,7 @@ impl Progress {
 }
 
 /// Progress drawn on stderr, one bar per phase, when stderr is a terminal (nowhere otherwise).
-#[cfg(feature = "terminal")]
+#[cfg(feature = "cli")]
 pub fn terminal() -> Progress {
     use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
     use std::io::IsTerminal;

@@ -11,7 +11,7 @@ struct Cli {
 }
 
 fn main() -> ExitCode {
-    match run(&Cli::parse().args) {
+    match run(&Cli::parse_from(quake_formats::cli::normalise_single_dash(std::env::args())).args) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
