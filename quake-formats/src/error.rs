@@ -27,7 +27,7 @@ pub enum FormatError {
         "{lump} lump: offset {offset} and length {length} run outside the {file_len}-byte file"
     )]
     LumpOutOfFile {
-        /// The lump's name.
+        /// The lump's name (`"faces"`).
         lump: &'static str,
         /// Byte offset the header gives.
         offset: i64,
@@ -49,7 +49,7 @@ pub enum FormatError {
     /// A lump's contents are damaged, or a value does not fit the version being written.
     #[error("{lump} lump: {detail}")]
     BadLump {
-        /// The lump's name.
+        /// The lump's name, or the structure read (`"BSPX"`, `".lit"`).
         lump: &'static str,
         /// What is wrong, with the values involved.
         detail: String,

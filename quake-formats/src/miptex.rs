@@ -177,7 +177,7 @@ impl TextureLump {
         out
     }
 
-    /// The slot of the first texture named `name`, ignoring ASCII case as engines do.
+    /// The slot of the first texture named `name`, ignoring ASCII case.
     pub fn find(&self, name: &str) -> Option<usize> {
         self.textures.iter().position(|t| {
             t.as_ref()

@@ -159,7 +159,7 @@ pub enum ReportError {
     /// A BSP or portal file could not be read.
     #[error("{}: {source}", path.display())]
     Format {
-        /// The file.
+        /// The BSP or portal file.
         path: PathBuf,
         /// What was wrong with it.
         source: quake_formats::FormatError,

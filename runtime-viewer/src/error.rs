@@ -11,7 +11,7 @@ pub enum ViewerError {
     /// A file (the map, its `.lit`, the palette) could not be parsed.
     #[error("{path}: {error}")]
     Format {
-        /// The file.
+        /// The file that did not parse.
         path: PathBuf,
         /// What was wrong with it.
         error: FormatError,
@@ -20,7 +20,7 @@ pub enum ViewerError {
     /// node tree is not a tree.
     #[error("{path}: {detail}")]
     BadMap {
-        /// The map.
+        /// The BSP file.
         path: PathBuf,
         /// Why it cannot be drawn.
         detail: String,

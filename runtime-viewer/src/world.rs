@@ -100,7 +100,8 @@ pub struct World {
     pub palette: PackedPalette,
     /// Where the palette came from.
     pub palette_source: PaletteSource,
-    /// One per texture slot of the BSP, then the checkerboard for faces naming none.
+    /// One per texture slot of the BSP, then a checkerboard for faces whose texinfo names a slot
+    /// past the last.
     pub textures: Vec<Texture>,
     /// One per BSP face; `None` for faces too broken to draw.
     pub surfaces: Vec<Option<Surface>>,

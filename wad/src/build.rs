@@ -41,7 +41,7 @@ pub struct LevelErrors {
 /// What became of one picture.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct TextureReport {
-    /// The texture name.
+    /// The texture name, as stored in the WAD.
     pub name: String,
     /// The picture file it was made from.
     pub file: PathBuf,

@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 /// One line of `slipgate wad list`.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Entry {
-    /// The lump's name.
+    /// The lump's name as the directory gives it.
     pub name: String,
     /// `miptex`, `palette`, `qpic`, `sound` or the type byte.
     pub kind: String,
