@@ -6,10 +6,12 @@ use crate::error::{FormatError, Result};
 /// as in Quake's `ValueForKey`).
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub struct Entity {
+    /// Keys and values as written, in file order.
     pub pairs: Vec<(String, String)>,
 }
 
 impl Entity {
+    /// The value of the first `key`, if there is one.
     pub fn get(&self, key: &str) -> Option<&str> {
         self.pairs
             .iter()
@@ -17,6 +19,7 @@ impl Entity {
             .map(|(_, v)| v.as_str())
     }
 
+    /// The `classname` value (`"worldspawn"`, `"info_player_start"`), or `""` when it has none.
     pub fn classname(&self) -> &str {
         self.get("classname").unwrap_or("")
     }
@@ -30,6 +33,7 @@ impl Entity {
         }
     }
 
+    /// Remove every pair with `key`.
     pub fn remove(&mut self, key: &str) {
         self.pairs.retain(|(k, _)| k != key);
     }
@@ -44,6 +48,7 @@ impl Entity {
         Some(out)
     }
 
+    /// A key parsed as one number (`"light" "300"`); `None` when it is missing or not a number.
     pub fn get_float(&self, key: &str) -> Option<f64> {
         self.get(key)?.trim().parse().ok()
     }

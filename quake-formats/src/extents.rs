@@ -101,6 +101,7 @@ impl LightmapExtents {
         ]
     }
 
+    /// Luxels in the whole lightmap: the bytes one style takes in the lighting lump.
     pub fn luxel_count(&self) -> usize {
         let [w, h] = self.luxel_size();
         w * h

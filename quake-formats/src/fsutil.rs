@@ -19,6 +19,8 @@ pub struct Staged {
 }
 
 impl Staged {
+    /// Write `bytes` to a temporary file beside `path` (in the same folder, so the rename stays
+    /// on one file system), leaving `path` untouched until [`Staged::commit`].
     pub fn write(path: &Path, bytes: &[u8]) -> Result<Self> {
         let file_name = path
             .file_name()

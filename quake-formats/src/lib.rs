@@ -7,12 +7,14 @@
 //! [`geom`] (f64 vectors, planes, windings and the epsilon policy); [`rng`] is the seeded
 //! generator the tools sample with, and [`progress`] the one way every stage reports progress.
 
+#![warn(missing_docs)]
+
 pub mod bsp;
 mod bytes;
 #[cfg(feature = "cli")]
 pub mod cli;
 pub mod entities;
-pub mod error;
+mod error;
 pub mod extents;
 pub mod fsutil;
 pub mod geom;
@@ -29,4 +31,4 @@ pub mod wad;
 
 pub use bsp::{Bsp, BspVersion, Problem, PvsRow, Severity, check_usable, validate};
 pub use bytes::{latin1_to_string, name16_to_string, string_to_latin1, string_to_name16};
-pub use error::FormatError;
+pub use error::{FormatError, Result};

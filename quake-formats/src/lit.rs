@@ -7,6 +7,7 @@ use crate::error::{FormatError, Result};
 const LIT_MAGIC: [u8; 4] = *b"QLIT";
 const LIT_VERSION: i32 = 1;
 
+/// A whole `.lit` file: the header, then `rgb` (three bytes per lighting lump byte).
 pub fn write_lit(rgb: &[u8]) -> Vec<u8> {
     let mut out = Vec::with_capacity(8 + rgb.len());
     out.extend_from_slice(&LIT_MAGIC);

@@ -12,8 +12,11 @@ pub const MIPTEX_HEADER_LEN: usize = 40;
 pub struct MipTex {
     /// The raw 16-byte name: bytes after the terminating NUL are kept for exact round trips.
     pub raw_name: [u8; 16],
+    /// Width of mip level 0 in texels; engines want a multiple of 16.
     pub width: u32,
+    /// Height of mip level 0 in texels; engines want a multiple of 16.
     pub height: u32,
+    /// Palette indices of levels 0 to 3, rows top to bottom; `None` when not stored.
     pub mips: Option<[Vec<u8>; 4]>,
 }
 
@@ -28,6 +31,7 @@ impl MipTex {
         }
     }
 
+    /// The name up to its first NUL, read as Latin-1.
     pub fn name(&self) -> String {
         name16_to_string(&self.raw_name)
     }
@@ -95,6 +99,7 @@ impl MipTex {
         }
     }
 
+    /// Bytes [`MipTex::encode`] writes: the header and the levels stored.
     pub fn encoded_len(&self) -> usize {
         MIPTEX_HEADER_LEN
             + self
@@ -107,10 +112,12 @@ impl MipTex {
 /// A BSP's texture lump: a count, an offset per texture (-1 for a missing one), the miptexes.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct TextureLump {
+    /// The texture slots texinfos index, `None` where the lump stores no texture (offset -1).
     pub textures: Vec<Option<MipTex>>,
 }
 
 impl TextureLump {
+    /// Read the lump; an empty lump has no textures.
     pub fn decode(data: &[u8]) -> Result<TextureLump> {
         if data.is_empty() {
             return Ok(TextureLump::default());
@@ -143,6 +150,7 @@ impl TextureLump {
         Ok(TextureLump { textures })
     }
 
+    /// Write the lump, each miptex 4-byte aligned; no textures make an empty lump.
     pub fn encode(&self) -> Vec<u8> {
         if self.textures.is_empty() {
             return Vec::new();
@@ -169,6 +177,7 @@ impl TextureLump {
         out
     }
 
+    /// The slot of the first texture named `name`, ignoring ASCII case.
     pub fn find(&self, name: &str) -> Option<usize> {
         self.textures.iter().position(|t| {
             t.as_ref()

@@ -19,12 +19,15 @@ pub fn find_game_palette(dir: &Path) -> Option<PathBuf> {
 /// Palette indices from here up are "fullbright": drawn unlit by engines.
 pub const FIRST_FULLBRIGHT: u8 = 224;
 
+/// The colour of each palette index that texture pixels hold.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Palette {
+    /// RGB of each index, 0-255 per channel.
     pub colors: [[u8; 3]; 256],
 }
 
 impl Palette {
+    /// Read a palette file's 768 bytes (e.g. `gfx/palette.lmp`); any other size is an error.
     pub fn from_bytes(data: &[u8]) -> Result<Palette> {
         if data.len() != 768 {
             return Err(FormatError::PaletteSize(data.len()));
@@ -36,6 +39,7 @@ impl Palette {
         Ok(Palette { colors })
     }
 
+    /// The 768 bytes of a palette file.
     pub fn to_bytes(&self) -> Vec<u8> {
         self.colors.iter().flatten().copied().collect()
     }

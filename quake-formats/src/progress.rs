@@ -7,7 +7,12 @@ use std::sync::Arc;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ProgressEvent {
     /// A phase starts with `total` units of work.
-    Start { phase: &'static str, total: u64 },
+    Start {
+        /// What the phase does, for the bar's label (`"brushes"`).
+        phase: &'static str,
+        /// Units of work the phase will report done.
+        total: u64,
+    },
     /// `n` more units of the current phase are done.
     Advance(u64),
     /// The current phase is over.
@@ -32,11 +37,6 @@ impl Progress {
     /// Reports go to `sink`, from any thread.
     pub fn new(sink: impl Fn(ProgressEvent) + Send + Sync + 'static) -> Progress {
         Progress(Some(Arc::new(sink)))
-    }
-
-    /// Whether anyone receives the reports (work only worth doing to report can be skipped).
-    pub fn is_reported(&self) -> bool {
-        self.0.is_some()
     }
 
     fn send(&self, event: ProgressEvent) {

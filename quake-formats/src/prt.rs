@@ -28,7 +28,9 @@ use glam::DVec3;
 /// A portal between two vis leaves.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PrtPortal {
+    /// The two vis leaves (clusters in PRT2) the portal joins, 0 standing for BSP leaf 1.
     pub leafs: [u32; 2],
+    /// The opening; its plane (clockwise seen from the front) faces `leafs[0]`.
     pub winding: Winding,
 }
 
@@ -44,6 +46,7 @@ pub struct PortalFile {
 }
 
 impl PortalFile {
+    /// Read a PRT1 or PRT2 file; a leaf or cluster number out of range is an error.
     pub fn parse(text: &str) -> Result<PortalFile> {
         let mut lines = text.lines().enumerate().map(|(i, l)| (i + 1, l.trim()));
         let mut next = |what: &str| -> Result<(usize, &str)> {
@@ -101,6 +104,7 @@ impl PortalFile {
         })
     }
 
+    /// The file's text: PRT2 when `clusters` is set, PRT1 otherwise.
     pub fn write(&self) -> String {
         let mut out = match &self.clusters {
             None => format!("PRT1\n{}\n{}\n", self.num_leafs, self.portals.len()),

@@ -11,34 +11,47 @@ const ENTRY_LEN: usize = 32;
 
 /// Lump types used by Quake's WADs.
 pub mod lump_type {
+    /// A 768-byte palette (`gfx.wad`'s `PALETTE`).
     pub const PALETTE: u8 = 0x40;
+    /// `TYP_QTEX` of Quake's source; Slipgate reads and writes no such lump.
     pub const QTEX: u8 = 0x41;
+    /// A status bar or menu picture: width, height, then palette indices (`gfx.wad`).
     pub const QPIC: u8 = 0x42;
+    /// `TYP_SOUND` of Quake's source; kept as raw bytes.
     pub const SOUND: u8 = 0x43;
+    /// A mip texture ([`MipTex`](crate::miptex::MipTex)): what texture WADs hold.
     pub const MIPTEX: u8 = 0x44;
 }
 
 /// A lump's payload: decoded miptex, or bytes kept as they are.
 #[derive(Debug, Clone, PartialEq)]
 pub enum WadData {
+    /// An uncompressed miptex lump whose bytes are exactly what [`MipTex::encode`] writes.
     MipTex(MipTex),
+    /// Any other lump, or a miptex with unusual padding or offsets, as stored.
     Raw(Vec<u8>),
 }
 
 /// One directory entry and its data.
 #[derive(Debug, Clone, PartialEq)]
 pub struct WadLump {
+    /// The raw 16-byte name: bytes after the terminating NUL are kept for exact round trips.
     pub raw_name: [u8; 16],
+    /// The lump's type, one of [`lump_type`].
     pub kind: u8,
+    /// The entry's compression byte; Quake's WADs use 0 (none), and nothing decompresses
+    /// others.
     pub compression: u8,
     /// The two padding bytes of the entry, kept for exact round trips.
     pub pad: [u8; 2],
     /// The entry's uncompressed `size` field when it differs from the stored length.
     pub declared_size: Option<u32>,
+    /// The lump's bytes, decoded where they are a miptex.
     pub data: WadData,
 }
 
 impl WadLump {
+    /// An uncompressed miptex lump named after the texture.
     pub fn miptex(tex: MipTex) -> WadLump {
         WadLump {
             raw_name: string_to_name16(&tex.name()),
@@ -50,6 +63,7 @@ impl WadLump {
         }
     }
 
+    /// The name up to its first NUL, read as Latin-1.
     pub fn name(&self) -> String {
         name16_to_string(&self.raw_name)
     }
@@ -69,11 +83,13 @@ impl WadLump {
 /// A WAD2 file.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Wad {
+    /// The directory's entries in order, each with its data.
     pub lumps: Vec<WadLump>,
     layout: Option<Layout>,
 }
 
 impl Wad {
+    /// A WAD of `lumps`, laid out afresh when written.
     pub fn new(lumps: Vec<WadLump>) -> Wad {
         Wad {
             lumps,
@@ -81,6 +97,7 @@ impl Wad {
         }
     }
 
+    /// Parse a WAD2 file; a directory or lump outside the file is an error.
     pub fn read(data: &[u8]) -> Result<Wad> {
         let mut r = Reader::new(data, "WAD header");
         let magic = r.array::<4>()?;
@@ -154,6 +171,7 @@ impl Wad {
         })
     }
 
+    /// Encode the file. A file read and written back unchanged is byte-identical.
     pub fn write(&self) -> Vec<u8> {
         let encoded: Vec<Vec<u8>> = self.lumps.iter().map(WadLump::encode).collect();
         let mut lens: Vec<usize> = encoded.iter().map(Vec::len).collect();
@@ -190,13 +208,6 @@ impl Wad {
                 WadData::Raw(b) => MipTex::decode(b, "WAD miptex").ok(),
             }
         })
-    }
-
-    pub fn miptex_count(&self) -> usize {
-        self.lumps
-            .iter()
-            .filter(|l| l.kind == lump_type::MIPTEX)
-            .count()
     }
 }
 

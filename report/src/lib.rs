@@ -7,6 +7,8 @@
 //! Output: `report.md` (one table per stage), `report.json` (every figure), a time-against-error
 //! plot per stage as SVG and PNG, and a self-contained `report.html`.
 
+#![warn(missing_docs)]
+
 mod html;
 mod machine;
 mod markdown;
@@ -27,7 +29,9 @@ pub use settings::{Stage, Tool};
 /// What to measure and where to write it.
 #[derive(Debug, Clone)]
 pub struct Options {
+    /// The `.map` files to compile and measure.
     pub maps: Vec<PathBuf>,
+    /// Where the report, its plots and the maps' work folders go.
     pub out_dir: PathBuf,
     /// Each timed step runs this many times; the best wall time counts.
     pub runs: usize,
@@ -56,35 +60,52 @@ pub struct Options {
 /// Everything one report measured.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Report {
+    /// The machine it ran on.
     pub machine: Machine,
+    /// Runs of every timed step; the best counts.
     pub runs: usize,
+    /// Whether the timed binary was a release build.
     pub release: bool,
+    /// ericw-tools' `bin` folder, when it was measured beside ours.
     pub anchor: Option<PathBuf>,
+    /// The maps measured.
     pub maps: Vec<PathBuf>,
     /// Per map: every Nth face lit by the light reference, and how long the references took.
     pub light_references: Vec<LightReference>,
+    /// Every stage at every setting on every map, by each tool.
     pub rows: Vec<Row>,
 }
 
 /// How light's reference was taken on one map.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct LightReference {
+    /// The map's name: its file name without extension (numbered when two maps share one).
     pub map: String,
+    /// The reference lit every Nth face; this is N.
     pub face_stride: usize,
+    /// Faces the reference lit.
     pub faces: usize,
+    /// Seconds the reference took for direct light.
     pub seconds_direct: f64,
+    /// Seconds the reference with one bounce took; `None` when no setting bounces.
     pub seconds_bounce: Option<f64>,
 }
 
 /// One stage at one setting on one map by one tool.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Row {
+    /// The map's name, as in [`LightReference::map`].
     pub map: String,
+    /// The stage measured.
     pub stage: Stage,
+    /// The setting's name: Slipgate's options as a mapper writes them (`--extra4 --soft`), or
+    /// `default`, `fast`, `full`, `span step N`.
     pub setting: String,
+    /// Whose implementation ran.
     pub tool: Tool,
     /// Best of the runs (by wall time); `None` when every run failed.
     pub timing: Option<Timing>,
+    /// The answer measured against its reference; `None` when the step or measuring failed.
     pub figures: Option<Figures>,
     /// Why the step or its measurement failed.
     pub failure: Option<String>,
@@ -94,9 +115,13 @@ pub struct Row {
 #[derive(Debug, Clone, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Figures {
+    /// A compiled BSP's counts, cracks and clip hull agreement.
     Bsp(BspFigures),
+    /// A PVS against sampled sight lines.
     Vis(VisFigures),
+    /// Lightmaps against light's reference.
     Light(LightFigures),
+    /// The viewer's frame rate and its picture against the exact renderer.
     View(ViewFigures),
 }
 
@@ -120,39 +145,70 @@ impl Row {
     }
 }
 
+/// Everything that stops a report; every message names the file or command.
 #[derive(Debug, thiserror::Error)]
 pub enum ReportError {
+    /// Reading or writing a file or folder failed.
     #[error("{}: {source}", path.display())]
     Io {
+        /// The file or folder.
         path: PathBuf,
+        /// What the OS reported.
         source: std::io::Error,
     },
+    /// A BSP or portal file could not be read.
     #[error("{}: {source}", path.display())]
     Format {
+        /// The BSP or portal file.
         path: PathBuf,
+        /// What was wrong with it.
         source: quake_formats::FormatError,
     },
+    /// A timed step exited with an error or was killed.
     #[error("`{command}` {status}; last lines of {}:\n{tail}", log.display())]
     CommandFailed {
+        /// The command line as run.
         command: String,
+        /// How it ended (`exited with status 1`, `was killed by signal 9`).
         status: String,
+        /// The file its output went to.
         log: PathBuf,
+        /// The log's last lines.
         tail: String,
     },
+    /// Measuring a PVS failed in vis' library.
     #[error("{}: {source}", path.display())]
     Vis {
+        /// The BSP measured.
         path: PathBuf,
+        /// vis' error.
         source: vis::VisError,
     },
+    /// Light's reference could not be computed.
     #[error("{}: {source}", path.display())]
     Light {
+        /// The BSP lit.
         path: PathBuf,
+        /// light's error.
         source: light::LightError,
     },
+    /// A measurement could not be made (the hull check, a statistics file, the JSON report).
     #[error("{}: {what}", path.display())]
-    Measure { path: PathBuf, what: String },
+    Measure {
+        /// The file measured or written.
+        path: PathBuf,
+        /// What went wrong.
+        what: String,
+    },
+    /// A plot could not be drawn.
     #[error("drawing {}: {what}", path.display())]
-    Plot { path: PathBuf, what: String },
+    Plot {
+        /// The picture being drawn.
+        path: PathBuf,
+        /// What went wrong.
+        what: String,
+    },
+    /// [`Options::maps`] is empty.
     #[error("no maps to report on")]
     NoMaps,
 }

@@ -6,12 +6,15 @@ use std::process::Command;
 /// CPU, cores, the vector ISA Embree traces with, and how busy the machine was.
 #[derive(Debug, Clone, Default, serde::Serialize)]
 pub struct Machine {
+    /// The CPU's model name from `/proc/cpuinfo` (`unknown` when it gives none).
     pub cpu: String,
+    /// Threads the machine can run at once.
     pub cores: usize,
     /// The widest kernel set Embree both supports on this CPU and was built with.
     pub embree_isa: String,
     /// Load averages (1, 5, 15 minutes) when the report started and ended.
     pub load_start: String,
+    /// Load averages when the report ended, in the same form.
     pub load_end: String,
     /// UTC date, YYYY-MM-DD.
     pub date: String,

@@ -20,16 +20,25 @@ pub fn read_bsp(path: &Path) -> Result<Bsp, ReportError> {
 /// A compiled BSP's counts and the cracks the crack checker finds in it.
 #[derive(Debug, Clone, Default, serde::Serialize)]
 pub struct BspFigures {
+    /// Faces in the BSP.
     pub faces: usize,
+    /// Leaves in the BSP, leaf 0 included.
     pub leaves: usize,
+    /// Hull 0 nodes.
     pub nodes: usize,
+    /// Clip nodes of hulls 1 and 2.
     pub clipnodes: usize,
     /// Portals in the `.prt` file beside the BSP.
     pub portals: usize,
+    /// Entries of the marksurfaces lump.
     pub marksurfaces: usize,
+    /// Size of the BSP file in bytes.
     pub file_bytes: u64,
+    /// Vertices lying inside another face's edge.
     pub tjunctions: usize,
+    /// Directed edges used by more than two faces, and by more or fewer than their reverse.
     pub overused_edges: usize,
+    /// Pairs of vertex indices of one model at the same position.
     pub duplicate_vertices: usize,
     /// Player-box (hull 1) moves traced through the clip hull and through the map's brushes.
     pub hull_traces: usize,
@@ -40,6 +49,8 @@ pub struct BspFigures {
 }
 
 impl BspFigures {
+    /// Everything that would show as a crack: T-junctions, overused edges and duplicate
+    /// vertices.
     pub fn cracks(&self) -> usize {
         self.tjunctions + self.overused_edges + self.duplicate_vertices
     }
@@ -103,9 +114,11 @@ pub fn bsp_figures(
 /// A vised BSP's PVS against sight lines sampled through its hull 0.
 #[derive(Debug, Clone, Default, serde::Serialize)]
 pub struct VisFigures {
+    /// Leaves the PVS has rows for.
     pub leaves: usize,
     /// Leaves each leaf's PVS holds, on average.
     pub average_visible: f64,
+    /// Random point pairs in open leaves whose sight line was traced.
     pub sampled_pairs: usize,
     /// Sampled pairs with a clear line of sight.
     pub clear_pairs: usize,
@@ -206,8 +219,11 @@ fn reference(
 /// A lit BSP's lightmaps against light's reference, in 8-bit grey levels.
 #[derive(Debug, Clone, Default, serde::Serialize)]
 pub struct LightFigures {
+    /// Luxels compared: those of the faces the reference lit.
     pub luxels: u64,
+    /// Root mean square difference from the reference, in levels.
     pub rmse: f64,
+    /// Largest difference from the reference, in levels.
     pub max: u8,
     /// Share of luxels more than 2 levels off (0 to 1).
     pub over_2_share: f64,
@@ -228,11 +244,13 @@ pub fn light_figures(lit_path: &Path, reference: &Lighting) -> Result<LightFigur
 /// The viewer's flythrough speed and its picture against the exact ray-cast renderer.
 #[derive(Debug, Clone, Default, serde::Serialize)]
 pub struct ViewFigures {
+    /// Pixels between exact perspective divides in this setting.
     pub span_step: u32,
     /// Best flythrough frame rate over the runs.
     pub fps: f64,
     /// Mean per-channel difference from the reference picture (of 255).
     pub mean_diff: f64,
+    /// Largest per-channel difference from the reference picture (of 255).
     pub max_diff: f64,
     /// Share of pixels that show another face than the reference's.
     pub face_mismatch: f64,

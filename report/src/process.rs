@@ -12,8 +12,11 @@ use crate::ReportError;
 /// What one run of a stage cost.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Timing {
+    /// Seconds from start to exit.
     pub wall_seconds: f64,
+    /// CPU seconds, user and system, of all its threads.
     pub cpu_seconds: f64,
+    /// Peak resident memory in MiB.
     pub peak_rss_mb: f64,
 }
 

@@ -4,15 +4,21 @@
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Stage {
+    /// Compiling a `.map` to BSP and portal file.
     Bsp,
+    /// Computing the PVS.
     Vis,
+    /// Computing lightmaps.
     Light,
+    /// Drawing the map with the software viewer.
     View,
 }
 
 impl Stage {
+    /// Every stage, in pipeline order.
     pub const ALL: [Stage; 4] = [Stage::Bsp, Stage::Vis, Stage::Light, Stage::View];
 
+    /// The stage's command-line name (`bsp`), as in file names and tables.
     pub fn name(self) -> &'static str {
         match self {
             Stage::Bsp => "bsp",
@@ -45,11 +51,14 @@ impl Stage {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Tool {
+    /// Slipgate's own stages.
     Slipgate,
+    /// The anchor: ericw-tools' `qbsp`, `vis` and `light`.
     EricwTools,
 }
 
 impl Tool {
+    /// The name tables and plots give the tool.
     pub fn name(self) -> &'static str {
         match self {
             Tool::Slipgate => "Slipgate",

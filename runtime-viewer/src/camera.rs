@@ -11,12 +11,16 @@ use quake_formats::geom::Plane;
 /// Anything nearer than this (map units along the view axis) is clipped away.
 pub const NEAR_CLIP: f64 = 0.5;
 
+/// Where the eye is, where it looks and the picture it makes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Camera {
+    /// The eye's position in map units.
     pub origin: DVec3,
     /// Pitch, yaw, roll in degrees.
     pub angles: [f64; 3],
+    /// Picture width in pixels.
     pub width: usize,
+    /// Picture height in pixels.
     pub height: usize,
     /// Horizontal field of view in degrees.
     pub fov_x: f64,
@@ -83,7 +87,7 @@ pub struct View {
 }
 
 impl Camera {
-    pub fn view(&self) -> View {
+    pub(crate) fn view(&self) -> View {
         let (forward, right, up) = angle_vectors(self.angles);
         let w = self.width as f64;
         let h = self.height as f64;

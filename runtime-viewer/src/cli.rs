@@ -13,6 +13,7 @@ use crate::render::{Frame, FrameStats, RenderOptions, Renderer};
 use crate::surface_cache::CacheStats;
 use crate::world::World;
 
+/// The viewer's command line, shared by `slipgate view` and `slipgate-view`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct Args {
     /// The compiled map (BSP29 or BSP2); a `.lit` beside it is used for coloured light.
@@ -91,6 +92,8 @@ fn parse_size(s: &str) -> Result<(usize, usize), String> {
     Ok((parse(w)?, parse(h)?))
 }
 
+/// Load the map and do what `args` ask: write a PNG (and with `--reference` the reference
+/// picture), run the flythrough benchmark, or open the window.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let start = Instant::now();
     let world = World::load(&args.map, args.palette.as_deref())?;

@@ -47,11 +47,16 @@ struct Edge {
     leading: bool,
 }
 
+/// What the edge list did in one frame.
 #[derive(Debug, Clone, Default, serde::Serialize)]
 pub struct EdgeStats {
+    /// Polygons handed to the edge list.
     pub polygons: usize,
+    /// Polygons that clipping to the frustum, or projecting to no area, left nothing of.
     pub clipped_away: usize,
+    /// Edges that cross at least one scanline centre.
     pub edges: usize,
+    /// Spans emitted, the background's included.
     pub spans: usize,
 }
 

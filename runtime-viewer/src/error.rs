@@ -8,13 +8,29 @@ pub enum ViewerError {
     /// Reading or writing a file failed (the error names the file).
     #[error(transparent)]
     File(FormatError),
+    /// A file (the map, its `.lit`, the palette) could not be parsed.
     #[error("{path}: {error}")]
-    Format { path: PathBuf, error: FormatError },
+    Format {
+        /// The file that did not parse.
+        path: PathBuf,
+        /// What was wrong with it.
+        error: FormatError,
+    },
+    /// The map parsed, but cannot be drawn: tools refuse it, its entities do not parse, or its
+    /// node tree is not a tree.
     #[error("{path}: {detail}")]
-    BadMap { path: PathBuf, detail: String },
+    BadMap {
+        /// The BSP file.
+        path: PathBuf,
+        /// Why it cannot be drawn.
+        detail: String,
+    },
+    /// A frame could not be encoded as PNG.
     #[error("{path}: writing PNG: {error}")]
     Png {
+        /// The picture that was to be written.
         path: PathBuf,
+        /// The encoder's error.
         error: ::image::ImageError,
     },
     /// The interactive window could not be opened or updated (no display, for instance).
@@ -35,4 +51,5 @@ impl ViewerError {
     }
 }
 
+/// A result whose error defaults to [`ViewerError`].
 pub type Result<T, E = ViewerError> = std::result::Result<T, E>;

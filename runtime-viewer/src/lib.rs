@@ -1,31 +1,39 @@
 //! Slipgate's viewer: a software renderer in the manner of Quake's, for compiled BSPs.
 //!
-//! A frame goes through [`visibility`] (PVS, frustum, BSP order), [`edges`] (global edge list
-//! and sorted spans, so each pixel is drawn once), [`surface_cache`] (lit texture tiles) and
-//! [`raster`] (perspective span texturing). [`reference`] is a slow ray-casting renderer that
-//! defines what the fast one should draw, and [`reference::compare`] measures the difference.
-//! With the cargo feature `window`, the `window` module shows frames live with noclip flight ([`fly`]).
+//! A [`World`] is a loaded map; a [`Renderer`] draws it as a [`Camera`] sees it into a [`Frame`].
+//! A frame goes through `visibility` (PVS, frustum, BSP order), `edges` (global edge list and
+//! sorted spans, so each pixel is drawn once), `surface_cache` (lit texture tiles) and `raster`
+//! (perspective span texturing). [`render_reference`] is a slow ray-casting renderer that
+//! defines what the fast one should draw, and [`compare`] measures the difference. [`cli`] is
+//! `slipgate view`, [`image`] writes frames as PNG and [`textures`] finds the palette. With the
+//! cargo feature `window`, the `window` module shows frames live with noclip flight (`fly`).
 
-pub mod camera;
+#![warn(missing_docs)]
+
+mod camera;
 pub mod cli;
-pub mod edges;
-pub mod error;
-pub mod fly;
+mod edges;
+mod error;
+#[cfg(any(feature = "window", test))]
+mod fly;
 pub mod image;
-pub mod raster;
-pub mod reference;
-pub mod render;
-pub mod surface_cache;
+mod raster;
+mod reference;
+mod render;
+mod surface_cache;
 pub mod textures;
-pub mod visibility;
+mod visibility;
 #[cfg(feature = "window")]
-pub mod window;
-pub mod world;
+mod window;
+mod world;
 
 pub use camera::Camera;
-pub use error::ViewerError;
-pub use render::{Frame, FrameStats, RenderOptions, Renderer};
-pub use surface_cache::SurfaceCache;
-pub use world::World;
+pub use edges::EdgeStats;
+pub use error::{Result, ViewerError};
+pub use reference::{Comparison, compare, render_reference};
+pub use render::{Frame, FrameStats, NO_FACE, RenderOptions, Renderer};
+pub use surface_cache::{CacheStats, LightStyles};
+pub use visibility::VisStats;
+pub use world::{Fragment, LoadStats, NO_STYLE, Surface, World};
 #[cfg(test)]
 mod test_room;

@@ -272,11 +272,13 @@ fn inside(s: &Surface, p: DVec3) -> bool {
 /// How two frames differ.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Comparison {
+    /// Pixels compared: the frames' width times height.
     pub pixels: usize,
     /// Mean absolute difference per colour channel (0..255) over all pixels.
     pub mean_diff: f64,
     /// The same over pixels where both drew the same face: texture-mapping error alone.
     pub mean_diff_same_face: f64,
+    /// Largest difference of one colour channel at one pixel (0..255).
     pub max_diff: u8,
     /// Fraction of pixels whose colour differs at all.
     pub differing_pixels: f64,
@@ -284,6 +286,7 @@ pub struct Comparison {
     pub face_mismatch: f64,
 }
 
+/// How far `a` is from `b`, pixel by pixel. Panics when the frames differ in size.
 pub fn compare(a: &Frame, b: &Frame) -> Comparison {
     assert_eq!(
         (a.width, a.height),

@@ -18,13 +18,18 @@ pub const NO_FACE: u32 = u32::MAX;
 /// A picture (0x00RRGGBB) and the face drawn at each pixel.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Frame {
+    /// Width in pixels.
     pub width: usize,
+    /// Height in pixels.
     pub height: usize,
+    /// Colours as 0x00RRGGBB, row by row from the top left.
     pub pixels: Vec<u32>,
+    /// The BSP face shown at each pixel, in the same order; [`NO_FACE`] where none is.
     pub faces: Vec<u32>,
 }
 
 impl Frame {
+    /// A black frame with no faces drawn.
     pub fn new(width: usize, height: usize) -> Frame {
         Frame {
             width,
@@ -35,6 +40,7 @@ impl Frame {
     }
 }
 
+/// How the renderer draws.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RenderOptions {
     /// Pixels between exact perspective divides along a span (1 = every pixel).
@@ -43,6 +49,7 @@ pub struct RenderOptions {
     pub time: f64,
     /// Off: the cache is emptied before every frame (to measure what it saves).
     pub use_cache: bool,
+    /// Bytes of lit surfaces the cache keeps before it evicts the least recently used.
     pub cache_budget: usize,
 }
 
@@ -57,22 +64,31 @@ impl Default for RenderOptions {
     }
 }
 
+/// Counts and timings of one frame.
 #[derive(Debug, Clone, Default, serde::Serialize)]
 pub struct FrameStats {
+    /// What the PVS, frustum and facing let through.
     pub visibility: VisStats,
+    /// What the edge list and span generator did.
     pub edges: EdgeStats,
+    /// How the surface cache fared.
     pub cache: CacheStats,
     /// Fence polygons drawn over the opaque picture.
     pub fences: usize,
-    /// Seconds per stage.
+    /// Seconds spent finding the visible surfaces.
     pub time_visibility: f64,
+    /// Seconds spent clipping, projecting and adding polygons to the edge list.
     pub time_edges: f64,
+    /// Seconds spent turning edges into sorted spans.
     pub time_spans: f64,
+    /// Seconds spent building lit surfaces for the cache.
     pub time_surfaces: f64,
+    /// Seconds spent texturing spans and drawing fences, surface building excluded.
     pub time_raster: f64,
 }
 
 impl FrameStats {
+    /// Seconds of the whole frame: the five stages' sum.
     pub fn total_time(&self) -> f64 {
         self.time_visibility
             + self.time_edges
@@ -82,11 +98,14 @@ impl FrameStats {
     }
 }
 
+/// The fast renderer, with the buffers and surface cache it keeps from frame to frame.
 #[derive(Debug)]
 pub struct Renderer {
+    /// How it draws; may change between frames (`time` animates light styles and liquids).
     pub options: RenderOptions,
+    /// The light styles' patterns; their values are set from `options.time` every frame.
     pub styles: LightStyles,
-    pub cache: SurfaceCache,
+    cache: SurfaceCache,
     visibility: Visibility,
     candidates: Vec<Candidate>,
     edges: EdgeList,
@@ -120,6 +139,7 @@ fn candidate_polygon<'w>(
 }
 
 impl Renderer {
+    /// A renderer for `world`, whose frames are drawn with `options`.
     pub fn new(world: &World, options: RenderOptions) -> Renderer {
         Renderer {
             options,
@@ -134,6 +154,8 @@ impl Renderer {
         }
     }
 
+    /// Draw `world` as `camera` sees it into `frame` (resized to the camera's picture when it
+    /// differs).
     pub fn render(&mut self, world: &World, camera: &Camera, frame: &mut Frame) -> FrameStats {
         if frame.width != camera.width || frame.height != camera.height {
             *frame = Frame::new(camera.width, camera.height);

@@ -59,6 +59,7 @@ pub const STYLE_STEPS_PER_SECOND: f64 = 10.0;
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct LightStyles {
     patterns: Vec<Vec<u8>>,
+    /// Each style's brightness now: 256 for 'm' (normal light), 0 for 'a', 533 for 'z'.
     pub values: [u32; 256],
 }
 
@@ -214,20 +215,28 @@ pub fn build_lit_surface(
     }
 }
 
+/// How the surface cache fared over one frame (or, added up, over many).
 #[derive(Debug, Clone, Copy, Default, serde::Serialize)]
 pub struct CacheStats {
+    /// Surfaces found in the cache, lit by current style values.
     pub hits: u64,
+    /// Surfaces built, because they were absent or lit by old style values.
     pub misses: u64,
     /// Misses caused by a light style changing under a cached surface.
     pub style_rebuilds: u64,
+    /// Bytes of lit surfaces built.
     pub bytes_built: u64,
+    /// Surfaces dropped to stay within the budget.
     pub evictions: u64,
+    /// Bytes the cache holds at the end.
     pub bytes_resident: u64,
+    /// Time spent building lit surfaces.
     #[serde(skip)]
     pub build_time: Duration,
 }
 
 impl CacheStats {
+    /// Hits over all look-ups; 1 when there were none.
     pub fn hit_rate(&self) -> f64 {
         let total = self.hits + self.misses;
         if total == 0 {
@@ -237,6 +246,7 @@ impl CacheStats {
         }
     }
 
+    /// Add another frame's counts and time; `bytes_resident` becomes the later frame's.
     pub fn add(&mut self, o: &CacheStats) {
         self.hits += o.hits;
         self.misses += o.misses;
@@ -360,18 +370,6 @@ impl SurfaceCache {
             }
         }
     }
-
-    pub fn len(&self) -> usize {
-        self.entries.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.entries.is_empty()
-    }
-
-    pub fn bytes(&self) -> usize {
-        self.bytes
-    }
 }
 
 #[cfg(test)]
@@ -405,7 +403,7 @@ mod tests {
         cache.begin_frame();
         cache.get(&world, 4, 0, &styles);
         assert_eq!(cache.stats.evictions, 2);
-        assert!(cache.bytes() <= size * 9 / 2 / 4 * 3);
+        assert!(cache.bytes <= size * 9 / 2 / 4 * 3);
         cache.begin_frame();
         for face in [0, 3, 4] {
             cache.get(&world, face, 0, &styles);

@@ -12,7 +12,9 @@ use crate::error::{Result, ViewerError};
 /// Where the palette came from, for the summary line.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum PaletteSource {
+    /// A palette file: the one given, or the game's `gfx/palette.lmp` found near the map.
     File(PathBuf),
+    /// Slipgate's own palette, as no file was given or found.
     Builtin,
 }
 
@@ -56,9 +58,13 @@ pub const FENCE_TRANSPARENT_INDEX: u8 = 255;
 /// One texture's four mip levels of palette indices.
 #[derive(Debug, Clone)]
 pub struct Texture {
+    /// The miptex name, which decides how it is drawn (see [`Texture::kind`]).
     pub name: String,
+    /// Width of mip level 0 in texels.
     pub width: u32,
+    /// Height of mip level 0 in texels.
     pub height: u32,
+    /// Palette indices of levels 0 to 3, rows top to bottom.
     pub mips: [Vec<u8>; 4],
 }
 
@@ -105,6 +111,8 @@ impl Texture {
         }
     }
 
+    /// How faces with this texture are drawn: by name (`sky`, `*`, `{`, any case), and as a
+    /// liquid when the texinfo is `special` (TEX_SPECIAL) but the name is not a sky.
     pub fn kind(&self, special: bool) -> TextureKind {
         let lower = self.name.to_ascii_lowercase();
         if lower.starts_with("sky") {
@@ -118,6 +126,7 @@ impl Texture {
         }
     }
 
+    /// Width and height of mip level `level` in texels, at least 1.
     pub fn mip_size(&self, level: usize) -> (usize, usize) {
         (
             ((self.width >> level) as usize).max(1),
@@ -137,11 +146,14 @@ impl Texture {
 /// Palette colours packed as 0x00RRGGBB, and whether each index is fullbright.
 #[derive(Debug, Clone)]
 pub struct PackedPalette {
+    /// Each index's colour as 0x00RRGGBB.
     pub rgb: [u32; 256],
+    /// Each index's colour as RGB bytes.
     pub colors: [[u8; 3]; 256],
 }
 
 impl PackedPalette {
+    /// Pack `p`'s colours.
     pub fn new(p: &Palette) -> PackedPalette {
         PackedPalette {
             rgb: std::array::from_fn(|i| pack(p.colors[i])),
@@ -162,10 +174,12 @@ impl PackedPalette {
     }
 }
 
+/// RGB bytes as 0x00RRGGBB, the form of frame pixels.
 pub fn pack(c: [u8; 3]) -> u32 {
     ((c[0] as u32) << 16) | ((c[1] as u32) << 8) | c[2] as u32
 }
 
+/// A 0x00RRGGBB pixel as RGB bytes.
 pub fn unpack(c: u32) -> [u8; 3] {
     [(c >> 16) as u8, (c >> 8) as u8, c as u8]
 }
@@ -176,7 +190,7 @@ const WARP_PERIOD: usize = 128;
 
 /// A sine table for the liquid warp: each coordinate is displaced by a sine of the other one.
 #[derive(Debug, Clone)]
-pub struct WarpTable {
+pub(crate) struct WarpTable {
     offsets: [i32; WARP_PERIOD],
 }
 
@@ -205,7 +219,7 @@ impl WarpTable {
 
 /// Colour of a liquid at mip-0 texel (s, t) before warping; liquids are drawn unlit.
 #[inline]
-pub fn liquid_color(
+pub(crate) fn liquid_color(
     tex: &Texture,
     palette: &PackedPalette,
     warp: &WarpTable,
@@ -218,7 +232,7 @@ pub fn liquid_color(
 
 /// The sky's colour along view direction `dir`: the front layer (left half of the texture,
 /// index 0 transparent) over the back layer (right half), both projected onto a flattened dome.
-pub fn sky_color(tex: &Texture, palette: &PackedPalette, dir: DVec3) -> u32 {
+pub(crate) fn sky_color(tex: &Texture, palette: &PackedPalette, dir: DVec3) -> u32 {
     let flat = DVec3::new(dir.x, dir.y, dir.z * 3.0);
     let len = flat.length().max(1e-9);
     let scale = 6.0 * 63.0 / len;

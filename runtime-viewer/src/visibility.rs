@@ -20,15 +20,20 @@ pub struct Candidate {
     pub clip_flags: u8,
 }
 
+/// What the visibility pass let through in one frame.
 #[derive(Debug, Clone, Default, serde::Serialize)]
 pub struct VisStats {
+    /// The leaf the eye is in (0, the solid leaf, when it is outside the map).
     pub camera_leaf: usize,
     /// Leaves the PVS row (or its absence) lets through.
     pub pvs_leaves: usize,
     /// Leaves reached by the walk after frustum culling.
     pub drawn_leaves: usize,
+    /// Nodes and leaves whose boxes lie wholly outside the frustum.
     pub frustum_culled: usize,
+    /// Faces and brush model pieces skipped for facing away from the eye.
     pub backfaces: usize,
+    /// Surfaces handed on to be drawn.
     pub candidates: usize,
 }
 

@@ -23,21 +23,31 @@ pub const NO_STYLE: u8 = 255;
 pub struct Surface {
     /// The face's plane, facing the side it is seen from.
     pub plane: Plane,
+    /// The polygon's corners in the BSP's winding order.
     pub points: Vec<DVec3>,
     /// Texture coordinates: `s = s_axis · p + s_offset`, likewise t.
     pub s_axis: DVec3,
+    /// Offset of `s` in texels, the entity origin's shift included.
     pub s_offset: f64,
+    /// The `t` axis in texels per map unit.
     pub t_axis: DVec3,
+    /// Offset of `t` in texels, the entity origin's shift included.
     pub t_offset: f64,
+    /// Index into [`World::textures`]; faces naming a texture the BSP lacks get the
+    /// checkerboard at the end.
     pub texture: usize,
+    /// How the surface is drawn.
     pub kind: TextureKind,
+    /// The lightmap rectangle, as engines compute it from the face's own (unmoved) vertices.
     pub extents: LightmapExtents,
+    /// The face's light styles; [`NO_STYLE`] ends the list.
     pub styles: [u8; MAX_LIGHTMAPS],
     /// First luxel in [`World::light`], when the face has a complete lightmap.
     pub light: Option<usize>,
 }
 
 impl Surface {
+    /// Texture coordinates (s, t) of world point `p`, in texels.
     pub fn st(&self, p: DVec3) -> (f64, f64) {
         (
             self.s_axis.dot(p) + self.s_offset,
@@ -45,6 +55,7 @@ impl Surface {
         )
     }
 
+    /// How many lightmaps the face has: its styles before the first [`NO_STYLE`].
     pub fn style_count(&self) -> usize {
         self.styles.iter().take_while(|&&s| s != NO_STYLE).count()
     }
@@ -53,35 +64,52 @@ impl Surface {
 /// A piece of a brush model face lying in one world leaf.
 #[derive(Debug, Clone)]
 pub struct Fragment {
+    /// The BSP face the piece is cut from.
     pub face: u32,
+    /// The piece's corners, in world space.
     pub points: Vec<DVec3>,
 }
 
 /// Counts for the load summary.
 #[derive(Debug, Clone, Default, serde::Serialize)]
 pub struct LoadStats {
+    /// Faces in the BSP.
     pub faces: usize,
+    /// Faces sound enough to draw.
     pub drawable_faces: usize,
+    /// Textures loaded, the fallback checkerboard included.
     pub textures: usize,
+    /// Texture slots the BSP stores without pixels (drawn as a checkerboard).
     pub missing_textures: usize,
+    /// Brush models that entities show (triggers are not drawn).
     pub brush_models_drawn: usize,
+    /// Pieces those models were cut into by the world's leaves.
     pub brush_model_fragments: usize,
+    /// Whether a `.lit` file gave the light its colour.
     pub coloured_light: bool,
     /// Why a `.lit` beside the BSP was not used (engines then draw the BSP's own light, grey).
     pub ignored_lit: Option<String>,
 }
 
+/// A loaded map, ready to draw.
 #[derive(Debug)]
 pub struct World {
+    /// The map as read.
     pub bsp: Bsp,
+    /// The palette textures are drawn through.
     pub palette: PackedPalette,
+    /// Where the palette came from.
     pub palette_source: PaletteSource,
+    /// One per texture slot of the BSP, then a checkerboard for faces whose texinfo names a slot
+    /// past the last.
     pub textures: Vec<Texture>,
     /// One per BSP face; `None` for faces too broken to draw.
     pub surfaces: Vec<Option<Surface>>,
     /// Lightmap samples as RGB, one per byte of the lighting lump.
     pub light: Vec<[u8; 3]>,
+    /// Parent node of each node of the world's tree; -1 for the root and unreached nodes.
     pub node_parent: Vec<i32>,
+    /// Parent node of each leaf; -1 for leaves the world's tree does not reach.
     pub leaf_parent: Vec<i32>,
     /// Brush model fragments per world leaf.
     pub leaf_fragments: Vec<Vec<Fragment>>,
@@ -89,7 +117,9 @@ pub struct World {
     pub brush_faces: Vec<u32>,
     /// Fence faces of the world and of the brush models shown.
     pub fence_faces: Vec<u32>,
+    /// The entity lump, parsed.
     pub entities: Vec<Entity>,
+    /// Counts for the summary line.
     pub stats: LoadStats,
 }
 
@@ -251,6 +281,7 @@ impl World {
         self.bsp.models.first().map(|m| m.head_nodes[0])
     }
 
+    /// The split plane of node `node`; `None` when the node or its plane index is out of range.
     pub fn node_plane(&self, node: usize) -> Option<Plane> {
         let n = self.bsp.nodes.get(node)?;
         let p = self.bsp.planes.get(n.plane as usize)?;

@@ -4,9 +4,9 @@
 use glam::DVec3;
 use std::path::{Path, PathBuf};
 
-use runtime_viewer::reference::{Comparison, compare, render_reference};
-use runtime_viewer::render::NO_FACE;
-use runtime_viewer::{Camera, Frame, RenderOptions, Renderer, World};
+use runtime_viewer::{
+    Camera, Comparison, Frame, NO_FACE, RenderOptions, Renderer, World, compare, render_reference,
+};
 
 const MAPS: [&str; 5] = [
     "librequake/start.bsp",

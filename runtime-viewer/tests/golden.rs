@@ -10,10 +10,10 @@ use std::path::{Path, PathBuf};
 
 use bsp_compiler::{CompileOptions, MapSource, compile};
 use quake_formats::palette::Palette;
-use runtime_viewer::reference::{compare, render_reference};
-use runtime_viewer::render::NO_FACE;
 use runtime_viewer::textures::PaletteSource;
-use runtime_viewer::{Camera, Frame, RenderOptions, Renderer, World};
+use runtime_viewer::{
+    Camera, Frame, NO_FACE, RenderOptions, Renderer, World, compare, render_reference,
+};
 
 const WIDTH: usize = 320;
 const HEIGHT: usize = 200;

@@ -11,8 +11,10 @@ use quake_formats::wad::{Wad, WadLump};
 use rayon::prelude::*;
 use std::path::PathBuf;
 
+/// How pictures become miptex.
 #[derive(Debug, Clone)]
 pub struct BuildOptions {
+    /// The palette colours are quantised to: the game's, or Slipgate's own by default.
     pub palette: Palette,
     /// Floyd-Steinberg error diffusion (otherwise each pixel takes its nearest colour).
     pub dither: bool,
@@ -30,20 +32,29 @@ impl Default for BuildOptions {
 /// One level's error both ways, whichever was written.
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
 pub struct LevelErrors {
+    /// The error with Floyd-Steinberg error diffusion.
     pub dithered: LevelError,
+    /// The error with each pixel's nearest colour.
     pub nearest: LevelError,
 }
 
 /// What became of one picture.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct TextureReport {
+    /// The texture name, as stored in the WAD.
     pub name: String,
+    /// The picture file it was made from.
     pub file: PathBuf,
+    /// What its name makes of transparent pixels.
     pub kind: Kind,
     /// The picture's own size, and the size stored (rounded up to multiples of 16).
     pub source_size: [usize; 2],
+    /// Width and height stored, multiples of 16.
     pub size: [usize; 2],
+    /// Pixels of the full-size level given fullbright colours (where the glow mask is bright).
     pub fullbright_pixels: usize,
+    /// Pixels of the full-size level given the transparent index (holes of `{` and sky
+    /// textures).
     pub transparent_pixels: usize,
     /// Pixels with coverage under one half in a texture that cannot have holes (drawn opaque).
     pub ignored_holes: usize,
@@ -52,14 +63,18 @@ pub struct TextureReport {
 }
 
 impl TextureReport {
+    /// Whether the picture was stretched to reach multiples of 16.
     pub fn resized(&self) -> bool {
         self.source_size != self.size
     }
 }
 
+/// A built WAD and what became of each picture.
 #[derive(Debug, Clone)]
 pub struct Built {
+    /// The WAD: one miptex lump per picture, in the sources' order.
     pub wad: Wad,
+    /// One report per picture, in the same order.
     pub textures: Vec<TextureReport>,
 }
 

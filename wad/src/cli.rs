@@ -28,23 +28,30 @@ sRGB values, weighted by alpha), then every level is quantised with Floyd-Steinb
 diffusion (--no-dither: nearest colour). The summary gives each level's mean colour error both \
 ways: per pixel, and of 2x2 block means (what a distant view sees).";
 
+/// `slipgate wad`'s command line.
 #[derive(clap::Args, Debug, Clone)]
 pub struct Args {
+    /// What to do.
     #[command(subcommand)]
     pub command: Command,
 }
 
+/// `slipgate wad`'s three commands.
 #[derive(clap::Subcommand, Debug, Clone)]
 pub enum Command {
     /// Build a WAD2 from a folder of PNG and TGA pictures
     #[command(long_about = format!("Build a WAD2 from a folder of PNG and TGA pictures.\n\n{CONVENTIONS}"))]
     Build(BuildArgs),
     /// List a WAD's lumps: name, type, size, fullbright and transparent pixels
-    List { wad: PathBuf },
+    List {
+        /// The WAD to list
+        wad: PathBuf,
+    },
     /// Write a WAD's textures as PNG pictures (holes as alpha 0, fullbrights as NAME_glow.png)
     Extract(ExtractArgs),
 }
 
+/// `slipgate wad build`'s arguments.
 #[derive(clap::Args, Debug, Clone)]
 pub struct BuildArgs {
     /// Folder of .png and .tga pictures
@@ -62,8 +69,10 @@ pub struct BuildArgs {
     pub stats: Option<PathBuf>,
 }
 
+/// `slipgate wad extract`'s arguments.
 #[derive(clap::Args, Debug, Clone)]
 pub struct ExtractArgs {
+    /// The WAD to extract
     pub wad: PathBuf,
     /// Folder to write the pictures into (created if missing)
     pub dir: PathBuf,
@@ -72,6 +81,7 @@ pub struct ExtractArgs {
     pub palette: Option<PathBuf>,
 }
 
+/// Do what `args` ask, printing a summary on stderr (and `list`'s table on stdout).
 pub fn run(args: &Args) -> Result<()> {
     match &args.command {
         Command::Build(args) => run_build(args),

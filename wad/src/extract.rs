@@ -16,16 +16,21 @@ use std::path::{Path, PathBuf};
 /// One line of `slipgate wad list`.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Entry {
+    /// The lump's name as the directory gives it.
     pub name: String,
     /// `miptex`, `palette`, `qpic`, `sound` or the type byte.
     pub kind: String,
+    /// Size of the lump's data in bytes.
     pub bytes: usize,
     /// Miptex only: size, and pixels of the full-size level that are fullbright or holes.
     pub size: Option<[u32; 2]>,
+    /// Pixels of the full-size level with fullbright colours (0 for other lumps).
     pub fullbright_pixels: usize,
+    /// Pixels of the full-size level that engines draw as holes (0 for other lumps).
     pub transparent_pixels: usize,
 }
 
+/// One entry per lump, in directory order.
 pub fn list(wad: &Wad) -> Vec<Entry> {
     wad.lumps
         .iter()
@@ -122,6 +127,7 @@ pub fn pictures(tex: &MipTex, palette: &Palette) -> Option<(RgbaImage, Option<Gr
 /// What `extract` wrote and passed over.
 #[derive(Debug, Clone, Default)]
 pub struct Extracted {
+    /// The pictures and glow masks written.
     pub written: Vec<PathBuf>,
     /// Lumps that are not miptex with pixels, with why.
     pub skipped: Vec<String>,

@@ -8,6 +8,7 @@
 use crate::picture::Picture;
 use crate::quantise::{Class, Quantiser, distance_squared};
 
+/// The colour error of one quantised mip level (see the module comment for the two measures).
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
 pub struct LevelError {
     /// Opaque pixels measured.
@@ -19,7 +20,7 @@ pub struct LevelError {
 }
 
 impl LevelError {
-    pub fn measure(quantiser: &Quantiser, picture: &Picture, indices: &[u8]) -> LevelError {
+    pub(crate) fn measure(quantiser: &Quantiser, picture: &Picture, indices: &[u8]) -> LevelError {
         let opaque = |at: usize| quantiser.class(&picture.texels[at]) != Class::Hole;
         let (mut pixel_sum, mut pixels) = (0.0, 0);
         for (at, &index) in indices.iter().enumerate() {

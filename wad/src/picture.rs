@@ -5,18 +5,25 @@
 /// for a fullbright colour, both 0..=1.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Texel {
+    /// Red, green and blue, 0..=255.
     pub rgb: [f64; 3],
+    /// Coverage: 0 for a hole, 1 for an opaque pixel.
     pub alpha: f64,
+    /// How strongly the pixel asks for a fullbright colour: 0 not at all, 1 fully.
     pub glow: f64,
 }
 
+#[cfg(test)]
 impl Texel {
-    pub const OPAQUE_BLACK: Texel = Texel {
+    /// A fully covered black pixel that does not glow, to build test pictures from.
+    pub(crate) const OPAQUE_BLACK: Texel = Texel {
         rgb: [0.0; 3],
         alpha: 1.0,
         glow: 0.0,
     };
+}
 
+impl Texel {
     /// Colour weighted by coverage, so that a hole's colour does not bleed into its neighbours
     /// when pixels are mixed.
     fn premultiplied(self) -> [f64; 5] {
@@ -34,15 +41,19 @@ impl Texel {
     }
 }
 
+/// A true-colour picture: a texture, or one of its mip levels, before quantising.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Picture {
+    /// Width in pixels.
     pub width: usize,
+    /// Height in pixels.
     pub height: usize,
     /// Rows top first.
     pub texels: Vec<Texel>,
 }
 
 impl Picture {
+    /// A `width` x `height` picture whose pixel (x, y) is `f(x, y)`.
     pub fn from_fn(width: usize, height: usize, f: impl Fn(usize, usize) -> Texel) -> Picture {
         let texels = (0..height)
             .flat_map(|y| (0..width).map(move |x| (x, y)))
@@ -55,6 +66,7 @@ impl Picture {
         }
     }
 
+    /// Pixel (x, y); panics outside the picture.
     pub fn at(&self, x: usize, y: usize) -> Texel {
         self.texels[y * self.width + x]
     }

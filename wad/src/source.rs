@@ -33,6 +33,7 @@ pub enum Kind {
 }
 
 impl Kind {
+    /// The kind a texture name makes: `{` names are fences, `sky` names (any case) skies.
     pub fn of(name: &str) -> Kind {
         if name.starts_with('{') {
             Kind::Fence
@@ -43,6 +44,7 @@ impl Kind {
         }
     }
 
+    /// The palette index engines draw as a hole in this kind of texture, if any.
     pub fn transparent_index(self) -> Option<u8> {
         match self {
             Kind::Plain => None,
@@ -55,8 +57,11 @@ impl Kind {
 /// One texture's picture, ready to quantise.
 #[derive(Debug, Clone)]
 pub struct Source {
+    /// The texture name the file gives.
     pub name: String,
+    /// The picture file.
     pub path: PathBuf,
+    /// The picture, its glow mask and (for kinds with holes) its alpha applied.
     pub picture: Picture,
     /// Pixels under half coverage in a texture whose kind has no transparent index (drawn anyway).
     pub ignored_holes: usize,

@@ -1,8 +1,8 @@
 //! BSP29 and BSP2 files: one typed model, two on-disk encodings.
 //!
 //! The model stores every index as `u32`/`i32` and every bound as `f32`, wide enough for both
-//! versions. Each record type knows its encoding per version ([`Record`]); lumps are read and
-//! written by one generic pair of functions. Trailing BSPX lumps are kept as named byte blobs;
+//! versions. Each record type knows its encoding per version (`records::Record`); lumps are
+//! read and written by one generic pair of functions. Trailing BSPX lumps are kept as named byte blobs;
 //! [`phong`] reads and writes Slipgate's own one.
 
 pub mod limits;
@@ -78,8 +78,14 @@ const FILE_ORDER: [usize; 15] = [1, 10, 3, 5, 6, 7, 9, 11, 13, 12, 14, 8, 4, 0, 
 pub enum PvsRow {
     /// No row: the leaf sees every leaf.
     All,
-    /// The decompressed row; `complete` is false when the data ended early (zero-padded).
-    Row { bits: Vec<u8>, complete: bool },
+    /// A stored row, decompressed.
+    Row {
+        /// One bit per leaf, leaf 1 in bit 0 of the first byte; as many bytes as the world
+        /// model's `vis_leafs` need.
+        bits: Vec<u8>,
+        /// False when the compressed data ended before the row was full; the rest is zeros.
+        complete: bool,
+    },
 }
 
 /// An extension lump stored after the standard ones (BSPX), kept verbatim.
@@ -87,10 +93,12 @@ pub enum PvsRow {
 pub struct BspxLump {
     /// 24-byte NUL-padded name as stored.
     pub raw_name: [u8; 24],
+    /// The lump's contents, which only readers that know its name interpret.
     pub data: Vec<u8>,
 }
 
 impl BspxLump {
+    /// The name up to its first NUL, read as Latin-1 (e.g. `"RGBLIGHTING"`, `"BRUSHLIST"`).
     pub fn name(&self) -> String {
         let end = self.raw_name.iter().position(|&b| b == 0).unwrap_or(24);
         crate::bytes::latin1_to_string(&self.raw_name[..end])
@@ -100,25 +108,41 @@ impl BspxLump {
 /// A whole BSP file.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Bsp {
+    /// The encoding [`Bsp::write`] uses; [`Bsp::read`] sets it from the file's magic.
     pub version: BspVersion,
     /// The entity lump's text as bytes, including its terminating NUL.
     pub entities: Vec<u8>,
+    /// Split planes of nodes and clip nodes, and the planes faces lie on.
     pub planes: Vec<BspPlane>,
+    /// The miptex lump: the textures texinfos name by index.
     pub textures: TextureLump,
+    /// Vertex positions in map units, shared by all faces through `edges`.
     pub vertices: Vec<[f32; 3]>,
     /// Compressed PVS rows; leaves point into it with `vis_offset`.
     pub visibility: Vec<u8>,
+    /// Hull 0's BSP nodes for every model; models point at their head node.
     pub nodes: Vec<Node>,
+    /// Texture projections; faces point at one each.
     pub texinfo: Vec<TexInfo>,
+    /// Drawn polygons of every model.
     pub faces: Vec<Face>,
     /// 8-bit lightmaps; faces point into it with `light_offset`.
     pub lighting: Vec<u8>,
+    /// The collision trees of hulls 1 and 2 (the player's box and the large monsters').
     pub clipnodes: Vec<ClipNode>,
+    /// Hull 0's leaves; leaf 0 is the shared solid leaf every solid child points at.
     pub leafs: Vec<Leaf>,
+    /// Face indices, in runs that leaves point into with `first_marksurface`.
     pub marksurfaces: Vec<u32>,
+    /// Vertex indices of each edge's two ends; edge 0 is unused, because surfedges tell the
+    /// direction by sign.
     pub edges: Vec<[u32; 2]>,
+    /// Edge indices, in runs that faces point into: `i` walks edge `i` from its first vertex to
+    /// its second, `-i` from the second to the first.
     pub surfedges: Vec<i32>,
+    /// The world (model 0) and each brush entity's model (`*1`, `*2`, ...).
     pub models: Vec<Model>,
+    /// Extension lumps after the standard ones, in file order.
     pub bspx: Vec<BspxLump>,
     /// How the file this came from was laid out (for byte-identical rewrites).
     layout: Option<(BspVersion, Layout)>,
@@ -138,6 +162,7 @@ struct LumpEntry {
 }
 
 impl Bsp {
+    /// An empty file in `version`: every lump empty, no layout to keep.
     pub fn new(version: BspVersion) -> Bsp {
         Bsp {
             version,

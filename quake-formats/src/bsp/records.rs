@@ -4,13 +4,19 @@ use super::BspVersion;
 use crate::bytes::{PutLe, Reader};
 use crate::error::{FormatError, Result};
 
-/// Leaf and clip node contents values.
+/// Leaf and clip node contents values: what fills a region of the map.
 pub mod contents {
+    /// Open space that players and monsters move through.
     pub const EMPTY: i32 = -1;
+    /// Inside a wall: nothing moves there and nothing in it is drawn.
     pub const SOLID: i32 = -2;
+    /// Water: players swim, and the view is tinted and warped underneath.
     pub const WATER: i32 = -3;
+    /// Slime: like water, and it hurts the player.
     pub const SLIME: i32 = -4;
+    /// Lava: like water, and it hurts the player more.
     pub const LAVA: i32 = -5;
+    /// The inside of sky brushes; faces towards it are drawn as scrolling sky.
     pub const SKY: i32 = -6;
 }
 
@@ -42,9 +48,13 @@ fn narrow<T: TryFrom<i64>>(value: i64, lump: &'static str, field: &'static str) 
 /// The BSP's plane record (`f32`), as opposed to [`crate::geom::Plane`] (`f64`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Plane {
+    /// Unit normal.
     pub normal: [f32; 3],
+    /// Distance from the origin along `normal`: points `p` on the plane have
+    /// `dot(normal, p) == dist`.
     pub dist: f32,
-    /// 0..2 axial X/Y/Z, 3..5 mostly X/Y/Z.
+    /// 0..2 axial X/Y/Z, 3..5 mostly X/Y/Z. Engines test a point against an axial plane with
+    /// its one coordinate instead of a dot product, so the kind must match the normal.
     pub kind: i32,
 }
 
@@ -161,11 +171,18 @@ fn write_wide_u(
 /// An interior node of the hull 0 tree. A child `>= 0` is a node, `< 0` is leaf `-(child + 1)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Node {
+    /// Index of the split plane in the planes lump.
     pub plane: u32,
+    /// The front child (on the normal's side of the plane), then the back one.
     pub children: [i32; 2],
+    /// Lower corner of the box around everything below the node, for frustum culling (BSP29
+    /// stores whole units, rounded outward).
     pub mins: [f32; 3],
+    /// Upper corner of the box around everything below the node.
     pub maxs: [f32; 3],
+    /// Index of the first of the faces that lie on this node's plane.
     pub first_face: u32,
+    /// Number of faces on this node's plane, from `first_face` on.
     pub num_faces: u32,
 }
 
@@ -204,12 +221,19 @@ impl Record for Node {
 /// A convex region of the hull 0 tree.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Leaf {
+    /// What fills the leaf: one of the [`contents`] values.
     pub contents: i32,
     /// Byte offset of this leaf's compressed PVS row, or -1 for none.
     pub vis_offset: i32,
+    /// Lower corner of the leaf's box, for frustum culling (BSP29 stores whole units, rounded
+    /// outward).
     pub mins: [f32; 3],
+    /// Upper corner of the leaf's box.
     pub maxs: [f32; 3],
+    /// Index of the leaf's first marksurface: the faces engines draw when the leaf is visible
+    /// start there.
     pub first_marksurface: u32,
+    /// Number of marksurfaces from `first_marksurface` on.
     pub num_marksurfaces: u32,
     /// Ambient sound levels: water, sky, slime, lava.
     pub ambient: [u8; 4],
@@ -276,7 +300,9 @@ impl Record for Leaf {
 /// A node of a clipping hull (1 and 2). A child `>= 0` is a clip node, `< 0` is contents.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ClipNode {
+    /// Index of the split plane in the planes lump.
     pub plane: u32,
+    /// The front child (on the normal's side of the plane), then the back one.
     pub children: [i32; 2],
 }
 
@@ -306,8 +332,11 @@ impl Record for ClipNode {
 /// Texture projection: `s = dot(p, vecs[0].xyz) + vecs[0].w`, likewise `t` with `vecs[1]`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TexInfo {
+    /// The `s` and `t` axes in texels per map unit, each followed by its offset in texels.
     pub vecs: [[f32; 4]; 2],
+    /// Index of the texture in the texture lump.
     pub miptex: u32,
+    /// Bits of [`texinfo_flags`].
     pub flags: i32,
 }
 
@@ -344,11 +373,15 @@ impl Record for TexInfo {
 /// A drawable polygon: a run of surfedges on one plane with one texinfo and up to four styles.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Face {
+    /// Index of the plane the face lies on.
     pub plane: u32,
     /// 1 when the face looks along the plane's back side.
     pub side: u32,
+    /// Index of the face's first surfedge.
     pub first_edge: u32,
+    /// Number of surfedges from `first_edge` on, which is also its number of vertices.
     pub num_edges: u32,
+    /// Index of the texinfo that projects the face's texture and lightmap.
     pub texinfo: u32,
     /// Light styles; 255 marks an empty slot.
     pub styles: [u8; 4],
@@ -436,14 +469,20 @@ impl Record for i32 {
 /// A brush model: the world (model 0) or a brush entity, with one head node per hull.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Model {
+    /// Lower corner of the model's box, in map units.
     pub mins: [f32; 3],
+    /// Upper corner of the model's box.
     pub maxs: [f32; 3],
+    /// A point stored with the model that engines do not place it by (the entity's `origin`
+    /// key does); Slipgate writes zero.
     pub origin: [f32; 3],
     /// Hull 0 node, then clip node heads of hulls 1..3.
     pub head_nodes: [i32; 4],
     /// Leaves of this model that have PVS rows (the world's count excludes leaf 0).
     pub vis_leafs: i32,
+    /// Index of the model's first face; a model's faces are one run.
     pub first_face: u32,
+    /// Number of faces from `first_face` on.
     pub num_faces: u32,
 }
 

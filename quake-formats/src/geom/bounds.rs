@@ -3,7 +3,9 @@ use glam::DVec3;
 /// An axis-aligned box; empty until a point is added.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Bounds {
+    /// Lowest corner; +infinity on every axis while empty.
     pub mins: DVec3,
+    /// Highest corner; -infinity on every axis while empty.
     pub maxs: DVec3,
 }
 
@@ -14,22 +16,26 @@ impl Default for Bounds {
 }
 
 impl Bounds {
+    /// The box of no points: inside out, so that adding any point makes it that point.
     pub const EMPTY: Bounds = Bounds {
         mins: DVec3::INFINITY,
         maxs: DVec3::NEG_INFINITY,
     };
 
+    /// Whether no point has been added (`mins` above `maxs` on some axis).
     #[inline]
     pub fn is_empty(&self) -> bool {
         self.mins.x > self.maxs.x || self.mins.y > self.maxs.y || self.mins.z > self.maxs.z
     }
 
+    /// Grow the box to hold `p`.
     #[inline]
     pub fn add_point(&mut self, p: DVec3) {
         self.mins = per_axis(self.mins, p, f64::min);
         self.maxs = per_axis(self.maxs, p, f64::max);
     }
 
+    /// The smallest box holding both boxes.
     #[inline]
     pub fn union(&self, o: &Bounds) -> Bounds {
         Bounds {
@@ -38,16 +44,19 @@ impl Bounds {
         }
     }
 
+    /// Whether `p` is inside or on the box.
     #[inline]
     pub fn contains(&self, p: DVec3) -> bool {
         (0..3).all(|i| p[i] >= self.mins[i] && p[i] <= self.maxs[i])
     }
 
+    /// Whether the two boxes overlap or touch.
     #[inline]
     pub fn intersects(&self, o: &Bounds) -> bool {
         (0..3).all(|i| self.mins[i] <= o.maxs[i] && o.mins[i] <= self.maxs[i])
     }
 
+    /// The middle of the box (meaningless while empty).
     #[inline]
     pub fn center(&self) -> DVec3 {
         (self.mins + self.maxs) * 0.5

@@ -5,16 +5,22 @@ use glam::DVec3;
 /// A plane `normal · p = dist` with a unit normal; the front side is where the normal points.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Plane {
+    /// Unit normal, pointing to the front side.
     pub normal: DVec3,
+    /// Distance from the origin along `normal`.
     pub dist: f64,
 }
 
 /// Where something lies relative to a plane, within [`ON_EPSILON`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PlaneSide {
+    /// Entirely in front (on the normal's side), or touching the plane from there.
     Front,
+    /// Entirely behind, or touching the plane from there.
     Back,
+    /// On the plane: every point within [`ON_EPSILON`] of it.
     On,
+    /// Partly in front and partly behind.
     Cross,
 }
 
@@ -42,6 +48,7 @@ impl PlaneSide {
 }
 
 impl Plane {
+    /// The plane `normal · p = dist`; `normal` must already be unit length.
     pub fn new(normal: DVec3, dist: f64) -> Self {
         Plane { normal, dist }
     }
@@ -53,14 +60,17 @@ impl Plane {
         Some(Plane::new(normal, normal.dot(b)))
     }
 
+    /// Signed distance of `p` from the plane: positive in front.
     pub fn distance(&self, p: DVec3) -> f64 {
         self.normal.dot(p) - self.dist
     }
 
+    /// The same plane facing the other way.
     pub fn flipped(&self) -> Plane {
         Plane::new(-self.normal, -self.dist)
     }
 
+    /// Which side `p` is on ([`PlaneSide::Front`], [`PlaneSide::Back`] or [`PlaneSide::On`]).
     pub fn side_of_point(&self, p: DVec3) -> PlaneSide {
         PlaneSide::of_distance(self.distance(p))
     }
@@ -130,6 +140,7 @@ impl Plane {
         Plane::new(normal, dist)
     }
 
+    /// Whether the normal and distance hold no NaN or infinity.
     pub fn is_finite(&self) -> bool {
         self.normal.is_finite() && self.dist.is_finite()
     }

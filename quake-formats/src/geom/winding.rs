@@ -6,26 +6,35 @@ use glam::DVec3;
 /// convention, matching [`Plane::from_points`]).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Winding {
+    /// The corners in order; the last connects back to the first.
     pub points: Vec<DVec3>,
 }
 
 /// The result of splitting a winding by a plane.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Split {
+    /// Entirely in front (some points may be on the plane): the winding unchanged.
     Front(Winding),
+    /// Entirely behind (some points may be on the plane): the winding unchanged.
     Back(Winding),
     /// Coplanar; `facing_front` tells whether the winding faces the same way as the plane.
     On {
+        /// The winding unchanged.
         winding: Winding,
+        /// Whether the winding's own normal points the way the plane's does.
         facing_front: bool,
     },
+    /// Crossing the plane: cut into two, the new points shared by both halves.
     Both {
+        /// The part in front of the plane.
         front: Winding,
+        /// The part behind the plane.
         back: Winding,
     },
 }
 
 impl Winding {
+    /// A winding of `points`, which must already be convex and in clockwise order.
     pub fn new(points: Vec<DVec3>) -> Self {
         Winding { points }
     }
@@ -58,14 +67,17 @@ impl Winding {
         ])
     }
 
+    /// Number of points.
     pub fn len(&self) -> usize {
         self.points.len()
     }
 
+    /// Whether the winding has no points (clipped away).
     pub fn is_empty(&self) -> bool {
         self.points.is_empty()
     }
 
+    /// The box around the points.
     pub fn bounds(&self) -> Bounds {
         let mut b = Bounds::EMPTY;
         for &p in &self.points {
@@ -74,11 +86,13 @@ impl Winding {
         b
     }
 
+    /// The mean of the points (the origin for an empty winding).
     pub fn center(&self) -> DVec3 {
         let sum = self.points.iter().fold(DVec3::ZERO, |acc, &p| acc + p);
         sum / self.points.len().max(1) as f64
     }
 
+    /// Area in square map units.
     pub fn area(&self) -> f64 {
         let mut total = DVec3::ZERO;
         for i in 2..self.points.len() {
@@ -109,6 +123,7 @@ impl Winding {
         Some(Plane::new(normal, normal.dot(self.center())))
     }
 
+    /// The same polygon in the opposite order, facing the other way.
     pub fn reversed(&self) -> Winding {
         Winding::new(self.points.iter().rev().copied().collect())
     }
@@ -258,6 +273,7 @@ impl Winding {
         long_edges < 3
     }
 
+    /// Whether every point is free of NaN and infinity.
     pub fn is_finite(&self) -> bool {
         self.points.iter().all(|p| p.is_finite())
     }

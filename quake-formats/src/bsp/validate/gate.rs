@@ -39,6 +39,7 @@ pub const MAX_TREE_DEPTH: usize = 4096;
 /// Whether a stage walks the world's hull 0 tree.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum TreeUse {
+    /// The stage walks the tree, so a file without nodes is refused.
     Needed,
     /// The stage uses the tree when the file has one (light culls by it) and works from the faces
     /// alone when the nodes lump is empty; a tree that is there must still be sound.

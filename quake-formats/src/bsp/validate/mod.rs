@@ -41,12 +41,15 @@ impl std::fmt::Display for Severity {
 /// One thing wrong with a BSP: the rule it breaks and the lump and record where.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Problem {
+    /// The rule broken.
     pub rule: Rule,
     /// The rule's severity, kept here for callers that only filter.
     pub severity: Severity,
+    /// Name of the lump the problem is in, as in [`LUMP_NAMES`](super::LUMP_NAMES) (`"faces"`).
     pub lump: &'static str,
     /// The record's index in its lump (0 for whole-lump problems).
     pub index: usize,
+    /// What is wrong with this record, with the values involved.
     pub detail: String,
 }
 

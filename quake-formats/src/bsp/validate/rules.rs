@@ -8,42 +8,78 @@ use super::Severity;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Rule {
     // Structure: what any reader of the format needs.
+    /// `index-range`: an index, offset or range points outside the lump it refers to.
     IndexRange,
+    /// `non-finite`: a plane, vertex, bound, texture axis or model origin is NaN or infinite.
     NonFinite,
+    /// `plane-normal`: a plane's normal is not of unit length.
     PlaneNormal,
+    /// `bsp29-limit`: a BSP29 file's count or bound does not fit its 16-bit field.
     Bsp29Limit,
+    /// `entity-text`: the entity lump lacks its NUL or does not parse.
     EntityText,
+    /// `face-edges`: a face has fewer than 3 edges.
     FaceEdges,
+    /// `contents-value`: a leaf or clip node child holds no valid contents value.
     ContentsValue,
+    /// `lightmap-range`: a lit face's lightmaps run past the lighting lump.
     LightmapRange,
+    /// `no-world-model`: the models lump is empty, so there is no world.
     NoWorldModel,
     // What engines enforce when they load or play the file.
+    /// `no-nodes`: the nodes lump is empty.
     NoNodes,
+    /// `world-head-node`: the world's hull 0 tree does not start at node 0.
     WorldHeadNode,
+    /// `hull-node-range`: a hull's tree reaches a node numbered before its head.
     HullNodeRange,
+    /// `tree-cycle`: a node or clip node leads back to itself.
     TreeCycle,
+    /// `clip-hulls-missing`: models name clip hull heads, but there are no clip nodes.
     ClipHullsMissing,
+    /// `node-same-children`: a world node has the same child on both sides.
     NodeSameChildren,
+    /// `node-plane-outside-region`: a world node's plane misses the region DarkPlaces gives it.
     NodePlaneOutsideRegion,
+    /// `leaf-zero-solid`: leaf 0 is not solid.
     LeafZeroSolid,
+    /// `surface-extents`: a lightmapped face is too large for mainstream engines.
     SurfaceExtents,
+    /// `surface-extents-vanilla`: a lightmapped face is too large for WinQuake or GLQuake.
     SurfaceExtentsVanilla,
+    /// `lightmap-extents-engines-disagree`: QuakeSpasm and DarkPlaces size a face's lightmap differently.
     LightmapExtentsEnginesDisagree,
+    /// `unlit-face-verts`: a liquid, sky or untextured unlit face has more vertices than engines buffer.
     UnlitFaceVerts,
+    /// `texture-alignment`: a texture's width or height is not a multiple of 16.
     TextureAlignment,
+    /// `animation-name`: a `+` texture's frame character is not 0-9 or a-j.
     AnimationName,
+    /// `animation-frames`: an animated sequence misses a frame below its highest.
     AnimationFrames,
+    /// `sky-texture-size`: a sky texture is not 256x128.
     SkyTextureSize,
+    /// `sky-name-case`: a sky texture's name does not start with lower-case `sky`.
     SkyNameCase,
+    /// `texinfo-miptex`: a texinfo names a slot past the texture lump's count.
     TexinfoMiptex,
+    /// `texture-missing`: a texinfo names a slot that holds no texture.
     TextureMissing,
+    /// `leaf-count`: a BSP29 file has more than 32767 leafs.
     LeafCount,
+    /// `vis-leafs`: the world's visleafs exceeds the leafs there are.
     VisLeafs,
+    /// `vis-leafs-vanilla`: the world's visleafs exceeds vanilla's 8192.
     VisLeafsVanilla,
+    /// `model-count`: the models leave no room for the game code's in a 2048-entry table.
     ModelCount,
+    /// `model-count-vanilla`: the models leave no room for the game code's in a 256-entry table.
     ModelCountVanilla,
+    /// `worldspawn`: there is no worldspawn entity.
     Worldspawn,
+    /// `worldspawn-first`: the first entity is not the worldspawn.
     WorldspawnFirst,
+    /// `player-start`: there is no info_player_start.
     PlayerStart,
 }
 
@@ -52,6 +88,7 @@ pub enum Rule {
 pub struct RuleInfo {
     /// Stable short id, e.g. `hull-node-range`.
     pub id: &'static str,
+    /// How bad breaking the rule is.
     pub severity: Severity,
     /// The engine families that enforce the rule.
     pub engines: &'static str,
@@ -64,6 +101,7 @@ pub struct RuleInfo {
 const QS: &str = "QuakeSpasm, vkQuake, Ironwail";
 
 impl Rule {
+    /// Every rule, in declaration order (structure first, then what engines enforce).
     pub const ALL: [Rule; 36] = [
         Rule::IndexRange,
         Rule::NonFinite,
@@ -103,14 +141,17 @@ impl Rule {
         Rule::PlayerStart,
     ];
 
+    /// The rule's stable short id, e.g. `hull-node-range`.
     pub fn id(self) -> &'static str {
         self.info().id
     }
 
+    /// How bad breaking the rule is.
     pub fn severity(self) -> Severity {
         self.info().severity
     }
 
+    /// Everything said about the rule: id, severity, engines, their message and what is checked.
     pub fn info(self) -> RuleInfo {
         use Severity::{Error, Warning};
         let (id, severity, engines, message, checks) = match self {
