@@ -402,18 +402,9 @@ fn vis_stage(
         let prt = PortalFile::parse(&String::from_utf8_lossy(&prt_bytes))
             .map_err(|e| format!("the portal file: {e}"))?;
         vis::check_portals_match(&bsp, prt.num_leafs as usize).map_err(|e| e.to_string())?;
-        let options = vis::VisOptions {
-            mode: if args.fast {
-                vis::VisMode::Fast
-            } else {
-                vis::VisMode::Full { level: args.level }
-            },
-            threads: args.threads,
-            ..vis::VisOptions::default()
-        };
+        let options = args.options();
         let result = vis::compute_vis(&prt, &options).map_err(|e| e.to_string())?;
-        vis::write_vis(&mut bsp, &result.pvs).map_err(|e| e.to_string())?;
-        vis::ambient::ambient_levels(&mut bsp, &result.pvs).map_err(|e| e.to_string())?;
+        vis::store(&mut bsp, &result.pvs, options.ambient).map_err(|e| e.to_string())?;
         let c = &result.stats;
         Ok(Product {
             outputs: vec![("bsp", bsp.write().map_err(|e| e.to_string())?)],

@@ -178,7 +178,7 @@ fn run_vis(bsp: &mut Bsp) {
         return;
     };
     if vis::write_vis(bsp, &result.pvs).is_ok() {
-        let _ = vis::ambient::ambient_levels(bsp, &result.pvs);
+        let _ = vis::ambient::ambient_levels(bsp, &result.pvs, vis::ambient::Channels::ALL);
     }
 }
 

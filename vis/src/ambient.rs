@@ -76,9 +76,31 @@ fn leaf_bounds(mins: [f32; 3], maxs: [f32; 3]) -> Bounds {
     b
 }
 
-/// Fill `Leaf::ambient` of every vis leaf from the sound surfaces of the leaves it sees. Returns
-/// how many leaves hear anything.
-pub fn ambient_levels(bsp: &mut Bsp, pvs: &Pvs) -> Result<usize, VisError> {
+/// Which ambient channels a run fills (ericw-tools' `-noambient*` options turn them off); an off
+/// channel is silent in every leaf.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Channels(pub [bool; 4]);
+
+impl Channels {
+    /// Every channel on: the default.
+    pub const ALL: Channels = Channels([true; 4]);
+
+    /// `self` with `channel` off.
+    pub fn without(mut self, channel: Ambient) -> Channels {
+        self.0[channel as usize] = false;
+        self
+    }
+}
+
+impl Default for Channels {
+    fn default() -> Self {
+        Channels::ALL
+    }
+}
+
+/// Fill `Leaf::ambient` of every vis leaf from the sound surfaces of the leaves it sees, on the
+/// channels `channels` has on. Returns how many leaves hear anything.
+pub fn ambient_levels(bsp: &mut Bsp, pvs: &Pvs, channels: Channels) -> Result<usize, VisError> {
     crate::lump::check_portals_match(bsp, pvs.num_leafs())?;
     // Each vis leaf's sound sources: channel and bounds. A liquid or sky leaf sounds as a
     // whole (its surfaces may be named unlike liquids and skies, or be missing), and so does
@@ -126,7 +148,11 @@ pub fn ambient_levels(bsp: &mut Bsp, pvs: &Pvs) -> Result<usize, VisError> {
                     *slot = slot.min(d);
                 }
             }
-            nearest.map(level_at)
+            let mut level = nearest.map(level_at);
+            for (l, on) in level.iter_mut().zip(channels.0) {
+                *l = if on { *l } else { 0 };
+            }
+            level
         })
         .collect();
     let mut hearing = 0;

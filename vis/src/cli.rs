@@ -1,6 +1,7 @@
 //! `slipgate-vis`: compute the PVS of a compiled map from the `.prt` file beside it; or one
 //! shard's part of the full flow (`--shard K/N`), joined later by `--merge`.
 
+use crate::ambient::{Ambient, Channels};
 use crate::saved::{InputsHash, SavedFlows, SavedKind};
 use crate::shards;
 use crate::{BitSet, Checkpoint, KnownFlows, SaveFlows, Shard, VisMode, VisOptions};
@@ -51,6 +52,21 @@ pub struct Args {
     /// Save the full flow's state every this many seconds (0: never)
     #[arg(long, default_value_t = 300.0)]
     pub save_interval: f64,
+    /// No ambient sounds at all (every leaf silent)
+    #[arg(long)]
+    pub noambient: bool,
+    /// No ambient sound from sky (textures named sky*)
+    #[arg(long)]
+    pub noambientsky: bool,
+    /// No ambient sound from water
+    #[arg(long)]
+    pub noambientwater: bool,
+    /// No ambient sound from slime
+    #[arg(long)]
+    pub noambientslime: bool,
+    /// No ambient sound from lava
+    #[arg(long)]
+    pub noambientlava: bool,
 }
 
 pub fn run(args: &Args) -> Result<()> {
@@ -80,16 +96,40 @@ pub fn run(args: &Args) -> Result<()> {
     finish(args, inputs, result, total)
 }
 
+impl Args {
+    /// The options these arguments ask for (no progress reported).
+    pub fn options(&self) -> VisOptions {
+        VisOptions {
+            mode: if self.fast {
+                VisMode::Fast
+            } else {
+                VisMode::Full { level: self.level }
+            },
+            threads: self.threads,
+            ambient: self.channels(),
+            ..Default::default()
+        }
+    }
+
+    /// The ambient channels the options leave on.
+    fn channels(&self) -> Channels {
+        [
+            (self.noambientsky, Ambient::Sky),
+            (self.noambientwater, Ambient::Water),
+            (self.noambientslime, Ambient::Slime),
+            (self.noambientlava, Ambient::Lava),
+        ]
+        .into_iter()
+        .filter(|&(off, _)| off || self.noambient)
+        .fold(Channels::ALL, |c, (_, channel)| c.without(channel))
+    }
+}
+
+/// The options of a run from the command line: the arguments', with a progress bar.
 fn options(args: &Args) -> VisOptions {
     VisOptions {
-        mode: if args.fast {
-            VisMode::Fast
-        } else {
-            VisMode::Full { level: args.level }
-        },
-        threads: args.threads,
         progress: quake_formats::progress::terminal(),
-        ..Default::default()
+        ..args.options()
     }
 }
 
@@ -253,8 +293,9 @@ fn finish(args: &Args, inputs: Inputs, result: crate::VisResult, total: Instant)
     }
 
     let start = Instant::now();
-    let lump = crate::write_vis(&mut bsp, &result.pvs).with_context(|| format!("{bsp_name}"))?;
-    let hearing = crate::ambient::ambient_levels(&mut bsp, &result.pvs)?;
+    let stored = crate::store(&mut bsp, &result.pvs, args.channels())
+        .with_context(|| format!("{bsp_name}"))?;
+    let (lump, hearing) = (stored.lump, stored.ambient_leafs);
     let bytes = bsp.write().with_context(|| format!("{bsp_name}"))?;
     write_atomic(&args.bsp, &bytes)?;
     let write_seconds = start.elapsed().as_secs_f64();

@@ -22,6 +22,7 @@ pub mod shards;
 pub mod synthetic;
 pub mod tree_portals;
 
+pub use ambient::Channels;
 pub use bitset::BitSet;
 pub use clusters::Clusters;
 pub use lump::{LumpStats, check_portals_match, check_sealed, read_pvs, write_vis};
@@ -29,6 +30,7 @@ pub use portals::PortalGraph;
 pub use pvs::Pvs;
 pub use schedule::{FlowPlan, Grouping, Shard};
 
+use quake_formats::Bsp;
 use quake_formats::progress::Progress;
 use quake_formats::prt::PortalFile;
 use rayon::prelude::*;
@@ -121,6 +123,8 @@ pub struct VisOptions {
     pub progress: Progress,
     /// Whether the full flow is planned in groups for shards ([`FlowPlan`]).
     pub grouping: Grouping,
+    /// The ambient sound channels [`store`] fills.
+    pub ambient: Channels,
 }
 
 impl Default for VisOptions {
@@ -130,8 +134,29 @@ impl Default for VisOptions {
             threads: None,
             progress: Progress::default(),
             grouping: Grouping::Auto,
+            ambient: Channels::ALL,
         }
     }
+}
+
+/// What [`store`] wrote into a BSP.
+#[derive(Debug, Clone, Default, serde::Serialize)]
+pub struct Stored {
+    /// The visibility lump.
+    pub lump: LumpStats,
+    /// Leaves that hear an ambient sound.
+    pub ambient_leafs: usize,
+}
+
+/// Store `pvs` in `bsp`: the visibility lump ([`write_vis`]) and the ambient sound levels its
+/// leaves hear on `channels` ([`ambient::ambient_levels`]).
+pub fn store(bsp: &mut Bsp, pvs: &Pvs, channels: Channels) -> Result<Stored, VisError> {
+    let lump = write_vis(bsp, pvs)?;
+    let ambient_leafs = ambient::ambient_levels(bsp, pvs, channels)?;
+    Ok(Stored {
+        lump,
+        ambient_leafs,
+    })
 }
 
 /// Counts and timings of one [`compute_vis`] run.

@@ -25,6 +25,11 @@ fn args(bsp: PathBuf) -> Args {
         merge: false,
         resume: false,
         save_interval: 0.0,
+        noambient: false,
+        noambientsky: false,
+        noambientwater: false,
+        noambientslime: false,
+        noambientlava: false,
     }
 }
 

@@ -38,6 +38,11 @@ fn args(bsp: &Path) -> Args {
         merge: false,
         resume: false,
         save_interval: 0.0,
+        noambient: false,
+        noambientsky: false,
+        noambientwater: false,
+        noambientslime: false,
+        noambientlava: false,
     }
 }
 

@@ -274,7 +274,8 @@ fn leaves_that_see_water_hear_it_fading_with_distance() {
     });
     bsp.marksurfaces.push(0);
     bsp.leafs[1].num_marksurfaces = 1;
-    let hearing = vis::ambient::ambient_levels(&mut bsp, &pvs).expect("ambient");
+    let hearing =
+        vis::ambient::ambient_levels(&mut bsp, &pvs, vis::ambient::Channels::ALL).expect("ambient");
     let water: Vec<u8> = bsp.leafs[1..].iter().map(|l| l.ambient[0]).collect();
     assert_eq!(water[0], 255);
     assert_eq!(water[1], 255, "64 units away");
@@ -282,6 +283,11 @@ fn leaves_that_see_water_hear_it_fading_with_distance() {
     assert_eq!(water[11], 0, "640 units away");
     assert_eq!(hearing, water.iter().filter(|&&l| l > 0).count());
     assert!(bsp.leafs.iter().all(|l| l.ambient[1..] == [0, 0, 0]));
+    // `-noambientwater` (and `-noambient`) silence the channel.
+    let quiet = vis::ambient::Channels::ALL.without(vis::ambient::Ambient::Water);
+    let hearing = vis::ambient::ambient_levels(&mut bsp, &pvs, quiet).expect("ambient");
+    assert_eq!(hearing, 0);
+    assert!(bsp.leafs.iter().all(|l| l.ambient == [0; 4]));
 }
 
 #[test]
@@ -292,7 +298,7 @@ fn leaves_that_see_a_slime_leaf_hear_it_without_any_slime_texture() {
     let pvs = run(&w.portal_file(), FULL);
     let mut bsp = w.bsp();
     bsp.leafs[1].contents = quake_formats::bsp::contents::SLIME;
-    vis::ambient::ambient_levels(&mut bsp, &pvs).expect("ambient");
+    vis::ambient::ambient_levels(&mut bsp, &pvs, vis::ambient::Channels::ALL).expect("ambient");
     let slime: Vec<u8> = bsp.leafs[1..].iter().map(|l| l.ambient[2]).collect();
     assert_eq!(slime[0], 255);
     assert_eq!(slime[1], 255, "touching the slime leaf");
