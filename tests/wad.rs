@@ -261,3 +261,44 @@ fn the_compiler_embeds_a_wad_built_from_pictures() {
         assert_eq!(tex.mips, from_wad.mips, "{}", tex.name());
     }
 }
+
+/// A compiled map's embedded textures come back out: as a WAD holding the very textures of the
+/// WAD it was compiled against, and as pictures.
+#[test]
+fn a_bsps_textures_extract_to_a_wad_and_to_pictures() {
+    let dir = scratch("wad", "from-bsp");
+    std::fs::create_dir_all(&dir).expect("dir");
+    let bsp = dir.join("demo.bsp");
+    let maps = repo().join("maps");
+    let out = slipgate(&[
+        "bsp",
+        "--wad-dir",
+        arg(&maps),
+        arg(&maps.join("demo.map")),
+        arg(&bsp),
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    let extracted = dir.join("demo-textures.wad");
+    let out = slipgate(&["wad", "extract", arg(&bsp), arg(&extracted)]);
+    assert!(out.status.success(), "{}", text(&out));
+    let source = read_wad(&maps.join("slipgate.wad"));
+    let wad = read_wad(&extracted);
+    assert!(!wad.lumps.is_empty());
+    for lump in &wad.lumps {
+        let name = lump.name();
+        let theirs = source
+            .find_miptex(&name)
+            .expect("a texture of the source WAD");
+        let ours = wad.find_miptex(&name).expect("miptex");
+        assert_eq!(
+            (ours.width, ours.height),
+            (theirs.width, theirs.height),
+            "{name}"
+        );
+        assert_eq!(ours.mips, theirs.mips, "{name}: pixels");
+    }
+    let pictures = dir.join("pictures");
+    let out = slipgate(&["wad", "extract", arg(&bsp), arg(&pictures)]);
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(pictures.join("brick1.png").exists());
+}

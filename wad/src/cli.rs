@@ -1,8 +1,9 @@
-//! `slipgate wad build DIR OUT.wad`, `slipgate wad list WAD`, `slipgate wad extract WAD DIR`.
+//! `slipgate wad build DIR OUT.wad`, `slipgate wad list WAD`, `slipgate wad extract WAD|BSP
+//! DIR|OUT.wad`.
 
 use crate::build::{BuildOptions, Built, LevelErrors};
 use crate::extract::{extract, list};
-use crate::{build_folder, read_wad};
+use crate::{build_folder, read_textures, read_wad};
 use anyhow::{Context, Result};
 use quake_formats::fsutil::{read_file, write_atomic};
 use quake_formats::palette::Palette;
@@ -72,9 +73,10 @@ pub struct BuildArgs {
 /// `slipgate wad extract`'s arguments.
 #[derive(clap::Args, Debug, Clone)]
 pub struct ExtractArgs {
-    /// The WAD to extract
+    /// The WAD to extract, or a BSP whose embedded textures to extract
     pub wad: PathBuf,
-    /// Folder to write the pictures into (created if missing)
+    /// Folder to write the pictures into (created if missing); a name ending in .wad writes the
+    /// textures as a WAD instead
     pub dir: PathBuf,
     /// A 768-byte palette (palette.lmp); default: gfx/palette.lmp near WAD, else Slipgate's own
     #[arg(long, value_name = "FILE.lmp")]
@@ -234,7 +236,21 @@ fn run_list(path: &Path) -> Result<()> {
 
 fn run_extract(args: &ExtractArgs) -> Result<()> {
     let started = Instant::now();
-    let wad = read_wad(&args.wad)?;
+    let wad = read_textures(&args.wad)?;
+    if args
+        .dir
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("wad"))
+    {
+        quake_formats::fsutil::write_atomic(&args.dir, &wad.write())?;
+        eprintln!(
+            "wrote the {} textures of {} to {}",
+            wad.lumps.len(),
+            args.wad.display(),
+            args.dir.display()
+        );
+        return Ok(());
+    }
     let (palette, palette_path) = palette(args.palette.as_deref(), &args.wad)?;
     let done = extract(&wad, &args.dir, &palette)?;
     eprintln!("{}", palette_name(palette_path.as_deref()));

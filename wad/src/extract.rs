@@ -13,6 +13,21 @@ use quake_formats::palette::{FIRST_FULLBRIGHT, Palette};
 use quake_formats::wad::{Wad, WadData, lump_type};
 use std::path::{Path, PathBuf};
 
+/// A BSP's textures as a WAD: every texture of its texture lump that holds pixels, once per name
+/// (the first, as engines take it), in lump order.
+pub fn textures_of(bsp: &quake_formats::Bsp) -> Wad {
+    let mut seen = std::collections::HashSet::new();
+    let lumps = bsp
+        .textures
+        .textures
+        .iter()
+        .flatten()
+        .filter(|t| t.mips.is_some() && seen.insert(t.name().to_ascii_lowercase()))
+        .map(|t| quake_formats::wad::WadLump::miptex(t.clone()))
+        .collect();
+    Wad::new(lumps)
+}
+
 /// One line of `slipgate wad list`.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Entry {

@@ -129,3 +129,17 @@ pub fn read_wad(path: &Path) -> Result<quake_formats::wad::Wad, WadError> {
         source,
     })
 }
+
+/// The textures at `path`: a WAD's, or a BSP's texture lump as a WAD (the textures it holds
+/// with pixels, in lump order; a mapper's way back to a map's textures when the WAD is lost).
+pub fn read_textures(path: &Path) -> Result<quake_formats::wad::Wad, WadError> {
+    let bytes = quake_formats::fsutil::read_file(path)?;
+    if bytes.starts_with(b"WAD2") {
+        return read_wad(path);
+    }
+    let bsp = quake_formats::Bsp::read(&bytes).map_err(|source| WadError::BadFile {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    Ok(extract::textures_of(&bsp))
+}
