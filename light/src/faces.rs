@@ -8,7 +8,7 @@ use quake_formats::extents::LightmapExtents;
 use quake_formats::geom::Plane;
 use rayon::prelude::*;
 
-use crate::LightError;
+use crate::error::LightError;
 
 /// What a face is for lighting and shadowing.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -23,17 +23,25 @@
 pub mod bench;
 pub mod bounce;
 pub mod cli;
+pub mod directions;
 pub mod dirt;
 pub mod embree;
+mod error;
 pub mod faces;
+pub mod grid;
 pub mod lights;
 pub mod output;
 pub mod phong;
+mod quality;
+pub mod reach;
 pub mod samples;
 pub mod scene;
 pub mod surface;
 pub mod trace;
 pub mod visibility;
+
+pub use error::LightError;
+pub use quality::Quality;
 
 use glam::{DVec3, Vec3};
 use std::collections::HashMap;
@@ -45,7 +53,7 @@ use quake_formats::geom::Bounds;
 use rayon::prelude::*;
 
 use crate::bounce::{BounceCounts, StyleLuxels};
-use crate::embree::{Device, EmbreeError};
+use crate::embree::Device;
 use crate::faces::{FaceKind, face_geometry};
 use crate::lights::{GlobalOverrides, parse_lights};
 use crate::output::{FaceLightmap, Finish, finish_face};
@@ -55,55 +63,6 @@ use crate::trace::{
     FaceLight, FaceRules, SampleLight, TraceCounts, TraceScratch, TraceSetup, trace_face,
 };
 use crate::visibility::Visibility;
-
-/// Everything that can stop lighting a map.
-#[derive(Debug, thiserror::Error)]
-pub enum LightError {
-    #[error("entity lump: {0}")]
-    Entities(#[from] quake_formats::FormatError),
-    #[error("entity {index} ({classname}): {detail}")]
-    Entity {
-        index: usize,
-        classname: String,
-        detail: String,
-    },
-    #[error("face {index}: {detail}")]
-    BadFace { index: usize, detail: String },
-    #[error("more switchable lights (distinct targetnames) than light styles 32..254")]
-    TooManySwitchableLights,
-    #[error(transparent)]
-    Embree(#[from] EmbreeError),
-    /// A damaged `SLIPGATE_PHONG` lump (the message names it).
-    #[error("{0}")]
-    PhongLump(quake_formats::FormatError),
-    /// The BSP breaks a rule that would make light read out of bounds ([`quake_formats::check_usable`]).
-    #[error(transparent)]
-    Unusable(quake_formats::FormatError),
-}
-
-/// How much work to spend per luxel.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-pub enum Quality {
-    /// One sample per luxel.
-    Default,
-    /// `--extra`: 2x2 samples per luxel.
-    Extra,
-    /// `--extra4`: 4x4 samples per luxel.
-    Extra4,
-    /// `--reference`: 16x16 samples per luxel, no light culling.
-    Reference,
-}
-
-impl Quality {
-    pub fn samples_per_axis(self) -> usize {
-        match self {
-            Quality::Default => 1,
-            Quality::Extra => 2,
-            Quality::Extra4 => 4,
-            Quality::Reference => 16,
-        }
-    }
-}
 
 /// Options of one lighting run.
 #[derive(Debug, Clone, PartialEq)]
@@ -221,7 +180,7 @@ impl Prepared {
     pub fn trace_setup<'a>(
         &'a self,
         bsp: &'a Bsp,
-        light_reaches: &'a trace::LightReaches,
+        light_reaches: &'a reach::LightReaches,
         gate: f64,
         cull: bool,
         adaptive: bool,
@@ -460,12 +419,7 @@ fn bounce_light(
     let mut total: Vec<StyleLuxels> = vec![Vec::new(); n];
     for pass in 1..=settings.passes {
         let last = pass == settings.passes;
-        let emitting = bounce::Field {
-            faces: &prep.faces,
-            reflectance,
-            light: &light,
-            kernel: settings.kernel(),
-        };
+        let emitting = bounce::Field::new(&prep.faces, reflectance, &light, &settings);
         if reference {
             let gathered: Vec<(usize, StyleLuxels, BounceCounts)> = traced
                 .par_iter()
@@ -531,7 +485,7 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
     let start = Instant::now();
     let prep = prepare(bsp, options)?;
     let setup_done = Instant::now();
-    let light_reaches = trace::light_reaches(&prep.point_lights, options.gate);
+    let light_reaches = reach::light_reaches(&prep.point_lights, options.gate);
     let reference = options.quality == Quality::Reference;
     let setup = prep.trace_setup(
         bsp,

@@ -13,8 +13,9 @@ use std::collections::HashMap;
 use quake_formats::bsp::phong;
 use quake_formats::entities::Entity;
 
-use crate::LightError;
-use crate::bounce::{BounceSettings, MAX_BOUNCE_PASSES};
+use crate::directions::{ball_points, cap_directions, mangle_to_vec};
+use crate::dirt::{DEFAULT_DIRT_ANGLE, DEFAULT_DIRT_DEPTH, DirtMode, DirtResponse, DirtSampling};
+use crate::error::LightError;
 
 /// `light` value of a light entity without one (or with `light 0`, as
 /// ericw-tools treats it).
@@ -28,10 +29,6 @@ pub const DEFAULT_RANGESCALE: f64 = 0.5;
 /// First style given to switchable lights (styles below are the engine's
 /// animated presets).
 pub const FIRST_SWITCHABLE_STYLE: u8 = 32;
-/// Dirt ray length when `_dirtdepth` is absent.
-pub const DEFAULT_DIRT_DEPTH: f64 = 128.0;
-/// Dirt cone (degrees from the normal) when `_dirtangle` is absent.
-pub const DEFAULT_DIRT_ANGLE: f64 = 88.0;
 /// Lights a `_deviance` light is split into when `_samples` is absent.
 pub const DEFAULT_DEVIANCE_SAMPLES: usize = 16;
 /// Distance (map units) at which the 1/x and 1/x² formulas give `light`.
@@ -124,74 +121,6 @@ pub fn angle_factor(cos_incidence: f64, anglescale: f64) -> f64 {
         0.0
     } else {
         anglescale * cos_incidence + (1.0 - anglescale)
-    }
-}
-
-/// How dirt (ambient occlusion) darkens one light: ericw-tools' `_dirtscale`
-/// and `_dirtgain`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct DirtResponse {
-    pub scale: f64,
-    pub gain: f64,
-}
-
-impl DirtResponse {
-    /// Multiplier for light reaching a point with `occlusion` (0 = open,
-    /// 1 = every dirt ray hit something right away): `1 - min(1, scale *
-    /// min(1, occlusion^gain))`.
-    pub fn factor(&self, occlusion: f64) -> f64 {
-        if occlusion <= 0.0 {
-            return 1.0;
-        }
-        let dirt = (occlusion.powf(self.gain).min(1.0) * self.scale).min(1.0);
-        1.0 - dirt
-    }
-}
-
-/// How dirt rays are spread over the cone around a sample's normal (`_dirtmode`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum DirtMode {
-    /// 0: the same evenly spaced directions for every sample.
-    Ordered,
-    /// 1: different pseudo-random directions per sample (deterministic).
-    Random,
-}
-
-/// How occlusion is measured: worldspawn `_dirtmode`, `_dirtdepth`, `_dirtangle`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct DirtSampling {
-    pub mode: DirtMode,
-    /// Rays longer than this see no occluder.
-    pub depth: f64,
-    /// Angle from the normal of the outermost rays, in degrees (1..=90).
-    cone_degrees: f64,
-    /// The ordered pattern for this cone in a face's own terms, worked out once: taking its
-    /// sines and cosines for every face was 5 % of e3m4's instructions.
-    ordered: crate::dirt::ConePattern,
-}
-
-impl DirtSampling {
-    pub fn new(mode: DirtMode, depth: f64, cone_degrees: f64) -> DirtSampling {
-        DirtSampling {
-            mode,
-            depth,
-            cone_degrees,
-            ordered: crate::dirt::ordered_components(cone_degrees.to_radians()),
-        }
-    }
-
-    pub fn cone_degrees(&self) -> f64 {
-        self.cone_degrees
-    }
-
-    pub(crate) fn ordered(&self) -> &crate::dirt::ConePattern {
-        &self.ordered
-    }
-}
-
-impl Default for DirtSampling {
-    fn default() -> Self {
-        DirtSampling::new(DirtMode::Ordered, DEFAULT_DIRT_DEPTH, DEFAULT_DIRT_ANGLE)
     }
 }
 
@@ -312,6 +241,43 @@ pub struct SurfaceTemplate {
     /// Copies shine along the face normal (`_surface_spotlight 1`).
     pub spotlight: bool,
     pub spot_angle: f64,
+}
+
+/// Passes beyond this bring nothing a lightmap byte can show.
+pub const MAX_BOUNCE_PASSES: usize = 16;
+
+/// Worldspawn `_bounce` and its keys (and their command-line overrides).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BounceSettings {
+    /// Passes (0 = off).
+    pub passes: usize,
+    /// `_bouncescale`.
+    pub scale: f64,
+    /// `_bouncecolorscale`: 0 = grey reflectance, 1 = the texture's mean colour.
+    pub color_scale: f64,
+    /// `_bouncestyled`: styled (switchable, animated) light bounces too, in its own style.
+    pub styled: bool,
+    /// How dirt darkens bounced light (worldspawn's dirt, when it is on).
+    pub dirt: Option<DirtResponse>,
+}
+
+impl Default for BounceSettings {
+    fn default() -> Self {
+        BounceSettings {
+            passes: 0,
+            scale: 1.0,
+            color_scale: 0.0,
+            styled: false,
+            dirt: None,
+        }
+    }
+}
+
+impl BounceSettings {
+    /// Whether any light bounces.
+    pub fn is_on(&self) -> bool {
+        self.passes > 0 && self.scale > 0.0
+    }
 }
 
 /// Settings that command-line options may override.
@@ -500,44 +466,6 @@ pub fn normalize_color(c: DVec3) -> DVec3 {
     }
 }
 
-/// Unit vector of a "yaw pitch roll" triple (degrees; pitch 90 is up).
-pub fn mangle_to_vec(yaw: f64, pitch: f64) -> DVec3 {
-    let (y, p) = (yaw.to_radians(), pitch.to_radians());
-    DVec3::new(y.cos() * p.cos(), y.sin() * p.cos(), p.sin())
-}
-
-/// Two unit vectors that make a right-handed orthonormal basis with unit `n`.
-pub fn tangent_basis(n: DVec3) -> [DVec3; 2] {
-    let helper = if n.z.abs() < 0.9 {
-        DVec3::new(0.0, 0.0, 1.0)
-    } else {
-        DVec3::new(1.0, 0.0, 0.0)
-    };
-    let u = helper.cross(n).normalized().unwrap_or(helper);
-    [u, n.cross(u)]
-}
-
-/// `n` unit directions spread evenly (a Fibonacci spiral) over the cap of
-/// half-angle `half_angle_deg` around unit `center`; `[center]` for `n <= 1`
-/// or a zero cap. Deterministic.
-pub fn cap_directions(center: DVec3, half_angle_deg: f64, n: usize) -> Vec<DVec3> {
-    if n <= 1 || half_angle_deg <= 0.0 {
-        return vec![center];
-    }
-    let [u, v] = tangent_basis(center);
-    let cos_cap = half_angle_deg.min(180.0).to_radians().cos();
-    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
-    (0..n)
-        .map(|i| {
-            // Uniform in z is uniform in solid angle.
-            let z = 1.0 - (1.0 - cos_cap) * (i as f64 + 0.5) / n as f64;
-            let r = (1.0 - z * z).max(0.0).sqrt();
-            let phi = golden * i as f64;
-            u * (r * phi.cos()) + v * (r * phi.sin()) + center * z
-        })
-        .collect()
-}
-
 /// Splits the light of `sun` evenly over `dirs` (its `to_sun` is replaced).
 fn suns_over(dirs: Vec<DVec3>, sun: &SunLight) -> Vec<SunLight> {
     let each = sun.light / dirs.len().max(1) as f64;
@@ -561,21 +489,6 @@ fn dirt_if(switch: Option<f64>, global_on: bool, response: DirtResponse) -> Opti
         _ => global_on,
     };
     on.then_some(response)
-}
-
-/// `count` points spread evenly through the ball of `radius` around
-/// `center` (deterministic: a Fibonacci spiral over shells of equal volume).
-pub fn ball_points(center: DVec3, radius: f64, count: usize) -> Vec<DVec3> {
-    let dirs = cap_directions(DVec3::new(0.0, 0.0, 1.0), 180.0, count);
-    dirs.into_iter()
-        .enumerate()
-        .map(|(i, d)| {
-            // Radius by the cube root of an evenly spaced volume fraction,
-            // scrambled by the golden ratio so shells do not line up with the spiral.
-            let fraction = ((i as f64 + 0.5) * 0.618_033_988_749_895).fract();
-            center + d * (radius * fraction.cbrt())
-        })
-        .collect()
 }
 
 fn model_index(e: &Entity) -> Option<usize> {
@@ -1098,28 +1011,6 @@ mod tests {
         // A soft angle wider than the cone is ignored.
         let s = Spot::new(down, 30.0, 50.0);
         assert_eq!(s.cos_inner, s.cos_outer);
-    }
-
-    #[test]
-    fn mangle_points_where_documented() {
-        let v = mangle_to_vec(0.0, -90.0);
-        assert!(v.near(DVec3::new(0.0, 0.0, -1.0), 1e-12));
-        let v = mangle_to_vec(90.0, 0.0);
-        assert!(v.near(DVec3::new(0.0, 1.0, 0.0), 1e-12));
-    }
-
-    #[test]
-    fn cap_directions_stay_in_the_cap_and_are_unit() {
-        let c = DVec3::new(0.0, 0.6, 0.8);
-        let dirs = cap_directions(c, 10.0, 50);
-        assert_eq!(dirs.len(), 50);
-        for d in &dirs {
-            assert!((d.length() - 1.0).abs() < 1e-9);
-            assert!(d.dot(c) >= 10f64.to_radians().cos() - 1e-9);
-        }
-        let hemi = cap_directions(DVec3::new(0.0, 0.0, 1.0), 90.0, 200);
-        let mean_z: f64 = hemi.iter().map(|d| d.z).sum::<f64>() / 200.0;
-        assert!((mean_z - 0.5).abs() < 0.01, "uniform hemisphere: {mean_z}");
     }
 
     #[test]

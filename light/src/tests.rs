@@ -9,8 +9,8 @@ use quake_formats::geom::DVec3Ext;
 
 use quake_formats::miptex::{MipTex, TextureLump};
 
+use crate::dirt::DirtMode;
 use crate::faces::{FaceKind, face_geometry};
-use crate::lights::DirtMode;
 use crate::samples::{FaceRegion, face_samples};
 use crate::scene::TraceScene;
 use crate::{
@@ -674,7 +674,7 @@ fn column_scene(world_keys: &str) -> Bsp {
 fn edge_jumps(world_keys: &str) -> Vec<f64> {
     let bsp = column_scene(world_keys);
     let prep = crate::prepare(&bsp, &Options::default()).expect("prepare");
-    let light_reaches = crate::trace::light_reaches(&prep.point_lights, 0.001);
+    let light_reaches = crate::reach::light_reaches(&prep.point_lights, 0.001);
     let setup = crate::trace::TraceSetup {
         suns: &[],
         dirt: None,
@@ -860,7 +860,7 @@ fn dirt_cone_follows_the_phong_normal() {
     let bsp = corner_scene("", "");
     let prep = crate::prepare(&bsp, &Options::default()).expect("prepare");
     let (mut samples, _) = face_samples(&prep.faces[0], 1, &prep.scene, &bsp);
-    let sampling = crate::lights::DirtSampling::default();
+    let sampling = crate::dirt::DirtSampling::default();
     let occlusion = |samples: &crate::samples::FaceSamples| {
         let all: Vec<usize> = (0..samples.points.len()).collect();
         crate::dirt::occlusion_at(
@@ -1073,7 +1073,7 @@ fn lit_faces(
     bounce: f32,
 ) -> (Vec<Vec<[f32; 3]>>, u64) {
     let prep = crate::prepare(bsp, &Options::default()).expect("prepare");
-    let light_reaches = crate::trace::light_reaches(&prep.point_lights, 0.001);
+    let light_reaches = crate::reach::light_reaches(&prep.point_lights, 0.001);
     let setup = prep.trace_setup(bsp, &light_reaches, 0.001, true, adaptive);
     let mut rays = 0;
     let luxels = prep
@@ -1148,7 +1148,7 @@ fn dirt_that_only_bounce_takes_is_interpolated_and_stays_close() {
     let bsp = corner_scene("\"_dirt\" \"1\" \"_bounce\" \"1\"", "\"_dirt\" \"-1\"");
     let rules = crate::trace::FaceRules {
         dirt: true,
-        bounce_dirt: Some(crate::lights::DirtResponse {
+        bounce_dirt: Some(crate::dirt::DirtResponse {
             scale: 1.0,
             gain: 1.0,
         }),

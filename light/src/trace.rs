@@ -7,12 +7,12 @@ use quake_formats::Bsp;
 use quake_formats::geom::Bounds;
 use quake_formats::geom::DVec3Ext;
 
-use crate::dirt::{self, DirtRays};
+use crate::dirt::{DirtFactors, DirtNeed, DirtResponse, DirtSampling, FaceDirt, face_occlusion};
 use crate::embree::RayPacket16;
 use crate::faces::FaceGeom;
-use crate::lights::{
-    DirtMode, DirtResponse, DirtSampling, Falloff, Minlight, PointLight, SunLight, angle_factor,
-};
+use crate::grid::SampleGrid;
+use crate::lights::{Falloff, Minlight, PointLight, SunLight, angle_factor};
+use crate::reach::{LightReaches, box_distance_squared};
 use crate::samples::{FaceSamples, WalkStart, solid_points_from};
 use crate::scene::TraceScene;
 use crate::visibility::Visibility;
@@ -362,162 +362,6 @@ fn sub(a: DVec3, b: [f32; 3]) -> DVec3 {
     a - Vec3::from(b).as_dvec3()
 }
 
-/// Where a light is and how far it reaches, packed for the per-face cull
-/// (e1m1 tests about 950k face/light pairs).
-#[derive(Debug, Clone, Copy)]
-pub struct LightReach {
-    origin: DVec3,
-    /// Square of [`PointLight::range`] (infinite for lights that never fade).
-    range_squared: f64,
-}
-
-/// Every light's [`LightReach`], and which lights may reach a box: a grid of
-/// cubes, each listing the lights whose reach (the box around its sphere)
-/// touches it, so a face looks at the lights near it instead of at all of them
-/// (e1m1: 198 lights, 1 % of face-light pairs within reach).
-pub struct LightReaches {
-    each: Vec<LightReach>,
-    /// The grid's lowest corner and its cube's side.
-    min: DVec3,
-    cube: f64,
-    dims: [usize; 3],
-    /// Per cube (x fastest): the lights reaching into it, in ascending order.
-    cubes: Vec<Vec<u32>>,
-    /// Lights that never fade, or reach more than [`MAX_CUBES_PER_LIGHT`] cubes: near every box.
-    everywhere: Vec<u32>,
-}
-
-/// Cubes of the [`LightReaches`] grid along its longest side (fewer when they
-/// would be smaller than [`MIN_CUBE`]).
-const CUBES_ALONG: f64 = 64.0;
-
-/// Smallest cube side of the [`LightReaches`] grid, in map units.
-const MIN_CUBE: f64 = 128.0;
-
-/// A light reaching more cubes than this is listed as near every box instead.
-const MAX_CUBES_PER_LIGHT: usize = 4096;
-
-/// Each light's [`LightReach`] at contribution cut-off `gate`.
-pub fn light_reaches(lights: &[PointLight], gate: f64) -> LightReaches {
-    LightReaches::new(
-        lights
-            .iter()
-            .map(|l| LightReach {
-                origin: l.origin,
-                range_squared: l.range(gate).powi(2),
-            })
-            .collect(),
-    )
-}
-
-impl LightReaches {
-    fn new(each: Vec<LightReach>) -> LightReaches {
-        let reach_box = |r: &LightReach| {
-            let radius = DVec3::splat(r.range_squared.sqrt());
-            (r.origin - radius, r.origin + radius)
-        };
-        let finite = |r: &LightReach| r.range_squared.is_finite();
-        let (mut min, mut max) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-        for r in each.iter().filter(|r| finite(r)) {
-            let (lo, hi) = reach_box(r);
-            (min, max) = (min.min(lo), max.max(hi));
-        }
-        let extent = (max - min).max_element();
-        let cube = if extent.is_finite() {
-            (extent / CUBES_ALONG).max(MIN_CUBE)
-        } else {
-            MIN_CUBE
-        };
-        let along = |a: f64| ((a / cube).ceil() as usize).max(1);
-        let dims = if extent.is_finite() {
-            [
-                along(max.x - min.x),
-                along(max.y - min.y),
-                along(max.z - min.z),
-            ]
-        } else {
-            [1, 1, 1]
-        };
-        let mut grid = LightReaches {
-            each: Vec::new(),
-            min,
-            cube,
-            dims,
-            cubes: vec![Vec::new(); dims[0] * dims[1] * dims[2]],
-            everywhere: Vec::new(),
-        };
-        for (li, r) in each.iter().enumerate() {
-            let (lo, hi) = reach_box(r);
-            // Every finite reach box lies inside the grid.
-            match finite(r).then(|| grid.cube_range(lo, hi)).flatten() {
-                Some(range)
-                    if range.iter().map(|a| a.len()).product::<usize>() <= MAX_CUBES_PER_LIGHT =>
-                {
-                    for c in grid.cubes_in(range) {
-                        grid.cubes[c].push(li as u32);
-                    }
-                }
-                _ => grid.everywhere.push(li as u32),
-            }
-        }
-        grid.each = each;
-        grid
-    }
-
-    /// The cubes `lo..hi` overlaps, per axis; None when it misses the grid.
-    fn cube_range(&self, lo: DVec3, hi: DVec3) -> Option<[std::ops::Range<usize>; 3]> {
-        let mut out = [0..0, 0..0, 0..0];
-        for a in 0..3 {
-            let first = ((lo[a] - self.min[a]) / self.cube).floor();
-            let last = ((hi[a] - self.min[a]) / self.cube).floor();
-            if last < 0.0 || first >= self.dims[a] as f64 || first.is_nan() || last.is_nan() {
-                return None;
-            }
-            out[a] = first.max(0.0) as usize..(last as usize).min(self.dims[a] - 1) + 1;
-        }
-        Some(out)
-    }
-
-    /// The index in `cubes` of every cube of `range` (x fastest).
-    fn cubes_in(&self, range: [std::ops::Range<usize>; 3]) -> impl Iterator<Item = usize> + use<> {
-        let [xs, ys, zs] = range;
-        let [dx, dy, _] = self.dims;
-        zs.flat_map(move |z| {
-            let xs = xs.clone();
-            ys.clone()
-                .flat_map(move |y| xs.clone().map(move |x| (z * dy + y) * dx + x))
-        })
-    }
-
-    /// Into `out`, in ascending order: every light whose reach may touch `b`.
-    fn near(&self, b: &Bounds, out: &mut Vec<u32>) {
-        out.clear();
-        out.extend(&self.everywhere);
-        if let Some(range) = self.cube_range(b.mins, b.maxs) {
-            for c in self.cubes_in(range) {
-                out.extend(&self.cubes[c]);
-            }
-        }
-        out.sort_unstable();
-        out.dedup();
-    }
-}
-
-impl std::ops::Index<usize> for LightReaches {
-    type Output = LightReach;
-    fn index(&self, li: usize) -> &LightReach {
-        &self.each[li]
-    }
-}
-
-/// Squared distance from `p` to the box `b` (0 inside).
-fn box_distance_squared(b: &Bounds, p: DVec3) -> f64 {
-    (b.mins - p)
-        .max(p - b.maxs)
-        .max(DVec3::ZERO)
-        .length_squared()
-}
-
 /// Sky faces closer to a box's edge than this still count as reachable
 /// (sample points and rays are f32).
 const SKY_BOX_MARGIN: f64 = 1.0;
@@ -558,292 +402,12 @@ fn direction_meets_any(boxes: &[Bounds], d: DVec3) -> bool {
     })
 }
 
-/// Occlusion may be interpolated between grid points that differ by at
-/// most this much (a light's dirt factor then moves by about as much). 0.05
-/// cast 14 % more dirt rays on e3m4 (default mode) for an RMSE against the
-/// reference 0.005 lower.
-const DIRT_SMOOTH: f32 = 0.1;
-
-/// [`DIRT_SMOOTH`] when supersampling, whose error against the reference is
-/// small enough for 0.05 to show: e3m4's `--extra4` RMSE is 0.395 with this
-/// and 0.399 with 0.05 (the default mode gains nothing from it).
-const DIRT_SMOOTH_SUPERSAMPLED: f32 = 0.01;
-
-/// A grid of points where dirt is measured or sunlight probed, over a face's
-/// grid of samples (`gw × gh` positions): every `stride`-th position along
-/// each axis, and the last row and column, so every position lies in a cell.
-struct SampleGrid {
-    xs: Vec<usize>,
-    ys: Vec<usize>,
-    /// Per position along each axis: the grid lines before and after it
-    /// (indices into `xs` / `ys`) and how far across it lies.
-    cx: Vec<(usize, usize, f32)>,
-    cy: Vec<(usize, usize, f32)>,
-}
-
-impl SampleGrid {
-    fn new(gw: usize, gh: usize, stride: usize) -> SampleGrid {
-        let xs = crate::bounce::grid(gw, stride);
-        let ys = crate::bounce::grid(gh, stride);
-        SampleGrid {
-            cx: crate::bounce::cell_of(&xs),
-            cy: crate::bounce::cell_of(&ys),
-            xs,
-            ys,
-        }
-    }
-
-    /// The four grid positions around position (gx, gy) (itself first when
-    /// it is on the grid), and how far across their cell it lies.
-    fn cell(&self, gx: usize, gy: usize) -> ([(usize, usize); 4], f32, f32) {
-        let (x0, x1, fx) = self.cx[gx];
-        let (y0, y1, fy) = self.cy[gy];
-        let (x0, x1, y0, y1) = (self.xs[x0], self.xs[x1], self.ys[y0], self.ys[y1]);
-        ([(x0, y0), (x1, y0), (x0, y1), (x1, y1)], fx, fy)
-    }
-}
-
 /// Luxels between sunlight probes ([`VisibilityScratch::trace_probed`]).
 const SUN_PROBE_STRIDE: usize = 2;
 
 /// Suns and domes spread over at least this many directions are probed in
 /// the default mode ([`VisibilityScratch::trace_probed`]).
 const SUN_PROBE_DIRECTIONS: usize = 16;
-
-/// Coarse dirt cells are this many fine cells wide: occlusion is first
-/// measured on the coarse grid, and cells whose corners differ are refined.
-const DIRT_COARSE_CELLS: usize = 2;
-
-/// Dirt occlusion of every sample of a face (see [`dirt::occlusion_at`]) and
-/// the rays cast. With `adaptive`, it is measured on a coarse grid of cells
-/// [`DIRT_COARSE_CELLS`] fine cells wide, then on the fine grid (every
-/// `stride`-th sample along each axis of the face's sample grid: one per
-/// luxel when supersampling, every other luxel otherwise), both with the
-/// face's last row and column; and at every sample off the grid: pulled ones
-/// ([`FaceSamples::pulled`]), and when supersampling every moved one (a
-/// luxel's sub-samples are close together; in the default mode a sample moved
-/// onto the face from past its edge stays beside its grid position and is
-/// interpolated like the others: 18 % fewer dirt rays on e3m4, RMSE against
-/// the reference +0.02). A sample whose cell's four corners (none of them
-/// pulled) differ by at most [`DIRT_SMOOTH`] (or [`DIRT_SMOOTH_SUPERSAMPLED`])
-/// takes their bilinear mean, first in the coarse cell, else in the fine one;
-/// so does one whose fine corners the coarse cell predicts to within as much.
-/// The others (corners, edges of objects) are measured. Only samples marked
-/// in `needed` get a value (the rest 0); a needed sample's value does not
-/// depend on which others are needed. When supersampling (a fine cell is one
-/// luxel), a sample needed only for bounced light ([`DirtNeed::Bounce`]) takes
-/// the bilinear mean of its fine cell whatever its corners' spread, moved or
-/// not (measured only when a corner is pulled).
-fn face_occlusion(
-    setup: &TraceSetup,
-    samples: &FaceSamples,
-    model: usize,
-    sampling: &DirtSampling,
-    adaptive: bool,
-    first_at: &[usize],
-    needed: &[DirtNeed],
-) -> (Vec<f32>, u64) {
-    let n = samples.points.len();
-    // Ordered dirt rays depend only on the point: samples at one point share them.
-    let same_rays = sampling.mode == DirtMode::Ordered;
-    let measure = |indices: &[usize], which: DirtRays| {
-        if !same_rays {
-            return dirt::occlusion_at(samples, indices, model, sampling, which, setup.scene);
-        }
-        let mut unique: Vec<usize> = indices.iter().map(|&i| first_at[i]).collect();
-        unique.sort_unstable();
-        unique.dedup();
-        let (values, rays) =
-            dirt::occlusion_at(samples, &unique, model, sampling, which, setup.scene);
-        let value_of = |i: usize| {
-            unique
-                .binary_search(&first_at[i])
-                .map_or(0.0, |k| values[k])
-        };
-        (indices.iter().map(|&i| value_of(i)).collect(), rays)
-    };
-    let mut known: Vec<Option<f32>> = vec![None; n];
-    let mut rays = 0;
-    let mut measure_into = |known: &mut Vec<Option<f32>>, indices: &mut Vec<usize>| {
-        indices.sort_unstable();
-        indices.dedup();
-        // Samples only bounced light takes dirt at cast half the rays (the adaptive modes).
-        let (half, all): (Vec<usize>, Vec<usize>) = indices
-            .iter()
-            .partition(|&&i| adaptive && needed[i] == DirtNeed::Bounce);
-        for (group, which) in [(all, DirtRays::All), (half, DirtRays::Half)] {
-            if group.is_empty() {
-                continue;
-            }
-            let (values, r) = measure(&group, which);
-            rays += r;
-            for (&i, v) in group.iter().zip(values) {
-                known[i] = Some(v);
-            }
-        }
-    };
-    if !adaptive {
-        let mut all: Vec<usize> = (0..n).filter(|&i| needed[i] != DirtNeed::No).collect();
-        measure_into(&mut known, &mut all);
-        return (known.into_iter().map(|v| v.unwrap_or(0.0)).collect(), rays);
-    }
-    let axis = samples.per_axis;
-    let supersampled = axis > 1;
-    let stride = axis.max(2);
-    let smooth = if axis > 1 {
-        DIRT_SMOOTH_SUPERSAMPLED
-    } else {
-        DIRT_SMOOTH
-    };
-    let (gw, gh) = (samples.width * axis, samples.height * axis);
-    // Sample index of grid position (gx, gy).
-    let index = |(gx, gy): (usize, usize)| {
-        ((gy / axis) * samples.width + gx / axis) * axis * axis + (gy % axis) * axis + gx % axis
-    };
-    let mut pending: Vec<(usize, usize)> = Vec::new();
-    let mut batch: Vec<usize> = Vec::new();
-    let mut interpolated: Vec<(usize, f32)> = Vec::new();
-    for gy in 0..gh {
-        for gx in 0..gw {
-            let i = index((gx, gy));
-            if needed[i] == DirtNeed::No {
-                continue;
-            }
-            let off_grid = if supersampled {
-                samples.moved[i]
-            } else {
-                samples.pulled[i]
-            };
-            if off_grid && !(needed[i] == DirtNeed::Bounce && supersampled) {
-                batch.push(i);
-            } else {
-                pending.push((gx, gy));
-            }
-        }
-    }
-    // The bilinear mean at (gx, gy) of its cell's corners in `grid` and how
-    // much they differ, when all four are measured (only measured values: a
-    // needed sample's value must not depend on which others are needed) and
-    // none was pulled (possibly far from its grid position; a sample moved
-    // onto the face from past its edge stays beside it).
-    let bilinear = |known: &[Option<f32>], grid: &SampleGrid, (gx, gy): (usize, usize)| {
-        let (corners, fx, fy) = grid.cell(gx, gy);
-        let values = corners.map(|c| {
-            let c = index(c);
-            known[c].filter(|_| !samples.pulled[c])
-        });
-        let [Some(a), Some(b), Some(c), Some(d)] = values else {
-            return None;
-        };
-        let top = a + (b - a) * fx;
-        let bottom = c + (d - c) * fx;
-        let spread = a.max(b).max(c).max(d) - a.min(b).min(c).min(d);
-        Some((top + (bottom - top) * fy, spread))
-    };
-    let coarse = SampleGrid::new(gw, gh, stride * DIRT_COARSE_CELLS);
-    let fine = SampleGrid::new(gw, gh, stride);
-    for (grid, outer) in [(&coarse, None), (&fine, Some(&coarse))] {
-        // The corners of the cells of the samples still pending (a sample on
-        // the grid is its own first corner), then what they let us interpolate.
-        for &(gx, gy) in &pending {
-            let (corners, _, _) = grid.cell(gx, gy);
-            batch.extend(
-                corners
-                    .map(index)
-                    .into_iter()
-                    .filter(|&c| known[c].is_none()),
-            );
-        }
-        measure_into(&mut known, &mut batch);
-        batch.clear();
-        pending.retain(|&at| {
-            if known[index(at)].is_some() {
-                return false;
-            }
-            let bounce_only = needed[index(at)] == DirtNeed::Bounce && supersampled;
-            if bounce_only && outer.is_none() {
-                return true; // the fine cell's corners are measured next
-            }
-            let Some((value, spread)) = bilinear(&known, grid, at) else {
-                return true;
-            };
-            // Corners that differ may still be interpolated between where the
-            // occlusion is close to bilinear (a steady slope away from a wall):
-            // the coarse cell's mean predicts each of them to within `smooth`.
-            let linear = || {
-                let Some(outer) = outer else {
-                    return false;
-                };
-                grid.cell(at.0, at.1).0.iter().all(|&c| {
-                    let measured = known[index(c)];
-                    let predicted = bilinear(&known, outer, c);
-                    matches!((measured, predicted), (Some(m), Some((p, _))) if (m - p).abs() <= smooth)
-                })
-            };
-            if !bounce_only && spread > smooth && !linear() {
-                return true;
-            }
-            interpolated.push((index(at), value));
-            false
-        });
-    }
-    batch.extend(pending.iter().map(|&p| index(p)));
-    measure_into(&mut known, &mut batch);
-    for (i, v) in interpolated {
-        known[i] = Some(v);
-    }
-    (known.into_iter().map(|v| v.unwrap_or(0.0)).collect(), rays)
-}
-
-/// Why a sample's dirt occlusion is wanted.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum DirtNeed {
-    No,
-    /// Only bounced light (which is smooth and faint where no light reaches) takes it.
-    Bounce,
-    /// A light, sun or minlight that takes dirt reaches the sample.
-    Light,
-}
-
-/// Dirt factors per sample, computed once per distinct [`DirtResponse`]
-/// (a face sees few of them; `powf` per sample and light is not cheap).
-struct DirtFactors<'a> {
-    occlusion: &'a [f32],
-    computed: Vec<(DirtResponse, Vec<f32>)>,
-}
-
-impl<'a> DirtFactors<'a> {
-    /// `occlusion` per sample, or empty when the face takes no dirt.
-    fn new(occlusion: &'a [f32], samples: usize) -> DirtFactors<'a> {
-        let occlusion = if occlusion.len() == samples {
-            occlusion
-        } else {
-            &[]
-        };
-        DirtFactors {
-            occlusion,
-            computed: Vec::new(),
-        }
-    }
-
-    /// The factor per sample for `response`; `None` means 1 everywhere.
-    fn get(&mut self, response: Option<DirtResponse>) -> Option<&[f32]> {
-        let r = response.filter(|_| !self.occlusion.is_empty())?;
-        let k = match self.computed.iter().position(|(c, _)| *c == r) {
-            Some(k) => k,
-            None => {
-                let f = self
-                    .occlusion
-                    .iter()
-                    .map(|&o| r.factor(f64::from(o)) as f32)
-                    .collect();
-                self.computed.push((r, f));
-                self.computed.len() - 1
-            }
-        };
-        Some(&self.computed[k].1)
-    }
-}
 
 /// What a luxel's probe ray (one sub-sample per luxel) found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -1518,13 +1082,15 @@ pub fn trace_face(
                 needed[a.sample as usize] = DirtNeed::Light;
             }
             let (values, rays) = face_occlusion(
-                setup,
-                samples,
-                face.model,
-                &sampling,
+                FaceDirt {
+                    scene: setup.scene,
+                    samples,
+                    model: face.model,
+                    sampling: &sampling,
+                    first_at: &scratch.first_at,
+                    needed: &needed,
+                },
                 setup.adaptive,
-                &scratch.first_at,
-                &needed,
             );
             counts.dirt_rays += rays;
             values
@@ -1582,41 +1148,6 @@ mod tests {
     }
 
     proptest::proptest! {
-        /// The grid finds every light within reach of a box (it may find more).
-        #[test]
-        fn light_grid_finds_every_light_within_reach(
-            lights in proptest::collection::vec(
-                ((-3000.0f64..3000.0, -3000.0f64..3000.0, -500.0f64..500.0), 0.0f64..2000.0, 0u8..8),
-                1..40,
-            ),
-            corner in (-3500.0f64..3500.0, -3500.0f64..3500.0, -900.0f64..900.0),
-            size in (0.0f64..600.0, 0.0f64..600.0, 0.0f64..600.0),
-        ) {
-            let each: Vec<LightReach> = lights
-                .iter()
-                .map(|&((x, y, z), range, kind)| LightReach {
-                    origin: DVec3::new(x, y, z),
-                    // Some never fade; some reach nothing.
-                    range_squared: match kind {
-                        0 => f64::INFINITY,
-                        1 => 0.0,
-                        _ => range * range,
-                    },
-                })
-                .collect();
-            let reaches = LightReaches::new(each);
-            let mins = DVec3::new(corner.0, corner.1, corner.2);
-            let b = Bounds { mins, maxs: mins + DVec3::new(size.0, size.1, size.2) };
-            let mut near = Vec::new();
-            reaches.near(&b, &mut near);
-            proptest::prop_assert!(near.windows(2).all(|w| w[0] < w[1]));
-            for (li, r) in reaches.each.iter().enumerate() {
-                if box_distance_squared(&b, r.origin) <= r.range_squared {
-                    proptest::prop_assert!(near.contains(&(li as u32)), "light {} missed", li);
-                }
-            }
-        }
-
         #[test]
         fn lights_past_the_far_distance_are_one_cell_away(
             radius in 0.01f64..64.0,
@@ -1631,26 +1162,6 @@ mod tests {
             let to_light = dir * dist;
             proptest::prop_assert_eq!(rule.cells(to_light, DVec3::Z, radius), 1, "{:?}", to_light);
         }
-    }
-
-    #[test]
-    fn dirt_grid_cells_reach_the_last_row_and_column() {
-        // 6 × 3 positions, stride 2: lines at x 0, 2, 4, 5 and y 0, 2.
-        let grid = SampleGrid::new(6, 3, 2);
-        assert_eq!(
-            grid.cell(0, 0),
-            ([(0, 0), (2, 0), (0, 2), (2, 2)], 0.0, 0.0)
-        );
-        assert_eq!(
-            grid.cell(3, 1),
-            ([(2, 0), (4, 0), (2, 2), (4, 2)], 0.5, 0.5)
-        );
-        // Past the last full stride: the cell up to the last column, and the last column itself.
-        assert_eq!(grid.cell(4, 1).0, [(4, 0), (5, 0), (4, 2), (5, 2)]);
-        assert_eq!(
-            grid.cell(5, 2),
-            ([(5, 2), (5, 2), (5, 2), (5, 2)], 0.0, 0.0)
-        );
     }
 
     #[test]

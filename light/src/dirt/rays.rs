@@ -1,12 +1,11 @@
-//! Dirt (ambient occlusion, after q3map2 and ericw-tools): how enclosed each
-//! sample point is, measured with rays in a cone around the face normal.
-//! Lights that take dirt are scaled by [`crate::lights::DirtResponse::factor`]
-//! of this occlusion.
+//! Dirt rays: the two patterns of directions over the cone, and the occlusion they measure at
+//! a face's samples, traced 16 to a packet.
 
 use glam::{DMat3, DVec3, Vec3};
 
+use super::{DirtMode, DirtSampling};
+use crate::directions::tangent_basis;
 use crate::embree::RayPacket16;
-use crate::lights::{DirtMode, DirtSampling, tangent_basis};
 use crate::samples::FaceSamples;
 use crate::scene::TraceScene;
 
@@ -29,7 +28,7 @@ pub type ConePattern = [[f64; 3]; RAYS_PER_SAMPLE];
 
 /// The ordered pattern in the face's own terms (see [`ordered_directions`]):
 /// the same for every sample and face, so the sines and cosines are taken
-/// once a run ([`crate::lights::DirtSampling::new`]).
+/// once a run ([`DirtSampling::new`]).
 pub fn ordered_components(cone: f64) -> ConePattern {
     let azimuth_step = std::f64::consts::TAU / AZIMUTH_STEPS as f64;
     let elevation_step = cone / ELEVATION_STEPS as f64;
