@@ -36,11 +36,11 @@ fn main() -> anyhow::Result<()> {
     println!("| mode | trace time | rays | RMSE | max | RMSE / max vs filtered reference |");
     println!("|---|---|---|---|---|---|");
     for (name, quality, soft_radius) in modes {
-        let options = Options {
+        let mut options = Options {
             quality,
-            soft_radius,
             ..Options::default()
         };
+        options.overrides.soft = Some(soft_radius);
         let mut best = f64::INFINITY;
         let mut rays = 0;
         for _ in 0..3 {

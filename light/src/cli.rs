@@ -8,7 +8,7 @@ use quake_formats::fsutil::{Staged, read_file, write_atomic};
 
 use quake_formats::palette::Palette;
 
-use crate::lights::GlobalOverrides;
+use crate::settings::Overrides;
 use crate::{
     ErrorStats, Options, Quality, compare, compute_lighting, finish_lighting, trace_lighting,
 };
@@ -131,23 +131,30 @@ impl Args {
     fn options(&self, quality: Quality) -> Options {
         Options {
             quality,
-            soft_radius: self.soft.unwrap_or(0),
-            gate: self.gate,
-            overrides: GlobalOverrides {
+            overrides: Overrides {
+                soft: self.soft,
+                gate: Some(self.gate),
                 dist: self.dist,
                 range: self.range,
-                sunsamples: self.sunsamples,
-                dirt: self.dirt,
-                dirt_mode: self.dirtmode,
+                sunsamples: Some(self.sunsamples),
+                dirt: self.dirt.then_some(true),
+                dirt_mode: self.dirtmode.map(|m| {
+                    if m == 1.0 {
+                        crate::dirt::DirtMode::Random
+                    } else {
+                        crate::dirt::DirtMode::Ordered
+                    }
+                }),
                 dirt_depth: self.dirtdepth,
                 dirt_scale: self.dirtscale,
                 dirt_gain: self.dirtgain,
                 dirt_angle: self.dirtangle,
-                addmin: self.addmin,
+                addmin: self.addmin.then_some(true),
                 bounce: self.bounce,
                 bounce_scale: self.bouncescale,
                 bounce_color_scale: self.bouncecolorscale,
-                bounce_styled: self.bouncestyled,
+                bounce_styled: self.bouncestyled.then_some(true),
+                ..Overrides::default()
             },
             only_faces: None,
             no_cull: self.no_cull,
@@ -279,6 +286,9 @@ fn run_with_current_threads(args: &Args) -> anyhow::Result<()> {
     }
     let lighting =
         compute_lighting(&bsp, &options).with_context(|| format!("lighting {}", path.display()))?;
+    for w in &lighting.warnings {
+        eprintln!("light: warning: {w}");
+    }
     let s = &lighting.stats;
     let rays = s.shadow_rays + s.sun_rays + s.dirt_rays + s.placement_rays;
     eprintln!(
@@ -334,9 +344,9 @@ fn run_with_current_threads(args: &Args) -> anyhow::Result<()> {
         let e: ErrorStats = compare(&lighting, &exact);
         report("--reference", &e);
         extra.insert("error_vs_reference".into(), serde_json::to_value(e)?);
-        if options.soft_radius > 0 {
+        if raw.soft_radius > 0 {
             // The filter blurs on purpose: also measure against the reference blurred the same way.
-            let e = compare(&lighting, &finish_lighting(&raw, options.soft_radius));
+            let e = compare(&lighting, &finish_lighting(&raw, raw.soft_radius));
             report("--reference with the same --soft filter", &e);
             extra.insert(
                 "error_vs_filtered_reference".into(),
@@ -350,7 +360,7 @@ fn run_with_current_threads(args: &Args) -> anyhow::Result<()> {
     }
     if let Some(max_rays) = args.bench_occlusion {
         let prep = crate::prepare(&bsp, &options)?;
-        let b = crate::bench::bare_occlusion(&bsp, &prep, options.gate, max_rays);
+        let b = crate::bench::bare_occlusion(&bsp, &prep, prep.lights.settings.gate, max_rays);
         eprintln!(
             "light: bare occlusion loop: {} rays in {:.3} s: {:.2} Mrays/s",
             b.rays,

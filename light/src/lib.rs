@@ -36,6 +36,7 @@ mod quality;
 pub mod reach;
 pub mod samples;
 pub mod scene;
+pub mod settings;
 pub mod surface;
 pub mod trace;
 pub mod visibility;
@@ -55,10 +56,11 @@ use rayon::prelude::*;
 use crate::bounce::{BounceCounts, StyleLuxels};
 use crate::embree::Device;
 use crate::faces::{FaceKind, face_geometry};
-use crate::lights::{GlobalOverrides, parse_lights};
+use crate::lights::parse_lights;
 use crate::output::{FaceLightmap, Finish, finish_face};
 use crate::samples::{FaceSamples, PlacementCounts, face_samples};
 use crate::scene::TraceScene;
+use crate::settings::Overrides;
 use crate::trace::{
     FaceLight, FaceRules, SampleLight, TraceCounts, TraceScratch, TraceSetup, trace_face,
 };
@@ -68,11 +70,8 @@ use crate::visibility::Visibility;
 #[derive(Debug, Clone, PartialEq)]
 pub struct Options {
     pub quality: Quality,
-    /// `--soft`: box filter radius over final luxels (0 = off).
-    pub soft_radius: usize,
-    /// `--gate`: contributions below this many light units count as zero.
-    pub gate: f64,
-    pub overrides: GlobalOverrides,
+    /// The settings given to the run; each wins over worldspawn's key.
+    pub overrides: Overrides,
     /// Light only these faces (others keep no lightmap); for measurements.
     pub only_faces: Option<Vec<usize>>,
     /// `--no-cull`: consider every light for every face (implied by `Reference`).
@@ -89,9 +88,7 @@ impl Default for Options {
     fn default() -> Self {
         Options {
             quality: Quality::Default,
-            soft_radius: 0,
-            gate: 0.001,
-            overrides: GlobalOverrides::default(),
+            overrides: Overrides::default(),
             only_faces: None,
             no_cull: false,
             progress: false,
@@ -148,6 +145,8 @@ pub struct Lighting {
     pub lightmaps: Vec<FaceLightmap>,
     pub entity_text: Option<String>,
     pub coloured: bool,
+    /// Worldspawn or command-line values light did not take as given.
+    pub warnings: Vec<settings::SettingWarning>,
     pub stats: Stats,
 }
 
@@ -294,6 +293,10 @@ pub struct RawLighting {
     pub coloured: bool,
     pub rangescale: f64,
     pub gamma: f64,
+    /// `--soft`: the box filter's radius the run asks for.
+    pub soft_radius: usize,
+    /// Worldspawn or command-line values light did not take as given.
+    pub warnings: Vec<settings::SettingWarning>,
     pub stats: Stats,
 }
 
@@ -485,12 +488,13 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
     let start = Instant::now();
     let prep = prepare(bsp, options)?;
     let setup_done = Instant::now();
-    let light_reaches = reach::light_reaches(&prep.point_lights, options.gate);
+    let gate = prep.lights.settings.gate;
+    let light_reaches = reach::light_reaches(&prep.point_lights, gate);
     let reference = options.quality == Quality::Reference;
     let setup = prep.trace_setup(
         bsp,
         &light_reaches,
-        options.gate,
+        gate,
         !options.no_cull && !reference,
         !reference,
     );
@@ -539,7 +543,7 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
     let mut bounce_counts = BounceCounts::default();
     let bounced = if bouncing && reference {
         // The reference's emitters: every face's direct light at --extra4.
-        let fine = prep.trace_setup(bsp, &light_reaches, options.gate, true, true);
+        let fine = prep.trace_setup(bsp, &light_reaches, gate, true, true);
         let keep = Keep {
             bouncing: true,
             samples: false,
@@ -640,8 +644,10 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
         faces,
         entity_text: prep.entity_text,
         coloured: stats.coloured,
-        rangescale: prep.lights.rangescale,
-        gamma: prep.lights.gamma,
+        rangescale: prep.lights.settings.range,
+        gamma: prep.lights.settings.gamma,
+        soft_radius: prep.lights.settings.soft,
+        warnings: prep.lights.warnings.clone(),
         stats,
     })
 }
@@ -668,6 +674,7 @@ pub fn finish_lighting(raw: &RawLighting, soft_radius: usize) -> Lighting {
         lightmaps,
         entity_text: raw.entity_text.clone(),
         coloured: raw.coloured,
+        warnings: raw.warnings.clone(),
         stats,
     }
 }
@@ -678,7 +685,7 @@ pub fn finish_lighting(raw: &RawLighting, soft_radius: usize) -> Lighting {
 /// Bad entities or faces, or an Embree failure.
 pub fn compute_lighting(bsp: &Bsp, options: &Options) -> Result<Lighting, LightError> {
     let raw = trace_lighting(bsp, options)?;
-    Ok(finish_lighting(&raw, options.soft_radius))
+    Ok(finish_lighting(&raw, raw.soft_radius))
 }
 
 /// Writes `lighting` into `bsp` (lighting lump, face styles and offsets,
@@ -802,6 +809,7 @@ pub fn lightmaps_in(bsp: &Bsp, faces: &[usize]) -> Lighting {
         lightmaps,
         entity_text: None,
         coloured: false,
+        warnings: Vec::new(),
         stats: Stats::default(),
     }
 }

@@ -598,7 +598,7 @@ fn dirt_switches_per_light_and_from_the_command_line() {
     assert!(opted_out.iter().all(|&v| v == 100), "{opted_out:?}");
     // --dirt turns it on without any key in the map; a stronger scale darkens more.
     let mut forced = options(Quality::Default);
-    forced.overrides.dirt = true;
+    forced.overrides.dirt = Some(true);
     let on = floor_row(&corner_scene("", ""), &forced, 8);
     assert!(on[11] < 80, "{on:?}");
     forced.overrides.dirt_scale = Some(2.0);
@@ -842,7 +842,7 @@ fn addmin_adds_minlight_instead_of_raising_to_it() {
     let floor = floor_row(&bsp, &options(Quality::Default), 8);
     assert!(floor.iter().all(|&v| v == 100), "floor: {floor:?}");
     let mut add = options(Quality::Default);
-    add.overrides.addmin = true;
+    add.overrides.addmin = Some(true);
     let added = floor_row(&bsp, &add, 8);
     assert!(added.iter().all(|&v| v == 120), "added: {added:?}");
     // Where no light reaches, both give the minlight itself.
@@ -860,7 +860,7 @@ fn dirt_cone_follows_the_phong_normal() {
     let bsp = corner_scene("", "");
     let prep = crate::prepare(&bsp, &Options::default()).expect("prepare");
     let (mut samples, _) = face_samples(&prep.faces[0], 1, &prep.scene, &bsp);
-    let sampling = crate::dirt::DirtSampling::default();
+    let sampling = crate::lights::dirt_sampling(&crate::settings::Settings::default());
     let occlusion = |samples: &crate::samples::FaceSamples| {
         let all: Vec<usize> = (0..samples.points.len()).collect();
         crate::dirt::occlusion_at(
@@ -1264,20 +1264,22 @@ fn output_does_not_depend_on_the_thread_count() {
         let rgb = apply_lighting(&mut lit, &lighting);
         (lit.lighting, rgb)
     };
-    for (quality, dirt_mode, soft_radius) in [(Quality::Default, 0.0, 0), (Quality::Extra, 1.0, 1)]
-    {
+    for (quality, dirt_mode, soft_radius) in [
+        (Quality::Default, DirtMode::Ordered, 0),
+        (Quality::Extra, DirtMode::Random, 1),
+    ] {
         let mut options = options(quality);
-        options.soft_radius = soft_radius;
-        options.overrides.dirt = true;
+        options.overrides.soft = Some(soft_radius);
+        options.overrides.dirt = Some(true);
         options.overrides.dirt_mode = Some(dirt_mode);
-        options.overrides.sunsamples = 16;
+        options.overrides.sunsamples = Some(16);
         // Bounce gathers across faces: one pass, and two with supersampling.
         options.overrides.bounce = Some(if quality == Quality::Default { 1 } else { 2 });
         let one = lit_bytes(1, &options);
         assert!(one.0.iter().any(|&b| b > 0), "{quality:?}: lit");
         assert!(
             one == lit_bytes(2, &options),
-            "{quality:?}, dirt mode {dirt_mode}: 1 and 2 threads differ"
+            "{quality:?}, dirt mode {dirt_mode:?}: 1 and 2 threads differ"
         );
     }
 }

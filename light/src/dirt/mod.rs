@@ -18,12 +18,6 @@ mod rays;
 pub use adaptive::{DirtNeed, FaceDirt, face_occlusion};
 pub use rays::{ConePattern, DirtRays, RAYS_PER_SAMPLE, occlusion_at, ordered_components};
 
-/// Dirt ray length when `_dirtdepth` is absent.
-pub const DEFAULT_DIRT_DEPTH: f64 = 128.0;
-
-/// Dirt cone (degrees from the normal) when `_dirtangle` is absent.
-pub const DEFAULT_DIRT_ANGLE: f64 = 88.0;
-
 /// How dirt (ambient occlusion) darkens one light: ericw-tools' `_dirtscale`
 /// and `_dirtgain`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -88,12 +82,6 @@ impl DirtSampling {
 
     pub fn ordered(&self) -> &ConePattern {
         &self.ordered
-    }
-}
-
-impl Default for DirtSampling {
-    fn default() -> Self {
-        DirtSampling::new(DirtMode::Ordered, DEFAULT_DIRT_DEPTH, DEFAULT_DIRT_ANGLE)
     }
 }
 
