@@ -95,7 +95,9 @@ pub fn face_reflectance(
 /// at the last row and column), each casting `strata²` rays.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Density {
+    /// Luxels between receivers along each axis.
     pub stride: usize,
+    /// Rays per receiver along each axis of the stratified grid.
     pub strata: usize,
     /// A last step of at most half a stride widens the cell before it instead of adding a
     /// row or column of receivers ([`receiver_grid`]): the default mode's trade.

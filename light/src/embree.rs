@@ -498,12 +498,13 @@ impl SceneBuilder {
 
     /// Enables `RTC_SCENE_FLAG_ROBUST`: slower, but avoids rays leaking
     /// through shared edges (useful for light leaks at brush seams).
+    #[cfg(test)]
     pub fn set_robust(&mut self, robust: bool) {
         self.robust = robust;
     }
 
-    /// Adds a triangle mesh and returns the geometry id Embree reports in
-    /// [`Hit::geom_id`]. Ids are assigned sequentially from 0.
+    /// Adds a triangle mesh and returns the geometry id Embree reports for its hits. Ids are
+    /// assigned sequentially from 0.
     ///
     /// # Errors
     /// [`EmbreeError::InvalidInput`] for an out-of-range vertex index, or the
@@ -641,7 +642,9 @@ unsafe impl Send for Scene {}
 // SAFETY: as above.
 unsafe impl Sync for Scene {}
 
-/// Closest-hit result of [`Scene::intersect`].
+/// Closest-hit result of [`Scene::intersect`] (the single-ray queries are the tests' oracle
+/// for the packets).
+#[cfg(test)]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Hit {
     /// Ray parameter of the hit (distance if `dir` is unit length).
@@ -703,6 +706,7 @@ fn context(coherent: bool) -> sys::RTCIntersectContext {
 
 impl Scene {
     /// True if anything lies on the segment `org + t*dir`, `t` in `[tnear, tfar]`.
+    #[cfg(test)]
     #[must_use]
     pub fn occluded(&self, org: [f32; 3], dir: [f32; 3], tnear: f32, tfar: f32) -> bool {
         if !ray_ok(org, dir, tnear, tfar) {
@@ -718,6 +722,7 @@ impl Scene {
     }
 
     /// Closest hit on the segment, if any.
+    #[cfg(test)]
     #[must_use]
     pub fn intersect(&self, org: [f32; 3], dir: [f32; 3], tnear: f32, tfar: f32) -> Option<Hit> {
         if !ray_ok(org, dir, tnear, tfar) {

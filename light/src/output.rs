@@ -14,8 +14,11 @@ const NO_STYLE: u8 = 255;
 /// A face's final lightmaps: up to four styles, grey bytes and RGB bytes.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FaceLightmap {
+    /// The face's index.
     pub face: usize,
+    /// Luxels across (s).
     pub width: usize,
+    /// Luxels down (t).
     pub height: usize,
     /// Style of each lightmap, style 0 first.
     pub styles: Vec<u8>,
@@ -181,6 +184,13 @@ pub fn write_lighting(bsp: &mut Bsp, maps: &[FaceLightmap], coloured: bool) -> O
     }
     bsp.lighting = grey;
     coloured.then_some(rgb)
+}
+
+/// The `.lit` of white light: each luxel's grey level of `lighting` (a lighting lump) in all
+/// three channels.
+pub fn grey_lit(lighting: &[u8]) -> Vec<u8> {
+    let rgb: Vec<u8> = lighting.iter().flat_map(|&g| [g, g, g]).collect();
+    quake_formats::lit::write_lit(&rgb)
 }
 
 #[cfg(test)]

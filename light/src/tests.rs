@@ -673,7 +673,7 @@ fn column_scene(world_keys: &str) -> Bsp {
 /// shared edge at mid height (light units).
 fn edge_jumps(world_keys: &str) -> Vec<f64> {
     let bsp = column_scene(world_keys);
-    let prep = crate::prepare(&bsp, &Options::default()).expect("prepare");
+    let prep = crate::prepare::prepare(&bsp, &Options::default()).expect("prepare");
     let light_reaches = crate::reach::light_reaches(&prep.point_lights, 0.001);
     let setup = crate::trace::TraceSetup {
         suns: &[],
@@ -696,8 +696,10 @@ fn edge_jumps(world_keys: &str) -> Vec<f64> {
                     })
                     .collect();
             }
-            let (light, _) =
-                crate::trace::light_face(&setup, &samples, &crate::trace::FaceRules::default());
+            let rules = crate::trace::FaceRules::default();
+            let mut scratch = crate::trace::TraceScratch::default();
+            let (light, _) = crate::trace::trace_face(&setup, &samples, &rules, &mut scratch);
+            let light = light.finish(&[]);
             samples
                 .points
                 .iter()
@@ -858,7 +860,7 @@ fn addmin_adds_minlight_instead_of_raising_to_it() {
 fn dirt_cone_follows_the_phong_normal() {
     // The floor of the corner scene: the wall stands at x = 192.
     let bsp = corner_scene("", "");
-    let prep = crate::prepare(&bsp, &Options::default()).expect("prepare");
+    let prep = crate::prepare::prepare(&bsp, &Options::default()).expect("prepare");
     let (mut samples, _) = face_samples(&prep.faces[0], 1, &prep.scene, &bsp);
     let sampling = crate::lights::dirt_sampling(&crate::settings::Settings::default());
     let occlusion = |samples: &crate::samples::FaceSamples| {
@@ -995,7 +997,7 @@ fn detail_column_bsp(detail_keys: &str) -> Bsp {
 #[test]
 fn phong_on_func_detail_reaches_light_through_the_bsp() {
     // The column's side faces: vertical, near the axis (the room's walls are 128 out).
-    let column_sides = |prep: &crate::Prepared| -> Vec<usize> {
+    let column_sides = |prep: &crate::prepare::Prepared| -> Vec<usize> {
         prep.faces
             .iter()
             .filter(|f| f.plane.normal.z.abs() < 0.1)
@@ -1006,7 +1008,7 @@ fn phong_on_func_detail_reaches_light_through_the_bsp() {
 
     let plain = detail_column_bsp("");
     assert_eq!(plain.phong_faces().expect("lump"), None);
-    let prep = crate::prepare(&plain, &Options::default()).expect("prepare");
+    let prep = crate::prepare::prepare(&plain, &Options::default()).expect("prepare");
     assert_eq!(column_sides(&prep).len(), 8);
     assert!(
         prep.phong.iter().all(Option::is_none),
@@ -1018,7 +1020,7 @@ fn phong_on_func_detail_reaches_light_through_the_bsp() {
         .phong_faces()
         .expect("lump")
         .expect("phong lump written");
-    let prep = crate::prepare(&smooth, &Options::default()).expect("prepare");
+    let prep = crate::prepare::prepare(&smooth, &Options::default()).expect("prepare");
     let sides = column_sides(&prep);
     assert_eq!(sides.len(), 8);
     let group = lump[sides[0]].group;
@@ -1072,7 +1074,7 @@ fn lit_faces(
     rules: &crate::trace::FaceRules,
     bounce: f32,
 ) -> (Vec<Vec<[f32; 3]>>, u64) {
-    let prep = crate::prepare(bsp, &Options::default()).expect("prepare");
+    let prep = crate::prepare::prepare(bsp, &Options::default()).expect("prepare");
     let light_reaches = crate::reach::light_reaches(&prep.point_lights, 0.001);
     let setup = prep.trace_setup(bsp, &light_reaches, 0.001, true, adaptive);
     let mut rays = 0;
@@ -1084,7 +1086,7 @@ fn lit_faces(
             let (samples, _) = face_samples(geom, per_axis, &prep.scene, bsp);
             let mut scratch = crate::trace::TraceScratch::default();
             let (raw, counts) = crate::trace::trace_face(&setup, &samples, rules, &mut scratch);
-            rays += counts.rays();
+            rays += counts.shadow_rays + counts.sun_rays + counts.dirt_rays;
             let bounced = [(0, vec![[bounce; 3]; samples.width * samples.height])];
             let light = raw.finish(if bounce > 0.0 { &bounced } else { &[] });
             light.styles[0].1.clone()
@@ -1180,7 +1182,7 @@ fn dirt_occlusion_does_not_depend_on_the_rays_traced_beside_it() {
     // alone and among its neighbours differed.
     let bsp = corner_scene("\"_dirt\" \"1\"", "");
     for mode in [DirtMode::Ordered, DirtMode::Random] {
-        let mut prep = crate::prepare(&bsp, &Options::default()).expect("prepare");
+        let mut prep = crate::prepare::prepare(&bsp, &Options::default()).expect("prepare");
         prep.lights.dirt.mode = mode;
         for geom in prep.faces.iter().filter(|f| f.kind == FaceKind::Lit) {
             for per_axis in [1, 2] {

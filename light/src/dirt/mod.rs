@@ -1,6 +1,6 @@
 //! Dirt: ambient occlusion after q3map2 and ericw-tools, how enclosed each sample point is.
 //!
-//! A sample casts [`RAYS_PER_SAMPLE`] rays into the cone of `_dirtangle` degrees around its
+//! A sample casts [`rays::RAYS_PER_SAMPLE`] rays into the cone of `_dirtangle` degrees around its
 //! shading normal (the `_phong` one on smoothed faces), up to `_dirtdepth` units ([`rays`]):
 //! `_dirtmode 0` spreads them over the same rings and azimuths for every sample, `1` at
 //! directions drawn per sample from a hash of face and sample, so results do not depend on
@@ -16,7 +16,9 @@ mod adaptive;
 mod rays;
 
 pub use adaptive::{DirtNeed, FaceDirt, face_occlusion};
-pub use rays::{ConePattern, DirtRays, RAYS_PER_SAMPLE, occlusion_at, ordered_components};
+pub use rays::{ConePattern, ordered_components};
+#[cfg(test)]
+pub use rays::{DirtRays, occlusion_at};
 
 /// How dirt (ambient occlusion) darkens one light: ericw-tools' `_dirtscale`
 /// and `_dirtgain`.

@@ -164,6 +164,8 @@ impl PointLight {
     /// Brightness this light adds at a point `dist` away in unit direction
     /// `to_point` (from the light), on a surface whose normal makes cosine
     /// `cos_incidence` with the direction back to the light.
+    // Inlined into the per-sample loop of every face and light, which lives in another module.
+    #[inline]
     pub fn contribution(&self, dist: f64, to_point: DVec3, cos_incidence: f64) -> f64 {
         let angle = if self.falloff == Falloff::LocalMin {
             f64::from(u8::from(cos_incidence > 0.0))

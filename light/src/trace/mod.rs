@@ -91,8 +91,11 @@ pub struct FaceRules<'a> {
 /// Per-luxel colour of each style a face receives, in light units.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FaceLight {
+    /// The face's index.
     pub face: usize,
+    /// Luxels across (s).
     pub width: usize,
+    /// Luxels down (t).
     pub height: usize,
     /// Style and its luxels (row-major), style 0 first.
     pub styles: Vec<(u8, Vec<[f32; 3]>)>,
@@ -117,20 +120,6 @@ impl TraceCounts {
         self.pairs += o.pairs;
         self.pairs_culled += o.pairs_culled;
     }
-
-    pub fn rays(&self) -> u64 {
-        self.shadow_rays + self.sun_rays + self.dirt_rays
-    }
-}
-
-/// Lights one face's samples and averages them to luxels.
-pub fn light_face(
-    setup: &TraceSetup,
-    samples: &FaceSamples,
-    rules: &FaceRules,
-) -> (FaceLight, TraceCounts) {
-    let (light, counts) = trace_face(setup, samples, rules, &mut TraceScratch::default());
-    (light.finish(&[]), counts)
 }
 
 /// Working buffers of [`trace_face`] that one thread keeps from face to face, so no face
