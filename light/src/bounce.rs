@@ -100,9 +100,9 @@ pub struct Density {
     /// Rays per receiver along each axis of the stratified grid.
     pub strata: usize,
     /// A last step of at most half a stride widens the cell before it instead of adding a
-    /// row or column of receivers ([`receiver_grid`]): the default mode's trade.
+    /// row or column of receivers: the default mode's trade.
     pub widen_last: bool,
-    /// Receivers' values are smoothed by their neighbours ([`smooth_receivers`]) before they
+    /// Receivers' values are smoothed by their neighbours before they
     /// are spread onto the luxels: few rays per receiver, noise averaged over several.
     pub smooth: bool,
 }
@@ -111,10 +111,9 @@ impl Density {
     /// The density of each quality mode; the reference's later passes gather at every luxel.
     pub fn for_quality(quality: Quality) -> Density {
         match quality {
-            // Measured against the written references (light/README.md, "Bounce: measurements"):
-            // 6x6 rays smoothed give the RMSE of 8x8 unsmoothed (e1m1 4.67 / 4.58, e3m4 2.65 /
-            // 2.68, retrojam1 3.66 / 3.69) with 44 % fewer rays. Where noise is already low
-            // (16x16) smoothing only adds its bias at corners (e1m1 release 0.90 -> 1.31).
+            // Few rays, smoothed over neighbouring receivers, have the error of more rays
+            // unsmoothed (bench/results/light-bounce.md). Where noise is already low,
+            // smoothing only adds its bias at corners, so the supersampled modes do not.
             Quality::Default => Density {
                 stride: 2,
                 strata: 6,
@@ -127,8 +126,6 @@ impl Density {
                 widen_last: false,
                 smooth: false,
             },
-            // 12x12 instead of 16x16: 44 % fewer rays for RMSE e1m1 0.90 -> 0.96, e3m4 0.49 ->
-            // 0.54, retrojam1 0.73 -> 0.82 at the release settings.
             Quality::Extra4 => Density {
                 stride: 2,
                 strata: 12,
@@ -161,7 +158,7 @@ fn jitter(key: u64) -> (f64, f64) {
 
 /// Sine and cosine of `turns` of a full turn (0 ≤ `turns` < 1), within 1e-10 of `sin_cos`:
 /// the nearest quarter turn is exact, and what is left (at most π/4) takes a short series.
-/// libm's `sincos` was a tenth of the instructions gathering spent outside Embree.
+/// libm's `sincos` is a large share of what gathering spends outside Embree.
 fn sin_cos_turns(turns: f64) -> (f64, f64) {
     debug_assert!((0.0..1.0).contains(&turns), "{turns}");
     let quarter = (turns * 4.0 + 0.5) as u32;

@@ -294,9 +294,34 @@ fn run_with_current_threads(args: &Args) -> anyhow::Result<()> {
         compute_lighting(&bsp, &options).with_context(|| format!("lighting {}", path.display()))?;
     print_summary(&lighting);
 
+    let extra = measurements(args, &bsp, &options, &lighting)?;
+
+    let lit = crate::apply_lighting(&mut bsp, &lighting);
+    let lit = args.lit_to_write(&bsp, lit);
+    let out = args.output.as_ref().unwrap_or(path);
+    place_lit_pair(out, &bsp.write()?, lit)?;
+    if let Some(stats_path) = &args.stats {
+        let mut json = serde_json::to_value(&lighting.stats)?;
+        if let serde_json::Value::Object(map) = &mut json {
+            map.extend(extra);
+            map.insert("quality".into(), serde_json::to_value(options.quality)?);
+        }
+        write_atomic(stats_path, serde_json::to_string_pretty(&json)?.as_bytes())?;
+    }
+    Ok(())
+}
+
+/// The measurements `--compare-reference` and `--bench-occlusion` ask for, printed and as
+/// fields for `--stats`.
+fn measurements(
+    args: &Args,
+    bsp: &Bsp,
+    options: &Options,
+    lighting: &Lighting,
+) -> anyhow::Result<serde_json::Map<String, serde_json::Value>> {
     let mut extra = serde_json::Map::new();
     if args.compare_reference {
-        let c = compare_with_reference(&bsp, &options, &lighting)?;
+        let c = compare_with_reference(bsp, options, lighting)?;
         eprintln!(
             "light: --reference took {:.2} s, {} rays",
             c.reference_seconds, c.reference_rays
@@ -322,7 +347,7 @@ fn run_with_current_threads(args: &Args) -> anyhow::Result<()> {
         );
     }
     if let Some(max_rays) = args.bench_occlusion {
-        let b = crate::bench::bare_occlusion(&bsp, &options, max_rays)?;
+        let b = crate::bare_occlusion(bsp, options, max_rays)?;
         eprintln!(
             "light: bare occlusion loop: {} rays in {:.3} s: {:.2} Mrays/s",
             b.rays,
@@ -332,19 +357,7 @@ fn run_with_current_threads(args: &Args) -> anyhow::Result<()> {
         extra.insert("bare_occlusion".into(), serde_json::to_value(b)?);
     }
 
-    let lit = crate::apply_lighting(&mut bsp, &lighting);
-    let lit = args.lit_to_write(&bsp, lit);
-    let out = args.output.as_ref().unwrap_or(path);
-    place_lit_pair(out, &bsp.write()?, lit)?;
-    if let Some(stats_path) = &args.stats {
-        let mut json = serde_json::to_value(&lighting.stats)?;
-        if let serde_json::Value::Object(map) = &mut json {
-            map.extend(extra);
-            map.insert("quality".into(), serde_json::to_value(options.quality)?);
-        }
-        write_atomic(stats_path, serde_json::to_string_pretty(&json)?.as_bytes())?;
-    }
-    Ok(())
+    Ok(extra)
 }
 
 /// What the run did, and its warnings, on stderr.

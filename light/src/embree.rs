@@ -342,7 +342,7 @@ unsafe extern "C" fn record_error(user_ptr: *mut c_void, _code: sys::RTCError, m
 }
 
 /// Environment variable whose value is appended to the config string of the
-/// devices [`Device::new`] creates: Embree 3 options such as `isa=avx2`,
+/// devices `Device::new` creates: Embree 3 options such as `isa=avx2`,
 /// `isa=sse4.2` (which vector kernels trace the rays) or `verbose=1`.
 pub const CONFIG_ENV: &str = "SLIPGATE_EMBREE_CONFIG";
 
@@ -568,8 +568,8 @@ impl SceneBuilder {
         Ok(id)
     }
 
-    /// Builds the BVH (build quality MEDIUM: on e1m1 the HIGH build cost more
-    /// than its faster traversal saved; e3m4 traced as fast). The result is immutable.
+    /// Builds the BVH (build quality MEDIUM: the HIGH build costs more than its faster
+    /// traversal saves on Quake maps). The result is immutable.
     ///
     /// # Errors
     /// Returns the Embree error if the build fails (e.g. out of memory).
@@ -796,8 +796,8 @@ impl Scene {
         if packet.active_mask() == 0 {
             return ids;
         }
-        // The packet holds the hit records beside its rays, so Embree answers in place (copying
-        // the rays out and back was 2 % of e3m4's instructions, most of them dirt's).
+        // The packet holds the hit records beside its rays, so Embree answers in place instead
+        // of the rays being copied out and back for every dirt packet.
         let hit = &mut packet.rayhit.hit;
         hit.geomID = [sys::RTC_INVALID_GEOMETRY_ID; 16];
         hit.instID = [[sys::RTC_INVALID_GEOMETRY_ID; 16]; sys::RTC_MAX_INSTANCE_LEVEL_COUNT];

@@ -6,7 +6,7 @@
 //!
 //! 1. Settings ([`settings`]): each map-wide setting from the command line, else worldspawn,
 //!    else its default; values that do not read warn and fall back.
-//! 2. Preparation ([`prepare`]): faces as world-space geometry with their lightmap extents
+//! 2. Preparation (`prepare`): faces as world-space geometry with their lightmap extents
 //!    (`faces`); the Embree scene of everything opaque, sky faces as their own geometry and a
 //!    small scene per `_shadowself` model (`scene`); lights, suns, sky domes, minlight and
 //!    switchable styles from the entity lump (`lights`), `_surface` templates copied over

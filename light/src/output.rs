@@ -24,7 +24,7 @@ pub struct FaceLightmap {
     pub styles: Vec<u8>,
     /// One byte per luxel per style: the mean of the RGB channels.
     pub grey: Vec<Vec<u8>>,
-    /// The channels themselves, per style, when [`Finish::rgb`] asks for them (else empty).
+    /// The channels themselves, per style, when the light is coloured (else empty).
     pub rgb: Vec<Vec<[u8; 3]>>,
 }
 

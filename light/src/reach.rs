@@ -13,8 +13,8 @@ use quake_formats::geom::Bounds;
 
 use crate::lights::PointLight;
 
-/// Where a light is and how far it reaches, packed for the per-face cull
-/// (e1m1 tests about 950k face/light pairs).
+/// Where a light is and how far it reaches, packed for the per-face cull (a map tests about
+/// as many face/light pairs as it has faces times lights).
 #[derive(Debug, Clone, Copy)]
 pub struct LightReach {
     pub origin: DVec3,
@@ -25,7 +25,7 @@ pub struct LightReach {
 /// Every light's [`LightReach`], and which lights may reach a box: a grid of
 /// cubes, each listing the lights whose reach (the box around its sphere)
 /// touches it, so a face looks at the lights near it instead of at all of them
-/// (e1m1: 198 lights, 1 % of face-light pairs within reach).
+/// (few of a map's lights reach any one face).
 pub struct LightReaches {
     each: Vec<LightReach>,
     /// The grid's lowest corner and its cube's side.

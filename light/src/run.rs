@@ -388,7 +388,19 @@ fn bounce_light(
         let last = pass == settings.passes;
         let emitting = Field::new(&prep.faces, reflectance, &light, &settings);
         if reference {
-            for (face, b, c) in gather_at_samples(prep, &emitting, traced, pass) {
+            // The reference gathers at every sample of the faces it measures.
+            let at_samples = gather_faces(traced, |t, c| {
+                let (samples, model) = (t.samples.as_deref()?, prep.faces[t.face].model);
+                Some(bounce::reference::gather(
+                    &emitting,
+                    &prep.scene,
+                    samples,
+                    model,
+                    pass,
+                    c,
+                ))
+            });
+            for (face, b, c) in at_samples {
                 bounce::accumulate(&mut total[face], &b);
                 counts.add(&c);
             }
@@ -403,7 +415,11 @@ fn bounce_light(
             .filter(|t| (!reference && t.light.is_some()) || (!last && t.reflected.is_some()))
             .collect();
         let mut next: Vec<Option<StyleLuxels>> = vec![None; n];
-        for (face, b, c) in gather_at_receivers(prep, &emitting, &receiving, pass, density) {
+        let at_receivers = gather_faces(receiving.par_iter().copied(), |t, c| {
+            let receivers = t.receivers.as_deref()?;
+            Some(emitting.gather_face(&prep.scene, receivers, pass, density, c))
+        });
+        for (face, b, c) in at_receivers {
             counts.add(&c);
             if !reference {
                 bounce::accumulate(&mut total[face], &b);
@@ -420,42 +436,17 @@ fn bounce_light(
 /// One face's light gathered in one pass, and the work it took.
 type Gathered = (usize, StyleLuxels, BounceCounts);
 
-/// Pass `pass` of the reference's bounce: what `emitting` gives every sample of the faces of
-/// `traced` that kept theirs.
-fn gather_at_samples(
-    prep: &Prepared,
-    emitting: &Field,
-    traced: &[Traced],
-    pass: usize,
+/// What `gather` brings each of `faces` (in parallel), for those it has a place for.
+fn gather_faces<'t>(
+    faces: impl IntoParallelIterator<Item = &'t Traced>,
+    gather: impl Fn(&Traced, &mut BounceCounts) -> Option<StyleLuxels> + Sync + Send,
 ) -> Vec<Gathered> {
-    traced
-        .par_iter()
-        .filter_map(|t| Some((t.face, &**t.samples.as_ref()?)))
-        .map(|(face, samples)| {
-            let mut c = BounceCounts::default();
-            let model = prep.faces[face].model;
-            let b = bounce::reference::gather(emitting, &prep.scene, samples, model, pass, &mut c);
-            (face, b, c)
-        })
-        .collect()
-}
-
-/// Pass `pass` of the fast bounce: what `emitting` gives the luxels of `receiving`, gathered
-/// at their receivers at `density`.
-fn gather_at_receivers(
-    prep: &Prepared,
-    emitting: &Field,
-    receiving: &[&Traced],
-    pass: usize,
-    density: Density,
-) -> Vec<Gathered> {
-    receiving
-        .par_iter()
-        .filter_map(|t| Some((t.face, &**t.receivers.as_ref()?)))
-        .map(|(face, r)| {
-            let mut c = BounceCounts::default();
-            let b = emitting.gather_face(&prep.scene, r, pass, density, &mut c);
-            (face, b, c)
+    faces
+        .into_par_iter()
+        .filter_map(|t| {
+            let mut counts = BounceCounts::default();
+            let light = gather(t, &mut counts)?;
+            Some((t.face, light, counts))
         })
         .collect()
 }

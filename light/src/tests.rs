@@ -742,8 +742,8 @@ fn phong_smooths_a_column_without_facet_bands() {
 }
 
 /// Culling is exact: on a `_phong` column, the faces just past the light's terminator have the
-/// light behind their flat plane but in front of their smoothed corner normals, and they were
-/// culled by that plane (e3m4: 228 faces, up to 41 levels darker than without culling).
+/// light behind their flat plane but in front of their smoothed corner normals, so culling by
+/// that plane would darken them.
 #[test]
 fn culling_leaves_phong_faces_lit_from_behind_their_plane() {
     let bsp = column_scene("\"_phong\" \"1\"");
@@ -1138,13 +1138,10 @@ fn adaptive_dirt_stays_close_to_measuring_every_sample() {
 }
 
 /// Where only bounced light takes dirt (here the light has `_dirt -1`), a supersampled sample's
-/// occlusion is the bilinear mean of its luxel's corners, edges included: 24 % fewer dirt rays
-/// on e3m4's release settings, RMSE 0.486 -> 0.488 against the reference. Without
-/// supersampling a fine cell is two luxels wide, and the same rule was 12 % off at this wall's
-/// foot (2 % at 4x4), so there it keeps the usual rule. Samples measured for bounce alone cast
-/// half the dirt rays (`dirt::DirtRays::Half`): 6 % off at this wall's foot in both modes (the
-/// 8-azimuth pattern against 16), for 21 % fewer dirt rays on e3m4 `--bounce` (RMSE 2.696 ->
-/// 2.697) and 12 % on e3m4's and retrojam1's release settings (RMSE unchanged or lower).
+/// occlusion is the bilinear mean of its luxel's corners, edges included. Without
+/// supersampling a fine cell is two luxels wide, too coarse at this wall's foot, so there it
+/// keeps the usual rule. Samples measured for bounce alone cast half the dirt rays
+/// (`dirt::DirtRays::Half`: the 8-azimuth pattern against 16).
 #[test]
 fn dirt_that_only_bounce_takes_is_interpolated_and_stays_close() {
     let bsp = corner_scene("\"_dirt\" \"1\" \"_bounce\" \"1\"", "\"_dirt\" \"-1\"");
@@ -1233,9 +1230,8 @@ fn demo_bsp_with_sun() -> Bsp {
 }
 
 /// In the default mode the dome's directions (each carrying 1/100 of it) are probed every
-/// other luxel and filled in where a cell's probes agree (`VisibilityScratch::trace_probed`):
-/// on e3m4 40 % fewer sun rays, RMSE against the reference unchanged to three places. The
-/// single sun (one direction) is traced at every luxel as before.
+/// other luxel and filled in where a cell's probes agree (`VisibilityScratch::trace_probed`).
+/// The single sun (one direction) is traced at every luxel.
 #[test]
 fn probed_sky_dome_stays_close_to_tracing_every_luxel() {
     let bsp = demo_bsp_with_sun();

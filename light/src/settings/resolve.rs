@@ -91,44 +91,27 @@ pub fn resolve<T: SettingValue>(
     world: Option<World>,
     warnings: &mut Vec<SettingWarning>,
 ) -> T {
-    let warn = |given: Given, value: String, problem: String| SettingWarning {
-        given,
-        value,
-        problem,
-    };
-    let (value, at, text) = match given {
+    let (value, given, text) = match given {
         Some(value) => {
             let text = value.show();
             (value, Given::Run(declared.given_as), text)
         }
-        None => {
-            let Some(world) = world else {
+        None => match world.and_then(|w| first_key::<T>(declared.keys, w)) {
+            None => return default,
+            Some((at, text, Ok(value))) => (value, at, text),
+            Some((given, value, Err(expected))) => {
+                let problem = format!(
+                    "expected {expected}; the default {} is used",
+                    default.show()
+                );
+                warnings.push(SettingWarning {
+                    given,
+                    value,
+                    problem,
+                });
                 return default;
-            };
-            let found = declared.keys.iter().find_map(|&key| {
-                let text = world.entity.get(key)?;
-                Some((key, text, T::read(text)?))
-            });
-            let Some((key, text, read)) = found else {
-                return default;
-            };
-            let at = Given::Key {
-                entity: world.index,
-                classname: world.entity.classname().to_string(),
-                key,
-            };
-            match read {
-                Ok(value) => (value, at, text.to_string()),
-                Err(expected) => {
-                    let problem = format!(
-                        "expected {expected}; the default {} is used",
-                        default.show()
-                    );
-                    warnings.push(warn(at, text.to_string(), problem));
-                    return default;
-                }
             }
-        }
+        },
     };
     match value.within(declared.range) {
         Ok(value) => value,
@@ -145,8 +128,30 @@ pub fn resolve<T: SettingValue>(
                     (default, problem)
                 }
             };
-            warnings.push(warn(at, text, problem));
+            warnings.push(SettingWarning {
+                given,
+                value: text,
+                problem,
+            });
             value
         }
     }
+}
+
+/// The first of `keys` `world` holds with a value that is not blank: where it is, its text and
+/// what it reads as.
+fn first_key<T: SettingValue>(
+    keys: &'static [&'static str],
+    world: World,
+) -> Option<(Given, String, Result<T, &'static str>)> {
+    keys.iter().find_map(|&key| {
+        let text = world.entity.get(key)?;
+        let read = T::read(text)?;
+        let at = Given::Key {
+            entity: world.index,
+            classname: world.entity.classname().to_string(),
+            key,
+        };
+        Some((at, text.to_string(), read))
+    })
 }
