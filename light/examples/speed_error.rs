@@ -1,4 +1,4 @@
-//! The rows of README's speed-against-error table for one map:
+//! The rows of `bench/results/light-speed-error.md` for one map:
 //! `cargo run --release -p slipgate-light --example speed_error -- MAP.bsp STRIDE`.
 //! Time (best of 3) and rays are for the whole map; RMSE and max error
 //! (8-bit levels) are against `--reference` on every STRIDE-th face.

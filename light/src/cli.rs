@@ -34,9 +34,10 @@ pub struct Args {
     /// The slow exact answer: 16x16 samples per luxel and no light culling.
     #[arg(long)]
     pub reference: bool,
-    /// The map-wide settings (each wins over its worldspawn key).
+    /// The map-wide settings (each wins over its worldspawn key); boxed, being most of the
+    /// arguments' size.
     #[command(flatten)]
-    pub overrides: Overrides,
+    pub overrides: Box<Overrides>,
     /// Palette for texture colours (`--bouncecolorscale`); default: `gfx/palette.lmp` in the
     /// BSP's folder or up to three above it, else Slipgate's own palette.
     #[arg(long, value_name = "FILE.lmp")]
@@ -189,7 +190,7 @@ impl Args {
     pub fn lighting_options(&self) -> anyhow::Result<Options> {
         Ok(Options {
             quality: self.quality(),
-            overrides: self.overrides.clone(),
+            overrides: Overrides::clone(&self.overrides),
             no_cull: self.no_cull,
             palette: find_palette(self)?,
             ..Options::default()
