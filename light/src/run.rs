@@ -150,13 +150,15 @@ impl<'a> Plan<'a> {
         let reference = self.reference();
         let cull = !self.options.no_cull && !reference;
         let gate = self.prep.lights.settings.gate;
-        (self.prep).trace_setup(self.bsp, &self.reaches, gate, cull, !reference)
+        self.prep
+            .trace_setup(self.bsp, &self.reaches, gate, cull, !reference)
     }
 
     /// What tracing the reference's bounce emitters reads: culled and adaptive, as `--extra4`.
     fn emitter_setup(&self) -> TraceSetup<'_> {
         let gate = self.prep.lights.settings.gate;
-        (self.prep).trace_setup(self.bsp, &self.reaches, gate, true, true)
+        self.prep
+            .trace_setup(self.bsp, &self.reaches, gate, true, true)
     }
 
     /// Each traced face's direct light. The reference's bounce gathers at the samples of the

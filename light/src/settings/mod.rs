@@ -18,7 +18,7 @@ mod value;
 
 use glam::DVec3;
 
-use crate::dirt::DirtMode;
+pub use crate::dirt::DirtMode;
 pub use declare::Setting;
 use declare::settings;
 use resolve::{Declared, given, resolve};
