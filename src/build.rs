@@ -349,7 +349,7 @@ mod tests {
         })
         .expect("light options parse");
         assert_eq!(
-            (light.bounce, light.lit, light.threads),
+            (light.overrides.bounce, light.lit, light.threads),
             (Some(2), true, Some(1))
         );
     }

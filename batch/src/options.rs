@@ -39,7 +39,7 @@ mod tests {
         words.extend(stage_words("-bounce 2 -lit -threads 1"));
         let light: light::cli::Args = parse_stage("light", &words).expect("light options parse");
         assert_eq!(
-            (light.bounce, light.lit, light.threads),
+            (light.overrides.bounce, light.lit, light.threads),
             (Some(2), true, Some(1))
         );
     }

@@ -452,10 +452,9 @@ fn light_stage(
 ) -> StageResult<StageRecord> {
     let words = stage_words(&job.options.light);
     let args: light::cli::Args = stage_args("light", &job.output(ctx.output_dir, "bsp"), &words)?;
-    let mut options = args
+    let options = args
         .lighting_options()
         .map_err(|e| fail("light")(format!("{e:#}")))?;
-    options.progress = false;
     let mut key = key_with_options(ctx, "light", &words);
     key.field("bsp", output_hash(with_entities, "bsp").as_bytes());
     if let Some(palette) = &options.palette {

@@ -6,8 +6,9 @@
 //! receivers every GRID luxels casting STRATA² rays each; a trailing `s` (`2x6s`) smooths the
 //! receivers as the default mode does.
 
-use light::bounce::Density;
-use light::{Lighting, Options, Quality, compare, compute_lighting, lightmaps_in};
+use light::{
+    BounceDensity as Density, Lighting, Options, Quality, compare, compute_lighting, lightmaps_in,
+};
 use quake_formats::Bsp;
 
 /// RMSE, max and share of luxels more than 2 levels off.

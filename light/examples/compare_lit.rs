@@ -5,8 +5,7 @@
 //! DIRECT.bsp (the reference without bounce), it also lists the faces lit only by bounce (no
 //! direct light anywhere on them) that have luxels black where the reference is lit.
 
-use light::output::FaceLightmap;
-use light::{compare, lightmaps_in};
+use light::{FaceLightmap, compare, lightmaps_in};
 use quake_formats::Bsp;
 use std::collections::HashMap;
 

@@ -1,4 +1,4 @@
-//! The rows of README's speed-against-error table for one map:
+//! The rows of `bench/results/light-speed-error.md` for one map:
 //! `cargo run --release -p slipgate-light --example speed_error -- MAP.bsp STRIDE`.
 //! Time (best of 3) and rays are for the whole map; RMSE and max error
 //! (8-bit levels) are against `--reference` on every STRIDE-th face.
@@ -36,11 +36,11 @@ fn main() -> anyhow::Result<()> {
     println!("| mode | trace time | rays | RMSE | max | RMSE / max vs filtered reference |");
     println!("|---|---|---|---|---|---|");
     for (name, quality, soft_radius) in modes {
-        let options = Options {
+        let mut options = Options {
             quality,
-            soft_radius,
             ..Options::default()
         };
+        options.overrides.soft = Some(soft_radius);
         let mut best = f64::INFINITY;
         let mut rays = 0;
         for _ in 0..3 {

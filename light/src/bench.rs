@@ -8,9 +8,11 @@ use std::time::Instant;
 use quake_formats::Bsp;
 use rayon::prelude::*;
 
-use crate::Prepared;
 use crate::embree::RayPacket16;
+use crate::error::LightError;
 use crate::faces::FaceKind;
+use crate::options::Options;
+use crate::prepare::prepare;
 use crate::samples::face_samples;
 
 /// One shadow ray: origin, unit direction, length.
@@ -19,14 +21,26 @@ type Ray = ([f32; 3], [f32; 3], f32);
 /// Result of [`bare_occlusion`].
 #[derive(Debug, Clone, Copy, serde::Serialize)]
 pub struct BareOcclusion {
+    /// Rays traced.
     pub rays: u64,
+    /// Time tracing them.
     pub seconds: f64,
+    /// Their rate.
     pub rays_per_second: f64,
 }
 
-/// Collects up to `max_rays` shadow rays (default sampling, plane-side and
-/// range culling) and times tracing them in 16-ray packets on all threads.
-pub fn bare_occlusion(bsp: &Bsp, prep: &Prepared, gate: f64, max_rays: usize) -> BareOcclusion {
+/// Collects up to `max_rays` shadow rays of `bsp` lit with `options` (default sampling,
+/// plane-side and range culling) and times tracing them in 16-ray packets on all threads.
+///
+/// # Errors
+/// As [`crate::trace_lighting`].
+pub fn bare_occlusion(
+    bsp: &Bsp,
+    options: &Options,
+    max_rays: usize,
+) -> Result<BareOcclusion, LightError> {
+    let prep = prepare(bsp, options)?;
+    let gate = prep.lights.settings.gate;
     let mut rays: Vec<Ray> = Vec::new();
     'faces: for face in prep.faces.iter().filter(|f| f.kind == FaceKind::Lit) {
         let (samples, _) = face_samples(face, 1, &prep.scene, bsp);
@@ -61,9 +75,9 @@ pub fn bare_occlusion(bsp: &Bsp, prep: &Prepared, gate: f64, max_rays: usize) ->
         .sum();
     let seconds = start.elapsed().as_secs_f64();
     debug_assert!(blocked <= rays.len() as u64);
-    BareOcclusion {
+    Ok(BareOcclusion {
         rays: rays.len() as u64,
         seconds,
         rays_per_second: rays.len() as f64 / seconds.max(1e-9),
-    }
+    })
 }

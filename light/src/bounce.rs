@@ -23,61 +23,23 @@ use quake_formats::bsp::limits::LIGHTMAP_SCALE;
 
 use quake_formats::palette::Palette;
 
-use crate::Quality;
+use crate::directions::tangent_basis;
 use crate::embree::RayPacket16;
 use crate::faces::{FaceGeom, FaceKind};
-use crate::lights::{DirtResponse, MapLights, tangent_basis};
+use crate::grid::{cell_of, grid, receiver_grid};
+use crate::lights::{BounceSettings, MapLights};
+use crate::quality::Quality;
 use crate::samples::FaceSamples;
 use crate::scene::TraceScene;
 
 pub mod reference;
 
-/// Passes beyond this bring nothing a lightmap byte can show.
-pub const MAX_BOUNCE_PASSES: usize = 16;
 /// Reflectance of a texture with `_bouncecolorscale 0` (and of a texture without pixels).
 pub const GREY_REFLECTANCE: f32 = 127.0 / 255.0;
 /// ericw-tools' factor on `_bouncescale` for bounced light.
 pub const KERNEL_SCALE: f64 = 0.5;
 /// Distances below this count as this (ericw-tools' bounce hotspot clamp).
 pub const HOTSPOT_CLAMP: f64 = 128.0;
-
-/// Worldspawn `_bounce` and its keys (and their command-line overrides).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BounceSettings {
-    /// Passes (0 = off).
-    pub passes: usize,
-    /// `_bouncescale`.
-    pub scale: f64,
-    /// `_bouncecolorscale`: 0 = grey reflectance, 1 = the texture's mean colour.
-    pub color_scale: f64,
-    /// `_bouncestyled`: styled (switchable, animated) light bounces too, in its own style.
-    pub styled: bool,
-    /// How dirt darkens bounced light (worldspawn's dirt, when it is on).
-    pub dirt: Option<DirtResponse>,
-}
-
-impl Default for BounceSettings {
-    fn default() -> Self {
-        BounceSettings {
-            passes: 0,
-            scale: 1.0,
-            color_scale: 0.0,
-            styled: false,
-            dirt: None,
-        }
-    }
-}
-
-impl BounceSettings {
-    pub fn is_on(&self) -> bool {
-        self.passes > 0 && self.scale > 0.0
-    }
-
-    /// The kernel's constant factor.
-    pub fn kernel(&self) -> f64 {
-        KERNEL_SCALE * self.scale
-    }
-}
 
 /// Light per style and luxel (row-major) of one face.
 pub type StyleLuxels = Vec<(u8, Vec<[f32; 3]>)>;
@@ -133,12 +95,14 @@ pub fn face_reflectance(
 /// at the last row and column), each casting `strata²` rays.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Density {
+    /// Luxels between receivers along each axis.
     pub stride: usize,
+    /// Rays per receiver along each axis of the stratified grid.
     pub strata: usize,
     /// A last step of at most half a stride widens the cell before it instead of adding a
-    /// row or column of receivers ([`receiver_grid`]): the default mode's trade.
+    /// row or column of receivers: the default mode's trade.
     pub widen_last: bool,
-    /// Receivers' values are smoothed by their neighbours ([`smooth_receivers`]) before they
+    /// Receivers' values are smoothed by their neighbours before they
     /// are spread onto the luxels: few rays per receiver, noise averaged over several.
     pub smooth: bool,
 }
@@ -147,10 +111,9 @@ impl Density {
     /// The density of each quality mode; the reference's later passes gather at every luxel.
     pub fn for_quality(quality: Quality) -> Density {
         match quality {
-            // Measured against the written references (light/README.md, "Bounce: measurements"):
-            // 6x6 rays smoothed give the RMSE of 8x8 unsmoothed (e1m1 4.67 / 4.58, e3m4 2.65 /
-            // 2.68, retrojam1 3.66 / 3.69) with 44 % fewer rays. Where noise is already low
-            // (16x16) smoothing only adds its bias at corners (e1m1 release 0.90 -> 1.31).
+            // Few rays, smoothed over neighbouring receivers, have the error of more rays
+            // unsmoothed (bench/results/light-bounce.md). Where noise is already low,
+            // smoothing only adds its bias at corners, so the supersampled modes do not.
             Quality::Default => Density {
                 stride: 2,
                 strata: 6,
@@ -163,8 +126,6 @@ impl Density {
                 widen_last: false,
                 smooth: false,
             },
-            // 12x12 instead of 16x16: 44 % fewer rays for RMSE e1m1 0.90 -> 0.96, e3m4 0.49 ->
-            // 0.54, retrojam1 0.73 -> 0.82 at the release settings.
             Quality::Extra4 => Density {
                 stride: 2,
                 strata: 12,
@@ -197,7 +158,7 @@ fn jitter(key: u64) -> (f64, f64) {
 
 /// Sine and cosine of `turns` of a full turn (0 ≤ `turns` < 1), within 1e-10 of `sin_cos`:
 /// the nearest quarter turn is exact, and what is left (at most π/4) takes a short series.
-/// libm's `sincos` was a tenth of the instructions gathering spent outside Embree.
+/// libm's `sincos` is a large share of what gathering spends outside Embree.
 fn sin_cos_turns(turns: f64) -> (f64, f64) {
     debug_assert!((0.0..1.0).contains(&turns), "{turns}");
     let quarter = (turns * 4.0 + 0.5) as u32;
@@ -244,8 +205,25 @@ pub struct Field<'a> {
     pub reflectance: &'a [Option<[f32; 3]>],
     /// Per face (by index): its light per style and luxel, when it has any.
     pub light: &'a [Option<StyleLuxels>],
-    /// [`BounceSettings::kernel`].
+    /// The kernel's constant factor: [`KERNEL_SCALE`] × `_bouncescale`.
     pub kernel: f64,
+}
+
+impl<'a> Field<'a> {
+    /// What `faces` give off with `light`, reflecting as `reflectance` says, at `settings`' scale.
+    pub fn new(
+        faces: &'a [FaceGeom],
+        reflectance: &'a [Option<[f32; 3]>],
+        light: &'a [Option<StyleLuxels>],
+        settings: &BounceSettings,
+    ) -> Field<'a> {
+        Field {
+            faces,
+            reflectance,
+            light,
+            kernel: KERNEL_SCALE * settings.scale,
+        }
+    }
 }
 
 /// The light of `face` at world point `q`, bilinear between luxel centres.
@@ -460,46 +438,6 @@ fn smooth_receivers(grid: &mut StyleLuxels, w: usize, h: usize) {
     }
 }
 
-/// Every `stride`th index below `size`, and the last.
-pub(crate) fn grid(size: usize, stride: usize) -> Vec<usize> {
-    let mut at: Vec<usize> = (0..size).step_by(stride.max(1)).collect();
-    if size > 0 && at.last() != Some(&(size - 1)) {
-        at.push(size - 1);
-    }
-    at
-}
-
-/// Where receivers go along an axis of `size` luxels: every `stride`th index and the last, but a
-/// step to the last of at most half a stride widens the cell before it instead (a cell of at
-/// most `stride + stride / 2`). The extra row and column of [`grid`] were a third of the
-/// receivers on maps of small faces (two of every five luxels of e3m4 gathered at stride 2).
-/// It costs accuracy at face edges, where bounce changes fastest: used in the default mode
-/// only (e1m1 `--bounce` RMSE 4.49 -> 4.58 for 13 % fewer rays; at `--extra4` 1.70 -> 1.92).
-pub(crate) fn receiver_grid(size: usize, stride: usize) -> Vec<usize> {
-    let mut at = grid(size, stride);
-    let n = at.len();
-    if n >= 3 && at[n - 1] - at[n - 2] <= stride / 2 {
-        at.remove(n - 2);
-    }
-    at
-}
-
-/// For each index below the grid's last: the grid cell it lies in and how far across.
-pub(crate) fn cell_of(at: &[usize]) -> Vec<(usize, usize, f32)> {
-    let Some(&last) = at.last() else {
-        return Vec::new();
-    };
-    let mut out = Vec::with_capacity(last + 1);
-    for (j, pair) in at.windows(2).enumerate() {
-        for x in pair[0]..pair[1] {
-            out.push((j, j + 1, (x - pair[0]) as f32 / (pair[1] - pair[0]) as f32));
-        }
-    }
-    let j = at.len() - 1;
-    out.push((j, j, 0.0));
-    out
-}
-
 /// `at_grid` (per style, `xs.len() × ys.len()` values) spread bilinearly onto `w × h` luxels.
 fn interpolate(
     at_grid: &StyleLuxels,
@@ -641,19 +579,6 @@ mod tests {
                 "{t}: {s} {c}"
             );
         }
-    }
-
-    #[test]
-    fn receivers_widen_the_last_cell_rather_than_add_a_row() {
-        assert_eq!(receiver_grid(2, 2), vec![0, 1]);
-        assert_eq!(receiver_grid(3, 2), vec![0, 2]);
-        assert_eq!(receiver_grid(4, 2), vec![0, 3]);
-        assert_eq!(receiver_grid(6, 2), vec![0, 2, 5]);
-        assert_eq!(receiver_grid(7, 2), vec![0, 2, 4, 6]);
-        assert_eq!(receiver_grid(10, 4), vec![0, 4, 9]);
-        assert_eq!(receiver_grid(11, 4), vec![0, 4, 10]);
-        assert_eq!(receiver_grid(12, 4), vec![0, 4, 8, 11]);
-        assert_eq!(receiver_grid(5, 1), vec![0, 1, 2, 3, 4]);
     }
 
     #[test]

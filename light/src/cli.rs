@@ -1,17 +1,21 @@
-//! Command line of `slipgate-light` (mounted by the lead as `slipgate light`).
+//! The command line of `slipgate light` and `slipgate-light`: arguments (the settings' flags
+//! built from [`crate::settings::TABLE`]), the progress bar, what is printed, and the files
+//! written (the BSP and its `.lit` as a pair, `--stats`).
 
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 use anyhow::Context;
+use clap::{Arg, ArgAction, ArgMatches, Command, FromArgMatches};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use quake_formats::Bsp;
 use quake_formats::fsutil::{Staged, read_file, write_atomic};
-
 use quake_formats::palette::Palette;
+use quake_formats::progress::{Progress, ProgressEvent};
 
-use crate::lights::GlobalOverrides;
-use crate::{
-    ErrorStats, Options, Quality, compare, compute_lighting, finish_lighting, trace_lighting,
-};
+use crate::settings::{Overrides, Setting, TABLE};
+use crate::{Lighting, Options, Quality, compare_with_reference, compute_lighting};
 
 /// Light a BSP: compute lightmaps from its light entities.
 #[derive(clap::Args, Debug, Clone)]
@@ -30,68 +34,10 @@ pub struct Args {
     /// The slow exact answer: 16x16 samples per luxel and no light culling.
     #[arg(long)]
     pub reference: bool,
-    /// Average each luxel with its neighbours within N luxels (`--soft` = 1, `--soft=N`).
-    #[arg(
-        long,
-        value_name = "N",
-        num_args = 0..=1,
-        require_equals = true,
-        default_missing_value = "1"
-    )]
-    pub soft: Option<usize>,
-    /// Light contributions below this (in light units) count as zero.
-    #[arg(long, default_value_t = 0.001)]
-    pub gate: f64,
-    /// Scale every light's fade distance (overrides worldspawn `_dist`).
-    #[arg(long)]
-    pub dist: Option<f64>,
-    /// Scale brightness to bytes (overrides worldspawn `_range`, default 0.5).
-    #[arg(long)]
-    pub range: Option<f64>,
-    /// Directions per sun penumbra and per sky dome.
-    #[arg(long, default_value_t = 100)]
-    pub sunsamples: usize,
-    /// Dirt (ambient occlusion) on every light, whatever worldspawn `_dirt` says
-    /// (lights with `_dirt -1` still opt out).
-    #[arg(long)]
-    pub dirt: bool,
-    /// Dirt ray pattern: 0 ordered, 1 random (overrides worldspawn `_dirtmode`).
-    #[arg(long, value_name = "N")]
-    pub dirtmode: Option<f64>,
-    /// Dirt ray length (overrides worldspawn `_dirtdepth`, default 128).
-    #[arg(long, value_name = "UNITS")]
-    pub dirtdepth: Option<f64>,
-    /// Dirt strength (overrides worldspawn `_dirtscale`, default 1).
-    #[arg(long, value_name = "N")]
-    pub dirtscale: Option<f64>,
-    /// Dirt exponent (overrides worldspawn `_dirtgain`, default 1).
-    #[arg(long, value_name = "N")]
-    pub dirtgain: Option<f64>,
-    /// Dirt cone angle from the normal in degrees, 1-90 (overrides `_dirtangle`, default 88).
-    #[arg(long, value_name = "DEGREES")]
-    pub dirtangle: Option<f64>,
-    /// Add minlight to every luxel's light instead of raising dark luxels to it.
-    #[arg(long)]
-    pub addmin: bool,
-    /// Diffuse interreflection, N passes (`--bounce` = 1; overrides worldspawn `_bounce`).
-    #[arg(
-        long,
-        value_name = "N",
-        num_args = 0..=1,
-        require_equals = true,
-        default_missing_value = "1"
-    )]
-    pub bounce: Option<usize>,
-    /// Brightness of bounced light (overrides worldspawn `_bouncescale`, default 1).
-    #[arg(long, value_name = "S")]
-    pub bouncescale: Option<f64>,
-    /// 0 = surfaces reflect grey, 1 = their texture's mean colour (overrides
-    /// `_bouncecolorscale`, default 0).
-    #[arg(long, value_name = "W")]
-    pub bouncecolorscale: Option<f64>,
-    /// Styled (switchable, animated) light bounces too (as worldspawn `_bouncestyled 1`).
-    #[arg(long)]
-    pub bouncestyled: bool,
+    /// The map-wide settings (each wins over its worldspawn key); boxed, being most of the
+    /// arguments' size.
+    #[command(flatten)]
+    pub overrides: Box<Overrides>,
     /// Palette for texture colours (`--bouncecolorscale`); default: `gfx/palette.lmp` in the
     /// BSP's folder or up to three above it, else Slipgate's own palette.
     #[arg(long, value_name = "FILE.lmp")]
@@ -127,36 +73,106 @@ pub struct Args {
     pub bench_occlusion: Option<usize>,
 }
 
-impl Args {
-    fn options(&self, quality: Quality) -> Options {
-        Options {
-            quality,
-            soft_radius: self.soft.unwrap_or(0),
-            gate: self.gate,
-            overrides: GlobalOverrides {
-                dist: self.dist,
-                range: self.range,
-                sunsamples: self.sunsamples,
-                dirt: self.dirt,
-                dirt_mode: self.dirtmode,
-                dirt_depth: self.dirtdepth,
-                dirt_scale: self.dirtscale,
-                dirt_gain: self.dirtgain,
-                dirt_angle: self.dirtangle,
-                addmin: self.addmin,
-                bounce: self.bounce,
-                bounce_scale: self.bouncescale,
-                bounce_color_scale: self.bouncecolorscale,
-                bounce_styled: self.bouncestyled,
-            },
-            only_faces: None,
-            no_cull: self.no_cull,
-            progress: true,
-            palette: None,
-            bounce_density: None,
-        }
+/// The settings' flags, one per setting of [`TABLE`] that has one.
+impl clap::Args for Overrides {
+    fn augment_args(command: Command) -> Command {
+        command.args(TABLE.iter().filter_map(setting_arg))
     }
 
+    fn augment_args_for_update(command: Command) -> Command {
+        Overrides::augment_args(command)
+    }
+}
+
+impl FromArgMatches for Overrides {
+    fn from_arg_matches(matches: &ArgMatches) -> Result<Overrides, clap::Error> {
+        let mut overrides = Overrides::default();
+        overrides.update_from_arg_matches(matches)?;
+        Ok(overrides)
+    }
+
+    fn update_from_arg_matches(&mut self, matches: &ArgMatches) -> Result<(), clap::Error> {
+        for s in TABLE.iter().filter(|s| s.flag.is_some()) {
+            let given = if s.switch {
+                matches.get_flag(s.field).then_some("1")
+            } else {
+                matches.get_one::<String>(s.field).map(String::as_str)
+            };
+            if let Some(text) = given {
+                self.set(s.field, text)
+                    .map_err(|e| clap::Error::raw(clap::error::ErrorKind::ValueValidation, e))?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The flag of setting `s`, if it has one: a switch, a value, or a value that may be left out
+/// (`--bounce`), with the setting's help and worldspawn keys.
+fn setting_arg(s: &'static Setting) -> Option<Arg> {
+    let flag = s.flag?;
+    let help = s.help.split_whitespace().collect::<Vec<_>>().join(" ");
+    let help = help.trim_end_matches('.').to_string();
+    let help = match s.keys {
+        [] => help,
+        keys => format!("{help} [worldspawn {}]", keys.join(", ")),
+    };
+    let mut arg = Arg::new(s.field).long(flag).help(help);
+    if let Some(alias) = s.alias {
+        arg = arg.alias(alias);
+    }
+    if s.switch {
+        return Some(arg.action(ArgAction::SetTrue));
+    }
+    arg = arg.value_name("N").value_parser(move |text: &str| {
+        (s.check)(text)
+            .map(|()| text.to_string())
+            .map_err(|expected| format!("expected {expected}"))
+    });
+    if let Some(missing) = s.missing {
+        arg = arg
+            .num_args(0..=1)
+            .require_equals(true)
+            .default_missing_value(missing);
+    }
+    Some(arg)
+}
+
+/// Options whose value may be left out (`--bounce [N]`, `--soft [N]`, ericw-tools' spelling)
+/// take a following number as their value: `--bounce 2` becomes `--bounce=2`, while `--bounce
+/// map.bsp` leaves the BSP as the positional argument.
+pub fn join_optional_values(args: impl IntoIterator<Item = String>) -> Vec<String> {
+    let optional: Vec<String> = TABLE
+        .iter()
+        .filter(|s| s.missing.is_some())
+        .filter_map(|s| Some(format!("--{}", s.flag?)))
+        .collect();
+    let mut out: Vec<String> = Vec::new();
+    for a in args {
+        let joins = out.last().is_some_and(|prev| optional.contains(prev))
+            && !a.is_empty()
+            && a.chars().all(|c| c.is_ascii_digit());
+        match out.last_mut() {
+            Some(prev) if joins => {
+                prev.push('=');
+                prev.push_str(&a);
+            }
+            _ => out.push(a),
+        }
+    }
+    out
+}
+
+/// Whether to write a `.lit` file beside the lit BSP.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum LitFile {
+    /// Only when some light is coloured.
+    WhenColoured,
+    Always,
+    Never,
+}
+
+impl Args {
     fn quality(&self) -> Quality {
         if self.reference {
             Quality::Reference
@@ -166,6 +182,38 @@ impl Args {
             Quality::Extra
         } else {
             Quality::Default
+        }
+    }
+
+    /// The library options these arguments ask for, with the palette `run` would find (and no
+    /// progress reported).
+    pub fn lighting_options(&self) -> anyhow::Result<Options> {
+        Ok(Options {
+            quality: self.quality(),
+            overrides: Overrides::clone(&self.overrides),
+            no_cull: self.no_cull,
+            palette: find_palette(self)?,
+            ..Options::default()
+        })
+    }
+
+    /// The `.lit` to write beside `bsp`, which [`crate::apply_lighting`] just lit and which
+    /// returned `coloured` (`--lit` and `--nolit` decide; `None`: no `.lit`).
+    pub fn lit_to_write(&self, bsp: &Bsp, coloured: Option<Vec<u8>>) -> Option<Vec<u8>> {
+        match self.lit_file() {
+            LitFile::WhenColoured => coloured,
+            LitFile::Always => coloured.or_else(|| Some(crate::grey_lit(&bsp.lighting))),
+            LitFile::Never => None,
+        }
+    }
+
+    fn lit_file(&self) -> LitFile {
+        if self.nolit {
+            LitFile::Never
+        } else if self.lit {
+            LitFile::Always
+        } else {
+            LitFile::WhenColoured
         }
     }
 }
@@ -190,70 +238,35 @@ fn find_palette(args: &Args) -> anyhow::Result<Option<Palette>> {
         .transpose()
 }
 
-/// Options whose value is optional (`--bounce [N]`, `--soft [N]`, ericw-tools' spelling) take a
-/// following number as their value: `--bounce 2` becomes `--bounce=2`, while `--bounce
-/// map.bsp` leaves the BSP as the positional argument.
-pub fn join_optional_values(args: impl IntoIterator<Item = String>) -> Vec<String> {
-    let mut out: Vec<String> = Vec::new();
-    for a in args {
-        let joins = out
-            .last()
-            .is_some_and(|prev| prev == "--bounce" || prev == "--soft")
-            && !a.is_empty()
-            && a.chars().all(|c| c.is_ascii_digit());
-        match out.last_mut() {
-            Some(prev) if joins => {
-                prev.push('=');
-                prev.push_str(&a);
+/// A bar on stderr for the faces being lit, when stderr is a terminal.
+fn progress_bar() -> Progress {
+    if !std::io::stderr().is_terminal() {
+        return Progress::default();
+    }
+    let bar: Mutex<Option<ProgressBar>> = Mutex::new(None);
+    Progress::new(move |event| {
+        let Ok(mut bar) = bar.lock() else {
+            return;
+        };
+        match event {
+            ProgressEvent::Start { phase, total } => {
+                let b = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
+                let template = format!("{phase} {{bar:40}} {{pos}}/{{len}} faces {{elapsed}}");
+                if let Ok(style) = ProgressStyle::with_template(&template) {
+                    b.set_style(style);
+                }
+                *bar = Some(b);
             }
-            _ => out.push(a),
+            ProgressEvent::Advance(n) => bar.iter().for_each(|b| b.inc(n)),
+            ProgressEvent::Finish => bar.take().iter().for_each(ProgressBar::finish_and_clear),
         }
-    }
-    out
+    })
 }
 
-/// Whether to write a `.lit` file beside the lit BSP.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum LitFile {
-    /// Only when some light is coloured.
-    WhenColoured,
-    Always,
-    Never,
-}
-
-impl Args {
-    /// The library options these arguments ask for, with the palette `run` would find.
-    pub fn lighting_options(&self) -> anyhow::Result<Options> {
-        let mut options = self.options(self.quality());
-        options.palette = find_palette(self)?;
-        Ok(options)
-    }
-
-    /// The `.lit` to write beside `bsp`, which [`crate::apply_lighting`] just lit and which
-    /// returned `coloured` (`--lit` and `--nolit` decide; `None`: no `.lit`).
-    pub fn lit_to_write(&self, bsp: &Bsp, coloured: Option<Vec<u8>>) -> Option<Vec<u8>> {
-        match self.lit_file() {
-            LitFile::WhenColoured => coloured,
-            // White light: each luxel's grey level in all three channels.
-            LitFile::Always => coloured.or_else(|| {
-                let rgb: Vec<u8> = bsp.lighting.iter().flat_map(|&g| [g, g, g]).collect();
-                Some(quake_formats::lit::write_lit(&rgb))
-            }),
-            LitFile::Never => None,
-        }
-    }
-
-    fn lit_file(&self) -> LitFile {
-        if self.nolit {
-            LitFile::Never
-        } else if self.lit {
-            LitFile::Always
-        } else {
-            LitFile::WhenColoured
-        }
-    }
-}
-
+/// Runs `slipgate light` with `args`.
+///
+/// # Errors
+/// Files that do not read or write, a BSP light refuses, or what [`compute_lighting`] reports.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     match args.threads {
         Some(n) => rayon::ThreadPoolBuilder::new()
@@ -273,12 +286,86 @@ fn run_with_current_threads(args: &Args) -> anyhow::Result<()> {
         return update_entities_only(args, bsp);
     }
     let mut options = args.lighting_options()?;
+    options.progress = progress_bar();
     if let Some(stride) = args.face_stride {
         anyhow::ensure!(stride > 0, "--face-stride must be at least 1");
         options.only_faces = Some((0..bsp.faces.len()).step_by(stride).collect());
     }
     let lighting =
         compute_lighting(&bsp, &options).with_context(|| format!("lighting {}", path.display()))?;
+    print_summary(&lighting);
+
+    let extra = measurements(args, &bsp, &options, &lighting)?;
+
+    let lit = crate::apply_lighting(&mut bsp, &lighting);
+    let lit = args.lit_to_write(&bsp, lit);
+    let out = args.output.as_ref().unwrap_or(path);
+    place_lit_pair(out, &bsp.write()?, lit)?;
+    if let Some(stats_path) = &args.stats {
+        let mut json = serde_json::to_value(&lighting.stats)?;
+        if let serde_json::Value::Object(map) = &mut json {
+            map.extend(extra);
+            map.insert("quality".into(), serde_json::to_value(options.quality)?);
+        }
+        write_atomic(stats_path, serde_json::to_string_pretty(&json)?.as_bytes())?;
+    }
+    Ok(())
+}
+
+/// The measurements `--compare-reference` and `--bench-occlusion` ask for, printed and as
+/// fields for `--stats`.
+fn measurements(
+    args: &Args,
+    bsp: &Bsp,
+    options: &Options,
+    lighting: &Lighting,
+) -> anyhow::Result<serde_json::Map<String, serde_json::Value>> {
+    let mut extra = serde_json::Map::new();
+    if args.compare_reference {
+        let c = compare_with_reference(bsp, options, lighting)?;
+        eprintln!(
+            "light: --reference took {:.2} s, {} rays",
+            c.reference_seconds, c.reference_rays
+        );
+        let report = |what: &str, e: &crate::ErrorStats| {
+            eprintln!(
+                "light: against {what}: RMSE {:.3}, max {} levels over {} luxels ({} differ by more than 8)",
+                e.rmse, e.max, e.luxels, e.over_8
+            );
+        };
+        report("--reference", &c.error);
+        extra.insert("error_vs_reference".into(), serde_json::to_value(c.error)?);
+        if let Some(e) = &c.error_filtered {
+            report("--reference with the same --soft filter", e);
+            extra.insert(
+                "error_vs_filtered_reference".into(),
+                serde_json::to_value(e)?,
+            );
+        }
+        extra.insert(
+            "reference_seconds".into(),
+            serde_json::to_value(c.reference_seconds)?,
+        );
+    }
+    if let Some(max_rays) = args.bench_occlusion {
+        let b = crate::bare_occlusion(bsp, options, max_rays)?;
+        eprintln!(
+            "light: bare occlusion loop: {} rays in {:.3} s: {:.2} Mrays/s",
+            b.rays,
+            b.seconds,
+            b.rays_per_second / 1e6
+        );
+        extra.insert("bare_occlusion".into(), serde_json::to_value(b)?);
+    }
+
+    Ok(extra)
+}
+
+/// What the run did, and its warnings, on stderr.
+fn print_summary(lighting: &Lighting) {
+    for w in &lighting.warnings {
+        eprintln!("light: warning: {w}");
+    }
     let s = &lighting.stats;
     let rays = s.shadow_rays + s.sun_rays + s.dirt_rays + s.placement_rays;
     eprintln!(
@@ -312,67 +399,6 @@ fn run_with_current_threads(args: &Args) -> anyhow::Result<()> {
             s.faces_with_dropped_styles
         );
     }
-
-    let mut extra = serde_json::Map::new();
-    if args.compare_reference {
-        let mut reference = options.clone();
-        reference.quality = Quality::Reference;
-        let raw = trace_lighting(&bsp, &reference)?;
-        let exact = finish_lighting(&raw, 0);
-        let report = |what: &str, e: &ErrorStats| {
-            eprintln!(
-                "light: against {what}: RMSE {:.3}, max {} levels over {} luxels ({} differ by more than 8)",
-                e.rmse, e.max, e.luxels, e.over_8
-            );
-        };
-        let r = &exact.stats;
-        eprintln!(
-            "light: --reference took {:.2} s, {} rays",
-            r.seconds_total,
-            r.shadow_rays + r.sun_rays + r.dirt_rays + r.placement_rays
-        );
-        let e: ErrorStats = compare(&lighting, &exact);
-        report("--reference", &e);
-        extra.insert("error_vs_reference".into(), serde_json::to_value(e)?);
-        if options.soft_radius > 0 {
-            // The filter blurs on purpose: also measure against the reference blurred the same way.
-            let e = compare(&lighting, &finish_lighting(&raw, options.soft_radius));
-            report("--reference with the same --soft filter", &e);
-            extra.insert(
-                "error_vs_filtered_reference".into(),
-                serde_json::to_value(e)?,
-            );
-        }
-        extra.insert(
-            "reference_seconds".into(),
-            serde_json::to_value(r.seconds_total)?,
-        );
-    }
-    if let Some(max_rays) = args.bench_occlusion {
-        let prep = crate::prepare(&bsp, &options)?;
-        let b = crate::bench::bare_occlusion(&bsp, &prep, options.gate, max_rays);
-        eprintln!(
-            "light: bare occlusion loop: {} rays in {:.3} s: {:.2} Mrays/s",
-            b.rays,
-            b.seconds,
-            b.rays_per_second / 1e6
-        );
-        extra.insert("bare_occlusion".into(), serde_json::to_value(b)?);
-    }
-
-    let lit = crate::apply_lighting(&mut bsp, &lighting);
-    let lit = args.lit_to_write(&bsp, lit);
-    let out = args.output.as_ref().unwrap_or(path);
-    place_lit_pair(out, &bsp.write()?, lit)?;
-    if let Some(stats_path) = &args.stats {
-        let mut json = serde_json::to_value(&lighting.stats)?;
-        if let serde_json::Value::Object(map) = &mut json {
-            map.extend(extra);
-            map.insert("quality".into(), serde_json::to_value(options.quality)?);
-        }
-        write_atomic(stats_path, serde_json::to_string_pretty(&json)?.as_bytes())?;
-    }
-    Ok(())
 }
 
 /// One step of putting a lit BSP and its `.lit` in place.

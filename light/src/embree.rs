@@ -342,7 +342,7 @@ unsafe extern "C" fn record_error(user_ptr: *mut c_void, _code: sys::RTCError, m
 }
 
 /// Environment variable whose value is appended to the config string of the
-/// devices [`Device::new`] creates: Embree 3 options such as `isa=avx2`,
+/// devices `Device::new` creates: Embree 3 options such as `isa=avx2`,
 /// `isa=sse4.2` (which vector kernels trace the rays) or `verbose=1`.
 pub const CONFIG_ENV: &str = "SLIPGATE_EMBREE_CONFIG";
 
@@ -498,12 +498,13 @@ impl SceneBuilder {
 
     /// Enables `RTC_SCENE_FLAG_ROBUST`: slower, but avoids rays leaking
     /// through shared edges (useful for light leaks at brush seams).
+    #[cfg(test)]
     pub fn set_robust(&mut self, robust: bool) {
         self.robust = robust;
     }
 
-    /// Adds a triangle mesh and returns the geometry id Embree reports in
-    /// [`Hit::geom_id`]. Ids are assigned sequentially from 0.
+    /// Adds a triangle mesh and returns the geometry id Embree reports for its hits. Ids are
+    /// assigned sequentially from 0.
     ///
     /// # Errors
     /// [`EmbreeError::InvalidInput`] for an out-of-range vertex index, or the
@@ -567,8 +568,8 @@ impl SceneBuilder {
         Ok(id)
     }
 
-    /// Builds the BVH (build quality MEDIUM: on e1m1 the HIGH build cost more
-    /// than its faster traversal saved; e3m4 traced as fast). The result is immutable.
+    /// Builds the BVH (build quality MEDIUM: the HIGH build costs more than its faster
+    /// traversal saves on Quake maps). The result is immutable.
     ///
     /// # Errors
     /// Returns the Embree error if the build fails (e.g. out of memory).
@@ -641,7 +642,9 @@ unsafe impl Send for Scene {}
 // SAFETY: as above.
 unsafe impl Sync for Scene {}
 
-/// Closest-hit result of [`Scene::intersect`].
+/// Closest-hit result of [`Scene::intersect`] (the single-ray queries are the tests' oracle
+/// for the packets).
+#[cfg(test)]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Hit {
     /// Ray parameter of the hit (distance if `dir` is unit length).
@@ -703,6 +706,7 @@ fn context(coherent: bool) -> sys::RTCIntersectContext {
 
 impl Scene {
     /// True if anything lies on the segment `org + t*dir`, `t` in `[tnear, tfar]`.
+    #[cfg(test)]
     #[must_use]
     pub fn occluded(&self, org: [f32; 3], dir: [f32; 3], tnear: f32, tfar: f32) -> bool {
         if !ray_ok(org, dir, tnear, tfar) {
@@ -718,6 +722,7 @@ impl Scene {
     }
 
     /// Closest hit on the segment, if any.
+    #[cfg(test)]
     #[must_use]
     pub fn intersect(&self, org: [f32; 3], dir: [f32; 3], tnear: f32, tfar: f32) -> Option<Hit> {
         if !ray_ok(org, dir, tnear, tfar) {
@@ -791,8 +796,8 @@ impl Scene {
         if packet.active_mask() == 0 {
             return ids;
         }
-        // The packet holds the hit records beside its rays, so Embree answers in place (copying
-        // the rays out and back was 2 % of e3m4's instructions, most of them dirt's).
+        // The packet holds the hit records beside its rays, so Embree answers in place instead
+        // of the rays being copied out and back for every dirt packet.
         let hit = &mut packet.rayhit.hit;
         hit.geomID = [sys::RTC_INVALID_GEOMETRY_ID; 16];
         hit.instID = [[sys::RTC_INVALID_GEOMETRY_ID; 16]; sys::RTC_MAX_INSTANCE_LEVEL_COUNT];

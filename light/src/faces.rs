@@ -8,7 +8,7 @@ use quake_formats::extents::LightmapExtents;
 use quake_formats::geom::Plane;
 use rayon::prelude::*;
 
-use crate::LightError;
+use crate::error::LightError;
 
 /// What a face is for lighting and shadowing.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -43,6 +43,7 @@ pub struct FaceGeom {
 
 impl FaceGeom {
     /// The mean of the vertices (inside the face: faces are convex).
+    #[cfg(test)]
     pub fn centroid(&self) -> DVec3 {
         let sum = self.points.iter().fold(DVec3::ZERO, |a, &p| a + p);
         sum / self.points.len().max(1) as f64

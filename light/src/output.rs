@@ -14,14 +14,17 @@ const NO_STYLE: u8 = 255;
 /// A face's final lightmaps: up to four styles, grey bytes and RGB bytes.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FaceLightmap {
+    /// The face's index.
     pub face: usize,
+    /// Luxels across (s).
     pub width: usize,
+    /// Luxels down (t).
     pub height: usize,
     /// Style of each lightmap, style 0 first.
     pub styles: Vec<u8>,
     /// One byte per luxel per style: the mean of the RGB channels.
     pub grey: Vec<Vec<u8>>,
-    /// The channels themselves, per style, when [`Finish::rgb`] asks for them (else empty).
+    /// The channels themselves, per style, when the light is coloured (else empty).
     pub rgb: Vec<Vec<[u8; 3]>>,
 }
 
@@ -181,6 +184,13 @@ pub fn write_lighting(bsp: &mut Bsp, maps: &[FaceLightmap], coloured: bool) -> O
     }
     bsp.lighting = grey;
     coloured.then_some(rgb)
+}
+
+/// The `.lit` of white light: each luxel's grey level of `lighting` (a lighting lump) in all
+/// three channels.
+pub fn grey_lit(lighting: &[u8]) -> Vec<u8> {
+    let rgb: Vec<u8> = lighting.iter().flat_map(|&g| [g, g, g]).collect();
+    quake_formats::lit::write_lit(&rgb)
 }
 
 #[cfg(test)]

@@ -6,8 +6,8 @@
 
 use std::collections::HashMap;
 
-use crate::LightError;
 use crate::embree::{Device, RayPacket16, Scene, SceneBuilder, sys};
+use crate::error::LightError;
 use crate::faces::{FaceGeom, FaceKind};
 
 /// Sun rays are tested for blockers up to this fraction of their distance to the sky.

@@ -9,8 +9,8 @@ use quake_formats::geom::DVec3Ext;
 
 use quake_formats::miptex::{MipTex, TextureLump};
 
+use crate::dirt::DirtMode;
 use crate::faces::{FaceKind, face_geometry};
-use crate::lights::DirtMode;
 use crate::samples::{FaceRegion, face_samples};
 use crate::scene::TraceScene;
 use crate::{
@@ -598,7 +598,7 @@ fn dirt_switches_per_light_and_from_the_command_line() {
     assert!(opted_out.iter().all(|&v| v == 100), "{opted_out:?}");
     // --dirt turns it on without any key in the map; a stronger scale darkens more.
     let mut forced = options(Quality::Default);
-    forced.overrides.dirt = true;
+    forced.overrides.dirt = Some(true);
     let on = floor_row(&corner_scene("", ""), &forced, 8);
     assert!(on[11] < 80, "{on:?}");
     forced.overrides.dirt_scale = Some(2.0);
@@ -673,8 +673,8 @@ fn column_scene(world_keys: &str) -> Bsp {
 /// shared edge at mid height (light units).
 fn edge_jumps(world_keys: &str) -> Vec<f64> {
     let bsp = column_scene(world_keys);
-    let prep = crate::prepare(&bsp, &Options::default()).expect("prepare");
-    let light_reaches = crate::trace::light_reaches(&prep.point_lights, 0.001);
+    let prep = crate::prepare::prepare(&bsp, &Options::default()).expect("prepare");
+    let light_reaches = crate::reach::light_reaches(&prep.point_lights, 0.001);
     let setup = crate::trace::TraceSetup {
         suns: &[],
         dirt: None,
@@ -696,8 +696,10 @@ fn edge_jumps(world_keys: &str) -> Vec<f64> {
                     })
                     .collect();
             }
-            let (light, _) =
-                crate::trace::light_face(&setup, &samples, &crate::trace::FaceRules::default());
+            let rules = crate::trace::FaceRules::default();
+            let mut scratch = crate::trace::TraceScratch::default();
+            let (light, _) = crate::trace::trace_face(&setup, &samples, &rules, &mut scratch);
+            let light = light.finish(&[]);
             samples
                 .points
                 .iter()
@@ -740,8 +742,8 @@ fn phong_smooths_a_column_without_facet_bands() {
 }
 
 /// Culling is exact: on a `_phong` column, the faces just past the light's terminator have the
-/// light behind their flat plane but in front of their smoothed corner normals, and they were
-/// culled by that plane (e3m4: 228 faces, up to 41 levels darker than without culling).
+/// light behind their flat plane but in front of their smoothed corner normals, so culling by
+/// that plane would darken them.
 #[test]
 fn culling_leaves_phong_faces_lit_from_behind_their_plane() {
     let bsp = column_scene("\"_phong\" \"1\"");
@@ -842,7 +844,7 @@ fn addmin_adds_minlight_instead_of_raising_to_it() {
     let floor = floor_row(&bsp, &options(Quality::Default), 8);
     assert!(floor.iter().all(|&v| v == 100), "floor: {floor:?}");
     let mut add = options(Quality::Default);
-    add.overrides.addmin = true;
+    add.overrides.addmin = Some(true);
     let added = floor_row(&bsp, &add, 8);
     assert!(added.iter().all(|&v| v == 120), "added: {added:?}");
     // Where no light reaches, both give the minlight itself.
@@ -858,9 +860,9 @@ fn addmin_adds_minlight_instead_of_raising_to_it() {
 fn dirt_cone_follows_the_phong_normal() {
     // The floor of the corner scene: the wall stands at x = 192.
     let bsp = corner_scene("", "");
-    let prep = crate::prepare(&bsp, &Options::default()).expect("prepare");
+    let prep = crate::prepare::prepare(&bsp, &Options::default()).expect("prepare");
     let (mut samples, _) = face_samples(&prep.faces[0], 1, &prep.scene, &bsp);
-    let sampling = crate::lights::DirtSampling::default();
+    let sampling = crate::lights::dirt_sampling(&crate::settings::Settings::default());
     let occlusion = |samples: &crate::samples::FaceSamples| {
         let all: Vec<usize> = (0..samples.points.len()).collect();
         crate::dirt::occlusion_at(
@@ -995,7 +997,7 @@ fn detail_column_bsp(detail_keys: &str) -> Bsp {
 #[test]
 fn phong_on_func_detail_reaches_light_through_the_bsp() {
     // The column's side faces: vertical, near the axis (the room's walls are 128 out).
-    let column_sides = |prep: &crate::Prepared| -> Vec<usize> {
+    let column_sides = |prep: &crate::prepare::Prepared| -> Vec<usize> {
         prep.faces
             .iter()
             .filter(|f| f.plane.normal.z.abs() < 0.1)
@@ -1006,7 +1008,7 @@ fn phong_on_func_detail_reaches_light_through_the_bsp() {
 
     let plain = detail_column_bsp("");
     assert_eq!(plain.phong_faces().expect("lump"), None);
-    let prep = crate::prepare(&plain, &Options::default()).expect("prepare");
+    let prep = crate::prepare::prepare(&plain, &Options::default()).expect("prepare");
     assert_eq!(column_sides(&prep).len(), 8);
     assert!(
         prep.phong.iter().all(Option::is_none),
@@ -1018,7 +1020,7 @@ fn phong_on_func_detail_reaches_light_through_the_bsp() {
         .phong_faces()
         .expect("lump")
         .expect("phong lump written");
-    let prep = crate::prepare(&smooth, &Options::default()).expect("prepare");
+    let prep = crate::prepare::prepare(&smooth, &Options::default()).expect("prepare");
     let sides = column_sides(&prep);
     assert_eq!(sides.len(), 8);
     let group = lump[sides[0]].group;
@@ -1072,8 +1074,8 @@ fn lit_faces(
     rules: &crate::trace::FaceRules,
     bounce: f32,
 ) -> (Vec<Vec<[f32; 3]>>, u64) {
-    let prep = crate::prepare(bsp, &Options::default()).expect("prepare");
-    let light_reaches = crate::trace::light_reaches(&prep.point_lights, 0.001);
+    let prep = crate::prepare::prepare(bsp, &Options::default()).expect("prepare");
+    let light_reaches = crate::reach::light_reaches(&prep.point_lights, 0.001);
     let setup = prep.trace_setup(bsp, &light_reaches, 0.001, true, adaptive);
     let mut rays = 0;
     let luxels = prep
@@ -1084,7 +1086,7 @@ fn lit_faces(
             let (samples, _) = face_samples(geom, per_axis, &prep.scene, bsp);
             let mut scratch = crate::trace::TraceScratch::default();
             let (raw, counts) = crate::trace::trace_face(&setup, &samples, rules, &mut scratch);
-            rays += counts.rays();
+            rays += counts.shadow_rays + counts.sun_rays + counts.dirt_rays;
             let bounced = [(0, vec![[bounce; 3]; samples.width * samples.height])];
             let light = raw.finish(if bounce > 0.0 { &bounced } else { &[] });
             light.styles[0].1.clone()
@@ -1136,19 +1138,16 @@ fn adaptive_dirt_stays_close_to_measuring_every_sample() {
 }
 
 /// Where only bounced light takes dirt (here the light has `_dirt -1`), a supersampled sample's
-/// occlusion is the bilinear mean of its luxel's corners, edges included: 24 % fewer dirt rays
-/// on e3m4's release settings, RMSE 0.486 -> 0.488 against the reference. Without
-/// supersampling a fine cell is two luxels wide, and the same rule was 12 % off at this wall's
-/// foot (2 % at 4x4), so there it keeps the usual rule. Samples measured for bounce alone cast
-/// half the dirt rays (`dirt::DirtRays::Half`): 6 % off at this wall's foot in both modes (the
-/// 8-azimuth pattern against 16), for 21 % fewer dirt rays on e3m4 `--bounce` (RMSE 2.696 ->
-/// 2.697) and 12 % on e3m4's and retrojam1's release settings (RMSE unchanged or lower).
+/// occlusion is the bilinear mean of its luxel's corners, edges included. Without
+/// supersampling a fine cell is two luxels wide, too coarse at this wall's foot, so there it
+/// keeps the usual rule. Samples measured for bounce alone cast half the dirt rays
+/// (`dirt::DirtRays::Half`: the 8-azimuth pattern against 16).
 #[test]
 fn dirt_that_only_bounce_takes_is_interpolated_and_stays_close() {
     let bsp = corner_scene("\"_dirt\" \"1\" \"_bounce\" \"1\"", "\"_dirt\" \"-1\"");
     let rules = crate::trace::FaceRules {
         dirt: true,
-        bounce_dirt: Some(crate::lights::DirtResponse {
+        bounce_dirt: Some(crate::dirt::DirtResponse {
             scale: 1.0,
             gain: 1.0,
         }),
@@ -1180,7 +1179,7 @@ fn dirt_occlusion_does_not_depend_on_the_rays_traced_beside_it() {
     // alone and among its neighbours differed.
     let bsp = corner_scene("\"_dirt\" \"1\"", "");
     for mode in [DirtMode::Ordered, DirtMode::Random] {
-        let mut prep = crate::prepare(&bsp, &Options::default()).expect("prepare");
+        let mut prep = crate::prepare::prepare(&bsp, &Options::default()).expect("prepare");
         prep.lights.dirt.mode = mode;
         for geom in prep.faces.iter().filter(|f| f.kind == FaceKind::Lit) {
             for per_axis in [1, 2] {
@@ -1231,9 +1230,8 @@ fn demo_bsp_with_sun() -> Bsp {
 }
 
 /// In the default mode the dome's directions (each carrying 1/100 of it) are probed every
-/// other luxel and filled in where a cell's probes agree (`VisibilityScratch::trace_probed`):
-/// on e3m4 40 % fewer sun rays, RMSE against the reference unchanged to three places. The
-/// single sun (one direction) is traced at every luxel as before.
+/// other luxel and filled in where a cell's probes agree (`VisibilityScratch::trace_probed`).
+/// The single sun (one direction) is traced at every luxel.
 #[test]
 fn probed_sky_dome_stays_close_to_tracing_every_luxel() {
     let bsp = demo_bsp_with_sun();
@@ -1264,20 +1262,22 @@ fn output_does_not_depend_on_the_thread_count() {
         let rgb = apply_lighting(&mut lit, &lighting);
         (lit.lighting, rgb)
     };
-    for (quality, dirt_mode, soft_radius) in [(Quality::Default, 0.0, 0), (Quality::Extra, 1.0, 1)]
-    {
+    for (quality, dirt_mode, soft_radius) in [
+        (Quality::Default, DirtMode::Ordered, 0),
+        (Quality::Extra, DirtMode::Random, 1),
+    ] {
         let mut options = options(quality);
-        options.soft_radius = soft_radius;
-        options.overrides.dirt = true;
+        options.overrides.soft = Some(soft_radius);
+        options.overrides.dirt = Some(true);
         options.overrides.dirt_mode = Some(dirt_mode);
-        options.overrides.sunsamples = 16;
+        options.overrides.sunsamples = Some(16);
         // Bounce gathers across faces: one pass, and two with supersampling.
         options.overrides.bounce = Some(if quality == Quality::Default { 1 } else { 2 });
         let one = lit_bytes(1, &options);
         assert!(one.0.iter().any(|&b| b > 0), "{quality:?}: lit");
         assert!(
             one == lit_bytes(2, &options),
-            "{quality:?}, dirt mode {dirt_mode}: 1 and 2 threads differ"
+            "{quality:?}, dirt mode {dirt_mode:?}: 1 and 2 threads differ"
         );
     }
 }

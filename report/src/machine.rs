@@ -57,7 +57,7 @@ fn embree_isa(slipgate: &Path, bsp: &Path, scratch: &Path) -> Option<String> {
         .arg("-o")
         .arg(scratch)
         .args(["--face-stride", "1000000000"])
-        .env(light::embree::CONFIG_ENV, "verbose=1")
+        .env(light::EMBREE_CONFIG_ENV, "verbose=1")
         .output()
         .ok()?;
     let _ = std::fs::remove_file(scratch);

@@ -1,12 +1,11 @@
-//! Dirt (ambient occlusion, after q3map2 and ericw-tools): how enclosed each
-//! sample point is, measured with rays in a cone around the face normal.
-//! Lights that take dirt are scaled by [`crate::lights::DirtResponse::factor`]
-//! of this occlusion.
+//! Dirt rays: the two patterns of directions over the cone, and the occlusion they measure at
+//! a face's samples, traced 16 to a packet.
 
 use glam::{DMat3, DVec3, Vec3};
 
+use super::{DirtMode, DirtSampling};
+use crate::directions::tangent_basis;
 use crate::embree::RayPacket16;
-use crate::lights::{DirtMode, DirtSampling, tangent_basis};
 use crate::samples::FaceSamples;
 use crate::scene::TraceScene;
 
@@ -29,7 +28,7 @@ pub type ConePattern = [[f64; 3]; RAYS_PER_SAMPLE];
 
 /// The ordered pattern in the face's own terms (see [`ordered_directions`]):
 /// the same for every sample and face, so the sines and cosines are taken
-/// once a run ([`crate::lights::DirtSampling::new`]).
+/// once a run ([`DirtSampling::new`]).
 pub fn ordered_components(cone: f64) -> ConePattern {
     let azimuth_step = std::f64::consts::TAU / AZIMUTH_STEPS as f64;
     let elevation_step = cone / ELEVATION_STEPS as f64;
@@ -54,12 +53,11 @@ fn ordered_directions(basis: DMat3, components: &[[f64; 3]]) -> Vec<[f32; 3]> {
 /// the axis planes and their diagonals, and from a sample on the luxel grid
 /// such a ray meets a grid-aligned edge exactly: a tie that Embree breaks one
 /// way or the other with the CPU's vector width and with the other rays in
-/// the packet (the corner scene's wall foot measured 0.185 or 0.247). Moved
-/// by these two unequal binary fractions (exact in f32), the ray passes such
-/// an edge by at least 1/64 · cos 45° = 0.011 units, over 20 f32 steps at
-/// coordinates up to 4096. (Turning the azimuths half a step instead avoids
-/// the ties too, but raised the default mode's error against `--reference`
-/// by 1–2 %.)
+/// the packet. Moved by these two unequal binary fractions (exact in f32), the
+/// ray passes such an edge by at least 1/64 · cos 45° = 0.011 units, over 20
+/// f32 steps at coordinates up to 4096. (Turning the azimuths half a step
+/// instead avoids the ties too, but moves the pattern away from the one the
+/// reference's error was measured with.)
 const RAY_START_SHIFT: [f64; 2] = [1.0 / 32.0, 1.0 / 64.0];
 
 /// A uniform value in [0, 1) from a 64-bit key (SplitMix64 finaliser):
@@ -132,89 +130,123 @@ pub fn occlusion_at(
     rays: DirtRays,
     scene: &TraceScene,
 ) -> (Vec<f32>, u64) {
-    let cone = sampling.cone_degrees().to_radians();
-    let basis_of = |n: DVec3| {
-        let [u, v] = tangent_basis(n);
-        DMat3::from_cols(u, v, n)
-    };
-    // Without per-sample normals every sample shares one ordered pattern.
-    let flat_basis = basis_of(samples.normal);
-    let ordered = sampling.ordered();
-    // Each pattern is turned in front of the face once, not per ray.
-    let in_front_all = |dirs: Vec<[f32; 3]>| -> Vec<[f32; 3]> {
-        dirs.into_iter()
-            .enumerate()
-            .filter(|&(k, _)| rays.casts(k))
-            .map(|(_, d)| in_front(d, samples.normal))
-            .collect()
-    };
-    let flat_ordered = in_front_all(ordered_directions(flat_basis, ordered));
-    let shift = flat_basis.x_axis * RAY_START_SHIFT[0] + flat_basis.y_axis * RAY_START_SHIFT[1];
-    let depth = sampling.depth as f32;
-    let mut packet = RayPacket16::new();
-    // Rays go in pattern order, each direction from every sample in turn, 16
-    // to a packet: a packet holds one direction from up to 16 neighbouring
-    // samples (rays that nearly coincide, which Embree traverses faster than
-    // 16 directions from one point), and no packet is left part empty while
-    // rays remain (a face's few samples fill packets with their next
-    // directions). Each sample sums its rays in pattern order.
-    let starts: Vec<[f32; 3]> = indices
-        .iter()
-        .map(|&i| {
-            (Vec3::from(samples.points[i]).as_dvec3() + shift)
-                .as_vec3()
-                .to_array()
-        })
-        .collect();
-    let own: Vec<Vec<[f32; 3]>> = indices
-        .iter()
-        .map(|&i| match sampling.mode {
-            DirtMode::Ordered if samples.normals.is_empty() => Vec::new(),
-            DirtMode::Ordered => {
-                in_front_all(ordered_directions(basis_of(samples.normal_at(i)), ordered))
-            }
-            DirtMode::Random => in_front_all(random_directions(
-                basis_of(samples.normal_at(i)),
-                cone,
-                samples.face,
-                i,
-            )),
-        })
-        .collect();
-    let dirs_of = |s: usize| {
-        if own[s].is_empty() {
-            &flat_ordered
-        } else {
-            &own[s]
-        }
-    };
-    let n = indices.len();
-    let per_sample = flat_ordered.len();
-    let total = n * per_sample;
-    let mut gathered = vec![0.0f32; n];
-    // Direction and sample of the next ray.
-    let (mut k, mut s) = (0, 0);
-    let mut lane_sample = [0usize; 16];
-    for first in (0..total).step_by(16) {
-        packet.clear();
-        let lanes = (total - first).min(16);
-        for (lane, sample) in lane_sample.iter_mut().enumerate().take(lanes) {
-            packet.set(lane, starts[s], dirs_of(s)[k], 0.0, depth);
-            *sample = s;
-            s += 1;
-            if s == n {
-                (k, s) = (k + 1, 0);
-            }
-        }
-        let hits = scene.opaque_hits16(&mut packet, model);
-        for (hit, &sample) in hits.iter().zip(&lane_sample).take(lanes) {
-            if let Some(t) = hit {
-                gathered[sample] += 1.0 - (t / depth).min(1.0);
-            }
+    let sample_rays = SampleRays::new(samples, indices, sampling, rays);
+    sample_rays.occlusion(scene, model, sampling.depth as f32)
+}
+
+/// Where the dirt rays of some samples start and which directions they take.
+struct SampleRays {
+    /// Per sample, where its rays start.
+    starts: Vec<[f32; 3]>,
+    /// The ordered pattern around the face's own normal, which every sample without
+    /// directions of its own shares.
+    flat: Vec<[f32; 3]>,
+    /// Per sample, its own directions (empty: `flat`).
+    own: Vec<Vec<[f32; 3]>>,
+}
+
+impl SampleRays {
+    /// The `rays` of the samples `indices` of `samples`, in their patterns turned in front of
+    /// the face.
+    fn new(
+        samples: &FaceSamples,
+        indices: &[usize],
+        sampling: &DirtSampling,
+        rays: DirtRays,
+    ) -> SampleRays {
+        let cone = sampling.cone_degrees().to_radians();
+        let basis_of = |n: DVec3| {
+            let [u, v] = tangent_basis(n);
+            DMat3::from_cols(u, v, n)
+        };
+        // Without per-sample normals every sample shares one ordered pattern.
+        let flat_basis = basis_of(samples.normal);
+        let ordered = sampling.ordered();
+        // Each pattern is turned in front of the face once, not per ray.
+        let in_front_all = |dirs: Vec<[f32; 3]>| -> Vec<[f32; 3]> {
+            dirs.into_iter()
+                .enumerate()
+                .filter(|&(k, _)| rays.casts(k))
+                .map(|(_, d)| in_front(d, samples.normal))
+                .collect()
+        };
+        let shift = flat_basis.x_axis * RAY_START_SHIFT[0] + flat_basis.y_axis * RAY_START_SHIFT[1];
+        let starts = indices
+            .iter()
+            .map(|&i| {
+                (Vec3::from(samples.points[i]).as_dvec3() + shift)
+                    .as_vec3()
+                    .to_array()
+            })
+            .collect();
+        let own = indices
+            .iter()
+            .map(|&i| match sampling.mode {
+                DirtMode::Ordered if samples.normals.is_empty() => Vec::new(),
+                DirtMode::Ordered => {
+                    in_front_all(ordered_directions(basis_of(samples.normal_at(i)), ordered))
+                }
+                DirtMode::Random => in_front_all(random_directions(
+                    basis_of(samples.normal_at(i)),
+                    cone,
+                    samples.face,
+                    i,
+                )),
+            })
+            .collect();
+        SampleRays {
+            starts,
+            flat: in_front_all(ordered_directions(flat_basis, ordered)),
+            own,
         }
     }
-    let values = gathered.iter().map(|g| g / per_sample as f32).collect();
-    (values, total as u64)
+
+    /// Sample `s`'s directions.
+    fn directions(&self, s: usize) -> &[[f32; 3]] {
+        if self.own[s].is_empty() {
+            &self.flat
+        } else {
+            &self.own[s]
+        }
+    }
+
+    /// Each sample's occlusion with rays `depth` long, and the rays cast.
+    ///
+    /// Rays go in pattern order, each direction from every sample in turn, 16 to a packet: a
+    /// packet holds one direction from up to 16 neighbouring samples (rays that nearly
+    /// coincide, which Embree traverses faster than 16 directions from one point), and no
+    /// packet is left part empty while rays remain (a face's few samples fill packets with
+    /// their next directions). Each sample sums its rays in pattern order.
+    fn occlusion(&self, scene: &TraceScene, model: usize, depth: f32) -> (Vec<f32>, u64) {
+        let n = self.starts.len();
+        let per_sample = self.flat.len();
+        let total = n * per_sample;
+        let mut gathered = vec![0.0f32; n];
+        let mut packet = RayPacket16::new();
+        // Direction and sample of the next ray.
+        let (mut k, mut s) = (0, 0);
+        let mut lane_sample = [0usize; 16];
+        for first in (0..total).step_by(16) {
+            packet.clear();
+            let lanes = (total - first).min(16);
+            for (lane, sample) in lane_sample.iter_mut().enumerate().take(lanes) {
+                packet.set(lane, self.starts[s], self.directions(s)[k], 0.0, depth);
+                *sample = s;
+                s += 1;
+                if s == n {
+                    (k, s) = (k + 1, 0);
+                }
+            }
+            let hits = scene.opaque_hits16(&mut packet, model);
+            for (hit, &sample) in hits.iter().zip(&lane_sample).take(lanes) {
+                if let Some(t) = hit {
+                    gathered[sample] += 1.0 - (t / depth).min(1.0);
+                }
+            }
+        }
+        let values = gathered.iter().map(|g| g / per_sample as f32).collect();
+        (values, total as u64)
+    }
 }
 
 #[cfg(test)]

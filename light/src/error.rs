@@ -1,0 +1,41 @@
+//! What can stop lighting a map.
+
+use crate::embree::EmbreeError;
+
+/// Everything that can stop lighting a map.
+#[derive(Debug, thiserror::Error)]
+pub enum LightError {
+    /// The entity lump does not parse.
+    #[error("entity lump: {0}")]
+    Entities(#[from] quake_formats::FormatError),
+    /// A key of a light or brush entity that does not read as what it must be.
+    #[error("entity {index} ({classname}): {detail}")]
+    Entity {
+        /// The entity's place in the lump (0 = worldspawn).
+        index: usize,
+        /// Its `classname`.
+        classname: String,
+        /// Which key, what it holds and what was expected.
+        detail: String,
+    },
+    /// A face whose indices run outside the file.
+    #[error("face {index}: {detail}")]
+    BadFace {
+        /// The face's index.
+        index: usize,
+        /// What is wrong with it.
+        detail: String,
+    },
+    /// More distinct switchable light names than styles to give them.
+    #[error("more switchable lights (distinct targetnames) than light styles 32..254")]
+    TooManySwitchableLights,
+    /// Embree failed (starting the device or building the scene).
+    #[error(transparent)]
+    Embree(#[from] EmbreeError),
+    /// A damaged `SLIPGATE_PHONG` lump (the message names it).
+    #[error("{0}")]
+    PhongLump(quake_formats::FormatError),
+    /// The BSP breaks a rule that would make light read out of bounds ([`quake_formats::check_usable`]).
+    #[error(transparent)]
+    Unusable(quake_formats::FormatError),
+}

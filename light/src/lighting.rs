@@ -1,0 +1,106 @@
+//! What a lighting run gives back: lightmaps in light units ([`RawLighting`]), in bytes
+//! ([`Lighting`]), and the counts and timings of the run ([`Stats`]).
+
+use crate::output::FaceLightmap;
+use crate::settings::SettingWarning;
+use crate::trace::FaceLight;
+
+/// Counts and timings of a run (`--stats`).
+#[derive(Debug, Clone, Default, serde::Serialize)]
+pub struct Stats {
+    /// Faces in the BSP.
+    pub faces: usize,
+    /// Faces given a lightmap.
+    pub faces_lit: usize,
+    /// Luxels of those lightmaps.
+    pub luxels: u64,
+    /// Sample points traced for them.
+    pub samples: u64,
+    /// Triangles in the shadow scene.
+    pub scene_triangles: usize,
+    /// Point lights from light entities (`_deviance` copies counted).
+    pub point_lights: usize,
+    /// Copies of `_surface` templates.
+    pub surface_lights: usize,
+    /// Directions of suns and sky domes.
+    pub sun_directions: usize,
+    /// Switchable light names given a style.
+    pub switchable_styles: usize,
+    /// Some light is coloured (a `.lit` is written).
+    pub coloured: bool,
+    /// The map has no light source (light, sun, lit surface or minlight): the lighting lump is
+    /// left empty, which engines draw fullbright.
+    pub fullbright: bool,
+    /// Shadow rays to point lights.
+    pub shadow_rays: u64,
+    /// Rays towards suns and sky domes.
+    pub sun_rays: u64,
+    /// Ambient-occlusion rays (`_dirt`).
+    pub dirt_rays: u64,
+    /// Rays placing sample points in the open.
+    pub placement_rays: u64,
+    /// Bounce passes run.
+    pub bounce_passes: usize,
+    /// Rays cast gathering bounced light.
+    pub bounce_rays: u64,
+    /// Time gathering bounced light.
+    pub seconds_bounce: f64,
+    /// Points outside their face moved onto it (inset from its edges).
+    pub points_clamped_to_face: u64,
+    /// Points pulled back because something stood between them and their face's centre.
+    pub points_pulled_back: u64,
+    /// Points still in solid after that, moved onto their face's centre.
+    pub points_moved_to_centre: u64,
+    /// Face/light pairs looked at.
+    pub face_light_pairs: u64,
+    /// Of those, the pairs culling skipped.
+    pub face_light_pairs_culled: u64,
+    /// Faces reached by more than four light styles (the dimmest dropped).
+    pub faces_with_dropped_styles: u64,
+    /// Time reading the map and building the scene.
+    pub seconds_setup: f64,
+    /// Time tracing direct light.
+    pub seconds_trace: f64,
+    /// Time of the whole run.
+    pub seconds_total: f64,
+    /// All rays cast (shadow, sun, dirt, placement and bounce) per second of tracing.
+    pub rays_per_second: f64,
+}
+
+/// Lightmaps in light units, before the `--soft` filter and the conversion
+/// to bytes (so one tracing run can be finished more than one way).
+#[derive(Debug, Clone)]
+pub struct RawLighting {
+    /// Each lit face's light per luxel and style.
+    pub faces: Vec<FaceLight>,
+    /// The entity lump with the styles given to switchable lights (`None`: unchanged).
+    pub entity_text: Option<String>,
+    /// Some light is coloured: a `.lit` is needed.
+    pub coloured: bool,
+    /// Lightmap bytes per light unit (`_range`).
+    pub rangescale: f64,
+    /// Gamma applied to the bytes (`_gamma`).
+    pub gamma: f64,
+    /// `--soft`: the box filter's radius the run asks for.
+    pub soft_radius: usize,
+    /// Worldspawn or command-line values light did not take as given.
+    pub warnings: Vec<SettingWarning>,
+    /// Counts and timings.
+    pub stats: Stats,
+}
+
+/// The result of lighting: final lightmaps of the lit faces, the entity
+/// text with assigned styles, and whether a `.lit` is needed.
+#[derive(Debug, Clone)]
+pub struct Lighting {
+    /// Each lit face's lightmaps, in bytes.
+    pub lightmaps: Vec<FaceLightmap>,
+    /// The entity lump with the styles given to switchable lights (`None`: unchanged).
+    pub entity_text: Option<String>,
+    /// Some light is coloured: a `.lit` is needed.
+    pub coloured: bool,
+    /// Worldspawn or command-line values light did not take as given.
+    pub warnings: Vec<SettingWarning>,
+    /// Counts and timings.
+    pub stats: Stats,
+}

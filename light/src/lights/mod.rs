@@ -1,0 +1,315 @@
+//! What the entity lump says about light: map-wide settings, suns and sky domes, brush
+//! models' keys and light entities, read in that order by [`parse_lights`].
+//!
+//! Keys follow ericw-tools' documented meanings. Worldspawn's map-wide keys are settings
+//! ([`crate::settings`]): the command line may override them, and a value that does not read
+//! is a warning. A light's or brush model's key that does not read is an error naming the
+//! entity and key.
+
+mod entities;
+mod keys;
+mod models;
+mod point;
+mod styles;
+mod sun;
+mod worldspawn;
+
+use glam::DVec3;
+use std::collections::HashMap;
+
+use quake_formats::entities::Entity;
+
+use crate::dirt::{DirtResponse, DirtSampling};
+use crate::error::LightError;
+use crate::settings::{Overrides, SettingWarning, Settings, World};
+pub use point::{Falloff, PointLight, Spot, angle_factor};
+pub use styles::assign_switchable_styles;
+pub use sun::SunLight;
+pub use worldspawn::dirt_sampling;
+
+/// A minimum light level: no luxel of style 0 ends up darker than this
+/// (times the dirt factor when minlight takes dirt).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Minlight {
+    pub level: f64,
+    /// `--addmin`: the level is added to style 0 instead of being a floor.
+    pub add: bool,
+    pub color: DVec3,
+    pub dirt: Option<DirtResponse>,
+    /// Faces with this texture get no minlight (`_minlight_exclude`).
+    pub exclude_texture: Option<String>,
+}
+
+/// A `_surface` light: copied over every face whose texture is `texture`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SurfaceTemplate {
+    pub texture: String,
+    /// The light each copy starts from (origin and spot are set per copy).
+    pub light: PointLight,
+    /// Distance of each copy in front of its face (`_surface_offset`).
+    pub offset: f64,
+    /// Copies shine along the face normal (`_surface_spotlight 1`).
+    pub spotlight: bool,
+    pub spot_angle: f64,
+}
+
+/// How light bounces: worldspawn's `_bounce` and its keys (or the command line's).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BounceSettings {
+    /// Passes (0 = off).
+    pub passes: usize,
+    /// `_bouncescale`.
+    pub scale: f64,
+    /// `_bouncecolorscale`: 0 = grey reflectance, 1 = the texture's mean colour.
+    pub color_scale: f64,
+    /// `_bouncestyled`: styled (switchable, animated) light bounces too, in its own style.
+    pub styled: bool,
+    /// How dirt darkens bounced light (worldspawn's dirt, when it is on).
+    pub dirt: Option<DirtResponse>,
+}
+
+impl BounceSettings {
+    /// Whether any light bounces.
+    pub fn is_on(&self) -> bool {
+        self.passes > 0 && self.scale > 0.0
+    }
+}
+
+/// Everything the entity lump says about lighting.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MapLights {
+    pub points: Vec<PointLight>,
+    pub suns: Vec<SunLight>,
+    pub templates: Vec<SurfaceTemplate>,
+    /// Minlight per model index (0 = world, from worldspawn).
+    pub minlight: HashMap<usize, Minlight>,
+    /// Brush models that cast shadows (`_shadow 1`).
+    pub shadow_models: Vec<usize>,
+    /// Brush models that shadow only their own faces (`_shadowself 1`).
+    pub self_shadow_models: Vec<usize>,
+    /// Brush models whose faces never take dirt (`_dirt -1`).
+    pub no_dirt_models: Vec<usize>,
+    /// Brush models whose faces get minlight only (`_lightignore 1`).
+    pub lightignore_models: Vec<usize>,
+    /// Brush models whose faces do not reflect light (`_bounce 0`).
+    pub no_bounce_models: Vec<usize>,
+    /// Diffuse interreflection (`_bounce` and its keys).
+    pub bounce: BounceSettings,
+    /// How dirt occlusion is measured (used only when something takes dirt).
+    pub dirt: DirtSampling,
+    /// Brush models (0 = world) with `_phong` smoothing, and their angle in degrees.
+    pub phong: HashMap<usize, f64>,
+    /// Offset of each brush model with an `origin` key (rotating entities).
+    pub model_origins: HashMap<usize, DVec3>,
+    /// The map-wide settings, resolved (the command line's, else worldspawn's, else the
+    /// defaults).
+    pub settings: Settings,
+    /// Worldspawn values light did not take as given.
+    pub warnings: Vec<SettingWarning>,
+    /// Styles given to switchable lights (`targetname` -> style), also
+    /// written back into the entities as `style`.
+    pub switchable_styles: Vec<(String, u8)>,
+}
+
+impl MapLights {
+    /// True if any light, sun or minlight is darkened by dirt.
+    pub fn uses_dirt(&self) -> bool {
+        self.points.iter().any(|l| l.dirt.is_some())
+            || self.suns.iter().any(|s| s.dirt.is_some())
+            || self.templates.iter().any(|t| t.light.dirt.is_some())
+            || self.minlight.values().any(|m| m.dirt.is_some())
+            || (self.bounce.is_on() && self.bounce.dirt.is_some())
+    }
+
+    /// True if any light, sun or minlight is not white (a `.lit` is needed).
+    pub fn is_coloured(&self) -> bool {
+        let grey = |c: &DVec3| c.x != c.y || c.y != c.z;
+        self.points.iter().any(|l| grey(&l.color))
+            || self.suns.iter().any(|s| grey(&s.color))
+            || self.templates.iter().any(|t| grey(&t.light.color))
+            || self.minlight.values().any(|m| grey(&m.color))
+    }
+}
+
+/// Reads every light from `entities`, with the map-wide settings resolved against
+/// `overrides`, and assigns styles to switchable lights (writing `style` into those
+/// entities).
+///
+/// # Errors
+/// [`LightError::Entity`] for a key of a light or brush entity that does not read.
+pub fn parse_lights(
+    entities: &mut [Entity],
+    overrides: &Overrides,
+) -> Result<MapLights, LightError> {
+    let switchable_styles = assign_switchable_styles(entities)?;
+    let world = entities.iter().position(|e| e.classname() == "worldspawn");
+    let (settings, warnings) = Settings::resolve(
+        world.map(|index| World {
+            index,
+            entity: &entities[index],
+        }),
+        overrides,
+    );
+    let global = worldspawn::Global::new(&settings);
+    let mut out = MapLights {
+        points: Vec::new(),
+        suns: sun::world_suns(&settings, &global),
+        templates: Vec::new(),
+        minlight: HashMap::new(),
+        shadow_models: Vec::new(),
+        self_shadow_models: Vec::new(),
+        no_dirt_models: Vec::new(),
+        lightignore_models: Vec::new(),
+        no_bounce_models: Vec::new(),
+        bounce: worldspawn::bounce(&settings, &global),
+        dirt: dirt_sampling(&settings),
+        phong: HashMap::new(),
+        model_origins: HashMap::new(),
+        switchable_styles,
+        settings,
+        warnings,
+    };
+    if let Some(m) = worldspawn::world_minlight(&out.settings, &global) {
+        out.minlight.insert(0, m);
+    }
+    models::read_phong(entities, world, &mut out)?;
+    models::read_models(entities, &global, &mut out)?;
+    entities::read_lights(entities, &global, &mut out)?;
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dirt::DirtMode;
+    use entities::DEFAULT_LIGHT;
+    use quake_formats::entities::parse_entities;
+    use quake_formats::geom::DVec3Ext;
+
+    fn close(a: f64, b: f64) -> bool {
+        (a - b).abs() < 1e-9 * b.abs().max(1.0)
+    }
+
+    #[test]
+    fn parses_keys_and_assigns_switchable_styles() {
+        let text = r#"
+{ "classname" "worldspawn" "light" "20" "_sunlight" "100" "_sun_mangle" "0 -90 0" "_sunlight_color" "255 128 0" }
+{ "classname" "light" "origin" "0 0 64" "delay" "2" "wait" "2" "_color" "1 0.5 0.5" }
+{ "classname" "light_fluoro" "origin" "0 0 0" "targetname" "door" }
+{ "classname" "light" "origin" "8 0 0" "targetname" "door" "light" "200" }
+{ "classname" "light" "origin" "8 0 0" "targetname" "other" "style" "5" }
+{ "classname" "light" "origin" "0 0 0" "target" "t1" "angle" "60" }
+{ "classname" "info_null" "origin" "0 0 -100" "targetname" "t1" }
+{ "classname" "light" "_surface" "sky4" "light" "100" }
+{ "classname" "func_door" "model" "*1" "_shadow" "1" "_minlight" "10" }
+"#;
+        let mut ents = parse_entities(text).expect("parse");
+        let lights = parse_lights(&mut ents, &Overrides::default()).expect("lights");
+        assert_eq!(lights.points.len(), 5);
+        let p = &lights.points[0];
+        assert_eq!(p.falloff, Falloff::InverseSquare);
+        assert_eq!(p.atten, 2.0);
+        assert_eq!(p.light, DEFAULT_LIGHT);
+        assert_eq!(p.color, DVec3::new(1.0, 0.5, 0.5));
+        assert_eq!(lights.points[1].style, 32);
+        assert_eq!(lights.points[2].style, 32, "same targetname, same style");
+        assert_eq!(lights.points[3].style, 5, "explicit style kept");
+        let spot = lights.points[4].spot.expect("spotlight");
+        assert!(spot.dir.near(DVec3::new(0.0, 0.0, -1.0), 1e-12));
+        assert!(close(spot.cos_outer, 30f64.to_radians().cos()));
+        assert_eq!(ents[2].get("style"), Some("32"));
+        assert_eq!(ents[4].get("style"), Some("5"));
+        assert_eq!(lights.switchable_styles, vec![("door".to_string(), 32)]);
+        assert_eq!(lights.templates.len(), 1);
+        assert_eq!(lights.templates[0].texture, "sky4");
+        assert_eq!(lights.suns.len(), 1, "no penumbra: one direction");
+        assert!(lights.suns[0].to_sun.near(DVec3::new(0.0, 0.0, 1.0), 1e-12));
+        assert!(close(lights.suns[0].color.y, 128.0 / 255.0));
+        assert_eq!(lights.minlight[&0].level, 20.0);
+        assert_eq!(lights.minlight[&1].level, 10.0);
+        assert_eq!(lights.shadow_models, vec![1]);
+        assert!(lights.is_coloured());
+    }
+
+    #[test]
+    fn bad_numbers_name_the_entity() {
+        let mut ents = parse_entities(
+            "{ \"classname\" \"worldspawn\" }\n{ \"classname\" \"light\" \"light\" \"bright\" }",
+        )
+        .expect("parse");
+        let err = parse_lights(&mut ents, &Overrides::default()).expect_err("bad light");
+        let msg = err.to_string();
+        assert!(
+            msg.contains("entity 1") && msg.contains("\"light\""),
+            "{msg}"
+        );
+        let mut ents =
+            parse_entities("{ \"classname\" \"light\" \"delay\" \"7\" }").expect("parse");
+        assert!(parse_lights(&mut ents, &Overrides::default()).is_err());
+    }
+
+    #[test]
+    fn dirt_keys_resolve_per_light() {
+        let text = r#"
+{ "classname" "worldspawn" "_dirt" "1" "_dirtscale" "1.5" "_dirtgain" "0.5" "_dirtdepth" "64" "_dirtangle" "120" "_dirtmode" "1" "_sunlight" "100" "_sunlight_dirt" "-1" }
+{ "classname" "light" "origin" "0 0 0" }
+{ "classname" "light" "origin" "0 0 0" "_dirt" "-1" }
+{ "classname" "light" "origin" "0 0 0" "_dirtscale" "3" }
+{ "classname" "func_wall" "model" "*1" "_dirt" "-1" "_lightignore" "1" "_minlight" "5" "_minlight_exclude" "sky1" }
+"#;
+        let mut ents = parse_entities(text).expect("parse");
+        let lights = parse_lights(&mut ents, &Overrides::default()).expect("lights");
+        let global = DirtResponse {
+            scale: 1.5,
+            gain: 0.5,
+        };
+        assert_eq!(lights.points[0].dirt, Some(global));
+        assert_eq!(lights.points[1].dirt, None);
+        assert_eq!(lights.points[2].dirt.map(|d| d.scale), Some(3.0));
+        assert_eq!(lights.suns[0].dirt, None, "_sunlight_dirt -1");
+        assert_eq!(lights.dirt.mode, DirtMode::Random);
+        assert_eq!(lights.dirt.depth, 64.0);
+        assert_eq!(lights.dirt.cone_degrees(), 90.0, "clamped to 90");
+        assert_eq!(lights.no_dirt_models, vec![1]);
+        assert_eq!(lights.lightignore_models, vec![1]);
+        assert_eq!(lights.minlight[&1].exclude_texture.as_deref(), Some("sky1"));
+        assert!(lights.uses_dirt());
+        // Factor: 1 - min(1, scale * occlusion^gain).
+        assert!(close(global.factor(0.25), 1.0 - 1.5 * 0.5));
+        assert_eq!(global.factor(0.0), 1.0);
+        assert_eq!(global.factor(1.0), 0.0);
+    }
+
+    #[test]
+    fn bounce_keeps_dirt_when_every_light_opts_out() {
+        // Regression: dirt was only traced for lights, so bounce lost its dirt here.
+        let text = r#"
+{ "classname" "worldspawn" "_dirt" "1" "_bounce" "1" }
+{ "classname" "light" "origin" "0 0 0" "_dirt" "-1" }
+"#;
+        let mut ents = parse_entities(text).expect("parse");
+        let lights = parse_lights(&mut ents, &Overrides::default()).expect("lights");
+        assert_eq!(lights.points[0].dirt, None);
+        assert!(lights.bounce.dirt.is_some());
+        assert!(lights.uses_dirt());
+    }
+
+    #[test]
+    fn falloff_key_and_deviance_split() {
+        let text = r#"
+{ "classname" "light" "origin" "0 0 0" "light" "200" "_falloff" "400" }
+{ "classname" "light" "origin" "0 0 0" "light" "160" "delay" "2" "_deviance" "8" "_samples" "4" }
+"#;
+        let mut ents = parse_entities(text).expect("parse");
+        let lights = parse_lights(&mut ents, &Overrides::default()).expect("lights");
+        assert_eq!(lights.points.len(), 5);
+        let linear = &lights.points[0];
+        assert!(close(linear.value_at(200.0), 100.0), "half way to 400");
+        assert_eq!(linear.value_at(400.0), 0.0);
+        let total: f64 = lights.points[1..].iter().map(|l| l.light).sum();
+        assert!(close(total, 160.0), "copies share the light");
+        for l in &lights.points[1..] {
+            assert!(l.origin.length() <= 8.0 + 1e-9);
+        }
+    }
+}

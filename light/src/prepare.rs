@@ -1,0 +1,166 @@
+//! Everything built before tracing: faces, the shadow scene, the PVS, the lights (with
+//! `_surface` copies and their leaves) and `_phong` normals, and the rules each face takes.
+
+use glam::DVec3;
+use quake_formats::Bsp;
+use quake_formats::entities::{parse_entities, write_entities};
+use quake_formats::geom::Bounds;
+
+use crate::embree::Device;
+use crate::error::LightError;
+use crate::faces::{FaceGeom, face_geometry};
+use crate::lights::{MapLights, PointLight, parse_lights};
+use crate::options::Options;
+use crate::phong;
+use crate::reach::LightReaches;
+use crate::scene::TraceScene;
+use crate::surface;
+use crate::trace::{FaceRules, TraceSetup};
+use crate::visibility::Visibility;
+
+/// Everything built before tracing, reusable by later passes and benchmarks.
+pub struct Prepared {
+    /// Every face as geometry.
+    pub faces: Vec<FaceGeom>,
+    /// The shadow scene.
+    pub scene: TraceScene,
+    /// The PVS, for culling.
+    pub vis: Visibility,
+    /// What the entity lump says about light.
+    pub lights: MapLights,
+    /// Entity lights followed by surface-light copies.
+    pub point_lights: Vec<PointLight>,
+    /// Each point light's world leaf (`None`: in solid or outside).
+    pub light_leafs: Vec<Option<u32>>,
+    /// Length of sun rays (longer than the map's diagonal).
+    pub sun_distance: f32,
+    /// How many of `point_lights` are surface-light copies.
+    pub surface_lights: usize,
+    /// The entity lump with switchable lights' styles (`None`: unchanged).
+    pub entity_text: Option<String>,
+    /// Per face: `_phong` corner normals, for faces of smoothed models.
+    pub phong: Vec<Option<Vec<DVec3>>>,
+}
+
+impl Prepared {
+    /// Whether anything gives light: a light entity, a sun or sky dome, a `_surface` light that
+    /// found its texture, or a minlight.
+    pub fn has_light_sources(&self) -> bool {
+        !self.point_lights.is_empty()
+            || !self.lights.suns.is_empty()
+            || self.lights.minlight.values().any(|m| m.level > 0.0)
+    }
+
+    /// What tracing reads, with lights cut off at `light_reaches` (built with `gate`).
+    pub fn trace_setup<'a>(
+        &'a self,
+        bsp: &'a Bsp,
+        light_reaches: &'a LightReaches,
+        gate: f64,
+        cull: bool,
+        adaptive: bool,
+    ) -> TraceSetup<'a> {
+        TraceSetup {
+            bsp,
+            faces: &self.faces,
+            scene: &self.scene,
+            vis: &self.vis,
+            lights: &self.point_lights,
+            light_leafs: &self.light_leafs,
+            light_reaches,
+            suns: &self.lights.suns,
+            cull,
+            gate,
+            sun_distance: self.sun_distance,
+            dirt: self.lights.uses_dirt().then_some(self.lights.dirt),
+            adaptive,
+        }
+    }
+}
+
+/// Reads faces, entities and visibility and builds the Embree scene.
+///
+/// # Errors
+/// Bad entities or faces, or an Embree failure.
+pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
+    // Starting Embree (its device and thread pool) takes as long as the check: both at once.
+    // Embree's own threads only build the BVH; rayon does the tracing.
+    let (usable, device) = rayon::join(
+        || quake_formats::bsp::check_usable_for(bsp, quake_formats::bsp::TreeUse::IfPresent),
+        || Device::new(rayon::current_num_threads()),
+    );
+    usable.map_err(LightError::Unusable)?;
+    let device = device?;
+    let mut entities = parse_entities(&bsp.entity_text())?;
+    let map_lights = parse_lights(&mut entities, &options.overrides)?;
+    let entity_text = (!map_lights.switchable_styles.is_empty()).then(|| write_entities(&entities));
+    let origin_of = |m: usize| {
+        map_lights
+            .model_origins
+            .get(&m)
+            .copied()
+            .unwrap_or(DVec3::ZERO)
+    };
+    let faces = face_geometry(bsp, origin_of)?;
+    let scene = TraceScene::build(
+        &device,
+        &faces,
+        &map_lights.shadow_models,
+        &map_lights.self_shadow_models,
+    )?;
+    let vis = Visibility::new(bsp, &faces);
+    let lump = bsp.phong_faces().map_err(LightError::PhongLump)?;
+    let groups = phong::groups(&faces, &map_lights.phong, lump.as_deref());
+    let phong = phong::corner_normals(&faces, &groups);
+    let surface =
+        surface::expand_templates(&map_lights.templates, &faces, surface::DEFAULT_SPACING);
+    let surface_lights = surface.len();
+    let mut point_lights = map_lights.points.clone();
+    point_lights.extend(surface);
+    let light_leafs = point_lights
+        .iter()
+        .map(|l| vis.open_leaf_at(bsp, l.origin))
+        .collect();
+    let mut bounds = Bounds::EMPTY;
+    for p in faces.iter().flat_map(|f| &f.points) {
+        bounds.add_point(*p);
+    }
+    let diagonal = if bounds.is_empty() {
+        1.0
+    } else {
+        (bounds.maxs - bounds.mins).length()
+    };
+    Ok(Prepared {
+        faces,
+        scene,
+        vis,
+        lights: map_lights,
+        point_lights,
+        light_leafs,
+        sun_distance: (diagonal * 2.0 + 1024.0) as f32,
+        surface_lights,
+        entity_text,
+        phong,
+    })
+}
+
+/// The rules of the faces of brush model `model` (0 = world).
+pub fn face_rules<'a>(lights: &'a MapLights, geom: &FaceGeom) -> FaceRules<'a> {
+    // A brush model's own `_minlight` wins; otherwise worldspawn's applies.
+    let minlight = lights
+        .minlight
+        .get(&geom.model)
+        .or_else(|| lights.minlight.get(&0))
+        .filter(|m| {
+            m.exclude_texture
+                .as_ref()
+                .is_none_or(|t| !t.eq_ignore_ascii_case(&geom.texture))
+        });
+    let dirt = !lights.no_dirt_models.contains(&geom.model);
+    FaceRules {
+        minlight,
+        dirt,
+        minlight_only: lights.lightignore_models.contains(&geom.model),
+        bounce_dirt: lights.bounce.dirt.filter(|_| dirt && lights.bounce.is_on()),
+    }
+}

@@ -1,0 +1,524 @@
+//! One lighting run, stage by stage: prepare the map, trace every face's direct light, gather
+//! bounced light, finish each face (bounce added, floors applied, samples averaged to luxels)
+//! and count what was done; then turn light units into bytes and write them into the BSP.
+
+use glam::Vec3;
+use std::time::Instant;
+
+use quake_formats::Bsp;
+use quake_formats::entities::{parse_entities, write_entities};
+use quake_formats::palette::Palette;
+use quake_formats::progress::Progress;
+use rayon::prelude::*;
+
+use crate::bounce::{self, BounceCounts, Density, Field, Receivers, StyleLuxels};
+use crate::error::LightError;
+use crate::faces::FaceKind;
+use crate::lighting::{Lighting, RawLighting, Stats};
+use crate::lights::assign_switchable_styles;
+use crate::options::Options;
+use crate::output::{self, Finish, finish_face};
+use crate::phong;
+use crate::prepare::{Prepared, face_rules, prepare};
+use crate::quality::Quality;
+use crate::reach::{LightReaches, light_reaches};
+use crate::samples::{FaceSamples, PlacementCounts, face_samples};
+use crate::trace::{FaceLight, SampleLight, TraceCounts, TraceScratch, TraceSetup, trace_face};
+
+/// Lights every lit face of `bsp` (or `options.only_faces`).
+///
+/// # Errors
+/// A BSP light cannot read safely, bad entities or faces, or an Embree failure.
+pub fn compute_lighting(bsp: &Bsp, options: &Options) -> Result<Lighting, LightError> {
+    let raw = trace_lighting(bsp, options)?;
+    Ok(finish_lighting(&raw, raw.soft_radius))
+}
+
+/// Traces every lit face of `bsp` (or `options.only_faces`): light units per
+/// luxel and style, minlight and bounced light included.
+///
+/// # Errors
+/// A BSP light cannot read safely, bad entities or faces, or an Embree failure.
+pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, LightError> {
+    let start = Instant::now();
+    let prep = prepare(bsp, options)?;
+    let setup_done = Instant::now();
+    let plan = Plan::new(bsp, &prep, options);
+    let traced = plan.direct_light();
+    let trace_done = Instant::now();
+    let mut bounce_counts = BounceCounts::default();
+    let bounced = plan.bounced_light(&traced, &mut bounce_counts);
+    let bounce_done = Instant::now();
+    let mut stats = plan.stats(&traced, &bounce_counts);
+    let faces = finish_faces(traced, &bounced);
+    stats.luxels = faces.iter().map(|l| (l.width * l.height) as u64).sum();
+    stats.faces_lit = faces.len();
+    if plan.bouncing {
+        // Bounced light takes the reflecting texture's colour.
+        stats.coloured |= faces.iter().any(|f| {
+            f.styles
+                .iter()
+                .flat_map(|(_, l)| l)
+                .any(|c| c[0] != c[1] || c[1] != c[2])
+        });
+    }
+    stats.seconds_setup = (setup_done - start).as_secs_f64();
+    stats.seconds_trace = (trace_done - setup_done).as_secs_f64();
+    stats.seconds_bounce = (bounce_done - trace_done).as_secs_f64();
+    stats.seconds_total = start.elapsed().as_secs_f64();
+    let rays = stats.shadow_rays
+        + stats.sun_rays
+        + stats.dirt_rays
+        + stats.placement_rays
+        + stats.bounce_rays;
+    stats.rays_per_second = rays as f64 / (stats.seconds_trace + stats.seconds_bounce).max(1e-9);
+    let settings = &prep.lights.settings;
+    Ok(RawLighting {
+        faces,
+        entity_text: prep.entity_text.clone(),
+        coloured: stats.coloured,
+        rangescale: settings.range,
+        gamma: settings.gamma,
+        soft_radius: settings.soft,
+        warnings: prep.lights.warnings.clone(),
+        stats,
+    })
+}
+
+/// What a run traces, and how.
+struct Plan<'a> {
+    bsp: &'a Bsp,
+    prep: &'a Prepared,
+    options: &'a Options,
+    /// Each light's reach at the run's gate.
+    reaches: LightReaches,
+    /// Per face: its lightmap is wanted (every face, or `options.only_faces`).
+    wanted: Vec<bool>,
+    /// No light source: the lump stays empty, which engines draw fullbright (a lump of zeros
+    /// would be black), as they draw a map never lit.
+    fullbright: bool,
+    /// Bounced light is gathered.
+    bouncing: bool,
+    /// Per face, what it reflects (when bouncing).
+    reflectance: Vec<Option<[f32; 3]>>,
+    /// The faces whose direct light is traced: bounce needs every lit face's (they all
+    /// reflect, and receive for later passes).
+    to_trace: Vec<usize>,
+}
+
+impl<'a> Plan<'a> {
+    fn new(bsp: &'a Bsp, prep: &'a Prepared, options: &'a Options) -> Plan<'a> {
+        let n = prep.faces.len();
+        let mut wanted = vec![options.only_faces.is_none(); n];
+        for &f in options.only_faces.iter().flatten() {
+            if let Some(w) = wanted.get_mut(f) {
+                *w = true;
+            }
+        }
+        let fullbright = !prep.has_light_sources();
+        let bouncing = prep.lights.bounce.is_on() && !fullbright;
+        let reflectance = if bouncing {
+            let palette = options.palette.clone().unwrap_or_else(Palette::slipgate);
+            bounce::face_reflectance(bsp, &prep.faces, &prep.lights, &palette)
+        } else {
+            vec![None; n]
+        };
+        let to_trace = (0..n)
+            .filter(|&f| !fullbright && prep.faces[f].kind == FaceKind::Lit)
+            .filter(|&f| bouncing || wanted[f])
+            .collect();
+        Plan {
+            bsp,
+            prep,
+            options,
+            reaches: light_reaches(&prep.point_lights, prep.lights.settings.gate),
+            wanted,
+            fullbright,
+            bouncing,
+            reflectance,
+            to_trace,
+        }
+    }
+
+    fn reference(&self) -> bool {
+        self.options.quality == Quality::Reference
+    }
+
+    /// What tracing the run's faces reads: no culling for the reference or with `--no-cull`,
+    /// and no adaptive sampling for the reference.
+    fn setup(&self) -> TraceSetup<'_> {
+        let reference = self.reference();
+        let cull = !self.options.no_cull && !reference;
+        let gate = self.prep.lights.settings.gate;
+        self.prep
+            .trace_setup(self.bsp, &self.reaches, gate, cull, !reference)
+    }
+
+    /// What tracing the reference's bounce emitters reads: culled and adaptive, as `--extra4`.
+    fn emitter_setup(&self) -> TraceSetup<'_> {
+        let gate = self.prep.lights.settings.gate;
+        self.prep
+            .trace_setup(self.bsp, &self.reaches, gate, true, true)
+    }
+
+    /// Each traced face's direct light. The reference's bounce gathers at the samples of the
+    /// faces it measures, so only those are traced here when it bounces.
+    fn direct_light(&self) -> Vec<Traced> {
+        let reference = self.reference();
+        let keep = Keep {
+            wanted: &self.wanted,
+            reflectance: &self.reflectance,
+            bouncing: self.bouncing && !reference,
+            samples: self.bouncing && reference,
+        };
+        let faces: Vec<usize> = if self.bouncing && reference {
+            let wanted = self.to_trace.iter().copied();
+            wanted.filter(|&f| self.wanted[f]).collect()
+        } else {
+            self.to_trace.clone()
+        };
+        let progress = &self.options.progress;
+        progress.start("light", faces.len());
+        let traced = trace_faces(
+            self.bsp,
+            self.prep,
+            &self.setup(),
+            &faces,
+            self.options.quality,
+            keep,
+            progress,
+        );
+        progress.finish();
+        traced
+    }
+
+    /// Bounced light per face (by index), when bouncing.
+    fn bounced_light(&self, traced: &[Traced], counts: &mut BounceCounts) -> Vec<StyleLuxels> {
+        if !self.bouncing {
+            return Vec::new();
+        }
+        if !self.reference() {
+            let density = self
+                .options
+                .bounce_density
+                .unwrap_or_else(|| Density::for_quality(self.options.quality));
+            return bounce_light(
+                self.prep,
+                &self.reflectance,
+                traced,
+                traced,
+                false,
+                density,
+                counts,
+            );
+        }
+        // The reference's emitters: every face's direct light at --extra4.
+        let keep = Keep {
+            wanted: &self.wanted,
+            reflectance: &self.reflectance,
+            bouncing: true,
+            samples: false,
+        };
+        let field = trace_faces(
+            self.bsp,
+            self.prep,
+            &self.emitter_setup(),
+            &self.to_trace,
+            Quality::Extra4,
+            keep,
+            &Progress::default(),
+        );
+        let density = Density::for_quality(Quality::Reference);
+        bounce_light(
+            self.prep,
+            &self.reflectance,
+            traced,
+            &field,
+            true,
+            density,
+            counts,
+        )
+    }
+
+    /// The counts of the run so far (luxels and timings are the caller's).
+    fn stats(&self, traced: &[Traced], bounce: &BounceCounts) -> Stats {
+        let prep = self.prep;
+        let mut placement = PlacementCounts::default();
+        let mut counts = TraceCounts::default();
+        let mut samples = 0;
+        for t in traced {
+            placement.add(&t.placement);
+            counts.add(&t.counts);
+            if t.light.is_some() {
+                samples += t.sample_count;
+            }
+        }
+        Stats {
+            faces: self.bsp.faces.len(),
+            samples,
+            scene_triangles: prep.scene.triangles,
+            point_lights: prep.lights.points.len(),
+            surface_lights: prep.surface_lights,
+            sun_directions: prep.lights.suns.len(),
+            switchable_styles: prep.lights.switchable_styles.len(),
+            coloured: prep.lights.is_coloured(),
+            fullbright: self.fullbright,
+            shadow_rays: counts.shadow_rays,
+            sun_rays: counts.sun_rays,
+            dirt_rays: counts.dirt_rays,
+            placement_rays: placement.rays,
+            points_clamped_to_face: placement.clamped,
+            points_pulled_back: placement.pulled_back,
+            points_moved_to_centre: placement.to_centre,
+            face_light_pairs: counts.pairs,
+            face_light_pairs_culled: counts.pairs_culled,
+            bounce_passes: if self.bouncing {
+                prep.lights.bounce.passes
+            } else {
+                0
+            },
+            bounce_rays: bounce.rays,
+            ..Stats::default()
+        }
+    }
+}
+
+/// Each wanted face's light with its bounced light added, floors applied and samples averaged
+/// to luxels.
+fn finish_faces(traced: Vec<Traced>, bounced: &[StyleLuxels]) -> Vec<FaceLight> {
+    // Gathered first, into room for all, so no vector here grows in steps (each step takes
+    // fresh pages) and the parallel collect knows its length.
+    let mut lit: Vec<SampleLight> = Vec::with_capacity(traced.len());
+    lit.extend(traced.into_iter().filter_map(|t| t.light));
+    lit.into_par_iter()
+        .map(|light| {
+            let bounce = bounced.get(light.face).map_or(&[][..], |b| &b[..]);
+            light.finish(bounce)
+        })
+        .collect()
+}
+
+/// One face after direct light: what later steps need of it.
+struct Traced {
+    face: usize,
+    /// Its light per sample (faces whose lightmap is wanted).
+    light: Option<SampleLight>,
+    /// Its sample points (kept for the reference's bounce gathering). Boxed, as `receivers`:
+    /// most runs keep neither, and every face's record is in one large vector.
+    samples: Option<Box<FaceSamples>>,
+    /// Where it receives bounced light (when bouncing).
+    receivers: Option<Box<Receivers>>,
+    /// The light it reflects (when bouncing and the face reflects).
+    reflected: Option<StyleLuxels>,
+    placement: PlacementCounts,
+    counts: TraceCounts,
+    sample_count: u64,
+}
+
+/// What a run of [`trace_faces`] keeps of each face.
+#[derive(Debug, Clone, Copy)]
+struct Keep<'a> {
+    wanted: &'a [bool],
+    reflectance: &'a [Option<[f32; 3]>],
+    bouncing: bool,
+    samples: bool,
+}
+
+/// Direct light of `faces` at `quality`.
+fn trace_faces(
+    bsp: &Bsp,
+    prep: &Prepared,
+    setup: &TraceSetup,
+    faces: &[usize],
+    quality: Quality,
+    keep: Keep,
+    progress: &Progress,
+) -> Vec<Traced> {
+    let per_axis = quality.samples_per_axis();
+    let styled = prep.lights.bounce.styled;
+    faces
+        .par_iter()
+        .map_init(TraceScratch::default, |reuse, &f| {
+            let geom = &prep.faces[f];
+            let (mut samples, placement) = face_samples(geom, per_axis, &prep.scene, bsp);
+            if let Some(corners) = &prep.phong[f] {
+                samples.normals = phong_normals(&samples, geom, corners);
+            }
+            let rules = face_rules(&prep.lights, geom);
+            let (light, counts) = trace_face(setup, &samples, &rules, reuse);
+            progress.advance(1);
+            let reflected =
+                (keep.bouncing && keep.reflectance[f].is_some()).then(|| light.reflected(styled));
+            Traced {
+                face: f,
+                light: keep.wanted[f].then_some(light),
+                receivers: keep
+                    .bouncing
+                    .then(|| Box::new(Receivers::new(&samples, geom))),
+                reflected,
+                placement,
+                counts,
+                sample_count: samples.points.len() as u64,
+                samples: (keep.samples && keep.wanted[f]).then(|| Box::new(samples)),
+            }
+        })
+        .collect()
+}
+
+/// Bounced light per face (by index; per luxel, or per sample for the reference), `passes`
+/// passes of it, gathered at `density`. `traced` is the direct light of every lit face; with
+/// `reference`, `field` is the same at `--extra4` (the reference's emitters) and bounce is
+/// gathered at the samples of `traced` by [`bounce::reference::gather`] (the light a pass
+/// brings to the faces of `field`, for the next pass, at `density`).
+fn bounce_light(
+    prep: &Prepared,
+    reflectance: &[Option<[f32; 3]>],
+    traced: &[Traced],
+    field: &[Traced],
+    reference: bool,
+    density: Density,
+    counts: &mut BounceCounts,
+) -> Vec<StyleLuxels> {
+    let settings = prep.lights.bounce;
+    let n = prep.faces.len();
+    let mut light: Vec<Option<StyleLuxels>> = vec![None; n];
+    for t in field {
+        light[t.face] = t.reflected.clone().filter(|r| !r.is_empty());
+    }
+    let mut total: Vec<StyleLuxels> = vec![Vec::new(); n];
+    for pass in 1..=settings.passes {
+        let last = pass == settings.passes;
+        let emitting = Field::new(&prep.faces, reflectance, &light, &settings);
+        if reference {
+            // The reference gathers at every sample of the faces it measures.
+            let at_samples = gather_faces(traced, |t, c| {
+                let (samples, model) = (t.samples.as_deref()?, prep.faces[t.face].model);
+                Some(bounce::reference::gather(
+                    &emitting,
+                    &prep.scene,
+                    samples,
+                    model,
+                    pass,
+                    c,
+                ))
+            });
+            for (face, b, c) in at_samples {
+                bounce::accumulate(&mut total[face], &b);
+                counts.add(&c);
+            }
+            if last {
+                break;
+            }
+        }
+        // Wanted faces receive every pass (unless the reference measures them); reflecting ones
+        // every pass but the last, for the next.
+        let receiving: Vec<&Traced> = field
+            .iter()
+            .filter(|t| (!reference && t.light.is_some()) || (!last && t.reflected.is_some()))
+            .collect();
+        let mut next: Vec<Option<StyleLuxels>> = vec![None; n];
+        let at_receivers = gather_faces(receiving.par_iter().copied(), |t, c| {
+            let receivers = t.receivers.as_deref()?;
+            Some(emitting.gather_face(&prep.scene, receivers, pass, density, c))
+        });
+        for (face, b, c) in at_receivers {
+            counts.add(&c);
+            if !reference {
+                bounce::accumulate(&mut total[face], &b);
+            }
+            if reflectance[face].is_some() && !b.is_empty() {
+                next[face] = Some(b);
+            }
+        }
+        light = next;
+    }
+    total
+}
+
+/// One face's light gathered in one pass, and the work it took.
+type Gathered = (usize, StyleLuxels, BounceCounts);
+
+/// What `gather` brings each of `faces` (in parallel), for those it has a place for.
+fn gather_faces<'t>(
+    faces: impl IntoParallelIterator<Item = &'t Traced>,
+    gather: impl Fn(&Traced, &mut BounceCounts) -> Option<StyleLuxels> + Sync + Send,
+) -> Vec<Gathered> {
+    faces
+        .into_par_iter()
+        .filter_map(|t| {
+            let mut counts = BounceCounts::default();
+            let light = gather(t, &mut counts)?;
+            Some((t.face, light, counts))
+        })
+        .collect()
+}
+
+/// The `_phong` normal at each of `samples`, from its face's corner normals `corners`.
+fn phong_normals(
+    samples: &FaceSamples,
+    geom: &crate::faces::FaceGeom,
+    corners: &[glam::DVec3],
+) -> Vec<[f32; 3]> {
+    samples
+        .points
+        .iter()
+        .map(|&p| {
+            phong::interpolate(geom, corners, Vec3::from(p).as_dvec3())
+                .as_vec3()
+                .to_array()
+        })
+        .collect()
+}
+
+/// Filters (`soft_radius`, the `--soft` box radius) and converts `raw` to
+/// lightmap bytes.
+pub fn finish_lighting(raw: &RawLighting, soft_radius: usize) -> Lighting {
+    let start = Instant::now();
+    let finish = Finish {
+        rangescale: raw.rangescale,
+        gamma: raw.gamma,
+        soft_radius,
+        rgb: raw.coloured,
+    };
+    let mut stats = raw.stats.clone();
+    let (lightmaps, dropped): (Vec<_>, Vec<usize>) = raw
+        .faces
+        .par_iter()
+        .map(|light| finish_face(light, &finish))
+        .unzip();
+    stats.faces_with_dropped_styles += dropped.iter().filter(|&&d| d > 0).count() as u64;
+    stats.seconds_total += start.elapsed().as_secs_f64();
+    Lighting {
+        lightmaps,
+        entity_text: raw.entity_text.clone(),
+        coloured: raw.coloured,
+        warnings: raw.warnings.clone(),
+        stats,
+    }
+}
+
+/// Writes `lighting` into `bsp` (lighting lump, face styles and offsets,
+/// entity styles) and returns the `.lit` file bytes when the map is coloured.
+pub fn apply_lighting(bsp: &mut Bsp, lighting: &Lighting) -> Option<Vec<u8>> {
+    let rgb = output::write_lighting(bsp, &lighting.lightmaps, lighting.coloured);
+    if let Some(text) = &lighting.entity_text {
+        bsp.set_entity_text(text);
+    }
+    rgb.map(|rgb| quake_formats::lit::write_lit(&rgb))
+}
+
+/// `--onlyents`: gives switchable lights their styles in the entity lump (the lump `slipgate bsp
+/// --onlyents` just replaced) without relighting; the lightmaps stay as they are. Returns how many
+/// switchable light names got a style.
+///
+/// # Errors
+/// An entity lump that does not parse, a `style` that is not a number, or more switchable lights
+/// than styles.
+pub fn update_entities_only(bsp: &mut Bsp) -> Result<usize, LightError> {
+    let mut entities = parse_entities(&bsp.entity_text())?;
+    let assigned = assign_switchable_styles(&mut entities)?;
+    if !assigned.is_empty() {
+        bsp.set_entity_text(&write_entities(&entities));
+    }
+    Ok(assigned.len())
+}

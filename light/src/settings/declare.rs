@@ -1,0 +1,133 @@
+//! The `settings!` macro: one declaration per setting becomes the typed [`super::Settings`],
+//! the [`super::Overrides`] a run is given, the [`super::TABLE`] the command line and the docs
+//! are built from, and the resolution of worldspawn keys against the given values.
+
+/// What the table says about one setting, for the command line, messages and the docs.
+#[derive(Debug, Clone, Copy)]
+pub struct Setting {
+    /// The field of [`super::Settings`] and [`super::Overrides`] it fills.
+    pub field: &'static str,
+    /// Its command-line flag (`--flag`), if it has one.
+    pub flag: Option<&'static str>,
+    /// Another spelling of the flag (ericw-tools').
+    pub alias: Option<&'static str>,
+    /// The flag's value when it is given without one (`--bounce` = `--bounce=1`).
+    pub missing: Option<&'static str>,
+    /// The worldspawn keys that set it, the first present one winning.
+    pub keys: &'static [&'static str],
+    /// What its values mean.
+    pub help: &'static str,
+    /// The values it takes.
+    pub range: super::Range,
+    /// Its flag is a switch (takes no value).
+    pub switch: bool,
+    /// Its default, as the docs write it.
+    pub default: fn() -> String,
+    /// Whether a flag's argument reads as a value of the setting (else what was expected).
+    pub check: fn(&str) -> Result<(), &'static str>,
+}
+
+/// Declares the settings. Each entry reads
+///
+/// ```text
+/// /// Help text (the flag's help, the docs' meaning, the fields' doc comment).
+/// field: Type = default, flag "name" [alias "other"] [missing "value"], keys ["_key", ...], range Range::...;
+/// ```
+///
+/// with `flag ...,` left out for a setting only worldspawn sets, and `keys []` for one only the
+/// command line sets. `Type` implements [`super::SettingValue`].
+macro_rules! settings {
+    ($(
+        $(#[doc = $doc:literal])+
+        $field:ident: $ty:ty = $default:expr,
+        $(flag $flag:literal $(alias $alias:literal)? $(missing $missing:literal)?,)?
+        keys [$($key:literal),*],
+        range $range:expr;
+    )*) => {
+        /// Every setting of a run, resolved: the command line's value, else worldspawn's, else
+        /// the default.
+        #[derive(Debug, Clone, PartialEq)]
+        pub struct Settings {
+            $($(#[doc = $doc])+ pub $field: $ty,)*
+        }
+
+        impl Default for Settings {
+            fn default() -> Settings {
+                Settings { $($field: $default,)* }
+            }
+        }
+
+        /// The settings a run is given (on the command line): each given one wins over
+        /// worldspawn's key.
+        #[derive(Debug, Clone, Default, PartialEq)]
+        pub struct Overrides {
+            $($(#[doc = $doc])+ pub $field: Option<$ty>,)*
+        }
+
+        /// Every setting, in the order of their declarations.
+        pub static TABLE: &[Setting] = &[$(Setting {
+            field: stringify!($field),
+            flag: settings!(@opt $($flag)?),
+            alias: settings!(@opt $($($alias)?)?),
+            missing: settings!(@opt $($($missing)?)?),
+            keys: &[$($key),*],
+            help: concat!($($doc),+),
+            range: $range,
+            switch: <$ty as SettingValue>::SWITCH,
+            default: || <$ty as SettingValue>::show(&$default),
+            check: |text| match <$ty as SettingValue>::read(text) {
+                Some(Ok(_)) => Ok(()),
+                Some(Err(expected)) => Err(expected),
+                None => Err("a value"),
+            },
+        }),*];
+
+        impl Settings {
+            /// Each setting from `overrides`, else from worldspawn (`world`), else its default;
+            /// and the warnings for values that did not read or lay outside their range.
+            pub fn resolve(
+                world: Option<World>,
+                overrides: &Overrides,
+            ) -> (Settings, Vec<SettingWarning>) {
+                let mut warnings = Vec::new();
+                let settings = Settings {
+                    $($field: resolve(
+                        Declared {
+                            given_as: settings!(@given $field $($flag)?),
+                            keys: &[$($key),*],
+                            range: $range,
+                        },
+                        $default,
+                        overrides.$field.clone(),
+                        world,
+                        &mut warnings,
+                    ),)*
+                };
+                (settings, warnings)
+            }
+        }
+
+        impl Overrides {
+            /// Sets the setting whose field is `field` from a flag's argument `text`.
+            ///
+            /// # Errors
+            /// What was expected, when `text` does not read as the setting's value or no
+            /// setting has that field.
+            pub fn set(&mut self, field: &str, text: &str) -> Result<(), String> {
+                match field {
+                    $(stringify!($field) => {
+                        self.$field = Some(given::<$ty>(text)?);
+                    })*
+                    _ => return Err(format!("no setting is called {field}")),
+                }
+                Ok(())
+            }
+        }
+    };
+    (@given $field:ident) => { stringify!($field) };
+    (@given $field:ident $flag:literal) => { concat!("--", $flag) };
+    (@opt) => { None };
+    (@opt $x:literal) => { Some($x) };
+}
+
+pub(super) use settings;

@@ -1,0 +1,173 @@
+//! Light's map-wide settings, each declared once below: its command-line flag (and any other
+//! spelling ericw-tools uses), its worldspawn keys, its default, its range and its help text.
+//!
+//! From that one declaration come the typed [`Settings`] a run resolves, the [`Overrides`] a
+//! run is given, the command line's arguments (built from [`TABLE`] by the `cli` feature), the
+//! settings table of `docs/mapping.md` ([`markdown_table`]; a test holds the two together) and
+//! the reading of worldspawn's keys ([`Settings::resolve`]). A value given on the command line
+//! wins over worldspawn's, as in ericw-tools. A worldspawn value that does not read as its type
+//! leaves the default; one outside its range is clamped into it or leaves the default, as its
+//! [`Range`] says; either way with a warning naming the entity and key, never an error.
+//!
+//! Adding a setting is one more entry in the `settings!` list below (its type implementing
+//! [`SettingValue`]); the code that uses it reads the new field of [`Settings`].
+
+mod declare;
+mod resolve;
+mod value;
+
+use glam::DVec3;
+
+pub use crate::dirt::DirtMode;
+pub use declare::Setting;
+use declare::settings;
+use resolve::{Declared, given, resolve};
+pub use resolve::{Given, SettingWarning, World};
+pub use value::{Color, DirtToggle, Range, SettingValue, normalize_color};
+
+settings! {
+    /// Average each luxel with its neighbours within N luxels (`--soft` alone: 1).
+    soft: usize = 0, flag "soft" missing "1", keys [], range Range::Any;
+
+    /// Light contributions below this many light units count as zero.
+    gate: f64 = 0.001, flag "gate", keys [], range Range::Any;
+
+    /// Scales every light's falloff distance.
+    dist: f64 = 1.0, flag "dist", keys ["_dist"], range Range::Any;
+
+    /// Lightmap bytes per light unit (scales every light's brightness).
+    range: f64 = 0.5, flag "range", keys ["_range"], range Range::Any;
+
+    /// Gamma applied to the lightmaps.
+    gamma: f64 = 1.0, keys ["_gamma"], range Range::Above(0.0);
+
+    /// How much a surface's angle to the light matters, 0 (not at all) to 1 (the cosine); lights
+    /// without their own `_anglescale` take this.
+    anglescale: f64 = 0.5, keys ["_anglescale", "_anglesense"], range Range::Clamp(0.0, 1.0);
+
+    /// Directions per sun penumbra and per sky dome.
+    sunsamples: usize = 100, flag "sunsamples", keys [], range Range::Clamp(1.0, f64::INFINITY);
+
+    /// Minimum light of the world's faces.
+    minlight: f64 = 0.0, keys ["_minlight", "light"], range Range::Any;
+
+    /// Colour of the minimum light.
+    minlight_color: Color = Color::WHITE, keys ["_minlight_color", "_mincolor"], range Range::Any;
+
+    /// A texture that does not get the world's minimum light.
+    minlight_exclude: Option<String> = None, keys ["_minlight_exclude"], range Range::Any;
+
+    /// `1`: dirt darkens the minimum light too; `-1`: it does not.
+    minlight_dirt: DirtToggle = DirtToggle::AsDirt, keys ["_minlight_dirt"], range Range::Any;
+
+    /// Add minlight to every luxel's light instead of raising dark luxels to it.
+    addmin: bool = false, flag "addmin", keys [], range Range::Any;
+
+    /// Sun brightness (light from sky faces).
+    sunlight: f64 = 0.0, keys ["_sunlight"], range Range::Any;
+
+    /// Direction the sunlight travels, `yaw pitch roll` in degrees.
+    sun_mangle: DVec3 = DVec3::new(0.0, -90.0, 0.0), keys ["_sun_mangle", "_sunlight_mangle"], range Range::Any;
+
+    /// Soft sun: its directions spread over a cone this many degrees wide.
+    sun_penumbra: f64 = 0.0, keys ["_sunlight_penumbra"], range Range::Any;
+
+    /// Sun colour.
+    sunlight_color: Color = Color::WHITE, keys ["_sunlight_color"], range Range::Any;
+
+    /// `1`/`-1`: dirt on sunlight on/off.
+    sunlight_dirt: DirtToggle = DirtToggle::AsDirt, keys ["_sunlight_dirt"], range Range::Any;
+
+    /// Brightness of a sky dome lighting from above.
+    sunlight2: f64 = 0.0, keys ["_sunlight2"], range Range::Any;
+
+    /// Colour of the upper sky dome.
+    sunlight2_color: Color = Color::WHITE, keys ["_sunlight2_color", "_sunlight_color2"], range Range::Any;
+
+    /// `1`/`-1`: dirt on both sky domes on/off.
+    sunlight2_dirt: DirtToggle = DirtToggle::AsDirt, keys ["_sunlight2_dirt"], range Range::Any;
+
+    /// Brightness of a sky dome lighting from below.
+    sunlight3: f64 = 0.0, keys ["_sunlight3"], range Range::Any;
+
+    /// Colour of the lower sky dome.
+    sunlight3_color: Color = Color::WHITE, keys ["_sunlight3_color", "_sunlight_color3"], range Range::Any;
+
+    /// Dirt (ambient occlusion) on every light, sun and minlight (lights with `_dirt -1` still
+    /// opt out).
+    dirt: bool = false, flag "dirt" alias "dirty", keys ["_dirt"], range Range::Any;
+
+    /// Dirt ray pattern: `0` an ordered cone, `1` random directions per sample.
+    dirt_mode: DirtMode = DirtMode::Ordered, flag "dirtmode", keys ["_dirtmode"], range Range::Any;
+
+    /// How far dirt rays look, in units.
+    dirt_depth: f64 = 128.0, flag "dirtdepth", keys ["_dirtdepth"], range Range::Above(0.0);
+
+    /// Strength of dirt.
+    dirt_scale: f64 = 1.0, flag "dirtscale", keys ["_dirtscale"], range Range::AtLeast(0.0);
+
+    /// Contrast of dirt (the exponent on occlusion).
+    dirt_gain: f64 = 1.0, flag "dirtgain", keys ["_dirtgain"], range Range::Above(0.0);
+
+    /// Dirt cone half-angle from the normal, in degrees.
+    dirt_angle: f64 = 88.0, flag "dirtangle", keys ["_dirtangle"], range Range::Clamp(1.0, 90.0);
+
+    /// Bounced light: passes of diffuse interreflection (`--bounce` alone: 1). Passes beyond 16
+    /// bring nothing a lightmap byte can show.
+    bounce: usize = 0, flag "bounce" missing "1", keys ["_bounce"], range Range::Clamp(0.0, 16.0);
+
+    /// Brightness of bounced light.
+    bounce_scale: f64 = 1.0, flag "bouncescale", keys ["_bouncescale"], range Range::Clamp(0.0, f64::INFINITY);
+
+    /// How much of a texture's mean colour its reflection takes, 0 (grey) to 1.
+    bounce_color_scale: f64 = 0.0, flag "bouncecolorscale", keys ["_bouncecolorscale"], range Range::Clamp(0.0, 1.0);
+
+    /// Light of switchable and animated styles reflects too, in its own style.
+    bounce_styled: bool = false, flag "bouncestyled", keys ["_bouncestyled"], range Range::Any;
+}
+
+/// The settings as `docs/mapping.md` tables them: one row per setting, with its worldspawn
+/// keys, its flag, its default, its range and its meaning.
+pub fn markdown_table() -> String {
+    let code = |s: &str| format!("`{s}`");
+    let mut out = String::from(
+        "| worldspawn key | option | default | range | meaning |\n|---|---|---|---|---|\n",
+    );
+    for s in TABLE {
+        let keys = match s.keys {
+            [] => "—".to_string(),
+            [key] => code(key),
+            [key, others @ ..] => {
+                let others: Vec<String> = others.iter().map(|k| code(k)).collect();
+                format!("{} ({})", code(key), others.join(", "))
+            }
+        };
+        let flag = match s.flag {
+            None => "—".to_string(),
+            Some(flag) => {
+                let value = match (s.switch, s.missing) {
+                    (true, _) => "",
+                    (false, Some(_)) => " [N]",
+                    (false, None) => " N",
+                };
+                let alias = s.alias.map_or(String::new(), |a| format!(" (`--{a}`)"));
+                format!("`--{flag}{value}`{alias}")
+            }
+        };
+        let default = (s.default)();
+        let default = if default.starts_with("as ") || default == "white" || default == "—" {
+            default
+        } else {
+            code(&default)
+        };
+        let help = s.help.split_whitespace().collect::<Vec<_>>().join(" ");
+        out += &format!(
+            "| {keys} | {flag} | {default} | {} | {help} |\n",
+            s.range.show()
+        );
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,123 @@
+use super::*;
+use quake_formats::entities::parse_entities;
+
+fn resolve_text(world: &str, overrides: &Overrides) -> (Settings, Vec<SettingWarning>) {
+    let entities = parse_entities(world).expect("parse");
+    let world = World {
+        index: 0,
+        entity: &entities[0],
+    };
+    Settings::resolve(Some(world), overrides)
+}
+
+#[test]
+fn the_command_line_wins_over_worldspawn_which_wins_over_the_default() {
+    let world = r#"{ "classname" "worldspawn" "_dist" "2" "_range" "0.7" "light" "5" "_sunlight_mangle" "0 -45 0" "_gamma" " " }"#;
+    let overrides = Overrides {
+        range: Some(0.9),
+        ..Overrides::default()
+    };
+    let (s, warnings) = resolve_text(world, &overrides);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert_eq!(s.dist, 2.0);
+    assert_eq!(s.range, 0.9);
+    assert_eq!(s.minlight, 5.0, "`light` stands for `_minlight`");
+    assert_eq!(s.sun_mangle, DVec3::new(0.0, -45.0, 0.0));
+    assert_eq!(s.gamma, 1.0, "a blank value is absent");
+    assert_eq!(s.bounce, 0);
+    assert_eq!(
+        Settings::resolve(None, &Overrides::default()).0,
+        Settings::default()
+    );
+}
+
+#[test]
+fn worldspawn_values_out_of_range_or_unreadable_warn_and_fall_back() {
+    let world = r#"{ "classname" "worldspawn" "_dirtangle" "120" "_gamma" "0" "_bounce" "1.5" "_sunlight_color" "255 200" "_bouncescale" "-2" }"#;
+    let (s, warnings) = resolve_text(world, &Overrides::default());
+    assert_eq!(s.dirt_angle, 90.0, "clamped");
+    assert_eq!(s.gamma, 1.0, "the default");
+    assert_eq!(s.bounce, 0);
+    assert_eq!(s.sunlight_color, Color::WHITE);
+    assert_eq!(s.bounce_scale, 0.0);
+    let messages: Vec<String> = warnings.iter().map(ToString::to_string).collect();
+    assert_eq!(
+        messages,
+        [
+            "entity 0 (worldspawn): key \"_gamma\" is \"0\": outside > 0; the default 1 is used",
+            "entity 0 (worldspawn): key \"_sunlight_color\" is \"255 200\": expected three numbers; the default white is used",
+            "entity 0 (worldspawn): key \"_dirtangle\" is \"120\": outside 1–90 (clamped); 90 is used",
+            "entity 0 (worldspawn): key \"_bounce\" is \"1.5\": expected a whole number, 0 or more; the default 0 is used",
+            "entity 0 (worldspawn): key \"_bouncescale\" is \"-2\": outside ≥ 0 (clamped); 0 is used",
+        ]
+    );
+    let overrides = Overrides {
+        sunsamples: Some(0),
+        ..Overrides::default()
+    };
+    let (s, warnings) = Settings::resolve(None, &overrides);
+    assert_eq!(s.sunsamples, 1);
+    assert_eq!(
+        warnings[0].to_string(),
+        "--sunsamples 0: outside ≥ 1 (clamped); 1 is used"
+    );
+}
+
+#[test]
+fn flags_and_keys_are_each_declared_once() {
+    let mut names: Vec<&str> = TABLE
+        .iter()
+        .flat_map(|s| s.flag.into_iter().chain(s.alias))
+        .collect();
+    let mut keys: Vec<&str> = TABLE.iter().flat_map(|s| s.keys.iter().copied()).collect();
+    for list in [&mut names, &mut keys] {
+        let n = list.len();
+        list.sort_unstable();
+        list.dedup();
+        assert_eq!(list.len(), n, "repeated: {list:?}");
+    }
+    for s in TABLE {
+        assert!(
+            s.flag.is_some() || !s.keys.is_empty(),
+            "{} has neither flag nor key",
+            s.field
+        );
+        assert!(!s.help.trim().is_empty(), "{} has no help", s.field);
+        let default = (s.default)();
+        if s.flag.is_some() && !s.switch {
+            assert_eq!(
+                (s.check)(&default),
+                Ok(()),
+                "{}'s default reads back",
+                s.field
+            );
+        }
+    }
+}
+
+const DOCS_START: &str = "<!-- light settings: generated from light/src/settings/mod.rs -->\n";
+const DOCS_END: &str = "<!-- end of light settings -->";
+
+/// `docs/mapping.md` lists every setting with its keys, flag and default as the table declares
+/// them. `SLIPGATE_WRITE_DOCS=1 cargo test -p slipgate-light settings` rewrites the list.
+#[test]
+fn the_docs_list_every_setting_as_declared() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/mapping.md");
+    let docs = std::fs::read_to_string(&path).expect("docs/mapping.md");
+    let start = docs
+        .find(DOCS_START)
+        .expect("the settings table's start marker")
+        + DOCS_START.len();
+    let end = start + docs[start..].find(DOCS_END).expect("its end marker");
+    let table = markdown_table();
+    if std::env::var_os("SLIPGATE_WRITE_DOCS").is_some() {
+        let written = format!("{}{table}{}", &docs[..start], &docs[end..]);
+        std::fs::write(&path, written).expect("write docs/mapping.md");
+        return;
+    }
+    assert!(
+        docs[start..end] == table,
+        "docs/mapping.md's settings table is not the declared one; rewrite it with \
+         SLIPGATE_WRITE_DOCS=1 cargo test -p slipgate-light settings. Declared:\n{table}"
+    );
+}

@@ -1,0 +1,172 @@
+//! Light that got through to a sample, on its way into the face's sums.
+//!
+//! Without dirt each arrival goes straight into the per-style sums. With dirt measured on the
+//! face, arrivals wait until every shadow ray is traced, so occlusion is measured only where
+//! some light that takes it arrived; they are then added in the order they came, so the sums
+//! are the same as adding each as it was traced.
+
+use super::sample_light::{SampleLight, StyleBuffers};
+use crate::dirt::DirtFactors;
+use crate::lights::{Falloff, PointLight, SunLight};
+
+/// Where light arriving at a sample comes from.
+#[derive(Debug, Clone, Copy)]
+pub enum Source {
+    Light(usize),
+    Sun(usize),
+}
+
+/// Light that reached a sample (its shadow ray got through), before dirt.
+#[derive(Debug, Clone, Copy)]
+pub struct Arrival {
+    source: Source,
+    pub sample: u32,
+    value: f64,
+    /// The source takes dirt on this face.
+    pub dirty: bool,
+    /// Dropped when below the gate once dirt is applied (not for
+    /// close-light squares, which are kept whatever their value).
+    gated: bool,
+}
+
+impl Arrival {
+    pub fn new(source: Source, sample: usize, value: f64, dirty: bool, gated: bool) -> Arrival {
+        Arrival {
+            source,
+            sample: sample as u32,
+            value,
+            dirty,
+            gated,
+        }
+    }
+}
+
+/// Where a face's arrivals go. With dirt measured they wait (dirt is measured
+/// after the shadow rays, only where some light that takes it arrives); without,
+/// they go straight into the sums, in the same order and so to the same sums
+/// (a gated arrival is above the gate already: nothing darkens it).
+#[derive(Debug, Default)]
+pub struct Arrivals {
+    pub waiting: Vec<Arrival>,
+    wait: bool,
+}
+
+impl Arrivals {
+    pub fn start_face(&mut self, wait: bool) {
+        self.waiting.clear();
+        self.wait = wait;
+    }
+
+    pub fn add(
+        &mut self,
+        a: Arrival,
+        lights: &[PointLight],
+        suns: &[SunLight],
+        out: &mut SampleLight,
+    ) {
+        if self.wait {
+            self.waiting.push(a);
+        } else {
+            settle(&a, a.value, lights, suns, out);
+        }
+    }
+
+    /// [`Arrivals::add`] for light `li` arriving at each `(sample, value)` of `arrived`, in
+    /// one go when nothing waits.
+    pub fn add_light(
+        &mut self,
+        li: usize,
+        light: &PointLight,
+        arrived: impl Iterator<Item = (usize, f64)> + Clone,
+        (dirty, gated): (bool, bool),
+        out: &mut SampleLight,
+    ) {
+        if self.wait {
+            self.waiting
+                .extend(arrived.map(|(i, v)| Arrival::new(Source::Light(li), i, v, dirty, gated)));
+        } else {
+            deposit(light, arrived, out);
+        }
+    }
+
+    /// Adds the arrivals that waited for dirt, each darkened by its source's response
+    /// (`dirt`), in the order they were found, so sums come out the same as adding each light
+    /// as it is traced; those that dirt takes below `gate` are dropped.
+    pub fn settle_waiting(
+        &self,
+        lights: &[PointLight],
+        suns: &[SunLight],
+        dirt: &mut DirtFactors,
+        gate: f64,
+        out: &mut SampleLight,
+    ) {
+        for a in &self.waiting {
+            let i = a.sample as usize;
+            let response = match a.source {
+                Source::Light(li) => lights[li].dirt,
+                Source::Sun(si) => suns[si].dirt,
+            };
+            let v = a.value * dirt.get(response).map_or(1.0, |d| f64::from(d[i]));
+            if a.gated && v.abs() < gate {
+                continue;
+            }
+            settle(a, v, lights, suns, out);
+        }
+    }
+}
+
+/// Adds arrival `a` to `out` at `value` (its value after dirt).
+fn settle(
+    a: &Arrival,
+    value: f64,
+    lights: &[PointLight],
+    suns: &[SunLight],
+    out: &mut SampleLight,
+) {
+    let i = a.sample as usize;
+    match a.source {
+        Source::Light(li) => deposit(&lights[li], std::iter::once((i, value)), out),
+        Source::Sun(si) => {
+            let sun = &suns[si];
+            let slot = &mut out.sums.get(sun.style)[i];
+            for (o, c) in slot.iter_mut().zip(sun.color.to_array()) {
+                *o += (value * c) as f32;
+            }
+        }
+    }
+}
+
+/// Adds `value` of `light` (its colour) to sample `i` for each `(i, value)`
+/// of `arrived`, or for a local minlight raises the sample's floor to it.
+/// Light of a `_bounce 0` light is also kept in `no_bounce`, so it can be
+/// taken out of what reflects.
+fn deposit(
+    light: &PointLight,
+    arrived: impl Iterator<Item = (usize, f64)> + Clone,
+    out: &mut SampleLight,
+) {
+    let local_min = light.falloff == Falloff::LocalMin;
+    let color = light.color.to_array();
+    let target = if local_min {
+        &mut out.floors
+    } else {
+        &mut out.sums
+    };
+    let buffer = target.get(light.style);
+    for (i, value) in arrived.clone() {
+        for (o, c) in buffer[i].iter_mut().zip(color) {
+            let add = (value * c) as f32;
+            *o = if local_min { o.max(add) } else { *o + add };
+        }
+    }
+    if !local_min && !light.bounce {
+        let len = out.sums.len;
+        let kept = out.no_bounce.get_or_insert_with(|| StyleBuffers::new(len));
+        let buffer = kept.get(light.style);
+        for (i, value) in arrived {
+            for (o, c) in buffer[i].iter_mut().zip(color) {
+                *o += (value * c) as f32;
+            }
+        }
+    }
+}

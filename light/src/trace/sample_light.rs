@@ -1,0 +1,146 @@
+//! A face's light per sample and style, as tracing leaves it: sums, local-minlight floors,
+//! `--addmin` minlight and the dirt factor of bounced light, until [`SampleLight::finish`]
+//! adds bounce, applies the floors and averages samples to luxels.
+
+use super::FaceLight;
+
+/// Per-sample buffers, one per style (style 0 always present and first).
+#[derive(Debug)]
+pub struct StyleBuffers {
+    pub len: usize,
+    pub styles: Vec<(u8, Vec<[f32; 3]>)>,
+}
+
+impl StyleBuffers {
+    pub fn new(len: usize) -> StyleBuffers {
+        StyleBuffers {
+            len,
+            styles: vec![(0, vec![[0.0; 3]; len])],
+        }
+    }
+
+    pub fn get(&mut self, style: u8) -> &mut Vec<[f32; 3]> {
+        let i = match self.styles.iter().position(|(s, _)| *s == style) {
+            Some(i) => i,
+            None => {
+                self.styles.push((style, vec![[0.0; 3]; self.len]));
+                self.styles.len() - 1
+            }
+        };
+        &mut self.styles[i].1
+    }
+}
+
+/// A face's light per sample before minlight floors are applied, so that
+/// bounced light can still be added (floors apply to the sum).
+#[derive(Debug)]
+pub struct SampleLight {
+    pub face: usize,
+    pub width: usize,
+    pub height: usize,
+    pub(super) per_luxel: usize,
+    pub(super) sums: StyleBuffers,
+    pub(super) floors: StyleBuffers,
+    /// `--addmin` minlight of style 0, added when finishing (it does not bounce).
+    pub(super) added_minlight: Option<Vec<[f32; 3]>>,
+    /// The part of `sums` from `_bounce 0` lights.
+    pub(super) no_bounce: Option<StyleBuffers>,
+    /// Per sample, the dirt factor of bounced light (empty: none).
+    pub(super) bounce_dirt: Vec<f32>,
+}
+
+/// Luxel means of per-sample values, `per` samples to a luxel (one sample to a luxel, as in
+/// the default mode: the values themselves, not copied).
+fn luxel_means(values: Vec<[f32; 3]>, per: usize) -> Vec<[f32; 3]> {
+    if per == 1 {
+        return values;
+    }
+    values
+        .chunks(per)
+        .map(|c| {
+            let mut acc = [0.0f32; 3];
+            for v in c {
+                for k in 0..3 {
+                    acc[k] += v[k];
+                }
+            }
+            acc.map(|a| a / per as f32)
+        })
+        .collect()
+}
+
+impl SampleLight {
+    /// Per style, the luxel means of the light that reflects: lights and
+    /// suns without minlight or `_bounce 0` lights; style 0 only unless
+    /// `styled`. Styles with no light are left out.
+    pub fn reflected(&self, styled: bool) -> Vec<(u8, Vec<[f32; 3]>)> {
+        let mut out = Vec::new();
+        for (style, values) in &self.sums.styles {
+            if *style != 0 && !styled {
+                continue;
+            }
+            let mut values = values.clone();
+            if let Some(no) = &self.no_bounce
+                && let Some((_, minus)) = no.styles.iter().find(|(s, _)| s == style)
+            {
+                for (v, m) in values.iter_mut().zip(minus) {
+                    for k in 0..3 {
+                        v[k] = (v[k] - m[k]).max(0.0);
+                    }
+                }
+            }
+            if values.iter().any(|v| v.iter().any(|&c| c > 0.0)) {
+                out.push((*style, luxel_means(values, self.per_luxel)));
+            }
+        }
+        out
+    }
+
+    /// Adds `bounce` (per style, per luxel (given to each of the luxel's
+    /// samples) or per sample, times each sample's dirt factor), applies
+    /// minlight and the floors, and averages samples to luxels.
+    pub fn finish(mut self, bounce: &[(u8, Vec<[f32; 3]>)]) -> FaceLight {
+        let per = self.per_luxel;
+        if let Some(min) = &self.added_minlight {
+            for (s, m) in self.sums.get(0).iter_mut().zip(min) {
+                for k in 0..3 {
+                    s[k] += m[k];
+                }
+            }
+        }
+        for (style, luxels) in bounce {
+            let dirt = &self.bounce_dirt;
+            let sums = self.sums.get(*style);
+            let step = if luxels.len() == sums.len() { 1 } else { per };
+            for (i, s) in sums.iter_mut().enumerate() {
+                let Some(b) = luxels.get(i / step) else {
+                    continue;
+                };
+                let f = dirt.get(i).copied().unwrap_or(1.0);
+                for k in 0..3 {
+                    s[k] += b[k] * f;
+                }
+            }
+        }
+        for (style, floor) in &self.floors.styles {
+            let sum = self.sums.get(*style);
+            for (s, f) in sum.iter_mut().zip(floor) {
+                for c in 0..3 {
+                    s[c] = s[c].max(f[c]);
+                }
+            }
+        }
+        let styles = self
+            .sums
+            .styles
+            .into_iter()
+            .map(|(style, values)| (style, luxel_means(values, per)))
+            .collect();
+        FaceLight {
+            face: self.face,
+            width: self.width,
+            height: self.height,
+            styles,
+        }
+    }
+}
