@@ -3,7 +3,6 @@
 
 use anyhow::{Context, Result};
 use clap::{Args, FromArgMatches};
-use serde_json::Value;
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -75,58 +74,35 @@ fn stage_args<A: Args + FromArgMatches>(name: &'static str, argv: Vec<OsString>)
     Ok(A::from_arg_matches(&matches)?)
 }
 
-/// One stage's wall time and the stats JSON it wrote.
+/// One stage's wall time and its main figures.
 struct StageRun {
     name: &'static str,
     seconds: f64,
-    stats: Value,
+    figures: String,
 }
 
-/// Where a stage writes its stats: the path its `--*-opts` name, else one in `scratch`.
-fn stats_path(argv: &mut Vec<OsString>, scratch: &Path, stage: &str) -> PathBuf {
-    let given = argv.iter().enumerate().find_map(|(i, a)| {
-        let a = a.to_str()?;
-        match a.strip_prefix("--stats") {
-            Some("") => argv.get(i + 1).map(PathBuf::from),
-            Some(v) => v.strip_prefix('=').map(PathBuf::from),
-            None => None,
-        }
-    });
-    given.unwrap_or_else(|| {
-        let path = scratch.join(format!("{stage}.json"));
-        argv.extend(["--stats".into(), path.clone().into()]);
-        path
-    })
-}
-
-/// Runs a stage with `--stats`, timing it.
-fn run_stage<A: Args + FromArgMatches>(
+/// Runs a stage's command with `argv`, timing it; `figures` summarises what it returned.
+fn run_stage<A: Args + FromArgMatches, T>(
     name: &'static str,
-    mut argv: Vec<OsString>,
-    scratch: &Path,
-    run: impl FnOnce(&A) -> Result<()>,
-) -> Result<StageRun> {
-    let stats = stats_path(&mut argv, scratch, name);
+    argv: Vec<OsString>,
+    run: impl FnOnce(&A) -> Result<T>,
+    figures: impl FnOnce(&T) -> String,
+) -> Result<(StageRun, T)> {
     eprintln!("== {name}");
     let start = Instant::now();
-    run(&stage_args(name, argv)?)?;
-    let seconds = start.elapsed().as_secs_f64();
-    let text = std::fs::read(&stats).with_context(|| format!("{}", stats.display()))?;
-    Ok(StageRun {
+    let out = run(&stage_args(name, argv)?)?;
+    let stage = StageRun {
         name,
-        seconds,
-        stats: serde_json::from_slice(&text).with_context(|| format!("{}", stats.display()))?,
-    })
+        seconds: start.elapsed().as_secs_f64(),
+        figures: figures(&out),
+    };
+    Ok((stage, out))
 }
 
 pub fn build(args: &BuildArgs) -> Result<()> {
     let start = Instant::now();
     let bsp = args.map.with_extension("bsp");
-    let scratch = std::env::temp_dir().join(format!("slipgate-build-{}", std::process::id()));
-    std::fs::create_dir_all(&scratch).with_context(|| format!("{}", scratch.display()))?;
-    let stages = run_stages(args, &bsp, &scratch);
-    let _ = std::fs::remove_dir_all(&scratch);
-    let stages = stages?;
+    let stages = run_stages(args, &bsp)?;
     eprint!("{}", summary(&args.map, &stages));
     eprintln!(
         "build: {} in {:.2} s",
@@ -136,7 +112,7 @@ pub fn build(args: &BuildArgs) -> Result<()> {
     Ok(())
 }
 
-fn run_stages(args: &BuildArgs, bsp: &Path, scratch: &Path) -> Result<Vec<StageRun>> {
+fn run_stages(args: &BuildArgs, bsp: &Path) -> Result<Vec<StageRun>> {
     let mut stages = Vec::new();
     let mut argv: Vec<OsString> = vec![args.map.clone().into(), bsp.into()];
     if args.bsp2 {
@@ -146,10 +122,13 @@ fn run_stages(args: &BuildArgs, bsp: &Path, scratch: &Path) -> Result<Vec<StageR
         argv.extend(["--wad-dir".into(), dir.clone().into()]);
     }
     argv.extend(extra_args(args.bsp_opts.as_deref()));
-    stages.push(run_stage("bsp", argv, scratch, bsp_compiler::cli::run)?);
+    let (stage, compiled) = run_stage("bsp", argv, bsp_compiler::cli::run, |s| {
+        s.as_ref().map_or(String::new(), bsp_figures)
+    })?;
+    stages.push(stage);
 
     // A leaking map has no .prt unless the bsp options asked for one (--keepprt).
-    let leaked = stages[0].stats.pointer("/leaked") == Some(&Value::Bool(true));
+    let leaked = compiled.is_some_and(|s| s.leaked);
     if leaked && !bsp.with_extension("prt").exists() {
         eprintln!("== vis skipped: the map leaks, and vis needs a sealed map (see the pointfile)");
     } else {
@@ -158,7 +137,10 @@ fn run_stages(args: &BuildArgs, bsp: &Path, scratch: &Path) -> Result<Vec<StageR
             argv.push("--fast".into());
         }
         argv.extend(extra_args(args.vis_opts.as_deref()));
-        stages.push(run_stage("vis", argv, scratch, vis::cli::run)?);
+        let (stage, _) = run_stage("vis", argv, vis::cli::run, |r| {
+            r.as_ref().map_or(String::new(), vis_figures)
+        })?;
+        stages.push(stage);
     }
 
     let mut argv: Vec<OsString> = vec![bsp.into()];
@@ -174,7 +156,10 @@ fn run_stages(args: &BuildArgs, bsp: &Path, scratch: &Path) -> Result<Vec<StageR
         }
     }
     argv.extend(extra_args(args.light_opts.as_deref()));
-    stages.push(run_stage("light", argv, scratch, light::cli::run)?);
+    let (stage, _) = run_stage("light", argv, light::cli::run, |s| {
+        s.as_ref().map_or(String::new(), light_figures)
+    })?;
+    stages.push(stage);
 
     if !args.no_preview {
         let argv: Vec<OsString> = vec![
@@ -184,15 +169,40 @@ fn run_stages(args: &BuildArgs, bsp: &Path, scratch: &Path) -> Result<Vec<StageR
             "--size".into(),
             args.size.clone().into(),
         ];
-        stages.push(run_stage("view", argv, scratch, runtime_viewer::cli::run)?);
+        let (stage, ()) = run_stage("view", argv, runtime_viewer::cli::run, |()| String::new())?;
+        stages.push(stage);
     }
     Ok(stages)
 }
 
-/// The table printed at the end of a build: time and the main figures of each stage, from the
-/// stats each stage wrote, and the sizes of the files written.
+fn bsp_figures(s: &bsp_compiler::CompileStats) -> String {
+    format!(
+        "{} faces, {} leaves, {} nodes, {} clipnodes, {} portals",
+        s.faces, s.leaves, s.nodes, s.clipnodes, s.vis_portals
+    )
+}
+
+fn vis_figures(r: &vis::VisReport) -> String {
+    format!(
+        "PVS average {:.1} of {} leaves; visibility lump {:.1} KB",
+        r.compute.average_visible,
+        r.compute.leafs,
+        r.lump.compressed_bytes as f64 / 1024.0
+    )
+}
+
+fn light_figures(s: &light::Stats) -> String {
+    let rays = s.shadow_rays + s.sun_rays + s.dirt_rays + s.placement_rays + s.bounce_rays;
+    format!(
+        "{:.2} M rays, {:.1} Mrays/s",
+        rays as f64 / 1e6,
+        s.rays_per_second / 1e6
+    )
+}
+
+/// The table printed at the end of a build: time and the main figures of each stage, and the
+/// sizes of the files written.
 fn summary(map: &Path, stages: &[StageRun]) -> String {
-    let number = |v: &Value, pointer: &str| v.pointer(pointer).and_then(Value::as_f64);
     let size = |ext: &str| {
         let path = map.with_extension(ext);
         std::fs::metadata(&path).ok().map(|m| {
@@ -202,44 +212,6 @@ fn summary(map: &Path, stages: &[StageRun]) -> String {
     };
     let mut out = String::from("| stage | time | figures | files |\n|---|---|---|---|\n");
     for stage in stages {
-        let s = &stage.stats;
-        let figures = match stage.name {
-            "bsp" => [
-                ("faces", "faces"),
-                ("leaves", "leaves"),
-                ("nodes", "nodes"),
-                ("clipnodes", "clipnodes"),
-                ("vis_portals", "portals"),
-            ]
-            .iter()
-            .filter_map(|(k, name)| Some(format!("{} {name}", number(s, &format!("/{k}"))?)))
-            .collect::<Vec<_>>()
-            .join(", "),
-            "vis" => format!(
-                "PVS average {:.1} of {} leaves; visibility lump {:.1} KB",
-                number(s, "/compute/average_visible").unwrap_or(0.0),
-                number(s, "/compute/leafs").unwrap_or(0.0),
-                number(s, "/lump/compressed_bytes").unwrap_or(0.0) / 1024.0
-            ),
-            "light" => {
-                let rays: f64 = [
-                    "shadow_rays",
-                    "sun_rays",
-                    "dirt_rays",
-                    "placement_rays",
-                    "bounce_rays",
-                ]
-                .iter()
-                .filter_map(|k| number(s, &format!("/{k}")))
-                .sum();
-                format!(
-                    "{:.2} M rays, {:.1} Mrays/s",
-                    rays / 1e6,
-                    number(s, "/rays_per_second").unwrap_or(0.0) / 1e6
-                )
-            }
-            _ => String::new(),
-        };
         let files: Vec<String> = match stage.name {
             "bsp" => ["bsp", "prt"].iter().filter_map(|e| size(e)).collect(),
             "light" => size("lit").into_iter().collect(),
@@ -247,9 +219,10 @@ fn summary(map: &Path, stages: &[StageRun]) -> String {
             _ => Vec::new(),
         };
         out += &format!(
-            "| {} | {:.2} s | {figures} | {} |\n",
+            "| {} | {:.2} s | {} | {} |\n",
             stage.name,
             stage.seconds,
+            stage.figures,
             files.join(", ")
         );
     }
@@ -274,55 +247,36 @@ mod tests {
     }
 
     #[test]
-    fn stats_go_where_the_options_say_else_to_scratch() {
-        let scratch = Path::new("/tmp/s");
-        let mut argv: Vec<OsString> = vec!["x.bsp".into()];
-        assert_eq!(
-            stats_path(&mut argv, scratch, "vis"),
-            scratch.join("vis.json")
-        );
-        assert_eq!(argv.len(), 3);
-        let mut argv: Vec<OsString> = vec!["x.bsp".into(), "--stats".into(), "mine.json".into()];
-        assert_eq!(
-            stats_path(&mut argv, scratch, "vis"),
-            PathBuf::from("mine.json")
-        );
-        let mut argv: Vec<OsString> = vec!["--stats=m.json".into()];
-        assert_eq!(
-            stats_path(&mut argv, scratch, "vis"),
-            PathBuf::from("m.json")
-        );
-        assert_eq!(argv.len(), 1);
-    }
-
-    #[test]
     fn summary_names_each_stage_s_figures() {
-        let stage = |name, stats| StageRun {
-            name,
-            seconds: 0.5,
-            stats,
+        let stats = bsp_compiler::CompileStats {
+            faces: 61,
+            leaves: 8,
+            nodes: 34,
+            ..Default::default()
+        };
+        let light = light::Stats {
+            shadow_rays: 1_500_000,
+            bounce_rays: 500_000,
+            rays_per_second: 4e6,
+            ..Default::default()
         };
         let stages = [
-            stage(
-                "bsp",
-                serde_json::json!({"faces": 61, "leaves": 8, "nodes": 34}),
-            ),
-            stage(
-                "vis",
-                serde_json::json!({"compute": {"average_visible": 5.25, "leafs": 7}}),
-            ),
-            stage(
-                "light",
-                serde_json::json!({"shadow_rays": 1_500_000, "bounce_rays": 500_000,
-                                   "rays_per_second": 4e6}),
-            ),
+            StageRun {
+                name: "bsp",
+                seconds: 0.5,
+                figures: bsp_figures(&stats),
+            },
+            StageRun {
+                name: "light",
+                seconds: 0.25,
+                figures: light_figures(&light),
+            },
         ];
         let table = summary(Path::new("/nonexistent/x.map"), &stages);
         assert!(
-            table.contains("| bsp | 0.50 s | 61 faces, 8 leaves, 34 nodes |"),
+            table.contains("| bsp | 0.50 s | 61 faces, 8 leaves, 34 nodes, 0 clipnodes,"),
             "{table}"
         );
-        assert!(table.contains("PVS average 5.2 of 7 leaves;"), "{table}");
         assert!(table.contains("2.00 M rays, 4.0 Mrays/s"), "{table}");
     }
 

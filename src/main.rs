@@ -71,9 +71,9 @@ fn main() -> ExitCode {
 fn run(command: Command) -> Result<ExitCode> {
     match command {
         Command::Build(args) => build::build(&args).map(|()| ExitCode::SUCCESS),
-        Command::Bsp(args) => bsp_compiler::cli::run(&args).map(|()| ExitCode::SUCCESS),
-        Command::Vis(args) => vis::cli::run(&args).map(|()| ExitCode::SUCCESS),
-        Command::Light(args) => light::cli::run(&args).map(|()| ExitCode::SUCCESS),
+        Command::Bsp(args) => bsp_compiler::cli::run(&args).map(|_| ExitCode::SUCCESS),
+        Command::Vis(args) => vis::cli::run(&args).map(|_| ExitCode::SUCCESS),
+        Command::Light(args) => light::cli::run(&args).map(|_| ExitCode::SUCCESS),
         Command::View(args) => runtime_viewer::cli::run(&args).map(|()| ExitCode::SUCCESS),
         Command::Info(args) => inspect::info(&args),
         Command::Convert(args) => inspect::convert(&args).map(|()| ExitCode::SUCCESS),

@@ -184,17 +184,19 @@ fn remove_stale(path: &Path) -> Result<()> {
     }
 }
 
-pub fn run(args: &Args) -> Result<()> {
+/// Runs `slipgate bsp` with `args`: the compile's counts and timings, or `None` when the
+/// options ask for no compile (`--onlyents`, `--convert`).
+pub fn run(args: &Args) -> Result<Option<crate::CompileStats>> {
     let source = MapSource::read(&args.input)?;
     let bsp_path = args
         .output
         .clone()
         .unwrap_or_else(|| args.input.with_extension("bsp"));
     if args.onlyents {
-        return only_entities(&source, args, &bsp_path);
+        return only_entities(&source, args, &bsp_path).map(|()| None);
     }
     if let Some(format) = args.convert {
-        return convert(&source, format);
+        return convert(&source, format).map(|()| None);
     }
     let out = compile(&source, &args.compile_options())?;
     let pts_path = bsp_path.with_extension("pts");
@@ -286,5 +288,5 @@ pub fn run(args: &Args) -> Result<()> {
         let json = serde_json::to_string_pretty(s)?;
         write_atomic(path, json.as_bytes())?;
     }
-    Ok(())
+    Ok(Some(out.stats))
 }

@@ -13,7 +13,7 @@ struct Cli {
 fn main() -> ExitCode {
     let cli = Cli::parse_from(quake_formats::cli::normalise_single_dash(std::env::args()));
     match run(&cli.args) {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(_) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::FAILURE

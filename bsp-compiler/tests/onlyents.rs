@@ -15,7 +15,7 @@ fn repo() -> PathBuf {
 
 fn bsp_stage(args: &[&str]) -> anyhow::Result<()> {
     let cli = BspCli::try_parse_from(std::iter::once("bsp").chain(args.iter().copied()))?;
-    bsp_compiler::cli::run(&cli.args)
+    bsp_compiler::cli::run(&cli.args).map(drop)
 }
 
 /// The raw bytes of each of the 15 BSP29 lumps, from the file's header.

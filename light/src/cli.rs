@@ -2,17 +2,13 @@
 //! built from [`crate::settings::TABLE`]), the progress bar, what is printed, and the files
 //! written (the BSP and its `.lit` as a pair, `--stats`).
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 
 use anyhow::Context;
 use clap::{Arg, ArgAction, ArgMatches, Command, FromArgMatches};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use quake_formats::Bsp;
 use quake_formats::fsutil::{Staged, read_file, write_atomic};
 use quake_formats::palette::Palette;
-use quake_formats::progress::{Progress, ProgressEvent};
 
 use crate::settings::{Overrides, Setting, TABLE};
 use crate::{Lighting, Options, Quality, compare_with_reference, compute_lighting};
@@ -238,36 +234,12 @@ fn find_palette(args: &Args) -> anyhow::Result<Option<Palette>> {
         .transpose()
 }
 
-/// A bar on stderr for the faces being lit, when stderr is a terminal.
-fn progress_bar() -> Progress {
-    if !std::io::stderr().is_terminal() {
-        return Progress::default();
-    }
-    let bar: Mutex<Option<ProgressBar>> = Mutex::new(None);
-    Progress::new(move |event| {
-        let Ok(mut bar) = bar.lock() else {
-            return;
-        };
-        match event {
-            ProgressEvent::Start { phase, total } => {
-                let b = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
-                let template = format!("{phase} {{bar:40}} {{pos}}/{{len}} faces {{elapsed}}");
-                if let Ok(style) = ProgressStyle::with_template(&template) {
-                    b.set_style(style);
-                }
-                *bar = Some(b);
-            }
-            ProgressEvent::Advance(n) => bar.iter().for_each(|b| b.inc(n)),
-            ProgressEvent::Finish => bar.take().iter().for_each(ProgressBar::finish_and_clear),
-        }
-    })
-}
 
-/// Runs `slipgate light` with `args`.
+/// Runs `slipgate light` with `args`: the run's counts and timings, or `None` for `--onlyents`.
 ///
 /// # Errors
 /// Files that do not read or write, a BSP light refuses, or what [`compute_lighting`] reports.
-pub fn run(args: &Args) -> anyhow::Result<()> {
+pub fn run(args: &Args) -> anyhow::Result<Option<crate::Stats>> {
     match args.threads {
         Some(n) => rayon::ThreadPoolBuilder::new()
             .num_threads(usize::from(n))
@@ -278,15 +250,15 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
 }
 
-fn run_with_current_threads(args: &Args) -> anyhow::Result<()> {
+fn run_with_current_threads(args: &Args) -> anyhow::Result<Option<crate::Stats>> {
     let path = &args.bsp;
     let data = read_file(path)?;
     let mut bsp = Bsp::read(&data).with_context(|| format!("{}", path.display()))?;
     if args.onlyents {
-        return update_entities_only(args, bsp);
+        return update_entities_only(args, bsp).map(|()| None);
     }
     let mut options = args.lighting_options()?;
-    options.progress = progress_bar();
+    options.progress = quake_formats::progress::terminal();
     if let Some(stride) = args.face_stride {
         anyhow::ensure!(stride > 0, "--face-stride must be at least 1");
         options.only_faces = Some((0..bsp.faces.len()).step_by(stride).collect());
@@ -309,7 +281,7 @@ fn run_with_current_threads(args: &Args) -> anyhow::Result<()> {
         }
         write_atomic(stats_path, serde_json::to_string_pretty(&json)?.as_bytes())?;
     }
-    Ok(())
+    Ok(Some(lighting.stats))
 }
 
 /// The measurements `--compare-reference` and `--bench-occlusion` ask for, printed and as

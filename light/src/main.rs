@@ -14,7 +14,9 @@ struct Cli {
 }
 
 fn main() {
-    let cli = Cli::parse_from(light::cli::join_optional_values(std::env::args()));
+    let cli = Cli::parse_from(light::cli::join_optional_values(
+        quake_formats::cli::normalise_single_dash(std::env::args()),
+    ));
     if let Err(e) = light::cli::run(&cli.args) {
         eprintln!("error: {e:#}");
         std::process::exit(1);

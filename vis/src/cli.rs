@@ -69,11 +69,13 @@ pub struct Args {
     pub noambientlava: bool,
 }
 
-pub fn run(args: &Args) -> Result<()> {
+/// Runs `slipgate vis` with `args`: the run's report, or `None` for one shard's part.
+pub fn run(args: &Args) -> Result<Option<crate::VisReport>> {
     let total = Instant::now();
     let inputs = Inputs::read(args)?;
     if let Some(shard) = args.shard {
-        return run_shard(args, &inputs, shard);
+        run_shard(args, &inputs, shard)?;
+        return Ok(None);
     }
     let result = if args.merge {
         merge(args, &inputs)?
@@ -93,7 +95,7 @@ pub fn run(args: &Args) -> Result<()> {
         remove_state(&state_path);
         result
     };
-    finish(args, inputs, result, total)
+    finish(args, inputs, result, total).map(Some)
 }
 
 impl Args {
@@ -277,7 +279,12 @@ fn merge(args: &Args, inputs: &Inputs) -> Result<crate::VisResult> {
 }
 
 /// Write the sets into the BSP and report.
-fn finish(args: &Args, inputs: Inputs, result: crate::VisResult, total: Instant) -> Result<()> {
+fn finish(
+    args: &Args,
+    inputs: Inputs,
+    result: crate::VisResult,
+    total: Instant,
+) -> Result<crate::VisReport> {
     let Inputs {
         mut bsp, prt_path, ..
     } = inputs;
@@ -350,18 +357,18 @@ fn finish(args: &Args, inputs: Inputs, result: crate::VisResult, total: Instant)
             s.violations
         );
     }
+    let report = crate::VisReport {
+        mode: if args.fast { "fast" } else { "full" },
+        level: args.level,
+        compute: result.stats,
+        lump,
+        ambient_leafs: hearing,
+        write_seconds,
+        total_seconds: total.elapsed().as_secs_f64(),
+        sampling,
+    };
     if let Some(path) = &args.stats {
-        let json = serde_json::json!({
-            "mode": if args.fast { "fast" } else { "full" },
-            "level": args.level,
-            "compute": c,
-            "lump": lump,
-            "ambient_leafs": hearing,
-            "write_seconds": write_seconds,
-            "total_seconds": total.elapsed().as_secs_f64(),
-            "sampling": sampling,
-        });
-        write_atomic(path, serde_json::to_string_pretty(&json)?.as_bytes())?;
+        write_atomic(path, serde_json::to_string_pretty(&report)?.as_bytes())?;
     }
-    Ok(())
+    Ok(report)
 }

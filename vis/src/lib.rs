@@ -139,6 +139,27 @@ impl Default for VisOptions {
     }
 }
 
+/// A vis run as the command line reports it (and writes with `--stats`).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct VisReport {
+    /// `fast` or `full`.
+    pub mode: &'static str,
+    /// The full flow's level.
+    pub level: u8,
+    /// What computing the sets counted.
+    pub compute: ComputeStats,
+    /// The visibility lump written.
+    pub lump: LumpStats,
+    /// Leaves that hear an ambient sound.
+    pub ambient_leafs: usize,
+    /// Seconds storing and writing the BSP took.
+    pub write_seconds: f64,
+    /// Seconds the whole run took.
+    pub total_seconds: f64,
+    /// The PVS checked against sight lines, when asked for.
+    pub sampling: Option<sample::SamplingReport>,
+}
+
 /// What [`store`] wrote into a BSP.
 #[derive(Debug, Clone, Default, serde::Serialize)]
 pub struct Stored {

@@ -12,7 +12,7 @@ struct Cli {
 
 fn main() -> ExitCode {
     match run(&Cli::parse_from(quake_formats::cli::normalise_single_dash(std::env::args())).args) {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(_) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::FAILURE
