@@ -294,7 +294,9 @@ fn side(
             let projection = if valve {
                 to_valve(t.rows, normal)
             } else {
-                let (projection, exact) = to_quake(t.rows, normal);
+                // The rows are in map coordinates: so is the plane they are fitted on.
+                let plane = Plane::new(normal, draft.plane.dist + normal.dot(ctx.origin));
+                let (projection, exact) = to_quake(t.rows, &plane);
                 stats.approximate_projections += usize::from(!exact);
                 projection
             };

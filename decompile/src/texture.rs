@@ -8,6 +8,7 @@
 
 use glam::DVec3;
 use quake_formats::bsp::contents;
+use quake_formats::geom::Plane;
 
 /// A texture projection as a `.map` face line gives it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -99,13 +100,30 @@ pub(crate) fn to_valve(rows: [[f64; 4]; 2], normal: DVec3) -> Projection {
     Projection::Valve { axes, scale }
 }
 
-/// The Quake projection nearest `rows` on a face of `normal`, and whether it gives `rows` back.
-/// Quake turns the base axes within the two coordinates they run along, so only those
-/// components of each row can be kept: the s row's give the rotation and s scale, the t row's
-/// part along the turned t axis its scale.
-pub(crate) fn to_quake(rows: [[f64; 4]; 2], normal: DVec3) -> (Projection, bool) {
+/// The Quake projection nearest `rows` on a face of `plane` (in map coordinates), and whether it
+/// gives the face the same texture coordinates.
+///
+/// On the face's plane a row and the row plus any multiple of the plane's normal (with the
+/// offset moved to match) map every point alike, so each row is first moved along the normal
+/// into the two coordinates Quake's base axes for the plane run along: a Valve 220 projection
+/// on a slope becomes the Quake one that looks the same. What is left is exact unless the two
+/// rows are sheared against each other, which Quake's one rotation for both cannot express.
+pub(crate) fn to_quake(rows: [[f64; 4]; 2], plane: &Plane) -> (Projection, bool) {
+    let normal = plane.normal;
     let (s, t) = quake_axes(normal);
     let (p, q) = (axis_index(s), axis_index(t));
+    let dropped = 3 - p - q;
+    let mut rows = rows;
+    if normal[dropped].abs() > 1e-9 {
+        for row in &mut rows {
+            let k = -row[dropped] / normal[dropped];
+            for (axis, component) in row.iter_mut().take(3).enumerate() {
+                *component += k * normal[axis];
+            }
+            row[dropped] = 0.0;
+            row[3] -= k * plane.dist;
+        }
+    }
     let (s_sign, t_sign) = (s[p], t[q]);
     let (cos_s, sin_s) = (rows[0][p] * s_sign, rows[0][q] * s_sign);
     let s_len = cos_s.hypot(sin_s);
@@ -259,7 +277,7 @@ mod tests {
                 ([7.0, 0.0], 180.0, [2.0, 2.0]),
             ] {
                 let rows = quake_rows(normal, shift, rotation, scale);
-                let (back, exact) = to_quake(rows, normal);
+                let (back, exact) = to_quake(rows, &Plane::new(normal, 40.0));
                 assert!(exact, "{normal} {shift:?} {rotation} {scale:?}: {back:?}");
                 let Projection::Quake {
                     shift: s,
@@ -275,15 +293,50 @@ mod tests {
     }
 
     #[test]
-    fn valve_axes_off_the_base_plane_are_inexact_in_quake_format() {
-        let rows = [[1.0, 0.0, 0.5, 0.0], [0.0, -1.0, 0.0, 0.0]];
-        assert!(!to_quake(rows, DVec3::Z).1);
+    fn a_valve_projection_on_a_slope_is_exact_in_quake_format() {
+        // A texture laid along a 30 degree ramp in Valve 220: its t axis runs up the slope.
+        let normal = DVec3::new(0.0, -0.5, 0.866_025_403_784_438_6);
+        let plane = Plane::new(normal, 100.0);
+        let up_slope = DVec3::new(0.0, 0.866_025_403_784_438_6, 0.5);
+        let rows = [
+            [1.0, 0.0, 0.0, 3.0],
+            [-up_slope.x, -up_slope.y, -up_slope.z, 5.0],
+        ];
+        let (quake, exact) = to_quake(rows, &plane);
+        assert!(exact, "{quake:?}");
+        let Projection::Quake {
+            shift,
+            rotation,
+            scale,
+        } = quake
+        else {
+            panic!("quake projection expected");
+        };
+        // Every point of the plane gets the texture coordinates the Valve rows give it.
+        let back = quake_rows(normal, shift, rotation, scale);
+        for p in [
+            normal * 100.0,
+            normal * 100.0 + DVec3::X * 17.0 + up_slope * 40.0,
+        ] {
+            for i in 0..2 {
+                let want = DVec3::new(rows[i][0], rows[i][1], rows[i][2]).dot(p) + rows[i][3];
+                let got = DVec3::new(back[i][0], back[i][1], back[i][2]).dot(p) + back[i][3];
+                // Within what taking the f32 noise off the offsets may move them.
+                assert!((want - got).abs() < 1e-4, "{want} {got}");
+            }
+        }
+    }
+
+    #[test]
+    fn sheared_axes_are_inexact_in_quake_format() {
+        let rows = [[1.0, 0.5, 0.0, 0.0], [0.0, -1.0, 0.0, 0.0]];
+        assert!(!to_quake(rows, &Plane::new(DVec3::Z, 0.0)).1);
         let Projection::Valve { axes, scale } = to_valve(rows, DVec3::Z) else {
             panic!("valve projection expected");
         };
         let len = 1.25f64.sqrt();
         assert!((scale[0] - 1.0 / len).abs() < 1e-6);
-        assert!((axes[0][2] - 0.5 / len).abs() < 1e-6);
+        assert!((axes[0][1] - 0.5 / len).abs() < 1e-6);
     }
 
     #[test]

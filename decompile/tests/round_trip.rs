@@ -52,13 +52,13 @@ fn check(map: &str, format: MapFormat) {
         "{map}: contents differ away from boundaries"
     );
     assert_eq!(
-        sides.same + sides.inside_liquid,
-        sides.faces,
+        sides.same_projection,
+        sides.compared(),
         "{map}: brush sides do not carry their faces' textures"
     );
     assert_eq!(textures.unmatched, 0, "{map}: faces lost");
     assert!(
-        textures.same_projection as f64 >= MIN_RECOMPILED_TEXTURES * textures.faces as f64,
+        textures.same_projection as f64 >= MIN_RECOMPILED_TEXTURES * textures.compared() as f64,
         "{map}: too few recompiled faces keep their texture"
     );
 }

@@ -20,8 +20,13 @@ pub fn maps_dir() -> PathBuf {
 /// Compile `text` as if it were the file `path` (which need not exist: WADs are looked for
 /// beside it and in `maps/`).
 pub fn compile_text(path: &Path, text: String) -> CompileOutput {
+    compile_with_wads(path, text, vec![maps_dir()])
+}
+
+/// Compile `text` as if it were the file `path`, looking for WADs in `wad_dirs`.
+pub fn compile_with_wads(path: &Path, text: String, wad_dirs: Vec<PathBuf>) -> CompileOutput {
     let options = CompileOptions {
-        wad_dirs: vec![maps_dir()],
+        wad_dirs,
         ..CompileOptions::default()
     };
     let source = MapSource {
@@ -40,8 +45,18 @@ pub fn compile_file(path: &Path) -> CompileOutput {
 /// Decompile `bsp` and compile the result again (as a file named `name` in `maps/`), checking
 /// that it compiles sealed and with every brush good.
 pub fn round_trip(bsp: &Bsp, options: &Options, name: &str) -> (Decompiled, CompileOutput) {
+    round_trip_with_wads(bsp, options, name, vec![maps_dir()])
+}
+
+/// [`round_trip`], looking for WADs in `wad_dirs`.
+pub fn round_trip_with_wads(
+    bsp: &Bsp,
+    options: &Options,
+    name: &str,
+    wad_dirs: Vec<PathBuf>,
+) -> (Decompiled, CompileOutput) {
     let decompiled = decompile(bsp, options).expect("decompile");
-    let again = compile_text(&maps_dir().join(name), decompiled.text.clone());
+    let again = compile_with_wads(&maps_dir().join(name), decompiled.text.clone(), wad_dirs);
     assert!(again.leak.is_none(), "{name}: the decompiled map leaks");
     let bad: Vec<String> = again
         .warnings
@@ -123,9 +138,11 @@ pub fn contents_agreement(
     out
 }
 
-/// A face's texture name, texinfo rows, plane (facing the way the face does) and polygon.
+/// A face's texture name and size, texinfo rows, plane (facing the way the face does) and
+/// polygon.
 pub struct FaceInfo {
     pub texture: String,
+    pub size: [f64; 2],
     pub rows: [[f64; 4]; 2],
     pub plane: Plane,
     pub points: Vec<DVec3>,
@@ -144,12 +161,10 @@ pub fn faces(bsp: &Bsp, model: usize) -> Vec<FaceInfo> {
                 plane = plane.flipped();
             }
             let info = &bsp.texinfo[f.texinfo as usize];
-            let texture = bsp.textures.textures[info.miptex as usize]
-                .as_ref()
-                .map(|t| t.name())
-                .unwrap_or_default();
+            let miptex = bsp.textures.textures[info.miptex as usize].as_ref();
             FaceInfo {
-                texture,
+                texture: miptex.map(|t| t.name()).unwrap_or_default(),
+                size: miptex.map_or([0.0; 2], |t| [f64::from(t.width), f64::from(t.height)]),
                 rows: info.vecs.map(|r| r.map(f64::from)),
                 plane,
                 points: bsp
@@ -183,73 +198,175 @@ impl FaceInfo {
             len < 1e-9 || inward.dot(p - a) / len >= -eps
         })
     }
+
+    /// Whether `rows` give this face's corners the texture coordinates its own rows do, to
+    /// within `tolerance` texels, or coordinates a whole texture further on (which look the
+    /// same). Rows that differ by a multiple of the face's normal do that on its plane.
+    pub fn same_projection(&self, rows: &[[f64; 4]; 2], tolerance: f64) -> bool {
+        let at = |r: &[f64; 4], p: DVec3| DVec3::new(r[0], r[1], r[2]).dot(p) + r[3];
+        (0..2).all(|i| {
+            let diffs: Vec<f64> = self
+                .points
+                .iter()
+                .map(|&p| at(&self.rows[i], p) - at(&rows[i], p))
+                .collect();
+            let lo = diffs.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = diffs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            let mut d = ((lo + hi) / 2.0).abs();
+            if self.size[i] > 0.0 {
+                d %= self.size[i];
+                d = d.min(self.size[i] - d);
+            }
+            hi - lo <= tolerance && d <= tolerance
+        })
+    }
 }
 
-/// How the textures of a recompiled model compare with the original's at its faces' centres.
+/// Where a face of a BSP comes from, as the decompiler sees it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FaceKind {
+    /// A side of a filled leaf (solid, liquid, sky) seen from open space or a liquid: a brush
+    /// side of the decompiled map lies under it.
+    BrushSide,
+    /// Open space behind it: the underside of a liquid's surface (the compiler makes it from the
+    /// liquid brush's side) or a face of a brush without collision (lost).
+    OpenBehind,
+    /// Seen only from inside sky, which Slipgate's compiler does not draw (ericw-tools does).
+    IntoSky,
+    /// The same contents on both sides (ericw-tools writes a few between solid brushes): no
+    /// boundary of contents lies there for a brush side to bound.
+    NoBoundary,
+}
+
+/// What face `f` of model `model` of `bsp` is.
+pub fn face_kind(bsp: &Bsp, model: usize, f: &FaceInfo) -> FaceKind {
+    let head = bsp.models[model].head_nodes[0];
+    let c = f.centre();
+    let front = contents_and_clearance(bsp, head, c + f.plane.normal * 0.1).0;
+    let behind = contents_and_clearance(bsp, head, c - f.plane.normal * 0.1).0;
+    if behind == contents::EMPTY {
+        FaceKind::OpenBehind
+    } else if front == behind {
+        FaceKind::NoBoundary
+    } else if front == contents::SKY {
+        FaceKind::IntoSky
+    } else {
+        FaceKind::BrushSide
+    }
+}
+
+/// How a map's faces compare with the original BSP's brush-side faces ([`FaceKind::BrushSide`])
+/// at those faces' centres.
 #[derive(Debug, Default, Clone, Copy)]
 pub struct TextureAgreement {
+    /// Faces of the original.
     pub faces: usize,
-    /// Original faces whose centre lies on no face of the recompiled model facing the same way.
+    /// Faces of the original that are no brush side (not compared).
+    pub open_behind: usize,
+    pub into_sky: usize,
+    pub no_boundary: usize,
+    /// Brush-side faces whose centre lies on nothing facing the same way.
     pub unmatched: usize,
+    /// Brush-side faces where everything at the centre has the same texture.
     pub same_texture: usize,
-    /// Of those with the same texture: the same projection (axes within 1e-4, offsets within
-    /// `offset_tolerance` texels).
+    /// Of those: the same projection too.
     pub same_projection: usize,
 }
 
-/// Compare the faces of model `model` of `a` with those of `b` at `a`'s face centres.
-pub fn texture_agreement(
-    a: &Bsp,
-    b: &Bsp,
+impl TextureAgreement {
+    /// The faces compared.
+    pub fn compared(&self) -> usize {
+        self.faces - self.open_behind - self.into_sky - self.no_boundary
+    }
+}
+
+/// Compare the brush-side faces of model `model` of `original` with `candidates` (faces or brush
+/// sides, as `FaceInfo`s) at the faces' centres.
+fn agreement(
+    original: &Bsp,
     model: usize,
+    candidates: &[FaceInfo],
     offset_tolerance: f64,
 ) -> TextureAgreement {
-    let (fa, fb) = (faces(a, model), faces(b, model));
     let mut out = TextureAgreement::default();
-    for f in &fa {
+    for f in faces(original, model) {
         out.faces += 1;
+        match face_kind(original, model, &f) {
+            FaceKind::OpenBehind => {
+                out.open_behind += 1;
+                continue;
+            }
+            FaceKind::IntoSky => {
+                out.into_sky += 1;
+                continue;
+            }
+            FaceKind::NoBoundary => {
+                out.no_boundary += 1;
+                continue;
+            }
+            FaceKind::BrushSide => {}
+        }
         let c = f.centre();
-        let Some(g) = fb
-            .iter()
-            .find(|g| g.plane.normal.dot(f.plane.normal) > 0.999 && g.holds(c, 0.05))
-        else {
-            out.unmatched += 1;
-            eprintln!("  no face at {c} facing {}", f.plane.normal);
-            continue;
+        // What lies on the face: the candidates through its centre on its plane, or where
+        // two planes nearly coincide there (a wedge between two brushes), those on the nearer.
+        let gap = |g: &FaceInfo| {
+            g.plane.distance(c).abs() + 1000.0 * (1.0 - g.plane.normal.dot(f.plane.normal))
         };
-        if g.texture != f.texture {
-            eprintln!(
-                "  at {c}: {} became {} ({:?} on {:?})",
-                f.texture, g.texture, f.points, g.points
-            );
+        let through: Vec<&FaceInfo> = candidates
+            .iter()
+            .filter(|g| g.plane.normal.dot(f.plane.normal) > 0.999 && g.holds(c, 0.05))
+            .collect();
+        let nearest = through.iter().map(|g| gap(g)).fold(f64::INFINITY, f64::min);
+        let on: Vec<&FaceInfo> = through
+            .into_iter()
+            .filter(|g| gap(g) <= nearest + 1e-3)
+            .collect();
+        if on.is_empty() {
+            out.unmatched += 1;
+            eprintln!("  nothing at {c} facing {} ({})", f.plane.normal, f.texture);
+            continue;
+        }
+        if !on.iter().all(|g| g.texture == f.texture) {
+            let got: Vec<&str> = on.iter().map(|g| g.texture.as_str()).collect();
+            eprintln!("  at {c}: {} became {got:?}", f.texture);
+            if std::env::var_os("DECOMPILE_DEBUG").is_some() {
+                eprintln!("    face {:?} {:?}", f.plane, f.points);
+                for g in &on {
+                    eprintln!("    {} {:?} {:?}", g.texture, g.plane, g.points);
+                }
+            }
             continue;
         }
         out.same_texture += 1;
-        let same = (0..2).all(|i| {
-            (0..3).all(|k| (f.rows[i][k] - g.rows[i][k]).abs() < 1e-4)
-                && (f.rows[i][3] - g.rows[i][3]).abs() <= offset_tolerance
-        });
-        if same {
+        if on
+            .iter()
+            .all(|g| f.same_projection(&g.rows, offset_tolerance))
+        {
             out.same_projection += 1;
         } else {
+            let got: Vec<_> = on.iter().map(|g| g.rows).collect();
             eprintln!(
-                "  at {c} ({}): projection {:?} became {:?}",
-                f.texture, f.rows, g.rows
+                "  at {c} ({}): projection {:?} became {got:?}",
+                f.texture, f.rows
             );
         }
     }
     out
 }
 
-/// A brush side of a `.map` file: its plane, polygon, texture and texinfo rows.
-pub struct MapSideInfo {
-    pub texture: String,
-    pub rows: [[f64; 4]; 2],
-    pub face: FaceInfo,
+/// Compare the faces of model `model` of `a` with those of `b` (a recompile) at `a`'s face
+/// centres.
+pub fn texture_agreement(
+    a: &Bsp,
+    b: &Bsp,
+    model: usize,
+    offset_tolerance: f64,
+) -> TextureAgreement {
+    agreement(a, model, &faces(b, model), offset_tolerance)
 }
 
 /// The brush sides of entity `entity` of `text`, in the entity's coordinates less `origin`.
-pub fn map_sides(text: &str, entity: usize, origin: DVec3) -> Vec<MapSideInfo> {
+pub fn map_sides(text: &str, entity: usize, origin: DVec3) -> Vec<FaceInfo> {
     let map = bsp_compiler::map::parse_map(Path::new("decompiled.map"), text).expect("parse");
     let mut out = Vec::new();
     for brush in &map.entities[entity].brushes {
@@ -266,78 +383,27 @@ pub fn map_sides(text: &str, entity: usize, origin: DVec3) -> Vec<MapSideInfo> {
                 }
             }
             let Some(w) = w else { continue };
-            let rows = f.projection.vecs(&planes[i]);
-            out.push(MapSideInfo {
+            out.push(FaceInfo {
                 texture: f.texture.clone(),
-                rows,
-                face: FaceInfo {
-                    texture: f.texture.clone(),
-                    rows,
-                    plane: planes[i],
-                    points: w.points,
-                },
+                size: [0.0; 2],
+                rows: f.projection.vecs(&planes[i]),
+                plane: planes[i],
+                points: w.points,
             });
         }
     }
     out
 }
 
-/// How the brush sides of a decompiled map compare with the original BSP's faces they cover.
-#[derive(Debug, Default, Clone, Copy)]
-pub struct SideAgreement {
-    pub faces: usize,
-    /// Faces seen from inside a liquid or sky whose back is open space (the underside of a
-    /// water surface): no brush has a side there, the compiler makes them from the liquid's.
-    pub inside_liquid: usize,
-    /// Faces whose centre lies on no brush side facing the same way.
-    pub uncovered: usize,
-    /// Faces every brush side at whose centre carries the face's texture and projection.
-    pub same: usize,
-}
-
 /// Compare the faces of model `model` of `bsp` with the brush sides of entity `entity` of the
-/// decompiled `text` (written with `origin`) at the faces' centres.
+/// decompiled `text` (written with `origin`) at the faces' centres: every brush side there must
+/// carry the face's texture and projection (offsets within a thousandth of a texel).
 pub fn side_agreement(
     bsp: &Bsp,
     model: usize,
     text: &str,
     entity: usize,
     origin: DVec3,
-) -> SideAgreement {
-    let sides = map_sides(text, entity, origin);
-    let mut out = SideAgreement::default();
-    for f in faces(bsp, model) {
-        out.faces += 1;
-        let c = f.centre();
-        let m = &bsp.models[model];
-        let (behind, _) = contents_and_clearance(bsp, m.head_nodes[0], c - f.plane.normal * 0.1);
-        if behind == contents::EMPTY {
-            out.inside_liquid += 1;
-            continue;
-        }
-        let on: Vec<&MapSideInfo> = sides
-            .iter()
-            .filter(|s| s.face.plane.normal.dot(f.plane.normal) > 0.999 && s.face.holds(c, 0.01))
-            .collect();
-        if on.is_empty() {
-            out.uncovered += 1;
-            eprintln!("  no brush side at {c} facing {}", f.plane.normal);
-            continue;
-        }
-        let same = |s: &&MapSideInfo| {
-            s.texture == f.texture
-                && (0..2).all(|i| {
-                    (0..3).all(|k| (f.rows[i][k] - s.rows[i][k]).abs() < 1e-5)
-                        && (f.rows[i][3] - s.rows[i][3]).abs() < 1e-3
-                })
-        };
-        if on.iter().all(same) {
-            out.same += 1;
-        } else {
-            let got: Vec<(&str, [[f64; 4]; 2])> =
-                on.iter().map(|s| (s.texture.as_str(), s.rows)).collect();
-            eprintln!("  at {c}: {} {:?} written as {got:?}", f.texture, f.rows);
-        }
-    }
-    out
+) -> TextureAgreement {
+    agreement(bsp, model, &map_sides(text, entity, origin), 1e-3)
 }
