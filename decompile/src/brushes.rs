@@ -2,9 +2,9 @@
 //! projection, in an order that gives the brush the leaf's contents.
 
 use crate::faces::{ModelFaces, SideFace, TexturedRegion, texture_region};
-use crate::leaves::{FilledLeaf, bsp_plane, filled_leaves};
+use crate::leaves::{FilledLeaf, filled_leaves};
 use crate::points::{read_back, three_points};
-use crate::region::{Region, SideSource, touching_planes, volume};
+use crate::region::{Region, touching_planes, volume};
 use crate::texture::{Gives, Projection, default_name, gives, plain, to_quake, to_valve};
 use crate::{DecompileStats, MapFormat};
 use glam::DVec3;
@@ -14,8 +14,10 @@ use quake_formats::geom::{Bounds, Plane, Winding};
 use std::collections::HashMap;
 
 /// A region holding less than this (cubic units) is a sliver between planes, not a brush: the
-/// compiler refuses brushes under 0.1.
-const MIN_VOLUME: f64 = 0.5;
+/// compiler refuses brushes under 0.1, and the margin covers the difference between its volume
+/// of the planes read back and ours. (At 0.5, forty wedges of trim a unit long went from
+/// LibreQuake's lq1m1.)
+const MIN_VOLUME: f64 = 0.15;
 
 /// Half the size of the origin brush written for an entity with an origin.
 const ORIGIN_BRUSH_HALF: f64 = 8.0;
@@ -104,9 +106,6 @@ struct DraftSide {
     plane: Plane,
     /// The side's polygon's centre.
     centre: DVec3,
-    /// The BSP plane the side lies on and whether it faces the way that plane does; `None` for
-    /// the model's box and texture cuts, on which no face lies.
-    bsp_plane: Option<(u32, bool)>,
     texture: Option<SideTexture>,
     /// The texture is another side's (see [`borrow_textures`]).
     borrowed: bool,
@@ -136,18 +135,10 @@ fn draft(ctx: &ModelContext, piece: &TexturedRegion, value: i32) -> Option<Draft
             let mut polygons = vec![&side.winding];
             polygons.extend(face_polygon.as_ref());
             let points = three_points(&side.plane, &polygons, ctx.origin);
-            let bsp_plane = match side.source {
-                SideSource::Node(n) => ctx.bsp.nodes.get(n).and_then(|node| {
-                    let own = bsp_plane(ctx.bsp, node.plane)?;
-                    Some((node.plane, own.normal.dot(side.plane.normal) > 0.0))
-                }),
-                _ => None,
-            };
             let draft = DraftSide {
                 points,
                 plane: read_back(points, ctx.origin)?,
                 centre: side.winding.center(),
-                bsp_plane,
                 texture: face.and_then(|f| texinfo_of(ctx, f.texinfo)),
                 borrowed: false,
             };
@@ -196,35 +187,55 @@ fn draft(ctx: &ModelContext, piece: &TexturedRegion, value: i32) -> Option<Draft
 /// on the face's plane (Slipgate's does) may take it for a visible face of the leaf: `skip`
 /// there would drop the face.
 fn borrow_textures(drafts: &mut [DraftBrush], stats: &mut DecompileStats) {
-    let mut textured: HashMap<(i32, u32, bool), Vec<(DVec3, SideTexture)>> = HashMap::new();
+    let mut textured: HashMap<PlaneKey, Vec<(Plane, DVec3, SideTexture)>> = HashMap::new();
     for b in drafts.iter() {
         for s in &b.sides {
-            if let (Some(key), Some(texture)) = (s.bsp_plane, &s.texture) {
+            if let Some(texture) = &s.texture {
                 textured
-                    .entry((b.contents, key.0, key.1))
+                    .entry(PlaneKey::of(b.contents, &s.plane, 0))
                     .or_default()
-                    .push((s.centre, texture.clone()));
+                    .push((s.plane, s.centre, texture.clone()));
             }
         }
     }
     for b in drafts.iter_mut() {
         for s in b.sides.iter_mut().filter(|s| s.texture.is_none()) {
-            let Some(candidates) = s
-                .bsp_plane
-                .and_then(|k| textured.get(&(b.contents, k.0, k.1)))
-            else {
-                continue;
-            };
-            let nearest = candidates.iter().min_by(|x, y| {
-                (x.0 - s.centre)
-                    .length_squared()
-                    .total_cmp(&(y.0 - s.centre).length_squared())
-            });
-            if let Some((_, texture)) = nearest {
+            // The planes within the epsilons of this one: in its key's bucket or, where the
+            // distance sits near a bucket's edge, the next one.
+            let nearest = [-1, 0, 1]
+                .into_iter()
+                .filter_map(|step| textured.get(&PlaneKey::of(b.contents, &s.plane, step)))
+                .flatten()
+                .filter(|(plane, _, _)| plane.same_as(&s.plane))
+                .min_by(|x, y| {
+                    (x.1 - s.centre)
+                        .length_squared()
+                        .total_cmp(&(y.1 - s.centre).length_squared())
+                });
+            if let Some((_, _, texture)) = nearest {
                 s.texture = Some(texture.clone());
                 s.borrowed = true;
                 stats.borrowed_textures += 1;
             }
+        }
+    }
+}
+
+/// A bucket of planes near one another, for brushes of one contents: the normal to a
+/// thousandth, the distance to a unit (`step` buckets further on).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+struct PlaneKey {
+    contents: i32,
+    normal: [i64; 3],
+    dist: i64,
+}
+
+impl PlaneKey {
+    fn of(contents: i32, plane: &Plane, step: i64) -> PlaneKey {
+        PlaneKey {
+            contents,
+            normal: (plane.normal * 1000.0).round().as_i64vec3().to_array(),
+            dist: plane.dist.round() as i64 + step,
         }
     }
 }
@@ -258,6 +269,11 @@ fn face_winding(bsp: &Bsp, f: SideFace) -> Option<Winding> {
     ))
 }
 
+/// The name written for a face whose texture the BSP does not hold (a slot of the texture lump
+/// left empty): the name engines give the checkerboard they draw such faces with. Writing
+/// `skip` instead (as ericw-tools does) would drop the face from the map.
+pub(crate) const MISSING_TEXTURE: &str = "notexture";
+
 /// A texinfo's name and rows, in the entity's map coordinates.
 fn texinfo_of(ctx: &ModelContext, texinfo: u32) -> Option<SideTexture> {
     let info = ctx.bsp.texinfo.get(texinfo as usize)?;
@@ -265,12 +281,11 @@ fn texinfo_of(ctx: &ModelContext, texinfo: u32) -> Option<SideTexture> {
         .bsp
         .textures
         .textures
-        .get(info.miptex as usize)?
-        .as_ref()?
-        .name();
-    if name.is_empty() {
-        return None;
-    }
+        .get(info.miptex as usize)
+        .and_then(|t| t.as_ref())
+        .map(|t| t.name())
+        .filter(|n| !n.is_empty())
+        .unwrap_or_else(|| MISSING_TEXTURE.to_string());
     let mut rows = info.vecs.map(|r| r.map(f64::from));
     // The compiler added each axis's reach to the origin to the offset, so the texture stays
     // where the mapper put it when the engine moves the model by its origin.
@@ -300,6 +315,7 @@ fn side(
                 stats.approximate_projections += usize::from(!exact);
                 projection
             };
+            stats.missing_textures += usize::from(t.name == MISSING_TEXTURE);
             (t.name.clone(), projection)
         }
         None => (

@@ -91,6 +91,9 @@ pub struct DecompileStats {
     pub unknown_contents_leaves: usize,
     /// Sides whose texture was replaced because no side's texture gave the brush its contents.
     pub renamed_for_contents: usize,
+    /// Textured sides whose texture the BSP does not hold (an empty slot of its texture lump),
+    /// written as `notexture`.
+    pub missing_textures: usize,
     /// Untextured sides given the texture of a textured side on the same plane (counted among
     /// the untextured): see `Options`' note on compilers that texture a leaf from one side.
     pub borrowed_textures: usize,

@@ -163,7 +163,7 @@ pub fn faces(bsp: &Bsp, model: usize) -> Vec<FaceInfo> {
             let info = &bsp.texinfo[f.texinfo as usize];
             let miptex = bsp.textures.textures[info.miptex as usize].as_ref();
             FaceInfo {
-                texture: miptex.map(|t| t.name()).unwrap_or_default(),
+                texture: miptex.map_or("notexture".to_string(), |t| t.name()),
                 size: miptex.map_or([0.0; 2], |t| [f64::from(t.width), f64::from(t.height)]),
                 rows: info.vecs.map(|r| r.map(f64::from)),
                 plane,
