@@ -10,7 +10,7 @@ use crate::{DecompileStats, MapFormat};
 use glam::DVec3;
 use quake_formats::Bsp;
 use quake_formats::bsp::{Model, contents};
-use quake_formats::geom::{Bounds, Plane, Winding};
+use quake_formats::geom::{Bounds, ON_EPSILON, Plane, Winding};
 use std::collections::HashMap;
 
 /// A region holding less than this (cubic units) is a sliver between planes, not a brush: the
@@ -104,8 +104,8 @@ pub(crate) fn model_brushes(
 struct DraftSide {
     points: [DVec3; 3],
     plane: Plane,
-    /// The side's polygon's centre.
-    centre: DVec3,
+    /// The box around the side's polygon.
+    bounds: Bounds,
     texture: Option<SideTexture>,
     /// The texture is another side's (see [`borrow_textures`]).
     borrowed: bool,
@@ -138,7 +138,7 @@ fn draft(ctx: &ModelContext, piece: &TexturedRegion, value: i32) -> Option<Draft
             let draft = DraftSide {
                 points,
                 plane: read_back(points, ctx.origin)?,
-                centre: side.winding.center(),
+                bounds: side.winding.bounds(),
                 texture: face.and_then(|f| texinfo_of(ctx, f.texinfo)),
                 borrowed: false,
             };
@@ -181,36 +181,46 @@ fn draft(ctx: &ModelContext, piece: &TexturedRegion, value: i32) -> Option<Draft
     })
 }
 
-/// Give each side without a face of its own the texture of the nearest textured side of a brush
-/// of the same contents lying on the same plane and facing the same way. Such a side is hidden
+/// Give each side without a face of its own the texture of a textured side of a brush of the
+/// same contents lying on the same plane and facing the same way: one it touches, else the
+/// nearest. Such a side is hidden
 /// where it is, but a compiler that textures each leaf's face from the first brush side it finds
 /// on the face's plane (Slipgate's does) may take it for a visible face of the leaf: `skip`
 /// there would drop the face.
 fn borrow_textures(drafts: &mut [DraftBrush], stats: &mut DecompileStats) {
-    let mut textured: HashMap<PlaneKey, Vec<(Plane, DVec3, SideTexture)>> = HashMap::new();
+    let mut textured: HashMap<PlaneKey, Vec<(Plane, Bounds, SideTexture)>> = HashMap::new();
     for b in drafts.iter() {
         for s in &b.sides {
             if let Some(texture) = &s.texture {
                 textured
                     .entry(PlaneKey::of(b.contents, &s.plane, 0))
                     .or_default()
-                    .push((s.plane, s.centre, texture.clone()));
+                    .push((s.plane, s.bounds, texture.clone()));
             }
         }
     }
     for b in drafts.iter_mut() {
         for s in b.sides.iter_mut().filter(|s| s.texture.is_none()) {
-            // The planes within the epsilons of this one: in its key's bucket or, where the
-            // distance sits near a bucket's edge, the next one.
+            // A side this one touches first (the compiler's leaf holds both), else the nearest:
+            // leaves of flush brushes reach far. The planes within the epsilons of this one are
+            // in its key's bucket or, where the distance sits near a bucket's edge, the next.
+            let touching = |bounds: &Bounds| {
+                let pad = DVec3::splat(ON_EPSILON);
+                bounds.intersects(&Bounds {
+                    mins: s.bounds.mins - pad,
+                    maxs: s.bounds.maxs + pad,
+                })
+            };
             let nearest = [-1, 0, 1]
                 .into_iter()
                 .filter_map(|step| textured.get(&PlaneKey::of(b.contents, &s.plane, step)))
                 .flatten()
                 .filter(|(plane, _, _)| plane.same_as(&s.plane))
                 .min_by(|x, y| {
-                    (x.1 - s.centre)
-                        .length_squared()
-                        .total_cmp(&(y.1 - s.centre).length_squared())
+                    let gap = |b: &Bounds| (b.center() - s.bounds.center()).length_squared();
+                    touching(&y.1)
+                        .cmp(&touching(&x.1))
+                        .then(gap(&x.1).total_cmp(&gap(&y.1)))
                 });
             if let Some((_, _, texture)) = nearest {
                 s.texture = Some(texture.clone());

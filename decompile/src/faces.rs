@@ -18,8 +18,9 @@ const MIN_PIECE_AREA: f64 = 0.01;
 const SAME_AXIS: f64 = 1e-4;
 const SAME_OFFSET: f64 = 0.25;
 
-/// How many times one leaf may be cut to give each side one texture.
-const MAX_CUTS: usize = 16;
+/// How many pieces one leaf may be cut into to give each side one texture: a bound on the work a
+/// damaged or pathological file can ask for (real leaves take a few).
+const MAX_PIECES: usize = 64;
 
 /// The faces of one model, by the index of the plane they lie on.
 pub(crate) struct ModelFaces<'a> {
@@ -186,20 +187,23 @@ pub(crate) fn texture_region(
     split: bool,
 ) -> Vec<TexturedRegion> {
     let mut out = Vec::new();
-    let mut work = vec![(region, 0)];
-    while let Some((region, cuts)) = work.pop() {
+    let mut work = vec![region];
+    while let Some(region) = work.pop() {
         let pieces = side_faces(faces, &region);
-        if split && cuts < MAX_CUTS {
-            let cut = pieces
+        if split && out.len() + work.len() + 2 <= MAX_PIECES {
+            // The first side of mixed looks that a cut separates.
+            let halves = pieces
                 .iter()
                 .zip(&region.sides)
-                .find(|(p, _)| mixed(faces.bsp, p))
-                .and_then(|(p, side)| best_cut(faces.bsp, p, &side.plane));
-            if let Some(cut) = cut
-                && let (Some(front), Some(back)) = region.split(&cut, SideSource::Cut)
-            {
-                work.push((back, cuts + 1));
-                work.push((front, cuts + 1));
+                .filter(|(p, _)| mixed(faces.bsp, p))
+                .filter_map(|(p, side)| best_cut(faces.bsp, p, &side.plane))
+                .find_map(|cut| match region.split(&cut, SideSource::Cut) {
+                    (Some(front), Some(back)) => Some((front, back)),
+                    _ => None,
+                });
+            if let Some((front, back)) = halves {
+                work.push(back);
+                work.push(front);
                 continue;
             }
         }
