@@ -95,7 +95,8 @@ pub struct DecompileStats {
     /// written as `notexture`.
     pub missing_textures: usize,
     /// Untextured sides given the texture of a textured side on the same plane (counted among
-    /// the untextured): see `Options`' note on compilers that texture a leaf from one side.
+    /// the untextured), for compilers that texture a leaf's face from the first brush side on
+    /// its plane, where `skip` would drop it.
     pub borrowed_textures: usize,
 }
 

@@ -13,14 +13,13 @@ use std::path::{Path, PathBuf};
 /// The share of the recompiled faces that must keep their texture (see `round_trip.rs`).
 const MIN_RECOMPILED_TEXTURES: f64 = 0.85;
 
+/// The corpus folder, or `None` (saying SKIPPED) when it is absent.
 fn corpus() -> Option<PathBuf> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/corpus");
-    if dir.exists() {
-        Some(dir)
-    } else {
-        println!("SKIPPED: no corpus at {}", dir.display());
+    dir.exists().then_some(dir).or_else(|| {
+        println!("SKIPPED: no ../shared/corpus beside the repository");
         None
-    }
+    })
 }
 
 #[test]

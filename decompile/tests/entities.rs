@@ -8,24 +8,29 @@ use decompile::{MapFormat, Options};
 use glam::DVec3;
 use quake_formats::entities::{Entity, parse_entities};
 
-/// A box brush from `lo` to `hi`, every face `texture` (standard format, clockwise points).
+/// A box brush from `lo` to `hi`, every face `texture` (standard format).
 fn block(lo: [i32; 3], hi: [i32; 3], texture: &str) -> String {
-    let [x0, y0, z0] = lo;
-    let [x1, y1, z1] = hi;
-    let faces = [
-        [[x1, y0, z0], [x1, y0, z1], [x1, y1, z0]],
-        [[x0, y0, z0], [x0, y1, z0], [x0, y0, z1]],
-        [[x0, y1, z0], [x1, y1, z0], [x0, y1, z1]],
-        [[x0, y0, z0], [x0, y0, z1], [x1, y0, z0]],
-        [[x0, y0, z1], [x0, y1, z1], [x1, y0, z1]],
-        [[x0, y0, z0], [x1, y0, z0], [x0, y1, z0]],
-    ];
     let mut out = String::from("{\n");
-    for f in faces {
-        for [x, y, z] in f {
-            out += &format!("( {x} {y} {z} ) ");
+    for axis in 0..3 {
+        // On the face across `axis`: a corner and the corners along the next two axes, which
+        // wind clockwise seen from outside in one order on the high face, the other on the low.
+        let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+        for high in [true, false] {
+            let mut corner = lo;
+            corner[axis] = if high { hi[axis] } else { lo[axis] };
+            let (mut along_u, mut along_v) = (corner, corner);
+            along_u[u] = hi[u];
+            along_v[v] = hi[v];
+            let points = if high {
+                [along_u, corner, along_v]
+            } else {
+                [along_v, corner, along_u]
+            };
+            for [x, y, z] in points {
+                out += &format!("( {x} {y} {z} ) ");
+            }
+            out += &format!("{texture} 0 0 0 1 1\n");
         }
-        out += &format!("{texture} 0 0 0 1 1\n");
     }
     out + "}\n"
 }
