@@ -170,22 +170,26 @@ pub(crate) fn plain(normal: DVec3, valve: bool) -> Projection {
 }
 
 /// How far a value read from `f32` fields may be from the number it stood for, per unit of
-/// its size: a little over two `f32` steps.
-const F32_NOISE: f64 = 1.5e-7;
+/// its size: four `f32` steps (texinfo rows are sums and quotients of a few `f32` values).
+const F32_NOISE: f64 = 4.8e-7;
 
 /// How far a rotation recovered from `f32` axes may be from the angle it stood for, in degrees.
 const ROTATION_NOISE: f64 = 1e-5;
 
-/// `x` read from `f32` data, with the noise taken off: the number of at most six decimals
+/// The most decimals a tidied number keeps: few enough that a number read from `f32` is seldom
+/// within the noise of one by chance.
+const TIDY_DECIMALS: i32 = 5;
+
+/// `x` read from `f32` data, with the noise taken off: the number of at most five decimals
 /// within `F32_NOISE` of it (relative to its size, at least 1), when there is one: a scale of
-/// 0.49999997 is 0.5. Otherwise `x`.
+/// 0.49999997 is 0.5, one of -1.0000004 is -1. Otherwise `x`.
 pub(crate) fn tidy(x: f64) -> f64 {
     tidy_within(x, F32_NOISE * x.abs().max(1.0))
 }
 
-/// `x` with at most six decimals when that moves it by `noise` at most.
+/// `x` with at most five decimals when that moves it by `noise` at most.
 fn tidy_within(x: f64, noise: f64) -> f64 {
-    for digits in 0..=6 {
+    for digits in 0..=TIDY_DECIMALS {
         let m = 10f64.powi(digits);
         let r = (x * m).round() / m;
         if (r - x).abs() <= noise {
@@ -341,6 +345,7 @@ mod tests {
         assert_eq!(tidy(29.999_998), 30.0);
         assert_eq!(tidy(12.031_25), 12.031_25);
         assert_eq!(tidy(-0.0), 0.0);
+        assert_eq!(tidy(-1.000_000_357_627_996_6), -1.0);
         let irrational = f64::from(std::f32::consts::FRAC_1_SQRT_2);
         assert_eq!(tidy(irrational), irrational);
     }

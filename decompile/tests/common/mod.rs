@@ -397,7 +397,8 @@ pub fn map_sides(text: &str, entity: usize, origin: DVec3) -> Vec<FaceInfo> {
 
 /// Compare the faces of model `model` of `bsp` with the brush sides of entity `entity` of the
 /// decompiled `text` (written with `origin`) at the faces' centres: every brush side there must
-/// carry the face's texture and projection (offsets within a thousandth of a texel).
+/// carry the face's texture and projection (coordinates within a hundredth of a texel: the
+/// rows are `f32`, and the decompiler takes their noise off).
 pub fn side_agreement(
     bsp: &Bsp,
     model: usize,
@@ -405,5 +406,5 @@ pub fn side_agreement(
     entity: usize,
     origin: DVec3,
 ) -> TextureAgreement {
-    agreement(bsp, model, &map_sides(text, entity, origin), 1e-3)
+    agreement(bsp, model, &map_sides(text, entity, origin), 0.01)
 }
