@@ -127,6 +127,8 @@ struct DraftBrush {
 /// bound too little to be a brush.
 fn draft(ctx: &ModelContext, piece: &TexturedRegion, value: i32) -> Option<DraftBrush> {
     let sides = &piece.region.sides;
+    // A side whose points read back as no plane at all (not found in practice) would leave the
+    // brush open: the brush goes.
     let mut written: Vec<Option<(DraftSide, f64)>> = sides
         .iter()
         .zip(&piece.faces)
@@ -142,9 +144,9 @@ fn draft(ctx: &ModelContext, piece: &TexturedRegion, value: i32) -> Option<Draft
                 texture: face.and_then(|f| texinfo_of(ctx, f.texinfo)),
                 borrowed: false,
             };
-            Some((draft, side.winding.area()))
+            Some(Some((draft, side.winding.area())))
         })
-        .collect();
+        .collect::<Option<_>>()?;
     // Two sides read back as one plane would make the compiler refuse the brush; the smaller one
     // goes (it was within the plane epsilons of the other).
     for i in 0..written.len() {
@@ -183,10 +185,9 @@ fn draft(ctx: &ModelContext, piece: &TexturedRegion, value: i32) -> Option<Draft
 
 /// Give each side without a face of its own the texture of a textured side of a brush of the
 /// same contents lying on the same plane and facing the same way: one it touches, else the
-/// nearest. Such a side is hidden
-/// where it is, but a compiler that textures each leaf's face from the first brush side it finds
-/// on the face's plane (Slipgate's does) may take it for a visible face of the leaf: `skip`
-/// there would drop the face.
+/// nearest. Such a side is hidden where it is, but a compiler that textures each leaf's face
+/// from the first brush side it finds on the face's plane (Slipgate's does) may take it for a
+/// visible face of the leaf: `skip` there would drop the face.
 fn borrow_textures(drafts: &mut [DraftBrush], stats: &mut DecompileStats) {
     let mut textured: HashMap<PlaneKey, Vec<(Plane, Bounds, SideTexture)>> = HashMap::new();
     for b in drafts.iter() {
