@@ -1,6 +1,7 @@
 //! `slipgate`: the one command. Each subcommand is a thin shell over a library stage.
 
 mod build;
+mod decompile;
 mod inspect;
 mod report;
 
@@ -53,6 +54,8 @@ enum Command {
     Batch(batch::cli::Args),
     /// Texture WADs: build one from a folder of PNG/TGA pictures, list one, extract its pictures
     Wad(wad::cli::Args),
+    /// Turn a compiled BSP back into a .map (ericw-tools' bsputil --decompile)
+    Decompile(decompile::DecompileArgs),
 }
 
 fn main() -> ExitCode {
@@ -80,6 +83,7 @@ fn run(command: Command) -> Result<ExitCode> {
         Command::Report(args) => report::report(&args).map(|()| ExitCode::SUCCESS),
         Command::Batch(args) => batch::cli::run(&args),
         Command::Wad(args) => wad::cli::run(&args).map(|()| ExitCode::SUCCESS),
+        Command::Decompile(args) => decompile::decompile(&args).map(|()| ExitCode::SUCCESS),
     }
 }
 

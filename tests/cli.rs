@@ -290,3 +290,32 @@ fn a_leak_writes_a_pointfile_and_no_portal_file_and_vis_refuses_the_void() {
     assert!(out.status.success());
     assert!(prt.exists() && !pts.exists());
 }
+
+/// `slipgate decompile` writes a `.map` that compiles again, sealed, with brushes and textures.
+#[test]
+fn a_decompiled_bsp_compiles_again() {
+    let dir = scratch("decompile");
+    std::fs::create_dir_all(&dir).expect("dir");
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let maps = repo.join("maps");
+    let bsp = dir.join("demo.bsp");
+    let arg = |p: &Path| p.to_str().expect("utf8").to_string();
+    let out = slipgate(&[
+        "bsp",
+        "--wad-dir",
+        &arg(&maps),
+        &arg(&maps.join("demo.map")),
+        &arg(&bsp),
+    ]);
+    assert!(out.status.success());
+    let out = slipgate(&["decompile", &arg(&bsp)]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let map = dir.join("demo-decompile.map");
+    assert!(stderr.contains("brushes"), "{stderr}");
+    let again = dir.join("again.bsp");
+    let out = slipgate(&["bsp", "--wad-dir", &arg(&maps), &arg(&map), &arg(&again)]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(!stderr.contains("LEAK"), "{stderr}");
+}

@@ -234,7 +234,6 @@ fn find_palette(args: &Args) -> anyhow::Result<Option<Palette>> {
         .transpose()
 }
 
-
 /// Runs `slipgate light` with `args`: the run's counts and timings, or `None` for `--onlyents`.
 ///
 /// # Errors
