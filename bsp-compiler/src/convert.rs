@@ -13,7 +13,8 @@ use glam::DVec3;
 use std::fmt::Write;
 
 /// A `.map` dialect, by how faces give their texture projection.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum MapFormat {
     /// Quake's own: shift, rotation and scale on axes picked from the face's normal.
     Quake,

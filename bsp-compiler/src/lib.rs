@@ -13,6 +13,7 @@
 
 pub mod brush;
 pub mod brushlist;
+#[cfg(feature = "cli")]
 pub mod cli;
 mod compile;
 pub mod convert;

@@ -6,6 +6,7 @@ use std::path::Path;
 use light::{Lighting, Options, Quality, compare, finish_lighting, lightmaps_in, trace_lighting};
 use quake_formats::Bsp;
 use quake_formats::prt::PortalFile;
+use runtime_viewer::{Comparison, ViewSummary};
 
 use crate::ReportError;
 
@@ -256,19 +257,31 @@ pub struct ViewFigures {
     pub face_mismatch: f64,
 }
 
-/// A number at `pointer` in a stats JSON file the viewer wrote.
-pub fn json_number(path: &Path, pointer: &str) -> Result<f64, ReportError> {
+/// What `slipgate view --stats` wrote to `path`.
+fn view_summary(path: &Path) -> Result<ViewSummary, ReportError> {
     let text = std::fs::read(path).map_err(ReportError::io(path))?;
-    let value: serde_json::Value =
-        serde_json::from_slice(&text).map_err(|e| ReportError::Measure {
-            path: path.to_path_buf(),
-            what: e.to_string(),
-        })?;
-    value
-        .pointer(pointer)
-        .and_then(serde_json::Value::as_f64)
-        .ok_or_else(|| ReportError::Measure {
-            path: path.to_path_buf(),
-            what: format!("no number at {pointer}"),
-        })
+    serde_json::from_slice(&text).map_err(|e| ReportError::Measure {
+        path: path.to_path_buf(),
+        what: e.to_string(),
+    })
+}
+
+/// A part of the viewer's summary at `path` that the run asked for and that is not there.
+fn missing(path: &Path, what: &str) -> ReportError {
+    ReportError::Measure {
+        path: path.to_path_buf(),
+        what: format!("the viewer wrote no {what}"),
+    }
+}
+
+/// The frame rate of the flythrough the viewer's summary at `path` records.
+pub fn flythrough_fps(path: &Path) -> Result<f64, ReportError> {
+    let bench = view_summary(path)?.bench;
+    Ok(bench.ok_or_else(|| missing(path, "flythrough"))?.fps)
+}
+
+/// The picture against the reference renderer's, from the viewer's summary at `path`.
+pub fn reference_comparison(path: &Path) -> Result<Comparison, ReportError> {
+    let reference = view_summary(path)?.reference;
+    reference.ok_or_else(|| missing(path, "comparison with the reference"))
 }

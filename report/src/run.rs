@@ -85,12 +85,15 @@ pub fn run(options: &Options) -> Result<Report, ReportError> {
                     setting.name,
                     tool.name()
                 ));
-                let result = time_step(options, map, setting, tool);
+                let mut result = time_step(options, map, setting, tool);
                 if let (Ok(_), Stage::View) = (&result, setting.stage) {
                     let stats = map.dir.join(format!("{}.json", setting.key()));
-                    if let Ok(f) = measure::json_number(&stats, "/bench/fps") {
-                        let best = fps.entry((m, s)).or_insert(0.0);
-                        *best = best.max(f);
+                    match measure::flythrough_fps(&stats) {
+                        Ok(f) => {
+                            let best = fps.entry((m, s)).or_insert(0.0);
+                            *best = best.max(f);
+                        }
+                        Err(e) => result = Err(e),
                     }
                 }
                 record(&mut timings, (m, s, tool), result);
@@ -423,12 +426,13 @@ fn view_figures(
         .last()
         .and_then(|s| s.parse().ok())
         .unwrap_or(0);
+    let reference = measure::reference_comparison(&stats)?;
     Ok(ViewFigures {
         span_step,
         fps: best_fps.unwrap_or(0.0),
-        mean_diff: measure::json_number(&stats, "/reference/mean_diff")?,
-        max_diff: measure::json_number(&stats, "/reference/max_diff")?,
-        face_mismatch: measure::json_number(&stats, "/reference/face_mismatch")?,
+        mean_diff: reference.mean_diff,
+        max_diff: f64::from(reference.max_diff),
+        face_mismatch: reference.face_mismatch,
     })
 }
 

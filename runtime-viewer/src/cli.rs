@@ -6,11 +6,14 @@ use std::time::Instant;
 
 use anyhow::bail;
 
+use quake_formats::progress::terminal;
+
 use crate::camera::Camera;
+use crate::flythrough::flythrough;
 use crate::image::write_png;
 use crate::reference::{compare, render_reference};
-use crate::render::{Frame, FrameStats, RenderOptions, Renderer};
-use crate::surface_cache::CacheStats;
+use crate::render::{Frame, RenderOptions, Renderer};
+use crate::summary::ViewSummary;
 use crate::world::World;
 
 /// The viewer's command line, shared by `slipgate view` and `slipgate-view`.
@@ -103,38 +106,32 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let load_time = start.elapsed().as_secs_f64();
     let camera = initial_camera(&world, args)?;
     let mut renderer = Renderer::new(&world, args.render_options());
-    let mut report = serde_json::json!({
-        "map": args.map,
-        "load": world.stats,
-        "load_seconds": load_time,
-        "palette": format!("{:?}", world.palette_source),
-    });
+    let mut summary = ViewSummary {
+        map: args.map.clone(),
+        load: world.stats.clone(),
+        load_seconds: load_time,
+        palette: format!("{:?}", world.palette_source),
+        ..ViewSummary::default()
+    };
 
     if args.window {
-        report["window"] = open_window(&world, &mut renderer, camera, args)?;
+        open_window(&world, &mut renderer, camera, args, &mut summary)?;
     } else if let Some(frames) = args.bench {
-        let bench = run_bench(&world, &mut renderer, &camera, frames.max(1));
+        let bench = flythrough(&world, &mut renderer, &camera, frames, &terminal());
         eprintln!(
-            "{frames} frames at {}x{}: {:.1} fps, cache hit rate {:.1}%, per frame: visibility {:.2} ms, edges {:.2} ms, spans {:.2} ms, surfaces {:.2} ms, raster {:.2} ms",
-            camera.width,
-            camera.height,
+            "{} frames at {}x{}: {:.1} fps, cache hit rate {:.1}%, per frame: visibility {:.2} ms, edges {:.2} ms, spans {:.2} ms, surfaces {:.2} ms, raster {:.2} ms",
+            bench.frames,
+            bench.width,
+            bench.height,
             bench.fps,
-            bench.cache.hit_rate() * 100.0,
-            bench.mean.time_visibility * 1e3,
-            bench.mean.time_edges * 1e3,
-            bench.mean.time_spans * 1e3,
-            bench.mean.time_surfaces * 1e3,
-            bench.mean.time_raster * 1e3,
+            bench.cache_hit_rate * 100.0,
+            bench.mean_frame.time_visibility * 1e3,
+            bench.mean_frame.time_edges * 1e3,
+            bench.mean_frame.time_spans * 1e3,
+            bench.mean_frame.time_surfaces * 1e3,
+            bench.mean_frame.time_raster * 1e3,
         );
-        report["bench"] = serde_json::json!({
-            "frames": frames,
-            "width": camera.width,
-            "height": camera.height,
-            "fps": bench.fps,
-            "cache_hit_rate": bench.cache.hit_rate(),
-            "cache": bench.cache,
-            "mean_frame": bench.mean,
-        });
+        summary.bench = Some(bench);
     } else {
         let mut frame = Frame::new(camera.width, camera.height);
         let stats = renderer.render(&world, &camera, &mut frame);
@@ -154,7 +151,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             stats.cache.bytes_built / 1024,
             args.out.display()
         );
-        report["frame"] = serde_json::to_value(&stats)?;
+        summary.frame = Some(stats);
         if args.reference {
             let reference = render_reference(&world, &camera, &renderer.styles, args.time);
             let path = args.out.with_extension("reference.png");
@@ -168,11 +165,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 diff.face_mismatch * 100.0,
                 path.display()
             );
-            report["reference"] = serde_json::to_value(diff)?;
+            summary.reference = Some(diff);
         }
     }
     if let Some(path) = &args.stats {
-        let text = serde_json::to_string_pretty(&report)?;
+        let text = serde_json::to_string_pretty(&summary)?;
         quake_formats::fsutil::write_atomic(path, text.as_bytes())?;
     }
     Ok(())
@@ -184,7 +181,8 @@ fn open_window(
     renderer: &mut Renderer,
     camera: Camera,
     args: &Args,
-) -> anyhow::Result<serde_json::Value> {
+    view: &mut ViewSummary,
+) -> anyhow::Result<()> {
     let name = format!("slipgate-view {}", args.map.display());
     let summary = crate::window::run_window(world, renderer, camera, &name)?;
     let [x, y, z] = summary.origin;
@@ -195,7 +193,8 @@ fn open_window(
         summary.seconds,
         summary.frames as f64 / summary.seconds.max(1e-9),
     );
-    Ok(serde_json::to_value(summary)?)
+    view.window = Some(summary);
+    Ok(())
 }
 
 #[cfg(not(feature = "window"))]
@@ -204,7 +203,8 @@ fn open_window(
     _: &mut Renderer,
     _: Camera,
     _: &Args,
-) -> anyhow::Result<serde_json::Value> {
+    _: &mut ViewSummary,
+) -> anyhow::Result<()> {
     bail!(
         "--window needs a viewer built with the `window` feature (cargo build --features slipgate-viewer/window)"
     )
@@ -240,81 +240,6 @@ pub fn initial_camera(world: &World, args: &Args) -> anyhow::Result<Camera> {
         height,
         fov_x: args.fov,
     })
-}
-
-/// The flythrough's clock runs as if it were shown at 60 frames a second.
-const BENCH_SECONDS_PER_FRAME: f64 = 1.0 / 60.0;
-
-struct BenchResult {
-    fps: f64,
-    cache: CacheStats,
-    mean: FrameStats,
-}
-
-/// Render `frames` frames along a path through the map's spawn spots (turning as it goes), or a
-/// full turn on the spot when there is only one.
-fn run_bench(
-    world: &World,
-    renderer: &mut Renderer,
-    camera: &Camera,
-    frames: usize,
-) -> BenchResult {
-    let mut spots = world.spots();
-    if spots.is_empty() {
-        spots.push((camera.origin, camera.angles[1]));
-    }
-    let progress = indicatif::ProgressBar::new(frames as u64);
-    if !std::io::IsTerminal::is_terminal(&std::io::stderr()) {
-        progress.set_draw_target(indicatif::ProgressDrawTarget::hidden());
-    }
-    let start_time = renderer.options.time;
-    let mut frame = Frame::new(camera.width, camera.height);
-    let mut cache = CacheStats::default();
-    let mut sum = FrameStats::default();
-    let start = Instant::now();
-    for i in 0..frames {
-        let along = i as f64 / frames as f64 * spots.len() as f64;
-        let (a, b) = (
-            along.floor() as usize % spots.len(),
-            (along.floor() as usize + 1) % spots.len(),
-        );
-        let f = along.fract();
-        let origin = if spots.len() > 1 {
-            spots[a].0.lerp_monotonic(spots[b].0, f)
-        } else {
-            spots[0].0
-        };
-        let cam = Camera {
-            origin,
-            angles: [0.0, spots[a].1 + 360.0 * i as f64 / frames as f64, 0.0],
-            ..*camera
-        };
-        renderer.options.time = start_time + i as f64 * BENCH_SECONDS_PER_FRAME;
-        let s = renderer.render(world, &cam, &mut frame);
-        cache.add(&s.cache);
-        sum.time_visibility += s.time_visibility;
-        sum.time_edges += s.time_edges;
-        sum.time_spans += s.time_spans;
-        sum.time_surfaces += s.time_surfaces;
-        sum.time_raster += s.time_raster;
-        progress.inc(1);
-    }
-    progress.finish_and_clear();
-    let elapsed = start.elapsed().as_secs_f64();
-    let n = frames as f64;
-    let mean = FrameStats {
-        time_visibility: sum.time_visibility / n,
-        time_edges: sum.time_edges / n,
-        time_spans: sum.time_spans / n,
-        time_surfaces: sum.time_surfaces / n,
-        time_raster: sum.time_raster / n,
-        ..FrameStats::default()
-    };
-    BenchResult {
-        fps: n / elapsed,
-        cache,
-        mean,
-    }
 }
 
 #[cfg(test)]

@@ -48,7 +48,7 @@ struct Edge {
 }
 
 /// What the edge list did in one frame.
-#[derive(Debug, Clone, Default, serde::Serialize)]
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
 pub struct EdgeStats {
     /// Polygons handed to the edge list.
     pub polygons: usize,

@@ -270,7 +270,7 @@ fn inside(s: &Surface, p: DVec3) -> bool {
 }
 
 /// How two frames differ.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Comparison {
     /// Pixels compared: the frames' width times height.
     pub pixels: usize,

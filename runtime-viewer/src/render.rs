@@ -65,7 +65,7 @@ impl Default for RenderOptions {
 }
 
 /// Counts and timings of one frame.
-#[derive(Debug, Clone, Default, serde::Serialize)]
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
 pub struct FrameStats {
     /// What the PVS, frustum and facing let through.
     pub visibility: VisStats,

@@ -216,7 +216,7 @@ pub fn build_lit_surface(
 }
 
 /// How the surface cache fared over one frame (or, added up, over many).
-#[derive(Debug, Clone, Copy, Default, serde::Serialize)]
+#[derive(Debug, Clone, Copy, Default, serde::Serialize, serde::Deserialize)]
 pub struct CacheStats {
     /// Surfaces found in the cache, lit by current style values.
     pub hits: u64,

@@ -21,7 +21,7 @@ pub struct Candidate {
 }
 
 /// What the visibility pass let through in one frame.
-#[derive(Debug, Clone, Default, serde::Serialize)]
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
 pub struct VisStats {
     /// The leaf the eye is in (0, the solid leaf, when it is outside the map).
     pub camera_leaf: usize,

@@ -21,7 +21,7 @@ const MAX_STEP: f64 = 0.1;
 const TITLE_INTERVAL: Duration = Duration::from_millis(500);
 
 /// What a session in the window amounted to.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct WindowSummary {
     pub frames: u64,
     pub seconds: f64,

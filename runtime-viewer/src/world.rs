@@ -71,7 +71,7 @@ pub struct Fragment {
 }
 
 /// Counts for the load summary.
-#[derive(Debug, Clone, Default, serde::Serialize)]
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
 pub struct LoadStats {
     /// Faces in the BSP.
     pub faces: usize,

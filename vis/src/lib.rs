@@ -8,6 +8,7 @@
 pub mod ambient;
 pub mod base;
 pub mod bitset;
+#[cfg(feature = "cli")]
 pub mod cli;
 pub mod clusters;
 pub mod explored;

@@ -12,6 +12,7 @@
 #![warn(missing_docs)]
 
 pub mod build;
+#[cfg(feature = "cli")]
 pub mod cli;
 pub mod extract;
 mod measure;
