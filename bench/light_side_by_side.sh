@@ -2,7 +2,7 @@
 # Default-quality light, ours against ericw-tools' (../shared/anchors/ericw-tools), on copies of
 # the same BSPs, interleaved, ROUNDS rounds (default 3): prints wall, user and system seconds per
 # run; take the best (or median) of each, and the median of the paired rounds' ratios.
-# light/README.md's "Direct light, side by side" tables come from this.
+# bench/results/light-side-by-side.md comes from this.
 # Usage: [ROUNDS=3] [OURS="--bounce"] [ERICW="-bounce"] bench/light_side_by_side.sh MAP.bsp...
 # (vised BSPs; nothing is written beside them). OURS and ERICW are each tool's options for the
 # same settings, e.g. OURS="--extra4 --soft --bounce --dirt" ERICW="-extra4 -soft -bounce -dirt".
