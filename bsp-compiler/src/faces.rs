@@ -113,8 +113,65 @@ struct TextureSearch<'a> {
 }
 
 impl TextureSearch<'_> {
+    /// The brushes of leaf `owner` whose sides texture its faces: those of the leaf's own
+    /// contents, else every textured one; in map order.
+    fn own_brushes(&self, owner: u32) -> Vec<&Brush> {
+        let leaf = &self.tree.nodes[owner as usize];
+        let brushes: Vec<&Brush> = leaf
+            .brushes
+            .iter()
+            .filter(|b| b.contents == leaf.contents)
+            .collect();
+        if brushes.is_empty() {
+            leaf.brushes.iter().filter(|b| is_textured(b)).collect()
+        } else {
+            brushes
+        }
+    }
+
+    /// `winding`, a face on `plane` looking out of leaf `owner` (`flipped` as in
+    /// [`crate::brush::Side`]), cut where the sides of the leaf's brushes lying on it change,
+    /// each part with its texinfo: where sides overlap, the brush latest in the map wins (a
+    /// button set flush into a floor shows its own face), as in id's qbsp and ericw-tools, where
+    /// later brushes clip earlier ones. Parts no side covers take [`TextureSearch::texinfo`]'s.
+    fn paint(
+        &self,
+        owner: u32,
+        plane: PlaneId,
+        flipped: bool,
+        winding: &Winding,
+    ) -> Vec<(Winding, u32)> {
+        let normal = self.outward(plane, flipped).normal;
+        // Latest first: fragments keep their map order.
+        let sides: Vec<&Side> = textured_sides(self.own_brushes(owner).into_iter().rev())
+            .into_iter()
+            .filter(|s| s.plane == plane && s.flipped == flipped)
+            .collect();
+        let mut out = Vec::new();
+        let mut rest = vec![winding.clone()];
+        if sides.windows(2).any(|w| w[0].texinfo != w[1].texinfo) {
+            for s in &sides {
+                let mut outside = Vec::new();
+                for piece in rest {
+                    if let Some(inside) = split_by_polygon(piece, &s.winding, normal, &mut outside)
+                    {
+                        out.extend(s.texinfo.map(|t| (inside, t)));
+                    }
+                }
+                rest = outside;
+            }
+        }
+        for piece in rest {
+            if let Some(t) = self.texinfo(owner, plane, flipped, piece.center()) {
+                out.push((piece, t));
+            }
+        }
+        out
+    }
+
     /// The texinfo of the side of leaf `owner`'s brushes on `plane` facing out of it (`flipped`
-    /// as in [`crate::brush::Side`]), brushes of the leaf's own contents first; failing that,
+    /// as in [`crate::brush::Side`]), brushes of the leaf's own contents first, the latest in the
+    /// map first; failing that,
     /// of the side whose outward plane lies closest to the face (centred at `center`) among
     /// the brushes of `owner` and of the leaves of its contents next to it; `None` when
     /// `owner`'s brushes have no textured side. The tree leaves out a side within the epsilon of
@@ -122,15 +179,7 @@ impl TextureSearch<'_> {
     /// filled whole the wall's own side is in the next leaf.
     fn texinfo(&self, owner: u32, plane: PlaneId, flipped: bool, center: DVec3) -> Option<u32> {
         let leaf = &self.tree.nodes[owner as usize];
-        let mut brushes: Vec<&Brush> = leaf
-            .brushes
-            .iter()
-            .filter(|b| b.contents == leaf.contents)
-            .collect();
-        if brushes.is_empty() {
-            brushes = leaf.brushes.iter().filter(|b| is_textured(b)).collect();
-        }
-        let own = textured_sides(brushes);
+        let own = textured_sides(self.own_brushes(owner).into_iter().rev());
         if let Some(s) = own
             .iter()
             .find(|s| s.plane == plane && s.flipped == flipped)
@@ -176,6 +225,43 @@ fn textured_sides<'a>(brushes: impl IntoIterator<Item = &'a Brush>) -> Vec<&'a S
         .flat_map(|b| &b.sides)
         .filter(|s| s.texinfo.is_some())
         .collect()
+}
+
+/// Split `piece`, a polygon on the plane of the convex `polygon` (both facing `normal`), into
+/// the part inside `polygon` (returned) and the parts outside it (pushed to `outside`).
+fn split_by_polygon(
+    piece: Winding,
+    polygon: &Winding,
+    normal: DVec3,
+    outside: &mut Vec<Winding>,
+) -> Option<Winding> {
+    let center = polygon.center();
+    let n = polygon.len();
+    let mut inside = piece;
+    for i in 0..n {
+        let (a, b) = (polygon.points[i], polygon.points[(i + 1) % n]);
+        let Some(across) = normal.cross(b - a).normalized() else {
+            continue;
+        };
+        // Facing out of the polygon, whichever way it winds.
+        let across = if across.dot(center - a) > 0.0 {
+            -across
+        } else {
+            across
+        };
+        match inside.split(&Plane::new(across, across.dot(a))) {
+            Split::Front(w) => {
+                outside.push(w);
+                return None;
+            }
+            Split::Both { front, back } => {
+                outside.push(front);
+                inside = back;
+            }
+            Split::Back(w) | Split::On { winding: w, .. } => inside = w,
+        }
+    }
+    Some(inside)
 }
 
 /// The leaves a face seen from `viewer` is listed in. A face behind a fence or a detail wall
@@ -238,32 +324,30 @@ pub fn faces_from_portals(
             .iter()
             .flat_map(|br| br.sides.iter())
             .any(|s| s.plane == plane && s.flipped == owner_is_front && s.texinfo.is_some());
-        let center = p.winding.center();
-        let Some(texinfo) = search.texinfo(owner, plane, owner_is_front, center) else {
-            continue;
-        };
-        if !texinfos[texinfo as usize].role.is_drawn() {
-            continue;
-        }
-        for (viewer, front) in [(a, true), (b, false)] {
-            let viewer_contents = tree.nodes[viewer as usize].contents;
-            if !seen_from(owner_node, viewer_contents, viewer == owner) {
+        for (winding, texinfo) in search.paint(owner, plane, owner_is_front, &p.winding) {
+            if !texinfos[texinfo as usize].role.is_drawn() {
                 continue;
             }
-            stats.from_portals += 1;
-            stats.untextured += usize::from(!exact);
-            faces.push(ModelFace {
-                node,
-                plane,
-                back: !front,
-                texinfo,
-                winding: if front {
-                    p.winding.clone()
-                } else {
-                    p.winding.reversed()
-                },
-                leaves: viewing_leaves(tree, portals, viewer),
-            });
+            for (viewer, front) in [(a, true), (b, false)] {
+                let viewer_contents = tree.nodes[viewer as usize].contents;
+                if !seen_from(owner_node, viewer_contents, viewer == owner) {
+                    continue;
+                }
+                stats.from_portals += 1;
+                stats.untextured += usize::from(!exact);
+                faces.push(ModelFace {
+                    node,
+                    plane,
+                    back: !front,
+                    texinfo,
+                    winding: if front {
+                        winding.clone()
+                    } else {
+                        winding.reversed()
+                    },
+                    leaves: viewing_leaves(tree, portals, viewer),
+                });
+            }
         }
     }
     faces
