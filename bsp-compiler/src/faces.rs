@@ -77,28 +77,47 @@ pub fn projection_squareness(vecs: &[[f64; 4]; 2], normal: DVec3) -> f64 {
         .map_or(0.0, |t| t.dot(normal).abs())
 }
 
-/// Whether a face on the boundary of leaf `owner` is seen from the leaf of contents `viewer` on
-/// its other side (`own_side` false) or from inside the owner (see [`mirrors_inside`]).
-fn seen_from(owner: &TreeNode, viewer: i32, own_side: bool) -> bool {
+/// Whether a face on the boundary of leaf `owner`, drawn seen from inside it when `mirrored`, is
+/// seen from the leaf of contents `viewer` on its other side (`own_side` false) or from inside
+/// the owner.
+fn seen_from(mirrored: bool, viewer: i32, own_side: bool) -> bool {
     if own_side {
-        mirrors_inside(owner)
+        mirrored
     } else {
         shows_faces_behind(viewer)
     }
 }
 
-/// Whether the faces of a leaf's brushes are drawn seen from inside it: as its brushes'
-/// `_mirrorinside` says, else (as in ericw-tools) for liquids and vis blockers, which players
-/// look out of, and not for solid, fence or illusionary brushes.
-pub fn mirrors_inside(leaf: &TreeNode) -> bool {
+/// Whether a brush's faces are drawn seen from inside it: as its `_mirrorinside` says, else (as
+/// in ericw-tools) for liquids and vis blockers, which players look out of, and not for solid,
+/// fence or illusionary brushes.
+fn brush_mirrors_inside(b: &Brush) -> bool {
+    b.mirror_inside.unwrap_or(mirrors_by_default(b.contents))
+}
+
+fn mirrors_by_default(c: i32) -> bool {
+    matches!(
+        c,
+        contents::WATER | contents::SLIME | contents::LAVA | VISBLOCKER
+    )
+}
+
+/// Whether the faces of a leaf's brushes are drawn seen from inside it, for a face no brush side
+/// of the leaf lies on: as its brushes of its contents say ([`brush_mirrors_inside`]).
+fn mirrors_inside(leaf: &TreeNode) -> bool {
     leaf.brushes
         .iter()
         .filter(|b| b.contents == leaf.contents)
         .find_map(|b| b.mirror_inside)
-        .unwrap_or(matches!(
-            leaf.contents,
-            contents::WATER | contents::SLIME | contents::LAVA | VISBLOCKER
-        ))
+        .unwrap_or(mirrors_by_default(leaf.contents))
+}
+
+/// A part of a portal face: its winding, texinfo and whether it is drawn seen from inside its
+/// owner too.
+struct Painted {
+    winding: Winding,
+    texinfo: u32,
+    mirrored: bool,
 }
 
 /// How much a brush side's plane turned away from a face's counts against it, in units of
@@ -131,39 +150,49 @@ impl TextureSearch<'_> {
 
     /// `winding`, a face on `plane` looking out of leaf `owner` (`flipped` as in
     /// [`crate::brush::Side`]), cut where the sides of the leaf's brushes lying on it change,
-    /// each part with its texinfo: where sides overlap, the brush latest in the map wins (a
-    /// button set flush into a floor shows its own face), as in id's qbsp and ericw-tools, where
-    /// later brushes clip earlier ones. Parts no side covers take [`TextureSearch::texinfo`]'s.
-    fn paint(
-        &self,
-        owner: u32,
-        plane: PlaneId,
-        flipped: bool,
-        winding: &Winding,
-    ) -> Vec<(Winding, u32)> {
+    /// each part with its texinfo and mirroring from its side's brush: where sides overlap, the
+    /// brush latest in the map wins (a button set flush into a floor shows its own face), as in
+    /// id's qbsp and ericw-tools, where later brushes clip earlier ones. Parts no side covers
+    /// take [`TextureSearch::texinfo`]'s.
+    fn paint(&self, owner: u32, plane: PlaneId, flipped: bool, winding: &Winding) -> Vec<Painted> {
         let normal = self.outward(plane, flipped).normal;
         // Latest first: fragments keep their map order.
-        let sides: Vec<&Side> = textured_sides(self.own_brushes(owner).into_iter().rev())
+        let sides: Vec<(&Brush, &Side)> = self
+            .own_brushes(owner)
             .into_iter()
-            .filter(|s| s.plane == plane && s.flipped == flipped)
+            .rev()
+            .flat_map(|b| b.sides.iter().map(move |s| (b, s)))
+            .filter(|(_, s)| s.texinfo.is_some() && s.plane == plane && s.flipped == flipped)
             .collect();
+        let look = |(b, s): &(&Brush, &Side)| (s.texinfo, brush_mirrors_inside(b));
         let mut out = Vec::new();
         let mut rest = vec![winding.clone()];
-        if sides.windows(2).any(|w| w[0].texinfo != w[1].texinfo) {
-            for s in &sides {
+        if sides.windows(2).any(|w| look(&w[0]) != look(&w[1])) {
+            for side in &sides {
+                let (texinfo, mirrored) = look(side);
                 let mut outside = Vec::new();
                 for piece in rest {
-                    if let Some(inside) = split_by_polygon(piece, &s.winding, normal, &mut outside)
-                    {
-                        out.extend(s.texinfo.map(|t| (inside, t)));
-                    }
+                    let inside = split_by_polygon(piece, &side.1.winding, normal, &mut outside);
+                    out.extend(inside.zip(texinfo).map(|(winding, texinfo)| Painted {
+                        winding,
+                        texinfo,
+                        mirrored,
+                    }));
                 }
                 rest = outside;
             }
         }
+        let mirrored = sides.first().map_or_else(
+            || mirrors_inside(&self.tree.nodes[owner as usize]),
+            |s| look(s).1,
+        );
         for piece in rest {
-            if let Some(t) = self.texinfo(owner, plane, flipped, piece.center()) {
-                out.push((piece, t));
+            if let Some(texinfo) = self.texinfo(owner, plane, flipped, piece.center()) {
+                out.push(Painted {
+                    winding: piece,
+                    texinfo,
+                    mirrored,
+                });
             }
         }
         out
@@ -324,13 +353,18 @@ pub fn faces_from_portals(
             .iter()
             .flat_map(|br| br.sides.iter())
             .any(|s| s.plane == plane && s.flipped == owner_is_front && s.texinfo.is_some());
-        for (winding, texinfo) in search.paint(owner, plane, owner_is_front, &p.winding) {
+        for part in search.paint(owner, plane, owner_is_front, &p.winding) {
+            let Painted {
+                winding,
+                texinfo,
+                mirrored,
+            } = part;
             if !texinfos[texinfo as usize].role.is_drawn() {
                 continue;
             }
             for (viewer, front) in [(a, true), (b, false)] {
                 let viewer_contents = tree.nodes[viewer as usize].contents;
-                if !seen_from(owner_node, viewer_contents, viewer == owner) {
+                if !seen_from(mirrored, viewer_contents, viewer == owner) {
                     continue;
                 }
                 stats.from_portals += 1;

@@ -33,3 +33,48 @@ fn a_later_brushs_coplanar_face_wins() {
     let top = faces_at(bsp, 1, [88.0, 88.0, -112.0], UP);
     assert_eq!(face_texture(bsp, top[0]), "slab");
 }
+
+/// A `func_detail_illusionary` block standing in water up through its surface keeps its faces
+/// below the water line, outward and (with `_mirrorinside`) inward, and is water inside there, as
+/// in ericw-tools (`waterDetailIllusionary`).
+#[test]
+fn illusionary_detail_keeps_its_faces_under_water() {
+    let water = box_brush([-128.0, -128.0, -128.0], [128.0, 128.0, 0.0], "*water");
+    let block = box_brush([0.0, 0.0, -128.0], [64.0, 64.0, 128.0], "{vine");
+    for mirror in [false, true] {
+        let key = if mirror {
+            "\"_mirrorinside\" \"1\"\n"
+        } else {
+            ""
+        };
+        let entity = format!("{{\n\"classname\" \"func_detail_illusionary\"\n{key}{block}}}\n");
+        let out = compile_text(&room_map_with(false, &water, &entity));
+        let bsp = &out.bsp;
+        assert_eq!(errors(bsp), Vec::<String>::new());
+        assert!(out.leak.is_none(), "{:?}", out.warnings);
+        let contents_at = |p| bsp.leafs[bsp.leaf_at(p).expect("leaf")].contents;
+        assert_eq!(
+            contents_at([32.0, 32.0, -64.0]),
+            quake_formats::bsp::contents::WATER
+        );
+        assert_eq!(
+            contents_at([32.0, 32.0, 64.0]),
+            quake_formats::bsp::contents::EMPTY
+        );
+        for z in [-64.0, 64.0] {
+            let outward = faces_at(bsp, 0, [0.0, 32.0, z], Some([-1.0, 0.0, 0.0]));
+            let names: Vec<String> = outward.iter().map(|&f| face_texture(bsp, f)).collect();
+            assert_eq!(names, ["{vine"], "z {z}, mirror {mirror}");
+            let inward = faces_at(bsp, 0, [0.0, 32.0, z], Some([1.0, 0.0, 0.0]));
+            let names: Vec<String> = inward.iter().map(|&f| face_texture(bsp, f)).collect();
+            let expected: &[&str] = if mirror { &["{vine"] } else { &[] };
+            assert_eq!(names, expected, "z {z}, mirror {mirror}");
+        }
+        // The water's surface runs on through the block, seen from above and below.
+        for normal in [[0.0, 0.0, 1.0], [0.0, 0.0, -1.0]] {
+            let surface = faces_at(bsp, 0, [32.0, 32.0, 0.0], Some(normal));
+            let names: Vec<String> = surface.iter().map(|&f| face_texture(bsp, f)).collect();
+            assert_eq!(names, ["*water"], "{normal:?}, mirror {mirror}");
+        }
+    }
+}
