@@ -182,7 +182,9 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
 
     // Faces, edges and, per model node and leaf, which faces they hold.
     bsp.edges.push([0, 0]); // edge 0 cannot be negated, so it is never used
-    let mut edge_index: HashMap<(u32, u32), (u32, bool)> = HashMap::new();
+    // Keyed by the contents the face is seen from too: only faces seen from the same contents
+    // share an edge (see `ModelFace::seen_from`), each once each way.
+    let mut edge_index: HashMap<(u32, u32, i32), (u32, bool)> = HashMap::new();
     let mut node_faces: HashMap<(usize, u32), (u32, u32)> = HashMap::new();
     let mut leaf_faces: HashMap<(usize, u32), Vec<u32>> = HashMap::new();
     let mut model_faces: Vec<(u32, u32)> = vec![(0, 0); input.models.len()];
@@ -196,7 +198,7 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
         let first_edge = bsp.surfedges.len() as u32;
         for k in 0..poly.len() {
             let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
-            match edge_index.get_mut(&(b, a)) {
+            match edge_index.get_mut(&(b, a, f.seen_from)) {
                 Some((e, reused)) if !*reused => {
                     *reused = true;
                     bsp.surfedges.push(-(*e as i32));
@@ -204,7 +206,7 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
                 _ => {
                     let e = bsp.edges.len() as u32;
                     bsp.edges.push([a, b]);
-                    edge_index.insert((a, b), (e, false));
+                    edge_index.insert((a, b, f.seen_from), (e, false));
                     bsp.surfedges.push(e as i32);
                 }
             }

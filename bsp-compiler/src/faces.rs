@@ -30,6 +30,10 @@ pub struct ModelFace {
     pub winding: Winding,
     /// Tree leaves the face can be seen from.
     pub leaves: Vec<u32>,
+    /// The engine contents of the leaf the face is seen from. As in id's qbsp, faces seen from
+    /// different contents (a water surface from above and from below) neither merge nor share
+    /// edges: software renderers (WinQuake's edge list) draw such faces wrongly.
+    pub seen_from: i32,
 }
 
 impl ModelFace {
@@ -367,6 +371,13 @@ pub fn faces_from_portals(
                 if !seen_from(mirrored, viewer_contents, viewer == owner) {
                     continue;
                 }
+                let leaves = viewing_leaves(tree, portals, viewer);
+                // A face behind a fence is seen from the open leaves around it.
+                let seen_from = leaves
+                    .iter()
+                    .map(|&l| engine_contents(tree.nodes[l as usize].contents))
+                    .find(|&c| c != contents::SOLID)
+                    .unwrap_or(engine_contents(viewer_contents));
                 stats.from_portals += 1;
                 stats.untextured += usize::from(!exact);
                 faces.push(ModelFace {
@@ -379,7 +390,8 @@ pub fn faces_from_portals(
                     } else {
                         winding.reversed()
                     },
-                    leaves: viewing_leaves(tree, portals, viewer),
+                    leaves: leaves.clone(),
+                    seen_from,
                 });
             }
         }
@@ -432,23 +444,25 @@ fn simplify_convex(mut points: Vec<DVec3>, normal: DVec3) -> Option<Winding> {
     (points.len() >= 3).then(|| Winding::new(points))
 }
 
-/// Merge faces that share a node, side and texinfo wherever the union stays convex.
+/// Merge faces that share a node, side, texinfo and the contents they are seen from wherever
+/// the union stays convex.
 pub fn merge_faces(
     mut faces: Vec<ModelFace>,
     plane_of: impl Fn(&ModelFace) -> Plane,
 ) -> Vec<ModelFace> {
-    faces.sort_by_key(|f| (f.node, f.back, f.texinfo));
+    let key = |f: &ModelFace| (f.node, f.back, f.texinfo, f.seen_from);
+    faces.sort_by_key(key);
     let mut out: Vec<ModelFace> = Vec::with_capacity(faces.len());
     let mut start = 0;
     while start < faces.len() {
-        let key = (faces[start].node, faces[start].back, faces[start].texinfo);
+        let group_key = key(&faces[start]);
         let end = start
             + faces[start..]
                 .iter()
-                .take_while(|f| (f.node, f.back, f.texinfo) == key)
+                .take_while(|f| key(f) == group_key)
                 .count();
         let mut group: Vec<ModelFace> = faces[start..end].to_vec();
-        let normal = plane_of(&group[0]).normal * if key.1 { -1.0 } else { 1.0 };
+        let normal = plane_of(&group[0]).normal * if group_key.1 { -1.0 } else { 1.0 };
         loop {
             let mut merged_any = false;
             let mut i = 0;

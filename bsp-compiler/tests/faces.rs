@@ -78,3 +78,62 @@ fn illusionary_detail_keeps_its_faces_under_water() {
         }
     }
 }
+
+/// The contents a face of `bsp` is seen from: those just in front of its middle.
+fn seen_from(bsp: &quake_formats::Bsp, f: usize) -> i32 {
+    let vs = bsp.face_vertices(&bsp.faces[f]).expect("vertices");
+    let n = face_normal(bsp, f);
+    let mut c = [0.0f32; 3];
+    for v in &vs {
+        for i in 0..3 {
+            c[i] += v[i] / vs.len() as f32;
+        }
+    }
+    let p = [c[0] + n[0] * 0.5, c[1] + n[1] * 0.5, c[2] + n[2] * 0.5];
+    bsp.leafs[bsp.leaf_at(p).expect("leaf")].contents
+}
+
+/// Software renderers (WinQuake's edge list) draw a face wrongly when it shares an edge with a
+/// face seen from other contents (a water surface and its mirror seen from below), or when an
+/// edge is used more than once each way. As id's qbsp and ericw-tools (`liquidSoftware`,
+/// `edgeSharingSoftware`), edges are shared only between faces seen from the same contents.
+#[test]
+fn edges_are_shared_only_between_faces_seen_from_the_same_contents() {
+    let pool = box_brush([-128.0, -128.0, -128.0], [0.0, 128.0, -64.0], "*water");
+    let pillar = box_brush([32.0, 32.0, -128.0], [64.0, 64.0, 128.0], "pillar");
+    let out = compile_text(&room_map(false, &format!("{pool}{pillar}")));
+    let bsp = &out.bsp;
+    assert_eq!(errors(bsp), Vec::<String>::new());
+    assert!(out.leak.is_none() && out.stats.filled_leaves > 0);
+    let mut users: std::collections::HashMap<i32, Vec<usize>> = Default::default();
+    for (f, face) in bsp.faces.iter().enumerate() {
+        let first = face.first_edge as usize;
+        for &se in &bsp.surfedges[first..first + face.num_edges as usize] {
+            users.entry(se).or_default().push(f);
+        }
+    }
+    let mut shared = 0;
+    for (&se, faces) in &users {
+        assert_eq!(
+            faces.len(),
+            1,
+            "edge {se} used twice the same way: {faces:?}"
+        );
+        let Some(back) = users.get(&-se) else {
+            continue;
+        };
+        shared += 1;
+        assert_eq!(
+            seen_from(bsp, faces[0]),
+            seen_from(bsp, back[0]),
+            "edge {se} of faces {} and {}",
+            faces[0],
+            back[0]
+        );
+    }
+    assert!(shared > 0, "no edge is shared at all");
+    // The water's surface is drawn from above and below.
+    let up = faces_at(bsp, 0, [-64.0, 64.0, -64.0], Some([0.0, 0.0, 1.0]));
+    let down = faces_at(bsp, 0, [-64.0, 64.0, -64.0], Some([0.0, 0.0, -1.0]));
+    assert_eq!((up.len(), down.len()), (1, 1));
+}
