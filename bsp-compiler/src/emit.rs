@@ -187,6 +187,9 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
     let mut edge_index: HashMap<(u32, u32, i32), (u32, bool)> = HashMap::new();
     let mut node_faces: HashMap<(usize, u32), (u32, u32)> = HashMap::new();
     let mut leaf_faces: HashMap<(usize, u32), Vec<u32>> = HashMap::new();
+    // The bounds of the faces each leaf lists away from where they are seen (behind fences):
+    // engines that cull a leaf by its bounds must not cull them.
+    let mut leaf_growth: HashMap<(usize, u32), Bounds> = HashMap::new();
     let mut model_faces: Vec<(u32, u32)> = vec![(0, 0); input.models.len()];
     let mut phong = Vec::with_capacity(pending.len());
     for (pf, poly) in pending.iter().zip(polygons) {
@@ -240,6 +243,10 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
                 .entry((pf.model, leaf))
                 .or_default()
                 .push(face_index);
+            if f.stored {
+                let grown = leaf_growth.entry((pf.model, leaf)).or_insert(Bounds::EMPTY);
+                *grown = grown.union(&f.winding.bounds());
+            }
         }
     }
 
@@ -257,6 +264,7 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
             planes: &mut planes,
             node_faces: &node_faces,
             leaf_faces: &leaf_faces,
+            leaf_growth: &leaf_growth,
             leaf_index: HashMap::new(),
         };
         let (mut head, _) = w.node(0);
@@ -328,6 +336,7 @@ struct TreeWriter<'a, 'b> {
     planes: &'b mut PlaneTable<'a>,
     node_faces: &'b HashMap<(usize, u32), (u32, u32)>,
     leaf_faces: &'b HashMap<(usize, u32), Vec<u32>>,
+    leaf_growth: &'b HashMap<(usize, u32), Bounds>,
     /// Tree leaf to BSP leaf.
     leaf_index: HashMap<u32, u32>,
 }
@@ -347,6 +356,10 @@ impl TreeWriter<'_, '_> {
                 self.output.bounds
             } else {
                 bounds
+            };
+            let bounds = match self.leaf_growth.get(&(self.model, n)) {
+                Some(grown) => bounds.union(grown),
+                None => bounds,
             };
             let marks = self.leaf_faces.get(&(self.model, n));
             let first = self.bsp.marksurfaces.len() as u32;

@@ -15,6 +15,8 @@ use quake_formats::bsp::limits::MAX_SURFACE_EXTENT;
 use quake_formats::extents::LightmapExtents;
 use quake_formats::geom::DVec3Ext;
 use quake_formats::geom::{ON_EPSILON, POINT_EPSILON, Plane, Split, Winding};
+use std::collections::{HashMap, HashSet};
+use std::rc::Rc;
 
 /// A face of one model, before vertices and edges are shared.
 #[derive(Debug, Clone, PartialEq)]
@@ -28,8 +30,11 @@ pub struct ModelFace {
     pub texinfo: u32,
     /// Clockwise seen from the side the face is looked at from.
     pub winding: Winding,
-    /// Tree leaves the face can be seen from.
+    /// Tree leaves whose marksurfaces list the face.
     pub leaves: Vec<u32>,
+    /// Listed away from the leaf it is seen from (behind a fence, seen from the open leaves
+    /// around it): those leaves' bounds must grow to hold it.
+    pub stored: bool,
     /// The engine contents of the leaf the face is seen from. As in id's qbsp, faces seen from
     /// different contents (a water surface from above and from below) neither merge nor share
     /// edges: software renderers (WinQuake's edge list) draw such faces wrongly.
@@ -297,25 +302,60 @@ fn split_by_polygon(
     Some(inside)
 }
 
-/// The leaves a face seen from `viewer` is listed in. A face behind a fence or a detail wall
-/// (solid leaves engines never draw from) is listed in the open leaves around them too.
-fn viewing_leaves(tree: &Tree, portals: &Portals, viewer: u32) -> Vec<u32> {
-    let mut leaves = vec![viewer];
-    let solid_viewer = |c: i32| engine_contents(c) == contents::SOLID;
-    if solid_viewer(tree.nodes[viewer as usize].contents) {
-        for &p in &portals.leaf_portals[viewer as usize] {
-            let other = portals.other(p, viewer);
-            if other != portals.outside
-                && is_see_through(tree.nodes[other as usize].contents)
-                && !solid_viewer(tree.nodes[other as usize].contents)
-            {
-                leaves.push(other);
+/// Where faces seen from each leaf are listed. A face seen from a fence or a detail wall (solid
+/// leaves, which engines never draw from) is listed in the open leaves the connected fence or
+/// wall leaves border, flooding through them (a fence cut into several leaves may hold a face
+/// only one of them sees, far from any open leaf), as ericw-tools' `FixupDetailFence` does.
+struct ViewingLeaves<'a> {
+    tree: &'a Tree,
+    portals: &'a Portals,
+    /// The open leaves around each flooded solid viewer.
+    around: HashMap<u32, Rc<Vec<u32>>>,
+}
+
+impl ViewingLeaves<'_> {
+    fn solid_viewer(&self, leaf: u32) -> bool {
+        leaf != self.portals.outside
+            && engine_contents(self.tree.nodes[leaf as usize].contents) == contents::SOLID
+    }
+
+    /// The leaves a face seen from `viewer` is listed in, and whether they are open leaves
+    /// around a solid viewer rather than the viewer itself.
+    fn of(&mut self, viewer: u32) -> (Rc<Vec<u32>>, bool) {
+        if !self.solid_viewer(viewer) {
+            return (Rc::new(vec![viewer]), false);
+        }
+        if let Some(open) = self.around.get(&viewer) {
+            return (open.clone(), !open.contains(&viewer));
+        }
+        let mut flooded = vec![viewer];
+        let mut seen = HashSet::from([viewer]);
+        let mut open = Vec::new();
+        let mut i = 0;
+        while i < flooded.len() {
+            let leaf = flooded[i];
+            i += 1;
+            for &p in &self.portals.leaf_portals[leaf as usize] {
+                let other = self.portals.other(p, leaf);
+                if other == self.portals.outside || !seen.insert(other) {
+                    continue;
+                }
+                let c = self.tree.nodes[other as usize].contents;
+                if self.solid_viewer(other) && c != contents::SOLID {
+                    flooded.push(other);
+                } else if is_see_through(c) {
+                    open.push(other);
+                }
             }
         }
-        leaves.sort_unstable();
-        leaves.dedup();
+        open.sort_unstable();
+        // Nothing open around it: the face stays with its viewer, seen by nobody.
+        let open = Rc::new(if open.is_empty() { vec![viewer] } else { open });
+        for leaf in flooded {
+            self.around.insert(leaf, open.clone());
+        }
+        (open.clone(), !open.contains(&viewer))
     }
-    leaves
 }
 
 /// Faces on every portal between leaves of different contents, seen from each side that can see
@@ -331,6 +371,11 @@ pub fn faces_from_portals(
         tree,
         portals,
         planes,
+    };
+    let mut viewing = ViewingLeaves {
+        tree,
+        portals,
+        around: HashMap::new(),
     };
     let mut faces = Vec::new();
     for p in &portals.portals {
@@ -371,7 +416,7 @@ pub fn faces_from_portals(
                 if !seen_from(mirrored, viewer_contents, viewer == owner) {
                     continue;
                 }
-                let leaves = viewing_leaves(tree, portals, viewer);
+                let (leaves, stored) = viewing.of(viewer);
                 // A face behind a fence is seen from the open leaves around it.
                 let seen_from = leaves
                     .iter()
@@ -390,7 +435,8 @@ pub fn faces_from_portals(
                     } else {
                         winding.reversed()
                     },
-                    leaves: leaves.clone(),
+                    leaves: leaves.to_vec(),
+                    stored,
                     seen_from,
                 });
             }
@@ -481,6 +527,7 @@ pub fn merge_faces(
                         group[i].leaves.extend(other.leaves);
                         group[i].leaves.sort_unstable();
                         group[i].leaves.dedup();
+                        group[i].stored |= other.stored;
                         merged_any = true;
                         j = i + 1;
                     } else {

@@ -137,3 +137,83 @@ fn edges_are_shared_only_between_faces_seen_from_the_same_contents() {
     let down = faces_at(bsp, 0, [-64.0, 64.0, -64.0], Some([0.0, 0.0, -1.0]));
     assert_eq!((up.len(), down.len()), (1, 1));
 }
+
+/// The BSP leaves whose marksurfaces list face `f`.
+fn leaves_listing(bsp: &quake_formats::Bsp, f: usize) -> Vec<usize> {
+    (0..bsp.leafs.len())
+        .filter(|&l| {
+            let leaf = &bsp.leafs[l];
+            let first = leaf.first_marksurface as usize;
+            bsp.marksurfaces[first..first + leaf.num_marksurfaces as usize].contains(&(f as u32))
+        })
+        .collect()
+}
+
+/// A fence filling a niche in the -x wall, cut in two by a hint: the niche's back wall is seen
+/// only from the fence's back leaf, which is solid to engines (they never draw from it) and
+/// borders no open leaf. Faces seen from a fence are listed in the open leaves its leaves border
+/// (flooding through the fence), which grow to hold them, and not in the fence's own leaves, as
+/// in ericw-tools (`detailFence`).
+#[test]
+fn faces_seen_through_a_fence_are_listed_in_the_open_leaves_around_it() {
+    let t = |lo: [f64; 3], hi: [f64; 3], tex: &str| box_brush(lo, hi, tex);
+    let (a, b) = (-144.0, 144.0);
+    // The room of `room`, its -x wall holding a niche x -192..-128, y -32..32, z -128..-64.
+    let mut world = String::new();
+    world += &t([a, a, a], [b, b, -128.0], "floor");
+    world += &t([a, a, 128.0], [b, b, b], "ceiling");
+    world += &t([128.0, a, -128.0], [b, b, 128.0], "wall");
+    world += &t([-128.0, a, -128.0], [128.0, -128.0, 128.0], "wall");
+    world += &t([-128.0, 128.0, -128.0], [128.0, b, 128.0], "wall");
+    world += &t([-208.0, a, -128.0], [-128.0, -32.0, 128.0], "wall");
+    world += &t([-208.0, 32.0, -128.0], [-128.0, b, 128.0], "wall");
+    world += &t([-208.0, -32.0, -64.0], [-128.0, 32.0, 128.0], "wall");
+    world += &t([-208.0, -32.0, -128.0], [-192.0, 32.0, -64.0], "niche");
+    world += &t([-208.0, -32.0, -144.0], [-144.0, 32.0, -128.0], "floor");
+    // A hint across the niche at x = -160; its other faces do not split.
+    world += "{\n( -160 -32 -128 ) ( -160 -32 -64 ) ( -160 32 -128 ) hint 0 0 0 1 1\n\
+              ( -176 -32 -128 ) ( -176 32 -128 ) ( -176 -32 -64 ) hintskip 0 0 0 1 1\n\
+              ( -176 32 -128 ) ( -160 32 -128 ) ( -176 32 -64 ) hintskip 0 0 0 1 1\n\
+              ( -176 -32 -128 ) ( -176 -32 -64 ) ( -160 -32 -128 ) hintskip 0 0 0 1 1\n\
+              ( -176 -32 -64 ) ( -176 32 -64 ) ( -160 -32 -64 ) hintskip 0 0 0 1 1\n\
+              ( -176 -32 -128 ) ( -160 -32 -128 ) ( -176 32 -128 ) hintskip 0 0 0 1 1\n}\n";
+    let fence = t([-192.0, -32.0, -128.0], [-128.0, 32.0, -64.0], "{fence");
+    let text = format!(
+        "{{\n\"classname\" \"worldspawn\"\n\"wad\" \"none.wad\"\n{world}}}\n{}\
+         {{\n\"classname\" \"info_player_start\"\n\"origin\" \"0 0 -100\"\n}}\n",
+        brush_entity("func_detail_fence", &fence)
+    );
+    let out = compile_text(&text);
+    let bsp = &out.bsp;
+    assert_eq!(errors(bsp), Vec::<String>::new());
+    assert!(out.leak.is_none(), "{:?}", out.warnings);
+    let contents = quake_formats::bsp::contents::SOLID;
+    // The fence is cut in two, both solid leaves of their own.
+    let back = bsp.leaf_at([-176.0, 0.0, -96.0]).expect("leaf");
+    let front = bsp.leaf_at([-144.0, 0.0, -96.0]).expect("leaf");
+    assert!(back != front && back != 0 && front != 0, "{back} {front}");
+    for l in [back, front] {
+        assert_eq!(bsp.leafs[l].contents, contents);
+        assert_eq!(bsp.leafs[l].num_marksurfaces, 0, "leaf {l}");
+    }
+    let niche = faces_at(bsp, 0, [-192.0, 0.0, -96.0], Some([1.0, 0.0, 0.0]));
+    assert_eq!(niche.len(), 1);
+    let listed = leaves_listing(bsp, niche[0]);
+    assert!(!listed.is_empty());
+    for l in listed {
+        let leaf = &bsp.leafs[l];
+        assert_ne!(leaf.contents, contents, "leaf {l}");
+        // Grown to hold the face, for engines that cull leaves by their bounds.
+        assert!(
+            leaf.mins[0] <= -192.0 && leaf.maxs[0] >= -128.0,
+            "leaf {l}: {leaf:?}"
+        );
+    }
+    // Every face is listed in an open leaf.
+    for f in 0..bsp.faces.len() {
+        let open = leaves_listing(bsp, f)
+            .iter()
+            .any(|&l| bsp.leafs[l].contents != contents);
+        assert!(open, "face {f} ({})", face_texture(bsp, f));
+    }
+}
