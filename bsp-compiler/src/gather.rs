@@ -7,7 +7,7 @@
 //! Point entities become the occupants the outside fill floods from.
 
 use crate::brush::{Brush, BrushKind, BrushPlane};
-use crate::brushlist::ListedBrush;
+use crate::brushlist::{self, ListedBrush};
 use crate::faces::{MIN_SQUARENESS, projection_squareness};
 use crate::hulls::{HULL_BOXES, expand_brush};
 use crate::leak::MapBrushRef;
@@ -549,11 +549,11 @@ impl EntityContext<'_> {
     }
 }
 
-/// A built brush as the `BRUSHLIST` lump stores it: clip brushes collide as solid; brushes
-/// nothing collides with (hint, illusionary) are left out.
+/// A built brush as the `BRUSHLIST` lump stores it: clip brushes as [`brushlist::CLIP`], as
+/// ericw-tools writes them; brushes nothing collides with (hint, illusionary) are left out.
 fn listed_brush(brush: &Brush, clip: bool, planes: &PlaneSet) -> Option<ListedBrush> {
     let contents = match engine_contents(brush.contents) {
-        _ if clip => contents::SOLID,
+        _ if clip => brushlist::CLIP,
         _ if brush.kind == BrushKind::Hint => return None,
         contents::EMPTY => return None,
         c => c,

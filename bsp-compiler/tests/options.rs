@@ -185,6 +185,26 @@ fn maxnodesize_changes_where_big_nodes_are_cut() {
     assert_ne!(small.nodes.len(), default.nodes.len());
 }
 
+/// `text` compiled with `--wrbrushes`, its `BRUSHLIST` lump as the `qbsp` crate reads it.
+fn brush_list_of(text: &str) -> Vec<qbsp::data::bspx::ModelBrushes> {
+    let bsp = compile_options(
+        text,
+        CompileOptions {
+            brush_list: true,
+            ..CompileOptions::default()
+        },
+    );
+    assert_eq!(errors(&bsp), Vec::<String>::new());
+    let bytes = bsp.write().expect("write");
+    let parsed = qbsp::BspData::parse(qbsp::BspParseInput {
+        bsp: &bytes,
+        lit: None,
+        settings: Default::default(),
+    })
+    .expect("qbsp parses the BSP");
+    parsed.bspx.brush_list.expect("a BRUSHLIST lump")
+}
+
 #[test]
 fn wrbrushes_lists_every_model_brush_for_the_qbsp_crate() {
     // A wedge (one sloped side) in the world, a crate in a func_wall, a clip brush, a hint.
@@ -206,25 +226,10 @@ fn wrbrushes_lists_every_model_brush_for_the_qbsp_crate() {
             &box_brush([64.0, 64.0, -128.0], [96.0, 96.0, -96.0], "crate"),
         ),
     );
-    let bsp = compile_options(
-        &text,
-        CompileOptions {
-            brush_list: true,
-            ..CompileOptions::default()
-        },
-    );
-    assert_eq!(errors(&bsp), Vec::<String>::new());
-    let bytes = bsp.write().expect("write");
-    let parsed = qbsp::BspData::parse(qbsp::BspParseInput {
-        bsp: &bytes,
-        lit: None,
-        settings: Default::default(),
-    })
-    .expect("qbsp parses the BSP");
-    let list = parsed.bspx.brush_list.expect("a BRUSHLIST lump");
+    let list = brush_list_of(&text);
     assert_eq!(list.len(), 2);
     assert_eq!((list[0].model_idx, list[1].model_idx), (0, 1));
-    // Six room brushes, the wedge and the clip brush (solid); the hint is left out.
+    // Six room brushes, the wedge and the clip brush; the hint is left out.
     let world = &list[0].brushes.inner;
     assert_eq!(world.len(), 8);
     let sloped: Vec<_> = world
@@ -238,6 +243,54 @@ fn wrbrushes_lists_every_model_brush_for_the_qbsp_crate() {
     let crate_brush = &list[1].brushes.inner[0];
     assert_eq!(crate_brush.bound.min.to_array(), [64.0, 64.0, -128.0]);
     assert_eq!(crate_brush.bound.max.to_array(), [96.0, 96.0, -96.0]);
+}
+
+/// ericw-tools' `wrbrushesContentTypes`: clip brushes are listed with BSPX's own clip contents
+/// (-8), which engines colliding with brushes let shots through, in the world and in brush
+/// entities; and `hullExpansionBasic`: a prism's ridge has a bevel (a cap plane) listed beside
+/// its sloped sides, or a box sliding along the ridge falls into it.
+#[test]
+fn wrbrushes_lists_clip_as_clip_and_every_bevel() {
+    // A prism along y, sheared: its ridge rises from z -112 at y -64 to z -64 at y 64.
+    let prism = "{\n( -16 64 -80 ) ( 0 -64 -112 ) ( -16 -64 -128 ) wall 0 0 0 1 1\n\
+                 ( 16 -64 -128 ) ( 0 -64 -112 ) ( 16 64 -80 ) wall 0 0 0 1 1\n\
+                 ( -16 -64 -128 ) ( 16 -64 -128 ) ( -16 64 -80 ) wall 0 0 0 1 1\n\
+                 ( -16 -64 -128 ) ( 0 -64 -112 ) ( 16 -64 -128 ) wall 0 0 0 1 1\n\
+                 ( 16 64 -80 ) ( 0 64 -64 ) ( -16 64 -80 ) wall 0 0 0 1 1\n}\n";
+    let clip = box_brush([64.0, 0.0, -128.0], [80.0, 16.0, 0.0], "clip");
+    let text = room_map_with(
+        false,
+        &clip,
+        &format!(
+            "{}{}",
+            brush_entity("func_wall", prism),
+            brush_entity("func_wall", &clip)
+        ),
+    );
+    let list = brush_list_of(&text);
+    let clip_contents = qbsp::data::nodes::Bsp29LeafContents::Clip;
+    let world = &list[0].brushes.inner;
+    assert_eq!(world.len(), 7);
+    assert_eq!(world[6].contents.0, clip_contents);
+    assert_eq!(list[2].brushes.inner[0].contents.0, clip_contents);
+    let prism = &list[1].brushes.inner[0];
+    let planes: Vec<[f32; 4]> = prism
+        .planes
+        .inner
+        .iter()
+        .map(|p| [p.normal.x, p.normal.y, p.normal.z, p.dist])
+        .collect();
+    assert!(planes.len() >= 3, "{planes:?}");
+    // The cap: through the ridge, parallel to x, facing up and back along the rise.
+    let rise = (48.0f32).atan2(128.0);
+    let cap = [0.0, -rise.sin(), rise.cos()];
+    let on_ridge = cap[1] * -64.0 + cap[2] * -112.0;
+    assert!(
+        planes.iter().any(|p| {
+            (0..3).all(|i| (p[i] - cap[i]).abs() < 1e-4) && (p[3] - on_ridge).abs() < 1e-3
+        }),
+        "no cap plane {cap:?} {on_ridge} in {planes:?}"
+    );
 }
 
 fn temp_dir(name: &str) -> PathBuf {
