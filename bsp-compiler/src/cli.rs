@@ -3,6 +3,7 @@
 use crate::convert::{MapFormat, convert_map};
 use crate::map::parse_map;
 use crate::onlyents::replace_entities;
+use crate::outside::FillType;
 use crate::tree::MID_SPLIT_SIZE;
 use crate::{CompileOptions, MapSource, SplitHeuristic, compile};
 use anyhow::{Context, Result};
@@ -51,6 +52,22 @@ pub struct Args {
     /// for)
     #[arg(long)]
     pub nofill: bool,
+    /// How a sealed map's space no point entity reaches (a closed room, the inside of a closed
+    /// box) is filled after the void: auto or inside fill it, in each hull by what reaches there
+    /// in that hull (as ericw-tools does); outside fills only the void
+    #[arg(long, value_name = "TYPE", default_value = "auto")]
+    pub filltype: FillType,
+    /// Fill the space no point entity reaches leaf by leaf, so that pockets closed by detail
+    /// brushes are filled too, whatever --filltype says (0 turns it off)
+    #[arg(
+        long,
+        value_name = "N",
+        default_value = "1",
+        num_args = 0..=1,
+        default_missing_value = "1",
+        value_parser = clap::value_parser!(u8).range(0..=1)
+    )]
+    pub filldetail: u8,
     /// Write the .prt even when the map leaks (vis then works through the void as well, slowly;
     /// without it, a leaking map gets no .prt and an old one is removed)
     #[arg(long)]
@@ -122,6 +139,8 @@ impl Args {
                 self.subdivide
             },
             fill: !self.nofill,
+            fill_type: self.filltype,
+            fill_detail: self.filldetail != 0,
             clip_hulls: !self.noclip,
             omit,
             texture_data: !self.notex,

@@ -361,7 +361,7 @@ fn key_origin(entities: &[MapEntity], ent: &MapEntity) -> Option<DVec3> {
 /// The point entity `ent` (number `index`) as an occupant of open space for the flood: not
 /// when it has no origin, stands at the map's origin (where ericw-tools skips it, taking it for
 /// a brush entity), or is marked `_nofill` (or `_lightgrid_hint`) to stand in the void.
-fn occupant(ent: &MapEntity, index: usize) -> Option<Occupant> {
+pub(crate) fn occupant(ent: &MapEntity, index: usize) -> Option<Occupant> {
     let [x, y, z] = ent.entity.get_floats::<3>("origin")?;
     let origin = DVec3::new(x, y, z);
     let marked = |key| ent.entity.get_float(key).is_some_and(|v| v != 0.0);

@@ -1,5 +1,6 @@
 //! What a compile is asked to do.
 
+use crate::outside::{FillType, Reach};
 use crate::tree::{MID_SPLIT_SIZE, SplitHeuristic};
 use quake_formats::progress::Progress;
 use std::path::PathBuf;
@@ -21,6 +22,11 @@ pub struct CompileOptions {
     pub subdivide: f64,
     /// Fill the void outside the map (off keeps it, for debugging; leaks are not looked for).
     pub fill: bool,
+    /// Whether a sealed map's space no point entity reaches is filled too (`-filltype`).
+    pub fill_type: FillType,
+    /// Fill the space no point entity reaches leaf by leaf, so that pockets closed by detail
+    /// brushes are filled too (`-filldetail`), whatever `fill_type` says.
+    pub fill_detail: bool,
     /// Build clip hulls 1 and 2 (off: every model is empty to them).
     pub clip_hulls: bool,
     /// Classnames whose brushes are left out of the compile (`--omitdetail` and its kin).
@@ -35,6 +41,17 @@ pub struct CompileOptions {
     pub progress: Progress,
 }
 
+impl CompileOptions {
+    /// How a sealed map's space no point entity reaches is filled, if it is.
+    pub fn unreached_fill(&self) -> Option<Reach> {
+        match (self.fill_type, self.fill_detail) {
+            (_, true) => Some(Reach::Leaves),
+            (FillType::Outside, false) => None,
+            (FillType::Auto | FillType::Inside, false) => Some(Reach::Clusters),
+        }
+    }
+}
+
 impl Default for CompileOptions {
     fn default() -> Self {
         CompileOptions {
@@ -45,6 +62,8 @@ impl Default for CompileOptions {
             max_node_size: MID_SPLIT_SIZE,
             subdivide: 240.0,
             fill: true,
+            fill_type: FillType::default(),
+            fill_detail: true,
             clip_hulls: true,
             omit: Vec::new(),
             texture_data: true,

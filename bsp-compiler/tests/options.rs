@@ -327,3 +327,29 @@ fn leaktest_writes_nothing_but_the_pointfile_and_fails() {
     assert!(status.success());
     assert!(map.with_extension("bsp").exists());
 }
+
+/// The stage's arguments as the command parses them, ericw-tools' single dashes included.
+fn parsed_options(args: &[&str]) -> CompileOptions {
+    use clap::Parser;
+    let words = ["bsp"].iter().chain(args).map(|s| s.to_string());
+    let words = quake_formats::cli::normalise_single_dash(words);
+    BspCli::try_parse_from(words)
+        .expect("parses")
+        .args
+        .compile_options()
+}
+
+#[test]
+fn filltype_and_filldetail_take_ericw_tools_spellings() {
+    use bsp_compiler::outside::{FillType, Reach};
+    let default = parsed_options(&["x.map"]);
+    assert_eq!(default.fill_type, FillType::Auto);
+    assert_eq!(default.unreached_fill(), Some(Reach::Leaves));
+    let outside = parsed_options(&["-filltype", "outside", "-filldetail", "0", "x.map"]);
+    assert_eq!(outside.fill_type, FillType::Outside);
+    assert_eq!(outside.unreached_fill(), None);
+    let inside = parsed_options(&["-filltype", "inside", "-filldetail", "0", "x.map"]);
+    assert_eq!(inside.unreached_fill(), Some(Reach::Clusters));
+    let bare = parsed_options(&["-filltype", "outside", "-filldetail", "--nofill", "x.map"]);
+    assert!(bare.fill_detail && !bare.fill);
+}
