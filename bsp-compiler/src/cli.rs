@@ -68,6 +68,14 @@ pub struct Args {
         value_parser = clap::value_parser!(u8).range(0..=1)
     )]
     pub filldetail: u8,
+    /// Liquids are seen through: vis looks through their surfaces and they do not cut rooms
+    /// into clusters (the default)
+    #[arg(long, conflicts_with = "notranswater")]
+    pub transwater: bool,
+    /// Liquids are opaque to vis: their surfaces bound its clusters and it never looks through
+    /// them, for engines that draw liquids opaque
+    #[arg(long)]
+    pub notranswater: bool,
     /// Write the .prt even when the map leaks (vis then works through the void as well, slowly;
     /// without it, a leaking map gets no .prt and an old one is removed)
     #[arg(long)]
@@ -141,6 +149,7 @@ impl Args {
             fill: !self.nofill,
             fill_type: self.filltype,
             fill_detail: self.filldetail != 0,
+            transwater: !self.notranswater,
             clip_hulls: !self.noclip,
             omit,
             texture_data: !self.notex,

@@ -217,6 +217,7 @@ pub fn compile(
         wads: &wads,
         entities: &lump_entities(&map, &left_out, options),
         version,
+        transwater: options.transwater,
         warnings: &mut warnings,
     });
     let mut bsp = emitted.bsp;

@@ -7,7 +7,7 @@ use crate::gather::MapTexInfo;
 use crate::hulls::emit_clipnodes;
 use crate::model::ModelOutput;
 use crate::planes::{PlaneId, PlaneSet};
-use crate::tree::{Tree, engine_contents, is_see_through};
+use crate::tree::{Tree, engine_contents, is_see_through, vis_class};
 use crate::wad_lookup::WadSet;
 use crate::warnings::Warning;
 use crate::weld::{VertexWelder, fix_tjunctions};
@@ -27,6 +27,8 @@ pub(crate) struct EmitInput<'a> {
     pub wads: &'a WadSet,
     pub entities: &'a [Entity],
     pub version: BspVersion,
+    /// Vis looks through liquids' surfaces ([`crate::CompileOptions::transwater`]).
+    pub transwater: bool,
     pub warnings: &'a mut Vec<Warning>,
 }
 
@@ -320,7 +322,12 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
     bsp.planes = planes.planes;
     bsp.set_entity_text(&write_entities(input.entities));
 
-    let portals = world_portal_file(&input.models[0], &world_leaf_index, bsp.models[0].vis_leafs);
+    let portals = world_portal_file(
+        &input.models[0],
+        &world_leaf_index,
+        bsp.models[0].vis_leafs,
+        input.transwater,
+    );
     Emitted {
         bsp,
         portals,
@@ -403,14 +410,17 @@ impl TreeWriter<'_, '_> {
 }
 
 /// The world's portal file: PRT1 between see-through leaves, numbered from BSP leaf 1; or, when
-/// the world has detail, PRT2 between its clusters (structural leaves).
+/// the world has detail, PRT2 between its clusters (structural leaves). Without `transwater`
+/// vis does not look across a liquid's surface (see [`vis_class`]).
 fn world_portal_file(
     world: &ModelOutput,
     leaf_index: &HashMap<u32, u32>,
     vis_leafs: i32,
+    transwater: bool,
 ) -> PortalFile {
     let tree = &world.tree.nodes;
     let num_leafs = vis_leafs.max(0) as u32;
+    let across = |a: i32, b: i32| transwater || vis_class(a) == vis_class(b);
     let Some(cluster_portals) = &world.cluster_portals else {
         let mut portals = Vec::new();
         for p in &world.portals.portals {
@@ -418,10 +428,8 @@ fn world_portal_file(
             else {
                 continue;
             };
-            if p.nodes
-                .iter()
-                .all(|&n| is_see_through(tree[n as usize].contents))
-            {
+            let [ca, cb] = p.nodes.map(|n| tree[n as usize].contents);
+            if is_see_through(ca) && is_see_through(cb) && across(ca, cb) {
                 portals.push(PrtPortal {
                     leafs: [a - 1, b - 1],
                     winding: p.winding.clone(),
@@ -437,7 +445,7 @@ fn world_portal_file(
     // Clusters in tree order, each with the vis leaves below it; a cluster is open to sight when
     // one of its leaves is.
     let mut clusters = Vec::new();
-    let mut cluster_of: HashMap<u32, (u32, bool)> = HashMap::new();
+    let mut cluster_of: HashMap<u32, (u32, bool, i32)> = HashMap::new();
     let mut stack = vec![0u32];
     while let Some(n) = stack.pop() {
         let node = &tree[n as usize];
@@ -459,13 +467,15 @@ fn world_portal_file(
         let open = leaves
             .iter()
             .any(|&l| is_see_through(tree[l as usize].contents));
-        cluster_of.insert(n, (clusters.len() as u32, open));
+        let structural = node.cluster.unwrap_or(node.contents);
+        cluster_of.insert(n, (clusters.len() as u32, open, structural));
         clusters.push(vis);
     }
     let mut portals = Vec::new();
     for p in &cluster_portals.portals {
-        if let (Some(&(a, true)), Some(&(b, true))) =
+        if let (Some(&(a, true, ca)), Some(&(b, true, cb))) =
             (cluster_of.get(&p.nodes[0]), cluster_of.get(&p.nodes[1]))
+            && across(ca, cb)
         {
             portals.push(PrtPortal {
                 leafs: [a, b],

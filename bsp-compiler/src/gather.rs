@@ -16,7 +16,7 @@ use crate::options::CompileOptions;
 use crate::outside::Occupant;
 use crate::planes::PlaneSet;
 use crate::texinfo::{self, FaceContents, TextureRole};
-use crate::tree::{DETAIL_WALL, FENCE, ILLUSIONARY, VISBLOCKER, engine_contents};
+use crate::tree::{DETAIL_WALL, FENCE, ILLUSIONARY, VISBLOCKER, engine_contents, is_liquid};
 use crate::warnings::{DroppedFace, Warning};
 use glam::DVec3;
 use quake_formats::bsp::contents;
@@ -95,6 +95,7 @@ pub(crate) fn gather(
             class: brush_class,
             origin: origin.unwrap_or(DVec3::ZERO),
             phong: merged_phong(ent, index, brush_class),
+            transwater: options.transwater,
             table: &mut g.table,
             warnings,
         };
@@ -395,6 +396,9 @@ struct EntityContext<'a> {
     class: EntityBrushes,
     origin: DVec3,
     phong: FacePhong,
+    /// Liquids are seen through (ericw-tools' `-transwater`): they are detail, which vis does
+    /// not cut into clusters; otherwise structural in any entity, as vis's boundaries.
+    transwater: bool,
     table: &'a mut TexInfoTable,
     warnings: &'a mut Vec<Warning>,
 }
@@ -525,6 +529,11 @@ impl EntityContext<'_> {
                         }
                     } else if brush_contents == contents::SKY {
                         b.kind = BrushKind::Structural;
+                    } else if is_liquid(brush_contents) {
+                        b.kind = match self.transwater {
+                            true => BrushKind::Detail,
+                            false => BrushKind::Structural,
+                        };
                     } else {
                         b.kind = self.class.kind();
                     }

@@ -27,6 +27,10 @@ pub struct CompileOptions {
     /// Fill the space no point entity reaches leaf by leaf, so that pockets closed by detail
     /// brushes are filled too (`-filldetail`), whatever `fill_type` says.
     pub fill_detail: bool,
+    /// Liquids are seen through (ericw-tools' `-transwater`, the default): they are detail for
+    /// vis and it looks through their surfaces. Off (`-notranswater`): they are structural and
+    /// vis stops at their surfaces, for engines that draw them opaque.
+    pub transwater: bool,
     /// Build clip hulls 1 and 2 (off: every model is empty to them).
     pub clip_hulls: bool,
     /// Classnames whose brushes are left out of the compile (`--omitdetail` and its kin).
@@ -64,6 +68,7 @@ impl Default for CompileOptions {
             fill: true,
             fill_type: FillType::default(),
             fill_detail: true,
+            transwater: true,
             clip_hulls: true,
             omit: Vec::new(),
             texture_data: true,

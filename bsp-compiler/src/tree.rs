@@ -212,6 +212,17 @@ pub fn is_liquid(c: i32) -> bool {
     matches!(c, contents::WATER | contents::SLIME | contents::LAVA)
 }
 
+/// What vis may look between when liquids are opaque (`-notranswater`): leaves of one liquid,
+/// or leaves of no liquid.
+pub fn vis_class(c: i32) -> i32 {
+    let engine = engine_contents(c);
+    if is_liquid(engine) {
+        engine
+    } else {
+        contents::EMPTY
+    }
+}
+
 /// Whether a brush of contents `inner` keeps its sides (and so its faces) inside a brush of the
 /// stronger contents `outer`: an illusionary brush is drawn under a liquid's surface, which
 /// players see through.
@@ -244,7 +255,8 @@ pub fn shows_faces_behind(c: i32) -> bool {
 
 /// Whether sight passes through leaves of these contents. Liquids count: modern engines draw
 /// water translucent, so (like ericw-tools' default "transwater") vis sees through liquid
-/// surfaces instead of cutting the world in two at every waterline. Fences have holes.
+/// surfaces instead of cutting the world in two at every waterline (with `-notranswater` the
+/// portal file keeps liquids apart, see [`vis_class`]). Fences have holes.
 pub fn is_see_through(c: i32) -> bool {
     is_liquid(engine_contents(c)) || matches!(c, contents::EMPTY | FENCE | ILLUSIONARY)
 }
