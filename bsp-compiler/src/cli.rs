@@ -88,6 +88,11 @@ pub struct Args {
     /// elsewhere (FTE, QuakeSpasm-Spiked); the WADs are still read for the sizes
     #[arg(long)]
     pub notex: bool,
+    /// Merge another .map into this one (repeatable): its worldspawn brushes join the world and
+    /// its other entities follow; its worldspawn keys are ignored. A relative path not found from
+    /// the working directory is looked for beside the input map
+    #[arg(long, value_name = "FILE.map")]
+    pub add: Vec<PathBuf>,
     /// Leave out func_detail brushes
     #[arg(long)]
     pub omitdetail: bool,
@@ -151,6 +156,7 @@ impl Args {
             fill_detail: self.filldetail != 0,
             transwater: !self.notranswater,
             clip_hulls: !self.noclip,
+            add: self.add.clone(),
             omit,
             texture_data: !self.notex,
             brush_list: self.wrbrushes,

@@ -33,6 +33,9 @@ pub struct CompileOptions {
     pub transwater: bool,
     /// Build clip hulls 1 and 2 (off: every model is empty to them).
     pub clip_hulls: bool,
+    /// Maps whose brushes and entities are merged into the compiled one (ericw-tools' `-add`):
+    /// each one's worldspawn brushes join the world, its other entities follow.
+    pub add: Vec<PathBuf>,
     /// Classnames whose brushes are left out of the compile (`--omitdetail` and its kin).
     pub omit: Vec<String>,
     /// Write texture pixels (off: names and sizes only, for engines that have the textures).
@@ -70,6 +73,7 @@ impl Default for CompileOptions {
             fill_detail: true,
             transwater: true,
             clip_hulls: true,
+            add: Vec::new(),
             omit: Vec::new(),
             texture_data: true,
             brush_list: false,

@@ -353,3 +353,40 @@ fn filltype_and_filldetail_take_ericw_tools_spellings() {
     let bare = parsed_options(&["-filltype", "outside", "-filldetail", "--nofill", "x.map"]);
     assert!(bare.fill_detail && !bare.fill);
 }
+
+/// `-add FILE.map` (ericw-tools' `mergeMaps`): the added map's worldspawn brushes join the
+/// world and its entities follow the base map's; worldspawn's keys are the base map's. A
+/// relative path is found beside the base map too.
+#[test]
+fn add_merges_a_second_maps_brushes_and_entities() {
+    let dir = temp_dir("add");
+    let base = dir.join("base.map");
+    std::fs::write(&base, room_map(false, "")).expect("write");
+    let addition = format!(
+        "{{\n\"classname\" \"worldspawn\"\n\"message\" \"not this one\"\n{}}}\n{}",
+        box_brush([32.0, 32.0, -128.0], [64.0, 64.0, -96.0], "added"),
+        brush_entity(
+            "func_wall",
+            &box_brush([-96.0, 32.0, -128.0], [-64.0, 64.0, -96.0], "crate")
+        ),
+    );
+    std::fs::write(dir.join("addition.map"), addition).expect("write");
+    let options = parsed_options(&["-add", "addition.map", "base.map"]);
+    assert_eq!(options.add, [PathBuf::from("addition.map")]);
+    let source = bsp_compiler::MapSource::read(&base).expect("read");
+    let out = bsp_compiler::compile(&source, &options).expect("compile");
+    let bsp = &out.bsp;
+    assert!(out.leak.is_none(), "{:?}", out.leak);
+    assert_eq!(errors(bsp), Vec::<String>::new());
+    assert_eq!(bsp.models.len(), 2);
+    let top = faces_at(bsp, 0, [48.0, 48.0, -96.0], Some([0.0, 0.0, 1.0]));
+    assert_eq!(top.len(), 1);
+    assert_eq!(face_texture(bsp, top[0]), "added");
+    let entities = bsp.entity_text();
+    assert_eq!(entities.matches("\"classname\"").count(), 3, "{entities}");
+    assert!(entities.contains("func_wall") && !entities.contains("not this one"));
+    // A missing addition is an error naming it.
+    let missing = parsed_options(&["-add", "nowhere.map", "base.map"]);
+    let err = bsp_compiler::compile(&source, &missing).expect_err("no such map");
+    assert!(err.to_string().contains("nowhere.map"), "{err}");
+}
