@@ -3,6 +3,7 @@
 use crate::convert::{MapFormat, convert_map};
 use crate::map::parse_map;
 use crate::onlyents::replace_entities;
+use crate::options::DEFAULT_MAX_EDGES;
 use crate::outside::FillType;
 use crate::tree::MID_SPLIT_SIZE;
 use crate::{CompileOptions, MapSource, SplitHeuristic, compile};
@@ -45,6 +46,10 @@ pub struct Args {
     /// by the heuristic (0: never)
     #[arg(long, value_name = "N", default_value_t = MID_SPLIT_SIZE)]
     pub maxnodesize: f64,
+    /// Cut faces left with more than N edges by T-junction fixing into smaller ones, for engines
+    /// that copy faces into fixed buffers (0: never; liquids at most 60 either way but 0)
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_EDGES, value_parser = parse_max_edges)]
+    pub maxedges: usize,
     /// Make a leak an error: nothing but the .pts pointfile is written, and the exit status is 1
     #[arg(long)]
     pub leaktest: bool,
@@ -155,6 +160,7 @@ impl Args {
             fill_type: self.filltype,
             fill_detail: self.filldetail != 0,
             transwater: !self.notranswater,
+            max_edges: self.maxedges,
             clip_hulls: !self.noclip,
             add: self.add.clone(),
             omit,
@@ -163,6 +169,14 @@ impl Args {
             keep_editor_keys: self.keep_editor_keys,
             progress: quake_formats::progress::terminal(),
         }
+    }
+}
+
+/// `--maxedges`: 0 (no limit) or a face of at least a triangle.
+fn parse_max_edges(s: &str) -> Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(n) if n == 0 || n >= 3 => Ok(n),
+        _ => Err(format!("{s:?} is neither 0 (no limit) nor 3 or more edges")),
     }
 }
 

@@ -218,6 +218,7 @@ pub fn compile(
         entities: &lump_entities(&map, &left_out, options),
         version,
         transwater: options.transwater,
+        max_edges: options.max_edges,
         warnings: &mut warnings,
     });
     let mut bsp = emitted.bsp;

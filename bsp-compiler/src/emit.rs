@@ -7,11 +7,13 @@ use crate::gather::MapTexInfo;
 use crate::hulls::emit_clipnodes;
 use crate::model::ModelOutput;
 use crate::planes::{PlaneId, PlaneSet};
+use crate::texinfo::TextureRole;
 use crate::tree::{Tree, engine_contents, is_see_through, vis_class};
 use crate::wad_lookup::WadSet;
 use crate::warnings::Warning;
-use crate::weld::{VertexWelder, fix_tjunctions};
+use crate::weld::{VertexWelder, cut_to_max_vertices, fix_tjunctions};
 use glam::DVec3;
+use quake_formats::bsp::limits::QUAKESPASM_MAX_WARP_FACE_VERTS;
 use quake_formats::bsp::{BspPlane, Face, Leaf, Model, Node, TexInfo, contents, texinfo_flags};
 use quake_formats::entities::{Entity, write_entities};
 use quake_formats::geom::{Bounds, Plane};
@@ -29,6 +31,8 @@ pub(crate) struct EmitInput<'a> {
     pub version: BspVersion,
     /// Vis looks through liquids' surfaces ([`crate::CompileOptions::transwater`]).
     pub transwater: bool,
+    /// Faces with more edges are cut ([`crate::CompileOptions::max_edges`]; 0: never).
+    pub max_edges: usize,
     pub warnings: &'a mut Vec<Warning>,
 }
 
@@ -93,6 +97,16 @@ impl TextureTable<'_> {
             });
         }
         self.info_index[id as usize]
+    }
+}
+
+/// The most edges a face of texture `role` may have: `max_edges` (0: no limit), and for liquids
+/// no more than the buffer QuakeSpasm subdivides them from.
+fn max_face_edges(max_edges: usize, role: TextureRole) -> Option<usize> {
+    match (max_edges, role) {
+        (0, _) => None,
+        (n, TextureRole::Liquid(_)) => Some(n.min(QUAKESPASM_MAX_WARP_FACE_VERTS)),
+        (n, _) => Some(n),
     }
 }
 
@@ -194,7 +208,18 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
     let mut leaf_growth: HashMap<(usize, u32), Bounds> = HashMap::new();
     let mut model_faces: Vec<(u32, u32)> = vec![(0, 0); input.models.len()];
     let mut phong = Vec::with_capacity(pending.len());
-    for (pf, poly) in pending.iter().zip(polygons) {
+    let pieces = pending.iter().zip(polygons).flat_map(|(pf, poly)| {
+        let max = max_face_edges(
+            input.max_edges,
+            input.texinfos[pf.face.texinfo as usize].role,
+        );
+        let pieces = match max {
+            Some(max) => cut_to_max_vertices(poly, max, &welder.positions),
+            None => vec![poly],
+        };
+        pieces.into_iter().map(move |poly| (pf, poly))
+    });
+    for (pf, poly) in pieces {
         if poly.len() < 3 {
             continue;
         }

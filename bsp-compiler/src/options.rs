@@ -2,8 +2,13 @@
 
 use crate::outside::{FillType, Reach};
 use crate::tree::{MID_SPLIT_SIZE, SplitHeuristic};
+use quake_formats::bsp::limits::QUAKESPASM_MAX_UNLIT_FACE_VERTS;
 use quake_formats::progress::Progress;
 use std::path::PathBuf;
+
+/// ericw-tools' default `-maxedges` for Quake: the vertex buffer QuakeSpasm and vkQuake copy sky
+/// and unlit faces into.
+pub const DEFAULT_MAX_EDGES: usize = QUAKESPASM_MAX_UNLIT_FACE_VERTS;
 
 #[derive(Debug, Clone)]
 pub struct CompileOptions {
@@ -31,6 +36,9 @@ pub struct CompileOptions {
     /// vis and it looks through their surfaces. Off (`-notranswater`): they are structural and
     /// vis stops at their surfaces, for engines that draw them opaque.
     pub transwater: bool,
+    /// Faces left with more edges than this (by T-junction fixing) are cut into smaller ones,
+    /// for engines that copy faces into fixed buffers (ericw-tools' `-maxedges`; 0: never).
+    pub max_edges: usize,
     /// Build clip hulls 1 and 2 (off: every model is empty to them).
     pub clip_hulls: bool,
     /// Maps whose brushes and entities are merged into the compiled one (ericw-tools' `-add`):
@@ -72,6 +80,7 @@ impl Default for CompileOptions {
             fill_type: FillType::default(),
             fill_detail: true,
             transwater: true,
+            max_edges: DEFAULT_MAX_EDGES,
             clip_hulls: true,
             add: Vec::new(),
             omit: Vec::new(),

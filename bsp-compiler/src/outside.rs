@@ -320,13 +320,13 @@ pub fn fill_unreached(
         }
     }
     let mut filled = 0;
-    for unit in 0..tree.nodes.len() {
+    for (unit, &was_reached) in reached.iter().enumerate().take(tree.nodes.len()) {
         let node = &tree.nodes[unit];
         let is_unit = match reach {
             Reach::Clusters => node.cluster.is_some(),
             Reach::Leaves => node.is_leaf(),
         };
-        if !is_unit || reached[unit] || !open(contents_of(tree, unit as u32)) {
+        if !is_unit || was_reached || !open(contents_of(tree, unit as u32)) {
             continue;
         }
         for leaf in tree.leaves_below(unit as u32) {

@@ -390,3 +390,70 @@ fn add_merges_a_second_maps_brushes_and_entities() {
     let err = bsp_compiler::compile(&source, &missing).expect_err("no such map");
     assert!(err.to_string().contains("nowhere.map"), "{err}");
 }
+
+/// A room whose walls are 32 slabs each, of two textures in turn so that they do not merge: every
+/// slab's edge meets the sky ceiling's edge, and fixing those T-junctions gives the ceiling 128
+/// vertices.
+fn room_of_slabs() -> String {
+    let mut world = String::new();
+    world += &box_brush([-144.0, -144.0, -144.0], [144.0, 144.0, -128.0], "floor");
+    world += &box_brush([-144.0, -144.0, 128.0], [144.0, 144.0, 144.0], "sky1");
+    for i in 0..32 {
+        let (lo, hi) = (-128.0 + 8.0 * f64::from(i), -120.0 + 8.0 * f64::from(i));
+        let tex = ["wall", "wall2"][i as usize % 2];
+        world += &box_brush([-144.0, lo, -128.0], [-128.0, hi, 128.0], tex);
+        world += &box_brush([128.0, lo, -128.0], [144.0, hi, 128.0], tex);
+        world += &box_brush([lo, -144.0, -128.0], [hi, -128.0, 128.0], tex);
+        world += &box_brush([lo, 128.0, -128.0], [hi, 144.0, 128.0], tex);
+    }
+    for (x, y) in [
+        (-144.0, -144.0),
+        (-144.0, 128.0),
+        (128.0, -144.0),
+        (128.0, 128.0),
+    ] {
+        world += &box_brush([x, y, -128.0], [x + 16.0, y + 16.0, 128.0], "wall");
+    }
+    format!(
+        "{{\n\"classname\" \"worldspawn\"\n\"wad\" \"none.wad\"\n{world}}}\n\
+         {{\n\"classname\" \"info_player_start\"\n\"origin\" \"0 0 -100\"\n}}\n"
+    )
+}
+
+/// `-maxedges N` (ericw-tools' `tjuncManySidedFace` tests): faces whose T-junction fixes give
+/// them more than N edges (64 by default, as engines' fixed polygon buffers need) are cut into
+/// faces of at most N, none of them without area, and the cracks stay fixed; 0 leaves them whole.
+#[test]
+fn maxedges_cuts_faces_with_too_many_edges() {
+    let text = room_of_slabs();
+    let sky_faces = |bsp: &Bsp| -> Vec<usize> {
+        (0..bsp.faces.len())
+            .filter(|&f| face_texture(bsp, f) == "sky1")
+            .collect()
+    };
+    let area = |bsp: &Bsp, f: usize| {
+        let vs: Vec<glam::DVec3> = bsp
+            .face_vertices(&bsp.faces[f])
+            .expect("vertices")
+            .iter()
+            .map(|&v| glam::Vec3::from(v).as_dvec3())
+            .collect();
+        quake_formats::geom::Winding::new(vs).area()
+    };
+    let capped = compile_options(&text, parsed_options(&["x.map"]));
+    assert_eq!(errors(&capped), Vec::<String>::new());
+    assert!(bsp_compiler::cracks::find_cracks(&capped).is_empty());
+    assert!(capped.faces.iter().all(|f| f.num_edges <= 64));
+    let sky = sky_faces(&capped);
+    assert!(sky.len() > 1, "{sky:?}");
+    let total: f64 = sky.iter().map(|&f| area(&capped, f)).sum();
+    assert!((total - 256.0 * 256.0).abs() < 1.0, "{total}");
+    assert!(sky.iter().all(|&f| area(&capped, f) > 1.0));
+    let small = compile_options(&text, parsed_options(&["-maxedges", "16", "x.map"]));
+    assert!(small.faces.iter().all(|f| f.num_edges <= 16));
+    assert!(bsp_compiler::cracks::find_cracks(&small).is_empty());
+    let whole = compile_options(&text, parsed_options(&["-maxedges", "0", "x.map"]));
+    let sky = sky_faces(&whole);
+    assert_eq!(sky.len(), 1);
+    assert_eq!(whole.faces[sky[0]].num_edges, 128);
+}
