@@ -34,6 +34,35 @@ fn a_later_brushs_coplanar_face_wins() {
     assert_eq!(face_texture(bsp, top[0]), "slab");
 }
 
+/// Two brushes side by side with their tops flush, textured differently: each keeps its own
+/// texture on its own part of the plane, in the world and in a brush entity (one face does not
+/// take one brush's texture across both).
+#[test]
+fn flush_brushes_keep_their_own_textures() {
+    let left = box_brush([-128.0, -128.0, -128.0], [0.0, 128.0, -112.0], "tile_a");
+    let right = box_brush([0.0, -128.0, -128.0], [128.0, 128.0, -112.0], "tile_b");
+    let step_a = box_brush([-64.0, -64.0, -112.0], [0.0, 0.0, -96.0], "step_a");
+    let step_b = box_brush([0.0, -64.0, -112.0], [64.0, 0.0, -96.0], "step_b");
+    let text = room_map_with(
+        false,
+        &format!("{left}{right}"),
+        &brush_entity("func_wall", &format!("{step_a}{step_b}")),
+    );
+    let out = compile_text(&text);
+    let bsp = &out.bsp;
+    assert_eq!(errors(bsp), Vec::<String>::new());
+    for (model, p, name) in [
+        (0, [-96.0, 64.0, -112.0], "tile_a"),
+        (0, [96.0, 64.0, -112.0], "tile_b"),
+        (1, [-32.0, -32.0, -96.0], "step_a"),
+        (1, [32.0, -32.0, -96.0], "step_b"),
+    ] {
+        let found = faces_at(bsp, model, p, UP);
+        let names: Vec<String> = found.iter().map(|&f| face_texture(bsp, f)).collect();
+        assert_eq!(names, [name], "model {model} at {p:?}");
+    }
+}
+
 /// A `func_detail_illusionary` block standing in water up through its surface keeps its faces
 /// below the water line, outward and (with `_mirrorinside`) inward, and is water inside there, as
 /// in ericw-tools (`waterDetailIllusionary`).
