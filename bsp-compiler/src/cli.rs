@@ -69,10 +69,25 @@ pub struct Args {
         value_name = "N",
         default_value = "1",
         num_args = 0..=1,
+        require_equals = true,
         default_missing_value = "1",
         value_parser = clap::value_parser!(u8).range(0..=1)
     )]
     pub filldetail: u8,
+    /// Light liquids (1, the default): they get lightmaps and are subdivided like other faces, so
+    /// that QuakeSpasm, Ironwail, vkQuake and FTE draw them lit; 0 writes them unlit, drawn
+    /// fullbright everywhere. The `_litwater` key of worldspawn or a brush entity overrides it
+    #[arg(
+        long,
+        visible_alias = "splitturb",
+        value_name = "N",
+        default_value = "1",
+        num_args = 0..=1,
+        require_equals = true,
+        default_missing_value = "1",
+        value_parser = clap::value_parser!(u8).range(0..=1)
+    )]
+    pub litwater: u8,
     /// Liquids are seen through: vis looks through their surfaces and they do not cut rooms
     /// into clusters (the default)
     #[arg(long, conflicts_with = "notranswater")]
@@ -160,6 +175,7 @@ impl Args {
             fill_type: self.filltype,
             fill_detail: self.filldetail != 0,
             transwater: !self.notranswater,
+            lit_water: self.litwater != 0,
             max_edges: self.maxedges,
             clip_hulls: !self.noclip,
             add: self.add.clone(),
@@ -170,6 +186,12 @@ impl Args {
             progress: quake_formats::progress::terminal(),
         }
     }
+}
+
+/// The compiler's options whose value is optional (`-litwater`, `-litwater 0`): a following
+/// number is their value, anything else is left as the next argument.
+pub fn join_optional_values(args: impl IntoIterator<Item = String>) -> Vec<String> {
+    quake_formats::cli::join_optional_values(args, &["--filldetail", "--litwater", "--splitturb"])
 }
 
 /// `--maxedges`: 0 (no limit) or a face of at least a triangle.

@@ -272,6 +272,7 @@ fn build_models(
         .map(|i| FaceTexInfo {
             vecs: i.vecs,
             role: i.role,
+            special: i.is_special(),
         })
         .collect();
     let progress = &options.progress;
@@ -501,10 +502,11 @@ fn square_up_projections(
             squared += 1;
             let name = table.names[info.texture as usize].clone();
             let vecs = quake.vecs(&Plane::new(normal, 0.0));
-            f.texinfo = table.intern(&name, vecs, info.phong);
+            f.texinfo = table.intern(&name, vecs, info.phong, info.lit_water);
             let squared_info = FaceTexInfo {
                 vecs,
                 role: info.role,
+                special: info.is_special(),
             };
             cut_for_lightmaps(f, &squared_info, subdivide, &mut faces);
         }

@@ -89,7 +89,7 @@ impl TextureTable<'_> {
             self.out_infos.push(TexInfo {
                 vecs: info.vecs.map(|row| row.map(|c| c as f32)),
                 miptex: self.texture_index[tex],
-                flags: if info.role.is_special() {
+                flags: if info.is_special() {
                     texinfo_flags::SPECIAL
                 } else {
                     0
@@ -241,7 +241,7 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
                 }
             }
         }
-        let special = input.texinfos[f.texinfo as usize].role.is_special();
+        let special = input.texinfos[f.texinfo as usize].is_special();
         bsp.faces.push(Face {
             plane: planes.get(f.plane),
             side: u32::from(f.back),

@@ -54,6 +54,8 @@ impl ModelFace {
 pub struct FaceTexInfo {
     pub vecs: [[f64; 4]; 2],
     pub role: TextureRole,
+    /// Written with `TEX_SPECIAL` ([`crate::MapTexInfo::is_special`]).
+    pub special: bool,
 }
 
 /// Face counts for the summary.
@@ -582,7 +584,7 @@ pub fn subdivide(w: Winding, vecs: &[[f64; 4]; 2], size: f64, out: &mut Vec<Wind
 /// `face` as it is written: cut by [`subdivide`] when lit, whole when special (sky, liquids).
 pub fn cut_for_lightmaps(face: ModelFace, info: &FaceTexInfo, size: f64, out: &mut Vec<ModelFace>) {
     // A size of 0 asks for no subdivision at all (ericw-tools' `-subdivide 0`).
-    if info.role.is_special() || size <= 0.0 {
+    if info.special || size <= 0.0 {
         out.push(face);
         return;
     }

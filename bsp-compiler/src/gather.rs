@@ -96,6 +96,7 @@ pub(crate) fn gather(
             origin: origin.unwrap_or(DVec3::ZERO),
             phong: merged_phong(ent, index, brush_class),
             transwater: options.transwater,
+            lit_water: lit_water(&map.entities, ent, options.lit_water),
             table: &mut g.table,
             warnings,
         };
@@ -172,6 +173,16 @@ pub struct MapTexInfo {
     pub role: TextureRole,
     /// The `_phong` group of the world-merged entity the face came from.
     pub phong: FacePhong,
+    /// Liquid faces get lightmaps ([`crate::CompileOptions::lit_water`], or the entity's
+    /// `_litwater`).
+    pub lit_water: bool,
+}
+
+impl MapTexInfo {
+    /// Written with `TEX_SPECIAL`: no lightmap, never subdivided.
+    pub fn is_special(&self) -> bool {
+        self.role.is_special(self.lit_water)
+    }
 }
 
 /// One model's brushes before tree building.
@@ -249,13 +260,20 @@ pub(crate) struct TexInfoTable {
     pub names: Vec<String>,
     name_index: HashMap<String, u32>,
     pub infos: Vec<MapTexInfo>,
-    info_index: HashMap<([u64; 8], u32, u32), u32>,
+    info_index: HashMap<([u64; 8], u32, u32, bool), u32>,
 }
 
 impl TexInfoTable {
-    /// The texinfo of `name` projected by `vecs` on a face of `phong`'s group
-    /// (faces of different groups never share one, so they never merge).
-    pub fn intern(&mut self, name: &str, vecs: [[f64; 4]; 2], phong: FacePhong) -> u32 {
+    /// The texinfo of `name` projected by `vecs` on a face of `phong`'s group, a liquid lit
+    /// or not by `lit_water` (faces of different groups or lighting never share one, so they
+    /// never merge).
+    pub fn intern(
+        &mut self,
+        name: &str,
+        vecs: [[f64; 4]; 2],
+        phong: FacePhong,
+        lit_water: bool,
+    ) -> u32 {
         let key = name.to_ascii_lowercase();
         let texture = match self.name_index.get(&key) {
             Some(&i) => i,
@@ -267,17 +285,22 @@ impl TexInfoTable {
             }
         };
         let bits: [u64; 8] = std::array::from_fn(|i| (vecs[i / 4][i % 4] as f32).to_bits() as u64);
-        if let Some(&i) = self.info_index.get(&(bits, texture, phong.group)) {
+        let role = TextureRole::of(name);
+        // Only liquids' texinfos depend on it; others stay shared.
+        let lit_water = lit_water && matches!(role, TextureRole::Liquid(_));
+        let key = (bits, texture, phong.group, lit_water);
+        if let Some(&i) = self.info_index.get(&key) {
             return i;
         }
         let i = self.infos.len() as u32;
         self.infos.push(MapTexInfo {
             vecs,
             texture,
-            role: TextureRole::of(name),
+            role,
             phong,
+            lit_water,
         });
-        self.info_index.insert((bits, texture, phong.group), i);
+        self.info_index.insert(key, i);
         i
     }
 }
@@ -318,6 +341,14 @@ fn origin_brush_centre(ent: &MapEntity, planes: &mut PlaneSet) -> Option<DVec3> 
         }
     }
     (!bounds.is_empty()).then(|| bounds.center())
+}
+
+/// Whether `ent`'s liquids are lit: its `_litwater` key, else the worldspawn's, else `default`.
+fn lit_water(entities: &[MapEntity], ent: &MapEntity, default: bool) -> bool {
+    let key = |e: &MapEntity| e.entity.get_float("_litwater").map(|v| v != 0.0);
+    key(ent)
+        .or_else(|| entities.first().and_then(key))
+        .unwrap_or(default)
 }
 
 /// The `_phong` group of entity `index` if it is merged into the world (its
@@ -399,6 +430,8 @@ struct EntityContext<'a> {
     /// Liquids are seen through (ericw-tools' `-transwater`): they are detail, which vis does
     /// not cut into clusters; otherwise structural in any entity, as vis's boundaries.
     transwater: bool,
+    /// Its liquids get lightmaps (`_litwater`, else the worldspawn's, else the option).
+    lit_water: bool,
     table: &'a mut TexInfoTable,
     warnings: &'a mut Vec<Warning>,
 }
@@ -449,7 +482,9 @@ impl EntityContext<'_> {
                     texture: f.texture.clone(),
                 });
             }
-            let texinfo = self.table.intern(&f.texture, vecs, self.phong);
+            let texinfo = self
+                .table
+                .intern(&f.texture, vecs, self.phong, self.lit_water);
             out.roles.push(role);
             out.lines.push(f.line);
             out.planes.push(BrushPlane {
@@ -604,10 +639,10 @@ mod tests {
             group: 3,
             angle: 89.0,
         };
-        let plain = table.intern("wall", vecs, FacePhong::default());
-        let a = table.intern("wall", vecs, grouped);
+        let plain = table.intern("wall", vecs, FacePhong::default(), true);
+        let a = table.intern("wall", vecs, grouped, true);
         assert_ne!(plain, a);
-        assert_eq!(table.intern("wall", vecs, grouped), a);
+        assert_eq!(table.intern("wall", vecs, grouped, true), a);
         assert_eq!(table.infos[a as usize].phong, grouped);
         assert_eq!(table.names.len(), 1, "one texture either way");
     }

@@ -36,6 +36,10 @@ pub struct CompileOptions {
     /// vis and it looks through their surfaces. Off (`-notranswater`): they are structural and
     /// vis stops at their surfaces, for engines that draw them opaque.
     pub transwater: bool,
+    /// Liquids get lightmaps and are subdivided like other faces, for the engines that light
+    /// them (ericw-tools' `-litwater`, on by default; the `_litwater` key of worldspawn or a
+    /// brush entity overrides it); engines that do not draw them fullbright as before.
+    pub lit_water: bool,
     /// Faces left with more edges than this (by T-junction fixing) are cut into smaller ones,
     /// for engines that copy faces into fixed buffers (ericw-tools' `-maxedges`; 0: never).
     pub max_edges: usize,
@@ -80,6 +84,7 @@ impl Default for CompileOptions {
             fill_type: FillType::default(),
             fill_detail: true,
             transwater: true,
+            lit_water: true,
             max_edges: DEFAULT_MAX_EDGES,
             clip_hulls: true,
             add: Vec::new(),

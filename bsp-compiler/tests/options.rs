@@ -332,7 +332,8 @@ fn leaktest_writes_nothing_but_the_pointfile_and_fails() {
 fn parsed_options(args: &[&str]) -> CompileOptions {
     use clap::Parser;
     let words = ["bsp"].iter().chain(args).map(|s| s.to_string());
-    let words = quake_formats::cli::normalise_single_dash(words);
+    let words =
+        bsp_compiler::cli::join_optional_values(quake_formats::cli::normalise_single_dash(words));
     BspCli::try_parse_from(words)
         .expect("parses")
         .args
@@ -456,4 +457,55 @@ fn maxedges_cuts_faces_with_too_many_edges() {
     let sky = sky_faces(&whole);
     assert_eq!(sky.len(), 1);
     assert_eq!(whole.faces[sky[0]].num_edges, 128);
+}
+
+/// The texinfo flags of the faces textured `name`.
+fn flags_of(bsp: &Bsp, name: &str) -> Vec<i32> {
+    (0..bsp.faces.len())
+        .filter(|&f| face_texture(bsp, f) == name)
+        .map(|f| bsp.texinfo[bsp.faces[f].texinfo as usize].flags)
+        .collect()
+}
+
+/// Lit water (ericw-tools' `-litwater`, alias `-splitturb`, on by default): liquid faces are
+/// written without `TEX_SPECIAL`, so light gives them lightmaps, and are cut to lightmap size as
+/// other faces are; `-litwater 0` writes them special and whole; the `_litwater` key of
+/// worldspawn, and of a brush entity over it, decides for their liquids.
+#[test]
+fn liquids_are_lit_unless_litwater_is_off() {
+    use quake_formats::bsp::texinfo_flags::SPECIAL;
+    let pool = box_brush([-128.0, -128.0, -128.0], [128.0, 128.0, -96.0], "*water0");
+    let text = room_map(false, &pool);
+    let lit = compile_options(&text, parsed_options(&["x.map"]));
+    assert_eq!(errors(&lit), Vec::<String>::new());
+    let lit_flags = flags_of(&lit, "*water0");
+    assert!(lit_flags.iter().all(|f| f & SPECIAL == 0), "{lit_flags:?}");
+    let unlit = compile_options(&text, parsed_options(&["-litwater", "0", "x.map"]));
+    let unlit_flags = flags_of(&unlit, "*water0");
+    assert!(unlit_flags.iter().all(|f| f & SPECIAL != 0));
+    // The 256-unit surface, seen from above and below, is cut only when lit.
+    assert_eq!(unlit_flags.len(), 2);
+    assert!(lit_flags.len() > unlit_flags.len());
+    let split = compile_options(&text, parsed_options(&["-splitturb", "x.map"]));
+    assert_eq!(flags_of(&split, "*water0"), lit_flags);
+
+    let off_in_world = text.replacen(
+        "\"classname\" \"worldspawn\"",
+        "\"classname\" \"worldspawn\"\n\"_litwater\" \"0\"",
+        1,
+    );
+    let bsp = compile_options(&off_in_world, parsed_options(&["x.map"]));
+    assert!(flags_of(&bsp, "*water0").iter().all(|f| f & SPECIAL != 0));
+    let on_in_entity = room_map_with(
+        false,
+        "",
+        &format!("{{\n\"classname\" \"func_group\"\n\"_litwater\" \"1\"\n{pool}}}\n"),
+    )
+    .replacen(
+        "\"classname\" \"worldspawn\"",
+        "\"classname\" \"worldspawn\"\n\"_litwater\" \"0\"",
+        1,
+    );
+    let bsp = compile_options(&on_in_entity, parsed_options(&["x.map"]));
+    assert!(flags_of(&bsp, "*water0").iter().all(|f| f & SPECIAL == 0));
 }

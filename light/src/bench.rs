@@ -10,7 +10,6 @@ use rayon::prelude::*;
 
 use crate::Prepared;
 use crate::embree::RayPacket16;
-use crate::faces::FaceKind;
 use crate::samples::face_samples;
 
 /// One shadow ray: origin, unit direction, length.
@@ -28,7 +27,7 @@ pub struct BareOcclusion {
 /// range culling) and times tracing them in 16-ray packets on all threads.
 pub fn bare_occlusion(bsp: &Bsp, prep: &Prepared, gate: f64, max_rays: usize) -> BareOcclusion {
     let mut rays: Vec<Ray> = Vec::new();
-    'faces: for face in prep.faces.iter().filter(|f| f.kind == FaceKind::Lit) {
+    'faces: for face in prep.faces.iter().filter(|f| f.kind.has_lightmap()) {
         let (samples, _) = face_samples(face, 1, &prep.scene, bsp);
         for light in &prep.point_lights {
             if face.plane.distance(light.origin) <= 0.0 {

@@ -190,26 +190,10 @@ fn find_palette(args: &Args) -> anyhow::Result<Option<Palette>> {
         .transpose()
 }
 
-/// Options whose value is optional (`--bounce [N]`, `--soft [N]`, ericw-tools' spelling) take a
-/// following number as their value: `--bounce 2` becomes `--bounce=2`, while `--bounce
-/// map.bsp` leaves the BSP as the positional argument.
+/// Light's options whose value is optional (`--bounce [N]`, `--soft [N]`): a following number
+/// is their value ([`quake_formats::cli::join_optional_values`]).
 pub fn join_optional_values(args: impl IntoIterator<Item = String>) -> Vec<String> {
-    let mut out: Vec<String> = Vec::new();
-    for a in args {
-        let joins = out
-            .last()
-            .is_some_and(|prev| prev == "--bounce" || prev == "--soft")
-            && !a.is_empty()
-            && a.chars().all(|c| c.is_ascii_digit());
-        match out.last_mut() {
-            Some(prev) if joins => {
-                prev.push('=');
-                prev.push_str(&a);
-            }
-            _ => out.push(a),
-        }
-    }
-    out
+    quake_formats::cli::join_optional_values(args, &["--bounce", "--soft"])
 }
 
 /// Whether to write a `.lit` file beside the lit BSP.

@@ -46,7 +46,7 @@ use rayon::prelude::*;
 
 use crate::bounce::{BounceCounts, StyleLuxels};
 use crate::embree::{Device, EmbreeError};
-use crate::faces::{FaceKind, face_geometry};
+use crate::faces::face_geometry;
 use crate::lights::{GlobalOverrides, parse_lights};
 use crate::output::{FaceLightmap, Finish, finish_face};
 use crate::samples::{FaceSamples, PlacementCounts, face_samples};
@@ -550,7 +550,7 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
     // With nothing to give light, engines draw a map with an empty lighting lump fullbright
     // (a lump of zeros would be black), as they draw a map never lit.
     let fullbright = !prep.has_light_sources();
-    let lit = |f: &usize| !fullbright && prep.faces[*f].kind == FaceKind::Lit;
+    let lit = |f: &usize| !fullbright && prep.faces[*f].kind.has_lightmap();
     let bouncing = prep.lights.bounce.is_on() && !fullbright;
     let palette = options
         .palette
