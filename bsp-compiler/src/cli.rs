@@ -88,6 +88,10 @@ pub struct Args {
         value_parser = clap::value_parser!(u8).range(0..=1)
     )]
     pub litwater: u8,
+    /// A brush model's liquid brushes stay liquid (a func_door of water you can swim in, in FTE);
+    /// WinQuake-style engines give such a model no collision. Without it they are solid
+    #[arg(long)]
+    pub bmodelcontents: bool,
     /// Liquids are seen through: vis looks through their surfaces and they do not cut rooms
     /// into clusters (the default)
     #[arg(long, conflicts_with = "notranswater")]
@@ -176,6 +180,7 @@ impl Args {
             fill_detail: self.filldetail != 0,
             transwater: !self.notranswater,
             lit_water: self.litwater != 0,
+            bmodel_contents: self.bmodelcontents,
             max_edges: self.maxedges,
             clip_hulls: !self.noclip,
             add: self.add.clone(),

@@ -96,6 +96,7 @@ pub(crate) fn gather(
             origin: origin.unwrap_or(DVec3::ZERO),
             phong: merged_phong(ent, index, brush_class),
             transwater: options.transwater,
+            bmodel_contents: options.bmodel_contents,
             lit_water: lit_water(&map.entities, ent, options.lit_water),
             table: &mut g.table,
             warnings,
@@ -430,6 +431,8 @@ struct EntityContext<'a> {
     /// Liquids are seen through (ericw-tools' `-transwater`): they are detail, which vis does
     /// not cut into clusters; otherwise structural in any entity, as vis's boundaries.
     transwater: bool,
+    /// A brush model's liquid brushes keep their contents ([`CompileOptions::bmodel_contents`]).
+    bmodel_contents: bool,
     /// Its liquids get lightmaps (`_litwater`, else the worldspawn's, else the option).
     lit_water: bool,
     table: &'a mut TexInfoTable,
@@ -498,7 +501,8 @@ impl EntityContext<'_> {
     /// The contents of a (non-hint) brush of these faces. The texture decides first, as in
     /// ericw-tools: a sky or liquid brush stays one in any detail entity (sky seals the map
     /// wherever it is); only solid brushes take their entity's contents. The brush's first face
-    /// that gives contents decides them; a later one giving others is warned about.
+    /// that gives contents decides them; a later one giving others is warned about. A brush
+    /// model's brushes are solid, unless `-bmodelcontents` lets its liquids be liquid.
     fn contents(&mut self, faces: &BrushFaces, bi: usize) -> (i32, FaceContents) {
         let (textured, conflict) = texinfo::brush_contents(&faces.roles);
         if let Some(i) = conflict {
@@ -510,6 +514,7 @@ impl EntityContext<'_> {
             });
         }
         let contents = match (self.class, textured) {
+            (EntityBrushes::Submodel, FaceContents::Liquid(c)) if self.bmodel_contents => c,
             (EntityBrushes::Submodel, _) => contents::SOLID,
             (EntityBrushes::VisBlocker, _) => VISBLOCKER,
             (_, FaceContents::Sky) => contents::SKY,

@@ -36,6 +36,10 @@ pub struct CompileOptions {
     /// vis and it looks through their surfaces. Off (`-notranswater`): they are structural and
     /// vis stops at their surfaces, for engines that draw them opaque.
     pub transwater: bool,
+    /// A brush model's liquid brushes are liquid, as in the world (ericw-tools'
+    /// `-bmodelcontents`: a `func_door` of water swims in FTE; engines that collide with brush
+    /// models only as solid give it no collision). Off: every brush of a brush model is solid.
+    pub bmodel_contents: bool,
     /// Liquids get lightmaps and are subdivided like other faces, for the engines that light
     /// them (ericw-tools' `-litwater`, on by default; the `_litwater` key of worldspawn or a
     /// brush entity overrides it); engines that do not draw them fullbright as before.
@@ -84,6 +88,7 @@ impl Default for CompileOptions {
             fill_type: FillType::default(),
             fill_detail: true,
             transwater: true,
+            bmodel_contents: false,
             lit_water: true,
             max_edges: DEFAULT_MAX_EDGES,
             clip_hulls: true,

@@ -509,3 +509,28 @@ fn liquids_are_lit_unless_litwater_is_off() {
     let bsp = compile_options(&on_in_entity, parsed_options(&["x.map"]));
     assert!(flags_of(&bsp, "*water0").iter().all(|f| f & SPECIAL == 0));
 }
+
+/// `-bmodelcontents`: a brush model's water brush is water inside (FTE swims in it), its solid
+/// brush still solid; without it, both are solid, as engines that only collide with brush
+/// models as solid expect.
+#[test]
+fn bmodelcontents_keeps_a_brush_models_liquids() {
+    let water = box_brush([-64.0, -64.0, -128.0], [0.0, 64.0, -64.0], "*water0");
+    let crate_ = box_brush([32.0, -16.0, -128.0], [64.0, 16.0, -96.0], "crate");
+    let text = room_map_with(
+        false,
+        "",
+        &brush_entity("func_door", &format!("{water}{crate_}")),
+    );
+    let contents_at = |bsp: &Bsp, p| {
+        let leaf = bsp.leaf_from(bsp.models[1].head_nodes[0], p).expect("leaf");
+        bsp.leafs[leaf].contents
+    };
+    let kept = compile_options(&text, parsed_options(&["-bmodelcontents", "x.map"]));
+    assert_eq!(errors(&kept), Vec::<String>::new());
+    assert_eq!(contents_at(&kept, [-32.0, 0.0, -96.0]), contents::WATER);
+    assert_eq!(contents_at(&kept, [48.0, 0.0, -112.0]), contents::SOLID);
+    let solid = compile_options(&text, parsed_options(&["x.map"]));
+    assert_eq!(contents_at(&solid, [-32.0, 0.0, -96.0]), contents::SOLID);
+    assert_eq!(contents_at(&solid, [48.0, 0.0, -112.0]), contents::SOLID);
+}
