@@ -60,8 +60,7 @@ pub struct BuildArgs {
 fn extra_args(opts: Option<&str>) -> Vec<OsString> {
     let words = std::iter::once(String::new())
         .chain(opts.unwrap_or("").split_whitespace().map(str::to_string));
-    let normalised =
-        light::cli::join_optional_values(quake_formats::cli::normalise_single_dash(words));
+    let normalised = batch::options::command_words(words);
     normalised.into_iter().skip(1).map(OsString::from).collect()
 }
 

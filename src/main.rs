@@ -7,7 +7,6 @@ mod report;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
-use quake_formats::cli::normalise_single_dash;
 use std::process::ExitCode;
 
 // Every stage allocates small per-face buffers on rayon's threads and frees them on others, where
@@ -56,9 +55,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse_from(light::cli::join_optional_values(normalise_single_dash(
-        std::env::args(),
-    )));
+    let cli = Cli::parse_from(batch::options::command_words(std::env::args()));
     match run(cli.command) {
         Ok(code) => code,
         Err(e) => {
@@ -108,8 +105,10 @@ mod tests {
             "valve",
             "x.map",
         ];
-        let cli = Cli::try_parse_from(normalise_single_dash(args.iter().map(|s| s.to_string())))
-            .expect("parse");
+        let cli = Cli::try_parse_from(batch::options::command_words(
+            args.iter().map(|s| s.to_string()),
+        ))
+        .expect("parse");
         let Command::Bsp(bsp) = cli.command else {
             panic!("not the bsp command");
         };

@@ -5,12 +5,19 @@
 use clap::{Args, FromArgMatches};
 use quake_formats::cli::normalise_single_dash;
 
+/// Command-line words (the program's name first) as the stages' commands parse them: ericw-tools'
+/// single-dash spellings given two dashes, and a number after an option whose value is optional
+/// (`-bounce 2`, `-litwater 0`) joined to it.
+pub fn command_words(words: impl Iterator<Item = String>) -> Vec<String> {
+    let words = normalise_single_dash(words);
+    bsp_compiler::cli::join_optional_values(light::cli::join_optional_values(words))
+}
+
 /// A stage's option string as the words its command takes (ericw-tools' spellings accepted).
 pub fn stage_words(options: &str) -> Vec<String> {
     let words =
         std::iter::once(String::new()).chain(options.split_whitespace().map(str::to_string));
-    let normalised = light::cli::join_optional_values(normalise_single_dash(words));
-    normalised.into_iter().skip(1).collect()
+    command_words(words).into_iter().skip(1).collect()
 }
 
 /// Parse a stage's own arguments (`A`: the stage's `cli::Args`) from words.

@@ -5,9 +5,11 @@
 //! Per model, little-endian: `u32` version (1), `u32` model number, `u32` brush count, `u32`
 //! plane count over all its brushes; then per brush `f32` mins[3] and maxs[3], `i16` contents,
 //! `u16` plane count, and per plane `f32` normal[3] and dist, facing out of the brush. The axial
-//! planes are left out: readers take them from the bounds.
+//! planes are left out: readers take them from the bounds. The others include the brush's
+//! bevels ([`crate::hulls::bevelled_planes`]), which readers expanding the planes by a box need.
 
 use crate::brush::Brush;
+use crate::hulls::bevelled_planes;
 use crate::planes::PlaneSet;
 use quake_formats::bsp::BspxLump;
 use quake_formats::geom::{Bounds, Plane};
@@ -15,25 +17,24 @@ use quake_formats::geom::{Bounds, Plane};
 pub const LUMP_NAME: &str = "BRUSHLIST";
 const VERSION: u32 = 1;
 
+/// The contents the lump gives clip brushes (BSPX's own, Quake's compile-time clip): they stop
+/// players and monsters, not shots, as clip hulls do.
+pub const CLIP: i32 = -8;
+
 /// One brush as the lump stores it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ListedBrush {
     pub bounds: Bounds,
-    /// Engine contents (solid, water, sky...).
+    /// Engine contents (solid, water, sky...), or [`CLIP`].
     pub contents: i16,
-    /// Its non-axial side planes, facing out.
+    /// Its non-axial side and bevel planes, facing out.
     pub planes: Vec<Plane>,
 }
 
 impl ListedBrush {
     pub fn of(brush: &Brush, contents: i32, planes: &PlaneSet) -> ListedBrush {
-        let planes = brush
-            .sides
-            .iter()
-            .map(|s| {
-                let p = planes.get(s.plane);
-                if s.flipped { p.flipped() } else { *p }
-            })
+        let planes = bevelled_planes(brush, planes)
+            .into_iter()
             .filter(|p| p.axial().is_none())
             .collect();
         ListedBrush {

@@ -3,6 +3,8 @@
 use crate::convert::{MapFormat, convert_map};
 use crate::map::parse_map;
 use crate::onlyents::replace_entities;
+use crate::options::DEFAULT_MAX_EDGES;
+use crate::outside::FillType;
 use crate::tree::MID_SPLIT_SIZE;
 use crate::{CompileOptions, MapSource, SplitHeuristic, compile};
 use anyhow::{Context, Result};
@@ -44,6 +46,10 @@ pub struct Args {
     /// by the heuristic (0: never)
     #[arg(long, value_name = "N", default_value_t = MID_SPLIT_SIZE)]
     pub maxnodesize: f64,
+    /// Cut faces left with more than N edges by T-junction fixing into smaller ones, for engines
+    /// that copy faces into fixed buffers (0: never; liquids at most 60 either way but 0)
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_EDGES, value_parser = parse_max_edges)]
+    pub maxedges: usize,
     /// Make a leak an error: nothing but the .pts pointfile is written, and the exit status is 1
     #[arg(long)]
     pub leaktest: bool,
@@ -51,6 +57,49 @@ pub struct Args {
     /// for)
     #[arg(long)]
     pub nofill: bool,
+    /// How a sealed map's space no point entity reaches (a closed room, the inside of a closed
+    /// box) is filled after the void: auto or inside fill it, in each hull by what reaches there
+    /// in that hull (as ericw-tools does); outside fills only the void
+    #[arg(long, value_name = "TYPE", default_value = "auto")]
+    pub filltype: FillType,
+    /// Fill the space no point entity reaches leaf by leaf, so that pockets closed by detail
+    /// brushes are filled too, whatever --filltype says (0 turns it off)
+    #[arg(
+        long,
+        value_name = "N",
+        default_value = "1",
+        num_args = 0..=1,
+        require_equals = true,
+        default_missing_value = "1",
+        value_parser = clap::value_parser!(u8).range(0..=1)
+    )]
+    pub filldetail: u8,
+    /// Light liquids (1, the default): they get lightmaps and are subdivided like other faces, so
+    /// that QuakeSpasm, Ironwail, vkQuake and FTE draw them lit; 0 writes them unlit, drawn
+    /// fullbright everywhere. The `_litwater` key of worldspawn or a brush entity overrides it
+    #[arg(
+        long,
+        visible_alias = "splitturb",
+        value_name = "N",
+        default_value = "1",
+        num_args = 0..=1,
+        require_equals = true,
+        default_missing_value = "1",
+        value_parser = clap::value_parser!(u8).range(0..=1)
+    )]
+    pub litwater: u8,
+    /// A brush model's liquid brushes stay liquid (a func_door of water you can swim in, in FTE);
+    /// WinQuake-style engines give such a model no collision. Without it they are solid
+    #[arg(long)]
+    pub bmodelcontents: bool,
+    /// Liquids are seen through: vis looks through their surfaces and they do not cut rooms
+    /// into clusters (the default)
+    #[arg(long, conflicts_with = "notranswater")]
+    pub transwater: bool,
+    /// Liquids are opaque to vis: their surfaces bound its clusters and it never looks through
+    /// them, for engines that draw liquids opaque
+    #[arg(long)]
+    pub notranswater: bool,
     /// Write the .prt even when the map leaks (vis then works through the void as well, slowly;
     /// without it, a leaking map gets no .prt and an old one is removed)
     #[arg(long)]
@@ -63,6 +112,11 @@ pub struct Args {
     /// elsewhere (FTE, QuakeSpasm-Spiked); the WADs are still read for the sizes
     #[arg(long)]
     pub notex: bool,
+    /// Merge another .map into this one (repeatable): its worldspawn brushes join the world and
+    /// its other entities follow; its worldspawn keys are ignored. A relative path not found from
+    /// the working directory is looked for beside the input map
+    #[arg(long, value_name = "FILE.map")]
+    pub add: Vec<PathBuf>,
     /// Leave out func_detail brushes
     #[arg(long)]
     pub omitdetail: bool,
@@ -122,13 +176,34 @@ impl Args {
                 self.subdivide
             },
             fill: !self.nofill,
+            fill_type: self.filltype,
+            fill_detail: self.filldetail != 0,
+            transwater: !self.notranswater,
+            lit_water: self.litwater != 0,
+            bmodel_contents: self.bmodelcontents,
+            max_edges: self.maxedges,
             clip_hulls: !self.noclip,
+            add: self.add.clone(),
             omit,
             texture_data: !self.notex,
             brush_list: self.wrbrushes,
             keep_editor_keys: self.keep_editor_keys,
             progress: quake_formats::progress::terminal(),
         }
+    }
+}
+
+/// The compiler's options whose value is optional (`-litwater`, `-litwater 0`): a following
+/// number is their value, anything else is left as the next argument.
+pub fn join_optional_values(args: impl IntoIterator<Item = String>) -> Vec<String> {
+    quake_formats::cli::join_optional_values(args, &["--filldetail", "--litwater", "--splitturb"])
+}
+
+/// `--maxedges`: 0 (no limit) or a face of at least a triangle.
+fn parse_max_edges(s: &str) -> Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(n) if n == 0 || n >= 3 => Ok(n),
+        _ => Err(format!("{s:?} is neither 0 (no limit) nor 3 or more edges")),
     }
 }
 

@@ -141,7 +141,7 @@ pub fn compile(
     };
 
     let t = Instant::now();
-    let map = read_map(source)?;
+    let map = read_map(source, options)?;
     stats.entities = map.entities.len();
     timings.push(("parse".to_string(), t.elapsed().as_secs_f64()));
 
@@ -217,6 +217,8 @@ pub fn compile(
         wads: &wads,
         entities: &lump_entities(&map, &left_out, options),
         version,
+        transwater: options.transwater,
+        max_edges: options.max_edges,
         warnings: &mut warnings,
     });
     let mut bsp = emitted.bsp;
@@ -270,6 +272,7 @@ fn build_models(
         .map(|i| FaceTexInfo {
             vecs: i.vecs,
             role: i.role,
+            special: i.is_special(),
         })
         .collect();
     let progress = &options.progress;
@@ -370,8 +373,22 @@ pub(crate) fn entities_left_out(
     (left_out, layers)
 }
 
-/// Parse a map, its prefabs expanded; the first entity must be worldspawn.
-pub(crate) fn read_map(source: &MapSource) -> Result<MapFile, CompileError> {
+/// Parse a map, its prefabs expanded, with the maps `options.add` names merged in; the first
+/// entity must be worldspawn.
+pub(crate) fn read_map(
+    source: &MapSource,
+    options: &CompileOptions,
+) -> Result<MapFile, CompileError> {
+    let mut map = parse_with_worldspawn(source)?;
+    for add in &options.add {
+        let added = parse_with_worldspawn(&MapSource::read(&added_map_path(source, add))?)?;
+        merge_added_map(&mut map, added);
+    }
+    Ok(map)
+}
+
+/// Parse `source`, its prefabs expanded; its first entity must be worldspawn.
+fn parse_with_worldspawn(source: &MapSource) -> Result<MapFile, CompileError> {
     let map = expand_prefabs(parse_map(&source.path, &source.text)?, &source.path)?;
     let classname = map
         .entities
@@ -385,6 +402,35 @@ pub(crate) fn read_map(source: &MapSource) -> Result<MapFile, CompileError> {
         });
     }
     Ok(map)
+}
+
+/// Where `-add`'s `add` is: as written (absolute, or relative to the working directory) when
+/// it is there, else beside the map being compiled.
+fn added_map_path(source: &MapSource, add: &Path) -> PathBuf {
+    if add.is_absolute() || add.exists() {
+        return add.to_path_buf();
+    }
+    source
+        .path
+        .parent()
+        .map_or_else(|| add.to_path_buf(), |dir| dir.join(add))
+}
+
+/// Append the map `added` to `map`, as ericw-tools' `-add` does: its worldspawn's brushes join
+/// the world (as a `func_group`, which the entity lump leaves out, so that warnings number them
+/// apart from the base map's) and its other entities follow; its worldspawn's keys are dropped.
+fn merge_added_map(map: &mut MapFile, added: MapFile) {
+    let mut entities = added.entities.into_iter();
+    if let Some(world) = entities.next() {
+        let mut group = Entity::default();
+        group.set("classname", "func_group");
+        map.entities.push(MapEntity {
+            entity: group,
+            brushes: world.brushes,
+            line: world.line,
+        });
+    }
+    map.entities.extend(entities);
 }
 
 /// The entity lump's entities for `map` (leaving out those `left_out` marks, and editor keys
@@ -456,10 +502,11 @@ fn square_up_projections(
             squared += 1;
             let name = table.names[info.texture as usize].clone();
             let vecs = quake.vecs(&Plane::new(normal, 0.0));
-            f.texinfo = table.intern(&name, vecs, info.phong);
+            f.texinfo = table.intern(&name, vecs, info.phong, info.lit_water);
             let squared_info = FaceTexInfo {
                 vecs,
                 role: info.role,
+                special: info.is_special(),
             };
             cut_for_lightmaps(f, &squared_info, subdivide, &mut faces);
         }

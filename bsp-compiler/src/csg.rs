@@ -1,15 +1,16 @@
 //! CSG between brushes: a side buried inside other brushes of at least its contents strength
-//! (solid > detail wall > fence > sky > lava > slime > water > illusionary) can never be seen, so it never
-//! splits the tree. Detail brushes only hide the sides of other detail brushes. Faces
-//! between touching or overlapping brushes disappear that way, and trees (above all the clip
-//! hulls, whose grown brushes overlap a lot) get far fewer splits.
+//! (solid > detail wall > fence > sky > lava > slime > water > illusionary) can never be seen,
+//! so it never splits the tree; but illusionary brushes stay seen inside liquids. Detail brushes
+//! only hide the sides of other detail brushes. Faces between touching or overlapping brushes
+//! disappear that way, and trees (above all the clip hulls, whose grown brushes overlap a lot)
+//! get far fewer splits.
 //!
 //! This is sound for leaf contents: inside a leaf, the boundary of the stronger brushes' union
 //! is made of visible sides, which have all been used as node planes above the leaf.
 
 use crate::brush::{Brush, Side};
 use crate::planes::PlaneSet;
-use crate::tree::contents_priority;
+use crate::tree::{contents_priority, shows_inside};
 use glam::DVec3;
 use quake_formats::geom::{Bounds, ON_EPSILON, PlaneSide, Split, Winding};
 use rayon::prelude::*;
@@ -45,10 +46,12 @@ pub fn mark_hidden_sides(brushes: &mut [Brush], planes: &PlaneSet) -> usize {
                 .copied()
                 .filter(|&j| {
                     // Structure must not depend on detail: only detail is hidden by detail.
+                    // Illusionary brushes stay seen inside liquids.
                     j != i
                         && padded[j].intersects(&padded[i])
                         && contents_priority(brushes[j].contents) >= prio
                         && (me.is_detail() || !brushes[j].is_detail())
+                        && !shows_inside(brushes[j].contents, me.contents)
                 })
                 .collect();
             covers.sort_unstable();

@@ -7,11 +7,13 @@ use crate::gather::MapTexInfo;
 use crate::hulls::emit_clipnodes;
 use crate::model::ModelOutput;
 use crate::planes::{PlaneId, PlaneSet};
-use crate::tree::{Tree, engine_contents, is_see_through};
+use crate::texinfo::TextureRole;
+use crate::tree::{Tree, engine_contents, is_see_through, vis_class};
 use crate::wad_lookup::WadSet;
 use crate::warnings::Warning;
-use crate::weld::{VertexWelder, fix_tjunctions};
+use crate::weld::{VertexWelder, cut_to_max_vertices, fix_tjunctions};
 use glam::DVec3;
+use quake_formats::bsp::limits::QUAKESPASM_MAX_WARP_FACE_VERTS;
 use quake_formats::bsp::{BspPlane, Face, Leaf, Model, Node, TexInfo, contents, texinfo_flags};
 use quake_formats::entities::{Entity, write_entities};
 use quake_formats::geom::{Bounds, Plane};
@@ -27,6 +29,10 @@ pub(crate) struct EmitInput<'a> {
     pub wads: &'a WadSet,
     pub entities: &'a [Entity],
     pub version: BspVersion,
+    /// Vis looks through liquids' surfaces ([`crate::CompileOptions::transwater`]).
+    pub transwater: bool,
+    /// Faces with more edges are cut ([`crate::CompileOptions::max_edges`]; 0: never).
+    pub max_edges: usize,
     pub warnings: &'a mut Vec<Warning>,
 }
 
@@ -83,7 +89,7 @@ impl TextureTable<'_> {
             self.out_infos.push(TexInfo {
                 vecs: info.vecs.map(|row| row.map(|c| c as f32)),
                 miptex: self.texture_index[tex],
-                flags: if info.role.is_special() {
+                flags: if info.is_special() {
                     texinfo_flags::SPECIAL
                 } else {
                     0
@@ -91,6 +97,16 @@ impl TextureTable<'_> {
             });
         }
         self.info_index[id as usize]
+    }
+}
+
+/// The most edges a face of texture `role` may have: `max_edges` (0: no limit), and for liquids
+/// no more than the buffer QuakeSpasm subdivides them from.
+fn max_face_edges(max_edges: usize, role: TextureRole) -> Option<usize> {
+    match (max_edges, role) {
+        (0, _) => None,
+        (n, TextureRole::Liquid(_)) => Some(n.min(QUAKESPASM_MAX_WARP_FACE_VERTS)),
+        (n, _) => Some(n),
     }
 }
 
@@ -182,12 +198,28 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
 
     // Faces, edges and, per model node and leaf, which faces they hold.
     bsp.edges.push([0, 0]); // edge 0 cannot be negated, so it is never used
-    let mut edge_index: HashMap<(u32, u32), (u32, bool)> = HashMap::new();
+    // Keyed by the contents the face is seen from too: only faces seen from the same contents
+    // share an edge (see `ModelFace::seen_from`), each once each way.
+    let mut edge_index: HashMap<(u32, u32, i32), (u32, bool)> = HashMap::new();
     let mut node_faces: HashMap<(usize, u32), (u32, u32)> = HashMap::new();
     let mut leaf_faces: HashMap<(usize, u32), Vec<u32>> = HashMap::new();
+    // The bounds of the faces each leaf lists away from where they are seen (behind fences):
+    // engines that cull a leaf by its bounds must not cull them.
+    let mut leaf_growth: HashMap<(usize, u32), Bounds> = HashMap::new();
     let mut model_faces: Vec<(u32, u32)> = vec![(0, 0); input.models.len()];
     let mut phong = Vec::with_capacity(pending.len());
-    for (pf, poly) in pending.iter().zip(polygons) {
+    let pieces = pending.iter().zip(polygons).flat_map(|(pf, poly)| {
+        let max = max_face_edges(
+            input.max_edges,
+            input.texinfos[pf.face.texinfo as usize].role,
+        );
+        let pieces = match max {
+            Some(max) => cut_to_max_vertices(poly, max, &welder.positions),
+            None => vec![poly],
+        };
+        pieces.into_iter().map(move |poly| (pf, poly))
+    });
+    for (pf, poly) in pieces {
         if poly.len() < 3 {
             continue;
         }
@@ -196,7 +228,7 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
         let first_edge = bsp.surfedges.len() as u32;
         for k in 0..poly.len() {
             let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
-            match edge_index.get_mut(&(b, a)) {
+            match edge_index.get_mut(&(b, a, f.seen_from)) {
                 Some((e, reused)) if !*reused => {
                     *reused = true;
                     bsp.surfedges.push(-(*e as i32));
@@ -204,12 +236,12 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
                 _ => {
                     let e = bsp.edges.len() as u32;
                     bsp.edges.push([a, b]);
-                    edge_index.insert((a, b), (e, false));
+                    edge_index.insert((a, b, f.seen_from), (e, false));
                     bsp.surfedges.push(e as i32);
                 }
             }
         }
-        let special = input.texinfos[f.texinfo as usize].role.is_special();
+        let special = input.texinfos[f.texinfo as usize].is_special();
         bsp.faces.push(Face {
             plane: planes.get(f.plane),
             side: u32::from(f.back),
@@ -238,6 +270,10 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
                 .entry((pf.model, leaf))
                 .or_default()
                 .push(face_index);
+            if f.stored {
+                let grown = leaf_growth.entry((pf.model, leaf)).or_insert(Bounds::EMPTY);
+                *grown = grown.union(&f.winding.bounds());
+            }
         }
     }
 
@@ -255,6 +291,7 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
             planes: &mut planes,
             node_faces: &node_faces,
             leaf_faces: &leaf_faces,
+            leaf_growth: &leaf_growth,
             leaf_index: HashMap::new(),
         };
         let (mut head, _) = w.node(0);
@@ -310,7 +347,12 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
     bsp.planes = planes.planes;
     bsp.set_entity_text(&write_entities(input.entities));
 
-    let portals = world_portal_file(&input.models[0], &world_leaf_index, bsp.models[0].vis_leafs);
+    let portals = world_portal_file(
+        &input.models[0],
+        &world_leaf_index,
+        bsp.models[0].vis_leafs,
+        input.transwater,
+    );
     Emitted {
         bsp,
         portals,
@@ -326,6 +368,7 @@ struct TreeWriter<'a, 'b> {
     planes: &'b mut PlaneTable<'a>,
     node_faces: &'b HashMap<(usize, u32), (u32, u32)>,
     leaf_faces: &'b HashMap<(usize, u32), Vec<u32>>,
+    leaf_growth: &'b HashMap<(usize, u32), Bounds>,
     /// Tree leaf to BSP leaf.
     leaf_index: HashMap<u32, u32>,
 }
@@ -345,6 +388,10 @@ impl TreeWriter<'_, '_> {
                 self.output.bounds
             } else {
                 bounds
+            };
+            let bounds = match self.leaf_growth.get(&(self.model, n)) {
+                Some(grown) => bounds.union(grown),
+                None => bounds,
             };
             let marks = self.leaf_faces.get(&(self.model, n));
             let first = self.bsp.marksurfaces.len() as u32;
@@ -388,14 +435,17 @@ impl TreeWriter<'_, '_> {
 }
 
 /// The world's portal file: PRT1 between see-through leaves, numbered from BSP leaf 1; or, when
-/// the world has detail, PRT2 between its clusters (structural leaves).
+/// the world has detail, PRT2 between its clusters (structural leaves). Without `transwater`
+/// vis does not look across a liquid's surface (see [`vis_class`]).
 fn world_portal_file(
     world: &ModelOutput,
     leaf_index: &HashMap<u32, u32>,
     vis_leafs: i32,
+    transwater: bool,
 ) -> PortalFile {
     let tree = &world.tree.nodes;
     let num_leafs = vis_leafs.max(0) as u32;
+    let across = |a: i32, b: i32| transwater || vis_class(a) == vis_class(b);
     let Some(cluster_portals) = &world.cluster_portals else {
         let mut portals = Vec::new();
         for p in &world.portals.portals {
@@ -403,10 +453,8 @@ fn world_portal_file(
             else {
                 continue;
             };
-            if p.nodes
-                .iter()
-                .all(|&n| is_see_through(tree[n as usize].contents))
-            {
+            let [ca, cb] = p.nodes.map(|n| tree[n as usize].contents);
+            if is_see_through(ca) && is_see_through(cb) && across(ca, cb) {
                 portals.push(PrtPortal {
                     leafs: [a - 1, b - 1],
                     winding: p.winding.clone(),
@@ -422,7 +470,7 @@ fn world_portal_file(
     // Clusters in tree order, each with the vis leaves below it; a cluster is open to sight when
     // one of its leaves is.
     let mut clusters = Vec::new();
-    let mut cluster_of: HashMap<u32, (u32, bool)> = HashMap::new();
+    let mut cluster_of: HashMap<u32, (u32, bool, i32)> = HashMap::new();
     let mut stack = vec![0u32];
     while let Some(n) = stack.pop() {
         let node = &tree[n as usize];
@@ -444,13 +492,15 @@ fn world_portal_file(
         let open = leaves
             .iter()
             .any(|&l| is_see_through(tree[l as usize].contents));
-        cluster_of.insert(n, (clusters.len() as u32, open));
+        let structural = node.cluster.unwrap_or(node.contents);
+        cluster_of.insert(n, (clusters.len() as u32, open, structural));
         clusters.push(vis);
     }
     let mut portals = Vec::new();
     for p in &cluster_portals.portals {
-        if let (Some(&(a, true)), Some(&(b, true))) =
+        if let (Some(&(a, true, ca)), Some(&(b, true, cb))) =
             (cluster_of.get(&p.nodes[0]), cluster_of.get(&p.nodes[1]))
+            && across(ca, cb)
         {
             portals.push(PrtPortal {
                 leafs: [a, b],

@@ -15,6 +15,8 @@ use quake_formats::bsp::limits::MAX_SURFACE_EXTENT;
 use quake_formats::extents::LightmapExtents;
 use quake_formats::geom::DVec3Ext;
 use quake_formats::geom::{ON_EPSILON, POINT_EPSILON, Plane, Split, Winding};
+use std::collections::{HashMap, HashSet};
+use std::rc::Rc;
 
 /// A face of one model, before vertices and edges are shared.
 #[derive(Debug, Clone, PartialEq)]
@@ -28,8 +30,15 @@ pub struct ModelFace {
     pub texinfo: u32,
     /// Clockwise seen from the side the face is looked at from.
     pub winding: Winding,
-    /// Tree leaves the face can be seen from.
+    /// Tree leaves whose marksurfaces list the face.
     pub leaves: Vec<u32>,
+    /// Listed away from the leaf it is seen from (behind a fence, seen from the open leaves
+    /// around it): those leaves' bounds must grow to hold it.
+    pub stored: bool,
+    /// The engine contents of the leaf the face is seen from. As in id's qbsp, faces seen from
+    /// different contents (a water surface from above and from below) neither merge nor share
+    /// edges: software renderers (WinQuake's edge list) draw such faces wrongly.
+    pub seen_from: i32,
 }
 
 impl ModelFace {
@@ -45,6 +54,8 @@ impl ModelFace {
 pub struct FaceTexInfo {
     pub vecs: [[f64; 4]; 2],
     pub role: TextureRole,
+    /// Written with `TEX_SPECIAL` ([`crate::MapTexInfo::is_special`]).
+    pub special: bool,
 }
 
 /// Face counts for the summary.
@@ -77,28 +88,47 @@ pub fn projection_squareness(vecs: &[[f64; 4]; 2], normal: DVec3) -> f64 {
         .map_or(0.0, |t| t.dot(normal).abs())
 }
 
-/// Whether a face on the boundary of leaf `owner` is seen from the leaf of contents `viewer` on
-/// its other side (`own_side` false) or from inside the owner (see [`mirrors_inside`]).
-fn seen_from(owner: &TreeNode, viewer: i32, own_side: bool) -> bool {
+/// Whether a face on the boundary of leaf `owner`, drawn seen from inside it when `mirrored`, is
+/// seen from the leaf of contents `viewer` on its other side (`own_side` false) or from inside
+/// the owner.
+fn seen_from(mirrored: bool, viewer: i32, own_side: bool) -> bool {
     if own_side {
-        mirrors_inside(owner)
+        mirrored
     } else {
         shows_faces_behind(viewer)
     }
 }
 
-/// Whether the faces of a leaf's brushes are drawn seen from inside it: as its brushes'
-/// `_mirrorinside` says, else (as in ericw-tools) for liquids and vis blockers, which players
-/// look out of, and not for solid, fence or illusionary brushes.
-pub fn mirrors_inside(leaf: &TreeNode) -> bool {
+/// Whether a brush's faces are drawn seen from inside it: as its `_mirrorinside` says, else (as
+/// in ericw-tools) for liquids and vis blockers, which players look out of, and not for solid,
+/// fence or illusionary brushes.
+fn brush_mirrors_inside(b: &Brush) -> bool {
+    b.mirror_inside.unwrap_or(mirrors_by_default(b.contents))
+}
+
+fn mirrors_by_default(c: i32) -> bool {
+    matches!(
+        c,
+        contents::WATER | contents::SLIME | contents::LAVA | VISBLOCKER
+    )
+}
+
+/// Whether the faces of a leaf's brushes are drawn seen from inside it, for a face no brush side
+/// of the leaf lies on: as its brushes of its contents say ([`brush_mirrors_inside`]).
+fn mirrors_inside(leaf: &TreeNode) -> bool {
     leaf.brushes
         .iter()
         .filter(|b| b.contents == leaf.contents)
         .find_map(|b| b.mirror_inside)
-        .unwrap_or(matches!(
-            leaf.contents,
-            contents::WATER | contents::SLIME | contents::LAVA | VISBLOCKER
-        ))
+        .unwrap_or(mirrors_by_default(leaf.contents))
+}
+
+/// A part of a portal face: its winding, texinfo and whether it is drawn seen from inside its
+/// owner too.
+struct Painted {
+    winding: Winding,
+    texinfo: u32,
+    mirrored: bool,
 }
 
 /// How much a brush side's plane turned away from a face's counts against it, in units of
@@ -113,8 +143,75 @@ struct TextureSearch<'a> {
 }
 
 impl TextureSearch<'_> {
+    /// The brushes of leaf `owner` whose sides texture its faces: those of the leaf's own
+    /// contents, else every textured one; in map order.
+    fn own_brushes(&self, owner: u32) -> Vec<&Brush> {
+        let leaf = &self.tree.nodes[owner as usize];
+        let brushes: Vec<&Brush> = leaf
+            .brushes
+            .iter()
+            .filter(|b| b.contents == leaf.contents)
+            .collect();
+        if brushes.is_empty() {
+            leaf.brushes.iter().filter(|b| is_textured(b)).collect()
+        } else {
+            brushes
+        }
+    }
+
+    /// `winding`, a face on `plane` looking out of leaf `owner` (`flipped` as in
+    /// [`crate::brush::Side`]), cut where the sides of the leaf's brushes lying on it change,
+    /// each part with its texinfo and mirroring from its side's brush: where sides overlap, the
+    /// brush latest in the map wins (a button set flush into a floor shows its own face), as in
+    /// id's qbsp and ericw-tools, where later brushes clip earlier ones. Parts no side covers
+    /// take [`TextureSearch::texinfo`]'s.
+    fn paint(&self, owner: u32, plane: PlaneId, flipped: bool, winding: &Winding) -> Vec<Painted> {
+        let normal = self.outward(plane, flipped).normal;
+        // Latest first: fragments keep their map order.
+        let sides: Vec<(&Brush, &Side)> = self
+            .own_brushes(owner)
+            .into_iter()
+            .rev()
+            .flat_map(|b| b.sides.iter().map(move |s| (b, s)))
+            .filter(|(_, s)| s.texinfo.is_some() && s.plane == plane && s.flipped == flipped)
+            .collect();
+        let look = |(b, s): &(&Brush, &Side)| (s.texinfo, brush_mirrors_inside(b));
+        let mut out = Vec::new();
+        let mut rest = vec![winding.clone()];
+        if sides.windows(2).any(|w| look(&w[0]) != look(&w[1])) {
+            for side in &sides {
+                let (texinfo, mirrored) = look(side);
+                let mut outside = Vec::new();
+                for piece in rest {
+                    let inside = split_by_polygon(piece, &side.1.winding, normal, &mut outside);
+                    out.extend(inside.zip(texinfo).map(|(winding, texinfo)| Painted {
+                        winding,
+                        texinfo,
+                        mirrored,
+                    }));
+                }
+                rest = outside;
+            }
+        }
+        let mirrored = sides.first().map_or_else(
+            || mirrors_inside(&self.tree.nodes[owner as usize]),
+            |s| look(s).1,
+        );
+        for piece in rest {
+            if let Some(texinfo) = self.texinfo(owner, plane, flipped, piece.center()) {
+                out.push(Painted {
+                    winding: piece,
+                    texinfo,
+                    mirrored,
+                });
+            }
+        }
+        out
+    }
+
     /// The texinfo of the side of leaf `owner`'s brushes on `plane` facing out of it (`flipped`
-    /// as in [`crate::brush::Side`]), brushes of the leaf's own contents first; failing that,
+    /// as in [`crate::brush::Side`]), brushes of the leaf's own contents first, the latest in the
+    /// map first; failing that,
     /// of the side whose outward plane lies closest to the face (centred at `center`) among
     /// the brushes of `owner` and of the leaves of its contents next to it; `None` when
     /// `owner`'s brushes have no textured side. The tree leaves out a side within the epsilon of
@@ -122,15 +219,7 @@ impl TextureSearch<'_> {
     /// filled whole the wall's own side is in the next leaf.
     fn texinfo(&self, owner: u32, plane: PlaneId, flipped: bool, center: DVec3) -> Option<u32> {
         let leaf = &self.tree.nodes[owner as usize];
-        let mut brushes: Vec<&Brush> = leaf
-            .brushes
-            .iter()
-            .filter(|b| b.contents == leaf.contents)
-            .collect();
-        if brushes.is_empty() {
-            brushes = leaf.brushes.iter().filter(|b| is_textured(b)).collect();
-        }
-        let own = textured_sides(brushes);
+        let own = textured_sides(self.own_brushes(owner).into_iter().rev());
         if let Some(s) = own
             .iter()
             .find(|s| s.plane == plane && s.flipped == flipped)
@@ -178,25 +267,97 @@ fn textured_sides<'a>(brushes: impl IntoIterator<Item = &'a Brush>) -> Vec<&'a S
         .collect()
 }
 
-/// The leaves a face seen from `viewer` is listed in. A face behind a fence or a detail wall
-/// (solid leaves engines never draw from) is listed in the open leaves around them too.
-fn viewing_leaves(tree: &Tree, portals: &Portals, viewer: u32) -> Vec<u32> {
-    let mut leaves = vec![viewer];
-    let solid_viewer = |c: i32| engine_contents(c) == contents::SOLID;
-    if solid_viewer(tree.nodes[viewer as usize].contents) {
-        for &p in &portals.leaf_portals[viewer as usize] {
-            let other = portals.other(p, viewer);
-            if other != portals.outside
-                && is_see_through(tree.nodes[other as usize].contents)
-                && !solid_viewer(tree.nodes[other as usize].contents)
-            {
-                leaves.push(other);
+/// Split `piece`, a polygon on the plane of the convex `polygon` (both facing `normal`), into
+/// the part inside `polygon` (returned) and the parts outside it (pushed to `outside`).
+fn split_by_polygon(
+    piece: Winding,
+    polygon: &Winding,
+    normal: DVec3,
+    outside: &mut Vec<Winding>,
+) -> Option<Winding> {
+    let center = polygon.center();
+    let n = polygon.len();
+    let mut inside = piece;
+    for i in 0..n {
+        let (a, b) = (polygon.points[i], polygon.points[(i + 1) % n]);
+        let Some(across) = normal.cross(b - a).normalized() else {
+            continue;
+        };
+        // Facing out of the polygon, whichever way it winds.
+        let across = if across.dot(center - a) > 0.0 {
+            -across
+        } else {
+            across
+        };
+        match inside.split(&Plane::new(across, across.dot(a))) {
+            Split::Front(w) => {
+                outside.push(w);
+                return None;
+            }
+            Split::Both { front, back } => {
+                outside.push(front);
+                inside = back;
+            }
+            Split::Back(w) | Split::On { winding: w, .. } => inside = w,
+        }
+    }
+    Some(inside)
+}
+
+/// Where faces seen from each leaf are listed. A face seen from a fence or a detail wall (solid
+/// leaves, which engines never draw from) is listed in the open leaves the connected fence or
+/// wall leaves border, flooding through them (a fence cut into several leaves may hold a face
+/// only one of them sees, far from any open leaf), as ericw-tools' `FixupDetailFence` does.
+struct ViewingLeaves<'a> {
+    tree: &'a Tree,
+    portals: &'a Portals,
+    /// The open leaves around each flooded solid viewer.
+    around: HashMap<u32, Rc<Vec<u32>>>,
+}
+
+impl ViewingLeaves<'_> {
+    fn solid_viewer(&self, leaf: u32) -> bool {
+        leaf != self.portals.outside
+            && engine_contents(self.tree.nodes[leaf as usize].contents) == contents::SOLID
+    }
+
+    /// The leaves a face seen from `viewer` is listed in, and whether they are open leaves
+    /// around a solid viewer rather than the viewer itself.
+    fn of(&mut self, viewer: u32) -> (Rc<Vec<u32>>, bool) {
+        if !self.solid_viewer(viewer) {
+            return (Rc::new(vec![viewer]), false);
+        }
+        if let Some(open) = self.around.get(&viewer) {
+            return (open.clone(), !open.contains(&viewer));
+        }
+        let mut flooded = vec![viewer];
+        let mut seen = HashSet::from([viewer]);
+        let mut open = Vec::new();
+        let mut i = 0;
+        while i < flooded.len() {
+            let leaf = flooded[i];
+            i += 1;
+            for &p in &self.portals.leaf_portals[leaf as usize] {
+                let other = self.portals.other(p, leaf);
+                if other == self.portals.outside || !seen.insert(other) {
+                    continue;
+                }
+                let c = self.tree.nodes[other as usize].contents;
+                if self.solid_viewer(other) && c != contents::SOLID {
+                    flooded.push(other);
+                } else if is_see_through(c) {
+                    open.push(other);
+                }
             }
         }
-        leaves.sort_unstable();
-        leaves.dedup();
+        open.sort_unstable();
+        // Nothing open around it: the face stays with its viewer, seen by nobody.
+        let open = Rc::new(if open.is_empty() { vec![viewer] } else { open });
+        for leaf in flooded {
+            self.around.insert(leaf, open.clone());
+        }
+        (open.clone(), !open.contains(&viewer))
     }
-    leaves
 }
 
 /// Faces on every portal between leaves of different contents, seen from each side that can see
@@ -212,6 +373,11 @@ pub fn faces_from_portals(
         tree,
         portals,
         planes,
+    };
+    let mut viewing = ViewingLeaves {
+        tree,
+        portals,
+        around: HashMap::new(),
     };
     let mut faces = Vec::new();
     for p in &portals.portals {
@@ -238,32 +404,44 @@ pub fn faces_from_portals(
             .iter()
             .flat_map(|br| br.sides.iter())
             .any(|s| s.plane == plane && s.flipped == owner_is_front && s.texinfo.is_some());
-        let center = p.winding.center();
-        let Some(texinfo) = search.texinfo(owner, plane, owner_is_front, center) else {
-            continue;
-        };
-        if !texinfos[texinfo as usize].role.is_drawn() {
-            continue;
-        }
-        for (viewer, front) in [(a, true), (b, false)] {
-            let viewer_contents = tree.nodes[viewer as usize].contents;
-            if !seen_from(owner_node, viewer_contents, viewer == owner) {
+        for part in search.paint(owner, plane, owner_is_front, &p.winding) {
+            let Painted {
+                winding,
+                texinfo,
+                mirrored,
+            } = part;
+            if !texinfos[texinfo as usize].role.is_drawn() {
                 continue;
             }
-            stats.from_portals += 1;
-            stats.untextured += usize::from(!exact);
-            faces.push(ModelFace {
-                node,
-                plane,
-                back: !front,
-                texinfo,
-                winding: if front {
-                    p.winding.clone()
-                } else {
-                    p.winding.reversed()
-                },
-                leaves: viewing_leaves(tree, portals, viewer),
-            });
+            for (viewer, front) in [(a, true), (b, false)] {
+                let viewer_contents = tree.nodes[viewer as usize].contents;
+                if !seen_from(mirrored, viewer_contents, viewer == owner) {
+                    continue;
+                }
+                let (leaves, stored) = viewing.of(viewer);
+                // A face behind a fence is seen from the open leaves around it.
+                let seen_from = leaves
+                    .iter()
+                    .map(|&l| engine_contents(tree.nodes[l as usize].contents))
+                    .find(|&c| c != contents::SOLID)
+                    .unwrap_or(engine_contents(viewer_contents));
+                stats.from_portals += 1;
+                stats.untextured += usize::from(!exact);
+                faces.push(ModelFace {
+                    node,
+                    plane,
+                    back: !front,
+                    texinfo,
+                    winding: if front {
+                        winding.clone()
+                    } else {
+                        winding.reversed()
+                    },
+                    leaves: leaves.to_vec(),
+                    stored,
+                    seen_from,
+                });
+            }
         }
     }
     faces
@@ -314,23 +492,25 @@ fn simplify_convex(mut points: Vec<DVec3>, normal: DVec3) -> Option<Winding> {
     (points.len() >= 3).then(|| Winding::new(points))
 }
 
-/// Merge faces that share a node, side and texinfo wherever the union stays convex.
+/// Merge faces that share a node, side, texinfo and the contents they are seen from wherever
+/// the union stays convex.
 pub fn merge_faces(
     mut faces: Vec<ModelFace>,
     plane_of: impl Fn(&ModelFace) -> Plane,
 ) -> Vec<ModelFace> {
-    faces.sort_by_key(|f| (f.node, f.back, f.texinfo));
+    let key = |f: &ModelFace| (f.node, f.back, f.texinfo, f.seen_from);
+    faces.sort_by_key(key);
     let mut out: Vec<ModelFace> = Vec::with_capacity(faces.len());
     let mut start = 0;
     while start < faces.len() {
-        let key = (faces[start].node, faces[start].back, faces[start].texinfo);
+        let group_key = key(&faces[start]);
         let end = start
             + faces[start..]
                 .iter()
-                .take_while(|f| (f.node, f.back, f.texinfo) == key)
+                .take_while(|f| key(f) == group_key)
                 .count();
         let mut group: Vec<ModelFace> = faces[start..end].to_vec();
-        let normal = plane_of(&group[0]).normal * if key.1 { -1.0 } else { 1.0 };
+        let normal = plane_of(&group[0]).normal * if group_key.1 { -1.0 } else { 1.0 };
         loop {
             let mut merged_any = false;
             let mut i = 0;
@@ -349,6 +529,7 @@ pub fn merge_faces(
                         group[i].leaves.extend(other.leaves);
                         group[i].leaves.sort_unstable();
                         group[i].leaves.dedup();
+                        group[i].stored |= other.stored;
                         merged_any = true;
                         j = i + 1;
                     } else {
@@ -403,7 +584,7 @@ pub fn subdivide(w: Winding, vecs: &[[f64; 4]; 2], size: f64, out: &mut Vec<Wind
 /// `face` as it is written: cut by [`subdivide`] when lit, whole when special (sky, liquids).
 pub fn cut_for_lightmaps(face: ModelFace, info: &FaceTexInfo, size: f64, out: &mut Vec<ModelFace>) {
     // A size of 0 asks for no subdivision at all (ericw-tools' `-subdivide 0`).
-    if info.role.is_special() || size <= 0.0 {
+    if info.special || size <= 0.0 {
         out.push(face);
         return;
     }

@@ -7,7 +7,7 @@
 //! Point entities become the occupants the outside fill floods from.
 
 use crate::brush::{Brush, BrushKind, BrushPlane};
-use crate::brushlist::ListedBrush;
+use crate::brushlist::{self, ListedBrush};
 use crate::faces::{MIN_SQUARENESS, projection_squareness};
 use crate::hulls::{HULL_BOXES, expand_brush};
 use crate::leak::MapBrushRef;
@@ -16,7 +16,7 @@ use crate::options::CompileOptions;
 use crate::outside::Occupant;
 use crate::planes::PlaneSet;
 use crate::texinfo::{self, FaceContents, TextureRole};
-use crate::tree::{DETAIL_WALL, FENCE, ILLUSIONARY, VISBLOCKER, engine_contents};
+use crate::tree::{DETAIL_WALL, FENCE, ILLUSIONARY, VISBLOCKER, engine_contents, is_liquid};
 use crate::warnings::{DroppedFace, Warning};
 use glam::DVec3;
 use quake_formats::bsp::contents;
@@ -95,6 +95,9 @@ pub(crate) fn gather(
             class: brush_class,
             origin: origin.unwrap_or(DVec3::ZERO),
             phong: merged_phong(ent, index, brush_class),
+            transwater: options.transwater,
+            bmodel_contents: options.bmodel_contents,
+            lit_water: lit_water(&map.entities, ent, options.lit_water),
             table: &mut g.table,
             warnings,
         };
@@ -171,6 +174,16 @@ pub struct MapTexInfo {
     pub role: TextureRole,
     /// The `_phong` group of the world-merged entity the face came from.
     pub phong: FacePhong,
+    /// Liquid faces get lightmaps ([`crate::CompileOptions::lit_water`], or the entity's
+    /// `_litwater`).
+    pub lit_water: bool,
+}
+
+impl MapTexInfo {
+    /// Written with `TEX_SPECIAL`: no lightmap, never subdivided.
+    pub fn is_special(&self) -> bool {
+        self.role.is_special(self.lit_water)
+    }
 }
 
 /// One model's brushes before tree building.
@@ -248,13 +261,20 @@ pub(crate) struct TexInfoTable {
     pub names: Vec<String>,
     name_index: HashMap<String, u32>,
     pub infos: Vec<MapTexInfo>,
-    info_index: HashMap<([u64; 8], u32, u32), u32>,
+    info_index: HashMap<([u64; 8], u32, u32, bool), u32>,
 }
 
 impl TexInfoTable {
-    /// The texinfo of `name` projected by `vecs` on a face of `phong`'s group
-    /// (faces of different groups never share one, so they never merge).
-    pub fn intern(&mut self, name: &str, vecs: [[f64; 4]; 2], phong: FacePhong) -> u32 {
+    /// The texinfo of `name` projected by `vecs` on a face of `phong`'s group, a liquid lit
+    /// or not by `lit_water` (faces of different groups or lighting never share one, so they
+    /// never merge).
+    pub fn intern(
+        &mut self,
+        name: &str,
+        vecs: [[f64; 4]; 2],
+        phong: FacePhong,
+        lit_water: bool,
+    ) -> u32 {
         let key = name.to_ascii_lowercase();
         let texture = match self.name_index.get(&key) {
             Some(&i) => i,
@@ -266,17 +286,22 @@ impl TexInfoTable {
             }
         };
         let bits: [u64; 8] = std::array::from_fn(|i| (vecs[i / 4][i % 4] as f32).to_bits() as u64);
-        if let Some(&i) = self.info_index.get(&(bits, texture, phong.group)) {
+        let role = TextureRole::of(name);
+        // Only liquids' texinfos depend on it; others stay shared.
+        let lit_water = lit_water && matches!(role, TextureRole::Liquid(_));
+        let key = (bits, texture, phong.group, lit_water);
+        if let Some(&i) = self.info_index.get(&key) {
             return i;
         }
         let i = self.infos.len() as u32;
         self.infos.push(MapTexInfo {
             vecs,
             texture,
-            role: TextureRole::of(name),
+            role,
             phong,
+            lit_water,
         });
-        self.info_index.insert((bits, texture, phong.group), i);
+        self.info_index.insert(key, i);
         i
     }
 }
@@ -317,6 +342,14 @@ fn origin_brush_centre(ent: &MapEntity, planes: &mut PlaneSet) -> Option<DVec3> 
         }
     }
     (!bounds.is_empty()).then(|| bounds.center())
+}
+
+/// Whether `ent`'s liquids are lit: its `_litwater` key, else the worldspawn's, else `default`.
+fn lit_water(entities: &[MapEntity], ent: &MapEntity, default: bool) -> bool {
+    let key = |e: &MapEntity| e.entity.get_float("_litwater").map(|v| v != 0.0);
+    key(ent)
+        .or_else(|| entities.first().and_then(key))
+        .unwrap_or(default)
 }
 
 /// The `_phong` group of entity `index` if it is merged into the world (its
@@ -361,7 +394,7 @@ fn key_origin(entities: &[MapEntity], ent: &MapEntity) -> Option<DVec3> {
 /// The point entity `ent` (number `index`) as an occupant of open space for the flood: not
 /// when it has no origin, stands at the map's origin (where ericw-tools skips it, taking it for
 /// a brush entity), or is marked `_nofill` (or `_lightgrid_hint`) to stand in the void.
-fn occupant(ent: &MapEntity, index: usize) -> Option<Occupant> {
+pub(crate) fn occupant(ent: &MapEntity, index: usize) -> Option<Occupant> {
     let [x, y, z] = ent.entity.get_floats::<3>("origin")?;
     let origin = DVec3::new(x, y, z);
     let marked = |key| ent.entity.get_float(key).is_some_and(|v| v != 0.0);
@@ -395,6 +428,13 @@ struct EntityContext<'a> {
     class: EntityBrushes,
     origin: DVec3,
     phong: FacePhong,
+    /// Liquids are seen through (ericw-tools' `-transwater`): they are detail, which vis does
+    /// not cut into clusters; otherwise structural in any entity, as vis's boundaries.
+    transwater: bool,
+    /// A brush model's liquid brushes keep their contents ([`CompileOptions::bmodel_contents`]).
+    bmodel_contents: bool,
+    /// Its liquids get lightmaps (`_litwater`, else the worldspawn's, else the option).
+    lit_water: bool,
     table: &'a mut TexInfoTable,
     warnings: &'a mut Vec<Warning>,
 }
@@ -445,7 +485,9 @@ impl EntityContext<'_> {
                     texture: f.texture.clone(),
                 });
             }
-            let texinfo = self.table.intern(&f.texture, vecs, self.phong);
+            let texinfo = self
+                .table
+                .intern(&f.texture, vecs, self.phong, self.lit_water);
             out.roles.push(role);
             out.lines.push(f.line);
             out.planes.push(BrushPlane {
@@ -459,7 +501,8 @@ impl EntityContext<'_> {
     /// The contents of a (non-hint) brush of these faces. The texture decides first, as in
     /// ericw-tools: a sky or liquid brush stays one in any detail entity (sky seals the map
     /// wherever it is); only solid brushes take their entity's contents. The brush's first face
-    /// that gives contents decides them; a later one giving others is warned about.
+    /// that gives contents decides them; a later one giving others is warned about. A brush
+    /// model's brushes are solid, unless `-bmodelcontents` lets its liquids be liquid.
     fn contents(&mut self, faces: &BrushFaces, bi: usize) -> (i32, FaceContents) {
         let (textured, conflict) = texinfo::brush_contents(&faces.roles);
         if let Some(i) = conflict {
@@ -471,6 +514,7 @@ impl EntityContext<'_> {
             });
         }
         let contents = match (self.class, textured) {
+            (EntityBrushes::Submodel, FaceContents::Liquid(c)) if self.bmodel_contents => c,
             (EntityBrushes::Submodel, _) => contents::SOLID,
             (EntityBrushes::VisBlocker, _) => VISBLOCKER,
             (_, FaceContents::Sky) => contents::SKY,
@@ -525,6 +569,11 @@ impl EntityContext<'_> {
                         }
                     } else if brush_contents == contents::SKY {
                         b.kind = BrushKind::Structural;
+                    } else if is_liquid(brush_contents) {
+                        b.kind = match self.transwater {
+                            true => BrushKind::Detail,
+                            false => BrushKind::Structural,
+                        };
                     } else {
                         b.kind = self.class.kind();
                     }
@@ -549,11 +598,11 @@ impl EntityContext<'_> {
     }
 }
 
-/// A built brush as the `BRUSHLIST` lump stores it: clip brushes collide as solid; brushes
-/// nothing collides with (hint, illusionary) are left out.
+/// A built brush as the `BRUSHLIST` lump stores it: clip brushes as [`brushlist::CLIP`], as
+/// ericw-tools writes them; brushes nothing collides with (hint, illusionary) are left out.
 fn listed_brush(brush: &Brush, clip: bool, planes: &PlaneSet) -> Option<ListedBrush> {
     let contents = match engine_contents(brush.contents) {
-        _ if clip => contents::SOLID,
+        _ if clip => brushlist::CLIP,
         _ if brush.kind == BrushKind::Hint => return None,
         contents::EMPTY => return None,
         c => c,
@@ -595,10 +644,10 @@ mod tests {
             group: 3,
             angle: 89.0,
         };
-        let plain = table.intern("wall", vecs, FacePhong::default());
-        let a = table.intern("wall", vecs, grouped);
+        let plain = table.intern("wall", vecs, FacePhong::default(), true);
+        let a = table.intern("wall", vecs, grouped, true);
         assert_ne!(plain, a);
-        assert_eq!(table.intern("wall", vecs, grouped), a);
+        assert_eq!(table.intern("wall", vecs, grouped, true), a);
         assert_eq!(table.infos[a as usize].phong, grouped);
         assert_eq!(table.names.len(), 1, "one texture either way");
     }

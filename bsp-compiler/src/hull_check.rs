@@ -9,8 +9,10 @@
 //! with the box, so a point is inside the grown brush exactly when the box there overlaps the
 //! brush, and a segment clipped against the planes gives the exact first contact.
 //!
-//! Moves start at random points of the world's open space (hull 0 open there, and the box at
-//! least [`START_CLEARANCE`] from every brush), go a random direction and length, and are traced
+//! Moves start at random points of the world's open space that the box reaches from a point
+//! entity (hull 0 open there, the box at least [`START_CLEARANCE`] from every brush, and a
+//! straight sweep to it from the entity or an earlier start that touches no brush: the compiler
+//! fills each hull's space no entity reaches), go a random direction and length, and are traced
 //! both ways. A hull trace that stops first must stop next to a brush: the gap is how far its
 //! stop is from every grown brush (the largest plane distance, never more than the true
 //! distance). A hull trace that goes further must not have passed through a brush: the gap is
@@ -18,7 +20,7 @@
 //! (1/32) short of a brush; it may also stop where its path passes within that epsilon of a
 //! brush's edge without touching it, as engines do.
 
-use crate::gather::EntityBrushes;
+use crate::gather::{EntityBrushes, occupant};
 use crate::hulls::{HULL_BOXES, supporting_plane};
 use crate::map::{MapBrush, MapFile};
 use crate::texinfo::TextureRole;
@@ -123,10 +125,12 @@ pub fn hull_agreement(
     };
     let mut rng = SplitMix64::new(options.seed);
     let mut out = HullAgreement::default();
+    let mut reached = entity_points(map, &solids);
     for _ in 0..options.traces {
-        let Some(start) = open_point(bsp, &solids, space, &mut rng) else {
+        let Some(start) = open_point(bsp, &solids, space, &mut rng, &reached) else {
             break;
         };
+        reached.push(start);
         let end = start + random_direction(&mut rng) * rng.range(1.0, options.max_move);
         let end = end.as_vec3().as_dvec3();
         let hull = trace_hull(
@@ -373,13 +377,31 @@ fn clearance(solids: &[GrownBrush], p: DVec3) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// Reached points tried, nearest first, before a start point is taken to be out of reach.
+const REACH_TRIES: usize = 8;
+
+/// Where the map's point entities hold space open for the compiler's fill (as it takes them),
+/// where the box there is not inside a brush.
+fn entity_points(map: &MapFile, solids: &[GrownBrush]) -> Vec<DVec3> {
+    map.entities
+        .iter()
+        .enumerate()
+        .filter(|(_, e)| e.brushes.is_empty())
+        .filter_map(|(i, e)| occupant(e, i))
+        .map(|o| o.origin)
+        .filter(|&p| clearance(solids, p) >= -ON_EPSILON)
+        .collect()
+}
+
 /// A random point (exact in `f32`) in the world's open space: open in hull 0 (so inside the map,
-/// not in the filled outside) with the box clear of every brush by [`START_CLEARANCE`].
+/// not in the filled outside) with the box clear of every brush by [`START_CLEARANCE`], and
+/// reached by a sweep touching no brush from one of the [`REACH_TRIES`] nearest `reached` points.
 fn open_point(
     bsp: &Bsp,
     solids: &[GrownBrush],
     space: Bounds,
     rng: &mut SplitMix64,
+    reached: &[DVec3],
 ) -> Option<DVec3> {
     (0..TRIES_PER_TRACE).find_map(|_| {
         let mut p = DVec3::ZERO;
@@ -391,7 +413,23 @@ fn open_point(
             hull0_contents(bsp, p),
             contents::EMPTY | contents::WATER | contents::SLIME | contents::LAVA
         );
-        (open && clearance(solids, p) > START_CLEARANCE).then_some(p)
+        if !open || clearance(solids, p) <= START_CLEARANCE {
+            return None;
+        }
+        let mut nearest: Vec<DVec3> = reached.to_vec();
+        let tries = REACH_TRIES.min(nearest.len());
+        if tries == 0 {
+            return None;
+        }
+        nearest.select_nth_unstable_by(tries - 1, |a, b| {
+            (*a - p)
+                .length_squared()
+                .total_cmp(&(*b - p).length_squared())
+        });
+        nearest[..tries]
+            .iter()
+            .any(|&from| sweep(solids, from, p) >= 1.0)
+            .then_some(p)
     })
 }
 

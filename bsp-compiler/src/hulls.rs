@@ -41,14 +41,11 @@ pub fn supporting_plane(n: DVec3, points: &[DVec3]) -> Plane {
     Plane::new(n, dist)
 }
 
-/// `brush` grown so that a point outside it is a box (`mins`..`maxs` around the point) clear
-/// of the original brush. Solid, untextured.
-pub fn expand_brush(
-    brush: &Brush,
-    planes: &mut PlaneSet,
-    mins: DVec3,
-    maxs: DVec3,
-) -> Option<Brush> {
+/// The outward planes of `brush` and its bevels, each once: the axial planes of its bounds, and
+/// along each edge the planes parallel to an axis that touch the brush there. A box swept
+/// against these planes pushed out by its extents stops where it stops against the brush itself
+/// (without the bevels it would stop short of a ridge or corner, in the void beside it).
+pub fn bevelled_planes(brush: &Brush, planes: &PlaneSet) -> Vec<Plane> {
     let mut list: Vec<Plane> = brush
         .sides
         .iter()
@@ -90,6 +87,18 @@ pub fn expand_brush(
             }
         }
     }
+    list
+}
+
+/// `brush` grown so that a point outside it is a box (`mins`..`maxs` around the point) clear
+/// of the original brush. Solid, untextured.
+pub fn expand_brush(
+    brush: &Brush,
+    planes: &mut PlaneSet,
+    mins: DVec3,
+    maxs: DVec3,
+) -> Option<Brush> {
+    let list = bevelled_planes(brush, planes);
     // Planes that differ before growing may be one plane after it (a face and a bevel a
     // millionth of a radian apart, each pushed out by its own support): keep the first, or
     // building the brush refuses the pair and the hull loses the whole brush.

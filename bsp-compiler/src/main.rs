@@ -11,7 +11,9 @@ struct Cli {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse_from(quake_formats::cli::normalise_single_dash(std::env::args()));
+    let cli = Cli::parse_from(bsp_compiler::cli::join_optional_values(
+        quake_formats::cli::normalise_single_dash(std::env::args()),
+    ));
     match run(&cli.args) {
         Ok(_) => ExitCode::SUCCESS,
         Err(e) => {

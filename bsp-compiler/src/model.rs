@@ -4,8 +4,8 @@
 //! CSG marks the brush sides other brushes bury; the drawing tree (hull 0) and the two clip hull
 //! trees are built at once; hull 0 is portalised (and, when detail split its structural leaves,
 //! portalised again by clusters); the world's outside is flooded from its point entities and
-//! filled, and then so are its clip hulls; faces are made where leaf contents change, merged,
-//! and cut where their lightmaps would grow too large.
+//! filled, with the space no entity reaches, and then so are its clip hulls; faces are made
+//! where leaf contents change, merged, and cut where their lightmaps would grow too large.
 
 use crate::csg::mark_hidden_sides;
 use crate::faces::{
@@ -14,7 +14,7 @@ use crate::faces::{
 };
 use crate::gather::ModelInput;
 use crate::options::CompileOptions;
-use crate::outside::{FillOutcome, Occupant, OnPlane, fill_outside};
+use crate::outside::{FillOutcome, Occupant, OnPlane, Reach, fill_outside, fill_unreached};
 use crate::planes::PlaneSet;
 use crate::portals::{Portals, make_cluster_portals, make_portals};
 use crate::surface_tree::rebuild_from_surfaces;
@@ -108,14 +108,24 @@ pub(crate) fn build_model(
     let is_world = m.entity == 0;
     let fill = (is_world && options.fill).then(|| {
         let flood = cluster_portals.as_ref().unwrap_or(&portals);
-        fill_outside(
+        let mut outcome = fill_outside(
             &mut tree,
             planes,
             flood,
             occupants,
             OnPlane::Sealing,
             &mut warnings,
-        )
+        );
+        if let (FillOutcome::Sealed { filled }, Some(reach)) =
+            (&mut outcome, options.unreached_fill())
+        {
+            let units = match reach {
+                Reach::Leaves => &portals,
+                Reach::Clusters => flood,
+            };
+            *filled += fill_unreached(&mut tree, planes, units, occupants, reach);
+        }
+        outcome
     });
     timings[2] = t.elapsed().as_secs_f64();
 
@@ -125,8 +135,8 @@ pub(crate) fn build_model(
     if matches!(fill, Some(FillOutcome::Sealed { .. })) {
         let [h1, h2] = &mut hulls;
         rayon::join(
-            || fill_hull(h1, planes, &hull_bounds[0], occupants, splitting),
-            || fill_hull(h2, planes, &hull_bounds[1], occupants, splitting),
+            || fill_hull(h1, planes, &hull_bounds[0], occupants, splitting, options),
+            || fill_hull(h2, planes, &hull_bounds[1], occupants, splitting, options),
         );
     }
     progress.advance(counts[1] + counts[2]);
@@ -170,14 +180,15 @@ fn model_bounds(m: &ModelInput) -> Bounds {
     }
 }
 
-/// Fill the outside of a clip hull's tree, flooding from the world's point entities, and
-/// rebuild it from what is left.
+/// Fill the outside of a clip hull's tree, flooding from the world's point entities, then (as
+/// `options` ask) what no entity reaches in this hull, and rebuild it from what is left.
 fn fill_hull(
     tree: &mut Tree,
     planes: &PlaneSet,
     bounds: &Bounds,
     occupants: &[Occupant],
     splitting: Splitting,
+    options: &CompileOptions,
 ) {
     if bounds.is_empty() {
         return;
@@ -193,6 +204,10 @@ fn fill_hull(
         OnPlane::Open,
         &mut ignored,
     ) {
+        // A clip hull has no detail: its clusters are its leaves.
+        if options.unreached_fill().is_some() {
+            fill_unreached(tree, planes, &portals, occupants, Reach::Leaves);
+        }
         *tree = rebuild_from_surfaces(tree, &portals, planes, splitting);
     }
 }

@@ -40,7 +40,7 @@ pub fn replace_entities(
     options: &CompileOptions,
     bsp: &mut Bsp,
 ) -> Result<(), OnlyEntsError> {
-    let map = read_map(source)?;
+    let map = read_map(source, options)?;
     let (left_out, _) = entities_left_out(&map, options);
     let entities = lump_entities(&map, &left_out, options);
     let submodels = bsp.models.len().saturating_sub(1);

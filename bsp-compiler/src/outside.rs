@@ -1,5 +1,7 @@
 //! Outside filling: flood from the void through open portals; if that reaches a point entity the
 //! map leaks (report it with a path to the void), otherwise every flooded leaf becomes solid.
+//! Then, as ericw-tools does by default, the space no point entity reaches (a closed room, the
+//! inside of a closed box) is filled too ([`fill_unreached`]).
 //!
 //! The flood runs over the structural leaves (vis clusters) with their structural contents:
 //! detail brushes never seal a map, as in ericw-tools. An entity lying on a brush face (within
@@ -9,7 +11,7 @@
 use crate::leak::{LeakReport, MapBrushRef};
 use crate::planes::PlaneSet;
 use crate::portals::Portals;
-use crate::tree::{Tree, TreeNode, engine_contents, is_opaque};
+use crate::tree::{DETAIL_WALL, Tree, TreeNode, engine_contents, is_opaque};
 use crate::warnings::Warning;
 use glam::DVec3;
 use quake_formats::bsp::contents;
@@ -232,6 +234,121 @@ pub fn fill_outside(
         }
     }
     FillOutcome::Sealed { filled }
+}
+
+/// How the space inside a sealed map that no point entity reaches is filled (ericw-tools'
+/// `-filltype`, with `-filldetail` in [`crate::CompileOptions::fill_detail`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+pub enum FillType {
+    /// As ericw-tools decides for Quake maps: from the inside, in every hull.
+    #[default]
+    Auto,
+    /// After the void, every place no point entity reaches is filled, in each hull by what
+    /// reaches there in that hull.
+    Inside,
+    /// Only the void outside the map is filled.
+    Outside,
+}
+
+impl std::str::FromStr for FillType {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "auto" => Ok(FillType::Auto),
+            "inside" => Ok(FillType::Inside),
+            "outside" => Ok(FillType::Outside),
+            _ => Err(format!("unknown fill type {s:?} (auto, inside, outside)")),
+        }
+    }
+}
+
+/// What [`fill_unreached`] floods over.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Reach {
+    /// Vis clusters by their structural contents: detail neither blocks the flood nor is filled
+    /// apart from its cluster.
+    Clusters,
+    /// Leaves: solid detail blocks the flood too, so a pocket closed by detail brushes is filled
+    /// (`-filldetail`). Fences, which are seen through, do not block.
+    Leaves,
+}
+
+/// After [`fill_outside`] sealed `tree`, fill every open leaf (or cluster, by `reach`) that no
+/// occupant reaches through open ones: `portals` are between those units. An occupant reaches
+/// every open unit within [`quake_formats::geom::ON_EPSILON`] of it (a light on a floor holds
+/// the room above). Returns how many leaves became solid.
+pub fn fill_unreached(
+    tree: &mut Tree,
+    planes: &PlaneSet,
+    portals: &Portals,
+    occupants: &[Occupant],
+    reach: Reach,
+) -> usize {
+    let contents_of = |tree: &Tree, unit: u32| {
+        let node = &tree.nodes[unit as usize];
+        match reach {
+            Reach::Clusters => node.cluster.unwrap_or(node.contents),
+            Reach::Leaves => node.contents,
+        }
+    };
+    let open = |c: i32| match reach {
+        Reach::Clusters => !is_opaque(c),
+        Reach::Leaves => !is_opaque(c) && c != DETAIL_WALL,
+    };
+    let mut reached = vec![false; portals.leaf_portals.len()];
+    reached[portals.outside as usize] = true;
+    let mut queue = VecDeque::new();
+    for o in occupants {
+        let touching = match reach {
+            Reach::Clusters => tree.clusters_touching(planes, o.origin),
+            Reach::Leaves => tree.leaves_touching(planes, o.origin),
+        };
+        for unit in touching {
+            if !reached[unit as usize] && open(contents_of(tree, unit)) {
+                reached[unit as usize] = true;
+                queue.push_back(unit);
+            }
+        }
+    }
+    while let Some(unit) = queue.pop_front() {
+        for &p in &portals.leaf_portals[unit as usize] {
+            let next = portals.other(p, unit);
+            if !reached[next as usize] && open(contents_of(tree, next)) {
+                reached[next as usize] = true;
+                queue.push_back(next);
+            }
+        }
+    }
+    let mut filled = 0;
+    for (unit, &was_reached) in reached.iter().enumerate().take(tree.nodes.len()) {
+        let node = &tree.nodes[unit];
+        let is_unit = match reach {
+            Reach::Clusters => node.cluster.is_some(),
+            Reach::Leaves => node.is_leaf(),
+        };
+        if !is_unit || was_reached || !open(contents_of(tree, unit as u32)) {
+            continue;
+        }
+        for leaf in tree.leaves_below(unit as u32) {
+            let leaf = &mut tree.nodes[leaf as usize];
+            if leaf.contents != contents::SOLID {
+                leaf.contents = contents::SOLID;
+                filled += 1;
+            }
+        }
+    }
+    // A cluster all of whose leaves are filled is solid structure now.
+    for cluster in 0..tree.nodes.len() {
+        if tree.nodes[cluster].cluster.is_some()
+            && tree
+                .leaves_below(cluster as u32)
+                .iter()
+                .all(|&l| tree.nodes[l as usize].contents == contents::SOLID)
+        {
+            tree.nodes[cluster].cluster = Some(contents::SOLID);
+        }
+    }
+    filled
 }
 
 #[derive(PartialEq)]

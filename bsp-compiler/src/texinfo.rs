@@ -166,9 +166,15 @@ impl TextureRole {
         }
     }
 
-    /// Faces with these textures get no lightmap and are not subdivided (`TEX_SPECIAL`).
-    pub fn is_special(self) -> bool {
-        matches!(self, TextureRole::Sky | TextureRole::Liquid(_))
+    /// Faces with these textures get no lightmap and are not subdivided (`TEX_SPECIAL`): sky,
+    /// and liquids unless they are lit (ericw-tools' `-litwater`; engines that do not light
+    /// liquids draw them fullbright either way).
+    pub fn is_special(self, lit_water: bool) -> bool {
+        match self {
+            TextureRole::Sky => true,
+            TextureRole::Liquid(_) => !lit_water,
+            _ => false,
+        }
     }
 
     /// Faces with these textures never become BSP faces.
@@ -403,7 +409,9 @@ mod tests {
         );
         assert_eq!(TextureRole::of("CLIP"), TextureRole::Clip);
         assert_eq!(TextureRole::of("wall1"), TextureRole::Normal);
-        assert!(TextureRole::of("*slime0").is_special());
+        assert!(TextureRole::of("*slime0").is_special(false));
+        assert!(!TextureRole::of("*slime0").is_special(true));
+        assert!(TextureRole::of("sky4").is_special(true));
         assert!(!TextureRole::of("skip").is_drawn());
     }
 

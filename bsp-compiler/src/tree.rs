@@ -168,28 +168,77 @@ pub const ILLUSIONARY: i32 = -101;
 /// Written as empty.
 pub const VISBLOCKER: i32 = -103;
 
+/// Compiler-only contents of leaves inside both a `func_detail_illusionary` brush and a liquid:
+/// the liquid for engines, but a leaf of its own, so that the illusionary brush's faces are made
+/// under the surface too (as in ericw-tools). One for each liquid.
+pub const ILLUSIONARY_IN_WATER: i32 = -104;
+pub const ILLUSIONARY_IN_SLIME: i32 = -105;
+pub const ILLUSIONARY_IN_LAVA: i32 = -106;
+
 /// The contents engines see for a leaf of compiler contents `c`.
 pub fn engine_contents(c: i32) -> i32 {
     match c {
         FENCE | DETAIL_WALL => contents::SOLID,
         ILLUSIONARY | VISBLOCKER => contents::EMPTY,
+        ILLUSIONARY_IN_WATER => contents::WATER,
+        ILLUSIONARY_IN_SLIME => contents::SLIME,
+        ILLUSIONARY_IN_LAVA => contents::LAVA,
         c => c,
     }
 }
 
-/// Ranking of contents: a region holding several brushes takes the strongest.
+/// Ranking of contents: a region holding several brushes takes the strongest. A liquid holding
+/// an illusionary brush ranks just above the liquid alone, so that it owns the faces between them.
 pub fn contents_priority(c: i32) -> u8 {
     match c {
-        contents::SOLID => 9,
-        DETAIL_WALL => 8,
-        FENCE => 7,
-        contents::SKY => 6,
-        contents::LAVA => 5,
-        contents::SLIME => 4,
-        contents::WATER => 3,
-        VISBLOCKER => 2,
-        ILLUSIONARY => 1,
+        contents::SOLID => 18,
+        DETAIL_WALL => 16,
+        FENCE => 14,
+        contents::SKY => 12,
+        ILLUSIONARY_IN_LAVA => 11,
+        contents::LAVA => 10,
+        ILLUSIONARY_IN_SLIME => 9,
+        contents::SLIME => 8,
+        ILLUSIONARY_IN_WATER => 7,
+        contents::WATER => 6,
+        VISBLOCKER => 4,
+        ILLUSIONARY => 2,
         _ => 0,
+    }
+}
+
+/// Whether `c` is a liquid's contents (water, slime, lava).
+pub fn is_liquid(c: i32) -> bool {
+    matches!(c, contents::WATER | contents::SLIME | contents::LAVA)
+}
+
+/// What vis may look between when liquids are opaque (`-notranswater`): leaves of one liquid,
+/// or leaves of no liquid.
+pub fn vis_class(c: i32) -> i32 {
+    let engine = engine_contents(c);
+    if is_liquid(engine) {
+        engine
+    } else {
+        contents::EMPTY
+    }
+}
+
+/// Whether a brush of contents `inner` keeps its sides (and so its faces) inside a brush of the
+/// stronger contents `outer`: an illusionary brush is drawn under a liquid's surface, which
+/// players see through.
+pub fn shows_inside(outer: i32, inner: i32) -> bool {
+    inner == ILLUSIONARY && is_liquid(outer)
+}
+
+/// The contents of a region whose strongest brush is of contents `strongest`, when
+/// `illusionary` brushes lie in it too ([`shows_inside`]).
+fn with_illusionary(strongest: i32, illusionary: bool) -> i32 {
+    match strongest {
+        _ if !illusionary => strongest,
+        contents::WATER => ILLUSIONARY_IN_WATER,
+        contents::SLIME => ILLUSIONARY_IN_SLIME,
+        contents::LAVA => ILLUSIONARY_IN_LAVA,
+        c => c,
     }
 }
 
@@ -206,12 +255,10 @@ pub fn shows_faces_behind(c: i32) -> bool {
 
 /// Whether sight passes through leaves of these contents. Liquids count: modern engines draw
 /// water translucent, so (like ericw-tools' default "transwater") vis sees through liquid
-/// surfaces instead of cutting the world in two at every waterline. Fences have holes.
+/// surfaces instead of cutting the world in two at every waterline (with `-notranswater` the
+/// portal file keeps liquids apart, see [`vis_class`]). Fences have holes.
 pub fn is_see_through(c: i32) -> bool {
-    matches!(
-        c,
-        contents::EMPTY | contents::WATER | contents::SLIME | contents::LAVA | FENCE | ILLUSIONARY
-    )
+    is_liquid(engine_contents(c)) || matches!(c, contents::EMPTY | FENCE | ILLUSIONARY)
 }
 
 /// A node of the flattened tree; a leaf has no plane.
@@ -672,20 +719,34 @@ impl Builder<'_> {
 
 /// Whether a fragment of the strongest contents fills the region: it decides the region whatever
 /// lies inside, and splitting further would only cut up space of one contents. Above the
-/// structural leaves only a structural fragment may end the structure.
+/// structural leaves only a structural fragment may end the structure. Brushes that show inside
+/// the strongest ([`shows_inside`]) must fill the region too, or their sides split it further.
 fn strongest_fills(brushes: &[Brush], phase: Phase) -> bool {
     let strongest = brushes.iter().map(|b| contents_priority(b.contents)).max();
-    brushes.iter().any(|b| {
+    let Some(filler) = brushes.iter().find(|b| {
         Some(contents_priority(b.contents)) == strongest && b.fills_node() && phase.splits_with(b)
-    })
+    }) else {
+        return false;
+    };
+    brushes
+        .iter()
+        .all(|b| !shows_inside(filler.contents, b.contents) || b.fills_node())
 }
 
-/// The strongest contents among `brushes`, empty when there are none.
-fn strongest_contents<'a>(brushes: impl Iterator<Item = &'a Brush>) -> i32 {
-    brushes
+/// The contents of a region holding `brushes`: the strongest, with any shown inside it
+/// ([`with_illusionary`]); empty when there are none.
+fn strongest_contents<'a>(brushes: impl Iterator<Item = &'a Brush> + Clone) -> i32 {
+    let strongest = brushes
+        .clone()
         .map(|b| b.contents)
         .max_by_key(|&c| contents_priority(c))
-        .unwrap_or(contents::EMPTY)
+        .unwrap_or(contents::EMPTY);
+    with_illusionary(
+        strongest,
+        brushes
+            .into_iter()
+            .any(|b| shows_inside(strongest, b.contents)),
+    )
 }
 
 #[cfg(test)]

@@ -3,7 +3,7 @@
 
 use glam::DVec3;
 use quake_formats::geom::DVec3Ext;
-use quake_formats::geom::POINT_EPSILON;
+use quake_formats::geom::{ON_EPSILON, POINT_EPSILON};
 use std::collections::HashMap;
 
 /// Distance from an edge within which a vertex counts as lying on it.
@@ -230,6 +230,45 @@ pub fn remove_degenerate_vertices(poly: &mut Vec<u32>, positions: &[DVec3]) {
             outer
         };
     }
+}
+
+/// Cut `poly`, a convex polygon of vertex indices into `positions` whose edges carry the vertices
+/// T-junction fixing put on them, into polygons of at most `max` (at least 3) vertices, for
+/// engines that copy a face into a fixed buffer. Each cut is a chord between two of its
+/// vertices, so the pieces share their new edge whole and no T-junction appears; a chord is
+/// taken only where both sides have area (some vertex more than [`ON_EPSILON`] off it), never
+/// along a run of vertices on one edge. A polygon no chord cuts that way is left whole.
+pub fn cut_to_max_vertices(poly: Vec<u32>, max: usize, positions: &[DVec3]) -> Vec<Vec<u32>> {
+    let has_area = |part: &[u32]| {
+        let (Some(&a), Some(&b)) = (part.first(), part.last()) else {
+            return false;
+        };
+        let (pa, pb) = (positions[a as usize], positions[b as usize]);
+        let Some(dir) = (pb - pa).normalized() else {
+            return false;
+        };
+        part.iter().any(|&v| {
+            let d = positions[v as usize] - pa;
+            (d - dir * d.dot(dir)).length() > ON_EPSILON
+        })
+    };
+    let mut pieces = Vec::new();
+    let mut rest = poly;
+    while max >= 3 && rest.len() > max {
+        let n = rest.len();
+        let cut = (0..n).find_map(|i| {
+            let piece: Vec<u32> = (0..max).map(|k| rest[(i + k) % n]).collect();
+            let remainder: Vec<u32> = (max - 1..=n).map(|k| rest[(i + k) % n]).collect();
+            (has_area(&piece) && has_area(&remainder)).then_some((piece, remainder))
+        });
+        let Some((piece, remainder)) = cut else {
+            break;
+        };
+        pieces.push(piece);
+        rest = remainder;
+    }
+    pieces.push(rest);
+    pieces
 }
 
 /// The area of a closed polygon of vertex indices.

@@ -185,6 +185,26 @@ fn maxnodesize_changes_where_big_nodes_are_cut() {
     assert_ne!(small.nodes.len(), default.nodes.len());
 }
 
+/// `text` compiled with `--wrbrushes`, its `BRUSHLIST` lump as the `qbsp` crate reads it.
+fn brush_list_of(text: &str) -> Vec<qbsp::data::bspx::ModelBrushes> {
+    let bsp = compile_options(
+        text,
+        CompileOptions {
+            brush_list: true,
+            ..CompileOptions::default()
+        },
+    );
+    assert_eq!(errors(&bsp), Vec::<String>::new());
+    let bytes = bsp.write().expect("write");
+    let parsed = qbsp::BspData::parse(qbsp::BspParseInput {
+        bsp: &bytes,
+        lit: None,
+        settings: Default::default(),
+    })
+    .expect("qbsp parses the BSP");
+    parsed.bspx.brush_list.expect("a BRUSHLIST lump")
+}
+
 #[test]
 fn wrbrushes_lists_every_model_brush_for_the_qbsp_crate() {
     // A wedge (one sloped side) in the world, a crate in a func_wall, a clip brush, a hint.
@@ -206,25 +226,10 @@ fn wrbrushes_lists_every_model_brush_for_the_qbsp_crate() {
             &box_brush([64.0, 64.0, -128.0], [96.0, 96.0, -96.0], "crate"),
         ),
     );
-    let bsp = compile_options(
-        &text,
-        CompileOptions {
-            brush_list: true,
-            ..CompileOptions::default()
-        },
-    );
-    assert_eq!(errors(&bsp), Vec::<String>::new());
-    let bytes = bsp.write().expect("write");
-    let parsed = qbsp::BspData::parse(qbsp::BspParseInput {
-        bsp: &bytes,
-        lit: None,
-        settings: Default::default(),
-    })
-    .expect("qbsp parses the BSP");
-    let list = parsed.bspx.brush_list.expect("a BRUSHLIST lump");
+    let list = brush_list_of(&text);
     assert_eq!(list.len(), 2);
     assert_eq!((list[0].model_idx, list[1].model_idx), (0, 1));
-    // Six room brushes, the wedge and the clip brush (solid); the hint is left out.
+    // Six room brushes, the wedge and the clip brush; the hint is left out.
     let world = &list[0].brushes.inner;
     assert_eq!(world.len(), 8);
     let sloped: Vec<_> = world
@@ -238,6 +243,54 @@ fn wrbrushes_lists_every_model_brush_for_the_qbsp_crate() {
     let crate_brush = &list[1].brushes.inner[0];
     assert_eq!(crate_brush.bound.min.to_array(), [64.0, 64.0, -128.0]);
     assert_eq!(crate_brush.bound.max.to_array(), [96.0, 96.0, -96.0]);
+}
+
+/// ericw-tools' `wrbrushesContentTypes`: clip brushes are listed with BSPX's own clip contents
+/// (-8), which engines colliding with brushes let shots through, in the world and in brush
+/// entities; and `hullExpansionBasic`: a prism's ridge has a bevel (a cap plane) listed beside
+/// its sloped sides, or a box sliding along the ridge falls into it.
+#[test]
+fn wrbrushes_lists_clip_as_clip_and_every_bevel() {
+    // A prism along y, sheared: its ridge rises from z -112 at y -64 to z -64 at y 64.
+    let prism = "{\n( -16 64 -80 ) ( 0 -64 -112 ) ( -16 -64 -128 ) wall 0 0 0 1 1\n\
+                 ( 16 -64 -128 ) ( 0 -64 -112 ) ( 16 64 -80 ) wall 0 0 0 1 1\n\
+                 ( -16 -64 -128 ) ( 16 -64 -128 ) ( -16 64 -80 ) wall 0 0 0 1 1\n\
+                 ( -16 -64 -128 ) ( 0 -64 -112 ) ( 16 -64 -128 ) wall 0 0 0 1 1\n\
+                 ( 16 64 -80 ) ( 0 64 -64 ) ( -16 64 -80 ) wall 0 0 0 1 1\n}\n";
+    let clip = box_brush([64.0, 0.0, -128.0], [80.0, 16.0, 0.0], "clip");
+    let text = room_map_with(
+        false,
+        &clip,
+        &format!(
+            "{}{}",
+            brush_entity("func_wall", prism),
+            brush_entity("func_wall", &clip)
+        ),
+    );
+    let list = brush_list_of(&text);
+    let clip_contents = qbsp::data::nodes::Bsp29LeafContents::Clip;
+    let world = &list[0].brushes.inner;
+    assert_eq!(world.len(), 7);
+    assert_eq!(world[6].contents.0, clip_contents);
+    assert_eq!(list[2].brushes.inner[0].contents.0, clip_contents);
+    let prism = &list[1].brushes.inner[0];
+    let planes: Vec<[f32; 4]> = prism
+        .planes
+        .inner
+        .iter()
+        .map(|p| [p.normal.x, p.normal.y, p.normal.z, p.dist])
+        .collect();
+    assert!(planes.len() >= 3, "{planes:?}");
+    // The cap: through the ridge, parallel to x, facing up and back along the rise.
+    let rise = (48.0f32).atan2(128.0);
+    let cap = [0.0, -rise.sin(), rise.cos()];
+    let on_ridge = cap[1] * -64.0 + cap[2] * -112.0;
+    assert!(
+        planes.iter().any(|p| {
+            (0..3).all(|i| (p[i] - cap[i]).abs() < 1e-4) && (p[3] - on_ridge).abs() < 1e-3
+        }),
+        "no cap plane {cap:?} {on_ridge} in {planes:?}"
+    );
 }
 
 fn temp_dir(name: &str) -> PathBuf {
@@ -273,4 +326,211 @@ fn leaktest_writes_nothing_but_the_pointfile_and_fails() {
         .status;
     assert!(status.success());
     assert!(map.with_extension("bsp").exists());
+}
+
+/// The stage's arguments as the command parses them, ericw-tools' single dashes included.
+fn parsed_options(args: &[&str]) -> CompileOptions {
+    use clap::Parser;
+    let words = ["bsp"].iter().chain(args).map(|s| s.to_string());
+    let words =
+        bsp_compiler::cli::join_optional_values(quake_formats::cli::normalise_single_dash(words));
+    BspCli::try_parse_from(words)
+        .expect("parses")
+        .args
+        .compile_options()
+}
+
+#[test]
+fn filltype_and_filldetail_take_ericw_tools_spellings() {
+    use bsp_compiler::outside::{FillType, Reach};
+    let default = parsed_options(&["x.map"]);
+    assert_eq!(default.fill_type, FillType::Auto);
+    assert_eq!(default.unreached_fill(), Some(Reach::Leaves));
+    let outside = parsed_options(&["-filltype", "outside", "-filldetail", "0", "x.map"]);
+    assert_eq!(outside.fill_type, FillType::Outside);
+    assert_eq!(outside.unreached_fill(), None);
+    let inside = parsed_options(&["-filltype", "inside", "-filldetail", "0", "x.map"]);
+    assert_eq!(inside.unreached_fill(), Some(Reach::Clusters));
+    let bare = parsed_options(&["-filltype", "outside", "-filldetail", "--nofill", "x.map"]);
+    assert!(bare.fill_detail && !bare.fill);
+}
+
+/// `-add FILE.map` (ericw-tools' `mergeMaps`): the added map's worldspawn brushes join the
+/// world and its entities follow the base map's; worldspawn's keys are the base map's. A
+/// relative path is found beside the base map too.
+#[test]
+fn add_merges_a_second_maps_brushes_and_entities() {
+    let dir = temp_dir("add");
+    let base = dir.join("base.map");
+    std::fs::write(&base, room_map(false, "")).expect("write");
+    let addition = format!(
+        "{{\n\"classname\" \"worldspawn\"\n\"message\" \"not this one\"\n{}}}\n{}",
+        box_brush([32.0, 32.0, -128.0], [64.0, 64.0, -96.0], "added"),
+        brush_entity(
+            "func_wall",
+            &box_brush([-96.0, 32.0, -128.0], [-64.0, 64.0, -96.0], "crate")
+        ),
+    );
+    std::fs::write(dir.join("addition.map"), addition).expect("write");
+    let options = parsed_options(&["-add", "addition.map", "base.map"]);
+    assert_eq!(options.add, [PathBuf::from("addition.map")]);
+    let source = bsp_compiler::MapSource::read(&base).expect("read");
+    let out = bsp_compiler::compile(&source, &options).expect("compile");
+    let bsp = &out.bsp;
+    assert!(out.leak.is_none(), "{:?}", out.leak);
+    assert_eq!(errors(bsp), Vec::<String>::new());
+    assert_eq!(bsp.models.len(), 2);
+    let top = faces_at(bsp, 0, [48.0, 48.0, -96.0], Some([0.0, 0.0, 1.0]));
+    assert_eq!(top.len(), 1);
+    assert_eq!(face_texture(bsp, top[0]), "added");
+    let entities = bsp.entity_text();
+    assert_eq!(entities.matches("\"classname\"").count(), 3, "{entities}");
+    assert!(entities.contains("func_wall") && !entities.contains("not this one"));
+    // A missing addition is an error naming it.
+    let missing = parsed_options(&["-add", "nowhere.map", "base.map"]);
+    let err = bsp_compiler::compile(&source, &missing).expect_err("no such map");
+    assert!(err.to_string().contains("nowhere.map"), "{err}");
+}
+
+/// A room whose walls are 32 slabs each, of two textures in turn so that they do not merge: every
+/// slab's edge meets the sky ceiling's edge, and fixing those T-junctions gives the ceiling 128
+/// vertices.
+fn room_of_slabs() -> String {
+    let mut world = String::new();
+    world += &box_brush([-144.0, -144.0, -144.0], [144.0, 144.0, -128.0], "floor");
+    world += &box_brush([-144.0, -144.0, 128.0], [144.0, 144.0, 144.0], "sky1");
+    for i in 0..32 {
+        let (lo, hi) = (-128.0 + 8.0 * f64::from(i), -120.0 + 8.0 * f64::from(i));
+        let tex = ["wall", "wall2"][i as usize % 2];
+        world += &box_brush([-144.0, lo, -128.0], [-128.0, hi, 128.0], tex);
+        world += &box_brush([128.0, lo, -128.0], [144.0, hi, 128.0], tex);
+        world += &box_brush([lo, -144.0, -128.0], [hi, -128.0, 128.0], tex);
+        world += &box_brush([lo, 128.0, -128.0], [hi, 144.0, 128.0], tex);
+    }
+    for (x, y) in [
+        (-144.0, -144.0),
+        (-144.0, 128.0),
+        (128.0, -144.0),
+        (128.0, 128.0),
+    ] {
+        world += &box_brush([x, y, -128.0], [x + 16.0, y + 16.0, 128.0], "wall");
+    }
+    format!(
+        "{{\n\"classname\" \"worldspawn\"\n\"wad\" \"none.wad\"\n{world}}}\n\
+         {{\n\"classname\" \"info_player_start\"\n\"origin\" \"0 0 -100\"\n}}\n"
+    )
+}
+
+/// `-maxedges N` (ericw-tools' `tjuncManySidedFace` tests): faces whose T-junction fixes give
+/// them more than N edges (64 by default, as engines' fixed polygon buffers need) are cut into
+/// faces of at most N, none of them without area, and the cracks stay fixed; 0 leaves them whole.
+#[test]
+fn maxedges_cuts_faces_with_too_many_edges() {
+    let text = room_of_slabs();
+    let sky_faces = |bsp: &Bsp| -> Vec<usize> {
+        (0..bsp.faces.len())
+            .filter(|&f| face_texture(bsp, f) == "sky1")
+            .collect()
+    };
+    let area = |bsp: &Bsp, f: usize| {
+        let vs: Vec<glam::DVec3> = bsp
+            .face_vertices(&bsp.faces[f])
+            .expect("vertices")
+            .iter()
+            .map(|&v| glam::Vec3::from(v).as_dvec3())
+            .collect();
+        quake_formats::geom::Winding::new(vs).area()
+    };
+    let capped = compile_options(&text, parsed_options(&["x.map"]));
+    assert_eq!(errors(&capped), Vec::<String>::new());
+    assert!(bsp_compiler::cracks::find_cracks(&capped).is_empty());
+    assert!(capped.faces.iter().all(|f| f.num_edges <= 64));
+    let sky = sky_faces(&capped);
+    assert!(sky.len() > 1, "{sky:?}");
+    let total: f64 = sky.iter().map(|&f| area(&capped, f)).sum();
+    assert!((total - 256.0 * 256.0).abs() < 1.0, "{total}");
+    assert!(sky.iter().all(|&f| area(&capped, f) > 1.0));
+    let small = compile_options(&text, parsed_options(&["-maxedges", "16", "x.map"]));
+    assert!(small.faces.iter().all(|f| f.num_edges <= 16));
+    assert!(bsp_compiler::cracks::find_cracks(&small).is_empty());
+    let whole = compile_options(&text, parsed_options(&["-maxedges", "0", "x.map"]));
+    let sky = sky_faces(&whole);
+    assert_eq!(sky.len(), 1);
+    assert_eq!(whole.faces[sky[0]].num_edges, 128);
+}
+
+/// The texinfo flags of the faces textured `name`.
+fn flags_of(bsp: &Bsp, name: &str) -> Vec<i32> {
+    (0..bsp.faces.len())
+        .filter(|&f| face_texture(bsp, f) == name)
+        .map(|f| bsp.texinfo[bsp.faces[f].texinfo as usize].flags)
+        .collect()
+}
+
+/// Lit water (ericw-tools' `-litwater`, alias `-splitturb`, on by default): liquid faces are
+/// written without `TEX_SPECIAL`, so light gives them lightmaps, and are cut to lightmap size as
+/// other faces are; `-litwater 0` writes them special and whole; the `_litwater` key of
+/// worldspawn, and of a brush entity over it, decides for their liquids.
+#[test]
+fn liquids_are_lit_unless_litwater_is_off() {
+    use quake_formats::bsp::texinfo_flags::SPECIAL;
+    let pool = box_brush([-128.0, -128.0, -128.0], [128.0, 128.0, -96.0], "*water0");
+    let text = room_map(false, &pool);
+    let lit = compile_options(&text, parsed_options(&["x.map"]));
+    assert_eq!(errors(&lit), Vec::<String>::new());
+    let lit_flags = flags_of(&lit, "*water0");
+    assert!(lit_flags.iter().all(|f| f & SPECIAL == 0), "{lit_flags:?}");
+    let unlit = compile_options(&text, parsed_options(&["-litwater", "0", "x.map"]));
+    let unlit_flags = flags_of(&unlit, "*water0");
+    assert!(unlit_flags.iter().all(|f| f & SPECIAL != 0));
+    // The 256-unit surface, seen from above and below, is cut only when lit.
+    assert_eq!(unlit_flags.len(), 2);
+    assert!(lit_flags.len() > unlit_flags.len());
+    let split = compile_options(&text, parsed_options(&["-splitturb", "x.map"]));
+    assert_eq!(flags_of(&split, "*water0"), lit_flags);
+
+    let off_in_world = text.replacen(
+        "\"classname\" \"worldspawn\"",
+        "\"classname\" \"worldspawn\"\n\"_litwater\" \"0\"",
+        1,
+    );
+    let bsp = compile_options(&off_in_world, parsed_options(&["x.map"]));
+    assert!(flags_of(&bsp, "*water0").iter().all(|f| f & SPECIAL != 0));
+    let on_in_entity = room_map_with(
+        false,
+        "",
+        &format!("{{\n\"classname\" \"func_group\"\n\"_litwater\" \"1\"\n{pool}}}\n"),
+    )
+    .replacen(
+        "\"classname\" \"worldspawn\"",
+        "\"classname\" \"worldspawn\"\n\"_litwater\" \"0\"",
+        1,
+    );
+    let bsp = compile_options(&on_in_entity, parsed_options(&["x.map"]));
+    assert!(flags_of(&bsp, "*water0").iter().all(|f| f & SPECIAL == 0));
+}
+
+/// `-bmodelcontents`: a brush model's water brush is water inside (FTE swims in it), its solid
+/// brush still solid; without it, both are solid, as engines that only collide with brush
+/// models as solid expect.
+#[test]
+fn bmodelcontents_keeps_a_brush_models_liquids() {
+    let water = box_brush([-64.0, -64.0, -128.0], [0.0, 64.0, -64.0], "*water0");
+    let crate_ = box_brush([32.0, -16.0, -128.0], [64.0, 16.0, -96.0], "crate");
+    let text = room_map_with(
+        false,
+        "",
+        &brush_entity("func_door", &format!("{water}{crate_}")),
+    );
+    let contents_at = |bsp: &Bsp, p| {
+        let leaf = bsp.leaf_from(bsp.models[1].head_nodes[0], p).expect("leaf");
+        bsp.leafs[leaf].contents
+    };
+    let kept = compile_options(&text, parsed_options(&["-bmodelcontents", "x.map"]));
+    assert_eq!(errors(&kept), Vec::<String>::new());
+    assert_eq!(contents_at(&kept, [-32.0, 0.0, -96.0]), contents::WATER);
+    assert_eq!(contents_at(&kept, [48.0, 0.0, -112.0]), contents::SOLID);
+    let solid = compile_options(&text, parsed_options(&["x.map"]));
+    assert_eq!(contents_at(&solid, [-32.0, 0.0, -96.0]), contents::SOLID);
+    assert_eq!(contents_at(&solid, [48.0, 0.0, -112.0]), contents::SOLID);
 }

@@ -5,6 +5,7 @@ mod common;
 
 use common::*;
 
+use bsp_compiler::outside::FillType;
 use bsp_compiler::texinfo::FaceContents;
 use bsp_compiler::trace::hull_point_contents;
 use bsp_compiler::warnings::DroppedFace;
@@ -241,4 +242,141 @@ fn a_leaking_entity_beyond_every_brush_says_so() {
     let leak = out.leak.expect("the outside light leaks");
     assert!(leak.beyond_brushes && leak.exit.is_empty(), "{leak:?}");
     assert!(leak.to_string().contains("outside every brush"), "{leak}");
+}
+
+/// Three rooms in one sealed box: A holds the player start; C is open to A through a slit 8
+/// units wide (too narrow for the player's box); B is closed off and holds no entity. With
+/// `detail`, A also holds a hollow `func_detail` box (a pocket no entity reaches).
+fn three_rooms(detail: bool) -> String {
+    let (t, lo, hi) = (16.0, [-512.0, -256.0, 0.0], [512.0, 256.0, 256.0]);
+    let mut world = String::new();
+    world += &box_brush(
+        [lo[0] - t, lo[1] - t, -t],
+        [hi[0] + t, hi[1] + t, 0.0],
+        "floor",
+    );
+    world += &box_brush(
+        [lo[0] - t, lo[1] - t, 256.0],
+        [hi[0] + t, hi[1] + t, 272.0],
+        "ceiling",
+    );
+    world += &box_brush(
+        [lo[0] - t, lo[1] - t, 0.0],
+        [lo[0], hi[1] + t, 256.0],
+        "wall",
+    );
+    world += &box_brush(
+        [hi[0], lo[1] - t, 0.0],
+        [hi[0] + t, hi[1] + t, 256.0],
+        "wall",
+    );
+    world += &box_brush([lo[0], lo[1] - t, 0.0], [hi[0], lo[1], 256.0], "wall");
+    world += &box_brush([lo[0], hi[1], 0.0], [hi[0], hi[1] + t, 256.0], "wall");
+    // A | C through the slit y -4..4; C | B closed.
+    world += &box_brush([-128.0, -256.0, 0.0], [-96.0, -4.0, 256.0], "wall");
+    world += &box_brush([-128.0, 4.0, 0.0], [-96.0, 256.0, 256.0], "wall");
+    world += &box_brush([96.0, -256.0, 0.0], [128.0, 256.0, 256.0], "brick");
+    let mut entities = String::new();
+    if detail {
+        // A 64-unit box of 8-unit plates around (-400, 128, 64).
+        let (c, r, w) = ([-400.0, 128.0, 64.0], 32.0, 8.0);
+        let mut plates = String::new();
+        for axis in 0..3 {
+            for side in [-1.0, 1.0] {
+                let (mut a, mut b) = ([0.0; 3], [0.0; 3]);
+                for i in 0..3 {
+                    (a[i], b[i]) = (c[i] - r, c[i] + r);
+                }
+                if side < 0.0 {
+                    b[axis] = a[axis] + w;
+                } else {
+                    a[axis] = b[axis] - w;
+                }
+                plates += &box_brush(a, b, "crate");
+            }
+        }
+        entities += &brush_entity("func_detail", &plates);
+    }
+    format!(
+        "{{\n\"classname\" \"worldspawn\"\n\"wad\" \"none.wad\"\n{world}}}\n{entities}\
+         {{\n\"classname\" \"info_player_start\"\n\"origin\" \"-300 0 24\"\n}}\n"
+    )
+}
+
+const IN_A: [f32; 3] = [-300.0, 0.0, 60.0];
+const IN_C: [f32; 3] = [0.0, 0.0, 60.0];
+const IN_B: [f32; 3] = [300.0, 0.0, 60.0];
+const IN_POCKET: [f32; 3] = [-400.0, 128.0, 64.0];
+const IN_VOID: [f32; 3] = [0.0, 0.0, 1000.0];
+
+/// What hulls 0, 1 and 2 hold at `p`.
+fn hulls_at(out: &CompileOutput, p: [f32; 3]) -> [i32; 3] {
+    [
+        hull0_contents(out, p),
+        hull_point_contents(&out.bsp, 0, 1, p),
+        hull_point_contents(&out.bsp, 0, 2, p),
+    ]
+}
+
+/// ericw-tools' default (`-filltype auto`, `-filldetail 1`, its test `sealing`): after the void,
+/// every place no entity reaches is filled, in each hull by what reaches there in that hull. Hull
+/// 0 fills the closed room B and the pocket inside the detail box, keeping room C, which the
+/// slit joins to A; the clip hulls, whose boxes do not pass the slit, fill C too. B's faces go.
+#[test]
+fn rooms_no_entity_reaches_are_filled() {
+    let out = compile_text(&three_rooms(true));
+    assert!(out.leak.is_none(), "{:?}", out.leak);
+    let (empty, solid) = (contents::EMPTY, contents::SOLID);
+    assert_eq!(hulls_at(&out, IN_A), [empty; 3]);
+    assert_eq!(hulls_at(&out, IN_C), [empty, solid, solid]);
+    assert_eq!(hulls_at(&out, IN_B), [solid; 3]);
+    assert_eq!(hulls_at(&out, IN_VOID), [solid; 3]);
+    assert_eq!(hull0_contents(&out, IN_POCKET), solid);
+    // The wall between C and B is drawn from C only; the pocket's inner faces are gone.
+    let brick_facing = |x: f32| {
+        let bsp = &out.bsp;
+        (0..bsp.faces.len())
+            .filter(|&f| face_texture(bsp, f) == "brick" && face_normal(bsp, f)[0] == x)
+            .count()
+    };
+    assert!(brick_facing(-1.0) > 0);
+    assert_eq!(brick_facing(1.0), 0);
+    let inner = faces_at(&out.bsp, 0, [-400.0, 128.0, 40.0], Some([0.0, 0.0, 1.0]));
+    assert!(inner.is_empty(), "{inner:?}");
+    assert_eq!(errors(&out.bsp), Vec::<String>::new());
+}
+
+/// `-filltype outside` with `-filldetail 0` fills only the void, as before ericw-tools 2.0:
+/// every room and the pocket stay open in hull 0, and C and B in the clip hulls.
+#[test]
+fn filling_from_outside_only_keeps_every_room() {
+    let options = CompileOptions {
+        fill_type: FillType::Outside,
+        fill_detail: false,
+        ..CompileOptions::default()
+    };
+    let out = try_compile_with(&three_rooms(true), &options).expect("compile");
+    assert!(out.leak.is_none(), "{:?}", out.leak);
+    let (empty, solid) = (contents::EMPTY, contents::SOLID);
+    for p in [IN_A, IN_C, IN_B] {
+        assert_eq!(hulls_at(&out, p), [empty; 3], "{p:?}");
+    }
+    assert_eq!(hull0_contents(&out, IN_POCKET), empty);
+    assert_eq!(hulls_at(&out, IN_VOID), [solid; 3]);
+}
+
+/// `-filltype inside` without `-filldetail` floods by vis clusters, which detail does not split:
+/// the rooms are filled as by default, the pocket inside the detail box is not.
+#[test]
+fn filling_from_inside_without_filldetail_keeps_detail_pockets() {
+    let options = CompileOptions {
+        fill_type: FillType::Inside,
+        fill_detail: false,
+        ..CompileOptions::default()
+    };
+    let out = try_compile_with(&three_rooms(true), &options).expect("compile");
+    let (empty, solid) = (contents::EMPTY, contents::SOLID);
+    assert_eq!(hulls_at(&out, IN_C), [empty, solid, solid]);
+    assert_eq!(hulls_at(&out, IN_B), [solid; 3]);
+    assert_eq!(hull0_contents(&out, IN_POCKET), empty);
 }

@@ -10,7 +10,6 @@ use rayon::prelude::*;
 
 use crate::embree::RayPacket16;
 use crate::error::LightError;
-use crate::faces::FaceKind;
 use crate::options::Options;
 use crate::prepare::prepare;
 use crate::samples::face_samples;
@@ -42,7 +41,7 @@ pub fn bare_occlusion(
     let prep = prepare(bsp, options)?;
     let gate = prep.lights.settings.gate;
     let mut rays: Vec<Ray> = Vec::new();
-    'faces: for face in prep.faces.iter().filter(|f| f.kind == FaceKind::Lit) {
+    'faces: for face in prep.faces.iter().filter(|f| f.kind.has_lightmap()) {
         let (samples, _) = face_samples(face, 1, &prep.scene, bsp);
         for light in &prep.point_lights {
             if face.plane.distance(light.origin) <= 0.0 {

@@ -134,7 +134,7 @@ fn setting_arg(s: &'static Setting) -> Option<Arg> {
     Some(arg)
 }
 
-/// Options whose value may be left out (`--bounce [N]`, `--soft [N]`, ericw-tools' spelling)
+/// Light's options whose value may be left out (`--bounce [N]`, `--soft [N]`, ericw-tools' spelling)
 /// take a following number as their value: `--bounce 2` becomes `--bounce=2`, while `--bounce
 /// map.bsp` leaves the BSP as the positional argument.
 pub fn join_optional_values(args: impl IntoIterator<Item = String>) -> Vec<String> {
@@ -143,20 +143,8 @@ pub fn join_optional_values(args: impl IntoIterator<Item = String>) -> Vec<Strin
         .filter(|s| s.missing.is_some())
         .filter_map(|s| Some(format!("--{}", s.flag?)))
         .collect();
-    let mut out: Vec<String> = Vec::new();
-    for a in args {
-        let joins = out.last().is_some_and(|prev| optional.contains(prev))
-            && !a.is_empty()
-            && a.chars().all(|c| c.is_ascii_digit());
-        match out.last_mut() {
-            Some(prev) if joins => {
-                prev.push('=');
-                prev.push_str(&a);
-            }
-            _ => out.push(a),
-        }
-    }
-    out
+    let optional: Vec<&str> = optional.iter().map(String::as_str).collect();
+    quake_formats::cli::join_optional_values(args, &optional)
 }
 
 /// Whether to write a `.lit` file beside the lit BSP.

@@ -17,9 +17,19 @@ pub enum FaceKind {
     Lit,
     /// Sky: no lightmap; blocks lights, and sun rays that reach it see the sky.
     Sky,
-    /// Water, slime, lava, teleporters (`*` textures): no lightmap, and
+    /// Water, slime, lava, teleporters (`*` textures) written `TEX_SPECIAL`: no lightmap, and
     /// transparent to light (Quake's own light tool let light through them).
     Liquid,
+    /// A liquid the compiler left without `TEX_SPECIAL` (lit water): it has a lightmap, and
+    /// is transparent to light like any liquid.
+    LitLiquid,
+}
+
+impl FaceKind {
+    /// Whether light writes a lightmap for faces of this kind.
+    pub fn has_lightmap(self) -> bool {
+        matches!(self, FaceKind::Lit | FaceKind::LitLiquid)
+    }
 }
 
 /// One face, ready for sampling.
@@ -95,12 +105,12 @@ pub fn face_geometry(
                 .map(quake_formats::miptex::MipTex::name)
                 .unwrap_or_default();
             let lower = texture.to_ascii_lowercase();
-            let kind = if ti.flags & texinfo_flags::SPECIAL == 0 {
-                FaceKind::Lit
-            } else if lower.starts_with("sky") {
-                FaceKind::Sky
-            } else {
-                FaceKind::Liquid
+            let special = ti.flags & texinfo_flags::SPECIAL != 0;
+            let kind = match (special, lower.starts_with('*')) {
+                (false, false) => FaceKind::Lit,
+                (false, true) => FaceKind::LitLiquid,
+                (true, _) if lower.starts_with("sky") => FaceKind::Sky,
+                (true, _) => FaceKind::Liquid,
             };
             let model = model_of[index];
             let origin = origin_of(model);

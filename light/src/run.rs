@@ -13,7 +13,6 @@ use rayon::prelude::*;
 
 use crate::bounce::{self, BounceCounts, Density, Field, Receivers, StyleLuxels};
 use crate::error::LightError;
-use crate::faces::FaceKind;
 use crate::lighting::{Lighting, RawLighting, Stats};
 use crate::lights::assign_switchable_styles;
 use crate::options::Options;
@@ -124,7 +123,7 @@ impl<'a> Plan<'a> {
             vec![None; n]
         };
         let to_trace = (0..n)
-            .filter(|&f| !fullbright && prep.faces[f].kind == FaceKind::Lit)
+            .filter(|&f| !fullbright && prep.faces[f].kind.has_lightmap())
             .filter(|&f| bouncing || wanted[f])
             .collect();
         Plan {

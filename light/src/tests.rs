@@ -1516,3 +1516,42 @@ fn coloured_bounce_writes_a_lit_only_when_the_texture_is_coloured() {
     let lit_bytes = apply_lighting(&mut bsp, &lit);
     assert!(lit_bytes.is_some());
 }
+
+/// Lit water: a liquid face the compiler wrote without `TEX_SPECIAL` gets a lightmap, one
+/// written special gets none, and neither shades the floor under it (liquids let light through).
+#[test]
+fn lit_liquids_get_lightmaps_and_let_light_through() {
+    let surface = |x0: f32, x1: f32| {
+        quad(
+            [x0, 0.0, 64.0],
+            [x0, 256.0, 64.0],
+            [x1, 256.0, 64.0],
+            [x1, 0.0, 64.0],
+            [0.0, 0.0, 1.0],
+        )
+    };
+    let polys = [floor(256.0), surface(0.0, 128.0), surface(128.0, 256.0)];
+    let ents = "{ \"classname\" \"worldspawn\" }\n\
+                { \"classname\" \"light\" \"origin\" \"128 128 192\" \"light\" \"300\" }\n";
+    let mut bsp = synthetic_bsp(&polys, ents);
+    let open = synthetic_bsp(&[floor(256.0)], ents);
+    bsp.textures.textures.push(Some(mip("*water0")));
+    let water = bsp.textures.textures.len() as u32 - 1;
+    for (face, flags) in [(1, 0), (2, texinfo_flags::SPECIAL)] {
+        let info = &mut bsp.texinfo[bsp.faces[face].texinfo as usize];
+        info.miptex = water;
+        info.flags = flags;
+    }
+    let opts = options(Quality::Default);
+    let lighting = compute_lighting(&bsp, &opts).expect("light");
+    let lit: Vec<usize> = lighting.lightmaps.iter().map(|m| m.face).collect();
+    assert_eq!(lit, [0, 1]);
+    assert!(luxel_at(&bsp, &lighting, 1, 64.0, 128.0) > 0);
+    let without_water = compute_lighting(&open, &opts).expect("light");
+    for s in [64.0, 192.0] {
+        assert_eq!(
+            luxel_at(&bsp, &lighting, 0, s, 128.0),
+            luxel_at(&open, &without_water, 0, s, 128.0)
+        );
+    }
+}

@@ -19,9 +19,45 @@ pub fn normalise_single_dash(args: impl Iterator<Item = String>) -> Vec<String> 
         .collect()
 }
 
+/// Options whose value is optional (`--bounce [N]`, `--litwater [N]`: ericw-tools' spelling)
+/// and which are declared with `require_equals`, named in `optional`, take a following number as
+/// their value: `--bounce 2` becomes `--bounce=2`, while `--bounce map.bsp` leaves the file as
+/// the positional argument.
+pub fn join_optional_values(
+    args: impl IntoIterator<Item = String>,
+    optional: &[&str],
+) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for a in args {
+        let joins = out
+            .last()
+            .is_some_and(|prev| optional.contains(&prev.as_str()))
+            && !a.is_empty()
+            && a.chars().all(|c| c.is_ascii_digit());
+        match out.last_mut() {
+            Some(prev) if joins => {
+                prev.push('=');
+                prev.push_str(&a);
+            }
+            _ => out.push(a),
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_number_after_an_optional_value_option_is_its_value() {
+        let args = ["light", "--bounce", "2", "--soft", "x.bsp", "--other", "3"];
+        let out = join_optional_values(args.iter().map(|s| s.to_string()), &["--bounce", "--soft"]);
+        assert_eq!(
+            out,
+            ["light", "--bounce=2", "--soft", "x.bsp", "--other", "3"]
+        );
+    }
 
     #[test]
     fn single_dash_long_options_become_double_dash() {

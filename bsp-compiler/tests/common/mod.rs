@@ -115,3 +115,54 @@ pub struct LightCli {
     #[command(flatten)]
     pub args: light::cli::Args,
 }
+
+/// The name of the texture of face `f`.
+pub fn face_texture(bsp: &Bsp, f: usize) -> String {
+    let info = &bsp.texinfo[bsp.faces[f].texinfo as usize];
+    bsp.textures.textures[info.miptex as usize]
+        .as_ref()
+        .map(|t| t.name())
+        .unwrap_or_default()
+}
+
+/// The normal of the side face `f` is drawn on.
+pub fn face_normal(bsp: &Bsp, f: usize) -> [f32; 3] {
+    let face = &bsp.faces[f];
+    let n = bsp.planes[face.plane as usize].normal;
+    if face.side != 0 { n.map(|c| -c) } else { n }
+}
+
+/// The faces of model `model` that hold `p` (within 0.01 of their plane, inside their edges),
+/// seen along `normal` when it is given, as ericw-tools' tests look faces up.
+pub fn faces_at(bsp: &Bsp, model: usize, p: [f32; 3], normal: Option<[f32; 3]>) -> Vec<usize> {
+    let m = &bsp.models[model];
+    let first = m.first_face as usize;
+    (first..first + m.num_faces as usize)
+        .filter(|&f| {
+            let n = face_normal(bsp, f);
+            if normal.is_some_and(|want| (0..3).any(|i| (want[i] - n[i]).abs() > 1e-3)) {
+                return false;
+            }
+            let vs = bsp.face_vertices(&bsp.faces[f]).expect("vertices");
+            let d = |a: [f32; 3], b: [f32; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+            let dot = |a: [f32; 3], b: [f32; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+            if dot(d(p, vs[0]), n).abs() > 0.01 {
+                return false;
+            }
+            // Inside a convex polygon: on the same side of every edge, whichever way it winds.
+            let sides: Vec<f32> = (0..vs.len())
+                .map(|i| {
+                    let (a, b) = (vs[i], vs[(i + 1) % vs.len()]);
+                    let e = d(b, a);
+                    let across = [
+                        n[1] * e[2] - n[2] * e[1],
+                        n[2] * e[0] - n[0] * e[2],
+                        n[0] * e[1] - n[1] * e[0],
+                    ];
+                    dot(d(p, a), across)
+                })
+                .collect();
+            sides.iter().all(|&s| s >= -0.01) || sides.iter().all(|&s| s <= 0.01)
+        })
+        .collect()
+}
