@@ -13,6 +13,58 @@ use quake_formats::fsutil::write_atomic;
 use quake_formats::pts::write_pointfile;
 use std::path::{Path, PathBuf};
 
+quake_formats::ericw_accepted! {
+    /// ericw-tools' qbsp options that Slipgate's compiler accepts without acting on them.
+    pub struct EricwOnly {
+        verbose: bool => "the summary is the same either way",
+        noverbose: bool => "the summary is the same either way",
+        quiet: bool => "the summary is the same either way",
+        nopercent: bool => "progress is drawn only when standard error is a terminal",
+        noprogress: bool => "progress is drawn only when standard error is a terminal",
+        nostat: bool => "the summary is the same either way",
+        nocolor: bool => "Slipgate writes no colour codes",
+        log: bool => "Slipgate writes no log file; redirect its output",
+        nolog: bool => "Slipgate writes no log file",
+        loghulls: bool => "the summary counts every hull's nodes",
+        logbmodels: bool => "the summary is the same either way",
+        lowpriority: bool => "Slipgate runs at the priority it is started with (use nice)",
+        oldaxis: bool => "standard-format texture axes are always id's",
+        nooldaxis: bool => "standard-format texture axes are always id's; alignment may differ",
+        chop: bool => "brushes are never chopped; CSG happens in the BSP tree",
+        nochop: bool => "brushes are never chopped; CSG happens in the BSP tree",
+        chopfragment: bool => "brushes are never chopped; CSG happens in the BSP tree",
+        forcegoodtree: bool => "the tree is always chosen by the fewest-splits heuristic",
+        notjunc: bool => "T-junctions are always welded, so that no crack is left",
+        tjunc: Option<String> => "T-junctions are always welded, so that no crack is left",
+        splitsky: bool => "sky faces merge like any others",
+        splitspecial: bool => "sky and liquid faces merge like any others",
+        transsky: bool => "sky is always opaque to vis",
+        noskip: bool => "skip faces are always left out",
+        nodetail: bool => "detail brushes stay detail",
+        nomerge: bool => "faces are always merged",
+        noedgereuse: bool => "edges are shared wherever engines allow it",
+        leakdist: Option<String> => "the pointfile has one point per leaf crossed",
+        allowupgrade: bool => "BSP2 is written by itself when BSP29's limits break",
+        noallowupgrade: bool => "BSP2 is written by itself when BSP29's limits break",
+        software: bool => "output always suits software renderers",
+        nosoftware: bool => "output always suits software renderers",
+        epsilon: Option<String> => "one epsilon policy holds everywhere (see ARCHITECTURE.md)",
+        microvolume: Option<String> => "one epsilon policy holds everywhere (see ARCHITECTURE.md)",
+        worldextent: Option<String> => "the world's extent comes from its brushes",
+        forceprt1: bool => "PRT1 is written unless the map has detail",
+        objexport: bool => "no OBJ export; `slipgate view` previews the map",
+        outsidedebug: bool => "no debug maps are written",
+        debugchop: bool => "no debug maps are written",
+        debugleak: bool => "the pointfile and the leak message name the hole",
+        notriggermodels: bool => "trigger models are written as for every game",
+        includeskip: bool => "skip faces are always left out",
+        lmscale: Option<String> => "lightmaps are on the 16-texel grid",
+        missing_textures_as_zero_size: bool => "missing textures become 64x64 placeholders",
+        nodefaultpaths: bool => "WADs are found as docs/mapping.md says",
+        defaultpaths: bool => "WADs are found as docs/mapping.md says",
+    }
+}
+
 #[derive(clap::Args, Debug, Clone)]
 pub struct Args {
     /// The .map file to compile
@@ -138,6 +190,14 @@ pub struct Args {
     /// collide with brushes (FTE, bevy_trenchbroom)
     #[arg(long, alias = "bspx")]
     pub wrbrushes: bool,
+    /// --wrbrushes without clip hulls (--noclip): only for engines that collide with brushes
+    #[arg(long, alias = "bspxonly")]
+    pub wrbrushesonly: bool,
+    /// Worker threads (default: one per core); the output is the same for any number
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+    #[command(flatten)]
+    pub ericw_only: EricwOnly,
     /// Only replace the entities of the existing BSP (OUT.bsp) with the .map's, keeping its
     /// geometry, vis and light; its brush entities must match the BSP's models
     #[arg(long)]
@@ -182,11 +242,11 @@ impl Args {
             lit_water: self.litwater != 0,
             bmodel_contents: self.bmodelcontents,
             max_edges: self.maxedges,
-            clip_hulls: !self.noclip,
+            clip_hulls: !(self.noclip || self.wrbrushesonly),
             add: self.add.clone(),
             omit,
             texture_data: !self.notex,
-            brush_list: self.wrbrushes,
+            brush_list: self.wrbrushes || self.wrbrushesonly,
             keep_editor_keys: self.keep_editor_keys,
             progress: quake_formats::progress::terminal(),
         }
@@ -262,6 +322,13 @@ fn remove_stale(path: &Path) -> Result<()> {
 /// Runs `slipgate bsp` with `args`: the compile's counts and timings, or `None` when the
 /// options ask for no compile (`--onlyents`, `--convert`).
 pub fn run(args: &Args) -> Result<Option<crate::CompileStats>> {
+    for note in args.ericw_only.notes() {
+        eprintln!("note: {note}");
+    }
+    if let Some(n) = args.threads {
+        // Fails only when a pool already runs (a caller chose its threads): keep that one.
+        let _ = rayon::ThreadPoolBuilder::new().num_threads(n).build_global();
+    }
     let source = MapSource::read(&args.input)?;
     let bsp_path = args
         .output

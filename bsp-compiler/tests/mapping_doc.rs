@@ -34,10 +34,15 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
-/// The file's code without its unit tests (which use keys of every kind as examples).
+/// The file's code without its unit tests and comment lines (which use keys of every kind as
+/// examples).
 fn non_test_code(path: &Path) -> String {
     let text = std::fs::read_to_string(path).expect("read source");
-    text.split("#[cfg(test)]").next().unwrap_or("").to_string()
+    let code = text.split("#[cfg(test)]").next().unwrap_or("");
+    code.lines()
+        .filter(|line| !line.trim_start().starts_with("//"))
+        .collect::<Vec<_>>()
+        .join("\n")
 }
 
 /// The string literals in `code`, each with the text just before it.

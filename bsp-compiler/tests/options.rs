@@ -534,3 +534,38 @@ fn bmodelcontents_keeps_a_brush_models_liquids() {
     assert_eq!(contents_at(&solid, [-32.0, 0.0, -96.0]), contents::SOLID);
     assert_eq!(contents_at(&solid, [48.0, 0.0, -112.0]), contents::SOLID);
 }
+
+/// The bsp arguments `args` parse to, spelled as ericw-tools spells them.
+fn parsed_args(args: &[&str]) -> bsp_compiler::cli::Args {
+    use clap::Parser;
+    let words = ["bsp"].iter().chain(args).map(|s| s.to_string());
+    let words = bsp_compiler::cli::join_optional_values(quake_formats::cli::normalise_single_dash(
+        words,
+    ));
+    BspCli::try_parse_from(words).expect("parses").args
+}
+
+/// A compile profile written for ericw-tools' qbsp runs unchanged: its options that change only
+/// how qbsp talks, or that Slipgate's compiler has no need of, are accepted, each with a note
+/// saying what Slipgate does instead; `-threads N` and `-wrbrushesonly` act.
+#[test]
+fn ericw_tools_only_options_are_accepted_with_a_note() {
+    let args = parsed_args(&[
+        "-nopercent", "-verbose", "-nolog", "-tjunc", "mwt", "-splitsky", "-chop", "-threads",
+        "2", "-lowpriority", "x.map",
+    ]);
+    let notes = args.ericw_only.notes();
+    assert_eq!(notes.len(), 7, "{notes:?}");
+    for name in ["-nopercent", "-verbose", "-nolog", "-tjunc", "-splitsky", "-chop"] {
+        assert!(
+            notes.iter().any(|n| n.starts_with(&format!("{name} has no effect"))),
+            "{name}: {notes:?}"
+        );
+    }
+    assert_eq!(args.threads, Some(2));
+    assert_eq!(args.input, PathBuf::from("x.map"));
+    assert!(parsed_args(&["x.map"]).ericw_only.notes().is_empty());
+
+    let only = parsed_args(&["-bspxonly", "x.map"]).compile_options();
+    assert!(only.brush_list && !only.clip_hulls);
+}

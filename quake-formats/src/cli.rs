@@ -1,5 +1,59 @@
-//! What the command lines share: ericw-tools' single-dash spellings of long options, and (in
+//! What the command lines share: ericw-tools' single-dash spellings of long options, ericw-tools'
+//! options a stage accepts without acting on them ([`ericw_accepted!`]), and (in
 //! [`crate::progress::terminal`]) progress drawn as a bar.
+
+/// Whether an option was given on the command line: a flag set, or a value present.
+pub trait Given {
+    /// True when the option appeared.
+    fn given(&self) -> bool;
+}
+
+impl Given for bool {
+    fn given(&self) -> bool {
+        *self
+    }
+}
+
+impl<T> Given for Option<T> {
+    fn given(&self) -> bool {
+        self.is_some()
+    }
+}
+
+/// Declares a stage's ericw-tools options that it accepts without acting on them, so that a
+/// compile profile written for ericw-tools runs unchanged: each is a hidden clap option (a
+/// `bool` flag or an `Option<String>` value) with the note printed when it is given, saying
+/// what Slipgate does instead. Flatten the struct into the stage's arguments and print
+/// `notes()` when the stage runs.
+#[macro_export]
+macro_rules! ericw_accepted {
+    ($(#[$meta:meta])* $vis:vis struct $name:ident {
+        $( $field:ident : $ty:ty => $note:literal ),* $(,)?
+    }) => {
+        $(#[$meta])*
+        #[derive(clap::Args, Debug, Clone, Default)]
+        $vis struct $name {
+            $(
+                #[doc = $note]
+                #[arg(long, hide = true)]
+                $field: $ty,
+            )*
+        }
+
+        impl $name {
+            /// One line for each of these options given: its name and what Slipgate does instead.
+            pub fn notes(&self) -> Vec<String> {
+                let mut notes = Vec::new();
+                $(
+                    if $crate::cli::Given::given(&self.$field) {
+                        notes.push(format!("-{} has no effect: {}", stringify!($field), $note));
+                    }
+                )*
+                notes
+            }
+        }
+    };
+}
 
 /// ericw-tools writes long options with one dash (`-extra4`); clap wants two. Negative numbers
 /// and short flags (`-h`) are left alone. The first word (the program name) is kept as it is.
