@@ -104,12 +104,15 @@ pub fn lightmaps_in(bsp: &Bsp, faces: &[usize]) -> Lighting {
             styles,
             grey,
             rgb: Vec::new(),
+            hdr: Vec::new(),
+            directions: Vec::new(),
         });
     }
     Lighting {
         lightmaps,
         entity_text: None,
         coloured: false,
+        outputs: crate::Outputs::default(),
         warnings: Vec::new(),
         stats: Stats::default(),
     }

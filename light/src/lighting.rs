@@ -1,7 +1,7 @@
 //! What a lighting run gives back: lightmaps in light units ([`RawLighting`]), in bytes
 //! ([`Lighting`]), and the counts and timings of the run ([`Stats`]).
 
-use crate::output::FaceLightmap;
+use crate::output::{FaceLightmap, Outputs};
 use crate::settings::SettingWarning;
 use crate::trace::FaceLight;
 
@@ -77,6 +77,8 @@ pub struct RawLighting {
     pub entity_text: Option<String>,
     /// Some light is coloured: a `.lit` is needed.
     pub coloured: bool,
+    /// The forms of the lightmaps to write.
+    pub outputs: Outputs,
     /// Lightmap bytes per light unit (`_range`).
     pub rangescale: f64,
     /// Gamma applied to the bytes (`_gamma`).
@@ -99,6 +101,8 @@ pub struct Lighting {
     pub entity_text: Option<String>,
     /// Some light is coloured: a `.lit` is needed.
     pub coloured: bool,
+    /// The forms of the lightmaps to write.
+    pub outputs: Outputs,
     /// Worldspawn or command-line values light did not take as given.
     pub warnings: Vec<SettingWarning>,
     /// Counts and timings.

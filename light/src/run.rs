@@ -17,7 +17,7 @@ use crate::faces::FaceKind;
 use crate::lighting::{Lighting, RawLighting, Stats};
 use crate::lights::assign_switchable_styles;
 use crate::options::Options;
-use crate::output::{self, Finish, finish_face};
+use crate::output::{self, Finish, Outputs, finish_face};
 use crate::phong;
 use crate::prepare::{Prepared, face_rules, prepare};
 use crate::quality::Quality;
@@ -77,6 +77,7 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
         faces,
         entity_text: prep.entity_text.clone(),
         coloured: stats.coloured,
+        outputs: Outputs::from_settings(settings),
         rangescale: settings.range,
         gamma: settings.gamma,
         soft_radius: settings.soft,
@@ -474,11 +475,14 @@ fn phong_normals(
 /// lightmap bytes.
 pub fn finish_lighting(raw: &RawLighting, soft_radius: usize) -> Lighting {
     let start = Instant::now();
+    let outputs = raw.outputs;
     let finish = Finish {
         rangescale: raw.rangescale,
         gamma: raw.gamma,
         soft_radius,
-        rgb: raw.coloured,
+        rgb: raw.coloured || outputs.rgb_lump,
+        hdr: outputs.hdr(),
+        directions: outputs.directions(),
     };
     let mut stats = raw.stats.clone();
     let (lightmaps, dropped): (Vec<_>, Vec<usize>) = raw
@@ -492,19 +496,51 @@ pub fn finish_lighting(raw: &RawLighting, soft_radius: usize) -> Lighting {
         lightmaps,
         entity_text: raw.entity_text.clone(),
         coloured: raw.coloured,
+        outputs,
         warnings: raw.warnings.clone(),
         stats,
     }
 }
 
-/// Writes `lighting` into `bsp` (lighting lump, face styles and offsets,
-/// entity styles) and returns the `.lit` file bytes when the map is coloured.
-pub fn apply_lighting(bsp: &mut Bsp, lighting: &Lighting) -> Option<Vec<u8>> {
-    let rgb = output::write_lighting(bsp, &lighting.lightmaps, lighting.coloured);
+/// The files beside a lit BSP its light asks for.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LightFiles {
+    /// The `.lit`: the HDR one when `--hdr` asks for it, else the coloured one when the light is
+    /// coloured and the grey lump is written (with `--novanilla`, `RGBLIGHTING` carries the
+    /// colour). `None`: no `.lit` is needed.
+    pub lit: Option<Vec<u8>>,
+    /// Every luxel's colour as a `.lit` whatever the light (for `--lit`), when it was kept.
+    pub rgb_lit: Option<Vec<u8>>,
+    /// The `.lux` deluxemap, when `--lux` asks for it.
+    pub lux: Option<Vec<u8>>,
+}
+
+/// Writes `lighting` into `bsp` (lighting lump and the BSPX lumps asked for, face styles and
+/// offsets, entity styles) and returns the files to put beside it.
+pub fn apply_lighting(bsp: &mut Bsp, lighting: &Lighting) -> LightFiles {
+    let outputs = &lighting.outputs;
+    let data = output::write_lighting(bsp, &lighting.lightmaps, outputs);
     if let Some(text) = &lighting.entity_text {
         bsp.set_entity_text(text);
     }
-    rgb.map(|rgb| quake_formats::lit::write_lit(&rgb))
+    let rgb_lit = data.rgb.as_deref().map(quake_formats::lit::write_lit);
+    let hdr_lit = data
+        .hdr
+        .as_deref()
+        .filter(|_| outputs.hdr_file)
+        .map(quake_formats::lit::write_hdr_lit);
+    let coloured_lit = rgb_lit
+        .clone()
+        .filter(|_| lighting.coloured && outputs.grey_lump);
+    LightFiles {
+        lit: hdr_lit.or(coloured_lit),
+        rgb_lit,
+        lux: data
+            .directions
+            .as_deref()
+            .filter(|_| outputs.lux_file)
+            .map(quake_formats::lit::write_lux),
+    }
 }
 
 /// `--onlyents`: gives switchable lights their styles in the entity lump (the lump `slipgate bsp

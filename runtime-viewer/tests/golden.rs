@@ -50,6 +50,7 @@ fn build_demo(threads: usize) -> (Vec<u8>, Option<Vec<u8>>) {
         let lit = light::apply_lighting(&mut bsp, &lighting);
         let bytes = bsp.write().expect("BSP encodes");
         let rgb = lit
+            .lit
             .map(|lit| quake_formats::lit::read_lit(&lit, bsp.lighting.len()).expect("valid .lit"));
         (bytes, rgb)
     })

@@ -124,6 +124,27 @@ settings! {
 
     /// Light of switchable and animated styles reflects too, in its own style.
     bounce_styled: bool = false, flag "bouncestyled", keys ["_bouncestyled"], range Range::Any;
+
+    /// Write the coloured lightmaps into the BSP as the BSPX `RGBLIGHTING` lump (beside any
+    /// `.lit`), for FTE, QuakeSpasm-Spiked and Ironwail.
+    bspxlit: bool = false, flag "bspxlit", keys [], range Range::Any;
+
+    /// Leave out the grey lighting lump (implies `--bspxlit`; no `.lit` unless `--lit`): engines
+    /// that read only the grey lump (QuakeSpasm 0.95, DarkPlaces, vanilla) draw the map unlit.
+    novanilla: bool = false, flag "novanilla", keys [], range Range::Any;
+
+    /// Write a `.lux` deluxemap beside the BSP: per luxel, the light's mean direction in the
+    /// face's tangent space (DarkPlaces' `.dlit`, FTE's `.lux`).
+    lux: bool = false, flag "lux", keys [], range Range::Any;
+
+    /// Write the deluxemap into the BSP as the BSPX `LIGHTINGDIR` lump.
+    bspxlux: bool = false, flag "bspxlux", keys [], range Range::Any;
+
+    /// Write the `.lit` in HDR form (E5BGR9 words, light past 255 kept), for FTE.
+    hdr: bool = false, flag "hdr", keys [], range Range::Any;
+
+    /// Write HDR lightmaps into the BSP as the BSPX `LIGHTING_E5BGR9` lump.
+    bspxhdr: bool = false, flag "bspxhdr", keys [], range Range::Any;
 }
 
 /// The settings as `docs/mapping.md` tables them: one row per setting, with its worldspawn
