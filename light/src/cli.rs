@@ -378,6 +378,12 @@ fn print_summary(lighting: &Lighting) {
         s.seconds_setup,
         s.rays_per_second / 1e6
     );
+    if s.grid_points > 0 {
+        eprintln!(
+            "light: light grid: {} points ({} in the open), {} rays in {:.2} s",
+            s.grid_points, s.grid_points_open, s.grid_rays, s.seconds_lightgrid
+        );
+    }
     if s.fullbright {
         eprintln!(
             "light: no lights, suns or minlight: lighting lump left empty (engines draw the map fullbright)"

@@ -113,6 +113,7 @@ pub fn lightmaps_in(bsp: &Bsp, faces: &[usize]) -> Lighting {
         entity_text: None,
         coloured: false,
         outputs: crate::Outputs::default(),
+        light_grid: None,
         warnings: Vec::new(),
         stats: Stats::default(),
     }

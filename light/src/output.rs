@@ -149,7 +149,7 @@ pub fn soft_filter(
 }
 
 /// Light units to lightmap levels before clamping: range scale, then gamma.
-fn to_levels(c: [f32; 3], finish: &Finish) -> [f64; 3] {
+pub(crate) fn to_levels(c: [f32; 3], finish: &Finish) -> [f64; 3] {
     let v = c.map(|x| (f64::from(x) * finish.rangescale).max(0.0));
     if finish.gamma == 1.0 {
         return v;
@@ -158,7 +158,7 @@ fn to_levels(c: [f32; 3], finish: &Finish) -> [f64; 3] {
 }
 
 /// Lightmap levels to bytes: all channels scaled down together if the brightest exceeds 255.
-fn levels_to_bytes(mut v: [f64; 3]) -> [u8; 3] {
+pub(crate) fn levels_to_bytes(mut v: [f64; 3]) -> [u8; 3] {
     let max = v[0].max(v[1]).max(v[2]);
     if max > 255.0 {
         v = v.map(|x| x * 255.0 / max);

@@ -6,6 +6,7 @@ use glam::Vec3;
 use std::time::Instant;
 
 use quake_formats::Bsp;
+use quake_formats::bsp::lightgrid::LIGHTGRID_OCTREE;
 use quake_formats::entities::{parse_entities, write_entities};
 use quake_formats::palette::Palette;
 use quake_formats::progress::Progress;
@@ -14,6 +15,7 @@ use rayon::prelude::*;
 use crate::bounce::{self, BounceCounts, Density, Field, Receivers, StyleLuxels};
 use crate::error::LightError;
 use crate::faces::FaceKind;
+use crate::lightgrid::{GridSources, RawGrid, finish_grid, trace_grid};
 use crate::lighting::{Lighting, RawLighting, Stats};
 use crate::lights::assign_switchable_styles;
 use crate::options::Options;
@@ -49,7 +51,15 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
     let mut bounce_counts = BounceCounts::default();
     let bounced = plan.bounced_light(&traced, &mut bounce_counts);
     let bounce_done = Instant::now();
+    let grid = plan.light_grid()?;
+    let grid_done = Instant::now();
     let mut stats = plan.stats(&traced, &bounce_counts);
+    if let Some(g) = &grid {
+        stats.grid_points = g.points.len() as u64;
+        stats.grid_points_open = g.points.iter().flatten().count() as u64;
+        stats.grid_rays = g.rays;
+        stats.seconds_lightgrid = (grid_done - bounce_done).as_secs_f64();
+    }
     let faces = finish_faces(traced, &bounced);
     stats.luxels = faces.iter().map(|l| (l.width * l.height) as u64).sum();
     stats.faces_lit = faces.len();
@@ -78,6 +88,7 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
         entity_text: prep.entity_text.clone(),
         coloured: stats.coloured,
         outputs: Outputs::from_settings(settings),
+        grid,
         rangescale: settings.range,
         gamma: settings.gamma,
         soft_radius: settings.soft,
@@ -242,6 +253,28 @@ impl<'a> Plan<'a> {
     }
 
     /// The counts of the run so far (luxels and timings are the caller's).
+    /// The light grid in light units, when `--lightgrid` asks for it and anything gives light.
+    fn light_grid(&self) -> Result<Option<RawGrid>, LightError> {
+        let prep = self.prep;
+        let settings = &prep.lights.settings;
+        if !settings.lightgrid || self.fullbright {
+            return Ok(None);
+        }
+        let sources = GridSources {
+            bsp: self.bsp,
+            scene: &prep.scene,
+            vis: &prep.vis,
+            lights: &prep.point_lights,
+            light_leafs: &prep.light_leafs,
+            reaches: &self.reaches,
+            suns: &prep.lights.suns,
+            minlight: prep.lights.minlight.get(&0),
+            gate: settings.gate,
+            sun_distance: prep.sun_distance,
+        };
+        trace_grid(&sources, settings.lightgrid_dist.0).map(Some)
+    }
+
     fn stats(&self, traced: &[Traced], bounce: &BounceCounts) -> Stats {
         let prep = self.prep;
         let mut placement = PlacementCounts::default();
@@ -497,6 +530,7 @@ pub fn finish_lighting(raw: &RawLighting, soft_radius: usize) -> Lighting {
         entity_text: raw.entity_text.clone(),
         coloured: raw.coloured,
         outputs,
+        light_grid: raw.grid.as_ref().map(|g| finish_grid(g, &finish)),
         warnings: raw.warnings.clone(),
         stats,
     }
@@ -522,6 +556,10 @@ pub fn apply_lighting(bsp: &mut Bsp, lighting: &Lighting) -> LightFiles {
     let data = output::write_lighting(bsp, &lighting.lightmaps, outputs);
     if let Some(text) = &lighting.entity_text {
         bsp.set_entity_text(text);
+    }
+    match &lighting.light_grid {
+        Some(grid) => bsp.set_light_grid(grid),
+        None => bsp.remove_bspx_lump(LIGHTGRID_OCTREE),
     }
     let rgb_lit = data.rgb.as_deref().map(quake_formats::lit::write_lit);
     let hdr_lit = data

@@ -1281,6 +1281,7 @@ fn output_does_not_depend_on_the_thread_count() {
         let o = &mut options.overrides;
         (o.bspxlit, o.lux, o.bspxlux, o.hdr, o.bspxhdr) =
             (Some(true), Some(true), Some(true), Some(true), Some(true));
+        o.lightgrid = Some(true);
         // Bounce gathers across faces: one pass, and two with supersampling.
         options.overrides.bounce = Some(if quality == Quality::Default { 1 } else { 2 });
         let one = lit_bytes(1, &options);
@@ -1653,4 +1654,97 @@ fn novanilla_writes_colour_only_in_rgblighting() {
     };
     assert_eq!(rgb.len(), bsp.luxel_count());
     assert!(rgb.iter().any(|c| c[0] > 0) && rgb.iter().all(|c| c[1] == 0 && c[2] == 0));
+}
+
+/// The light grid over [`shadow_scene`] (a box 0..256 by 0..256 by 0..128) with a light that
+/// ignores the angle of incidence, so a face receives what a grid point beside it does.
+fn shadow_scene_grid() -> (Bsp, quake_formats::bsp::lightgrid::LightGrid, Vec<u8>) {
+    let mut bsp = shadow_scene("\"light\" \"300\" \"_anglescale\" \"0\"");
+    bsp.models[0].mins = [0.0; 3];
+    bsp.models[0].maxs = [256.0, 256.0, 128.0];
+    let mut options = options(Quality::Default);
+    options.overrides.lightgrid = Some(true);
+    let lighting = compute_lighting(&bsp, &options).expect("light");
+    assert!(lighting.stats.grid_rays > 0);
+    let grid = lighting
+        .light_grid
+        .clone()
+        .expect("--lightgrid gives a grid");
+    apply_lighting(&mut bsp, &lighting);
+    let bytes = bsp.write().expect("BSP encodes");
+    (bsp, grid, bytes)
+}
+
+#[test]
+fn grid_points_take_the_light_of_the_floor_beside_them() {
+    let (bsp, grid, _) = shadow_scene_grid();
+    assert_eq!(grid.spacing, [32.0; 3]);
+    assert_eq!(grid.mins, [0.5; 3], "half a unit off the floor's plane");
+    let floor = &bsp.faces[0];
+    let offset = usize::try_from(floor.light_offset).expect("the floor is lit");
+    // Floor luxel (i, j) stands at x = 16 i, y = 256 - 16 j (its t axis is world -y).
+    let luxel = |x: usize, y: usize| bsp.lighting[offset + (256 - y) / 16 * 17 + x / 16];
+    let point = |x: i32, y: i32| {
+        let p = grid.point([x / 32, y / 32, 0]).expect("inside the grid");
+        let styles = p.as_ref().expect("in the open");
+        styles.iter().find(|s| s.style == 0).map_or(0, |s| s.rgb[0])
+    };
+    // In the light, off the box's shadow.
+    let (lit_face, lit_grid) = (luxel(32, 32), point(32, 32));
+    assert!(lit_face > 20, "the floor is lit there: {lit_face}");
+    assert!(
+        lit_face.abs_diff(lit_grid) <= 1,
+        "face {lit_face}, grid {lit_grid}"
+    );
+    // In the box's shadow.
+    assert_eq!((luxel(128, 128), point(128, 128)), (0, 0));
+}
+
+#[test]
+fn qbsp_reads_the_light_grid_as_written() {
+    let (_, grid, bytes) = shadow_scene_grid();
+    let theirs = qbsp::BspData::parse(qbsp::BspParseInput {
+        bsp: &bytes,
+        lit: None,
+        settings: qbsp::BspParseSettings::default(),
+    })
+    .expect("qbsp reads the BSP");
+    let octree = theirs.bspx.light_grid_octree.expect("LIGHTGRID_OCTREE");
+    assert_eq!(octree.step.to_array(), grid.spacing);
+    assert_eq!(octree.mins.to_array(), grid.mins);
+    assert_eq!(octree.size.to_array().map(|s| s as i32), grid.size);
+}
+
+#[test]
+fn a_run_without_lightgrid_removes_an_old_grid() {
+    let (mut bsp, _, _) = shadow_scene_grid();
+    let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
+    apply_lighting(&mut bsp, &lighting);
+    assert!(
+        bsp.bspx_lump(quake_formats::bsp::lightgrid::LIGHTGRID_OCTREE)
+            .is_none()
+    );
+}
+
+#[test]
+fn a_grid_row_finds_the_leaves_leaf_at_does() {
+    let bsp = demo_bsp_with_sun();
+    let m = &bsp.models[0];
+    let (mins, maxs) = (
+        DVec3::from(m.mins.map(f64::from)),
+        DVec3::from(m.maxs.map(f64::from)),
+    );
+    let mut rows = 0;
+    for (y, z) in [(0.3, 0.2), (0.5, 0.5), (0.71, 0.13), (0.9, 0.8)] {
+        let at = |x: f64| mins + (maxs - mins) * DVec3::new(x, y, z);
+        let points: Vec<DVec3> = (0..=200).map(|i| at(f64::from(i) / 200.0)).collect();
+        let walked = crate::lightgrid::leaves_along(&bsp, &points);
+        let each: Vec<_> = points
+            .iter()
+            .map(|p| bsp.leaf_at(p.as_vec3().to_array()))
+            .collect();
+        assert_eq!(walked, each);
+        rows += usize::from(each.windows(2).any(|w| w[0] != w[1]));
+    }
+    assert!(rows >= 3, "the rows cross leaves");
 }

@@ -23,7 +23,7 @@ pub use declare::Setting;
 use declare::settings;
 use resolve::{Declared, given, resolve};
 pub use resolve::{Given, SettingWarning, World};
-pub use value::{Color, DirtToggle, Range, SettingValue, normalize_color};
+pub use value::{Color, DirtToggle, Range, SettingValue, Spacing, normalize_color};
 
 settings! {
     /// Average each luxel with its neighbours within N luxels (`--soft` alone: 1).
@@ -145,6 +145,14 @@ settings! {
 
     /// Write HDR lightmaps into the BSP as the BSPX `LIGHTING_E5BGR9` lump.
     bspxhdr: bool = false, flag "bspxhdr", keys [], range Range::Any;
+
+    /// Sample light through the map's open space into the BSPX `LIGHTGRID_OCTREE` lump, which
+    /// FTE, QuakeSpasm-Spiked and Ironwail light models with (direct light and minlight; bounced
+    /// light is not in it).
+    lightgrid: bool = false, flag "lightgrid", keys ["_lightgrid"], range Range::Any;
+
+    /// Map units between light grid points (one number, or one per axis; at least 1).
+    lightgrid_dist: Spacing = Spacing::EVEN_32, flag "lightgrid_dist", keys ["_lightgrid_dist"], range Range::Any;
 }
 
 /// The settings as `docs/mapping.md` tables them: one row per setting, with its worldspawn

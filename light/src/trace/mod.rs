@@ -24,7 +24,7 @@ mod footprints;
 mod points;
 mod sample_light;
 mod shadows;
-mod suns;
+pub(crate) mod suns;
 
 use glam::Vec3;
 use quake_formats::Bsp;
@@ -47,7 +47,7 @@ use shadows::VisibilityScratch;
 
 /// Shadow rays stop this far short of the light, so a light sitting right
 /// on a surface is not blocked by it.
-const LIGHT_CLEARANCE: f32 = 0.1;
+pub(crate) const LIGHT_CLEARANCE: f32 = 0.1;
 
 /// Everything shared by all faces while tracing.
 pub struct TraceSetup<'a> {
