@@ -12,12 +12,15 @@ use std::time::{Duration, Instant};
 use quake_formats::bsp::limits::MAX_LIGHTMAPS;
 
 use crate::camera::{NEAR_CLIP, View};
-use crate::textures::{FENCE_TRANSPARENT_INDEX, TextureKind};
+use crate::textures::{FENCE_TRANSPARENT_INDEX, TextureKind, pack};
 use crate::world::{Surface, World};
 
 /// Light value of every face of a map without lighting data: engines draw it fully lit. (In a
 /// map with lighting data, a face without a lightmap is dark, as in engines.)
 const UNLIT_MAP_LIGHT: u32 = 255;
+/// Light levels above this shade every palette colour to white (a channel of 1 times it /
+/// 128 is already past 255).
+const MAX_SHADED_LIGHT: u32 = 255 * 128;
 /// Style value for normal light ('m').
 pub const NORMAL_STYLE: u32 = 256;
 
@@ -153,7 +156,9 @@ pub struct LitSurface {
 }
 
 /// Light and texture a surface at `mip`: each texel's light is the bilinear blend of the four
-/// luxels around its corner, the styles summed with their current values.
+/// luxels around its corner, the styles summed with their current values. With
+/// [`World::lightmap_only`] the texture is left out: a texel shows its light (128 grey for the
+/// texture's own colour).
 pub fn build_lit_surface(
     world: &World,
     surface: &Surface,
@@ -200,6 +205,12 @@ pub fn build_lit_surface(
                 let bottom = c[k] * (16 - fx) + d[k] * fx;
                 ((top as u64 * (16 - fy) as u64 + bottom as u64 * fy as u64) >> 16) as u32
             });
+            // HDR light passes 255; past this every channel is white anyway.
+            let light = light.map(|l| l.min(MAX_SHADED_LIGHT));
+            if world.lightmap_only {
+                texels.push(pack(light.map(|l| l.min(255) as u8)));
+                continue;
+            }
             let idx = tex.index_at(mip, s0 + u as i32, t0 + v as i32);
             texels.push(if holes && idx == FENCE_TRANSPARENT_INDEX {
                 TRANSPARENT
@@ -436,6 +447,30 @@ mod tests {
         }
         let (bright, idx, palette) = texel(unlit_map, 1);
         assert_eq!(bright, palette.shade(idx, [UNLIT_MAP_LIGHT; 3]));
+    }
+
+    #[test]
+    fn lightmap_only_shows_the_light_without_the_texture() {
+        let mut world = room(0);
+        world.lightmap_only = true;
+        let s = world.surfaces[2].as_ref().expect("wall");
+        let lit = build_lit_surface(&world, s, 0, &LightStyles::default());
+        let l0 = world.light[s.light.expect("lit")][0] as u8;
+        assert_eq!(lit.texels[0], pack([l0; 3]));
+    }
+
+    #[test]
+    fn hdr_light_past_255_shades_to_white_without_overflow() {
+        let mut world = room(0);
+        let s = world.surfaces[2].clone().expect("wall");
+        let ofs = s.light.expect("lit");
+        world.light[ofs] = [u16::MAX; 3];
+        let lit = build_lit_surface(&world, &s, 0, &LightStyles::default());
+        let idx = world.textures[0].index_at(0, s.extents.tex_mins[0], s.extents.tex_mins[1]);
+        assert_eq!(
+            lit.texels[0],
+            world.palette.shade(idx, [MAX_SHADED_LIGHT; 3])
+        );
     }
 
     #[test]
