@@ -161,11 +161,57 @@ fn subdivide_zero_leaves_faces_whole() {
         },
     );
     assert!(faces_with_texture(&cut, "floor") > 2);
+    let wide = |out: &[bsp_compiler::Warning]| {
+        out.iter()
+            .filter(|w| matches!(w, bsp_compiler::Warning::WideFaces { .. }))
+            .map(ToString::to_string)
+            .collect::<Vec<_>>()
+    };
+    assert!(wide(&compile_text(&text).warnings).is_empty());
+    let unsubdivided = try_compile_with(
+        &text,
+        &CompileOptions {
+            subdivide: 0.0,
+            fill: false,
+            ..CompileOptions::default()
+        },
+    )
+    .expect("compiles");
+    let said = wide(&unsubdivided.warnings);
+    assert_eq!(said.len(), 1, "{said:?}");
+    assert!(
+        said[0].contains("widest 1024") && said[0].contains("WinQuake"),
+        "{}",
+        said[0]
+    );
     // Top and bottom of the floor, each side, one face each.
     assert!(
         faces_with_texture(&whole, "floor") <= 6,
         "{}",
         faces_with_texture(&whole, "floor")
+    );
+}
+
+#[test]
+fn nosubdivide_refuses_a_face_too_wide_for_quakespasm_naming_the_engines() {
+    let text = format!(
+        "{{\n\"classname\" \"worldspawn\"\n{}{}}}\n{{\n\"classname\" \"info_player_start\"\n\"origin\" \"0 0 32\"\n}}\n",
+        box_brush([-1536.0, -64.0, -16.0], [1536.0, 64.0, 0.0], "floor"),
+        box_brush([-1536.0, -64.0, 128.0], [1536.0, 64.0, 144.0], "ceiling"),
+    );
+    let options = CompileOptions {
+        subdivide: 0.0,
+        fill: false,
+        ..CompileOptions::default()
+    };
+    let refused = try_compile_with(&text, &options)
+        .expect_err("a 3072-texel face is refused")
+        .to_string();
+    assert!(
+        refused.contains("surface-extents")
+            && refused.contains("3072")
+            && refused.contains("QuakeSpasm"),
+        "{refused}"
     );
 }
 
