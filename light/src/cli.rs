@@ -136,24 +136,29 @@ fn setting_arg(s: &'static Setting) -> Option<Arg> {
 
 /// Options whose value may be left out (`--bounce [N]`, `--soft [N]`, ericw-tools' spelling)
 /// take a following number as their value: `--bounce 2` becomes `--bounce=2`, while `--bounce
-/// map.bsp` leaves the BSP as the positional argument.
+/// map.bsp` leaves the BSP as the positional argument. Options of several numbers take up to
+/// that many: `--lightgrid_dist 16 16 32` becomes `--lightgrid_dist=16 16 32`.
 pub fn join_optional_values(args: impl IntoIterator<Item = String>) -> Vec<String> {
-    let optional: Vec<String> = TABLE
+    let joining: Vec<(String, usize)> = TABLE
         .iter()
-        .filter(|s| s.missing.is_some())
-        .filter_map(|s| Some(format!("--{}", s.flag?)))
+        .filter(|s| s.missing.is_some() || s.words > 1)
+        .filter_map(|s| Some((format!("--{}", s.flag?), s.words)))
         .collect();
     let mut out: Vec<String> = Vec::new();
+    // Numbers the last option may still take.
+    let mut open = 0;
     for a in args {
-        let joins = out.last().is_some_and(|prev| optional.contains(prev))
-            && !a.is_empty()
-            && a.chars().all(|c| c.is_ascii_digit());
+        let number = !a.is_empty() && a.chars().all(|c| c.is_ascii_digit() || c == '.');
         match out.last_mut() {
-            Some(prev) if joins => {
-                prev.push('=');
+            Some(prev) if open > 0 && number => {
+                prev.push(if prev.contains('=') { ' ' } else { '=' });
                 prev.push_str(&a);
+                open -= 1;
             }
-            _ => out.push(a),
+            _ => {
+                open = joining.iter().find(|(f, _)| *f == a).map_or(0, |(_, n)| *n);
+                out.push(a);
+            }
         }
     }
     out
@@ -575,5 +580,13 @@ mod tests {
         assert_eq!(joined, strings(&["light", "--bounce=2", "x.bsp"]));
         let alone = join_optional_values(strings(&["light", "--bounce", "x.bsp", "--soft"]));
         assert_eq!(alone, strings(&["light", "--bounce", "x.bsp", "--soft"]));
+        let three = strings(&["light", "--lightgrid_dist", "16", "16", "32", "2", "x.bsp"]);
+        let three = join_optional_values(three);
+        assert_eq!(
+            three,
+            strings(&["light", "--lightgrid_dist=16 16 32", "2", "x.bsp"])
+        );
+        let one = join_optional_values(strings(&["light", "--lightgrid_dist", "24.5", "x.bsp"]));
+        assert_eq!(one, strings(&["light", "--lightgrid_dist=24.5", "x.bsp"]));
     }
 }

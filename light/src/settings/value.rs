@@ -10,6 +10,10 @@ pub trait SettingValue: Clone + Sized {
     /// The setting is a switch: its flag takes no value and turns it on.
     const SWITCH: bool = false;
 
+    /// Numbers a flag's value may be given as, each its own argument (ericw-tools'
+    /// `-lightgrid_dist 16 16 32`).
+    const WORDS: usize = 1;
+
     /// What `text` (a key's value or a flag's argument) says; `None` for a blank value, which
     /// counts as absent; `Err` names what was expected.
     fn read(text: &str) -> Option<Result<Self, &'static str>>;
@@ -178,6 +182,8 @@ impl Spacing {
 }
 
 impl SettingValue for Spacing {
+    const WORDS: usize = 3;
+
     fn read(text: &str) -> Option<Result<Spacing, &'static str>> {
         const WANT: &str = "one or three numbers, each at least 1";
         let parts: Vec<&str> = text.split_whitespace().collect();
