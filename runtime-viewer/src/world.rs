@@ -2,14 +2,14 @@
 //! lightmap rectangles, textures, the palette, lightmaps as RGB, node/leaf parents, and brush
 //! models cut into the world's leaves so they sort with the world.
 
-use glam::{DVec3, Vec3};
+use glam::{DMat3, DVec3, Vec3};
 use std::path::Path;
 
 use quake_formats::Bsp;
 use quake_formats::bsp::light_lumps::{LIGHTING_E5BGR9, RGBLIGHTING};
 use quake_formats::bsp::{contents, limits::MAX_LIGHTMAPS, texinfo_flags};
 use quake_formats::entities::{Entity, parse_entities};
-use quake_formats::extents::LightmapExtents;
+use quake_formats::extents::{LightmapExtents, LuxelGrid};
 use quake_formats::geom::{Plane, Split, Winding};
 use quake_formats::lit::{LitData, unpack_e5bgr9};
 use quake_formats::palette::Palette;
@@ -46,6 +46,49 @@ pub struct Surface {
     pub styles: [u8; MAX_LIGHTMAPS],
     /// First luxel in [`World::light`], when the face has a complete lightmap.
     pub light: Option<usize>,
+    /// The lightmap's own grid when it is not Quake's 16 texels over `extents` (`DECOUPLED_LM`,
+    /// `LMSHIFT`).
+    pub free_lightmap: Option<FreeLightmap>,
+}
+
+/// A lightmap on a grid of its own: the grid, and the point of the face's plane (in model space,
+/// where the grid's projection works) at texture coordinates (s, t): `at + s * per_s + t * per_t`.
+#[derive(Debug, Clone)]
+pub struct FreeLightmap {
+    pub grid: LuxelGrid,
+    pub at: DVec3,
+    pub per_s: DVec3,
+    pub per_t: DVec3,
+}
+
+impl FreeLightmap {
+    /// `grid` on a face of texture projection `vecs` and plane `normal · p = dist`; `None` when
+    /// the grid is empty or the projection runs along the plane (no point has a texture
+    /// coordinate).
+    fn new(grid: LuxelGrid, vecs: &[[f32; 4]; 2], normal: DVec3, dist: f64) -> Option<Self> {
+        if grid.luxel_count() == 0 {
+            return None;
+        }
+        let row = |v: [f32; 4]| DVec3::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2]));
+        let rows = DMat3::from_cols(row(vecs[0]), row(vecs[1]), normal).transpose();
+        if rows.determinant().abs() < 1e-9 {
+            return None;
+        }
+        let inverse = rows.inverse();
+        let offsets = DVec3::new(-f64::from(vecs[0][3]), -f64::from(vecs[1][3]), dist);
+        Some(FreeLightmap {
+            grid,
+            at: inverse * offsets,
+            per_s: inverse.x_axis,
+            per_t: inverse.y_axis,
+        })
+    }
+
+    /// Continuous luxel coordinates of texture coordinates (s, t).
+    pub fn luxel_at(&self, s: f64, t: f64) -> [f64; 2] {
+        self.grid
+            .luxel_at((self.at + self.per_s * s + self.per_t * t).to_array())
+    }
 }
 
 impl Surface {
@@ -55,6 +98,13 @@ impl Surface {
             self.s_axis.dot(p) + self.s_offset,
             self.t_axis.dot(p) + self.t_offset,
         )
+    }
+
+    /// Luxels across and down its lightmap.
+    pub fn luxel_size(&self) -> [usize; 2] {
+        self.free_lightmap
+            .as_ref()
+            .map_or_else(|| self.extents.luxel_size(), |f| f.grid.size)
     }
 
     /// How many lightmaps the face has: its styles before the first [`NO_STYLE`].
@@ -282,10 +332,15 @@ impl World {
             }
         }
 
+        let layouts = lightmap_layouts(&bsp);
         let surfaces: Vec<Option<Surface>> = (0..bsp.faces.len())
             .map(|f| {
                 let origin = face_origin[f].map_or(DVec3::ZERO, |(_, o)| o);
-                build_surface(&bsp, f, origin, &textures, fallback_texture, light.len())
+                let lightmap = Lightmap {
+                    layout: layouts.as_ref().and_then(|l| l.get(f).copied().flatten()),
+                    luxels: light.len(),
+                };
+                build_surface(&bsp, f, origin, &textures, fallback_texture, lightmap)
             })
             .collect();
         stats.drawable_faces = surfaces.iter().flatten().count();
@@ -394,13 +449,45 @@ impl World {
     }
 }
 
+/// Per face, the grid and first luxel of its lightmap when the BSP gives it one of its own: from
+/// `DECOUPLED_LM`, else from `LMSHIFT` (and `LMOFFSET`, else the face's light offset); `None`
+/// when neither lump is there (or reads).
+fn lightmap_layouts(bsp: &Bsp) -> Option<Vec<Option<(LuxelGrid, i32)>>> {
+    if let Ok(Some(records)) = bsp.decoupled_lightmaps() {
+        return Some(records.iter().map(|r| Some((r.grid(), r.offset))).collect());
+    }
+    let shifts = bsp.lightmap_shifts().ok()??;
+    let offsets = bsp.lightmap_offsets().ok()?;
+    let layouts = bsp
+        .faces
+        .iter()
+        .zip(&shifts)
+        .enumerate()
+        .map(|(i, (f, &shift))| {
+            let points = bsp.face_vertices(f)?;
+            let tex = bsp.texinfo.get(f.texinfo as usize)?;
+            let grid = LuxelGrid::shifted(&points, &tex.vecs, shift)?;
+            let offset = offsets.as_ref().map_or(f.light_offset, |o| o[i]);
+            Some((grid, offset))
+        })
+        .collect();
+    Some(layouts)
+}
+
+/// Where a face's lightmap lies: its own grid and first luxel, if the BSP gives it one, and the
+/// luxels of light there are.
+struct Lightmap {
+    layout: Option<(LuxelGrid, i32)>,
+    luxels: usize,
+}
+
 fn build_surface(
     bsp: &Bsp,
     f: usize,
     origin: DVec3,
     textures: &[Texture],
     fallback_texture: usize,
-    light_len: usize,
+    lightmap: Lightmap,
 ) -> Option<Surface> {
     let face = &bsp.faces[f];
     let raw_points = bsp.face_vertices(face)?;
@@ -425,9 +512,19 @@ fn build_surface(
     let kind = textures[texture].kind(ti.flags & texinfo_flags::SPECIAL != 0);
     let styles = face.styles;
     let styles_used = styles.iter().take_while(|&&s| s != NO_STYLE).count();
-    let light = usize::try_from(face.light_offset)
+    let model_normal = Vec3::from(bp.normal).as_dvec3();
+    let free_lightmap = lightmap
+        .layout
+        .as_ref()
+        .and_then(|(grid, _)| FreeLightmap::new(*grid, &ti.vecs, model_normal, f64::from(bp.dist)));
+    let (offset, count) = match (&lightmap.layout, &free_lightmap) {
+        (Some((_, offset)), Some(free)) => (*offset, free.grid.luxel_count()),
+        (Some(_), None) => (-1, 0),
+        (None, _) => (face.light_offset, extents.luxel_count()),
+    };
+    let light = usize::try_from(offset)
         .ok()
-        .filter(|&ofs| styles_used > 0 && ofs + styles_used * extents.luxel_count() <= light_len);
+        .filter(|&ofs| styles_used > 0 && ofs + styles_used * count <= lightmap.luxels);
     Some(Surface {
         plane,
         points: raw_points
@@ -443,6 +540,7 @@ fn build_surface(
         extents,
         styles,
         light,
+        free_lightmap,
     })
 }
 
