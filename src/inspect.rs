@@ -3,6 +3,7 @@
 use anyhow::{Context, Result, bail};
 use quake_formats::bsp::{LUMP_NAMES, Rule};
 use quake_formats::fsutil::{read_file, write_atomic};
+use quake_formats::lit::LitData;
 use quake_formats::wad::Wad;
 use quake_formats::{Bsp, BspVersion, Problem, Severity, validate};
 use std::collections::BTreeMap;
@@ -99,7 +100,7 @@ fn print_counts(bsp: &Bsp) {
         println!("  {name:<13} {count:>9}{unit}");
     }
     for lump in &bsp.bspx {
-        println!("  BSPX {:<8} {:>9} bytes", lump.name(), lump.data.len());
+        println!("  BSPX {:<16} {:>9} bytes", lump.name(), lump.data.len());
     }
     let entities = quake_formats::entities::parse_entities(&bsp.entity_text()).unwrap_or_default();
     println!(
@@ -116,8 +117,16 @@ fn print_lit_beside(file: &Path, bsp: &Bsp) -> Result<()> {
         return Ok(());
     }
     let data = read_file(&path)?;
-    let rgb = match quake_formats::lit::read_lit(&data, bsp.lighting.len()) {
-        Ok(rgb) => rgb,
+    let rgb = match quake_formats::lit::read_any_lit(&data, bsp.luxel_count()) {
+        Ok(LitData::Rgb(rgb)) => rgb,
+        Ok(LitData::Hdr(words)) => {
+            println!(
+                "{}: {} luxels of HDR colour (E5BGR9; FTE reads it)",
+                path.display(),
+                words.len()
+            );
+            return Ok(());
+        }
         Err(e) => {
             println!("warning: {}: {e}; engines ignore it", path.display());
             return Ok(());

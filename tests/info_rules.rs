@@ -6,6 +6,8 @@
 mod command;
 
 use command::slipgate;
+use quake_formats::bsp::light_lumps::{DecoupledLightmap, LMSHIFT, RGBLIGHTING};
+use quake_formats::bsp::lightgrid::LIGHTGRID_OCTREE;
 use quake_formats::bsp::{BspPlane, ClipNode, Node, Rule, contents, texinfo_flags};
 use quake_formats::entities::{parse_entities, write_entities};
 use quake_formats::extents::LightmapExtents;
@@ -196,7 +198,56 @@ fn breakers() -> Vec<(Rule, Break)> {
         (Rule::Worldspawn, Model(no_worldspawn)),
         (Rule::WorldspawnFirst, Model(worldspawn_last)),
         (Rule::PlayerStart, Model(no_player_start)),
+        (
+            Rule::BspxLightSize,
+            Model(|b| b.set_bspx_lump(RGBLIGHTING, vec![0; 3 * b.luxel_count() + 1])),
+        ),
+        (
+            Rule::BspxFaceRecords,
+            Model(|b| b.set_bspx_lump(LMSHIFT, vec![4; b.faces.len() - 1])),
+        ),
+        (Rule::ShiftedLightmap, Model(shift_past_30)),
+        (
+            Rule::DecoupledLightmap,
+            Model(decoupled_projection_not_finite),
+        ),
+        (
+            Rule::LightGrid,
+            Model(|b| b.set_bspx_lump(LIGHTGRID_OCTREE, vec![1, 2, 3])),
+        ),
+        (Rule::NoVanillaLighting, Model(colour_without_grey)),
     ]
+}
+
+/// Every face's `LMSHIFT` 31 (no engine holds `1 << 31`), its `LMOFFSET` the first luxel.
+fn shift_past_30(b: &mut Bsp) {
+    let n = b.faces.len();
+    b.set_shifted_lightmaps(&vec![31; n], &vec![0; n]);
+}
+
+/// A `DECOUPLED_LM` record per face, the first with a NaN in its projection.
+fn decoupled_projection_not_finite(b: &mut Bsp) {
+    let mut records = vec![
+        DecoupledLightmap {
+            width: 1,
+            height: 1,
+            offset: -1,
+            world_to_luxel: [[0.0; 4]; 2],
+        };
+        b.faces.len()
+    ];
+    records[0].world_to_luxel[0][0] = f32::NAN;
+    b.set_decoupled_lightmaps(&records);
+}
+
+/// One luxel of `RGBLIGHTING` and no grey lump (`-novanilla`), no face lit.
+fn colour_without_grey(b: &mut Bsp) {
+    for f in &mut b.faces {
+        f.light_offset = -1;
+        f.styles = [255; 4];
+    }
+    b.lighting.clear();
+    b.set_bspx_lump(RGBLIGHTING, vec![200, 100, 0]);
 }
 
 /// A BSP29 vertex lump of 65537 vertices, past 16-bit edge indices: our writer refuses it, so

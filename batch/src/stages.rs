@@ -129,10 +129,13 @@ fn run_stages(ctx: &Context, job: &MapJob, outcome: &mut MapOutcome) -> StageRes
         ("bsp", bsp_bytes),
         ("prt", blob(ctx, "bsp", &compiled, "prt")?),
     ];
-    if lit.outputs.contains_key("lit") {
-        outputs.push(("lit", blob(ctx, "light", &lit, "lit")?));
-    } else {
-        remove_stale(&job.output(ctx.output_dir, "lit")).map_err(fail("light"))?;
+    // Light's companion files: each written when light made it, else an old one removed.
+    for extension in ["lit", "lux"] {
+        if lit.outputs.contains_key(extension) {
+            outputs.push((extension, blob(ctx, "light", &lit, extension)?));
+        } else {
+            remove_stale(&job.output(ctx.output_dir, extension)).map_err(fail("light"))?;
+        }
     }
     for (extension, bytes) in &outputs {
         put_output(ctx, job, extension, bytes, &mut outcome.outputs).map_err(fail("light"))?;
@@ -471,10 +474,15 @@ fn light_stage(
             None => light::compute_lighting(&bsp, &options),
         }
         .map_err(|e| e.to_string())?;
-        let coloured = light::apply_lighting(&mut bsp, &lighting);
-        let lit = args.lit_to_write(&bsp, coloured);
+        let files = light::apply_lighting(&mut bsp, &lighting);
+        let companions = args.companion_files(&bsp, files);
         let mut outputs = vec![("bsp", bsp.write().map_err(|e| e.to_string())?)];
-        outputs.extend(lit.map(|bytes| ("lit", bytes)));
+        outputs.extend(
+            companions
+                .by_extension()
+                .into_iter()
+                .filter_map(|(extension, bytes)| Some((extension, bytes?))),
+        );
         let s = &lighting.stats;
         Ok(Product {
             outputs,

@@ -256,7 +256,10 @@ impl Args {
 /// The compiler's options whose value is optional (`-litwater`, `-litwater 0`): a following
 /// number is their value, anything else is left as the next argument.
 pub fn join_optional_values(args: impl IntoIterator<Item = String>) -> Vec<String> {
-    quake_formats::cli::join_optional_values(args, &["--filldetail", "--litwater", "--splitturb"])
+    quake_formats::cli::join_optional_values(
+        args,
+        &[("--filldetail", 1), ("--litwater", 1), ("--splitturb", 1)],
+    )
 }
 
 /// `--maxedges`: 0 (no limit) or a face of at least a triangle.
@@ -327,7 +330,9 @@ pub fn run(args: &Args) -> Result<Option<crate::CompileStats>> {
     }
     if let Some(n) = args.threads {
         // Fails only when a pool already runs (a caller chose its threads): keep that one.
-        let _ = rayon::ThreadPoolBuilder::new().num_threads(n).build_global();
+        let _ = rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global();
     }
     let source = MapSource::read(&args.input)?;
     let bsp_path = args

@@ -23,7 +23,10 @@ use crate::texinfo::Projection;
 use crate::tree::SplitHeuristic;
 use crate::wad_lookup::{WadSearch, WadSet};
 use crate::warnings::Warning;
+use quake_formats::bsp::limits::MAX_SURFACE_EXTENT;
+use quake_formats::bsp::texinfo_flags;
 use quake_formats::entities::Entity;
+use quake_formats::extents::LightmapExtents;
 use quake_formats::geom::Plane;
 use quake_formats::prt::PortalFile;
 use quake_formats::{Bsp, BspVersion, FormatError};
@@ -240,6 +243,7 @@ pub fn compile(
         });
         bsp.version = BspVersion::Bsp2;
     }
+    warnings.extend(wide_faces(&bsp));
     timings.push(("emit".to_string(), t.elapsed().as_secs_f64()));
     timings.push(("total".to_string(), total.elapsed().as_secs_f64()));
     stats.add_output(&bsp, &emitted.portals, emitted.tjunction_vertices);
@@ -255,6 +259,29 @@ pub fn compile(
         leak,
         warnings,
         stats,
+    })
+}
+
+/// The faces without `TEX_SPECIAL` wider than WinQuake accepts, when there are any (faces too
+/// wide for QuakeSpasm's family are refused by `check_usable` after).
+fn wide_faces(bsp: &Bsp) -> Option<Warning> {
+    let widths: Vec<i32> = bsp
+        .faces
+        .iter()
+        .filter_map(|f| {
+            let tex = bsp.texinfo.get(f.texinfo as usize)?;
+            if tex.flags & texinfo_flags::SPECIAL != 0 {
+                return None;
+            }
+            let ext = LightmapExtents::from_points(&bsp.face_vertices(f)?, &tex.vecs);
+            Some(ext.extents[0].max(ext.extents[1]))
+        })
+        .filter(|&w| w > MAX_SURFACE_EXTENT)
+        .collect();
+    let widest = *widths.iter().max()?;
+    Some(Warning::WideFaces {
+        faces: widths.len(),
+        widest,
     })
 }
 

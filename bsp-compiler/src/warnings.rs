@@ -4,6 +4,9 @@ use crate::editor::OmittedLayer;
 use crate::leak::LeakReport;
 use crate::texinfo::FaceContents;
 use glam::DVec3;
+use quake_formats::bsp::limits::{
+    GLQUAKE_MAX_SURFACE_EXTENT, MAX_SURFACE_EXTENT, QUAKESPASM_MAX_SURFACE_EXTENT,
+};
 
 use std::path::PathBuf;
 
@@ -80,6 +83,12 @@ pub enum Warning {
     EmptyBrushEntity {
         entity: usize,
         classname: String,
+    },
+    /// Faces without `TEX_SPECIAL` wider than WinQuake's limit (only with subdivision off or
+    /// coarser than it): `faces` of them, the widest spanning `widest` texels.
+    WideFaces {
+        faces: usize,
+        widest: i32,
     },
     /// Something the compiler does not do yet; the map compiles without it.
     Unsupported {
@@ -196,6 +205,13 @@ impl std::fmt::Display for Warning {
             Warning::EmptyBrushEntity { entity, classname } => {
                 write!(f, "entity {entity} ({classname}) has no usable brushes")
             }
+            Warning::WideFaces { faces, widest } => write!(
+                f,
+                "{faces} faces span more than {MAX_SURFACE_EXTENT} texels (the widest \
+                 {widest}): WinQuake refuses the map with \"Bad surface extents\" (GLQuake \
+                 above {GLQUAKE_MAX_SURFACE_EXTENT}); QuakeSpasm, vkQuake and Ironwail take up \
+                 to {QUAKESPASM_MAX_SURFACE_EXTENT}"
+            ),
             Warning::Unsupported { what } => write!(f, "not supported yet: {what}"),
         }
     }

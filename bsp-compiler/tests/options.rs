@@ -161,11 +161,57 @@ fn subdivide_zero_leaves_faces_whole() {
         },
     );
     assert!(faces_with_texture(&cut, "floor") > 2);
+    let wide = |out: &[bsp_compiler::Warning]| {
+        out.iter()
+            .filter(|w| matches!(w, bsp_compiler::Warning::WideFaces { .. }))
+            .map(ToString::to_string)
+            .collect::<Vec<_>>()
+    };
+    assert!(wide(&compile_text(&text).warnings).is_empty());
+    let unsubdivided = try_compile_with(
+        &text,
+        &CompileOptions {
+            subdivide: 0.0,
+            fill: false,
+            ..CompileOptions::default()
+        },
+    )
+    .expect("compiles");
+    let said = wide(&unsubdivided.warnings);
+    assert_eq!(said.len(), 1, "{said:?}");
+    assert!(
+        said[0].contains("widest 1024") && said[0].contains("WinQuake"),
+        "{}",
+        said[0]
+    );
     // Top and bottom of the floor, each side, one face each.
     assert!(
         faces_with_texture(&whole, "floor") <= 6,
         "{}",
         faces_with_texture(&whole, "floor")
+    );
+}
+
+#[test]
+fn nosubdivide_refuses_a_face_too_wide_for_quakespasm_naming_the_engines() {
+    let text = format!(
+        "{{\n\"classname\" \"worldspawn\"\n{}{}}}\n{{\n\"classname\" \"info_player_start\"\n\"origin\" \"0 0 32\"\n}}\n",
+        box_brush([-1536.0, -64.0, -16.0], [1536.0, 64.0, 0.0], "floor"),
+        box_brush([-1536.0, -64.0, 128.0], [1536.0, 64.0, 144.0], "ceiling"),
+    );
+    let options = CompileOptions {
+        subdivide: 0.0,
+        fill: false,
+        ..CompileOptions::default()
+    };
+    let refused = try_compile_with(&text, &options)
+        .expect_err("a 3072-texel face is refused")
+        .to_string();
+    assert!(
+        refused.contains("surface-extents")
+            && refused.contains("3072")
+            && refused.contains("QuakeSpasm"),
+        "{refused}"
     );
 }
 
@@ -539,9 +585,8 @@ fn bmodelcontents_keeps_a_brush_models_liquids() {
 fn parsed_args(args: &[&str]) -> bsp_compiler::cli::Args {
     use clap::Parser;
     let words = ["bsp"].iter().chain(args).map(|s| s.to_string());
-    let words = bsp_compiler::cli::join_optional_values(quake_formats::cli::normalise_single_dash(
-        words,
-    ));
+    let words =
+        bsp_compiler::cli::join_optional_values(quake_formats::cli::normalise_single_dash(words));
     BspCli::try_parse_from(words).expect("parses").args
 }
 
@@ -551,14 +596,32 @@ fn parsed_args(args: &[&str]) -> bsp_compiler::cli::Args {
 #[test]
 fn ericw_tools_only_options_are_accepted_with_a_note() {
     let args = parsed_args(&[
-        "-nopercent", "-verbose", "-nolog", "-tjunc", "mwt", "-splitsky", "-chop", "-threads",
-        "2", "-lowpriority", "x.map",
+        "-nopercent",
+        "-verbose",
+        "-nolog",
+        "-tjunc",
+        "mwt",
+        "-splitsky",
+        "-chop",
+        "-threads",
+        "2",
+        "-lowpriority",
+        "x.map",
     ]);
     let notes = args.ericw_only.notes();
     assert_eq!(notes.len(), 7, "{notes:?}");
-    for name in ["-nopercent", "-verbose", "-nolog", "-tjunc", "-splitsky", "-chop"] {
+    for name in [
+        "-nopercent",
+        "-verbose",
+        "-nolog",
+        "-tjunc",
+        "-splitsky",
+        "-chop",
+    ] {
         assert!(
-            notes.iter().any(|n| n.starts_with(&format!("{name} has no effect"))),
+            notes
+                .iter()
+                .any(|n| n.starts_with(&format!("{name} has no effect"))),
             "{name}: {notes:?}"
         );
     }

@@ -11,7 +11,7 @@ use quake_formats::fsutil::{Staged, read_file, write_atomic};
 use quake_formats::palette::Palette;
 
 use crate::settings::{Overrides, Setting, TABLE};
-use crate::{Lighting, Options, Quality, compare_with_reference, compute_lighting};
+use crate::{LightFiles, Lighting, Options, Quality, compare_with_reference, compute_lighting};
 
 /// Light a BSP: compute lightmaps from its light entities.
 #[derive(clap::Args, Debug, Clone)]
@@ -134,17 +134,33 @@ fn setting_arg(s: &'static Setting) -> Option<Arg> {
     Some(arg)
 }
 
-/// Light's options whose value may be left out (`--bounce [N]`, `--soft [N]`, ericw-tools' spelling)
-/// take a following number as their value: `--bounce 2` becomes `--bounce=2`, while `--bounce
-/// map.bsp` leaves the BSP as the positional argument.
+/// Light's options whose value may be left out (`--bounce [N]`, `--soft [N]`) or is several
+/// numbers (`--lightgrid_dist 16 16 32`) take the numbers that follow them
+/// ([`quake_formats::cli::join_optional_values`]).
 pub fn join_optional_values(args: impl IntoIterator<Item = String>) -> Vec<String> {
-    let optional: Vec<String> = TABLE
+    let joining: Vec<(String, usize)> = TABLE
         .iter()
-        .filter(|s| s.missing.is_some())
-        .filter_map(|s| Some(format!("--{}", s.flag?)))
+        .filter(|s| s.missing.is_some() || s.words > 1)
+        .filter_map(|s| Some((format!("--{}", s.flag?), s.words)))
         .collect();
-    let optional: Vec<&str> = optional.iter().map(String::as_str).collect();
-    quake_formats::cli::join_optional_values(args, &optional)
+    let joining: Vec<(&str, usize)> = joining.iter().map(|(f, n)| (f.as_str(), *n)).collect();
+    quake_formats::cli::join_optional_values(args, &joining)
+}
+
+/// The files written beside a lit BSP, each `None` when there is none (and an old one goes).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Companions {
+    /// The `.lit`.
+    pub lit: Option<Vec<u8>>,
+    /// The `.lux`.
+    pub lux: Option<Vec<u8>>,
+}
+
+impl Companions {
+    /// Each companion's file extension and bytes (`None`: not written).
+    pub fn by_extension(self) -> [(&'static str, Option<Vec<u8>>); 2] {
+        [("lit", self.lit), ("lux", self.lux)]
+    }
 }
 
 /// Whether to write a `.lit` file beside the lit BSP.
@@ -181,13 +197,20 @@ impl Args {
         })
     }
 
-    /// The `.lit` to write beside `bsp`, which [`crate::apply_lighting`] just lit and which
-    /// returned `coloured` (`--lit` and `--nolit` decide; `None`: no `.lit`).
-    pub fn lit_to_write(&self, bsp: &Bsp, coloured: Option<Vec<u8>>) -> Option<Vec<u8>> {
-        match self.lit_file() {
-            LitFile::WhenColoured => coloured,
-            LitFile::Always => coloured.or_else(|| Some(crate::grey_lit(&bsp.lighting))),
+    /// The files to write beside `bsp`, which [`crate::apply_lighting`] just lit and which
+    /// returned `files`: the `.lit` as `--lit` and `--nolit` decide, and the `.lux`.
+    pub fn companion_files(&self, bsp: &Bsp, files: LightFiles) -> Companions {
+        let lit = match self.lit_file() {
+            LitFile::WhenColoured => files.lit,
+            LitFile::Always => files
+                .lit
+                .or(files.rgb_lit)
+                .or_else(|| Some(crate::grey_lit(&bsp.lighting))),
             LitFile::Never => None,
+        };
+        Companions {
+            lit,
+            lux: files.lux,
         }
     }
 
@@ -200,10 +223,6 @@ impl Args {
             LitFile::WhenColoured
         }
     }
-}
-
-fn lit_path(bsp: &Path) -> PathBuf {
-    bsp.with_extension("lit")
 }
 
 /// The palette `--palette` names, else `gfx/palette.lmp` in the BSP's folder or up to three
@@ -256,10 +275,10 @@ fn run_with_current_threads(args: &Args) -> anyhow::Result<Option<crate::Stats>>
 
     let extra = measurements(args, &bsp, &options, &lighting)?;
 
-    let lit = crate::apply_lighting(&mut bsp, &lighting);
-    let lit = args.lit_to_write(&bsp, lit);
+    let files = crate::apply_lighting(&mut bsp, &lighting);
+    let companions = args.companion_files(&bsp, files);
     let out = args.output.as_ref().unwrap_or(path);
-    place_lit_pair(out, &bsp.write()?, lit)?;
+    place_with_companions(out, &bsp.write()?, companions)?;
     if let Some(stats_path) = &args.stats {
         let mut json = serde_json::to_value(&lighting.stats)?;
         if let serde_json::Value::Object(map) = &mut json {
@@ -347,9 +366,20 @@ fn print_summary(lighting: &Lighting) {
         s.seconds_setup,
         s.rays_per_second / 1e6
     );
+    if s.grid_points > 0 {
+        eprintln!(
+            "light: light grid: {} points ({} in the open), {} rays in {:.2} s",
+            s.grid_points, s.grid_points_open, s.grid_rays, s.seconds_lightgrid
+        );
+    }
     if s.fullbright {
         eprintln!(
             "light: no lights, suns or minlight: lighting lump left empty (engines draw the map fullbright)"
+        );
+    }
+    if !lighting.outputs.grey_lump && !s.fullbright {
+        eprintln!(
+            "light: warning: --novanilla: no grey lighting lump; engines without BSPX RGBLIGHTING (vanilla Quake, DarkPlaces, QuakeSpasm before 0.96) draw this map unlit"
         );
     }
     if s.faces_with_dropped_styles > 0 {
@@ -360,59 +390,74 @@ fn print_summary(lighting: &Lighting) {
     }
 }
 
-/// One step of putting a lit BSP and its `.lit` in place.
+/// One step of putting a lit BSP and its companions (`.lit`, `.lux`) in place.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum PairStep {
-    RemoveOldLit,
+    RemoveOldCompanions,
     PlaceBsp,
-    PlaceLit,
+    PlaceCompanions,
 }
 
-/// Engines take a `.lit` whose size is three times the BSP's lighting lump (QuakeSpasm and
-/// DarkPlaces check only that; older engines not even that), so an old `.lit` beside the new BSP
-/// would paint the old light's colours over it. The old `.lit` goes before the new BSP arrives and
-/// the new one after: a kill between any two steps leaves a BSP with its own `.lit` or with none.
+/// Engines take a `.lit` (or `.lux`) whose size is three times the BSP's lighting lump
+/// (QuakeSpasm and DarkPlaces check only that; older engines not even that), so an old one beside
+/// the new BSP would paint the old light's colours over it. The old companions go before the new
+/// BSP arrives and the new ones after: a kill between any two steps leaves a BSP with its own
+/// companions or with none.
 const PAIR_ORDER: [PairStep; 3] = [
-    PairStep::RemoveOldLit,
+    PairStep::RemoveOldCompanions,
     PairStep::PlaceBsp,
-    PairStep::PlaceLit,
+    PairStep::PlaceCompanions,
 ];
 
-/// Puts the lit BSP at `out` and its `.lit` (or none) beside it in [`PAIR_ORDER`], after both are
-/// written in full under temporary names (failing to write either leaves the old pair untouched).
-fn place_lit_pair(out: &Path, bsp: &[u8], lit: Option<Vec<u8>>) -> anyhow::Result<()> {
-    let lit_file = lit_path(out);
+/// Puts the lit BSP at `out` and its companions (or none) beside it in [`PAIR_ORDER`], after all
+/// are written in full under temporary names (failing to write any leaves the old files
+/// untouched).
+fn place_with_companions(out: &Path, bsp: &[u8], companions: Companions) -> anyhow::Result<()> {
     let mut staged_bsp = Some(Staged::write(out, bsp)?);
-    let mut staged_lit = lit
-        .map(|bytes| Staged::write(&lit_file, &bytes))
-        .transpose()?;
+    let mut staged = Vec::new();
+    let mut unwanted = Vec::new();
+    for (extension, bytes) in companions.by_extension() {
+        let path = out.with_extension(extension);
+        match bytes {
+            Some(bytes) => staged.push(Staged::write(&path, &bytes)?),
+            None => unwanted.push(path),
+        }
+    }
     for step in PAIR_ORDER {
-        let staged = match step {
-            PairStep::RemoveOldLit => {
-                remove_old_lit(&lit_file, staged_lit.is_none())?;
-                None
+        match step {
+            PairStep::RemoveOldCompanions => {
+                for s in &staged {
+                    remove_old_companion(s.target(), false)?;
+                }
+                for path in &unwanted {
+                    remove_old_companion(path, true)?;
+                }
             }
-            PairStep::PlaceBsp => staged_bsp.take(),
-            PairStep::PlaceLit => staged_lit.take(),
-        };
-        if let Some(staged) = staged {
-            staged.commit()?;
+            PairStep::PlaceBsp => {
+                if let Some(bsp) = staged_bsp.take() {
+                    bsp.commit()?;
+                }
+            }
+            PairStep::PlaceCompanions => {
+                for s in staged.drain(..) {
+                    s.commit()?;
+                }
+            }
         }
     }
     Ok(())
 }
 
-/// Removes a `.lit` left from an earlier run, saying so when no new one replaces it.
-fn remove_old_lit(lit_file: &Path, none_wanted: bool) -> anyhow::Result<()> {
-    if !lit_file.exists() {
+/// Removes a companion file left from an earlier run, saying so when no new one replaces it.
+fn remove_old_companion(file: &Path, none_wanted: bool) -> anyhow::Result<()> {
+    if !file.exists() {
         return Ok(());
     }
-    std::fs::remove_file(lit_file)
-        .with_context(|| format!("removing stale {}", lit_file.display()))?;
+    std::fs::remove_file(file).with_context(|| format!("removing stale {}", file.display()))?;
     if none_wanted {
         eprintln!(
-            "light: removed {} (left from an earlier run; no .lit is wanted now)",
-            lit_file.display()
+            "light: removed {} (left from an earlier run; none is wanted now)",
+            file.display()
         );
     }
     Ok(())
@@ -457,10 +502,10 @@ mod tests {
                 let what = format!("old .lit: {had_lit}, new .lit: {wants_lit}");
                 for step in PAIR_ORDER {
                     match step {
-                        PairStep::RemoveOldLit => lit = None,
+                        PairStep::RemoveOldCompanions => lit = None,
                         PairStep::PlaceBsp => bsp = Run::New,
-                        PairStep::PlaceLit if wants_lit => lit = Some(Run::New),
-                        PairStep::PlaceLit => {}
+                        PairStep::PlaceCompanions if wants_lit => lit = Some(Run::New),
+                        PairStep::PlaceCompanions => {}
                     }
                     assert!(
                         lit.is_none_or(|lit| lit == bsp),
@@ -481,15 +526,28 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("slipgate-light-pair-{}", std::process::id()));
         std::fs::create_dir_all(&dir).expect("temp dir");
         let bsp = dir.join("map.bsp");
-        let lit = lit_path(&bsp);
+        let lit = bsp.with_extension("lit");
+        let lux = bsp.with_extension("lux");
         std::fs::write(&bsp, b"old bsp").expect("write");
         std::fs::write(&lit, b"old lit").expect("write");
-        place_lit_pair(&bsp, b"new bsp", Some(b"new lit".to_vec())).expect("place");
+        std::fs::write(&lux, b"old lux").expect("write");
+        let both = Companions {
+            lit: Some(b"new lit".to_vec()),
+            lux: None,
+        };
+        place_with_companions(&bsp, b"new bsp", both).expect("place");
         assert_eq!(std::fs::read(&bsp).expect("bsp"), b"new bsp");
         assert_eq!(std::fs::read(&lit).expect("lit"), b"new lit");
-        place_lit_pair(&bsp, b"grey bsp", None).expect("place");
+        assert!(!lux.exists(), "the old .lux outlived a run that wants none");
+        let lux_only = Companions {
+            lit: None,
+            lux: Some(b"new lux".to_vec()),
+        };
+        place_with_companions(&bsp, b"grey bsp", lux_only).expect("place");
         assert_eq!(std::fs::read(&bsp).expect("bsp"), b"grey bsp");
         assert!(!lit.exists(), "the old .lit outlived a run that wants none");
+        assert_eq!(std::fs::read(&lux).expect("lux"), b"new lux");
+        place_with_companions(&bsp, b"grey bsp", Companions::default()).expect("place");
         let mut names: Vec<_> = std::fs::read_dir(&dir)
             .expect("list")
             .map(|e| e.expect("entry").file_name())
@@ -505,5 +563,13 @@ mod tests {
         assert_eq!(joined, strings(&["light", "--bounce=2", "x.bsp"]));
         let alone = join_optional_values(strings(&["light", "--bounce", "x.bsp", "--soft"]));
         assert_eq!(alone, strings(&["light", "--bounce", "x.bsp", "--soft"]));
+        let three = strings(&["light", "--lightgrid_dist", "16", "16", "32", "2", "x.bsp"]);
+        let three = join_optional_values(three);
+        assert_eq!(
+            three,
+            strings(&["light", "--lightgrid_dist=16 16 32", "2", "x.bsp"])
+        );
+        let one = join_optional_values(strings(&["light", "--lightgrid_dist", "24.5", "x.bsp"]));
+        assert_eq!(one, strings(&["light", "--lightgrid_dist=24.5", "x.bsp"]));
     }
 }

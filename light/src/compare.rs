@@ -104,12 +104,16 @@ pub fn lightmaps_in(bsp: &Bsp, faces: &[usize]) -> Lighting {
             styles,
             grey,
             rgb: Vec::new(),
+            hdr: Vec::new(),
+            directions: Vec::new(),
         });
     }
     Lighting {
         lightmaps,
         entity_text: None,
         coloured: false,
+        outputs: crate::Outputs::default(),
+        light_grid: None,
         warnings: Vec::new(),
         stats: Stats::default(),
     }

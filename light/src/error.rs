@@ -35,6 +35,16 @@ pub enum LightError {
     /// A damaged `SLIPGATE_PHONG` lump (the message names it).
     #[error("{0}")]
     PhongLump(quake_formats::FormatError),
+    /// `--lightgrid_dist` so fine for the map that the grid would hold too many points.
+    #[error(
+        "the light grid would hold {points} points (at most {most}): give --lightgrid_dist a wider spacing"
+    )]
+    LightGridTooFine {
+        /// Points the spacing gives.
+        points: u64,
+        /// The most allowed.
+        most: u64,
+    },
     /// The BSP breaks a rule that would make light read out of bounds ([`quake_formats::check_usable`]).
     #[error(transparent)]
     Unusable(quake_formats::FormatError),

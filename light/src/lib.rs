@@ -2,7 +2,8 @@
 //! shadows traced by Embree.
 //!
 //! [`compute_lighting`] reads a BSP and returns its lightmaps; [`apply_lighting`] writes them
-//! into it (and gives the `.lit` bytes when the light is coloured). In between, stage by stage:
+//! into it (the grey lump and the BSPX lumps asked for) and gives the files beside it (`.lit`,
+//! `.lux`). In between, stage by stage:
 //!
 //! 1. Settings ([`settings`]): each map-wide setting from the command line, else worldspawn,
 //!    else its default; values that do not read warn and fall back.
@@ -40,6 +41,7 @@ mod embree;
 mod error;
 mod faces;
 mod grid;
+mod lightgrid;
 mod lighting;
 mod lights;
 mod options;
@@ -63,10 +65,11 @@ pub use embree::CONFIG_ENV as EMBREE_CONFIG_ENV;
 pub use error::LightError;
 pub use lighting::{Lighting, RawLighting, Stats};
 pub use options::Options;
-pub use output::{FaceLightmap, grey_lit};
+pub use output::{FaceLightmap, Outputs, grey_lit};
 pub use quality::Quality;
 pub use run::{
-    apply_lighting, compute_lighting, finish_lighting, trace_lighting, update_entities_only,
+    LightFiles, apply_lighting, compute_lighting, finish_lighting, trace_lighting,
+    update_entities_only,
 };
 pub use trace::FaceLight;
 

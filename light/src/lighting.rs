@@ -1,7 +1,10 @@
 //! What a lighting run gives back: lightmaps in light units ([`RawLighting`]), in bytes
 //! ([`Lighting`]), and the counts and timings of the run ([`Stats`]).
 
-use crate::output::FaceLightmap;
+use quake_formats::bsp::lightgrid::LightGrid;
+
+use crate::lightgrid::RawGrid;
+use crate::output::{FaceLightmap, Outputs};
 use crate::settings::SettingWarning;
 use crate::trace::FaceLight;
 
@@ -57,6 +60,14 @@ pub struct Stats {
     pub face_light_pairs_culled: u64,
     /// Faces reached by more than four light styles (the dimmest dropped).
     pub faces_with_dropped_styles: u64,
+    /// Light grid points (`--lightgrid`).
+    pub grid_points: u64,
+    /// Of those, the points in the open.
+    pub grid_points_open: u64,
+    /// Rays cast sampling the light grid.
+    pub grid_rays: u64,
+    /// Time sampling the light grid.
+    pub seconds_lightgrid: f64,
     /// Time reading the map and building the scene.
     pub seconds_setup: f64,
     /// Time tracing direct light.
@@ -77,6 +88,10 @@ pub struct RawLighting {
     pub entity_text: Option<String>,
     /// Some light is coloured: a `.lit` is needed.
     pub coloured: bool,
+    /// The forms of the lightmaps to write.
+    pub outputs: Outputs,
+    /// The light grid, when `--lightgrid` asks for it.
+    pub grid: Option<RawGrid>,
     /// Lightmap bytes per light unit (`_range`).
     pub rangescale: f64,
     /// Gamma applied to the bytes (`_gamma`).
@@ -99,6 +114,10 @@ pub struct Lighting {
     pub entity_text: Option<String>,
     /// Some light is coloured: a `.lit` is needed.
     pub coloured: bool,
+    /// The forms of the lightmaps to write.
+    pub outputs: Outputs,
+    /// The `LIGHTGRID_OCTREE` lump's grid, when `--lightgrid` asks for it.
+    pub light_grid: Option<LightGrid>,
     /// Worldspawn or command-line values light did not take as given.
     pub warnings: Vec<SettingWarning>,
     /// Counts and timings.

@@ -1,12 +1,78 @@
-//! From light units to the bytes engines read: the `--soft` filter, range scale, gamma, clamping, and the lighting lump (plus the
-//! `.lit` colour data) with each face's `styles` and `light_offset`.
+//! From light units to the bytes engines read: the `--soft` filter, range scale, gamma, clamping,
+//! and the lighting lump with each face's `styles` and `light_offset`; beside it, as a run asks
+//! ([`Outputs`]), the `.lit` colour data, the `RGBLIGHTING`, `LIGHTINGDIR` and `LIGHTING_E5BGR9`
+//! lumps and the `.lux` and HDR `.lit` files.
 
 use std::borrow::Cow;
 
 use quake_formats::Bsp;
+use quake_formats::bsp::light_lumps::{LIGHTING_E5BGR9, LIGHTINGDIR, RGBLIGHTING};
 use quake_formats::bsp::limits::MAX_LIGHTMAPS;
+use quake_formats::lit::pack_e5bgr9;
 
+use crate::settings::Settings;
 use crate::trace::FaceLight;
+
+/// Lightmap bytes that stand for light 1.0 (the texture's own colour) in HDR lightmaps: engines
+/// scale lightmap bytes by 2/255, so 255 is twice the texture's colour ("overbright").
+const HDR_ONE: f64 = 128.0;
+/// The direction byte of a luxel no light with a direction reached: straight off the face.
+const NO_DIRECTION: [u8; 3] = [128, 128, 255];
+
+/// The forms of the lightmaps a run writes, beside the grey lump.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Outputs {
+    /// The grey lighting lump (false: `--novanilla`).
+    pub grey_lump: bool,
+    /// `RGBLIGHTING` (`--bspxlit`, or `--novanilla`).
+    pub rgb_lump: bool,
+    /// A `.lux` file (`--lux`).
+    pub lux_file: bool,
+    /// `LIGHTINGDIR` (`--bspxlux`).
+    pub direction_lump: bool,
+    /// The `.lit` in HDR form (`--hdr`).
+    pub hdr_file: bool,
+    /// `LIGHTING_E5BGR9` (`--bspxhdr`).
+    pub hdr_lump: bool,
+}
+
+impl Default for Outputs {
+    /// The grey lump alone (and a `.lit` when the light is coloured), as Quake's own tool.
+    fn default() -> Self {
+        Outputs {
+            grey_lump: true,
+            rgb_lump: false,
+            lux_file: false,
+            direction_lump: false,
+            hdr_file: false,
+            hdr_lump: false,
+        }
+    }
+}
+
+impl Outputs {
+    /// The outputs `settings` ask for.
+    pub fn from_settings(settings: &Settings) -> Outputs {
+        Outputs {
+            grey_lump: !settings.novanilla,
+            rgb_lump: settings.bspxlit || settings.novanilla,
+            lux_file: settings.lux,
+            direction_lump: settings.bspxlux,
+            hdr_file: settings.hdr,
+            hdr_lump: settings.bspxhdr,
+        }
+    }
+
+    /// Deluxemaps are wanted.
+    pub fn directions(&self) -> bool {
+        self.lux_file || self.direction_lump
+    }
+
+    /// HDR lightmaps are wanted.
+    pub fn hdr(&self) -> bool {
+        self.hdr_file || self.hdr_lump
+    }
+}
 
 /// Style slot value for "unused".
 const NO_STYLE: u8 = 255;
@@ -24,8 +90,14 @@ pub struct FaceLightmap {
     pub styles: Vec<u8>,
     /// One byte per luxel per style: the mean of the RGB channels.
     pub grey: Vec<Vec<u8>>,
-    /// The channels themselves, per style, when the light is coloured (else empty).
+    /// The channels themselves, per style, when the light is coloured or RGB output is asked
+    /// for (else empty).
     pub rgb: Vec<Vec<[u8; 3]>>,
+    /// Per style, each luxel's light as an E5BGR9 word, when HDR output is asked for (else
+    /// empty).
+    pub hdr: Vec<Vec<u32>>,
+    /// Per style, each luxel's direction bytes, when deluxemaps are asked for (else empty).
+    pub directions: Vec<Vec<[u8; 3]>>,
 }
 
 /// How light units become bytes.
@@ -35,8 +107,13 @@ pub struct Finish {
     pub gamma: f64,
     /// `--soft` box filter radius in luxels (0 = off).
     pub soft_radius: usize,
-    /// Keep each luxel's RGB bytes, not only their mean: the light is coloured (for a `.lit`).
+    /// Keep each luxel's RGB bytes, not only their mean: the light is coloured (for a `.lit`)
+    /// or RGB output is asked for.
     pub rgb: bool,
+    /// Keep each luxel's light as an E5BGR9 word.
+    pub hdr: bool,
+    /// Keep each luxel's direction bytes.
+    pub directions: bool,
 }
 
 /// Averages each luxel with its neighbours within `radius` (staying inside the face's grid;
@@ -71,13 +148,17 @@ pub fn soft_filter(
     Cow::Owned(out)
 }
 
-/// Light units to bytes: scale, gamma, then scale all channels down together
-/// if the brightest exceeds 255 (keeps the hue).
-pub fn to_bytes(c: [f32; 3], finish: &Finish) -> [u8; 3] {
-    let mut v = c.map(|x| (f64::from(x) * finish.rangescale).max(0.0));
-    if finish.gamma != 1.0 {
-        v = v.map(|x| 255.0 * (x / 255.0).powf(1.0 / finish.gamma));
+/// Light units to lightmap levels before clamping: range scale, then gamma.
+pub(crate) fn to_levels(c: [f32; 3], finish: &Finish) -> [f64; 3] {
+    let v = c.map(|x| (f64::from(x) * finish.rangescale).max(0.0));
+    if finish.gamma == 1.0 {
+        return v;
     }
+    v.map(|x| 255.0 * (x / 255.0).powf(1.0 / finish.gamma))
+}
+
+/// Lightmap levels to bytes: all channels scaled down together if the brightest exceeds 255.
+pub(crate) fn levels_to_bytes(mut v: [f64; 3]) -> [u8; 3] {
     let max = v[0].max(v[1]).max(v[2]);
     if max > 255.0 {
         v = v.map(|x| x * 255.0 / max);
@@ -93,12 +174,27 @@ fn round_non_negative(x: f64) -> f64 {
     if x - t >= 0.5 { t + 1.0 } else { t }
 }
 
-/// One style's lightmap of a face: its style, grey and (when kept) RGB bytes, and the sum of
-/// its channel bytes (0: dark all over).
+/// Light levels as an E5BGR9 word: [`HDR_ONE`] is 1.0, nothing is clamped.
+fn levels_to_hdr(v: [f64; 3]) -> u32 {
+    pack_e5bgr9(v.map(|x| (x / HDR_ONE) as f32))
+}
+
+/// A tangent-space unit direction as deluxemap bytes: each component `(c + 1) * 128`, clamped.
+fn direction_bytes(d: [f32; 3]) -> [u8; 3] {
+    if d == [0.0; 3] {
+        return NO_DIRECTION;
+    }
+    d.map(|c| ((f64::from(c) + 1.0) * 128.0).clamp(0.0, 255.0) as u8)
+}
+
+/// One style's lightmap of a face: its style, grey and (when kept) RGB, HDR and direction
+/// bytes, and the sum of its channel bytes (0: dark all over).
 struct StyleMap {
     style: u8,
     grey: Vec<u8>,
     rgb: Vec<[u8; 3]>,
+    hdr: Vec<u32>,
+    directions: Vec<[u8; 3]>,
     energy: u64,
 }
 
@@ -115,19 +211,32 @@ pub fn finish_face(light: &FaceLight, finish: &Finish) -> (FaceLightmap, usize) 
     for (style, luxels) in &light.styles {
         let filtered = soft_filter(luxels, w, h, finish.soft_radius);
         // One pass, into buffers sized once: this runs for every luxel of the map.
+        let kept = |on: bool| if on { filtered.len() } else { 0 };
         let mut map = StyleMap {
             style: *style,
             grey: Vec::with_capacity(filtered.len()),
-            rgb: Vec::with_capacity(if finish.rgb { filtered.len() } else { 0 }),
+            rgb: Vec::with_capacity(kept(finish.rgb)),
+            hdr: Vec::with_capacity(kept(finish.hdr)),
+            directions: Vec::new(),
             energy: 0,
         };
         for &c in filtered.iter() {
-            let bytes = to_bytes(c, finish);
+            let levels = to_levels(c, finish);
+            let bytes = levels_to_bytes(levels);
             map.energy += bytes.iter().map(|&b| u64::from(b)).sum::<u64>();
             map.grey.push(grey_of(bytes));
             if finish.rgb {
                 map.rgb.push(bytes);
             }
+            if finish.hdr {
+                map.hdr.push(levels_to_hdr(levels));
+            }
+        }
+        if finish.directions {
+            map.directions = match light.directions.iter().find(|(s, _)| s == style) {
+                Some((_, d)) => d.iter().map(|&d| direction_bytes(d)).collect(),
+                None => vec![NO_DIRECTION; filtered.len()],
+            };
         }
         // Style 0 is always written (a face without a lightmap renders fullbright).
         if map.style == 0 || map.energy > 0 {
@@ -144,7 +253,9 @@ pub fn finish_face(light: &FaceLight, finish: &Finish) -> (FaceLightmap, usize) 
         height: h,
         styles: Vec::with_capacity(maps.len()),
         grey: Vec::with_capacity(maps.len()),
-        rgb: Vec::with_capacity(if finish.rgb { maps.len() } else { 0 }),
+        rgb: Vec::new(),
+        hdr: Vec::new(),
+        directions: Vec::new(),
     };
     for map in maps {
         lightmap.styles.push(map.style);
@@ -152,17 +263,39 @@ pub fn finish_face(light: &FaceLight, finish: &Finish) -> (FaceLightmap, usize) 
         if finish.rgb {
             lightmap.rgb.push(map.rgb);
         }
+        if finish.hdr {
+            lightmap.hdr.push(map.hdr);
+        }
+        if finish.directions {
+            lightmap.directions.push(map.directions);
+        }
     }
     (lightmap, dropped)
 }
 
-/// Replaces the lighting lump with `maps` (faces not listed get no lightmap) and, when
-/// `coloured`, returns the `.lit` RGB payload matching it (white light needs none).
-pub fn write_lighting(bsp: &mut Bsp, maps: &[FaceLightmap], coloured: bool) -> Option<Vec<u8>> {
+/// What [`write_lighting`] gives back for files beside the BSP.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LuxelData {
+    /// Three bytes per luxel, when the maps kept RGB.
+    pub rgb: Option<Vec<u8>>,
+    /// One E5BGR9 word per luxel, when the maps kept HDR light.
+    pub hdr: Option<Vec<u32>>,
+    /// Three direction bytes per luxel, when the maps kept directions.
+    pub directions: Option<Vec<u8>>,
+}
+
+/// Replaces the lighting data with `maps` (faces not listed get no lightmap): the grey lump
+/// unless `outputs` leave it out, and the BSPX lumps `outputs` ask for (earlier ones of those
+/// names are removed). Returns every luxel's RGB, HDR and direction data the maps kept, for the
+/// files beside the BSP.
+pub fn write_lighting(bsp: &mut Bsp, maps: &[FaceLightmap], outputs: &Outputs) -> LuxelData {
     // Sized up front: growing them copied into fresh pages, which the kernel zeroes first.
-    let bytes: usize = maps.iter().flat_map(|m| &m.grey).map(Vec::len).sum();
-    let mut grey = Vec::with_capacity(bytes);
-    let mut rgb = Vec::with_capacity(if coloured { 3 * bytes } else { 0 });
+    let luxels: usize = maps.iter().flat_map(|m| &m.grey).map(Vec::len).sum();
+    let kept = |of: fn(&FaceLightmap) -> bool| maps.iter().any(|m| !m.styles.is_empty() && of(m));
+    let mut grey = Vec::with_capacity(luxels);
+    let mut rgb = kept(|m| !m.rgb.is_empty()).then(|| Vec::with_capacity(3 * luxels));
+    let mut hdr = kept(|m| !m.hdr.is_empty()).then(|| Vec::with_capacity(luxels));
+    let mut dirs = kept(|m| !m.directions.is_empty()).then(|| Vec::with_capacity(3 * luxels));
     for f in &mut bsp.faces {
         f.styles = [NO_STYLE; 4];
         f.light_offset = -1;
@@ -176,14 +309,37 @@ pub fn write_lighting(bsp: &mut Bsp, maps: &[FaceLightmap], coloured: bool) -> O
         for g in &m.grey {
             grey.extend_from_slice(g);
         }
-        if coloured {
-            for c in &m.rgb {
-                rgb.extend(c.iter().flatten());
-            }
+        if let Some(rgb) = &mut rgb {
+            rgb.extend(m.rgb.iter().flatten().flatten());
+        }
+        if let Some(hdr) = &mut hdr {
+            hdr.extend(m.hdr.iter().flatten());
+        }
+        if let Some(dirs) = &mut dirs {
+            dirs.extend(m.directions.iter().flatten().flatten());
         }
     }
-    bsp.lighting = grey;
-    coloured.then_some(rgb)
+    bsp.lighting = if outputs.grey_lump { grey } else { Vec::new() };
+    for name in [RGBLIGHTING, LIGHTINGDIR, LIGHTING_E5BGR9] {
+        bsp.remove_bspx_lump(name);
+    }
+    if let Some(rgb) = rgb.as_ref().filter(|_| outputs.rgb_lump) {
+        bsp.set_bspx_lump(RGBLIGHTING, rgb.clone());
+    }
+    if let Some(dirs) = dirs.as_ref().filter(|_| outputs.direction_lump) {
+        bsp.set_bspx_lump(LIGHTINGDIR, dirs.clone());
+    }
+    if let Some(hdr) = hdr.as_ref().filter(|_| outputs.hdr_lump) {
+        bsp.set_bspx_lump(
+            LIGHTING_E5BGR9,
+            hdr.iter().flat_map(|w: &u32| w.to_le_bytes()).collect(),
+        );
+    }
+    LuxelData {
+        rgb,
+        hdr,
+        directions: dirs,
+    }
 }
 
 /// The `.lit` of white light: each luxel's grey level of `lighting` (a lighting lump) in all
@@ -202,7 +358,15 @@ mod tests {
         gamma: 1.0,
         soft_radius: 0,
         rgb: true,
+        hdr: false,
+        directions: false,
     };
+
+    /// Light units to bytes: scale, gamma, then all channels scaled down together if the
+    /// brightest exceeds 255 (keeps the hue).
+    fn to_bytes(c: [f32; 3], finish: &Finish) -> [u8; 3] {
+        levels_to_bytes(to_levels(c, finish))
+    }
 
     #[test]
     fn bytes_scale_and_keep_hue_when_clamping() {
@@ -247,6 +411,7 @@ mod tests {
             width: 2,
             height: 1,
             styles,
+            directions: Vec::new(),
         };
         let (m, dropped) = finish_face(&light, &PLAIN);
         assert_eq!(m.styles, vec![0, 36, 35, 34]);
@@ -264,6 +429,7 @@ mod tests {
             width: 1,
             height: 1,
             styles: vec![(0, vec![[40.0, 20.0, 20.0]])],
+            directions: Vec::new(),
         };
         let (out, _) = finish_face(&light, &PLAIN);
         assert_eq!(out.rgb[0], vec![[20, 10, 10]]);
@@ -277,6 +443,7 @@ mod tests {
             width: 2,
             height: 1,
             styles: vec![(0, vec![[40.0; 3], [90.0; 3]]), (5, vec![[8.0; 3]; 2])],
+            directions: Vec::new(),
         };
         let (with_rgb, _) = finish_face(&light, &PLAIN);
         let grey_only = Finish {
@@ -296,8 +463,108 @@ mod tests {
             styles: [NO_STYLE; 4],
             light_offset: -1,
         });
-        assert_eq!(write_lighting(&mut bsp, &[without], false), None);
+        let data = write_lighting(&mut bsp, &[without], &Outputs::default());
+        assert_eq!(data, LuxelData::default());
+        assert!(bsp.bspx.is_empty());
         assert_eq!(bsp.lighting, vec![20, 45, 4, 4]);
         assert_eq!(bsp.faces[0].styles, [0, 5, NO_STYLE, NO_STYLE]);
+    }
+
+    fn one_face_bsp() -> Bsp {
+        let mut bsp = Bsp::default();
+        bsp.faces.push(quake_formats::bsp::Face {
+            plane: 0,
+            side: 0,
+            first_edge: 0,
+            num_edges: 0,
+            texinfo: 0,
+            styles: [NO_STYLE; 4],
+            light_offset: -1,
+        });
+        bsp
+    }
+
+    #[test]
+    fn hdr_keeps_light_past_255_that_bytes_clamp() {
+        let light = FaceLight {
+            face: 0,
+            width: 2,
+            height: 1,
+            styles: vec![(0, vec![[512.0, 256.0, 0.0], [256.0, 256.0, 256.0]])],
+            directions: Vec::new(),
+        };
+        let finish = Finish { hdr: true, ..PLAIN };
+        let (m, _) = finish_face(&light, &finish);
+        // Range 0.5: levels 256, 128, 0 (past 255, so the bytes scale down) and 128 everywhere.
+        assert_eq!(m.rgb[0][0], [255, 128, 0]);
+        let unpack = quake_formats::lit::unpack_e5bgr9;
+        assert_eq!(
+            unpack(m.hdr[0][0]),
+            [2.0, 1.0, 0.0],
+            "1.0 is level 128, nothing clamped"
+        );
+        assert_eq!(unpack(m.hdr[0][1]), [1.0; 3]);
+    }
+
+    #[test]
+    fn directions_become_bytes_and_unlit_luxels_face_straight_off() {
+        let light = FaceLight {
+            face: 0,
+            width: 2,
+            height: 1,
+            styles: vec![(0, vec![[10.0; 3]; 2]), (32, vec![[10.0; 3]; 2])],
+            directions: vec![(0, vec![[1.0, 0.0, 0.0], [0.0; 3]])],
+        };
+        let finish = Finish {
+            directions: true,
+            ..PLAIN
+        };
+        let (m, _) = finish_face(&light, &finish);
+        assert_eq!(m.directions[0], vec![[255, 128, 128], NO_DIRECTION]);
+        assert_eq!(
+            m.directions[1],
+            vec![NO_DIRECTION; 2],
+            "a style with no direction"
+        );
+        let mut bsp = one_face_bsp();
+        let outputs = Outputs {
+            direction_lump: true,
+            ..Outputs::default()
+        };
+        let data = write_lighting(&mut bsp, &[m], &outputs);
+        let lump = bsp.bspx_lump(LIGHTINGDIR).expect("LIGHTINGDIR");
+        assert_eq!(lump.len(), 3 * bsp.lighting.len());
+        assert_eq!(data.directions.as_deref(), Some(lump));
+    }
+
+    #[test]
+    fn novanilla_leaves_the_grey_lump_out_and_writes_rgblighting() {
+        let light = FaceLight {
+            face: 0,
+            width: 2,
+            height: 1,
+            styles: vec![(0, vec![[40.0; 3], [90.0; 3]])],
+            directions: Vec::new(),
+        };
+        let (m, _) = finish_face(&light, &PLAIN);
+        let mut bsp = one_face_bsp();
+        bsp.set_bspx_lump(LIGHTING_E5BGR9, vec![1, 2, 3, 4]);
+        let outputs = Outputs {
+            grey_lump: false,
+            rgb_lump: true,
+            ..Outputs::default()
+        };
+        write_lighting(&mut bsp, &[m], &outputs);
+        assert!(bsp.lighting.is_empty());
+        assert_eq!(
+            bsp.bspx_lump(RGBLIGHTING),
+            Some(&[20u8, 20, 20, 45, 45, 45][..])
+        );
+        assert_eq!(bsp.faces[0].light_offset, 0);
+        assert_eq!(bsp.luxel_count(), 2);
+        assert!(
+            bsp.bspx_lump(LIGHTING_E5BGR9).is_none(),
+            "a lump of an earlier run is removed"
+        );
     }
 }

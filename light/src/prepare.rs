@@ -74,6 +74,7 @@ impl Prepared {
             sun_distance: self.sun_distance,
             dirt: self.lights.uses_dirt().then_some(self.lights.dirt),
             adaptive,
+            directions: crate::output::Outputs::from_settings(&self.lights.settings).directions(),
         }
     }
 }

@@ -6,6 +6,7 @@ use glam::Vec3;
 use std::time::Instant;
 
 use quake_formats::Bsp;
+use quake_formats::bsp::lightgrid::LIGHTGRID_OCTREE;
 use quake_formats::entities::{parse_entities, write_entities};
 use quake_formats::palette::Palette;
 use quake_formats::progress::Progress;
@@ -13,10 +14,11 @@ use rayon::prelude::*;
 
 use crate::bounce::{self, BounceCounts, Density, Field, Receivers, StyleLuxels};
 use crate::error::LightError;
+use crate::lightgrid::{GridSources, RawGrid, finish_grid, trace_grid};
 use crate::lighting::{Lighting, RawLighting, Stats};
 use crate::lights::assign_switchable_styles;
 use crate::options::Options;
-use crate::output::{self, Finish, finish_face};
+use crate::output::{self, Finish, Outputs, finish_face};
 use crate::phong;
 use crate::prepare::{Prepared, face_rules, prepare};
 use crate::quality::Quality;
@@ -48,7 +50,15 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
     let mut bounce_counts = BounceCounts::default();
     let bounced = plan.bounced_light(&traced, &mut bounce_counts);
     let bounce_done = Instant::now();
+    let grid = plan.light_grid()?;
+    let grid_done = Instant::now();
     let mut stats = plan.stats(&traced, &bounce_counts);
+    if let Some(g) = &grid {
+        stats.grid_points = g.points.len() as u64;
+        stats.grid_points_open = g.points.iter().flatten().count() as u64;
+        stats.grid_rays = g.rays;
+        stats.seconds_lightgrid = (grid_done - bounce_done).as_secs_f64();
+    }
     let faces = finish_faces(traced, &bounced);
     stats.luxels = faces.iter().map(|l| (l.width * l.height) as u64).sum();
     stats.faces_lit = faces.len();
@@ -76,6 +86,8 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
         faces,
         entity_text: prep.entity_text.clone(),
         coloured: stats.coloured,
+        outputs: Outputs::from_settings(settings),
+        grid,
         rangescale: settings.range,
         gamma: settings.gamma,
         soft_radius: settings.soft,
@@ -240,6 +252,28 @@ impl<'a> Plan<'a> {
     }
 
     /// The counts of the run so far (luxels and timings are the caller's).
+    /// The light grid in light units, when `--lightgrid` asks for it and anything gives light.
+    fn light_grid(&self) -> Result<Option<RawGrid>, LightError> {
+        let prep = self.prep;
+        let settings = &prep.lights.settings;
+        if !settings.lightgrid || self.fullbright {
+            return Ok(None);
+        }
+        let sources = GridSources {
+            bsp: self.bsp,
+            scene: &prep.scene,
+            vis: &prep.vis,
+            lights: &prep.point_lights,
+            light_leafs: &prep.light_leafs,
+            reaches: &self.reaches,
+            suns: &prep.lights.suns,
+            minlight: prep.lights.minlight.get(&0),
+            gate: settings.gate,
+            sun_distance: prep.sun_distance,
+        };
+        trace_grid(&sources, settings.lightgrid_dist.0).map(Some)
+    }
+
     fn stats(&self, traced: &[Traced], bounce: &BounceCounts) -> Stats {
         let prep = self.prep;
         let mut placement = PlacementCounts::default();
@@ -473,11 +507,14 @@ fn phong_normals(
 /// lightmap bytes.
 pub fn finish_lighting(raw: &RawLighting, soft_radius: usize) -> Lighting {
     let start = Instant::now();
+    let outputs = raw.outputs;
     let finish = Finish {
         rangescale: raw.rangescale,
         gamma: raw.gamma,
         soft_radius,
-        rgb: raw.coloured,
+        rgb: raw.coloured || outputs.rgb_lump,
+        hdr: outputs.hdr(),
+        directions: outputs.directions(),
     };
     let mut stats = raw.stats.clone();
     let (lightmaps, dropped): (Vec<_>, Vec<usize>) = raw
@@ -491,19 +528,56 @@ pub fn finish_lighting(raw: &RawLighting, soft_radius: usize) -> Lighting {
         lightmaps,
         entity_text: raw.entity_text.clone(),
         coloured: raw.coloured,
+        outputs,
+        light_grid: raw.grid.as_ref().map(|g| finish_grid(g, &finish)),
         warnings: raw.warnings.clone(),
         stats,
     }
 }
 
-/// Writes `lighting` into `bsp` (lighting lump, face styles and offsets,
-/// entity styles) and returns the `.lit` file bytes when the map is coloured.
-pub fn apply_lighting(bsp: &mut Bsp, lighting: &Lighting) -> Option<Vec<u8>> {
-    let rgb = output::write_lighting(bsp, &lighting.lightmaps, lighting.coloured);
+/// The files beside a lit BSP its light asks for.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LightFiles {
+    /// The `.lit`: the HDR one when `--hdr` asks for it, else the coloured one when the light is
+    /// coloured and the grey lump is written (with `--novanilla`, `RGBLIGHTING` carries the
+    /// colour). `None`: no `.lit` is needed.
+    pub lit: Option<Vec<u8>>,
+    /// Every luxel's colour as a `.lit` whatever the light (for `--lit`), when it was kept.
+    pub rgb_lit: Option<Vec<u8>>,
+    /// The `.lux` deluxemap, when `--lux` asks for it.
+    pub lux: Option<Vec<u8>>,
+}
+
+/// Writes `lighting` into `bsp` (lighting lump and the BSPX lumps asked for, face styles and
+/// offsets, entity styles) and returns the files to put beside it.
+pub fn apply_lighting(bsp: &mut Bsp, lighting: &Lighting) -> LightFiles {
+    let outputs = &lighting.outputs;
+    let data = output::write_lighting(bsp, &lighting.lightmaps, outputs);
     if let Some(text) = &lighting.entity_text {
         bsp.set_entity_text(text);
     }
-    rgb.map(|rgb| quake_formats::lit::write_lit(&rgb))
+    match &lighting.light_grid {
+        Some(grid) => bsp.set_light_grid(grid),
+        None => bsp.remove_bspx_lump(LIGHTGRID_OCTREE),
+    }
+    let rgb_lit = data.rgb.as_deref().map(quake_formats::lit::write_lit);
+    let hdr_lit = data
+        .hdr
+        .as_deref()
+        .filter(|_| outputs.hdr_file)
+        .map(quake_formats::lit::write_hdr_lit);
+    let coloured_lit = rgb_lit
+        .clone()
+        .filter(|_| lighting.coloured && outputs.grey_lump);
+    LightFiles {
+        lit: hdr_lit.or(coloured_lit),
+        rgb_lit,
+        lux: data
+            .directions
+            .as_deref()
+            .filter(|_| outputs.lux_file)
+            .map(quake_formats::lit::write_lux),
+    }
 }
 
 /// `--onlyents`: gives switchable lights their styles in the entity lump (the lump `slipgate bsp

@@ -334,7 +334,7 @@ fn a_map_without_light_sources_is_left_fullbright() {
     let mut dark = synthetic_bsp(&[floor(256.0)], "{ \"classname\" \"worldspawn\" }\n");
     let lighting = compute_lighting(&dark, &options(Quality::Default)).expect("light");
     assert!(lighting.stats.fullbright);
-    assert!(apply_lighting(&mut dark, &lighting).is_none());
+    assert!(apply_lighting(&mut dark, &lighting).lit.is_none());
     assert!(dark.lighting.is_empty());
     assert!(dark.faces.iter().all(|f| f.light_offset == -1));
 
@@ -353,12 +353,14 @@ fn a_map_without_light_sources_is_left_fullbright() {
 fn lit_file_only_for_coloured_light() {
     let mut white = shadow_scene("\"light\" \"300\"");
     let lighting = compute_lighting(&white, &options(Quality::Default)).expect("white");
-    assert!(apply_lighting(&mut white, &lighting).is_none());
+    assert!(apply_lighting(&mut white, &lighting).lit.is_none());
     assert!(!white.lighting.is_empty());
 
     let mut red = shadow_scene("\"light\" \"300\" \"_color\" \"255 0 0\"");
     let lighting = compute_lighting(&red, &options(Quality::Default)).expect("red");
-    let lit = apply_lighting(&mut red, &lighting).expect("coloured map gets a .lit");
+    let lit = apply_lighting(&mut red, &lighting)
+        .lit
+        .expect("coloured map gets a .lit");
     assert_eq!(lit.len(), 8 + 3 * red.lighting.len());
     let rgb = quake_formats::lit::read_lit(&lit, red.lighting.len()).expect("valid .lit");
     assert!(rgb.chunks(3).all(|c| c[1] == 0 && c[2] == 0));
@@ -528,7 +530,7 @@ fn q1_cube_without_lights_stays_fullbright_and_round_trips() {
     let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
     assert!(lighting.stats.fullbright);
     assert!(
-        apply_lighting(&mut bsp, &lighting).is_none(),
+        apply_lighting(&mut bsp, &lighting).lit.is_none(),
         "no lights, no .lit"
     );
     assert!(bsp.lighting.is_empty());
@@ -1259,8 +1261,12 @@ fn output_does_not_depend_on_the_thread_count() {
             .install(|| compute_lighting(&bsp, options))
             .expect("light");
         let mut lit = bsp.clone();
-        let rgb = apply_lighting(&mut lit, &lighting);
-        (lit.lighting, rgb)
+        let files = apply_lighting(&mut lit, &lighting);
+        (
+            lit.lighting.clone(),
+            lit.write().expect("BSP encodes"),
+            files,
+        )
     };
     for (quality, dirt_mode, soft_radius) in [
         (Quality::Default, DirtMode::Ordered, 0),
@@ -1271,6 +1277,11 @@ fn output_does_not_depend_on_the_thread_count() {
         options.overrides.dirt = Some(true);
         options.overrides.dirt_mode = Some(dirt_mode);
         options.overrides.sunsamples = Some(16);
+        // The BSPX lumps and the files beside the BSP too.
+        let o = &mut options.overrides;
+        (o.bspxlit, o.lux, o.bspxlux, o.hdr, o.bspxhdr) =
+            (Some(true), Some(true), Some(true), Some(true), Some(true));
+        o.lightgrid = Some(true);
         // Bounce gathers across faces: one pass, and two with supersampling.
         options.overrides.bounce = Some(if quality == Quality::Default { 1 } else { 2 });
         let one = lit_bytes(1, &options);
@@ -1514,7 +1525,228 @@ fn coloured_bounce_writes_a_lit_only_when_the_texture_is_coloured() {
         "reddened by the floor"
     );
     let lit_bytes = apply_lighting(&mut bsp, &lit);
-    assert!(lit_bytes.is_some());
+    assert!(lit_bytes.lit.is_some());
+}
+
+/// The lumps and files of a run with every BSPX light output asked for, read back by the
+/// independent `qbsp` crate.
+fn light_with_bspx_outputs(light_keys: &str) -> (Bsp, crate::LightFiles, qbsp::BspData) {
+    let mut bsp = shadow_scene(light_keys);
+    let mut options = options(Quality::Default);
+    let o = &mut options.overrides;
+    (o.bspxlit, o.lux, o.bspxlux, o.hdr, o.bspxhdr) =
+        (Some(true), Some(true), Some(true), Some(true), Some(true));
+    let lighting = compute_lighting(&bsp, &options).expect("light");
+    let files = apply_lighting(&mut bsp, &lighting);
+    let bytes = bsp.write().expect("BSP encodes");
+    let theirs = qbsp::BspData::parse(qbsp::BspParseInput {
+        bsp: &bytes,
+        lit: None,
+        settings: qbsp::BspParseSettings::default(),
+    })
+    .expect("qbsp reads the BSP");
+    (bsp, files, theirs)
+}
+
+#[test]
+fn qbsp_reads_the_bspx_light_lumps_as_written() {
+    let (bsp, files, theirs) =
+        light_with_bspx_outputs("\"light\" \"300\" \"_color\" \"255 128 0\"");
+    let luxels = bsp.lighting.len();
+    // qbsp takes RGBLIGHTING in place of the grey lump, as engines that read it do.
+    let Some(qbsp::data::lighting::BspLighting::Colored(rgb)) = &theirs.lighting else {
+        panic!("qbsp did not take RGBLIGHTING's colour");
+    };
+    let ours = bsp.bspx_lump(quake_formats::bsp::light_lumps::RGBLIGHTING);
+    assert_eq!(rgb.len(), luxels);
+    assert_eq!(
+        ours.map(<[u8]>::to_vec),
+        Some(rgb.iter().flatten().copied().collect())
+    );
+    let lit = files.lit.expect("-hdr writes the HDR .lit");
+    let quake_formats::lit::LitData::Hdr(hdr_words) =
+        quake_formats::lit::read_any_lit(&lit, luxels).expect(".lit reads")
+    else {
+        panic!("-hdr's .lit is not HDR");
+    };
+    let hdr_lump = theirs
+        .bspx
+        .get_unparsed("LIGHTING_E5BGR9")
+        .expect("LIGHTING_E5BGR9");
+    assert_eq!(hdr_lump.len(), 4 * luxels);
+    let lump_words: Vec<u32> = hdr_lump
+        .chunks_exact(4)
+        .map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]))
+        .collect();
+    assert_eq!(lump_words, hdr_words, "the lump and the HDR .lit agree");
+    // Unclamped luxels: the HDR value (1.0 at byte 128) is the byte within rounding.
+    for (c, &w) in rgb.iter().zip(&lump_words) {
+        let hdr = quake_formats::lit::unpack_e5bgr9(w);
+        if c.iter().all(|&b| b < 255) {
+            for (b, h) in c.iter().zip(hdr) {
+                assert!(
+                    (f32::from(*b) - h * 128.0).abs() <= 1.0,
+                    "{c:?} against {hdr:?}"
+                );
+            }
+        }
+    }
+    let dir_lump = theirs
+        .bspx
+        .get_unparsed("LIGHTINGDIR")
+        .expect("LIGHTINGDIR");
+    assert_eq!(dir_lump.len(), 3 * luxels);
+    let lux = files.lux.expect("-lux writes a .lux");
+    assert_eq!(&lux[..4], b"QLIT");
+    assert_eq!(&lux[8..], dir_lump, "the .lux and LIGHTINGDIR agree");
+}
+
+#[test]
+fn deluxemap_points_towards_the_light_in_tangent_space() {
+    // The light hangs at (128 128 192) over the floor (0..256); the floor's texture s axis is
+    // world x and its t axis world -y, so tangent space is x, y, up there.
+    let (bsp, _, theirs) = light_with_bspx_outputs("\"light\" \"300\"");
+    let dirs = theirs
+        .bspx
+        .get_unparsed("LIGHTINGDIR")
+        .expect("LIGHTINGDIR");
+    let floor = &bsp.faces[0];
+    let offset = usize::try_from(floor.light_offset).expect("the floor is lit");
+    let (w, h) = (17, 17);
+    let at = |x: usize, y: usize| {
+        let i = 3 * (offset + y * w + x);
+        [dirs[i], dirs[i + 1], dirs[i + 2]]
+    };
+    let centre = at(w / 2, h / 2);
+    assert!(centre[2] > 250, "straight above the middle: {centre:?}");
+    // Luxel rows run along t, which is world -y: the first row is the floor's +y edge, where
+    // the light lies towards world -y, the tangent's negative y.
+    let corner = at(0, 0);
+    assert!(
+        corner[0] > 150,
+        "towards +x from the x = 0 edge: {corner:?}"
+    );
+    assert!(
+        corner[1] < 106,
+        "towards -y from the y = 256 edge: {corner:?}"
+    );
+    assert!(corner[2] > 150, "and upwards: {corner:?}");
+}
+
+#[test]
+fn novanilla_writes_colour_only_in_rgblighting() {
+    let mut bsp = shadow_scene("\"light\" \"300\" \"_color\" \"255 0 0\"");
+    let mut options = options(Quality::Default);
+    options.overrides.novanilla = Some(true);
+    let lighting = compute_lighting(&bsp, &options).expect("light");
+    let files = apply_lighting(&mut bsp, &lighting);
+    assert!(files.lit.is_none(), "RGBLIGHTING carries the colour");
+    assert!(bsp.lighting.is_empty());
+    let bytes = bsp.write().expect("BSP encodes");
+    let theirs = qbsp::BspData::parse(qbsp::BspParseInput {
+        bsp: &bytes,
+        lit: None,
+        settings: qbsp::BspParseSettings::default(),
+    })
+    .expect("qbsp reads the BSP");
+    let Some(qbsp::data::lighting::BspLighting::Colored(rgb)) = theirs.lighting else {
+        panic!("qbsp did not take RGBLIGHTING's colour");
+    };
+    assert_eq!(rgb.len(), bsp.luxel_count());
+    assert!(rgb.iter().any(|c| c[0] > 0) && rgb.iter().all(|c| c[1] == 0 && c[2] == 0));
+}
+
+/// The light grid over [`shadow_scene`] (a box 0..256 by 0..256 by 0..128) with a light that
+/// ignores the angle of incidence, so a face receives what a grid point beside it does.
+fn shadow_scene_grid() -> (Bsp, quake_formats::bsp::lightgrid::LightGrid, Vec<u8>) {
+    let mut bsp = shadow_scene("\"light\" \"300\" \"_anglescale\" \"0\"");
+    bsp.models[0].mins = [0.0; 3];
+    bsp.models[0].maxs = [256.0, 256.0, 128.0];
+    let mut options = options(Quality::Default);
+    options.overrides.lightgrid = Some(true);
+    let lighting = compute_lighting(&bsp, &options).expect("light");
+    assert!(lighting.stats.grid_rays > 0);
+    let grid = lighting
+        .light_grid
+        .clone()
+        .expect("--lightgrid gives a grid");
+    apply_lighting(&mut bsp, &lighting);
+    let bytes = bsp.write().expect("BSP encodes");
+    (bsp, grid, bytes)
+}
+
+#[test]
+fn grid_points_take_the_light_of_the_floor_beside_them() {
+    let (bsp, grid, _) = shadow_scene_grid();
+    assert_eq!(grid.spacing, [32.0; 3]);
+    assert_eq!(grid.mins, [0.5; 3], "half a unit off the floor's plane");
+    let floor = &bsp.faces[0];
+    let offset = usize::try_from(floor.light_offset).expect("the floor is lit");
+    // Floor luxel (i, j) stands at x = 16 i, y = 256 - 16 j (its t axis is world -y).
+    let luxel = |x: usize, y: usize| bsp.lighting[offset + (256 - y) / 16 * 17 + x / 16];
+    let point = |x: i32, y: i32| {
+        let p = grid.point([x / 32, y / 32, 0]).expect("inside the grid");
+        let styles = p.as_ref().expect("in the open");
+        styles.iter().find(|s| s.style == 0).map_or(0, |s| s.rgb[0])
+    };
+    // In the light, off the box's shadow.
+    let (lit_face, lit_grid) = (luxel(32, 32), point(32, 32));
+    assert!(lit_face > 20, "the floor is lit there: {lit_face}");
+    assert!(
+        lit_face.abs_diff(lit_grid) <= 1,
+        "face {lit_face}, grid {lit_grid}"
+    );
+    // In the box's shadow.
+    assert_eq!((luxel(128, 128), point(128, 128)), (0, 0));
+}
+
+#[test]
+fn qbsp_reads_the_light_grid_as_written() {
+    let (_, grid, bytes) = shadow_scene_grid();
+    let theirs = qbsp::BspData::parse(qbsp::BspParseInput {
+        bsp: &bytes,
+        lit: None,
+        settings: qbsp::BspParseSettings::default(),
+    })
+    .expect("qbsp reads the BSP");
+    let octree = theirs.bspx.light_grid_octree.expect("LIGHTGRID_OCTREE");
+    assert_eq!(octree.step.to_array(), grid.spacing);
+    assert_eq!(octree.mins.to_array(), grid.mins);
+    assert_eq!(octree.size.to_array().map(|s| s as i32), grid.size);
+}
+
+#[test]
+fn a_run_without_lightgrid_removes_an_old_grid() {
+    let (mut bsp, _, _) = shadow_scene_grid();
+    let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
+    apply_lighting(&mut bsp, &lighting);
+    assert!(
+        bsp.bspx_lump(quake_formats::bsp::lightgrid::LIGHTGRID_OCTREE)
+            .is_none()
+    );
+}
+
+#[test]
+fn a_grid_row_finds_the_leaves_leaf_at_does() {
+    let bsp = demo_bsp_with_sun();
+    let m = &bsp.models[0];
+    let (mins, maxs) = (
+        DVec3::from(m.mins.map(f64::from)),
+        DVec3::from(m.maxs.map(f64::from)),
+    );
+    let mut rows = 0;
+    for (y, z) in [(0.3, 0.2), (0.5, 0.5), (0.71, 0.13), (0.9, 0.8)] {
+        let at = |x: f64| mins + (maxs - mins) * DVec3::new(x, y, z);
+        let points: Vec<DVec3> = (0..=200).map(|i| at(f64::from(i) / 200.0)).collect();
+        let walked = crate::lightgrid::leaves_along(&bsp, &points);
+        let each: Vec<_> = points
+            .iter()
+            .map(|p| bsp.leaf_at(p.as_vec3().to_array()))
+            .collect();
+        assert_eq!(walked, each);
+        rows += usize::from(each.windows(2).any(|w| w[0] != w[1]));
+    }
+    assert!(rows >= 3, "the rows cross leaves");
 }
 
 /// Lit water: a liquid face the compiler wrote without `TEX_SPECIAL` gets a lightmap, one

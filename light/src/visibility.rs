@@ -110,13 +110,18 @@ impl Visibility {
     /// Light crossing a liquid surface is never culled: some vis tools treat
     /// liquids as opaque, but light passes through them.
     pub fn may_reach(&self, light_leaf: Option<u32>, face: usize) -> bool {
+        self.may_reach_leafs(light_leaf, &self.face_leafs[face])
+    }
+
+    /// False only if vis data proves nothing in `light_leaf` can see any of `leafs` (none:
+    /// cannot tell).
+    pub fn may_reach_leafs(&self, light_leaf: Option<u32>, leafs: &[u32]) -> bool {
         let Some(light_leaf) = light_leaf else {
             return true;
         };
         let Some(Some(row)) = self.rows.get(light_leaf as usize) else {
             return true;
         };
-        let leafs = &self.face_leafs[face];
         leafs.is_empty()
             || self.is_liquid(light_leaf)
             || leafs
@@ -126,7 +131,11 @@ impl Visibility {
 
     /// False only if vis data proves `face` cannot see any sky face.
     pub fn may_see_sky(&self, face: usize) -> bool {
-        let leafs = &self.face_leafs[face];
+        self.leafs_may_see_sky(&self.face_leafs[face])
+    }
+
+    /// False only if vis data proves none of `leafs` can see any sky face (none: cannot tell).
+    pub fn leafs_may_see_sky(&self, leafs: &[u32]) -> bool {
         leafs.is_empty()
             || leafs
                 .iter()
@@ -136,7 +145,12 @@ impl Visibility {
     /// Boxes around the sky faces `face` may see, one per leaf holding
     /// them; `None` when vis data cannot tell (every direction may reach sky).
     pub fn visible_sky_bounds(&self, face: usize) -> Option<Vec<Bounds>> {
-        let leafs = &self.face_leafs[face];
+        self.sky_bounds_seen_from(&self.face_leafs[face])
+    }
+
+    /// Boxes around the sky faces any of `leafs` may see, one per leaf holding them (merged
+    /// down to a few); `None` when vis data cannot tell (every direction may reach sky).
+    pub fn sky_bounds_seen_from(&self, leafs: &[u32]) -> Option<Vec<Bounds>> {
         if leafs.is_empty() {
             return None;
         }

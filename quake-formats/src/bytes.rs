@@ -18,6 +18,11 @@ impl<'a> Reader<'a> {
         Reader { data, pos, what }
     }
 
+    /// Bytes left after the cursor.
+    pub fn remaining(&self) -> usize {
+        self.data.len().saturating_sub(self.pos)
+    }
+
     pub fn bytes(&mut self, n: usize) -> Result<&'a [u8]> {
         let end = self.pos.checked_add(n).filter(|&e| e <= self.data.len());
         let Some(end) = end else {

@@ -73,27 +73,33 @@ pub fn normalise_single_dash(args: impl Iterator<Item = String>) -> Vec<String> 
         .collect()
 }
 
-/// Options whose value is optional (`--bounce [N]`, `--litwater [N]`: ericw-tools' spelling)
-/// and which are declared with `require_equals`, named in `optional`, take a following number as
-/// their value: `--bounce 2` becomes `--bounce=2`, while `--bounce map.bsp` leaves the file as
-/// the positional argument.
+/// Options whose value may be left out (`--bounce [N]`, `--litwater [N]`: ericw-tools'
+/// spelling), declared with `require_equals` and named in `options` with the most numbers each
+/// takes, take the numbers that follow them as their value: `--bounce 2` becomes `--bounce=2`
+/// and `--lightgrid_dist 16 16 32` becomes `--lightgrid_dist=16 16 32`, while `--bounce
+/// map.bsp` leaves the file as the positional argument.
 pub fn join_optional_values(
     args: impl IntoIterator<Item = String>,
-    optional: &[&str],
+    options: &[(&str, usize)],
 ) -> Vec<String> {
     let mut out: Vec<String> = Vec::new();
+    // Numbers the last option may still take.
+    let mut open = 0;
     for a in args {
-        let joins = out
-            .last()
-            .is_some_and(|prev| optional.contains(&prev.as_str()))
-            && !a.is_empty()
-            && a.chars().all(|c| c.is_ascii_digit());
+        let number = !a.is_empty() && a.chars().all(|c| c.is_ascii_digit() || c == '.');
         match out.last_mut() {
-            Some(prev) if joins => {
-                prev.push('=');
+            Some(prev) if open > 0 && number => {
+                prev.push(if prev.contains('=') { ' ' } else { '=' });
                 prev.push_str(&a);
+                open -= 1;
             }
-            _ => out.push(a),
+            _ => {
+                open = options
+                    .iter()
+                    .find(|(name, _)| *name == a)
+                    .map_or(0, |&(_, n)| n);
+                out.push(a);
+            }
         }
     }
     out
@@ -106,11 +112,15 @@ mod tests {
     #[test]
     fn a_number_after_an_optional_value_option_is_its_value() {
         let args = ["light", "--bounce", "2", "--soft", "x.bsp", "--other", "3"];
-        let out = join_optional_values(args.iter().map(|s| s.to_string()), &["--bounce", "--soft"]);
+        let options = [("--bounce", 1), ("--soft", 1), ("--dist", 3)];
+        let out = join_optional_values(args.iter().map(|s| s.to_string()), &options);
         assert_eq!(
             out,
             ["light", "--bounce=2", "--soft", "x.bsp", "--other", "3"]
         );
+        let three = ["light", "--dist", "16", "16", "32.5", "7", "x.bsp"];
+        let out = join_optional_values(three.iter().map(|s| s.to_string()), &options);
+        assert_eq!(out, ["light", "--dist=16 16 32.5", "7", "x.bsp"]);
     }
 
     #[test]

@@ -30,12 +30,7 @@ pub struct LightmapExtents {
 impl LightmapExtents {
     /// The extents QuakeSpasm and its family (and vanilla, and ericw-tools' light) compute.
     pub fn from_points(points: &[[f32; 3]], vecs: &[[f32; 4]; 2]) -> LightmapExtents {
-        Self::snapped(points, vecs, |p, v| {
-            (p[0] as f64 * v[0] as f64
-                + p[1] as f64 * v[1] as f64
-                + p[2] as f64 * v[2] as f64
-                + v[3] as f64) as f32
-        })
+        Self::snapped(points, vecs, quakespasm_coord)
     }
 
     /// The extents DarkPlaces computes. Its vectors are `float` (`vec_t`) and its dot-product
@@ -66,31 +61,11 @@ impl LightmapExtents {
         vecs: &[[f32; 4]; 2],
         coord: impl Fn(&[f32; 3], &[f32; 4]) -> f32,
     ) -> LightmapExtents {
-        let mut mins = [f64::INFINITY; 2];
-        let mut maxs = [f64::NEG_INFINITY; 2];
-        for p in points {
-            for axis in 0..2 {
-                let val = coord(p, &vecs[axis]) as f64;
-                mins[axis] = mins[axis].min(val);
-                maxs[axis] = maxs[axis].max(val);
-            }
+        let (lo, hi) = grid_lines(points, vecs, coord, LIGHTMAP_SCALE);
+        LightmapExtents {
+            tex_mins: lo.map(|l| l * LIGHTMAP_SCALE),
+            extents: std::array::from_fn(|axis| (hi[axis] - lo[axis]) * LIGHTMAP_SCALE),
         }
-        let scale = LIGHTMAP_SCALE as f64;
-        let mut tex_mins = [0; 2];
-        let mut extents = [0; 2];
-        for axis in 0..2 {
-            if points.is_empty() {
-                break;
-            }
-            // Damaged files can hold absurd coordinates; clamping keeps the arithmetic in range
-            // (such a face fails every size check downstream anyway).
-            let lo = (mins[axis] / scale).floor().clamp(-GRID_CLAMP, GRID_CLAMP) as i32;
-            let hi = (maxs[axis] / scale).ceil().clamp(-GRID_CLAMP, GRID_CLAMP) as i32;
-            tex_mins[axis] = lo * LIGHTMAP_SCALE;
-            // All-NaN coordinates leave lo above hi.
-            extents[axis] = (hi - lo).max(0) * LIGHTMAP_SCALE;
-        }
-        LightmapExtents { tex_mins, extents }
     }
 
     /// Luxels across (s) and down (t): one per grid line, so extent/16 + 1.
@@ -113,6 +88,129 @@ impl LightmapExtents {
             (self.tex_mins[0] + x as i32 * LIGHTMAP_SCALE) as f64,
             (self.tex_mins[1] + y as i32 * LIGHTMAP_SCALE) as f64,
         ]
+    }
+}
+
+/// The first and last grid lines (in steps of `scale` texels) around the texture coordinates of
+/// `points`, each computed by `coord`; `([0, 0], [0, 0])` for no points.
+fn grid_lines(
+    points: &[[f32; 3]],
+    vecs: &[[f32; 4]; 2],
+    coord: impl Fn(&[f32; 3], &[f32; 4]) -> f32,
+    scale: i32,
+) -> ([i32; 2], [i32; 2]) {
+    let mut mins = [f64::INFINITY; 2];
+    let mut maxs = [f64::NEG_INFINITY; 2];
+    for p in points {
+        for axis in 0..2 {
+            let val = coord(p, &vecs[axis]) as f64;
+            mins[axis] = mins[axis].min(val);
+            maxs[axis] = maxs[axis].max(val);
+        }
+    }
+    let mut lo = [0; 2];
+    let mut hi = [0; 2];
+    if points.is_empty() {
+        return (lo, hi);
+    }
+    let scale = f64::from(scale);
+    for axis in 0..2 {
+        // Damaged files can hold absurd coordinates; clamping keeps the arithmetic in range
+        // (such a face fails every size check downstream anyway).
+        lo[axis] = (mins[axis] / scale).floor().clamp(-GRID_CLAMP, GRID_CLAMP) as i32;
+        // All-NaN coordinates leave the maximum below the minimum.
+        hi[axis] =
+            ((maxs[axis] / scale).ceil().clamp(-GRID_CLAMP, GRID_CLAMP) as i32).max(lo[axis]);
+    }
+    (lo, hi)
+}
+
+/// The texture coordinate of `p` along axis row `v`, as QuakeSpasm computes it (products summed in
+/// `f64`, the sum kept as `f32`).
+fn quakespasm_coord(p: &[f32; 3], v: &[f32; 4]) -> f32 {
+    (p[0] as f64 * v[0] as f64
+        + p[1] as f64 * v[1] as f64
+        + p[2] as f64 * v[2] as f64
+        + v[3] as f64) as f32
+}
+
+/// Where a face's luxels lie, whatever their spacing: luxel (x, y) stands at texture
+/// coordinates `mins + scale * (x, y)` of the projection `axes` (`s = axes[0].xyz · p +
+/// axes[0].w` for a model-space point `p`). Quake's 16-texel grid is one such grid
+/// ([`LuxelGrid::vanilla`]); so are the coarser or finer grids of the BSPX `LMSHIFT` lump
+/// ([`LuxelGrid::shifted`]) and the world-space grids of `DECOUPLED_LM`, whose projection is in
+/// luxels already (scale 1, minimum 0).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LuxelGrid {
+    /// The projection, in texels per map unit (the texture's own for vanilla and `LMSHIFT`).
+    pub axes: [[f64; 4]; 2],
+    /// Texels from one luxel to the next.
+    pub scale: f64,
+    /// Texture coordinates of luxel (0, 0).
+    pub mins: [f64; 2],
+    /// Luxels across (s) and down (t).
+    pub size: [usize; 2],
+}
+
+impl LuxelGrid {
+    /// Quake's grid: one luxel every 16 texels over `extents` of the texture projection `vecs`.
+    pub fn vanilla(extents: &LightmapExtents, vecs: &[[f32; 4]; 2]) -> LuxelGrid {
+        LuxelGrid {
+            axes: vecs.map(|row| row.map(f64::from)),
+            scale: f64::from(LIGHTMAP_SCALE),
+            mins: extents.tex_mins.map(f64::from),
+            size: extents.luxel_size(),
+        }
+    }
+
+    /// The grid of a face whose `LMSHIFT` is `shift`: one luxel every `1 << shift` texels, its
+    /// extents snapped to that spacing as engines that read the lump snap them (shift 4 is
+    /// Quake's grid). `None` for a shift past 30, which no engine's integer arithmetic holds.
+    pub fn shifted(points: &[[f32; 3]], vecs: &[[f32; 4]; 2], shift: u8) -> Option<LuxelGrid> {
+        if shift > 30 {
+            return None;
+        }
+        let scale = 1i32 << shift;
+        let (lo, hi) = grid_lines(points, vecs, quakespasm_coord, scale);
+        Some(LuxelGrid {
+            axes: vecs.map(|row| row.map(f64::from)),
+            scale: f64::from(scale),
+            mins: lo.map(|l| f64::from(l) * f64::from(scale)),
+            size: std::array::from_fn(|axis| (hi[axis] - lo[axis]) as usize + 1),
+        })
+    }
+
+    /// A grid whose projection gives luxel coordinates directly (`DECOUPLED_LM`'s
+    /// world-to-lightmap rows), `size` luxels.
+    pub fn in_luxels(world_to_luxel: &[[f32; 4]; 2], size: [usize; 2]) -> LuxelGrid {
+        LuxelGrid {
+            axes: world_to_luxel.map(|row| row.map(f64::from)),
+            scale: 1.0,
+            mins: [0.0; 2],
+            size,
+        }
+    }
+
+    /// Luxels in one style's lightmap.
+    pub fn luxel_count(&self) -> usize {
+        self.size[0] * self.size[1]
+    }
+
+    /// Texture coordinates (s, t) of luxel (x, y).
+    pub fn luxel_st(&self, x: usize, y: usize) -> [f64; 2] {
+        [
+            self.mins[0] + x as f64 * self.scale,
+            self.mins[1] + y as f64 * self.scale,
+        ]
+    }
+
+    /// Continuous luxel coordinates of model-space point `p` (luxel (x, y) at whole numbers).
+    pub fn luxel_at(&self, p: [f64; 3]) -> [f64; 2] {
+        std::array::from_fn(|axis| {
+            let a = self.axes[axis];
+            let st = a[0] * p[0] + a[1] * p[1] + a[2] * p[2] + a[3];
+            (st - self.mins[axis]) / self.scale
+        })
     }
 }
 
@@ -223,5 +321,32 @@ mod tests {
         assert_eq!(e.extents[0], 32);
         let pts = [[0.0, 0.0, 0.0], [32.000004, 0.0, 0.0]];
         assert_eq!(LightmapExtents::from_points(&pts, &AXIAL).extents[0], 48);
+    }
+
+    #[test]
+    fn shift_four_is_quakes_grid_and_shift_three_doubles_it() {
+        let pts = [[1.5, 0.0, 0.0], [30.25, -17.0, 0.0], [8.0, 3.0, 0.0]];
+        let vanilla = LightmapExtents::from_points(&pts, &AXIAL);
+        let grid = LuxelGrid::vanilla(&vanilla, &AXIAL);
+        assert_eq!(LuxelGrid::shifted(&pts, &AXIAL, 4), Some(grid));
+        assert_eq!(grid.luxel_st(1, 2), vanilla.luxel_st(1, 2));
+        let fine = LuxelGrid::shifted(&pts, &AXIAL, 3).expect("shift 3");
+        assert_eq!(fine.scale, 8.0);
+        assert_eq!(fine.mins, [0.0, -8.0]);
+        assert_eq!(fine.size, [5, 5]);
+        assert_eq!(LuxelGrid::shifted(&pts, &AXIAL, 31), None);
+    }
+
+    #[test]
+    fn luxel_at_inverts_luxel_st() {
+        let pts = [[0.0, 0.0, 0.0], [64.0, 48.0, 0.0]];
+        let grid = LuxelGrid::shifted(&pts, &AXIAL, 3).expect("shift 3");
+        let [s, t] = grid.luxel_st(3, 2);
+        // AXIAL: s = x, t = -y.
+        assert_eq!(grid.luxel_at([s, -t, 7.0]), [3.0, 2.0]);
+        let decoupled =
+            LuxelGrid::in_luxels(&[[0.125, 0.0, 0.0, 1.0], [0.0, 0.125, 0.0, 0.0]], [9, 7]);
+        assert_eq!(decoupled.luxel_at([16.0, 8.0, 0.0]), [3.0, 1.0]);
+        assert_eq!(decoupled.luxel_count(), 63);
     }
 }

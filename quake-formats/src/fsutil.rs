@@ -36,6 +36,11 @@ impl Staged {
         Ok(staged)
     }
 
+    /// Where the file goes.
+    pub fn target(&self) -> &Path {
+        &self.path
+    }
+
     /// Renames the temporary into place (atomic within one file system).
     pub fn commit(mut self) -> Result<()> {
         std::fs::rename(&self.tmp, &self.path).map_err(|e| self.io(e))?;

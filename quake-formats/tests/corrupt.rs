@@ -234,3 +234,148 @@ fn pvs_rows_read_as_engines_read_them() {
     let err = bsp.pvs_row(1).expect_err("offset past the lump");
     assert!(err.to_string().contains("leaf 1"), "{err}");
 }
+
+/// The tiny BSP with every BSPX light lump, each sized and placed as light writes them.
+fn tiny_bsp_with_light_lumps() -> Bsp {
+    use quake_formats::bsp::light_lumps::{
+        DecoupledLightmap, LIGHTING_E5BGR9, LIGHTINGDIR, RGBLIGHTING,
+    };
+    use quake_formats::bsp::lightgrid::{GridSample, LightGrid};
+    let mut bsp = tiny_bsp(BspVersion::Bsp29);
+    // The 16-texel lightmap (25 luxels) at 0, a 2x2 decoupled one after it.
+    bsp.lighting = vec![128; 29];
+    let rgb: Vec<u8> = (0..29 * 3).map(|i| i as u8).collect();
+    bsp.set_bspx_lump(RGBLIGHTING, rgb);
+    bsp.set_bspx_lump(LIGHTINGDIR, vec![128; 29 * 3]);
+    let hdr = quake_formats::lit::pack_e5bgr9([1.5, 1.0, 0.5]).to_le_bytes();
+    bsp.set_bspx_lump(LIGHTING_E5BGR9, hdr.repeat(29));
+    bsp.set_decoupled_lightmaps(&[DecoupledLightmap {
+        width: 2,
+        height: 2,
+        offset: 25,
+        world_to_luxel: [[1.0 / 64.0, 0.0, 0.0, 0.0], [0.0, 1.0 / 64.0, 0.0, 0.0]],
+    }]);
+    let lit = Some(vec![GridSample {
+        style: 0,
+        rgb: [10, 20, 30],
+    }]);
+    let points: Vec<_> = (0..8)
+        .map(|i| if i < 4 { None } else { lit.clone() })
+        .collect();
+    bsp.set_light_grid(&LightGrid::build([32.0; 3], [0.0; 3], [2, 2, 2], &points));
+    bsp
+}
+
+fn rules_broken(bsp: &Bsp) -> Vec<quake_formats::bsp::Rule> {
+    validate(bsp).iter().map(|p| p.rule).collect()
+}
+
+#[test]
+fn bspx_light_lumps_as_light_writes_them_are_valid() {
+    let bsp = tiny_bsp_with_light_lumps();
+    assert_eq!(validate(&bsp), vec![]);
+    let mut shifted = tiny_bsp(BspVersion::Bsp29);
+    // An 8-texel grid: 9x9 luxels after the 25 of the 16-texel one.
+    shifted.lighting = vec![128; 25 + 81];
+    shifted.set_shifted_lightmaps(&[3], &[25]);
+    assert_eq!(validate(&shifted), vec![]);
+}
+
+#[test]
+fn damaged_bspx_light_lumps_break_their_rules() {
+    use quake_formats::bsp::Rule;
+    use quake_formats::bsp::light_lumps::{DECOUPLED_LM, RGBLIGHTING};
+    use quake_formats::bsp::lightgrid::LIGHTGRID_OCTREE;
+
+    let mut short_rgb = tiny_bsp_with_light_lumps();
+    short_rgb.set_bspx_lump(RGBLIGHTING, vec![0; 10]);
+    assert_eq!(rules_broken(&short_rgb), [Rule::BspxLightSize]);
+
+    let mut past_end = tiny_bsp_with_light_lumps();
+    let mut records = past_end
+        .decoupled_lightmaps()
+        .expect("reads")
+        .expect("lump");
+    records[0].offset = 27;
+    past_end.set_decoupled_lightmaps(&records);
+    assert_eq!(rules_broken(&past_end), [Rule::DecoupledLightmap]);
+    records[0].offset = 25;
+    records[0].world_to_luxel[1][3] = f32::NAN;
+    past_end.set_decoupled_lightmaps(&records);
+    assert_eq!(rules_broken(&past_end), [Rule::DecoupledLightmap]);
+
+    let mut two_records = tiny_bsp_with_light_lumps();
+    two_records.set_bspx_lump(DECOUPLED_LM, vec![0; 80]);
+    assert_eq!(rules_broken(&two_records), [Rule::BspxFaceRecords]);
+
+    let mut grid = tiny_bsp_with_light_lumps();
+    grid.set_bspx_lump(LIGHTGRID_OCTREE, vec![0; 12]);
+    assert_eq!(rules_broken(&grid), [Rule::LightGrid]);
+
+    // A 4-texel grid over 64 texels: 17x17 luxels, far more than the lighting holds.
+    let mut fine = tiny_bsp(BspVersion::Bsp29);
+    fine.set_shifted_lightmaps(&[2], &[0]);
+    assert_eq!(rules_broken(&fine), [Rule::ShiftedLightmap]);
+    // A 320-texel face at one texel per luxel: 321 luxels, past the 256 engines must accept.
+    fine.vertices.iter_mut().for_each(|v| v[0] *= 5.0);
+    fine.lighting = vec![0; 400 * 70];
+    fine.set_shifted_lightmaps(&[0], &[0]);
+    assert!(rules_broken(&fine).contains(&Rule::ShiftedLightmap));
+}
+
+#[test]
+fn light_only_in_rgblighting_is_a_warning_that_names_vanilla_engines() {
+    use quake_formats::bsp::Rule;
+    let mut bsp = tiny_bsp_with_light_lumps();
+    bsp.lighting.clear();
+    let problems = validate(&bsp);
+    assert_eq!(
+        problems.iter().map(|p| p.rule).collect::<Vec<_>>(),
+        [Rule::NoVanillaLighting]
+    );
+    assert_eq!(problems[0].severity, Severity::Warning);
+    assert!(
+        problems[0].to_string().contains("QuakeSpasm"),
+        "{}",
+        problems[0]
+    );
+}
+
+/// The `qbsp` crate, an independent reader, finds in our lumps what we wrote.
+#[test]
+fn the_qbsp_crate_reads_our_bspx_light_lumps() {
+    let bsp = tiny_bsp_with_light_lumps();
+    let bytes = bsp.write().expect("write");
+    let theirs = qbsp::BspData::parse(qbsp::BspParseInput {
+        bsp: &bytes,
+        lit: None,
+        settings: qbsp::BspParseSettings {
+            use_bspx_rgb_lighting: false,
+            ..Default::default()
+        },
+    })
+    .expect("qbsp parses");
+    let rgb = theirs.bspx.rgb_lighting.as_ref().expect("RGBLIGHTING");
+    let ours = bsp
+        .bspx_lump(quake_formats::bsp::light_lumps::RGBLIGHTING)
+        .expect("lump");
+    assert_eq!(rgb.len(), 29);
+    assert!(rgb.iter().flatten().eq(ours.iter()));
+    let decoupled = theirs.bspx.decoupled_lm.as_ref().expect("DECOUPLED_LM");
+    let record = bsp.decoupled_lightmaps().expect("reads").expect("lump")[0];
+    assert_eq!(decoupled.len(), 1);
+    assert_eq!(decoupled[0].size.to_array(), [record.width, record.height]);
+    assert_eq!(decoupled[0].offset.pixels, record.offset);
+    let p = &decoupled[0].projection;
+    // qbsp adds half a luxel to the offsets, as FTE does when it builds texture coordinates.
+    assert_eq!(p.u_axis.to_array(), record.world_to_luxel[0][..3]);
+    assert_eq!(p.u_offset - 0.5, record.world_to_luxel[0][3]);
+    assert_eq!(p.v_axis.to_array(), record.world_to_luxel[1][..3]);
+    assert_eq!(p.v_offset - 0.5, record.world_to_luxel[1][3]);
+    let grid = theirs
+        .bspx
+        .light_grid_octree
+        .as_ref()
+        .expect("LIGHTGRID_OCTREE");
+    assert_eq!(grid.size.to_array(), [2, 2, 2]);
+}

@@ -64,6 +64,9 @@ pub struct Args {
     /// With --bench: empty the surface cache before every frame.
     #[arg(long)]
     pub no_cache: bool,
+    /// Draw the lighting alone, without textures (128 grey is the texture's own colour).
+    #[arg(long)]
+    pub lightmap_only: bool,
     /// Write counts and timings as JSON.
     #[arg(long, value_name = "FILE.json")]
     pub stats: Option<PathBuf>,
@@ -99,7 +102,8 @@ fn parse_size(s: &str) -> Result<(usize, usize), String> {
 /// picture), run the flythrough benchmark, or open the window.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let start = Instant::now();
-    let world = World::load(&args.map, args.palette.as_deref())?;
+    let mut world = World::load(&args.map, args.palette.as_deref())?;
+    world.lightmap_only = args.lightmap_only;
     if let Some(why) = &world.stats.ignored_lit {
         eprintln!("warning: {why}; drawing the BSP's own light in grey, as engines do");
     }

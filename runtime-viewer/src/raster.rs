@@ -188,6 +188,7 @@ mod tests {
             },
             styles: [0, 255, 255, 255],
             light: None,
+            free_lightmap: None,
         };
         (view, surface)
     }

@@ -12,12 +12,15 @@ use std::time::{Duration, Instant};
 use quake_formats::bsp::limits::MAX_LIGHTMAPS;
 
 use crate::camera::{NEAR_CLIP, View};
-use crate::textures::{FENCE_TRANSPARENT_INDEX, TextureKind};
+use crate::textures::{FENCE_TRANSPARENT_INDEX, TextureKind, pack};
 use crate::world::{Surface, World};
 
 /// Light value of every face of a map without lighting data: engines draw it fully lit. (In a
 /// map with lighting data, a face without a lightmap is dark, as in engines.)
 const UNLIT_MAP_LIGHT: u32 = 255;
+/// Light levels above this shade every palette colour to white (a channel of 1 times it /
+/// 128 is already past 255).
+const MAX_SHADED_LIGHT: u32 = 255 * 128;
 /// Style value for normal light ('m').
 pub const NORMAL_STYLE: u32 = 256;
 
@@ -153,7 +156,9 @@ pub struct LitSurface {
 }
 
 /// Light and texture a surface at `mip`: each texel's light is the bilinear blend of the four
-/// luxels around its corner, the styles summed with their current values.
+/// luxels around its corner, the styles summed with their current values. With
+/// [`World::lightmap_only`] the texture is left out: a texel shows its light (128 grey for the
+/// texture's own colour).
 pub fn build_lit_surface(
     world: &World,
     surface: &Surface,
@@ -163,7 +168,7 @@ pub fn build_lit_surface(
     let ext = surface.extents;
     let width = ((ext.extents[0] >> mip) as usize).max(1);
     let height = ((ext.extents[1] >> mip) as usize).max(1);
-    let [lw, lh] = ext.luxel_size();
+    let [lw, lh] = surface.luxel_size();
     let count = lw * lh;
     let mut block = vec![[0u32; 3]; count];
     match surface.light {
@@ -193,13 +198,29 @@ pub fn build_lit_surface(
             let pu = u << mip;
             let (lx, fx) = ((pu >> 4).min(lw - 1), (pu & 15) as u32);
             let lx1 = (lx + 1).min(lw - 1);
-            let (a, b) = (block[ly * lw + lx], block[ly * lw + lx1]);
-            let (c, d) = (block[ly1 * lw + lx], block[ly1 * lw + lx1]);
-            let light: [u32; 3] = std::array::from_fn(|k| {
-                let top = a[k] * (16 - fx) + b[k] * fx;
-                let bottom = c[k] * (16 - fx) + d[k] * fx;
-                ((top as u64 * (16 - fy) as u64 + bottom as u64 * fy as u64) >> 16) as u32
-            });
+            let light = match &surface.free_lightmap {
+                // Quake's grid: luxels 16 texels apart, blended in 1/16 steps as engines do.
+                None => {
+                    let (a, b) = (block[ly * lw + lx], block[ly * lw + lx1]);
+                    let (c, d) = (block[ly1 * lw + lx], block[ly1 * lw + lx1]);
+                    std::array::from_fn(|k| {
+                        let top = a[k] * (16 - fx) + b[k] * fx;
+                        let bottom = c[k] * (16 - fx) + d[k] * fx;
+                        ((top as u64 * (16 - fy) as u64 + bottom as u64 * fy as u64) >> 16) as u32
+                    })
+                }
+                Some(free) => {
+                    let s = f64::from(ext.tex_mins[0] + (pu as i32));
+                    let t = f64::from(ext.tex_mins[1] + (pv as i32));
+                    free_light(&block, [lw, lh], free.luxel_at(s, t))
+                }
+            };
+            // HDR light passes 255; past this every channel is white anyway.
+            let light = light.map(|l| l.min(MAX_SHADED_LIGHT));
+            if world.lightmap_only {
+                texels.push(pack(light.map(|l| l.min(255) as u8)));
+                continue;
+            }
             let idx = tex.index_at(mip, s0 + u as i32, t0 + v as i32);
             texels.push(if holes && idx == FENCE_TRANSPARENT_INDEX {
                 TRANSPARENT
@@ -213,6 +234,25 @@ pub fn build_lit_surface(
         height,
         texels,
     }
+}
+
+/// The light of `block` (`size` luxels, each summed over styles at [`NORMAL_STYLE`] per unit) at
+/// continuous luxel coordinates `at`, blended between the four luxels around it and held to the
+/// lightmap's edge.
+fn free_light(block: &[[u32; 3]], size: [usize; 2], at: [f64; 2]) -> [u32; 3] {
+    let [lw, lh] = size;
+    let split = |c: f64, n: usize| {
+        let c = c.clamp(0.0, (n - 1) as f64);
+        let i = (c.floor() as usize).min(n - 1);
+        (i, (i + 1).min(n - 1), c - i as f64)
+    };
+    let ((x0, x1, fx), (y0, y1, fy)) = (split(at[0], lw), split(at[1], lh));
+    std::array::from_fn(|k| {
+        let at = |x: usize, y: usize| f64::from(block[y * lw + x][k]);
+        let top = at(x0, y0) * (1.0 - fx) + at(x1, y0) * fx;
+        let bottom = at(x0, y1) * (1.0 - fx) + at(x1, y1) * fx;
+        ((top * (1.0 - fy) + bottom * fy) / f64::from(NORMAL_STYLE)).round() as u32
+    })
 }
 
 /// How the surface cache fared over one frame (or, added up, over many).
@@ -436,6 +476,101 @@ mod tests {
         }
         let (bright, idx, palette) = texel(unlit_map, 1);
         assert_eq!(bright, palette.shade(idx, [UNLIT_MAP_LIGHT; 3]));
+    }
+
+    /// A `DECOUPLED_LM` record per face describing its own 16-texel grid: drawn through the
+    /// free-grid path, every texel matches Quake's path within rounding.
+    #[test]
+    fn a_decoupled_lightmap_on_quakes_grid_draws_as_quakes() {
+        use quake_formats::bsp::light_lumps::DecoupledLightmap;
+        use quake_formats::extents::LightmapExtents;
+        let mut bsp = room_bsp(0);
+        let records: Vec<DecoupledLightmap> = bsp
+            .faces
+            .iter()
+            .map(|f| {
+                let vecs = bsp.texinfo[f.texinfo as usize].vecs;
+                let points = bsp.face_vertices(f).expect("face");
+                let ext = LightmapExtents::from_points(&points, &vecs);
+                let [w, h] = ext.luxel_size();
+                let row = |axis: usize| {
+                    let v = vecs[axis];
+                    let mins = ext.tex_mins[axis] as f32;
+                    [v[0] / 16.0, v[1] / 16.0, v[2] / 16.0, (v[3] - mins) / 16.0]
+                };
+                DecoupledLightmap {
+                    width: w as u16,
+                    height: h as u16,
+                    offset: f.light_offset,
+                    world_to_luxel: [row(0), row(1)],
+                }
+            })
+            .collect();
+        let quake = World::new(
+            bsp.clone(),
+            &Palette::slipgate(),
+            PaletteSource::Builtin,
+            None,
+        )
+        .expect("room");
+        // A face without a lightmap, as ericw-tools writes it: no luxels, no offset.
+        let mut empty = records.clone();
+        (empty[1].width, empty[1].height, empty[1].offset) = (0, 0, -1);
+        bsp.set_decoupled_lightmaps(&empty);
+        let world = World::new(
+            bsp.clone(),
+            &Palette::slipgate(),
+            PaletteSource::Builtin,
+            None,
+        )
+        .expect("room");
+        let unlit = world.surfaces[1].as_ref().expect("wall");
+        assert!(unlit.free_lightmap.is_none() && unlit.light.is_none());
+        build_lit_surface(&world, unlit, 0, &LightStyles::default());
+        bsp.set_decoupled_lightmaps(&records);
+        let decoupled =
+            World::new(bsp, &Palette::slipgate(), PaletteSource::Builtin, None).expect("room");
+        let mut compared = 0;
+        for (q, d) in quake.surfaces.iter().zip(&decoupled.surfaces) {
+            let (Some(q), Some(d)) = (q, d) else { continue };
+            assert!(d.free_lightmap.is_some() && d.light == q.light);
+            let styles = LightStyles::default();
+            let a = build_lit_surface(&quake, q, 0, &styles);
+            let b = build_lit_surface(&decoupled, d, 0, &styles);
+            for (x, y) in a.texels.iter().zip(&b.texels) {
+                let (x, y) = (crate::textures::unpack(*x), crate::textures::unpack(*y));
+                assert!(
+                    x.iter().zip(y).all(|(p, q)| p.abs_diff(q) <= 2),
+                    "{x:?} {y:?}"
+                );
+                compared += 1;
+            }
+        }
+        assert!(compared > 1000);
+    }
+
+    #[test]
+    fn lightmap_only_shows_the_light_without_the_texture() {
+        let mut world = room(0);
+        world.lightmap_only = true;
+        let s = world.surfaces[2].as_ref().expect("wall");
+        let lit = build_lit_surface(&world, s, 0, &LightStyles::default());
+        let l0 = world.light[s.light.expect("lit")][0] as u8;
+        assert_eq!(lit.texels[0], pack([l0; 3]));
+    }
+
+    #[test]
+    fn hdr_light_past_255_shades_to_white_without_overflow() {
+        let mut world = room(0);
+        let s = world.surfaces[2].clone().expect("wall");
+        let ofs = s.light.expect("lit");
+        world.light[ofs] = [u16::MAX; 3];
+        let lit = build_lit_surface(&world, &s, 0, &LightStyles::default());
+        let idx = world.textures[0].index_at(0, s.extents.tex_mins[0], s.extents.tex_mins[1]);
+        assert_eq!(
+            lit.texels[0],
+            world.palette.shade(idx, [MAX_SHADED_LIGHT; 3])
+        );
     }
 
     #[test]

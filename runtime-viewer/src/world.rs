@@ -2,14 +2,16 @@
 //! lightmap rectangles, textures, the palette, lightmaps as RGB, node/leaf parents, and brush
 //! models cut into the world's leaves so they sort with the world.
 
-use glam::{DVec3, Vec3};
+use glam::{DMat3, DVec3, Vec3};
 use std::path::Path;
 
 use quake_formats::Bsp;
+use quake_formats::bsp::light_lumps::{LIGHTING_E5BGR9, RGBLIGHTING};
 use quake_formats::bsp::{contents, limits::MAX_LIGHTMAPS, texinfo_flags};
 use quake_formats::entities::{Entity, parse_entities};
-use quake_formats::extents::LightmapExtents;
+use quake_formats::extents::{LightmapExtents, LuxelGrid};
 use quake_formats::geom::{Plane, Split, Winding};
+use quake_formats::lit::{LitData, unpack_e5bgr9};
 use quake_formats::palette::Palette;
 
 use crate::error::{Result, ViewerError};
@@ -44,6 +46,49 @@ pub struct Surface {
     pub styles: [u8; MAX_LIGHTMAPS],
     /// First luxel in [`World::light`], when the face has a complete lightmap.
     pub light: Option<usize>,
+    /// The lightmap's own grid when it is not Quake's 16 texels over `extents` (`DECOUPLED_LM`,
+    /// `LMSHIFT`).
+    pub free_lightmap: Option<FreeLightmap>,
+}
+
+/// A lightmap on a grid of its own: the grid, and the point of the face's plane (in model space,
+/// where the grid's projection works) at texture coordinates (s, t): `at + s * per_s + t * per_t`.
+#[derive(Debug, Clone)]
+pub struct FreeLightmap {
+    pub grid: LuxelGrid,
+    pub at: DVec3,
+    pub per_s: DVec3,
+    pub per_t: DVec3,
+}
+
+impl FreeLightmap {
+    /// `grid` on a face of texture projection `vecs` and plane `normal · p = dist`; `None` when
+    /// the grid is empty or the projection runs along the plane (no point has a texture
+    /// coordinate).
+    fn new(grid: LuxelGrid, vecs: &[[f32; 4]; 2], normal: DVec3, dist: f64) -> Option<Self> {
+        if grid.luxel_count() == 0 {
+            return None;
+        }
+        let row = |v: [f32; 4]| DVec3::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2]));
+        let rows = DMat3::from_cols(row(vecs[0]), row(vecs[1]), normal).transpose();
+        if rows.determinant().abs() < 1e-9 {
+            return None;
+        }
+        let inverse = rows.inverse();
+        let offsets = DVec3::new(-f64::from(vecs[0][3]), -f64::from(vecs[1][3]), dist);
+        Some(FreeLightmap {
+            grid,
+            at: inverse * offsets,
+            per_s: inverse.x_axis,
+            per_t: inverse.y_axis,
+        })
+    }
+
+    /// Continuous luxel coordinates of texture coordinates (s, t).
+    pub fn luxel_at(&self, s: f64, t: f64) -> [f64; 2] {
+        self.grid
+            .luxel_at((self.at + self.per_s * s + self.per_t * t).to_array())
+    }
 }
 
 impl Surface {
@@ -53,6 +98,13 @@ impl Surface {
             self.s_axis.dot(p) + self.s_offset,
             self.t_axis.dot(p) + self.t_offset,
         )
+    }
+
+    /// Luxels across and down its lightmap.
+    pub fn luxel_size(&self) -> [usize; 2] {
+        self.free_lightmap
+            .as_ref()
+            .map_or_else(|| self.extents.luxel_size(), |f| f.grid.size)
     }
 
     /// How many lightmaps the face has: its styles before the first [`NO_STYLE`].
@@ -85,10 +137,69 @@ pub struct LoadStats {
     pub brush_models_drawn: usize,
     /// Pieces those models were cut into by the world's leaves.
     pub brush_model_fragments: usize,
-    /// Whether a `.lit` file gave the light its colour.
+    /// Whether the light has colour (a `.lit`, `RGBLIGHTING` or HDR light).
     pub coloured_light: bool,
+    /// Where the light came from.
+    pub light_source: LightSource,
     /// Why a `.lit` beside the BSP was not used (engines then draw the BSP's own light, grey).
     pub ignored_lit: Option<String>,
+}
+
+/// Where a map's light comes from, the first there is of: the BSPX `LIGHTING_E5BGR9` lump,
+/// the `RGBLIGHTING` lump, a `.lit` (HDR or not), the lighting lump. As FTE and QuakeSpasm-Spiked
+/// choose, engines without BSPX support reading only the last two.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum LightSource {
+    /// The grey lighting lump (or none).
+    #[default]
+    LightingLump,
+    /// A `.lit` beside the BSP.
+    Lit,
+    /// An HDR `.lit` beside the BSP.
+    HdrLit,
+    /// The `RGBLIGHTING` lump.
+    RgbLighting,
+    /// The `LIGHTING_E5BGR9` lump.
+    HdrLump,
+}
+
+/// Light levels of HDR light 1.0 (the texture's own colour), as lightmap bytes stand for it.
+const HDR_ONE: f32 = 128.0;
+
+/// Each luxel's light, 128 the texture's own colour, from the best source `bsp` and its `.lit`
+/// offer (see [`LightSource`]); a BSPX lump of the wrong size is passed over.
+fn choose_light(bsp: &Bsp, lit: Option<LitData>) -> (Vec<[u16; 3]>, LightSource) {
+    let luxels = bsp.luxel_count();
+    let from_hdr = |words: &mut dyn Iterator<Item = u32>| -> Vec<[u16; 3]> {
+        words
+            .map(|w| unpack_e5bgr9(w).map(|c| (c * HDR_ONE).round().clamp(0.0, 65535.0) as u16))
+            .collect()
+    };
+    let from_rgb = |rgb: &[u8]| -> Vec<[u16; 3]> {
+        rgb.chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2]].map(u16::from))
+            .collect()
+    };
+    if let Some(hdr) = bsp
+        .bspx_lump(LIGHTING_E5BGR9)
+        .filter(|l| l.len() == 4 * luxels)
+    {
+        let mut words = hdr
+            .chunks_exact(4)
+            .map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]));
+        return (from_hdr(&mut words), LightSource::HdrLump);
+    }
+    if let Some(rgb) = bsp.bspx_lump(RGBLIGHTING).filter(|l| l.len() == 3 * luxels) {
+        return (from_rgb(rgb), LightSource::RgbLighting);
+    }
+    match lit {
+        Some(LitData::Rgb(rgb)) => (from_rgb(&rgb), LightSource::Lit),
+        Some(LitData::Hdr(words)) => (from_hdr(&mut words.into_iter()), LightSource::HdrLit),
+        None => (
+            bsp.lighting.iter().map(|&l| [u16::from(l); 3]).collect(),
+            LightSource::LightingLump,
+        ),
+    }
 }
 
 /// A loaded map, ready to draw.
@@ -105,8 +216,12 @@ pub struct World {
     pub textures: Vec<Texture>,
     /// One per BSP face; `None` for faces too broken to draw.
     pub surfaces: Vec<Option<Surface>>,
-    /// Lightmap samples as RGB, one per byte of the lighting lump.
-    pub light: Vec<[u8; 3]>,
+    /// Lightmap samples as RGB, one per luxel (128: the texture's own colour; HDR light may
+    /// pass 255).
+    pub light: Vec<[u16; 3]>,
+    /// Draw the light alone, without textures: a texel shows its light level (128 grey for the
+    /// texture's own colour; `--lightmap-only`).
+    pub lightmap_only: bool,
     /// Parent node of each node of the world's tree; -1 for the root and unreached nodes.
     pub node_parent: Vec<i32>,
     /// Parent node of each leaf; -1 for leaves the world's tree does not reach.
@@ -136,8 +251,8 @@ impl World {
         // As QuakeSpasm and DarkPlaces do, a `.lit` that is not this BSP's is ignored, not fatal.
         let (lit, ignored_lit) = if lit_path.is_file() {
             let data = quake_formats::fsutil::read_file(&lit_path).map_err(format(&lit_path))?;
-            match quake_formats::lit::read_lit(&data, bsp.lighting.len()) {
-                Ok(rgb) => (Some(rgb), None),
+            match quake_formats::lit::read_any_lit(&data, bsp.luxel_count()) {
+                Ok(lit) => (Some(lit), None),
                 Err(e) => (None, Some(format!("{}: {e}", lit_path.display()))),
             }
         } else {
@@ -153,18 +268,20 @@ impl World {
         Ok(world)
     }
 
-    /// Build from parts; `lit` is the RGB data of a `.lit` file matching `bsp.lighting`.
+    /// Build from parts; `lit` is the data of a `.lit` file matching the BSP's luxels.
     pub fn new(
         bsp: Bsp,
         palette: &Palette,
         palette_source: PaletteSource,
-        lit: Option<Vec<u8>>,
+        lit: Option<LitData>,
     ) -> Result<World, String> {
         quake_formats::check_usable(&bsp).map_err(|e| e.to_string())?;
         let entities = parse_entities(&bsp.entity_text()).map_err(|e| format!("entities: {e}"))?;
+        let (light, light_source) = choose_light(&bsp, lit);
         let mut stats = LoadStats {
             faces: bsp.faces.len(),
-            coloured_light: lit.is_some(),
+            coloured_light: light_source != LightSource::LightingLump,
+            light_source,
             ..LoadStats::default()
         };
         let mut textures: Vec<Texture> = bsp
@@ -183,11 +300,6 @@ impl World {
         let fallback_texture = textures.len();
         textures.push(Texture::checker(String::new()));
         stats.textures = textures.len();
-
-        let light: Vec<[u8; 3]> = match &lit {
-            Some(rgb) => rgb.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
-            None => bsp.lighting.iter().map(|&l| [l; 3]).collect(),
-        };
 
         // Each drawn brush model's entity origin moves its faces.
         let mut model_origin: Vec<Option<DVec3>> = vec![None; bsp.models.len()];
@@ -220,10 +332,15 @@ impl World {
             }
         }
 
+        let layouts = lightmap_layouts(&bsp);
         let surfaces: Vec<Option<Surface>> = (0..bsp.faces.len())
             .map(|f| {
                 let origin = face_origin[f].map_or(DVec3::ZERO, |(_, o)| o);
-                build_surface(&bsp, f, origin, &textures, fallback_texture, light.len())
+                let lightmap = Lightmap {
+                    layout: layouts.as_ref().and_then(|l| l.get(f).copied().flatten()),
+                    luxels: light.len(),
+                };
+                build_surface(&bsp, f, origin, &textures, fallback_texture, lightmap)
             })
             .collect();
         stats.drawable_faces = surfaces.iter().flatten().count();
@@ -266,6 +383,7 @@ impl World {
             textures,
             surfaces,
             light,
+            lightmap_only: false,
             node_parent,
             leaf_parent,
             leaf_fragments,
@@ -331,13 +449,45 @@ impl World {
     }
 }
 
+/// Per face, the grid and first luxel of its lightmap when the BSP gives it one of its own: from
+/// `DECOUPLED_LM`, else from `LMSHIFT` (and `LMOFFSET`, else the face's light offset); `None`
+/// when neither lump is there (or reads).
+fn lightmap_layouts(bsp: &Bsp) -> Option<Vec<Option<(LuxelGrid, i32)>>> {
+    if let Ok(Some(records)) = bsp.decoupled_lightmaps() {
+        return Some(records.iter().map(|r| Some((r.grid(), r.offset))).collect());
+    }
+    let shifts = bsp.lightmap_shifts().ok()??;
+    let offsets = bsp.lightmap_offsets().ok()?;
+    let layouts = bsp
+        .faces
+        .iter()
+        .zip(&shifts)
+        .enumerate()
+        .map(|(i, (f, &shift))| {
+            let points = bsp.face_vertices(f)?;
+            let tex = bsp.texinfo.get(f.texinfo as usize)?;
+            let grid = LuxelGrid::shifted(&points, &tex.vecs, shift)?;
+            let offset = offsets.as_ref().map_or(f.light_offset, |o| o[i]);
+            Some((grid, offset))
+        })
+        .collect();
+    Some(layouts)
+}
+
+/// Where a face's lightmap lies: its own grid and first luxel, if the BSP gives it one, and the
+/// luxels of light there are.
+struct Lightmap {
+    layout: Option<(LuxelGrid, i32)>,
+    luxels: usize,
+}
+
 fn build_surface(
     bsp: &Bsp,
     f: usize,
     origin: DVec3,
     textures: &[Texture],
     fallback_texture: usize,
-    light_len: usize,
+    lightmap: Lightmap,
 ) -> Option<Surface> {
     let face = &bsp.faces[f];
     let raw_points = bsp.face_vertices(face)?;
@@ -362,9 +512,19 @@ fn build_surface(
     let kind = textures[texture].kind(ti.flags & texinfo_flags::SPECIAL != 0);
     let styles = face.styles;
     let styles_used = styles.iter().take_while(|&&s| s != NO_STYLE).count();
-    let light = usize::try_from(face.light_offset)
+    let model_normal = Vec3::from(bp.normal).as_dvec3();
+    let free_lightmap = lightmap
+        .layout
+        .as_ref()
+        .and_then(|(grid, _)| FreeLightmap::new(*grid, &ti.vecs, model_normal, f64::from(bp.dist)));
+    let (offset, count) = match (&lightmap.layout, &free_lightmap) {
+        (Some((_, offset)), Some(free)) => (*offset, free.grid.luxel_count()),
+        (Some(_), None) => (-1, 0),
+        (None, _) => (face.light_offset, extents.luxel_count()),
+    };
+    let light = usize::try_from(offset)
         .ok()
-        .filter(|&ofs| styles_used > 0 && ofs + styles_used * extents.luxel_count() <= light_len);
+        .filter(|&ofs| styles_used > 0 && ofs + styles_used * count <= lightmap.luxels);
     Some(Surface {
         plane,
         points: raw_points
@@ -380,6 +540,7 @@ fn build_surface(
         extents,
         styles,
         light,
+        free_lightmap,
     })
 }
 
@@ -463,6 +624,63 @@ fn cut_into_leaves(bsp: &Bsp, face: u32, winding: Winding, out: &mut [Vec<Fragme
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn load(bsp: Bsp) -> World {
+        World::new(bsp, &Palette::slipgate(), PaletteSource::Builtin, None).expect("room")
+    }
+
+    #[test]
+    fn bspx_light_lumps_win_over_the_lit_and_the_grey_lump() {
+        let mut bsp = crate::test_room::room_bsp(0);
+        let luxels = bsp.lighting.len();
+        let grey = load(bsp.clone());
+        assert_eq!(grey.stats.light_source, LightSource::LightingLump);
+        let rgb: Vec<u8> = (0..3 * luxels).map(|i| (i % 251) as u8).collect();
+        bsp.set_bspx_lump(RGBLIGHTING, rgb.clone());
+        let coloured = load(bsp.clone());
+        assert_eq!(coloured.stats.light_source, LightSource::RgbLighting);
+        assert_eq!(coloured.light[1], [3, 4, 5]);
+        // -novanilla: no grey lump, RGBLIGHTING alone.
+        let mut novanilla = bsp.clone();
+        novanilla.lighting.clear();
+        let world = load(novanilla);
+        assert_eq!(world.light, coloured.light);
+        assert_eq!(
+            world
+                .surfaces
+                .iter()
+                .flatten()
+                .filter(|s| s.light.is_some())
+                .count(),
+            coloured
+                .surfaces
+                .iter()
+                .flatten()
+                .filter(|s| s.light.is_some())
+                .count(),
+            "faces keep their lightmaps"
+        );
+        // HDR light, twice the texture's own colour in red.
+        let word = quake_formats::lit::pack_e5bgr9([2.0, 1.0, 0.0]);
+        bsp.set_bspx_lump(LIGHTING_E5BGR9, word.to_le_bytes().repeat(luxels));
+        let hdr = load(bsp.clone());
+        assert_eq!(hdr.stats.light_source, LightSource::HdrLump);
+        assert_eq!(hdr.light[0], [256, 128, 0]);
+        // A lump of the wrong size is passed over.
+        bsp.set_bspx_lump(LIGHTING_E5BGR9, vec![0; 4]);
+        assert_eq!(load(bsp).stats.light_source, LightSource::RgbLighting);
+    }
+
+    #[test]
+    fn an_hdr_lit_beside_the_bsp_is_read() {
+        let bsp = crate::test_room::room_bsp(0);
+        let words = vec![quake_formats::lit::pack_e5bgr9([0.5; 3]); bsp.lighting.len()];
+        let lit = Some(LitData::Hdr(words));
+        let world =
+            World::new(bsp, &Palette::slipgate(), PaletteSource::Builtin, lit).expect("room");
+        assert_eq!(world.stats.light_source, LightSource::HdrLit);
+        assert_eq!(world.light[0], [64; 3]);
+    }
 
     #[test]
     fn a_lit_of_another_bsp_is_ignored_as_engines_do_not_fatal() {

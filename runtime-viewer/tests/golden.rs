@@ -9,6 +9,7 @@
 use std::path::{Path, PathBuf};
 
 use bsp_compiler::{CompileOptions, MapSource, compile};
+use quake_formats::lit::LitData;
 use quake_formats::palette::Palette;
 use runtime_viewer::textures::PaletteSource;
 use runtime_viewer::{
@@ -50,6 +51,7 @@ fn build_demo(threads: usize) -> (Vec<u8>, Option<Vec<u8>>) {
         let lit = light::apply_lighting(&mut bsp, &lighting);
         let bytes = bsp.write().expect("BSP encodes");
         let rgb = lit
+            .lit
             .map(|lit| quake_formats::lit::read_lit(&lit, bsp.lighting.len()).expect("valid .lit"));
         (bytes, rgb)
     })
@@ -57,8 +59,13 @@ fn build_demo(threads: usize) -> (Vec<u8>, Option<Vec<u8>>) {
 
 fn render_demo(bsp: &[u8], lit: Option<Vec<u8>>) -> (World, Camera, Frame) {
     let bsp = quake_formats::Bsp::read(bsp).expect("BSP decodes");
-    let world =
-        World::new(bsp, &Palette::slipgate(), PaletteSource::Builtin, lit).expect("the demo loads");
+    let world = World::new(
+        bsp,
+        &Palette::slipgate(),
+        PaletteSource::Builtin,
+        lit.map(LitData::Rgb),
+    )
+    .expect("the demo loads");
     let (origin, yaw) = world.player_start().expect("demo has a player start");
     let camera = Camera {
         origin,

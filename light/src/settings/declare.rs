@@ -21,6 +21,9 @@ pub struct Setting {
     pub range: super::Range,
     /// Its flag is a switch (takes no value).
     pub switch: bool,
+    /// Numbers its flag's value may be given as, each its own argument (`--lightgrid_dist 16 16
+    /// 32`).
+    pub words: usize,
     /// Its default, as the docs write it.
     pub default: fn() -> String,
     /// Whether a flag's argument reads as a value of the setting (else what was expected).
@@ -74,6 +77,7 @@ macro_rules! settings {
             help: concat!($($doc),+),
             range: $range,
             switch: <$ty as SettingValue>::SWITCH,
+            words: <$ty as SettingValue>::WORDS,
             default: || <$ty as SettingValue>::show(&$default),
             check: |text| match <$ty as SettingValue>::read(text) {
                 Some(Ok(_)) => Ok(()),

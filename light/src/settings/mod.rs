@@ -23,7 +23,7 @@ pub use declare::Setting;
 use declare::settings;
 use resolve::{Declared, given, resolve};
 pub use resolve::{Given, SettingWarning, World};
-pub use value::{Color, DirtToggle, Range, SettingValue, normalize_color};
+pub use value::{Color, DirtToggle, Range, SettingValue, Spacing, normalize_color};
 
 settings! {
     /// Average each luxel with its neighbours within N luxels (`--soft` alone: 1).
@@ -124,6 +124,35 @@ settings! {
 
     /// Light of switchable and animated styles reflects too, in its own style.
     bounce_styled: bool = false, flag "bouncestyled", keys ["_bouncestyled"], range Range::Any;
+
+    /// Write the coloured lightmaps into the BSP as the BSPX `RGBLIGHTING` lump (beside any
+    /// `.lit`), for FTE, QuakeSpasm-Spiked and Ironwail.
+    bspxlit: bool = false, flag "bspxlit", keys [], range Range::Any;
+
+    /// Leave out the grey lighting lump (implies `--bspxlit`; no `.lit` unless `--lit`): engines
+    /// that read only the grey lump (QuakeSpasm 0.95, DarkPlaces, vanilla) draw the map unlit.
+    novanilla: bool = false, flag "novanilla", keys [], range Range::Any;
+
+    /// Write a `.lux` deluxemap beside the BSP: per luxel, the light's mean direction in the
+    /// face's tangent space (DarkPlaces' `.dlit`, FTE's `.lux`).
+    lux: bool = false, flag "lux", keys [], range Range::Any;
+
+    /// Write the deluxemap into the BSP as the BSPX `LIGHTINGDIR` lump.
+    bspxlux: bool = false, flag "bspxlux", keys [], range Range::Any;
+
+    /// Write the `.lit` in HDR form (E5BGR9 words, light past 255 kept), for FTE.
+    hdr: bool = false, flag "hdr", keys [], range Range::Any;
+
+    /// Write HDR lightmaps into the BSP as the BSPX `LIGHTING_E5BGR9` lump.
+    bspxhdr: bool = false, flag "bspxhdr", keys [], range Range::Any;
+
+    /// Sample light through the map's open space into the BSPX `LIGHTGRID_OCTREE` lump, which
+    /// FTE, QuakeSpasm-Spiked and Ironwail light models with (direct light and minlight; bounced
+    /// light is not in it).
+    lightgrid: bool = false, flag "lightgrid", keys ["_lightgrid"], range Range::Any;
+
+    /// Map units between light grid points (one number, or one per axis; at least 1).
+    lightgrid_dist: Spacing = Spacing::EVEN_32, flag "lightgrid_dist", keys ["_lightgrid_dist"], range Range::Any;
 }
 
 /// The settings as `docs/mapping.md` tables them: one row per setting, with its worldspawn

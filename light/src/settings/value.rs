@@ -10,6 +10,10 @@ pub trait SettingValue: Clone + Sized {
     /// The setting is a switch: its flag takes no value and turns it on.
     const SWITCH: bool = false;
 
+    /// Numbers a flag's value may be given as, each its own argument (ericw-tools'
+    /// `-lightgrid_dist 16 16 32`).
+    const WORDS: usize = 1;
+
     /// What `text` (a key's value or a flag's argument) says; `None` for a blank value, which
     /// counts as absent; `Err` names what was expected.
     fn read(text: &str) -> Option<Result<Self, &'static str>>;
@@ -168,6 +172,45 @@ impl SettingValue for DVec3 {
     }
 }
 
+/// Distances along x, y and z, each at least 1: one number for all three, or three.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Spacing(pub DVec3);
+
+impl Spacing {
+    /// 32 units on every axis (ericw-tools' light grid spacing).
+    pub const EVEN_32: Spacing = Spacing(DVec3::splat(32.0));
+}
+
+impl SettingValue for Spacing {
+    const WORDS: usize = 3;
+
+    fn read(text: &str) -> Option<Result<Spacing, &'static str>> {
+        const WANT: &str = "one or three numbers, each at least 1";
+        let parts: Vec<&str> = text.split_whitespace().collect();
+        let xyz = match parts[..] {
+            [] => return None,
+            [one] => DVec3::splat(one.parse().unwrap_or(f64::NAN)),
+            [x, y, z] => DVec3::new(
+                x.parse().unwrap_or(f64::NAN),
+                y.parse().unwrap_or(f64::NAN),
+                z.parse().unwrap_or(f64::NAN),
+            ),
+            _ => return Some(Err(WANT)),
+        };
+        let usable = xyz.is_finite() && xyz.min_element() >= 1.0;
+        Some(usable.then_some(Spacing(xyz)).ok_or(WANT))
+    }
+
+    fn show(&self) -> String {
+        let v = self.0;
+        if v.x == v.y && v.y == v.z {
+            v.x.to_string()
+        } else {
+            v.show()
+        }
+    }
+}
+
 /// A colour, 1.0 a full channel.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Color(pub DVec3);
@@ -296,6 +339,13 @@ mod tests {
         );
         assert_eq!(Color::read("1 2"), Some(Err("three numbers")));
         assert_eq!(Option::<String>::read(""), Some(Ok(Some(String::new()))));
+        assert_eq!(Spacing::read("16"), Some(Ok(Spacing(DVec3::splat(16.0)))));
+        assert_eq!(
+            Spacing::read("16 16 32"),
+            Some(Ok(Spacing(DVec3::new(16.0, 16.0, 32.0))))
+        );
+        assert!(matches!(Spacing::read("16 0.5 32"), Some(Err(_))));
+        assert!(matches!(Spacing::read("16 16"), Some(Err(_))));
     }
 
     #[test]

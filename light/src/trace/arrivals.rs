@@ -132,6 +132,9 @@ fn settle(
             for (o, c) in slot.iter_mut().zip(sun.color.to_array()) {
                 *o += (value * c) as f32;
             }
+            if let Some(d) = &mut out.directions {
+                d.add_from_sun(sun.style, i, sun.to_sun, value * brightness(sun.color));
+            }
         }
     }
 }
@@ -159,6 +162,12 @@ fn deposit(
             *o = if local_min { o.max(add) } else { *o + add };
         }
     }
+    if let Some(d) = out.directions.as_mut().filter(|_| !local_min) {
+        let weight = brightness(light.color);
+        for (i, value) in arrived.clone() {
+            d.add_from_point(light.style, i, light.origin, value * weight);
+        }
+    }
     if !local_min && !light.bounce {
         let len = out.sums.len;
         let kept = out.no_bounce.get_or_insert_with(|| StyleBuffers::new(len));
@@ -169,4 +178,9 @@ fn deposit(
             }
         }
     }
+}
+
+/// How bright a colour is, for weighing directions: the mean of its channels.
+fn brightness(color: glam::DVec3) -> f64 {
+    color.element_sum() / 3.0
 }

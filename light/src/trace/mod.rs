@@ -24,7 +24,7 @@ mod footprints;
 mod points;
 mod sample_light;
 mod shadows;
-mod suns;
+pub(crate) mod suns;
 
 use glam::Vec3;
 use quake_formats::Bsp;
@@ -40,13 +40,14 @@ use crate::scene::TraceScene;
 use crate::visibility::Visibility;
 use arrivals::Arrivals;
 use footprints::Footprints;
+use sample_light::Directions;
 pub use sample_light::SampleLight;
 use sample_light::StyleBuffers;
 use shadows::VisibilityScratch;
 
 /// Shadow rays stop this far short of the light, so a light sitting right
 /// on a surface is not blocked by it.
-const LIGHT_CLEARANCE: f32 = 0.1;
+pub(crate) const LIGHT_CLEARANCE: f32 = 0.1;
 
 /// Everything shared by all faces while tracing.
 pub struct TraceSetup<'a> {
@@ -72,6 +73,8 @@ pub struct TraceSetup<'a> {
     /// Supersampled faces trace sub-samples only where luxels disagree
     /// (see `VisibilityScratch::trace`); off for the reference.
     pub adaptive: bool,
+    /// Keep the directions light arrives from (for deluxemaps).
+    pub directions: bool,
 }
 
 /// What one face takes from the lights (set per brush model).
@@ -99,6 +102,9 @@ pub struct FaceLight {
     pub height: usize,
     /// Style and its luxels (row-major), style 0 first.
     pub styles: Vec<(u8, Vec<[f32; 3]>)>,
+    /// When deluxemaps are wanted: per style, each luxel's mean direction of arriving light in
+    /// the face's tangent space (unit; zero where none arrived). Styles not listed have none.
+    pub directions: Vec<(u8, Vec<[f32; 3]>)>,
 }
 
 /// Work done lighting one face.
@@ -202,6 +208,10 @@ impl<'a> FaceTrace<'a> {
             added_minlight: None,
             no_bounce: None,
             bounce_dirt: Vec::new(),
+            directions: setup.directions.then(|| {
+                let face = &setup.faces[samples.face];
+                Directions::new(&samples.points, &face.vecs, face.plane.normal)
+            }),
         };
         let mut bounds = Bounds::EMPTY;
         for &p in &samples.points {

@@ -1,6 +1,9 @@
 //! A face's light per sample and style, as tracing leaves it: sums, local-minlight floors,
-//! `--addmin` minlight and the dirt factor of bounced light, until [`SampleLight::finish`]
-//! adds bounce, applies the floors and averages samples to luxels.
+//! `--addmin` minlight, the dirt factor of bounced light and (for deluxemaps) the directions
+//! light arrived from, until [`SampleLight::finish`] adds bounce, applies the floors and
+//! averages samples to luxels.
+
+use glam::{DMat3, DVec3, Vec3};
 
 use super::FaceLight;
 
@@ -47,6 +50,76 @@ pub struct SampleLight {
     pub(super) no_bounce: Option<StyleBuffers>,
     /// Per sample, the dirt factor of bounced light (empty: none).
     pub(super) bounce_dirt: Vec<f32>,
+    /// Where light came from, when deluxemaps are wanted.
+    pub(super) directions: Option<Directions>,
+}
+
+/// Per sample and style, the directions towards the lights and suns that reached it, each
+/// weighted by the light it brought; and the face's tangent space, in which a luxel's mean
+/// direction is given (deluxemaps).
+#[derive(Debug)]
+pub struct Directions {
+    /// The sample points, for the direction to a point light.
+    points: Vec<[f32; 3]>,
+    sums: StyleBuffers,
+    /// Rows: the face's texture s direction, the direction of decreasing t, and its normal (all
+    /// unit), as ericw-tools, FTE and DarkPlaces read deluxemaps.
+    to_tangent: DMat3,
+}
+
+impl Directions {
+    /// Directions of light arriving at `points`, on a face with texture projection `vecs` and
+    /// outward `normal`.
+    pub fn new(points: &[[f32; 3]], vecs: &[[f32; 4]; 2], normal: DVec3) -> Directions {
+        let axis = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]).as_dvec3().normalize_or_zero();
+        let (s, t) = (axis(vecs[0]), -axis(vecs[1]));
+        Directions {
+            points: points.to_vec(),
+            sums: StyleBuffers::new(points.len()),
+            to_tangent: DMat3::from_cols(s, t, normal).transpose(),
+        }
+    }
+
+    /// Light of `weight` reached sample `i` in `style` from direction `to_light` (unit).
+    fn add(&mut self, style: u8, i: usize, to_light: DVec3, weight: f64) {
+        let sum = &mut self.sums.get(style)[i];
+        for (o, d) in sum.iter_mut().zip(to_light.to_array()) {
+            *o += (d * weight) as f32;
+        }
+    }
+
+    /// Light of `weight` reached sample `i` in `style` from a light at `origin`.
+    pub(super) fn add_from_point(&mut self, style: u8, i: usize, origin: DVec3, weight: f64) {
+        let to_light = origin - Vec3::from(self.points[i]).as_dvec3();
+        self.add(style, i, to_light.normalize_or_zero(), weight);
+    }
+
+    /// Light of `weight` reached sample `i` in `style` from a sun in direction `to_sun`.
+    pub(super) fn add_from_sun(&mut self, style: u8, i: usize, to_sun: DVec3, weight: f64) {
+        self.add(style, i, to_sun, weight);
+    }
+
+    /// Per style, each luxel's mean direction in tangent space (unit; zero where no light
+    /// with a direction arrived), `per` samples to a luxel.
+    fn luxel_directions(self, per: usize) -> Vec<(u8, Vec<[f32; 3]>)> {
+        let to_tangent = self.to_tangent;
+        self.sums
+            .styles
+            .into_iter()
+            .map(|(style, sums)| {
+                let luxels = sums
+                    .chunks(per)
+                    .map(|c| {
+                        let sum = c
+                            .iter()
+                            .fold(DVec3::ZERO, |a, v| a + Vec3::from(*v).as_dvec3());
+                        (to_tangent * sum).normalize_or_zero().as_vec3().to_array()
+                    })
+                    .collect();
+                (style, luxels)
+            })
+            .collect()
+    }
 }
 
 /// Luxel means of per-sample values, `per` samples to a luxel (one sample to a luxel, as in
@@ -141,6 +214,9 @@ impl SampleLight {
             width: self.width,
             height: self.height,
             styles,
+            directions: self
+                .directions
+                .map_or_else(Vec::new, |d| d.luxel_directions(per)),
         }
     }
 }

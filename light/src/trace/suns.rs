@@ -22,7 +22,7 @@ const SKY_BOX_MARGIN: f64 = 1.0;
 /// For each box in `sky`, the offsets `q - p` from a point `p` in `samples`
 /// to a point `q` in it (the box `sky - samples`, a little wider): a sun
 /// ray from a sample can only meet that sky if its direction meets this box.
-fn sky_offsets(sky: &[Bounds], samples: &Bounds) -> Vec<Bounds> {
+pub(crate) fn sky_offsets(sky: &[Bounds], samples: &Bounds) -> Vec<Bounds> {
     let margin = DVec3::new(SKY_BOX_MARGIN, SKY_BOX_MARGIN, SKY_BOX_MARGIN);
     sky.iter()
         .map(|b| Bounds {
@@ -33,7 +33,7 @@ fn sky_offsets(sky: &[Bounds], samples: &Bounds) -> Vec<Bounds> {
 }
 
 /// Whether the ray from the origin along `d` meets any of `boxes`.
-fn direction_meets_any(boxes: &[Bounds], d: DVec3) -> bool {
+pub(crate) fn direction_meets_any(boxes: &[Bounds], d: DVec3) -> bool {
     // Arrays, not DVec3 indexing: glam's Index has a panic arm, which this hot loop pays for.
     let d = d.to_array();
     boxes.iter().any(|b| {

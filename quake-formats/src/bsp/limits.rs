@@ -49,6 +49,9 @@ pub const GLQUAKE_MAX_SURFACE_EXTENT: i32 = 512;
 /// QuakeSpasm's, vkQuake's and Ironwail's extent limit on faces without `TEX_SPECIAL` ("Bad
 /// surface extents").
 pub const QUAKESPASM_MAX_SURFACE_EXTENT: i32 = 2000;
+/// Luxels across or down every engine that reads `LMSHIFT` must accept on a face (FTE's BSPX
+/// notes); more at a face's shift is refused or drawn wrong.
+pub const LMSHIFT_MAX_LIGHTMAP_SIZE: usize = 256;
 /// Luxels across or down DarkPlaces accepts on a face it lightmaps ("Bad surface extents").
 pub const DARKPLACES_MAX_LIGHTMAP_SIZE: usize = 256;
 /// Vertices QuakeSpasm and vkQuake copy into a fixed buffer for a sky or unlit face.

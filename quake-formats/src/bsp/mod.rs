@@ -3,8 +3,11 @@
 //! The model stores every index as `u32`/`i32` and every bound as `f32`, wide enough for both
 //! versions. Each record type knows its encoding per version (`records::Record`); lumps are
 //! read and written by one generic pair of functions. Trailing BSPX lumps are kept as named byte blobs;
-//! [`phong`] reads and writes Slipgate's own one.
+//! [`phong`] reads and writes Slipgate's own one, [`light_lumps`] those that carry light (coloured,
+//! directional, HDR, at other spacings) and [`lightgrid`] the light grid.
 
+pub mod light_lumps;
+pub mod lightgrid;
 pub mod limits;
 pub mod phong;
 mod records;

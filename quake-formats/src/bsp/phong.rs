@@ -9,7 +9,7 @@
 //! the same non-zero group smooth together, within that group's angle.
 //! Engines ignore BSPX lumps they do not know, so the file stays playable.
 
-use super::{Bsp, BspxLump};
+use super::Bsp;
 use crate::bytes::{PutLe, Reader};
 use crate::error::{FormatError, Result};
 
@@ -46,10 +46,9 @@ impl Bsp {
     /// length does not match the face count or an angle is not a number in
     /// (0, 180] for a grouped face.
     pub fn phong_faces(&self) -> Result<Option<Vec<FacePhong>>> {
-        let Some(lump) = self.bspx.iter().find(|l| l.name() == LUMP_NAME) else {
+        let Some(data) = self.bspx_lump(LUMP_NAME) else {
             return Ok(None);
         };
-        let data = &lump.data;
         if data.len() % RECORD_LEN != 0 {
             return Err(FormatError::LumpSize {
                 lump: LUMP_NAME,
@@ -90,8 +89,8 @@ impl Bsp {
     /// Stores `records` (one per face) as the `SLIPGATE_PHONG` lump, replacing
     /// any earlier one; with no grouped face the lump is left out.
     pub fn set_phong_faces(&mut self, records: &[FacePhong]) {
-        self.bspx.retain(|l| l.name() != LUMP_NAME);
         if records.iter().all(|r| r.group == 0) {
+            self.remove_bspx_lump(LUMP_NAME);
             return;
         }
         let mut data = Vec::with_capacity(records.len() * RECORD_LEN);
@@ -99,9 +98,7 @@ impl Bsp {
             data.put_u32(r.group);
             data.put_f32(r.angle);
         }
-        let mut raw_name = [0u8; 24];
-        raw_name[..LUMP_NAME.len()].copy_from_slice(LUMP_NAME.as_bytes());
-        self.bspx.push(BspxLump { raw_name, data });
+        self.set_bspx_lump(LUMP_NAME, data);
     }
 }
 

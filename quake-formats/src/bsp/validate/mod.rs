@@ -3,6 +3,7 @@
 //! DarkPlaces, FTE, and the vanilla engines), each a named [`Rule`] with the engine's message.
 //! `quake-formats/README.md` holds the table of rules; `slipgate info` prints the problems.
 
+mod bspx;
 mod counts;
 mod entities;
 mod gate;
@@ -92,6 +93,7 @@ pub fn validate(bsp: &Bsp) -> Vec<Problem> {
             trees::check,
             node_portals::check,
             surfaces::check,
+            bspx::check,
             textures::check,
             counts::check,
             entities::check,

@@ -24,6 +24,17 @@ pub enum Rule {
     ContentsValue,
     /// `lightmap-range`: a lit face's lightmaps run past the lighting lump.
     LightmapRange,
+    /// `bspx-light-size`: a per-luxel BSPX lump does not hold one record per luxel.
+    BspxLightSize,
+    /// `bspx-face-records`: a per-face BSPX lump does not hold one record per face.
+    BspxFaceRecords,
+    /// `decoupled-lightmap`: a `DECOUPLED_LM` lightmap runs past the lighting data or has a
+    /// projection that is not finite.
+    DecoupledLightmap,
+    /// `shifted-lightmap`: an `LMSHIFT` lightmap runs past the lighting data or is too large.
+    ShiftedLightmap,
+    /// `light-grid`: the `LIGHTGRID_OCTREE` lump does not read.
+    LightGrid,
     /// `no-world-model`: the models lump is empty, so there is no world.
     NoWorldModel,
     // What engines enforce when they load or play the file.
@@ -49,6 +60,8 @@ pub enum Rule {
     SurfaceExtentsVanilla,
     /// `lightmap-extents-engines-disagree`: QuakeSpasm and DarkPlaces size a face's lightmap differently.
     LightmapExtentsEnginesDisagree,
+    /// `no-vanilla-lighting`: lit faces have their light only in BSPX lumps.
+    NoVanillaLighting,
     /// `unlit-face-verts`: a liquid, sky or untextured unlit face has more vertices than engines buffer.
     UnlitFaceVerts,
     /// `texture-alignment`: a texture's width or height is not a multiple of 16.
@@ -102,7 +115,7 @@ const QS: &str = "QuakeSpasm, vkQuake, Ironwail";
 
 impl Rule {
     /// Every rule, in declaration order (structure first, then what engines enforce).
-    pub const ALL: [Rule; 36] = [
+    pub const ALL: [Rule; 42] = [
         Rule::IndexRange,
         Rule::NonFinite,
         Rule::PlaneNormal,
@@ -111,6 +124,11 @@ impl Rule {
         Rule::FaceEdges,
         Rule::ContentsValue,
         Rule::LightmapRange,
+        Rule::BspxLightSize,
+        Rule::BspxFaceRecords,
+        Rule::DecoupledLightmap,
+        Rule::ShiftedLightmap,
+        Rule::LightGrid,
         Rule::NoWorldModel,
         Rule::NoNodes,
         Rule::WorldHeadNode,
@@ -123,6 +141,7 @@ impl Rule {
         Rule::SurfaceExtents,
         Rule::SurfaceExtentsVanilla,
         Rule::LightmapExtentsEnginesDisagree,
+        Rule::NoVanillaLighting,
         Rule::UnlitFaceVerts,
         Rule::TextureAlignment,
         Rule::AnimationName,
@@ -211,7 +230,49 @@ impl Rule {
                 "QuakeSpasm family, vanilla",
                 "reads lightmaps past the lighting lump",
                 "a lit face's lightmaps (one per style, sized from its extents) lie inside the \
-                 lighting lump",
+                 lighting lump (or, without one, the luxels of RGBLIGHTING)",
+            ),
+            Rule::BspxLightSize => (
+                "bspx-light-size",
+                Error,
+                "FTE, QuakeSpasm-Spiked, Ironwail",
+                "the lump is ignored, or lightmaps are read past its end",
+                "RGBLIGHTING and LIGHTINGDIR hold 3 bytes and LIGHTING_E5BGR9 4 bytes for every \
+                 luxel of the lighting data",
+            ),
+            Rule::BspxFaceRecords => (
+                "bspx-face-records",
+                Error,
+                "FTE, QuakeSpasm-Spiked, Ironwail",
+                "the lump is ignored, or faces read records past its end",
+                "LMSHIFT (1 byte), LMOFFSET (4 bytes) and DECOUPLED_LM (40 bytes) hold one whole \
+                 record per face",
+            ),
+            Rule::DecoupledLightmap => (
+                "decoupled-lightmap",
+                Error,
+                "FTE, QuakeSpasm-Spiked, Ironwail",
+                "reads lightmaps past the lighting data; NaN texture coordinates",
+                "a DECOUPLED_LM face with an offset has a size, its lightmaps (one per style) lie \
+                 inside the lighting data, and its projection is finite",
+            ),
+            Rule::ShiftedLightmap => (
+                "shifted-lightmap",
+                Error,
+                "FTE, QuakeSpasm-Spiked",
+                "reads lightmaps past the lighting data; lightmaps over 256 luxels are refused",
+                "an LMSHIFT face's lightmaps (at its LMOFFSET, else its light offset; one per \
+                 style, sized at 1 << shift texels per luxel) lie inside the lighting data and \
+                 span at most 256 luxels per axis",
+            ),
+            Rule::LightGrid => (
+                "light-grid",
+                Error,
+                "FTE, QuakeSpasm-Spiked, Ironwail",
+                "the grid is ignored or walked out of bounds",
+                "LIGHTGRID_OCTREE reads whole: its counts fit the lump, its spacing is positive \
+                 and finite, its leaves lie inside the grid and every child names a node or leaf \
+                 without a cycle",
             ),
             Rule::NoWorldModel => (
                 "no-world-model",
@@ -283,7 +344,7 @@ impl Rule {
             Rule::SurfaceExtents => (
                 "surface-extents",
                 Error,
-                "QuakeSpasm family, DarkPlaces",
+                "QuakeSpasm, vkQuake, Ironwail, DarkPlaces",
                 "\"Bad surface extents\" (Sys_Error; Host_Error in DarkPlaces)",
                 "a face without TEX_SPECIAL spans at most 2000 texels per axis (QuakeSpasm family); \
                  a face DarkPlaces lightmaps (not TEX_SPECIAL, or lit) at most 256 luxels",
@@ -306,6 +367,14 @@ impl Rule {
                 "a face without TEX_SPECIAL gets the same lightmap extents from QuakeSpasm's rule \
                  (texture coordinates summed in double, kept as float) and DarkPlaces' (summed \
                  in float)",
+            ),
+            Rule::NoVanillaLighting => (
+                "no-vanilla-lighting",
+                Warning,
+                "QuakeSpasm 0.95, DarkPlaces, vanilla (engines without BSPX RGBLIGHTING)",
+                "the map is drawn unlit (fullbright): the grey lighting lump is empty",
+                "a map whose faces have lightmaps also has the grey lighting lump (ericw-tools' \
+                 -novanilla leaves it out)",
             ),
             Rule::UnlitFaceVerts => (
                 "unlit-face-verts",

@@ -97,20 +97,24 @@ fn check_engines_agree(
     c.report(Rule::LightmapExtentsEnginesDisagree, "faces", i, detail);
 }
 
+/// How many lightmaps (styles) a lit face has: its styles that are not 255, at least one.
+pub(super) fn lightmaps_of(f: &Face) -> usize {
+    f.styles.iter().filter(|&&s| s != 255).count().max(1)
+}
+
 /// A lit face's lightmaps (one per style) must lie inside the lighting lump.
 fn check_lightmap_data(c: &mut Checker, i: usize, f: &Face, tex: &TexInfo, ext: &LightmapExtents) {
     if f.light_offset < 0 || tex.flags & texinfo_flags::SPECIAL != 0 {
         return;
     }
-    let bsp = c.bsp;
-    let styles = f.styles.iter().filter(|&&s| s != 255).count().max(1);
+    let styles = lightmaps_of(f);
     let needed = ext.luxel_count() * styles;
     let offset = f.light_offset as usize;
-    if offset + needed > bsp.lighting.len() {
+    let luxels = c.bsp.luxel_count();
+    if offset + needed > luxels {
         let detail = format!(
-            "lightmap at {offset} ({needed} bytes for {styles} style(s)) runs past the lighting \
-             lump ({} bytes)",
-            bsp.lighting.len()
+            "lightmap at {offset} ({needed} luxels for {styles} style(s)) runs past the {luxels} \
+             luxels of lighting data"
         );
         c.report(Rule::LightmapRange, "faces", i, detail);
     }
