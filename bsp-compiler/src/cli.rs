@@ -196,6 +196,7 @@ pub struct Args {
     /// Worker threads (default: one per core); the output is the same for any number
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
+    /// ericw-tools' options accepted with a note (hidden from the help).
     #[command(flatten)]
     pub ericw_only: EricwOnly,
     /// Only replace the entities of the existing BSP (OUT.bsp) with the .map's, keeping its
@@ -328,12 +329,18 @@ pub fn run(args: &Args) -> Result<Option<crate::CompileStats>> {
     for note in args.ericw_only.notes() {
         eprintln!("note: {note}");
     }
-    if let Some(n) = args.threads {
-        // Fails only when a pool already runs (a caller chose its threads): keep that one.
-        let _ = rayon::ThreadPoolBuilder::new()
+    match args.threads {
+        Some(n) => rayon::ThreadPoolBuilder::new()
             .num_threads(n)
-            .build_global();
+            .build()
+            .context("starting the worker threads")?
+            .install(|| compile_and_write(args)),
+        None => compile_and_write(args),
     }
+}
+
+/// [`run`] on the current worker threads.
+fn compile_and_write(args: &Args) -> Result<Option<crate::CompileStats>> {
     let source = MapSource::read(&args.input)?;
     let bsp_path = args
         .output

@@ -13,6 +13,34 @@ use quake_formats::palette::Palette;
 use crate::settings::{Overrides, Setting, TABLE};
 use crate::{LightFiles, Lighting, Options, Quality, compare_with_reference, compute_lighting};
 
+quake_formats::ericw_accepted! {
+    /// ericw-tools' light options that Slipgate's light accepts without acting on them.
+    pub struct EricwOnly {
+        verbose: bool => "the summary is the same either way",
+        noverbose: bool => "the summary is the same either way",
+        quiet: bool => "the summary is the same either way",
+        nopercent: bool => "progress is drawn only when standard error is a terminal",
+        noprogress: bool => "progress is drawn only when standard error is a terminal",
+        nostat: bool => "the summary is the same either way",
+        nocolor: bool => "Slipgate writes no colour codes",
+        log: bool => "Slipgate writes no log file; redirect its output",
+        nolog: bool => "Slipgate writes no log file",
+        lowpriority: bool => "Slipgate runs at the priority it is started with (use nice)",
+        defaultpaths: bool => "the palette is found as --palette says",
+        nodefaultpaths: bool => "the palette is found as --palette says",
+        novisapprox: bool => "lights are culled by the PVS, which never cuts light off early",
+        dirtdebug: bool => "no debug lightmaps; `slipgate view --lightmap-only` shows the light",
+        phongdebug: bool => "no debug lightmaps; `slipgate view --lightmap-only` shows the light",
+        bouncedebug: bool => "no debug lightmaps; `slipgate view --lightmap-only` shows the light",
+        surflight_dump: bool => "surface lights are not written out",
+        surflight_subdivide: Option<String> => "surface lights are sampled over each face's own luxels",
+        lit2: bool => "the .lit2 format is not written",
+        litonly: bool => "the BSP is always written with its .lit",
+        nolighting: bool => "light is always computed",
+        wrnormals: bool => "no normals lump is written",
+    }
+}
+
 /// Light a BSP: compute lightmaps from its light entities.
 #[derive(clap::Args, Debug, Clone)]
 pub struct Args {
@@ -52,6 +80,9 @@ pub struct Args {
     /// Worker threads for tracing (default: one per core).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
     pub threads: Option<u16>,
+    /// ericw-tools' options accepted with a note (hidden from the help).
+    #[command(flatten)]
+    pub ericw_only: EricwOnly,
     /// Consider every light for every face (no range, plane-side or PVS culling).
     #[arg(long)]
     pub no_cull: bool,
@@ -246,6 +277,9 @@ fn find_palette(args: &Args) -> anyhow::Result<Option<Palette>> {
 /// # Errors
 /// Files that do not read or write, a BSP light refuses, or what [`compute_lighting`] reports.
 pub fn run(args: &Args) -> anyhow::Result<Option<crate::Stats>> {
+    for note in args.ericw_only.notes() {
+        eprintln!("note: {note}");
+    }
     match args.threads {
         Some(n) => rayon::ThreadPoolBuilder::new()
             .num_threads(usize::from(n))
@@ -484,6 +518,39 @@ mod tests {
 
     fn strings(a: &[&str]) -> Vec<String> {
         a.iter().map(|s| s.to_string()).collect()
+    }
+
+    #[derive(clap::Parser)]
+    struct LightCli {
+        #[command(flatten)]
+        args: Args,
+    }
+
+    /// A profile written for ericw-tools' light runs unchanged: its options that only change how
+    /// light reports, or its debug outputs, are accepted, each with a note.
+    #[test]
+    fn ericw_tools_only_options_are_accepted_with_a_note() {
+        use clap::Parser;
+        let words = strings(&[
+            "light",
+            "-nopercent",
+            "-extra4",
+            "-dirtdebug",
+            "-surflight_subdivide",
+            "64",
+            "x.bsp",
+        ]);
+        let words =
+            join_optional_values(quake_formats::cli::normalise_single_dash(words.into_iter()));
+        let cli = LightCli::try_parse_from(words).expect("parses");
+        let notes = cli.args.ericw_only.notes();
+        assert_eq!(notes.len(), 3, "{notes:?}");
+        assert!(
+            notes[0].starts_with("-nopercent has no effect"),
+            "{notes:?}"
+        );
+        assert!(cli.args.extra4);
+        assert_eq!(cli.args.bsp, PathBuf::from("x.bsp"));
     }
 
     /// Which run wrote a file of the pair.

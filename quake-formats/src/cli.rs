@@ -35,7 +35,7 @@ macro_rules! ericw_accepted {
         $vis struct $name {
             $(
                 #[doc = $note]
-                #[arg(long, hide = true)]
+                #[arg(long = stringify!($field), hide = true)]
                 $field: $ty,
             )*
         }
