@@ -14,6 +14,7 @@ use std::process::ExitCode;
 use std::sync::Mutex;
 use std::time::Duration;
 
+/// The batch command line, as `slipgate batch` mounts it.
 #[derive(clap::Args, Debug, Clone)]
 pub struct Args {
     /// A project file (TOML), or a folder whose .map files are all built with the default
@@ -45,6 +46,8 @@ pub struct Args {
     pub collect: Vec<PathBuf>,
 }
 
+/// Build the project's maps, or with `--collect` join the manifests; exit code 1 when a map
+/// failed or the manifests have problems.
 pub fn run(args: &Args) -> Result<ExitCode> {
     if !args.collect.is_empty() {
         return run_collect(args);

@@ -3,20 +3,23 @@
 //! out to shards whose manifests are joined and checked afterwards. `docs/batch.md` is the
 //! user's guide.
 //!
-//! Modules: [`project`] (the project file, or a folder of maps), [`stages`] (one map through the
-//! stages, and what each stage's cache key holds), [`cache`] (blobs and stage records),
-//! [`schedule`] (the memory budget), [`manifest`] (shards, manifests, `--collect`), [`options`]
-//! (option strings to stage arguments), [`summary`] (the table) and [`cli`].
+//! Modules: `project` (the project file, or a folder of maps), `stages` (one map through the
+//! stages, and what each stage's cache key holds), `cache` (blobs and stage records),
+//! `schedule` (the memory budget), `manifest` (shards, manifests, `--collect`), `options`
+//! (option strings to stage arguments), `summary` (the table) and [`cli`], the one public
+//! module: the command line `slipgate batch` mounts.
 
-pub mod cache;
+#![warn(missing_docs)]
+
+mod cache;
 pub mod cli;
-pub mod hash;
-pub mod manifest;
-pub mod options;
-pub mod project;
-pub mod schedule;
-pub mod stages;
-pub mod summary;
+mod hash;
+mod manifest;
+mod options;
+mod project;
+mod schedule;
+mod stages;
+mod summary;
 mod walk;
 
 use cache::Cache;
@@ -26,7 +29,7 @@ use stages::{Context, MapOutcome};
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, thiserror::Error)]
-pub enum BatchError {
+pub(crate) enum BatchError {
     #[error(transparent)]
     Project(#[from] ProjectError),
     #[error(transparent)]
@@ -41,7 +44,7 @@ pub enum BatchError {
 
 /// How to run a batch.
 #[derive(Debug, Clone)]
-pub struct BatchOptions {
+pub(crate) struct BatchOptions {
     /// A project file, or a folder whose `.map` files are built with the defaults.
     pub project: PathBuf,
     /// Maps in flight at once.
@@ -58,7 +61,7 @@ pub struct BatchOptions {
 }
 
 /// Told as maps start, change stage and finish.
-pub trait Observer: Sync {
+pub(crate) trait Observer: Sync {
     fn map_started(&self, map: &str);
     fn stage_started(&self, map: &str, stage: &str);
     fn map_finished(&self, outcome: &MapOutcome);
@@ -66,7 +69,7 @@ pub trait Observer: Sync {
 
 /// What a batch did.
 #[derive(Debug)]
-pub struct BatchReport {
+pub(crate) struct BatchReport {
     pub manifest: Manifest,
     pub manifest_path: PathBuf,
 }
@@ -79,7 +82,7 @@ impl BatchReport {
 
 /// Who made the outputs: the version and the hash of the running program, so a rebuilt tool
 /// never takes a stale stage from the cache.
-pub fn tool_identity() -> Result<String, BatchError> {
+fn tool_identity() -> Result<String, BatchError> {
     let exe = std::env::current_exe().map_err(|source| BatchError::Io {
         path: PathBuf::from("(the running program)"),
         source,
@@ -96,7 +99,7 @@ pub fn tool_identity() -> Result<String, BatchError> {
 }
 
 /// Build the project's maps (this shard's share of them).
-pub fn run_batch(
+pub(crate) fn run_batch(
     options: &BatchOptions,
     observer: &dyn Observer,
 ) -> Result<BatchReport, BatchError> {

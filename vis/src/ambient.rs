@@ -12,9 +12,13 @@ use rayon::prelude::*;
 /// Ambient channels in `Leaf::ambient` order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Ambient {
+    /// Water surfaces (`*water` textures).
     Water = 0,
+    /// Sky surfaces (`sky` textures).
     Sky = 1,
+    /// Slime surfaces (`*slime` textures).
     Slime = 2,
+    /// Lava surfaces (`*lava` textures).
     Lava = 3,
 }
 

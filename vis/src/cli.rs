@@ -12,6 +12,7 @@ use quake_formats::prt::PortalFile;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+/// The vis command line, shared by `slipgate vis` and `slipgate-vis`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct Args {
     /// The compiled map; its portal file MAP.prt must lie beside it. Rewritten in place.

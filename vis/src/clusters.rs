@@ -45,14 +45,6 @@ impl Clusters {
         }))
     }
 
-    pub fn len(&self) -> usize {
-        self.members.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.members.is_empty()
-    }
-
     /// Leaf rows from cluster rows: a leaf sees every leaf of every cluster its cluster sees.
     pub fn expand(&self, cluster_rows: &[BitSet]) -> Pvs {
         debug_assert_eq!(cluster_rows.len(), self.members.len());

@@ -41,12 +41,16 @@ use std::sync::OnceLock;
 
 /// The shared inputs of every portal's flow.
 pub struct FlowContext<'a> {
+    /// The portals and the clusters they join.
     pub graph: &'a PortalGraph,
+    /// Every portal's base vis set: what its flow may at most see.
     pub mightsee: &'a [BitSet],
     /// Finished portals' flow results: tighter than their mightsee. A flow uses only those
     /// `plan` allows ([`FlowPlan::bounds`]), so results do not depend on timing or sharding.
     pub results: &'a [OnceLock<BitSet>],
+    /// The waves, and which finished flows each flow may use.
     pub plan: &'a FlowPlan,
+    /// How hard separating planes are tested (0..=4): higher is tighter and slower.
     pub level: u8,
 }
 

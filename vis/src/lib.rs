@@ -5,6 +5,8 @@
 //! each leaf's ambient sounds from what it sees; [`sample::sample_visibility`] checks a PVS
 //! against sight lines traced through the BSP tree.
 
+#![warn(missing_docs)]
+
 pub mod ambient;
 pub mod base;
 pub mod bitset;
@@ -42,63 +44,118 @@ use std::time::{Duration, Instant};
 /// Everything vis can refuse.
 #[derive(Debug, thiserror::Error)]
 pub enum VisError {
+    /// The portal file and the BSP disagree on the leaf count: they come from different
+    /// compiles.
     #[error(
         "the portal file has {prt_leafs} leaves but the BSP's world model has {vis_leafs} vis \
          leaves: the .prt file does not belong to this BSP (compile the map again)"
     )]
-    LeafCountMismatch { prt_leafs: usize, vis_leafs: usize },
+    LeafCountMismatch {
+        /// Leaves the portal file declares.
+        prt_leafs: usize,
+        /// Vis leaves of the BSP's world model.
+        vis_leafs: usize,
+    },
+    /// The world keeps the void outside the map (open leaves past its bounds on every side):
+    /// the map leaks.
     #[error(
         "the map leaks: leaf {leaf} reaches past the world's brushes into the void outside the \
          map, which vis would have to work through; fix the leak (the compiler's .pts pointfile \
          leads to it) and compile again"
     )]
-    Void { leaf: usize },
+    Void {
+        /// One open leaf of the void (BSP leaf number).
+        leaf: usize,
+    },
+    /// A shard was asked of fast mode, which has no flow to split.
     #[error("a shard runs a share of the full flow; base vis (fast) has none")]
     FastShard,
+    /// The BSP has no world model.
     #[error("the BSP has no models, so no world model to compute visibility for")]
     NoWorldModel,
+    /// The world model's vis leaf count is negative or beyond the BSP's leaves.
     #[error("the world model claims {vis_leafs} vis leaves but the BSP has {leafs} leaves")]
-    BadVisLeafs { vis_leafs: i64, leafs: usize },
+    BadVisLeafs {
+        /// The count the world model claims.
+        vis_leafs: i64,
+        /// Leaves in the BSP's leaf lump.
+        leafs: usize,
+    },
+    /// A portal names a cluster (or leaf) that does not exist.
     #[error(
         "portal {index} joins clusters {clusters:?}, not both below the cluster count \
          {num_clusters} (in a PRT1 file, the leaf count)"
     )]
     PortalCluster {
+        /// The portal's position in the portal file.
         index: usize,
+        /// The two clusters it joins, as written.
         clusters: [u32; 2],
+        /// Clusters in the file (leaves in a PRT1 file).
         num_clusters: usize,
     },
+    /// A PRT2 cluster lists a leaf that does not exist.
     #[error("cluster {cluster} lists leaf {leaf}, not below the leaf count {num_leafs}")]
     ClusterLeaf {
+        /// The cluster listing it.
         cluster: usize,
+        /// The leaf as written.
         leaf: u32,
+        /// Leaves in the file.
         num_leafs: usize,
     },
+    /// A PRT2 leaf belongs to two clusters.
     #[error("leaf {leaf} is listed in two clusters, {clusters:?}")]
-    LeafInTwoClusters { leaf: u32, clusters: [usize; 2] },
+    LeafInTwoClusters {
+        /// The leaf listed twice.
+        leaf: u32,
+        /// The first and the second cluster listing it.
+        clusters: [usize; 2],
+    },
+    /// A portal's winding has an infinite or NaN coordinate.
     #[error("portal {index} has a coordinate that is not a finite number")]
-    PortalNotFinite { index: usize },
+    PortalNotFinite {
+        /// The portal's position in the portal file.
+        index: usize,
+    },
+    /// A leaf's visibility offset points outside the visibility lump.
     #[error("leaf {leaf}: vis offset {offset} is outside the {lump_len}-byte visibility lump")]
     BadVisOffset {
+        /// The BSP leaf.
         leaf: usize,
+        /// Its offset into the lump, in bytes.
         offset: i32,
+        /// The lump's length in bytes.
         lump_len: usize,
     },
+    /// The compressed rows are larger than a leaf's 32-bit offset can reach.
     #[error("the compressed visibility data does not fit a 32-bit offset")]
     LumpTooLarge,
+    /// The worker thread pool could not be built; holds the reason.
     #[error("could not start the worker threads: {0}")]
     Threads(String),
+    /// The portal file's counts would need more set memory than [`MAX_SET_BYTES`].
     #[error(
         "{leafs} leaves and {portals} portals would need {gib} GiB of visibility sets, more than \
          vis allows itself (4 GiB)"
     )]
     TooBig {
+        /// Leaves the portal file declares.
         leafs: u64,
+        /// Portals in the portal file.
         portals: usize,
+        /// The memory the sets would take, in GiB (rounded up).
         gib: u64,
     },
+    /// Joined flow results do not cover the portal graph one for one.
     #[error("{flows} portal flow results for {portals} one-way portals")]
-    FlowCount { flows: usize, portals: usize },
+    FlowCount {
+        /// Flow results given.
+        flows: usize,
+        /// One-way portals in the graph.
+        portals: usize,
+    },
+    /// The BSP's hull 0 node tree cannot be traced; holds what is wrong.
     #[error("the BSP's hull 0 tree is broken: {0}")]
     BadTree(String),
     /// The BSP breaks a rule that would make vis read out of bounds ([`quake_formats::check_usable`]).
@@ -112,11 +169,16 @@ pub enum VisMode {
     /// Base vis only: conservative, fast, loose.
     Fast,
     /// Portal flow with separating planes up to `level` (0..=4).
-    Full { level: u8 },
+    Full {
+        /// How hard the flow tests separating planes: higher is tighter and slower.
+        level: u8,
+    },
 }
 
+/// How [`compute_vis`] runs.
 #[derive(Debug, Clone)]
 pub struct VisOptions {
+    /// Fast base vis or the full flow, and its level.
     pub mode: VisMode,
     /// Worker threads; `None` uses every core.
     pub threads: Option<usize>,
@@ -184,20 +246,29 @@ pub fn store(bsp: &mut Bsp, pvs: &Pvs, channels: Channels) -> Result<Stored, Vis
 /// Counts and timings of one [`compute_vis`] run.
 #[derive(Debug, Clone, Default, serde::Serialize)]
 pub struct ComputeStats {
+    /// Vis leaves in the PVS (BSP leaves 1..=N).
     pub leafs: usize,
     /// Clusters visibility was computed between (the leaf count for a PRT1 file).
     pub clusters: usize,
+    /// One-way portals in the graph: two per portal of the file that was kept.
     pub portals: usize,
+    /// Portals of the file dropped as degenerate ([`PortalGraph::degenerate`]).
     pub degenerate_portals: usize,
     /// One-way portals whose leaf has another portal in front of them (see
     /// [`PortalGraph::misoriented_portals`]); non-zero means a suspicious portal file. Only
     /// counted for PRT1 files (clusters need not be convex).
     pub misoriented_portals: usize,
+    /// Portals base vis finds each one-way portal might see, on average.
     pub average_mightsee: f64,
+    /// Portals each one-way portal sees after the flow (the mightsee in fast mode), on average.
     pub average_portal_vis: f64,
+    /// Seconds base vis took.
     pub base_seconds: f64,
+    /// Seconds the full flow took (0 in fast mode).
     pub flow_seconds: f64,
+    /// Leaves each leaf's set holds, on average.
     pub average_visible: f64,
+    /// The most leaves any one leaf's set holds.
     pub max_visible: usize,
     /// One-way cluster pairs dropped because the other side does not see back (see
     /// [`Pvs::intersect_with_transpose`]).
@@ -207,7 +278,9 @@ pub struct ComputeStats {
 /// The result of [`compute_vis`].
 #[derive(Debug, Clone)]
 pub struct VisResult {
+    /// Every vis leaf's set.
     pub pvs: Pvs,
+    /// What the run counted and how long it took.
     pub stats: ComputeStats,
 }
 
@@ -225,7 +298,9 @@ pub type SaveFlows<'a> = dyn Fn(Vec<(usize, &BitSet)>) + Sync + 'a;
 
 /// Saving a run's progress now and then, so a killed run can resume.
 pub struct Checkpoint<'a> {
+    /// The least time between two saves.
     pub every: Duration,
+    /// What stores the results.
     pub save: &'a SaveFlows<'a>,
 }
 
@@ -281,7 +356,9 @@ pub struct ShardFlows {
     pub results: Vec<(usize, BitSet)>,
     /// Final groups in the plan ([`FlowPlan::groups`]): more shards than this get no final work.
     pub groups: usize,
+    /// Seconds base vis took.
     pub base_seconds: f64,
+    /// Seconds the shard's flows took.
     pub flow_seconds: f64,
 }
 

@@ -12,13 +12,17 @@ use std::collections::HashMap;
 /// What writing the lump produced.
 #[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
 pub struct LumpStats {
+    /// Leaves with a row (BSP leaves 1..=N).
     pub vis_leafs: usize,
     /// Distinct compressed rows (identical rows are stored once).
     pub unique_rows: usize,
+    /// The lump's size in bytes.
     pub compressed_bytes: usize,
     /// What the rows would take uncompressed and unshared.
     pub uncompressed_bytes: usize,
+    /// Leaves each leaf's row holds, on average.
     pub average_visible: f64,
+    /// The most leaves any one row holds.
     pub max_visible: usize,
 }
 

@@ -16,14 +16,14 @@ use quake_formats::prt::PortalFile;
 /// A portal seen from one side: looking from `from_cluster` through `winding` into `to_cluster`.
 #[derive(Debug, Clone)]
 pub struct OneWayPortal {
-    pub winding: Vec<DVec3>,
+    pub(crate) winding: Vec<DVec3>,
     /// Faces into `to_cluster`.
     pub plane: Plane,
-    pub from_cluster: u32,
-    pub to_cluster: u32,
+    pub(crate) from_cluster: u32,
+    pub(crate) to_cluster: u32,
     /// A sphere holding the winding, for quick plane tests.
     pub center: DVec3,
-    pub radius: f64,
+    pub(crate) radius: f64,
 }
 
 impl OneWayPortal {
@@ -89,7 +89,9 @@ impl OneWayPortal {
 /// leading out of each.
 #[derive(Debug, Clone)]
 pub struct PortalGraph {
-    pub num_clusters: usize,
+    pub(crate) num_clusters: usize,
+    /// The one-way portals, two per portal of the file that was kept (numbered as flow results
+    /// and [`KnownFlows`](crate::KnownFlows) number them).
     pub portals: Vec<OneWayPortal>,
     /// For each cluster, the one-way portals whose `from_cluster` it is.
     pub cluster_portals: Vec<Vec<u32>>,
@@ -98,6 +100,8 @@ pub struct PortalGraph {
 }
 
 impl PortalGraph {
+    /// The graph of a portal file; refuses portals naming clusters that do not exist or with
+    /// coordinates that are not finite.
     pub fn from_prt(prt: &PortalFile) -> Result<PortalGraph, VisError> {
         let num_clusters = prt
             .clusters

@@ -57,6 +57,7 @@ impl Pvs {
         dropped
     }
 
+    /// Vis leaves (rows), BSP leaves 1..=N.
     pub fn num_leafs(&self) -> usize {
         self.rows.len()
     }
@@ -66,20 +67,22 @@ impl Pvs {
         &self.rows[leaf]
     }
 
-    pub fn rows(&self) -> &[BitSet] {
+    pub(crate) fn rows(&self) -> &[BitSet] {
         &self.rows
     }
 
+    /// Whether vis leaf `from` may see vis leaf `to` (both BSP leaf - 1).
     pub fn sees(&self, from: usize, to: usize) -> bool {
         self.rows[from].contains(to)
     }
 
+    /// Leaves each leaf's set holds, on average.
     pub fn average_visible(&self) -> f64 {
         let total: usize = self.rows.iter().map(BitSet::count).sum();
         total as f64 / self.rows.len().max(1) as f64
     }
 
-    pub fn max_visible(&self) -> usize {
+    pub(crate) fn max_visible(&self) -> usize {
         self.rows.iter().map(BitSet::count).max().unwrap_or(0)
     }
 

@@ -28,6 +28,8 @@ pub struct Hull0 {
 }
 
 impl Hull0 {
+    /// The world model's hull 0 tree of `bsp`; refuses a tree that names missing planes,
+    /// nodes or leaves, or reaches a node twice.
     pub fn new(bsp: &Bsp) -> Result<Hull0, VisError> {
         let bad = |s: String| VisError::BadTree(s);
         let world = bsp.models.first().ok_or(VisError::NoWorldModel)?;
@@ -89,6 +91,7 @@ impl Hull0 {
         Ok(())
     }
 
+    /// The BSP leaf holding point `p`.
     pub fn leaf_at(&self, p: DVec3) -> usize {
         let mut n = self.head;
         while n >= 0 {
@@ -125,6 +128,7 @@ impl Hull0 {
 /// What sampling found.
 #[derive(Debug, Clone, Default, serde::Serialize)]
 pub struct SamplingReport {
+    /// Point pairs sampled, each point in a random open vis leaf.
     pub pairs: usize,
     /// Pairs whose segment crosses nothing opaque.
     pub clear_pairs: usize,

@@ -18,23 +18,42 @@ const VERSION: u32 = 1;
 /// Why a saved file cannot be used.
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]
 pub enum SavedError {
+    /// The file lacks the magic or names an unknown kind.
     #[error("not a Slipgate vis flow file (no SGVISFLO magic)")]
     NotFlowFile,
+    /// Another format version wrote the file; holds that version.
     #[error("written by format version {0}; this vis reads version {VERSION}")]
     Version(u32),
+    /// A state was read where a partial was expected, or the other way round.
     #[error("is a {found}, not a {expected}")]
     Kind {
+        /// What the file is.
         found: &'static str,
+        /// What the reader wanted.
         expected: &'static str,
     },
+    /// The data ends inside a field or a row, or goes on after the last result.
     #[error("ends early or has bytes after its last result")]
     Truncated,
+    /// A result names a portal the graph does not have.
     #[error("result for portal {portal}, but the file covers {portals} one-way portals")]
-    PortalOutOfRange { portal: u32, portals: u32 },
+    PortalOutOfRange {
+        /// The portal named.
+        portal: u32,
+        /// One-way portals the file covers.
+        portals: u32,
+    },
+    /// Results out of ascending portal order (a portal twice); holds the portal.
     #[error("holds portal {0} twice")]
     DuplicatePortal(u32),
+    /// The shard index is not below a non-zero count.
     #[error("shard {index} of {count} is not a valid shard")]
-    BadShard { index: u32, count: u32 },
+    BadShard {
+        /// The shard index, 0-based.
+        index: u32,
+        /// The shard count.
+        count: u32,
+    },
 }
 
 /// What a saved file is for.
@@ -65,8 +84,11 @@ impl SavedKind {
 /// Flow results of some portals, with what they were computed from.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct SavedFlows {
+    /// A state to resume from or a partial to merge.
     pub kind: SavedKind,
+    /// What the results were computed from; other inputs refuse them.
     pub inputs: InputsHash,
+    /// The shard that computed them ([`Shard::WHOLE`] for a whole run).
     pub shard: Shard,
     /// One-way portals in the graph (each result's length).
     pub portals: usize,
@@ -75,6 +97,7 @@ pub struct SavedFlows {
 }
 
 impl SavedFlows {
+    /// The file's bytes; [`SavedFlows::read`] reads them back.
     pub fn write(&self) -> Vec<u8> {
         let mut out = Vec::new();
         out.extend_from_slice(MAGIC);
@@ -201,6 +224,7 @@ impl std::fmt::Display for InputsHash {
 }
 
 impl InputsHash {
+    /// The hash of a portal file's text, the BSP it belongs to and the flow level.
     pub fn new(prt_text: &[u8], bsp: &Bsp, level: u8) -> InputsHash {
         let mut h = Fnv128::default();
         h.field(b"prt", prt_text);

@@ -48,7 +48,9 @@ pub fn estimated_cost(mightsee_count: usize) -> f64 {
 /// Shard `index` (0-based) of `count`: what `--shard K/N` names as `index + 1`/`count`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Shard {
+    /// Which shard, 0-based (below `count`).
     pub index: usize,
+    /// How many shards share the work.
     pub count: usize,
 }
 
@@ -93,6 +95,7 @@ pub struct FlowPlan {
 }
 
 impl FlowPlan {
+    /// The plan for portals with these mightsee sets, grouped for shards as `grouping` says.
     pub fn new(mightsee: &[BitSet], grouping: Grouping) -> FlowPlan {
         let n = mightsee.len();
         let counts: Vec<usize> = mightsee.iter().map(BitSet::count).collect();

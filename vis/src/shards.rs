@@ -16,12 +16,16 @@ use std::path::{Path, PathBuf};
 /// Why saved flows cannot be used.
 #[derive(Debug, thiserror::Error)]
 pub enum ShardError {
+    /// A file is not a usable flow file of the kind wanted.
     #[error("{}: {source}", path.display())]
     Unreadable {
+        /// The file.
         path: PathBuf,
+        /// What is wrong with it.
         #[source]
         source: SavedError,
     },
+    /// A saved state belongs to other inputs or another shard.
     #[error(
         "{}: saved from other inputs (inputs {found}, shard {found_shard}; this run has inputs \
          {inputs}, shard {shard}): the map, its portal file or the level changed; delete it to \
@@ -29,24 +33,35 @@ pub enum ShardError {
         path.display()
     )]
     OtherState {
+        /// The state file.
         path: PathBuf,
+        /// The inputs it was saved from.
         found: InputsHash,
+        /// The shard that saved it.
         found_shard: Shard,
+        /// This run's inputs.
         inputs: InputsHash,
+        /// This run's shard.
         shard: Shard,
     },
+    /// A partial belongs to other inputs.
     #[error(
         "{}: computed from other inputs (inputs {found}; this run has {inputs}): the partial \
          belongs to another map, portal file or level",
         path.display()
     )]
     OtherPartial {
+        /// The partial file.
         path: PathBuf,
+        /// The inputs it was computed from.
         found: InputsHash,
+        /// This run's inputs.
         inputs: InputsHash,
     },
+    /// A merge was given no partial files.
     #[error("no partial files: run `vis --shard K/N` for every shard first")]
     NoPartials,
+    /// Two partials come from runs with different shard counts.
     #[error(
         "{} is shard {shard} but {} is shard {first_shard}: the partials come from runs with \
          different shard counts",
@@ -54,23 +69,45 @@ pub enum ShardError {
         first.display()
     )]
     ShardCounts {
+        /// The partial that disagrees with the first.
         path: PathBuf,
+        /// Its shard.
         shard: Shard,
+        /// The first partial.
         first: PathBuf,
+        /// The first partial's shard.
         first_shard: Shard,
     },
+    /// Two partials are of the same shard.
     #[error("shard {shard} given twice: {} and {}", first.display(), second.display())]
     ShardTwice {
+        /// The shard.
         shard: Shard,
+        /// The partial read first.
         first: PathBuf,
+        /// The partial read second.
         second: PathBuf,
     },
+    /// Some shards have no partial.
     #[error("missing the partial of shard {missing}; found only {found}")]
-    MissingShards { missing: String, found: String },
+    MissingShards {
+        /// The shards missing, as `K/N`, comma-separated.
+        missing: String,
+        /// The partial files given, comma-separated.
+        found: String,
+    },
+    /// Two partials hold a result for the same portal.
     #[error("{}: portal {portal} is in two partials", path.display())]
-    PortalTwice { path: PathBuf, portal: usize },
+    PortalTwice {
+        /// The partial read second.
+        path: PathBuf,
+        /// The one-way portal.
+        portal: usize,
+    },
+    /// No partial holds a result for a portal; holds the one-way portal.
     #[error("no partial holds portal {0}")]
     PortalMissing(usize),
+    /// Joining the results failed.
     #[error(transparent)]
     Vis(#[from] VisError),
 }

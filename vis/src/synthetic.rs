@@ -69,12 +69,12 @@ impl VoxelWorld {
         self
     }
 
-    pub fn set_open(&mut self, c: [usize; 3]) {
+    fn set_open(&mut self, c: [usize; 3]) {
         let i = self.index(c);
         self.open[i] = true;
     }
 
-    pub fn is_open(&self, c: [usize; 3]) -> bool {
+    fn is_open(&self, c: [usize; 3]) -> bool {
         self.open[self.index(c)]
     }
 
@@ -100,7 +100,7 @@ impl VoxelWorld {
         )
     }
 
-    pub fn open_cells(&self) -> Vec<[usize; 3]> {
+    fn open_cells(&self) -> Vec<[usize; 3]> {
         self.cells().filter(|&c| self.is_open(c)).collect()
     }
 
