@@ -20,12 +20,20 @@ pub struct FaceLightmap {
     pub width: usize,
     /// Luxels down (t).
     pub height: usize,
-    /// Style of each lightmap, style 0 first.
+    /// Style of each lightmap, brightest first; empty when no light reaches the face.
     pub styles: Vec<u8>,
     /// One byte per luxel per style: the mean of the RGB channels.
     pub grey: Vec<Vec<u8>>,
     /// The channels themselves, per style, when the light is coloured (else empty).
     pub rgb: Vec<Vec<[u8; 3]>>,
+}
+
+impl FaceLightmap {
+    /// The grey bytes of `style`, when the face has a lightmap of that style.
+    pub fn style_grey(&self, style: u8) -> Option<&[u8]> {
+        let slot = self.styles.iter().position(|&s| s == style)?;
+        self.grey.get(slot).map(Vec::as_slice)
+    }
 }
 
 /// How light units become bytes.
@@ -129,13 +137,14 @@ pub fn finish_face(light: &FaceLight, finish: &Finish) -> (FaceLightmap, usize) 
                 map.rgb.push(bytes);
             }
         }
-        // Style 0 is always written (a face without a lightmap renders fullbright).
-        if map.style == 0 || map.energy > 0 {
+        // A style dark all over is not written, style 0 included: engines draw a face without
+        // a lightmap black (as ericw-tools writes it: style 255, no light offset).
+        if map.energy > 0 {
             maps.push(map);
         }
     }
-    // Style 0 stays first; the brightest of the others fill the remaining slots.
-    maps[1..].sort_by_key(|m| std::cmp::Reverse(m.energy));
+    // Brightest first, as ericw-tools orders them; the four brightest are kept.
+    maps.sort_by_key(|m| std::cmp::Reverse(m.energy));
     let dropped = maps.len().saturating_sub(MAX_LIGHTMAPS);
     maps.truncate(MAX_LIGHTMAPS);
     let mut lightmap = FaceLightmap {
@@ -156,7 +165,8 @@ pub fn finish_face(light: &FaceLight, finish: &Finish) -> (FaceLightmap, usize) 
     (lightmap, dropped)
 }
 
-/// Replaces the lighting lump with `maps` (faces not listed get no lightmap) and, when
+/// Replaces the lighting lump with `maps` (faces not listed, or without a style, get no
+/// lightmap) and, when
 /// `coloured`, returns the `.lit` RGB payload matching it (white light needs none).
 pub fn write_lighting(bsp: &mut Bsp, maps: &[FaceLightmap], coloured: bool) -> Option<Vec<u8>> {
     // Sized up front: growing them copied into fresh pages, which the kernel zeroes first.
@@ -167,7 +177,7 @@ pub fn write_lighting(bsp: &mut Bsp, maps: &[FaceLightmap], coloured: bool) -> O
         f.styles = [NO_STYLE; 4];
         f.light_offset = -1;
     }
-    for m in maps {
+    for m in maps.iter().filter(|m| !m.styles.is_empty()) {
         let face = &mut bsp.faces[m.face];
         face.light_offset = grey.len() as i32;
         for (slot, &s) in m.styles.iter().enumerate() {
@@ -249,12 +259,55 @@ mod tests {
             styles,
         };
         let (m, dropped) = finish_face(&light, &PLAIN);
-        assert_eq!(m.styles, vec![0, 36, 35, 34]);
+        assert_eq!(m.styles, vec![36, 35, 34, 33]);
         assert_eq!(
-            dropped, 2,
-            "two lit styles over the limit (the dark one is not counted)"
+            dropped, 1,
+            "one lit style over the limit (the dark ones are not counted)"
         );
-        assert_eq!(m.grey[0], vec![0, 0], "style 0 kept although dark");
+    }
+
+    /// Regression: a face no light reaches was written as style 0 with a lightmap of zeros;
+    /// ericw-tools writes no lightmap at all (style 255, offset -1), which engines draw black.
+    #[test]
+    fn a_face_no_light_reaches_gets_no_lightmap() {
+        let dark = FaceLight {
+            face: 0,
+            width: 2,
+            height: 1,
+            styles: vec![(0, vec![[0.0; 3]; 2])],
+        };
+        let (m, dropped) = finish_face(&dark, &PLAIN);
+        assert!(m.styles.is_empty() && m.grey.is_empty());
+        assert_eq!(dropped, 0);
+        let mut bsp = Bsp::default();
+        bsp.faces.push(face_without_light());
+        assert_eq!(write_lighting(&mut bsp, &[m], false), None);
+        assert!(bsp.lighting.is_empty());
+        assert_eq!(bsp.faces[0].styles, [NO_STYLE; 4]);
+        assert_eq!(bsp.faces[0].light_offset, -1);
+    }
+
+    #[test]
+    fn styles_are_ordered_brightest_first() {
+        let light = FaceLight {
+            face: 0,
+            width: 1,
+            height: 1,
+            styles: vec![(0, vec![[10.0; 3]]), (32, vec![[90.0; 3]])],
+        };
+        assert_eq!(finish_face(&light, &PLAIN).0.styles, vec![32, 0]);
+    }
+
+    fn face_without_light() -> quake_formats::bsp::Face {
+        quake_formats::bsp::Face {
+            plane: 0,
+            side: 0,
+            first_edge: 0,
+            num_edges: 0,
+            texinfo: 0,
+            styles: [NO_STYLE; 4],
+            light_offset: -1,
+        }
     }
 
     #[test]
@@ -287,15 +340,7 @@ mod tests {
         assert!(without.rgb.is_empty());
         assert_eq!(without.grey, with_rgb.grey);
         let mut bsp = Bsp::default();
-        bsp.faces.push(quake_formats::bsp::Face {
-            plane: 0,
-            side: 0,
-            first_edge: 0,
-            num_edges: 0,
-            texinfo: 0,
-            styles: [NO_STYLE; 4],
-            light_offset: -1,
-        });
+        bsp.faces.push(face_without_light());
         assert_eq!(write_lighting(&mut bsp, &[without], false), None);
         assert_eq!(bsp.lighting, vec![20, 45, 4, 4]);
         assert_eq!(bsp.faces[0].styles, [0, 5, NO_STYLE, NO_STYLE]);
