@@ -9,6 +9,10 @@
 //! stands for. Points are then pushed [`SURFACE_OFFSET`] units off the
 //! surface; one that something still hides from the face centre (an object
 //! resting on the face) is pulled back towards the centre into the open.
+//! A brush model's point inside the world's solid (a door's face in the wall it
+//! slides into) is nudged half a unit along each axis into the open when that
+//! frees it, else it is occluded: as in ericw-tools, it takes no light of its
+//! own and its luxel takes its neighbours'.
 //!
 //! [`FaceSamples`] is kept as its own structure so later passes (bounce
 //! lighting) can reuse the same points.
@@ -55,6 +59,9 @@ pub struct FaceSamples {
     /// something other than overhanging the face's edge, so possibly far
     /// from its neighbours).
     pub pulled: Vec<bool>,
+    /// Per sample: inside solid (a brush model's point in the world's solid), so its light
+    /// does not count (empty: no sample is).
+    pub occluded: Vec<bool>,
     /// Where the samples' texture coordinates land on the face.
     pub map: SurfaceMap,
 }
@@ -384,7 +391,13 @@ pub fn face_samples(
         })
         .unzip();
     counts.clamped += clamped.iter().filter(|&&c| c).count() as u64;
-    let (points, pulled) = into_open(&on_face, centre, face.model == 0, scene, bsp, &mut counts);
+    let (mut points, pulled) =
+        into_open(&on_face, centre, face.model == 0, scene, bsp, &mut counts);
+    let occluded = if face.model == 0 {
+        Vec::new()
+    } else {
+        nudge_out_of_solid(bsp, &mut points)
+    };
     let moved = clamped.iter().zip(&pulled).map(|(&c, &p)| c || p).collect();
     (
         FaceSamples {
@@ -397,10 +410,43 @@ pub fn face_samples(
             normals: Vec::new(),
             moved,
             pulled,
+            occluded,
             map,
         },
         counts,
     )
+}
+
+/// Half a unit along each axis, both ways: where a point inside solid is tried, in turn.
+const NUDGES: [[f32; 3]; 8] = [
+    [-0.5, -0.5, -0.5],
+    [-0.5, -0.5, 0.5],
+    [-0.5, 0.5, -0.5],
+    [-0.5, 0.5, 0.5],
+    [0.5, -0.5, -0.5],
+    [0.5, -0.5, 0.5],
+    [0.5, 0.5, -0.5],
+    [0.5, 0.5, 0.5],
+];
+
+/// Moves each of `points` inside a solid world leaf to the first of its [`NUDGES`] that is
+/// in the open; says which stay inside (empty when none does).
+fn nudge_out_of_solid(bsp: &Bsp, points: &mut [[f32; 3]]) -> Vec<bool> {
+    let solid = solid_points(bsp, points);
+    if !solid.contains(&true) {
+        return Vec::new();
+    }
+    let mut occluded = vec![false; points.len()];
+    for (i, _) in solid.iter().enumerate().filter(|(_, s)| **s) {
+        let p = points[i];
+        let tries = NUDGES.map(|d| [p[0] + d[0], p[1] + d[1], p[2] + d[2]]);
+        let free = solid_points(bsp, &tries).iter().position(|s| !s);
+        match free {
+            Some(k) => points[i] = tries[k],
+            None => occluded[i] = true,
+        }
+    }
+    occluded
 }
 
 /// Each of `points` if nothing stands between it and `centre`, else pulled

@@ -998,6 +998,73 @@ fn detail_column_bsp(detail_keys: &str) -> Bsp {
     out.bsp
 }
 
+/// The sealed room of [`detail_column_bsp`] with a `func_door` (x 96..140, y -16..16,
+/// z -128..-64) standing on the floor and reaching 12 units into the +x wall (128..144), and a
+/// light in the room, compiled by the bsp compiler.
+fn door_in_wall_bsp() -> Bsp {
+    let (lo, hi, t) = (-128.0, 128.0, 16.0);
+    let (a, b) = (lo - t, hi + t);
+    let mut world = String::new();
+    for (l, h) in [
+        ([a, a, a], [b, b, lo]),
+        ([a, a, hi], [b, b, b]),
+        ([a, a, lo], [lo, b, hi]),
+        ([hi, a, lo], [b, b, hi]),
+        ([lo, a, lo], [hi, lo, hi]),
+        ([lo, hi, lo], [hi, b, hi]),
+    ] {
+        world += &map_box(l, h);
+    }
+    let door = map_box([96.0, -16.0, -128.0], [140.0, 16.0, -64.0]);
+    let text = format!(
+        "{{\n\"classname\" \"worldspawn\"\n{world}}}\n\
+         {{\n\"classname\" \"func_door\"\n{door}}}\n\
+         {{\n\"classname\" \"light\"\n\"origin\" \"0 0 -32\"\n}}\n\
+         {{\n\"classname\" \"info_player_start\"\n\"origin\" \"-90 -90 -100\"\n}}\n"
+    );
+    let source = bsp_compiler::MapSource {
+        path: std::path::PathBuf::from("door_in_wall.map"),
+        text,
+    };
+    let out =
+        bsp_compiler::compile(&source, &bsp_compiler::CompileOptions::default()).expect("compile");
+    assert!(out.leak.is_none(), "the room leaks");
+    out.bsp
+}
+
+/// Regression: a door's faces inside the wall it slides into were black (their rays start in
+/// the wall's solid), so they showed black once the door moved. As in ericw-tools, samples in
+/// the world's solid are occluded: a luxel with some open samples keeps their mean, one with
+/// none takes its neighbours', and a face with no open sample takes its model's mean.
+#[test]
+fn door_faces_inside_a_wall_are_not_black() {
+    let bsp = door_in_wall_bsp();
+    let prep = crate::prepare::prepare(&bsp, &Options::default()).expect("prepare");
+    let door_face = |normal: DVec3| {
+        prep.faces
+            .iter()
+            .find(|f| f.model == 1 && f.plane.normal.dot(normal) > 0.99)
+            .map(|f| f.index)
+            .expect("door face")
+    };
+    let (end, top, front) = (
+        door_face(DVec3::X),
+        door_face(DVec3::Z),
+        door_face(-DVec3::X),
+    );
+    let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
+    let end_grey = face_grey(&lighting, end);
+    assert!(!end_grey.is_empty(), "the buried face has a lightmap");
+    assert!(
+        end_grey.iter().all(|&v| v > 10 && v == end_grey[0]),
+        "{end_grey:?}"
+    );
+    assert!(face_grey(&lighting, front).iter().all(|&v| v > 10));
+    // The top's luxels over the wall (x beyond 128) are filled from those in the room.
+    let top_grey = face_grey(&lighting, top);
+    assert!(top_grey.iter().all(|&v| v > 10), "{top_grey:?}");
+}
+
 #[test]
 fn phong_on_func_detail_reaches_light_through_the_bsp() {
     // The column's side faces: vertical, near the axis (the room's walls are 128 out).

@@ -202,6 +202,7 @@ impl<'a> FaceTrace<'a> {
             added_minlight: None,
             no_bounce: None,
             bounce_dirt: Vec::new(),
+            occluded: samples.occluded.clone(),
         };
         let mut bounds = Bounds::EMPTY;
         for &p in &samples.points {
