@@ -40,6 +40,7 @@ mod embree;
 mod error;
 mod faces;
 mod grid;
+mod hull;
 mod lighting;
 mod lights;
 mod options;

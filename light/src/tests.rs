@@ -227,7 +227,7 @@ fn samples_behind_a_wall_are_pulled_back_and_do_not_bleed() {
     let bsp = synthetic_bsp(&polys, ents);
     let faces = face_geometry(&bsp, |_| DVec3::ZERO).expect("faces");
     let device = crate::embree::Device::new(1).expect("device");
-    let scene = TraceScene::build(&device, &faces, &[], &[]).expect("scene");
+    let scene = TraceScene::build(&device, &faces, &[], &[], &[]).expect("scene");
     let (samples, counts) = face_samples(&faces[0], 1, &scene, &bsp);
     assert_eq!(samples.width, 8, "grid 0..112 has 8 luxels across");
     assert!(counts.clamped >= 8, "{counts:?}");
@@ -273,7 +273,7 @@ fn sample_points_invert_an_angled_projection() {
     bsp.texinfo[0].vecs = [[0.9, 0.1, 0.0, 5.5], [0.05, -0.7, -0.3, -3.25]];
     let faces = face_geometry(&bsp, |_| DVec3::ZERO).expect("faces");
     let device = crate::embree::Device::new(1).expect("device");
-    let scene = TraceScene::build(&device, &faces, &[], &[]).expect("scene");
+    let scene = TraceScene::build(&device, &faces, &[], &[], &[]).expect("scene");
     let (samples, _) = face_samples(&faces[0], 1, &scene, &bsp);
     let ext = faces[0].extents;
     assert_eq!([samples.width, samples.height], ext.luxel_size());
@@ -1063,6 +1063,75 @@ fn door_faces_inside_a_wall_are_not_black() {
     // The top's luxels over the wall (x beyond 128) are filled from those in the room.
     let top_grey = face_grey(&lighting, top);
     assert!(top_grey.iter().all(|&v| v > 10), "{top_grey:?}");
+}
+
+/// The sealed room of [`detail_column_bsp`] with a `func_wall` slab of `skip` brushes (x, y
+/// -32..32, z -64..-48) keyed `wall_keys` above the floor, and a light over it, compiled by the
+/// bsp compiler: the slab's model has no faces.
+fn skip_slab_bsp(wall_keys: &str) -> Bsp {
+    let (lo, hi, t) = (-128.0, 128.0, 16.0);
+    let (a, b) = (lo - t, hi + t);
+    let mut world = String::new();
+    for (l, h) in [
+        ([a, a, a], [b, b, lo]),
+        ([a, a, hi], [b, b, b]),
+        ([a, a, lo], [lo, b, hi]),
+        ([hi, a, lo], [b, b, hi]),
+        ([lo, a, lo], [hi, lo, hi]),
+        ([lo, hi, lo], [hi, b, hi]),
+    ] {
+        world += &map_box(l, h);
+    }
+    let slab = map_box([-32.0, -32.0, -64.0], [32.0, 32.0, -48.0]).replace("wall", "skip");
+    let text = format!(
+        "{{\n\"classname\" \"worldspawn\"\n{world}}}\n\
+         {{\n\"classname\" \"func_wall\"\n{wall_keys}\n{slab}}}\n\
+         {{\n\"classname\" \"light\"\n\"origin\" \"0 0 64\"\n}}\n\
+         {{\n\"classname\" \"info_player_start\"\n\"origin\" \"-90 -90 -100\"\n}}\n"
+    );
+    let source = bsp_compiler::MapSource {
+        path: std::path::PathBuf::from("skip_slab.map"),
+        text,
+    };
+    let out =
+        bsp_compiler::compile(&source, &bsp_compiler::CompileOptions::default()).expect("compile");
+    assert!(out.leak.is_none(), "the room leaks");
+    out.bsp
+}
+
+/// Regression: a brush model of `skip` brushes with `_shadow 1` cast no shadow (it has no faces
+/// to trace); its solid comes from the BSP's tree, as in ericw-tools.
+#[test]
+fn a_skip_model_with_shadow_casts_its_shadow() {
+    let floor_under_slab = |keys: &str| {
+        let bsp = skip_slab_bsp(keys);
+        assert_eq!(bsp.models[1].num_faces, 0, "the slab has no faces");
+        let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
+        let prep = crate::prepare::prepare(&bsp, &Options::default()).expect("prepare");
+        let floor = prep
+            .faces
+            .iter()
+            .find(|f| f.model == 0 && f.plane.normal.z > 0.99 && f.centroid().x.abs() < 64.0)
+            .expect("floor");
+        let mins = floor.extents.tex_mins;
+        let m = lighting
+            .lightmaps
+            .iter()
+            .find(|m| m.face == floor.index)
+            .expect("lit floor");
+        // The luxel under the slab's middle (world x, y 0: s = x, t = -y).
+        let (col, row) = (
+            (-f64::from(mins[0]) / 16.0).round() as usize,
+            (-f64::from(mins[1]) / 16.0).round() as usize,
+        );
+        m.style_grey(0).map_or(0, |g| g[row * m.width + col])
+    };
+    assert!(floor_under_slab("") > 20, "no shadow without _shadow");
+    assert_eq!(
+        floor_under_slab("\"_shadow\" \"1\""),
+        0,
+        "shadow of the skip slab"
+    );
 }
 
 #[test]
