@@ -138,8 +138,12 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
     let lump = bsp.phong_faces().map_err(LightError::PhongLump)?;
     let groups = phong::groups(&faces, &map_lights.phong, lump.as_deref());
     let phong = phong::corner_normals(&faces, &groups);
-    let surface =
-        surface::expand_templates(&map_lights.templates, &faces, surface::DEFAULT_SPACING);
+    let surface = surface::expand_templates(
+        &map_lights.templates,
+        &faces,
+        &map_lights.surflight_groups,
+        surface::DEFAULT_SPACING,
+    );
     let surface_lights = surface.len();
     let mut point_lights = map_lights.points.clone();
     point_lights.extend(surface);

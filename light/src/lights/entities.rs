@@ -245,6 +245,7 @@ fn point_light(
             offset: k.float("_surface_offset")?.unwrap_or(2.0),
             spotlight: k.float("_surface_spotlight")? == Some(1.0),
             spot_angle: angle,
+            group: k.float("_surflight_group")?.unwrap_or(0.0) as i64,
         }),
         None if c.deviance > 0.0 => {
             let count = k

@@ -51,6 +51,9 @@ pub struct SurfaceTemplate {
     /// Copies shine along the face normal (`_surface_spotlight 1`).
     pub spotlight: bool,
     pub spot_angle: f64,
+    /// `_surflight_group`: copies go only on faces of brush models with the same group (the
+    /// world and models without the key are group 0).
+    pub group: i64,
 }
 
 /// How light bounces: worldspawn's `_bounce` and its keys (or the command line's).
@@ -101,6 +104,8 @@ pub struct MapLights {
     pub phong: HashMap<usize, f64>,
     /// Offset of each brush model with an `origin` key (rotating entities).
     pub model_origins: HashMap<usize, DVec3>,
+    /// Brush models with a non-zero `_surflight_group`, and that group.
+    pub surflight_groups: HashMap<usize, i64>,
     /// The map-wide settings, resolved (the command line's, else worldspawn's, else the
     /// defaults).
     pub settings: Settings,
@@ -165,6 +170,7 @@ pub fn parse_lights(
         dirt: dirt_sampling(&settings),
         phong: HashMap::new(),
         model_origins: HashMap::new(),
+        surflight_groups: HashMap::new(),
         switchable_styles,
         settings,
         warnings,
