@@ -2,6 +2,8 @@
 //!
 //! One point per luxel (16 texels), or `n x n` per luxel when supersampling,
 //! found by inverting the face's texture projection onto its plane. A point
+//! past the face's edge that lands on a face continuing it (same model, same
+//! plane, a shared edge) stays there, as ericw-tools places it. Another point
 //! that falls outside the face (luxels past its edge, e.g. under a wall
 //! standing on a floor) moves to the nearest point of the face, kept
 //! [`FACE_INSET`] inside its edges, so light from the far side of the wall
@@ -238,6 +240,15 @@ impl FaceRegion {
         self.points.iter().fold(DVec3::ZERO, |a, &p| a + p) / self.points.len().max(1) as f64
     }
 
+    /// Whether `p` (a point on the face's plane) is inside the region or on its edge.
+    fn contains(&self, p: DVec3) -> bool {
+        let slack = 1e-6;
+        self.points
+            .iter()
+            .zip(&self.inward)
+            .all(|(&a, m)| m.dot(p - a) >= -slack)
+    }
+
     /// `p` (a point on the face's plane) if it is inside, else the nearest
     /// point of the region's outline. Only edges `p` is outside of can hold
     /// that point (or end in it): the region is convex.
@@ -273,6 +284,9 @@ impl FaceRegion {
 pub struct SurfaceMap {
     to_world: Option<TextureToWorld>,
     region: FaceRegion,
+    /// The face itself and the faces continuing it past its edges ([`FaceGeom::continuations`]).
+    outline: FaceRegion,
+    continuations: Vec<FaceRegion>,
     origin: DVec3,
     lift: DVec3,
     extents: LightmapExtents,
@@ -288,9 +302,16 @@ impl SurfaceMap {
         let footprint_radius = to_world.as_ref().map_or(0.0, |m| {
             (m.inverse.x_axis.length() + m.inverse.y_axis.length()) * step / 2.0
         });
+        let normal = face.plane.normal;
         SurfaceMap {
             to_world,
             region: FaceRegion::inset(face),
+            outline: FaceRegion::from_points(face.points.clone(), normal),
+            continuations: face
+                .continuations
+                .iter()
+                .map(|points| FaceRegion::from_points(points.clone(), normal))
+                .collect(),
             origin: face.origin,
             lift: face.plane.normal * SURFACE_OFFSET,
             extents: face.extents,
@@ -311,6 +332,11 @@ impl SurfaceMap {
             return (self.centre(), false);
         };
         let on_plane = m.point(s, t) + self.origin;
+        if !self.outline.contains(on_plane)
+            && self.continuations.iter().any(|c| c.contains(on_plane))
+        {
+            return (on_plane + self.lift, false);
+        }
         let on_face = self.region.nearest(on_plane);
         (on_face + self.lift, on_face != on_plane)
     }
@@ -319,7 +345,8 @@ impl SurfaceMap {
     /// wider, for rounding), in single precision.
     pub fn bounds(&self) -> ([f32; 3], [f32; 3]) {
         let (mut lo, mut hi) = (self.centre(), self.centre());
-        for &p in &self.region.points {
+        let continued = self.continuations.iter().flat_map(|c| &c.points);
+        for &p in self.region.points.iter().chain(continued) {
             lo = lo.min(p + self.lift);
             hi = hi.max(p + self.lift);
         }

@@ -94,6 +94,7 @@ mod tests {
                 tex_mins: [0, -64],
                 extents: [64, 64],
             },
+            continuations: Vec::new(),
         };
         let faces = [face(0, 0), face(1, 1), face(2, 2)];
         let template = |group: i64| SurfaceTemplate {

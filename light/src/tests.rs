@@ -253,6 +253,38 @@ fn samples_behind_a_wall_are_pulled_back_and_do_not_bleed() {
     );
 }
 
+/// Regression: a luxel past a face's edge was moved back onto the face even where a face on the
+/// same plane continues it (a thin strip beside a floor), so it measured the strip's edge instead
+/// of the surface it stands over; ericw-tools places it on the continuing face.
+#[test]
+fn samples_past_an_edge_land_on_the_face_that_continues_it() {
+    let strip = quad(
+        [0.0, 0.0, 0.0],
+        [0.0, 8.0, 0.0],
+        [256.0, 8.0, 0.0],
+        [256.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0],
+    );
+    let rest = quad(
+        [0.0, 8.0, 0.0],
+        [0.0, 256.0, 0.0],
+        [256.0, 256.0, 0.0],
+        [256.0, 8.0, 0.0],
+        [0.0, 0.0, 1.0],
+    );
+    let bsp = synthetic_bsp(&[strip, rest], "{ \"classname\" \"worldspawn\" }");
+    let faces = face_geometry(&bsp, |_| DVec3::ZERO).expect("faces");
+    assert_eq!(faces[0].continuations.len(), 1);
+    let device = crate::embree::Device::new(1).expect("device");
+    let scene = TraceScene::build(&device, &faces, &[], &[], &[]).expect("scene");
+    let (samples, _) = face_samples(&faces[0], 1, &scene, &bsp);
+    // Luxel rows at y 0 and 16: the second stands over the other face and stays there.
+    assert_eq!(samples.height, 2);
+    let over_rest: Vec<&[f32; 3]> = samples.points.iter().filter(|p| p[1] > 8.0).collect();
+    assert_eq!(over_rest.len(), samples.width, "{:?}", samples.points);
+    assert!(over_rest.iter().all(|p| p[1] == 16.0 && p[2] == 1.0));
+}
+
 #[test]
 fn sample_points_invert_an_angled_projection() {
     // A sloped face with a skewed, off-grid texture projection.
