@@ -8,7 +8,7 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 anchor="$root/../shared/anchors/ericw-tools/bin/light"
 [ -x "$anchor" ] || { echo "SKIPPED: $anchor not found" >&2; exit 0; }
-cargo build --release --manifest-path "$root/Cargo.toml" -p slipgate -p slipgate-light \
+cargo build --release --manifest-path "$root/Cargo.toml" -p slipgate -p slipgate-light --bins \
   --example ericw_agreement >/dev/null
 target="${CARGO_TARGET_DIR:-$root/target}/release"
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT

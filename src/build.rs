@@ -60,7 +60,7 @@ pub struct BuildArgs {
 fn extra_args(opts: Option<&str>) -> Vec<OsString> {
     let words = std::iter::once(String::new())
         .chain(opts.unwrap_or("").split_whitespace().map(str::to_string));
-    let normalised = batch::options::command_words(words);
+    let normalised = batch::command_words(words);
     normalised.into_iter().skip(1).map(OsString::from).collect()
 }
 

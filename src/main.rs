@@ -55,7 +55,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse_from(batch::options::command_words(std::env::args()));
+    let cli = Cli::parse_from(batch::command_words(std::env::args()));
     match run(cli.command) {
         Ok(code) => code,
         Err(e) => {
@@ -105,10 +105,8 @@ mod tests {
             "valve",
             "x.map",
         ];
-        let cli = Cli::try_parse_from(batch::options::command_words(
-            args.iter().map(|s| s.to_string()),
-        ))
-        .expect("parse");
+        let cli = Cli::try_parse_from(batch::command_words(args.iter().map(|s| s.to_string())))
+            .expect("parse");
         let Command::Bsp(bsp) = cli.command else {
             panic!("not the bsp command");
         };

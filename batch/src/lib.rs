@@ -22,6 +22,8 @@ mod stages;
 mod summary;
 mod walk;
 
+pub use options::command_words;
+
 use cache::Cache;
 use manifest::{Manifest, ManifestError, Shard};
 use project::{MapJob, Project, ProjectError};

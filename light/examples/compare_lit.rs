@@ -32,8 +32,7 @@ fn main() -> anyhow::Result<()> {
         let direct = lightmaps_in(&read(direct)?, &faces);
         let style0 = |maps: &[FaceLightmap]| -> HashMap<usize, Vec<u8>> {
             maps.iter()
-                .filter(|m| m.styles.first() == Some(&0))
-                .map(|m| (m.face, m.grey[0].clone()))
+                .filter_map(|m| Some((m.face, m.style_grey(0)?.to_vec())))
                 .collect()
         };
         let (ours, theirs, direct) = (

@@ -1,6 +1,8 @@
 //! The faces of a BSP as geometry the light tool works with: world-space
 //! polygon, facing plane, texture projection and lightmap extents.
 
+use std::collections::HashMap;
+
 use glam::{DVec3, Vec3};
 use quake_formats::Bsp;
 use quake_formats::bsp::texinfo_flags;
@@ -49,6 +51,9 @@ pub struct FaceGeom {
     /// Offset from model space to world space.
     pub origin: DVec3,
     pub extents: LightmapExtents,
+    /// The lit faces of the same model on the same plane that share an edge with this one, as
+    /// polygons: where a luxel past this face's edge finds the surface it stands over.
+    pub continuations: Vec<Vec<DVec3>>,
 }
 
 impl FaceGeom {
@@ -132,9 +137,63 @@ pub fn face_geometry(
                 vecs: ti.vecs,
                 origin,
                 extents: LightmapExtents::from_points(&verts, &ti.vecs),
+                continuations: Vec::new(),
             })
         })
         .collect();
     // The first bad face in file order, whichever thread found it.
-    faces.into_iter().collect()
+    let mut faces = faces.into_iter().collect::<Result<Vec<_>, _>>()?;
+    link_continuations(&mut faces);
+    Ok(faces)
+}
+
+/// Corners closer than this (units) are the same corner.
+const SAME_CORNER: f64 = 0.01;
+
+/// Fills each lit face's [`FaceGeom::continuations`]: the lit faces of its model on its plane
+/// that share one of its edges.
+fn link_continuations(faces: &mut [FaceGeom]) {
+    let key = |p: DVec3| (p / SAME_CORNER).round().as_i64vec3().to_array();
+    let mut by_edge: HashMap<([i64; 3], [i64; 3]), Vec<usize>> = HashMap::new();
+    for f in faces.iter().filter(|f| f.kind == FaceKind::Lit) {
+        for (a, b) in edges(&f.points) {
+            let (ka, kb) = (key(a), key(b));
+            by_edge
+                .entry((ka.min(kb), ka.max(kb)))
+                .or_default()
+                .push(f.index);
+        }
+    }
+    let same_plane = |a: &FaceGeom, b: &FaceGeom| {
+        a.model == b.model
+            && a.plane.normal.dot(b.plane.normal) > 1.0 - 1e-6
+            && (a.plane.dist - b.plane.dist).abs() < SAME_CORNER
+    };
+    let found: Vec<Vec<usize>> = faces
+        .iter()
+        .map(|f| {
+            if f.kind != FaceKind::Lit {
+                return Vec::new();
+            }
+            let mut next: Vec<usize> = edges(&f.points)
+                .flat_map(|(a, b)| {
+                    let (ka, kb) = (key(a), key(b));
+                    by_edge.get(&(ka.min(kb), ka.max(kb))).into_iter().flatten()
+                })
+                .copied()
+                .filter(|&g| g != f.index && same_plane(f, &faces[g]))
+                .collect();
+            next.sort_unstable();
+            next.dedup();
+            next
+        })
+        .collect();
+    for (f, next) in found.into_iter().enumerate() {
+        faces[f].continuations = next.iter().map(|&g| faces[g].points.clone()).collect();
+    }
+}
+
+/// The edges of a polygon, corner to next corner.
+fn edges(points: &[DVec3]) -> impl Iterator<Item = (DVec3, DVec3)> + '_ {
+    (0..points.len()).map(|i| (points[i], points[(i + 1) % points.len()]))
 }

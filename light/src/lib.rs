@@ -41,6 +41,7 @@ mod embree;
 mod error;
 mod faces;
 mod grid;
+mod hull;
 mod lightgrid;
 mod lighting;
 mod lights;

@@ -86,7 +86,7 @@ pub struct FaceLightmap {
     pub width: usize,
     /// Luxels down (t).
     pub height: usize,
-    /// Style of each lightmap, style 0 first.
+    /// Style of each lightmap, brightest first; empty when no light reaches the face.
     pub styles: Vec<u8>,
     /// One byte per luxel per style: the mean of the RGB channels.
     pub grey: Vec<Vec<u8>>,
@@ -98,6 +98,14 @@ pub struct FaceLightmap {
     pub hdr: Vec<Vec<u32>>,
     /// Per style, each luxel's direction bytes, when deluxemaps are asked for (else empty).
     pub directions: Vec<Vec<[u8; 3]>>,
+}
+
+impl FaceLightmap {
+    /// The grey bytes of `style`, when the face has a lightmap of that style.
+    pub fn style_grey(&self, style: u8) -> Option<&[u8]> {
+        let slot = self.styles.iter().position(|&s| s == style)?;
+        self.grey.get(slot).map(Vec::as_slice)
+    }
 }
 
 /// How light units become bytes.
@@ -238,13 +246,14 @@ pub fn finish_face(light: &FaceLight, finish: &Finish) -> (FaceLightmap, usize) 
                 None => vec![NO_DIRECTION; filtered.len()],
             };
         }
-        // Style 0 is always written (a face without a lightmap renders fullbright).
-        if map.style == 0 || map.energy > 0 {
+        // A style dark all over is not written, style 0 included: engines draw a face without
+        // a lightmap black (as ericw-tools writes it: style 255, no light offset).
+        if map.energy > 0 {
             maps.push(map);
         }
     }
-    // Style 0 stays first; the brightest of the others fill the remaining slots.
-    maps[1..].sort_by_key(|m| std::cmp::Reverse(m.energy));
+    // Brightest first, as ericw-tools orders them; the four brightest are kept.
+    maps.sort_by_key(|m| std::cmp::Reverse(m.energy));
     let dropped = maps.len().saturating_sub(MAX_LIGHTMAPS);
     maps.truncate(MAX_LIGHTMAPS);
     let mut lightmap = FaceLightmap {
@@ -284,7 +293,8 @@ pub struct LuxelData {
     pub directions: Option<Vec<u8>>,
 }
 
-/// Replaces the lighting data with `maps` (faces not listed get no lightmap): the grey lump
+/// Replaces the lighting data with `maps` (faces not listed, or without a style, get no
+/// lightmap): the grey lump
 /// unless `outputs` leave it out, and the BSPX lumps `outputs` ask for (earlier ones of those
 /// names are removed). Returns every luxel's RGB, HDR and direction data the maps kept, for the
 /// files beside the BSP.
@@ -300,7 +310,7 @@ pub fn write_lighting(bsp: &mut Bsp, maps: &[FaceLightmap], outputs: &Outputs) -
         f.styles = [NO_STYLE; 4];
         f.light_offset = -1;
     }
-    for m in maps {
+    for m in maps.iter().filter(|m| !m.styles.is_empty()) {
         let face = &mut bsp.faces[m.face];
         face.light_offset = grey.len() as i32;
         for (slot, &s) in m.styles.iter().enumerate() {
@@ -414,12 +424,58 @@ mod tests {
             directions: Vec::new(),
         };
         let (m, dropped) = finish_face(&light, &PLAIN);
-        assert_eq!(m.styles, vec![0, 36, 35, 34]);
+        assert_eq!(m.styles, vec![36, 35, 34, 33]);
         assert_eq!(
-            dropped, 2,
-            "two lit styles over the limit (the dark one is not counted)"
+            dropped, 1,
+            "one lit style over the limit (the dark ones are not counted)"
         );
-        assert_eq!(m.grey[0], vec![0, 0], "style 0 kept although dark");
+    }
+
+    /// Regression: a face no light reaches was written as style 0 with a lightmap of zeros;
+    /// ericw-tools writes no lightmap at all (style 255, offset -1), which engines draw black.
+    #[test]
+    fn a_face_no_light_reaches_gets_no_lightmap() {
+        let dark = FaceLight {
+            face: 0,
+            width: 2,
+            height: 1,
+            styles: vec![(0, vec![[0.0; 3]; 2])],
+            directions: Vec::new(),
+        };
+        let (m, dropped) = finish_face(&dark, &PLAIN);
+        assert!(m.styles.is_empty() && m.grey.is_empty());
+        assert_eq!(dropped, 0);
+        let mut bsp = Bsp::default();
+        bsp.faces.push(face_without_light());
+        let data = write_lighting(&mut bsp, &[m], &Outputs::default());
+        assert_eq!(data, LuxelData::default());
+        assert!(bsp.lighting.is_empty());
+        assert_eq!(bsp.faces[0].styles, [NO_STYLE; 4]);
+        assert_eq!(bsp.faces[0].light_offset, -1);
+    }
+
+    #[test]
+    fn styles_are_ordered_brightest_first() {
+        let light = FaceLight {
+            face: 0,
+            width: 1,
+            height: 1,
+            styles: vec![(0, vec![[10.0; 3]]), (32, vec![[90.0; 3]])],
+            directions: Vec::new(),
+        };
+        assert_eq!(finish_face(&light, &PLAIN).0.styles, vec![32, 0]);
+    }
+
+    fn face_without_light() -> quake_formats::bsp::Face {
+        quake_formats::bsp::Face {
+            plane: 0,
+            side: 0,
+            first_edge: 0,
+            num_edges: 0,
+            texinfo: 0,
+            styles: [NO_STYLE; 4],
+            light_offset: -1,
+        }
     }
 
     #[test]
@@ -454,15 +510,7 @@ mod tests {
         assert!(without.rgb.is_empty());
         assert_eq!(without.grey, with_rgb.grey);
         let mut bsp = Bsp::default();
-        bsp.faces.push(quake_formats::bsp::Face {
-            plane: 0,
-            side: 0,
-            first_edge: 0,
-            num_edges: 0,
-            texinfo: 0,
-            styles: [NO_STYLE; 4],
-            light_offset: -1,
-        });
+        bsp.faces.push(face_without_light());
         let data = write_lighting(&mut bsp, &[without], &Outputs::default());
         assert_eq!(data, LuxelData::default());
         assert!(bsp.bspx.is_empty());

@@ -230,6 +230,7 @@ mod tests {
             vecs: [[0.0; 4]; 2],
             origin: DVec3::ZERO,
             extents: LightmapExtents::from_points(&[], &[[0.0; 4]; 2]),
+            continuations: Vec::new(),
         }
     }
 

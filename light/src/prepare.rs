@@ -8,7 +8,8 @@ use quake_formats::geom::Bounds;
 
 use crate::embree::Device;
 use crate::error::LightError;
-use crate::faces::{FaceGeom, face_geometry};
+use crate::faces::{FaceGeom, FaceKind, face_geometry};
+use crate::hull;
 use crate::lights::{MapLights, PointLight, parse_lights};
 use crate::options::Options;
 use crate::phong;
@@ -79,6 +80,29 @@ impl Prepared {
     }
 }
 
+/// The solid (from the BSP's tree, world space) of each model of `shadow_models` without a lit
+/// face: a model of `skip` brushes casts its shadow from its brushes.
+fn faceless_solids(
+    bsp: &Bsp,
+    faces: &[FaceGeom],
+    shadow_models: &[usize],
+    origin_of: impl Fn(usize) -> DVec3,
+) -> Vec<Vec<DVec3>> {
+    let faceless = |m: usize| {
+        !faces
+            .iter()
+            .any(|f| f.model == m && f.kind == FaceKind::Lit)
+    };
+    let mut out = Vec::new();
+    for &m in shadow_models.iter().filter(|&&m| faceless(m)) {
+        let offset = origin_of(m);
+        for polygon in hull::solid_polygons(bsp, m) {
+            out.push(polygon.into_iter().map(|p| p + offset).collect());
+        }
+    }
+    out
+}
+
 /// Reads faces, entities and visibility and builds the Embree scene.
 ///
 /// # Errors
@@ -103,18 +127,24 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
             .unwrap_or(DVec3::ZERO)
     };
     let faces = face_geometry(bsp, origin_of)?;
+    let solids = faceless_solids(bsp, &faces, &map_lights.shadow_models, origin_of);
     let scene = TraceScene::build(
         &device,
         &faces,
         &map_lights.shadow_models,
         &map_lights.self_shadow_models,
+        &solids,
     )?;
     let vis = Visibility::new(bsp, &faces);
     let lump = bsp.phong_faces().map_err(LightError::PhongLump)?;
     let groups = phong::groups(&faces, &map_lights.phong, lump.as_deref());
     let phong = phong::corner_normals(&faces, &groups);
-    let surface =
-        surface::expand_templates(&map_lights.templates, &faces, surface::DEFAULT_SPACING);
+    let surface = surface::expand_templates(
+        &map_lights.templates,
+        &faces,
+        &map_lights.surflight_groups,
+        surface::DEFAULT_SPACING,
+    );
     let surface_lights = surface.len();
     let mut point_lights = map_lights.points.clone();
     point_lights.extend(surface);

@@ -3,6 +3,7 @@
 //! and count what was done; then turn light units into bytes and write them into the BSP.
 
 use glam::Vec3;
+use std::collections::BTreeMap;
 use std::time::Instant;
 
 use quake_formats::Bsp;
@@ -14,6 +15,7 @@ use rayon::prelude::*;
 
 use crate::bounce::{self, BounceCounts, Density, Field, Receivers, StyleLuxels};
 use crate::error::LightError;
+use crate::faces::FaceGeom;
 use crate::lightgrid::{GridSources, RawGrid, finish_grid, trace_grid};
 use crate::lighting::{Lighting, RawLighting, Stats};
 use crate::lights::assign_switchable_styles;
@@ -59,7 +61,7 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
         stats.grid_rays = g.rays;
         stats.seconds_lightgrid = (grid_done - bounce_done).as_secs_f64();
     }
-    let faces = finish_faces(traced, &bounced);
+    let faces = finish_faces(traced, &bounced, &prep.faces);
     stats.luxels = faces.iter().map(|l| (l.width * l.height) as u64).sum();
     stats.faces_lit = faces.len();
     if plan.bouncing {
@@ -318,17 +320,68 @@ impl<'a> Plan<'a> {
 
 /// Each wanted face's light with its bounced light added, floors applied and samples averaged
 /// to luxels.
-fn finish_faces(traced: Vec<Traced>, bounced: &[StyleLuxels]) -> Vec<FaceLight> {
+fn finish_faces(
+    traced: Vec<Traced>,
+    bounced: &[StyleLuxels],
+    geometry: &[FaceGeom],
+) -> Vec<FaceLight> {
     // Gathered first, into room for all, so no vector here grows in steps (each step takes
     // fresh pages) and the parallel collect knows its length.
     let mut lit: Vec<SampleLight> = Vec::with_capacity(traced.len());
     lit.extend(traced.into_iter().filter_map(|t| t.light));
-    lit.into_par_iter()
+    let buried: Vec<bool> = lit.iter().map(SampleLight::buried).collect();
+    let mut faces: Vec<FaceLight> = lit
+        .into_par_iter()
         .map(|light| {
             let bounce = bounced.get(light.face).map_or(&[][..], |b| &b[..]);
             light.finish(bounce)
         })
-        .collect()
+        .collect();
+    light_buried_faces(&mut faces, &buried, geometry);
+    faces
+}
+
+/// A brush model's face with every sample inside solid (a door's face in the wall it slides
+/// into) takes, per style, the mean luxel of its model's other faces: its own rays, traced from
+/// inside the wall, say nothing, and ericw-tools too gives such a face one value across it
+/// rather than black.
+fn light_buried_faces(faces: &mut [FaceLight], buried: &[bool], geometry: &[FaceGeom]) {
+    if !buried.contains(&true) {
+        return;
+    }
+    let model_of = |light: &FaceLight| geometry[light.face].model;
+    let mut means: BTreeMap<(usize, u8), ([f64; 3], usize)> = BTreeMap::new();
+    for light in faces
+        .iter()
+        .zip(buried)
+        .filter(|(_, b)| !**b)
+        .map(|(l, _)| l)
+    {
+        for (style, luxels) in &light.styles {
+            let (sum, count) = means.entry((model_of(light), *style)).or_default();
+            for l in luxels {
+                for k in 0..3 {
+                    sum[k] += f64::from(l[k]);
+                }
+            }
+            *count += luxels.len();
+        }
+    }
+    for light in faces
+        .iter_mut()
+        .zip(buried)
+        .filter(|(_, b)| **b)
+        .map(|(l, _)| l)
+    {
+        let (model, n) = (model_of(light), light.width * light.height);
+        light.styles = means
+            .range((model, 0)..=(model, u8::MAX))
+            .filter(|(_, (_, count))| *count > 0)
+            .map(|(&(_, style), (sum, count))| {
+                (style, vec![sum.map(|s| (s / *count as f64) as f32); n])
+            })
+            .collect();
+    }
 }
 
 /// One face after direct light: what later steps need of it.

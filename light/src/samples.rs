@@ -2,6 +2,8 @@
 //!
 //! One point per luxel (16 texels), or `n x n` per luxel when supersampling,
 //! found by inverting the face's texture projection onto its plane. A point
+//! past the face's edge that lands on a face continuing it (same model, same
+//! plane, a shared edge) stays there, as ericw-tools places it. Another point
 //! that falls outside the face (luxels past its edge, e.g. under a wall
 //! standing on a floor) moves to the nearest point of the face, kept
 //! [`FACE_INSET`] inside its edges, so light from the far side of the wall
@@ -9,6 +11,10 @@
 //! stands for. Points are then pushed [`SURFACE_OFFSET`] units off the
 //! surface; one that something still hides from the face centre (an object
 //! resting on the face) is pulled back towards the centre into the open.
+//! A brush model's point inside the world's solid (a door's face in the wall it
+//! slides into) is nudged half a unit along each axis into the open when that
+//! frees it, else it is occluded: as in ericw-tools, it takes no light of its
+//! own and its luxel takes its neighbours'.
 //!
 //! [`FaceSamples`] is kept as its own structure so later passes (bounce
 //! lighting) can reuse the same points.
@@ -55,6 +61,9 @@ pub struct FaceSamples {
     /// something other than overhanging the face's edge, so possibly far
     /// from its neighbours).
     pub pulled: Vec<bool>,
+    /// Per sample: inside solid (a brush model's point in the world's solid), so its light
+    /// does not count (empty: no sample is).
+    pub occluded: Vec<bool>,
     /// Where the samples' texture coordinates land on the face.
     pub map: SurfaceMap,
 }
@@ -231,6 +240,15 @@ impl FaceRegion {
         self.points.iter().fold(DVec3::ZERO, |a, &p| a + p) / self.points.len().max(1) as f64
     }
 
+    /// Whether `p` (a point on the face's plane) is inside the region or on its edge.
+    fn contains(&self, p: DVec3) -> bool {
+        let slack = 1e-6;
+        self.points
+            .iter()
+            .zip(&self.inward)
+            .all(|(&a, m)| m.dot(p - a) >= -slack)
+    }
+
     /// `p` (a point on the face's plane) if it is inside, else the nearest
     /// point of the region's outline. Only edges `p` is outside of can hold
     /// that point (or end in it): the region is convex.
@@ -266,6 +284,9 @@ impl FaceRegion {
 pub struct SurfaceMap {
     to_world: Option<TextureToWorld>,
     region: FaceRegion,
+    /// The face itself and the faces continuing it past its edges ([`FaceGeom::continuations`]).
+    outline: FaceRegion,
+    continuations: Vec<FaceRegion>,
     origin: DVec3,
     lift: DVec3,
     extents: LightmapExtents,
@@ -281,9 +302,16 @@ impl SurfaceMap {
         let footprint_radius = to_world.as_ref().map_or(0.0, |m| {
             (m.inverse.x_axis.length() + m.inverse.y_axis.length()) * step / 2.0
         });
+        let normal = face.plane.normal;
         SurfaceMap {
             to_world,
             region: FaceRegion::inset(face),
+            outline: FaceRegion::from_points(face.points.clone(), normal),
+            continuations: face
+                .continuations
+                .iter()
+                .map(|points| FaceRegion::from_points(points.clone(), normal))
+                .collect(),
             origin: face.origin,
             lift: face.plane.normal * SURFACE_OFFSET,
             extents: face.extents,
@@ -304,6 +332,11 @@ impl SurfaceMap {
             return (self.centre(), false);
         };
         let on_plane = m.point(s, t) + self.origin;
+        if !self.outline.contains(on_plane)
+            && self.continuations.iter().any(|c| c.contains(on_plane))
+        {
+            return (on_plane + self.lift, false);
+        }
         let on_face = self.region.nearest(on_plane);
         (on_face + self.lift, on_face != on_plane)
     }
@@ -312,7 +345,8 @@ impl SurfaceMap {
     /// wider, for rounding), in single precision.
     pub fn bounds(&self) -> ([f32; 3], [f32; 3]) {
         let (mut lo, mut hi) = (self.centre(), self.centre());
-        for &p in &self.region.points {
+        let continued = self.continuations.iter().flat_map(|c| &c.points);
+        for &p in self.region.points.iter().chain(continued) {
             lo = lo.min(p + self.lift);
             hi = hi.max(p + self.lift);
         }
@@ -384,7 +418,13 @@ pub fn face_samples(
         })
         .unzip();
     counts.clamped += clamped.iter().filter(|&&c| c).count() as u64;
-    let (points, pulled) = into_open(&on_face, centre, face.model == 0, scene, bsp, &mut counts);
+    let (mut points, pulled) =
+        into_open(&on_face, centre, face.model == 0, scene, bsp, &mut counts);
+    let occluded = if face.model == 0 {
+        Vec::new()
+    } else {
+        nudge_out_of_solid(bsp, &mut points)
+    };
     let moved = clamped.iter().zip(&pulled).map(|(&c, &p)| c || p).collect();
     (
         FaceSamples {
@@ -397,10 +437,43 @@ pub fn face_samples(
             normals: Vec::new(),
             moved,
             pulled,
+            occluded,
             map,
         },
         counts,
     )
+}
+
+/// Half a unit along each axis, both ways: where a point inside solid is tried, in turn.
+const NUDGES: [[f32; 3]; 8] = [
+    [-0.5, -0.5, -0.5],
+    [-0.5, -0.5, 0.5],
+    [-0.5, 0.5, -0.5],
+    [-0.5, 0.5, 0.5],
+    [0.5, -0.5, -0.5],
+    [0.5, -0.5, 0.5],
+    [0.5, 0.5, -0.5],
+    [0.5, 0.5, 0.5],
+];
+
+/// Moves each of `points` inside a solid world leaf to the first of its [`NUDGES`] that is
+/// in the open; says which stay inside (empty when none does).
+fn nudge_out_of_solid(bsp: &Bsp, points: &mut [[f32; 3]]) -> Vec<bool> {
+    let solid = solid_points(bsp, points);
+    if !solid.contains(&true) {
+        return Vec::new();
+    }
+    let mut occluded = vec![false; points.len()];
+    for (i, _) in solid.iter().enumerate().filter(|(_, s)| **s) {
+        let p = points[i];
+        let tries = NUDGES.map(|d| [p[0] + d[0], p[1] + d[1], p[2] + d[2]]);
+        let free = solid_points(bsp, &tries).iter().position(|s| !s);
+        match free {
+            Some(k) => points[i] = tries[k],
+            None => occluded[i] = true,
+        }
+    }
+    occluded
 }
 
 /// Each of `points` if nothing stands between it and `centre`, else pulled

@@ -6,9 +6,15 @@
 
 use std::collections::HashMap;
 
+use glam::DVec3;
+
 use crate::embree::{Device, RayPacket16, Scene, SceneBuilder, sys};
 use crate::error::LightError;
 use crate::faces::{FaceGeom, FaceKind};
+
+/// The face of a triangle that blocks light but is no face of the BSP (a faceless model's
+/// solid, see [`crate::hull`]).
+const NO_FACE: u32 = u32::MAX;
 
 /// Sun rays are tested for blockers up to this fraction of their distance to the sky.
 const SKY_HIT_SHORTEN: f32 = 1.0 - 1e-5;
@@ -53,21 +59,27 @@ impl Mesh {
     }
 
     fn add(&mut self, face: &FaceGeom) {
+        self.add_polygon(&face.points, face.index as u32);
+    }
+
+    /// A convex polygon, fan-triangulated, its triangles marked as `face`'s.
+    fn add_polygon(&mut self, points: &[DVec3], face: u32) {
         let base = self.vertices.len() as u32;
         self.vertices
-            .extend(face.points.iter().map(|p| p.as_vec3().to_array()));
-        for i in 1..face.points.len() as u32 - 1 {
+            .extend(points.iter().map(|p| p.as_vec3().to_array()));
+        for i in 1..(points.len() as u32).saturating_sub(1) {
             self.triangles.push([base, base + i, base + i + 1]);
-            self.faces.push(face.index as u32);
+            self.faces.push(face);
         }
     }
 }
 
 impl TraceScene {
     /// Builds the scene from `faces`: world faces, and faces of the brush
-    /// models in `shadow_models`; each model in `self_shadow_models` that is
-    /// not also in `shadow_models` gets a scene of its own faces. Liquids are
-    /// left out (they let light through).
+    /// models in `shadow_models`, and the polygons `solids` (world space: the
+    /// solid of shadow-casting models without faces); each model in
+    /// `self_shadow_models` that is not also in `shadow_models` gets a scene of
+    /// its own faces. Liquids are left out (they let light through).
     ///
     /// # Errors
     /// The Embree error if building fails.
@@ -76,6 +88,7 @@ impl TraceScene {
         faces: &[FaceGeom],
         shadow_models: &[usize],
         self_shadow_models: &[usize],
+        solids: &[Vec<DVec3>],
     ) -> Result<TraceScene, LightError> {
         let casts = |f: &FaceGeom| f.model == 0 || shadow_models.contains(&f.model);
         let mut opaque =
@@ -91,6 +104,9 @@ impl TraceScene {
                 FaceKind::Sky if f.model == 0 => sky.add(f),
                 _ => {}
             }
+        }
+        for polygon in solids {
+            opaque.add_polygon(polygon, NO_FACE);
         }
         let mut triangles = opaque.triangles.len() + sky.triangles.len();
         let mut own = HashMap::with_capacity(own_meshes.len());
@@ -171,6 +187,7 @@ impl TraceScene {
                 out[lane] = self
                     .opaque_faces
                     .get(*prim as usize)
+                    .filter(|&&f| f != NO_FACE)
                     .map(|&f| (f as usize, packet.tfar(lane)));
             }
         }

@@ -227,7 +227,7 @@ fn samples_behind_a_wall_are_pulled_back_and_do_not_bleed() {
     let bsp = synthetic_bsp(&polys, ents);
     let faces = face_geometry(&bsp, |_| DVec3::ZERO).expect("faces");
     let device = crate::embree::Device::new(1).expect("device");
-    let scene = TraceScene::build(&device, &faces, &[], &[]).expect("scene");
+    let scene = TraceScene::build(&device, &faces, &[], &[], &[]).expect("scene");
     let (samples, counts) = face_samples(&faces[0], 1, &scene, &bsp);
     assert_eq!(samples.width, 8, "grid 0..112 has 8 luxels across");
     assert!(counts.clamped >= 8, "{counts:?}");
@@ -246,9 +246,43 @@ fn samples_behind_a_wall_are_pulled_back_and_do_not_bleed() {
         .find(|m| m.face == 0)
         .expect("floor");
     assert!(
-        floor.grey[0].iter().all(|&v| v == 0),
+        floor
+            .style_grey(0)
+            .is_none_or(|g| g.iter().all(|&v| v == 0)),
         "light bled under the wall"
     );
+}
+
+/// Regression: a luxel past a face's edge was moved back onto the face even where a face on the
+/// same plane continues it (a thin strip beside a floor), so it measured the strip's edge instead
+/// of the surface it stands over; ericw-tools places it on the continuing face.
+#[test]
+fn samples_past_an_edge_land_on_the_face_that_continues_it() {
+    let strip = quad(
+        [0.0, 0.0, 0.0],
+        [0.0, 8.0, 0.0],
+        [256.0, 8.0, 0.0],
+        [256.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0],
+    );
+    let rest = quad(
+        [0.0, 8.0, 0.0],
+        [0.0, 256.0, 0.0],
+        [256.0, 256.0, 0.0],
+        [256.0, 8.0, 0.0],
+        [0.0, 0.0, 1.0],
+    );
+    let bsp = synthetic_bsp(&[strip, rest], "{ \"classname\" \"worldspawn\" }");
+    let faces = face_geometry(&bsp, |_| DVec3::ZERO).expect("faces");
+    assert_eq!(faces[0].continuations.len(), 1);
+    let device = crate::embree::Device::new(1).expect("device");
+    let scene = TraceScene::build(&device, &faces, &[], &[], &[]).expect("scene");
+    let (samples, _) = face_samples(&faces[0], 1, &scene, &bsp);
+    // Luxel rows at y 0 and 16: the second stands over the other face and stays there.
+    assert_eq!(samples.height, 2);
+    let over_rest: Vec<&[f32; 3]> = samples.points.iter().filter(|p| p[1] > 8.0).collect();
+    assert_eq!(over_rest.len(), samples.width, "{:?}", samples.points);
+    assert!(over_rest.iter().all(|p| p[1] == 16.0 && p[2] == 1.0));
 }
 
 #[test]
@@ -271,7 +305,7 @@ fn sample_points_invert_an_angled_projection() {
     bsp.texinfo[0].vecs = [[0.9, 0.1, 0.0, 5.5], [0.05, -0.7, -0.3, -3.25]];
     let faces = face_geometry(&bsp, |_| DVec3::ZERO).expect("faces");
     let device = crate::embree::Device::new(1).expect("device");
-    let scene = TraceScene::build(&device, &faces, &[], &[]).expect("scene");
+    let scene = TraceScene::build(&device, &faces, &[], &[], &[]).expect("scene");
     let (samples, _) = face_samples(&faces[0], 1, &scene, &bsp);
     let ext = faces[0].extents;
     assert_eq!([samples.width, samples.height], ext.luxel_size());
@@ -377,11 +411,11 @@ fn switchable_lights_get_their_own_style() {
     let mut bsp = shadow_scene("\"light\" \"300\" \"targetname\" \"lamp\"");
     let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
     apply_lighting(&mut bsp, &lighting);
-    assert_eq!(bsp.faces[0].styles, [0, 32, 255, 255]);
+    // Style 0 is dark all over, so only the switchable style is written.
+    assert_eq!(bsp.faces[0].styles, [32, 255, 255, 255]);
     assert!(bsp.entity_text().contains("\"style\" \"32\""));
     let floor = &lighting.lightmaps[0];
-    assert!(floor.grey[0].iter().all(|&v| v == 0), "style 0 is dark");
-    assert!(floor.grey[1].iter().any(|&v| v > 20));
+    assert!(floor.grey[0].iter().any(|&v| v > 20));
 }
 
 #[test]
@@ -799,7 +833,9 @@ fn luxel_at(bsp: &Bsp, lighting: &crate::Lighting, face: usize, s: f64, t: f64) 
         .expect("lit face");
     let col = ((s - f64::from(mins[0])) / 16.0).round() as usize;
     let row = ((t - f64::from(mins[1])) / 16.0).round() as usize;
-    m.grey[0][row.min(m.height - 1) * m.width + col.min(m.width - 1)]
+    m.style_grey(0).map_or(0, |g| {
+        g[row.min(m.height - 1) * m.width + col.min(m.width - 1)]
+    })
 }
 
 #[test]
@@ -994,6 +1030,142 @@ fn detail_column_bsp(detail_keys: &str) -> Bsp {
         bsp_compiler::compile(&source, &bsp_compiler::CompileOptions::default()).expect("compile");
     assert!(out.leak.is_none(), "the room leaks");
     out.bsp
+}
+
+/// The sealed room of [`detail_column_bsp`] with a `func_door` (x 96..140, y -16..16,
+/// z -128..-64) standing on the floor and reaching 12 units into the +x wall (128..144), and a
+/// light in the room, compiled by the bsp compiler.
+fn door_in_wall_bsp() -> Bsp {
+    let (lo, hi, t) = (-128.0, 128.0, 16.0);
+    let (a, b) = (lo - t, hi + t);
+    let mut world = String::new();
+    for (l, h) in [
+        ([a, a, a], [b, b, lo]),
+        ([a, a, hi], [b, b, b]),
+        ([a, a, lo], [lo, b, hi]),
+        ([hi, a, lo], [b, b, hi]),
+        ([lo, a, lo], [hi, lo, hi]),
+        ([lo, hi, lo], [hi, b, hi]),
+    ] {
+        world += &map_box(l, h);
+    }
+    let door = map_box([96.0, -16.0, -128.0], [140.0, 16.0, -64.0]);
+    let text = format!(
+        "{{\n\"classname\" \"worldspawn\"\n{world}}}\n\
+         {{\n\"classname\" \"func_door\"\n{door}}}\n\
+         {{\n\"classname\" \"light\"\n\"origin\" \"0 0 -32\"\n}}\n\
+         {{\n\"classname\" \"info_player_start\"\n\"origin\" \"-90 -90 -100\"\n}}\n"
+    );
+    let source = bsp_compiler::MapSource {
+        path: std::path::PathBuf::from("door_in_wall.map"),
+        text,
+    };
+    let out =
+        bsp_compiler::compile(&source, &bsp_compiler::CompileOptions::default()).expect("compile");
+    assert!(out.leak.is_none(), "the room leaks");
+    out.bsp
+}
+
+/// Regression: a door's faces inside the wall it slides into were black (their rays start in
+/// the wall's solid), so they showed black once the door moved. As in ericw-tools, samples in
+/// the world's solid are occluded: a luxel with some open samples keeps their mean, one with
+/// none takes its neighbours', and a face with no open sample takes its model's mean.
+#[test]
+fn door_faces_inside_a_wall_are_not_black() {
+    let bsp = door_in_wall_bsp();
+    let prep = crate::prepare::prepare(&bsp, &Options::default()).expect("prepare");
+    let door_face = |normal: DVec3| {
+        prep.faces
+            .iter()
+            .find(|f| f.model == 1 && f.plane.normal.dot(normal) > 0.99)
+            .map(|f| f.index)
+            .expect("door face")
+    };
+    let (end, top, front) = (
+        door_face(DVec3::X),
+        door_face(DVec3::Z),
+        door_face(-DVec3::X),
+    );
+    let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
+    let end_grey = face_grey(&lighting, end);
+    assert!(!end_grey.is_empty(), "the buried face has a lightmap");
+    assert!(
+        end_grey.iter().all(|&v| v > 10 && v == end_grey[0]),
+        "{end_grey:?}"
+    );
+    assert!(face_grey(&lighting, front).iter().all(|&v| v > 10));
+    // The top's luxels over the wall (x beyond 128) are filled from those in the room.
+    let top_grey = face_grey(&lighting, top);
+    assert!(top_grey.iter().all(|&v| v > 10), "{top_grey:?}");
+}
+
+/// The sealed room of [`detail_column_bsp`] with a `func_wall` slab of `skip` brushes (x, y
+/// -32..32, z -64..-48) keyed `wall_keys` above the floor, and a light over it, compiled by the
+/// bsp compiler: the slab's model has no faces.
+fn skip_slab_bsp(wall_keys: &str) -> Bsp {
+    let (lo, hi, t) = (-128.0, 128.0, 16.0);
+    let (a, b) = (lo - t, hi + t);
+    let mut world = String::new();
+    for (l, h) in [
+        ([a, a, a], [b, b, lo]),
+        ([a, a, hi], [b, b, b]),
+        ([a, a, lo], [lo, b, hi]),
+        ([hi, a, lo], [b, b, hi]),
+        ([lo, a, lo], [hi, lo, hi]),
+        ([lo, hi, lo], [hi, b, hi]),
+    ] {
+        world += &map_box(l, h);
+    }
+    let slab = map_box([-32.0, -32.0, -64.0], [32.0, 32.0, -48.0]).replace("wall", "skip");
+    let text = format!(
+        "{{\n\"classname\" \"worldspawn\"\n{world}}}\n\
+         {{\n\"classname\" \"func_wall\"\n{wall_keys}\n{slab}}}\n\
+         {{\n\"classname\" \"light\"\n\"origin\" \"0 0 64\"\n}}\n\
+         {{\n\"classname\" \"info_player_start\"\n\"origin\" \"-90 -90 -100\"\n}}\n"
+    );
+    let source = bsp_compiler::MapSource {
+        path: std::path::PathBuf::from("skip_slab.map"),
+        text,
+    };
+    let out =
+        bsp_compiler::compile(&source, &bsp_compiler::CompileOptions::default()).expect("compile");
+    assert!(out.leak.is_none(), "the room leaks");
+    out.bsp
+}
+
+/// Regression: a brush model of `skip` brushes with `_shadow 1` cast no shadow (it has no faces
+/// to trace); its solid comes from the BSP's tree, as in ericw-tools.
+#[test]
+fn a_skip_model_with_shadow_casts_its_shadow() {
+    let floor_under_slab = |keys: &str| {
+        let bsp = skip_slab_bsp(keys);
+        assert_eq!(bsp.models[1].num_faces, 0, "the slab has no faces");
+        let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
+        let prep = crate::prepare::prepare(&bsp, &Options::default()).expect("prepare");
+        let floor = prep
+            .faces
+            .iter()
+            .find(|f| f.model == 0 && f.plane.normal.z > 0.99 && f.centroid().x.abs() < 64.0)
+            .expect("floor");
+        let mins = floor.extents.tex_mins;
+        let m = lighting
+            .lightmaps
+            .iter()
+            .find(|m| m.face == floor.index)
+            .expect("lit floor");
+        // The luxel under the slab's middle (world x, y 0: s = x, t = -y).
+        let (col, row) = (
+            (-f64::from(mins[0]) / 16.0).round() as usize,
+            (-f64::from(mins[1]) / 16.0).round() as usize,
+        );
+        m.style_grey(0).map_or(0, |g| g[row * m.width + col])
+    };
+    assert!(floor_under_slab("") > 20, "no shadow without _shadow");
+    assert_eq!(
+        floor_under_slab("\"_shadow\" \"1\""),
+        0,
+        "shadow of the skip slab"
+    );
 }
 
 #[test]
@@ -1379,7 +1551,7 @@ fn face_grey(lighting: &crate::Lighting, face: usize) -> Vec<u8> {
         .lightmaps
         .iter()
         .find(|m| m.face == face)
-        .map(|m| m.grey[0].clone())
+        .and_then(|m| m.style_grey(0).map(<[u8]>::to_vec))
         .unwrap_or_default()
 }
 

@@ -17,7 +17,7 @@ use super::{MapLights, SurfaceTemplate};
 use crate::directions::mangle_to_vec;
 use crate::dirt::DirtResponse;
 use crate::error::LightError;
-use crate::settings::DirtToggle;
+use crate::settings::{DirtToggle, SettingWarning, normalize_color};
 
 /// `light` value of a light entity without one (or with `light 0`, as
 /// ericw-tools treats it).
@@ -76,7 +76,7 @@ fn read_light(
     global: &Global,
     out: &mut MapLights,
 ) -> Result<(), LightError> {
-    let c = common(k, origins, global)?;
+    let c = common(k, origins, global, &mut out.warnings)?;
     let sun = SunLight {
         to_sun: DVec3::ZERO,
         light: c.light,
@@ -109,20 +109,36 @@ fn read_light(
     point_light(k, c, global, out)
 }
 
-/// The keys every light entity reads.
-fn common(k: &Keys, origins: &HashMap<&str, DVec3>, global: &Global) -> Result<Common, LightError> {
+/// The keys every light entity reads; values out of range warn (into `warnings`) and take
+/// the default.
+fn common(
+    k: &Keys,
+    origins: &HashMap<&str, DVec3>,
+    global: &Global,
+    warnings: &mut Vec<SettingWarning>,
+) -> Result<Common, LightError> {
     let origin = k.vec3("origin")?.unwrap_or(DVec3::ZERO);
-    let light = match k.float("light")? {
-        None => DEFAULT_LIGHT,
-        Some(0.0) => DEFAULT_LIGHT,
-        Some(l) => l,
+    let (light, light_color) = brightness(k, warnings)?;
+    // An explicit `_color` wins over the colour of Half-Life's `light` form.
+    let color = match (k.vec3("_color")?, light_color) {
+        (Some(c), _) => normalize_color(c),
+        (None, Some(c)) => c,
+        (None, None) => DVec3::ONE,
     };
-    let color = k.color_any(&["_color"])?;
     let style = k.style()?;
-    let anglescale = k
-        .float_any(&["_anglescale", "_anglesense"])?
-        .unwrap_or(global.anglescale)
-        .clamp(0.0, 1.0);
+    let anglescale = match k.float_any(&["_anglescale", "_anglesense"])? {
+        Some(a) if (0.0..=1.0).contains(&a) => a,
+        Some(_) => {
+            let key = if k.entity.get("_anglescale").is_some() {
+                "_anglescale"
+            } else {
+                "_anglesense"
+            };
+            warnings.push(k.warning(key, "expected 0 to 1; the map's anglescale is used"));
+            global.anglescale
+        }
+        None => global.anglescale,
+    };
     let aim = match (k.vec3("mangle")?, k.entity.get("target")) {
         (Some(m), _) => Some(mangle_to_vec(m.x, m.y)),
         (None, Some(t)) => origins.get(t).and_then(|&to| (to - origin).normalized()),
@@ -154,6 +170,34 @@ fn common(k: &Keys, origins: &HashMap<&str, DVec3>, global: &Global) -> Result<C
     })
 }
 
+/// `light`: a brightness, or Half-Life's `R G B I` (colour in 0..255 or 0..1, then brightness).
+/// Absent or 0 is [`DEFAULT_LIGHT`]; another count of numbers warns and takes it too.
+fn brightness(
+    k: &Keys,
+    warnings: &mut Vec<SettingWarning>,
+) -> Result<(f64, Option<DVec3>), LightError> {
+    let Some(text) = k.entity.get("light").filter(|t| !t.trim().is_empty()) else {
+        return Ok((DEFAULT_LIGHT, None));
+    };
+    let numbers: Option<Vec<f64>> = text
+        .split_whitespace()
+        .map(|w| w.parse().ok().filter(|v: &f64| v.is_finite()))
+        .collect();
+    let or_default = |l: f64| if l == 0.0 { DEFAULT_LIGHT } else { l };
+    match numbers.as_deref() {
+        Some(&[l]) => Ok((or_default(l), None)),
+        Some(&[r, g, b, l]) => Ok((or_default(l), Some(normalize_color(DVec3::new(r, g, b))))),
+        Some(_) => {
+            warnings.push(k.warning(
+                "light",
+                &format!("expected a brightness or R G B brightness; {DEFAULT_LIGHT} is used"),
+            ));
+            Ok((DEFAULT_LIGHT, None))
+        }
+        None => Err(k.bad("light", "numbers")),
+    }
+}
+
 /// A point light or spotlight: one, `_samples` copies spread over its `_deviance`, or a
 /// `_surface` template.
 fn point_light(
@@ -165,7 +209,11 @@ fn point_light(
     let delay = k.float("delay")?.unwrap_or(0.0);
     let falloff = Falloff::from_delay(delay as i64)
         .filter(|_| delay.fract() == 0.0)
-        .ok_or_else(|| k.bad("delay", "0, 1, 2, 3, 4 or 5"))?;
+        .unwrap_or_else(|| {
+            let problem = "expected 0, 1, 2, 3, 4 or 5; linear falloff (0) is used";
+            out.warnings.push(k.warning("delay", problem));
+            Falloff::Linear
+        });
     let wait = k.float("wait")?.filter(|w| *w > 0.0).unwrap_or(1.0);
     // `_falloff` (linear only): reaches zero exactly that many units out.
     let atten = match k.float("_falloff")?.filter(|f| *f > 0.0) {
@@ -197,6 +245,7 @@ fn point_light(
             offset: k.float("_surface_offset")?.unwrap_or(2.0),
             spotlight: k.float("_surface_spotlight")? == Some(1.0),
             spot_angle: angle,
+            group: k.float("_surflight_group")?.unwrap_or(0.0) as i64,
         }),
         None if c.deviance > 0.0 => {
             let count = k

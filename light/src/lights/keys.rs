@@ -4,7 +4,7 @@ use glam::DVec3;
 use quake_formats::entities::Entity;
 
 use crate::error::LightError;
-use crate::settings::normalize_color;
+use crate::settings::{Given, SettingWarning, normalize_color};
 
 /// Reads a numeric key of entity `index`, naming the entity on failure.
 pub struct Keys<'a> {
@@ -23,6 +23,20 @@ impl Keys<'_> {
                 "key \"{key}\" is \"{}\", expected {want}",
                 self.entity.get(key).unwrap_or("")
             ),
+        }
+    }
+
+    /// A warning that `key` (present) is not taken as written: `problem` says why and what is
+    /// used instead.
+    pub fn warning(&self, key: &'static str, problem: &str) -> SettingWarning {
+        SettingWarning {
+            given: Given::Key {
+                entity: self.index,
+                classname: self.entity.classname().to_string(),
+                key,
+            },
+            value: self.entity.get(key).unwrap_or("").to_string(),
+            problem: problem.to_string(),
         }
     }
 

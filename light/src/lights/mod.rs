@@ -51,6 +51,9 @@ pub struct SurfaceTemplate {
     /// Copies shine along the face normal (`_surface_spotlight 1`).
     pub spotlight: bool,
     pub spot_angle: f64,
+    /// `_surflight_group`: copies go only on faces of brush models with the same group (the
+    /// world and models without the key are group 0).
+    pub group: i64,
 }
 
 /// How light bounces: worldspawn's `_bounce` and its keys (or the command line's).
@@ -101,6 +104,8 @@ pub struct MapLights {
     pub phong: HashMap<usize, f64>,
     /// Offset of each brush model with an `origin` key (rotating entities).
     pub model_origins: HashMap<usize, DVec3>,
+    /// Brush models with a non-zero `_surflight_group`, and that group.
+    pub surflight_groups: HashMap<usize, i64>,
     /// The map-wide settings, resolved (the command line's, else worldspawn's, else the
     /// defaults).
     pub settings: Settings,
@@ -165,6 +170,7 @@ pub fn parse_lights(
         dirt: dirt_sampling(&settings),
         phong: HashMap::new(),
         model_origins: HashMap::new(),
+        surflight_groups: HashMap::new(),
         switchable_styles,
         settings,
         warnings,
@@ -243,9 +249,38 @@ mod tests {
             msg.contains("entity 1") && msg.contains("\"light\""),
             "{msg}"
         );
-        let mut ents =
-            parse_entities("{ \"classname\" \"light\" \"delay\" \"7\" }").expect("parse");
-        assert!(parse_lights(&mut ents, &Overrides::default()).is_err());
+    }
+
+    /// Regression: `delay 15` and Half-Life's `light "R G B I"` stopped the run, where
+    /// ericw-tools lights the map: a value out of range warns, naming the entity, and the
+    /// default is used.
+    #[test]
+    fn out_of_range_light_keys_warn_and_take_the_default() {
+        let text = r#"
+{ "classname" "worldspawn" }
+{ "classname" "light" "origin" "0 0 0" "delay" "15" }
+{ "classname" "light" "origin" "0 0 0" "light" "255 127 0 200" }
+{ "classname" "light" "origin" "0 0 0" "light" "255 127 0" "_anglescale" "3" }
+"#;
+        let mut ents = parse_entities(text).expect("parse");
+        let lights = parse_lights(&mut ents, &Overrides::default()).expect("lights");
+        assert_eq!(lights.points[0].falloff, Falloff::Linear);
+        assert_eq!(lights.points[1].light, 200.0);
+        assert_eq!(lights.points[1].color, DVec3::new(1.0, 127.0 / 255.0, 0.0));
+        assert_eq!(lights.points[2].light, DEFAULT_LIGHT);
+        assert_eq!(lights.points[2].color, DVec3::ONE);
+        assert_eq!(lights.points[2].anglescale, lights.points[0].anglescale);
+        let told: Vec<String> = lights.warnings.iter().map(ToString::to_string).collect();
+        assert_eq!(told.len(), 3, "{told:?}");
+        assert!(
+            told[0].starts_with("entity 1 (light): key \"delay\" is \"15\""),
+            "{told:?}"
+        );
+        assert!(
+            told[1].starts_with("entity 3 (light): key \"light\""),
+            "{told:?}"
+        );
+        assert!(told[2].contains("\"_anglescale\" is \"3\""), "{told:?}");
     }
 
     #[test]

@@ -65,6 +65,9 @@ pub fn read_models(
         if let Some(o) = k.vec3("origin")? {
             out.model_origins.insert(model, o);
         }
+        if let Some(group) = k.float("_surflight_group")?.filter(|g| *g != 0.0) {
+            out.surflight_groups.insert(model, group as i64);
+        }
         if k.float("_dirt")? == Some(-1.0) {
             out.no_dirt_models.push(model);
         }

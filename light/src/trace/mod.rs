@@ -212,6 +212,7 @@ impl<'a> FaceTrace<'a> {
                 let face = &setup.faces[samples.face];
                 Directions::new(&samples.points, &face.vecs, face.plane.normal)
             }),
+            occluded: samples.occluded.clone(),
         };
         let mut bounds = Bounds::EMPTY;
         for &p in &samples.points {

@@ -52,6 +52,8 @@ pub struct SampleLight {
     pub(super) bounce_dirt: Vec<f32>,
     /// Where light came from, when deluxemaps are wanted.
     pub(super) directions: Option<Directions>,
+    /// Per sample, inside solid: left out of its luxel's mean (empty: none is).
+    pub(super) occluded: Vec<bool>,
 }
 
 /// Per sample and style, the directions towards the lights and suns that reached it, each
@@ -142,7 +144,70 @@ fn luxel_means(values: Vec<[f32; 3]>, per: usize) -> Vec<[f32; 3]> {
         .collect()
 }
 
+/// Luxel means of per-sample values over the samples not `occluded`; a luxel with none takes
+/// the mean of its neighbours that have (over and over, until every luxel has a value), as
+/// ericw-tools fills them. A face with every sample occluded keeps the means of all of them.
+fn open_luxel_means(
+    values: Vec<[f32; 3]>,
+    per: usize,
+    occluded: &[bool],
+    width: usize,
+) -> Vec<[f32; 3]> {
+    if !occluded.contains(&true) || occluded.iter().all(|&o| o) {
+        return luxel_means(values, per);
+    }
+    let mut luxels: Vec<Option<[f32; 3]>> = values
+        .chunks(per)
+        .zip(occluded.chunks(per))
+        .map(|(v, o)| {
+            let open: Vec<&[f32; 3]> = v
+                .iter()
+                .zip(o)
+                .filter(|(_, o)| !**o)
+                .map(|(v, _)| v)
+                .collect();
+            (!open.is_empty()).then(|| {
+                let mut acc = [0.0f32; 3];
+                for v in &open {
+                    for k in 0..3 {
+                        acc[k] += v[k];
+                    }
+                }
+                acc.map(|a| a / open.len() as f32)
+            })
+        })
+        .collect();
+    let height = luxels.len() / width.max(1);
+    while luxels.contains(&None) {
+        let before = luxels.clone();
+        for (i, luxel) in luxels.iter_mut().enumerate().filter(|(_, l)| l.is_none()) {
+            let (x, y) = (i % width, i / width);
+            let mut acc = [0.0f32; 3];
+            let mut count = 0.0f32;
+            for ny in y.saturating_sub(1)..(y + 2).min(height) {
+                for nx in x.saturating_sub(1)..(x + 2).min(width) {
+                    if let Some(v) = before[ny * width + nx] {
+                        for k in 0..3 {
+                            acc[k] += v[k];
+                        }
+                        count += 1.0;
+                    }
+                }
+            }
+            if count > 0.0 {
+                *luxel = Some(acc.map(|a| a / count));
+            }
+        }
+    }
+    luxels.into_iter().flatten().collect()
+}
+
 impl SampleLight {
+    /// Every sample is inside solid: the face's own light means nothing.
+    pub fn buried(&self) -> bool {
+        !self.occluded.is_empty() && self.occluded.iter().all(|&o| o)
+    }
+
     /// Per style, the luxel means of the light that reflects: lights and
     /// suns without minlight or `_bounce 0` lights; style 0 only unless
     /// `styled`. Styles with no light are left out.
@@ -203,11 +268,12 @@ impl SampleLight {
                 }
             }
         }
+        let (occluded, width) = (&self.occluded, self.width);
         let styles = self
             .sums
             .styles
             .into_iter()
-            .map(|(style, values)| (style, luxel_means(values, per)))
+            .map(|(style, values)| (style, open_luxel_means(values, per, occluded, width)))
             .collect();
         FaceLight {
             face: self.face,
