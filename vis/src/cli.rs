@@ -12,6 +12,26 @@ use quake_formats::prt::PortalFile;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+quake_formats::ericw_accepted! {
+    /// ericw-tools' vis options that Slipgate's vis accepts without acting on them.
+    pub struct EricwOnly {
+        verbose: bool => "the summary is the same either way",
+        noverbose: bool => "the summary is the same either way",
+        quiet: bool => "the summary is the same either way",
+        nopercent: bool => "progress is drawn only when standard error is a terminal",
+        noprogress: bool => "progress is drawn only when standard error is a terminal",
+        nostat: bool => "the summary is the same either way",
+        nocolor: bool => "Slipgate writes no colour codes",
+        log: bool => "Slipgate writes no log file; redirect its output",
+        nolog: bool => "Slipgate writes no log file",
+        lowpriority: bool => "Slipgate runs at the priority it is started with (use nice)",
+        nostate: bool => "saved state is read only with --resume",
+        noautoclean: bool => "state files are removed once vis finishes",
+        phsonly: bool => "Quake maps have no PHS",
+        visdist: Option<String> => "the PVS is never cut by distance; it stays exact",
+    }
+}
+
 /// The vis command line, shared by `slipgate vis` and `slipgate-vis`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct Args {
@@ -29,6 +49,9 @@ pub struct Args {
     /// Worker threads (default: all cores)
     #[arg(long)]
     pub threads: Option<usize>,
+    /// ericw-tools' options accepted with a note (hidden from the help).
+    #[command(flatten)]
+    pub ericw_only: EricwOnly,
     /// After computing, check the PVS against this many random sight lines traced through the map
     #[arg(long, default_value_t = 0)]
     pub sample_pairs: usize,
@@ -72,6 +95,9 @@ pub struct Args {
 
 /// Runs `slipgate vis` with `args`: the run's report, or `None` for one shard's part.
 pub fn run(args: &Args) -> Result<Option<crate::VisReport>> {
+    for note in args.ericw_only.notes() {
+        eprintln!("note: {note}");
+    }
     let total = Instant::now();
     let inputs = Inputs::read(args)?;
     if let Some(shard) = args.shard {

@@ -2,7 +2,7 @@
 
 use quake_formats::Bsp;
 use std::path::PathBuf;
-use vis::cli::{Args, run};
+use vis::cli::{Args, EricwOnly, run};
 use vis::synthetic::VoxelWorld;
 
 fn temp_dir(name: &str) -> PathBuf {
@@ -30,7 +30,36 @@ fn args(bsp: PathBuf) -> Args {
         noambientwater: false,
         noambientslime: false,
         noambientlava: false,
+        ericw_only: EricwOnly::default(),
     }
+}
+
+#[derive(clap::Parser)]
+struct VisCli {
+    #[command(flatten)]
+    args: Args,
+}
+
+/// A profile written for ericw-tools' vis runs unchanged: its options that only change how vis
+/// reports, or that Slipgate's vis has no need of, are accepted, each with a note.
+#[test]
+fn ericw_tools_only_options_are_accepted_with_a_note() {
+    use clap::Parser;
+    let words = [
+        "vis",
+        "-nopercent",
+        "-visdist",
+        "2000",
+        "-level",
+        "2",
+        "x.bsp",
+    ];
+    let words = quake_formats::cli::normalise_single_dash(words.iter().map(|s| s.to_string()));
+    let cli = VisCli::try_parse_from(words).expect("parses");
+    let notes = cli.args.ericw_only.notes();
+    assert_eq!(notes.len(), 2, "{notes:?}");
+    assert!(notes[1].starts_with("-visdist has no effect"), "{notes:?}");
+    assert_eq!(cli.args.level, 2);
 }
 
 #[test]

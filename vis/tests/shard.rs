@@ -43,6 +43,7 @@ fn args(bsp: &Path) -> Args {
         noambientwater: false,
         noambientslime: false,
         noambientlava: false,
+        ericw_only: vis::cli::EricwOnly::default(),
     }
 }
 
