@@ -106,6 +106,7 @@ pub fn lightmaps_in(bsp: &Bsp, faces: &[usize]) -> Lighting {
             rgb: Vec::new(),
             hdr: Vec::new(),
             directions: Vec::new(),
+            own_grid: None,
         });
     }
     Lighting {

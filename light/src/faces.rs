@@ -4,7 +4,7 @@
 use glam::{DVec3, Vec3};
 use quake_formats::Bsp;
 use quake_formats::bsp::texinfo_flags;
-use quake_formats::extents::LightmapExtents;
+use quake_formats::extents::{LightmapExtents, LuxelGrid};
 use quake_formats::geom::Plane;
 use rayon::prelude::*;
 
@@ -49,6 +49,12 @@ pub struct FaceGeom {
     /// Offset from model space to world space.
     pub origin: DVec3,
     pub extents: LightmapExtents,
+    /// The grid light samples the face on: Quake's 16-texel one over `extents`, or its own
+    /// world-aligned one.
+    pub grid: LuxelGrid,
+    /// The projection of its own grid (its `DECOUPLED_LM` record), when it has one; the
+    /// lightmap over `extents` is then taken from that grid.
+    pub world_to_luxel: Option<[[f32; 4]; 2]>,
 }
 
 impl FaceGeom {
@@ -60,13 +66,15 @@ impl FaceGeom {
     }
 }
 
-/// Every face of `bsp` with its model; `origins` gives per-model offsets.
+/// Every face of `bsp` with its model; `origin_of` gives per-model offsets, `units_of` the map
+/// units per luxel of a model's own lightmap grids (0: Quake's grid).
 ///
 /// # Errors
 /// [`LightError::BadFace`] for a face whose indices run outside the file.
 pub fn face_geometry(
     bsp: &Bsp,
     origin_of: impl Fn(usize) -> DVec3 + Sync,
+    units_of: impl Fn(usize) -> f64 + Sync,
 ) -> Result<Vec<FaceGeom>, LightError> {
     let mut model_of = vec![0usize; bsp.faces.len()];
     for (m, model) in bsp.models.iter().enumerate() {
@@ -119,6 +127,10 @@ pub fn face_geometry(
                 plane = plane.flipped();
             }
             plane.dist += plane.normal.dot(origin);
+            let extents = LightmapExtents::from_points(&verts, &ti.vecs);
+            let own = (units_of(model) > 0.0)
+                .then(|| LuxelGrid::world_aligned(&verts, plane.normal.to_array(), units_of(model)))
+                .flatten();
             Ok(FaceGeom {
                 index,
                 model,
@@ -131,7 +143,9 @@ pub fn face_geometry(
                 plane,
                 vecs: ti.vecs,
                 origin,
-                extents: LightmapExtents::from_points(&verts, &ti.vecs),
+                extents,
+                grid: own.map_or_else(|| LuxelGrid::vanilla(&extents, &ti.vecs), |(_, g)| g),
+                world_to_luxel: own.map(|(rows, _)| rows),
             })
         })
         .collect();

@@ -6,7 +6,9 @@
 use std::borrow::Cow;
 
 use quake_formats::Bsp;
-use quake_formats::bsp::light_lumps::{LIGHTING_E5BGR9, LIGHTINGDIR, RGBLIGHTING};
+use quake_formats::bsp::light_lumps::{
+    DECOUPLED_LM, DecoupledLightmap, LIGHTING_E5BGR9, LIGHTINGDIR, RGBLIGHTING,
+};
 use quake_formats::bsp::limits::MAX_LIGHTMAPS;
 use quake_formats::lit::pack_e5bgr9;
 
@@ -98,6 +100,18 @@ pub struct FaceLightmap {
     pub hdr: Vec<Vec<u32>>,
     /// Per style, each luxel's direction bytes, when deluxemaps are asked for (else empty).
     pub directions: Vec<Vec<[u8; 3]>>,
+    /// The face's lightmaps on its own grid (`--world_units_per_luxel`), the same styles in
+    /// the same order; these ones are then read from that grid.
+    pub own_grid: Option<Box<OwnGridLightmap>>,
+}
+
+/// A face's lightmaps on its own world-aligned grid: its `DECOUPLED_LM` record's contents.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OwnGridLightmap {
+    /// The lightmaps (their `face` and `own_grid` are the owner's and `None`).
+    pub lightmap: FaceLightmap,
+    /// Model space to luxel coordinates of the grid.
+    pub world_to_luxel: [[f32; 4]; 2],
 }
 
 /// How light units become bytes.
@@ -206,6 +220,39 @@ fn grey_of(c: [u8; 3]) -> u8 {
 /// Finishes one face. Returns the lightmap and how many styles were dropped
 /// for exceeding four.
 pub fn finish_face(light: &FaceLight, finish: &Finish) -> (FaceLightmap, usize) {
+    let (maps, dropped) = keep_styles(style_maps(light, finish));
+    (lightmap_of(light, maps, finish), dropped)
+}
+
+/// Finishes a face lit on its own grid: `own` is its light there, `vanilla` the 16-texel light
+/// read from it. The styles are chosen on its own grid (as ericw-tools chooses them) and both
+/// lightmaps keep those, so one `styles` list describes both. Returns the 16-texel lightmap
+/// carrying the other, and how many styles were dropped for exceeding four.
+pub fn finish_face_on_own_grid(
+    vanilla: &FaceLight,
+    own: &FaceLight,
+    world_to_luxel: [[f32; 4]; 2],
+    finish: &Finish,
+) -> (FaceLightmap, usize) {
+    let (own_maps, dropped) = keep_styles(style_maps(own, finish));
+    let mut all = style_maps(vanilla, finish);
+    let maps = own_maps
+        .iter()
+        .filter_map(|o| {
+            let at = all.iter().position(|m| m.style == o.style)?;
+            Some(all.swap_remove(at))
+        })
+        .collect();
+    let mut lightmap = lightmap_of(vanilla, maps, finish);
+    lightmap.own_grid = Some(Box::new(OwnGridLightmap {
+        lightmap: lightmap_of(own, own_maps, finish),
+        world_to_luxel,
+    }));
+    (lightmap, dropped)
+}
+
+/// Each style of `light` as bytes, in its order.
+fn style_maps(light: &FaceLight, finish: &Finish) -> Vec<StyleMap> {
     let (w, h) = (light.width, light.height);
     let mut maps: Vec<StyleMap> = Vec::with_capacity(light.styles.len());
     for (style, luxels) in &light.styles {
@@ -238,24 +285,37 @@ pub fn finish_face(light: &FaceLight, finish: &Finish) -> (FaceLightmap, usize) 
                 None => vec![NO_DIRECTION; filtered.len()],
             };
         }
-        // Style 0 is always written (a face without a lightmap renders fullbright).
-        if map.style == 0 || map.energy > 0 {
-            maps.push(map);
-        }
+        maps.push(map);
     }
-    // Style 0 stays first; the brightest of the others fill the remaining slots.
+    maps
+}
+
+/// The styles a face keeps of `maps`: style 0 always (a face without a lightmap renders
+/// fullbright) and first, then the brightest of the others that are lit anywhere, four in
+/// all. Also says how many lit styles were dropped.
+fn keep_styles(maps: Vec<StyleMap>) -> (Vec<StyleMap>, usize) {
+    let mut maps: Vec<StyleMap> = maps
+        .into_iter()
+        .filter(|m| m.style == 0 || m.energy > 0)
+        .collect();
     maps[1..].sort_by_key(|m| std::cmp::Reverse(m.energy));
     let dropped = maps.len().saturating_sub(MAX_LIGHTMAPS);
     maps.truncate(MAX_LIGHTMAPS);
+    (maps, dropped)
+}
+
+/// The lightmap of `light`'s face made of `maps`.
+fn lightmap_of(light: &FaceLight, maps: Vec<StyleMap>, finish: &Finish) -> FaceLightmap {
     let mut lightmap = FaceLightmap {
         face: light.face,
-        width: w,
-        height: h,
+        width: light.width,
+        height: light.height,
         styles: Vec::with_capacity(maps.len()),
         grey: Vec::with_capacity(maps.len()),
         rgb: Vec::new(),
         hdr: Vec::new(),
         directions: Vec::new(),
+        own_grid: None,
     };
     for map in maps {
         lightmap.styles.push(map.style);
@@ -270,7 +330,7 @@ pub fn finish_face(light: &FaceLight, finish: &Finish) -> (FaceLightmap, usize) 
             lightmap.directions.push(map.directions);
         }
     }
-    (lightmap, dropped)
+    lightmap
 }
 
 /// What [`write_lighting`] gives back for files beside the BSP.
@@ -285,40 +345,60 @@ pub struct LuxelData {
 }
 
 /// Replaces the lighting data with `maps` (faces not listed get no lightmap): the grey lump
-/// unless `outputs` leave it out, and the BSPX lumps `outputs` ask for (earlier ones of those
-/// names are removed). Returns every luxel's RGB, HDR and direction data the maps kept, for the
-/// files beside the BSP.
+/// unless `outputs` leave it out, the BSPX lumps `outputs` ask for, and `DECOUPLED_LM` when
+/// faces have lightmaps on their own grids (those follow the 16-texel ones in the same data);
+/// earlier lumps of those names are removed. Returns every luxel's RGB, HDR and direction data
+/// the maps kept, for the files beside the BSP.
 pub fn write_lighting(bsp: &mut Bsp, maps: &[FaceLightmap], outputs: &Outputs) -> LuxelData {
+    let own_grids: Vec<(usize, &OwnGridLightmap)> = maps
+        .iter()
+        .filter_map(|m| Some((m.face, m.own_grid.as_deref()?)))
+        .collect();
+    let all = || {
+        maps.iter()
+            .chain(own_grids.iter().map(|(_, o)| &o.lightmap))
+    };
     // Sized up front: growing them copied into fresh pages, which the kernel zeroes first.
-    let luxels: usize = maps.iter().flat_map(|m| &m.grey).map(Vec::len).sum();
+    let luxels: usize = all().flat_map(|m| &m.grey).map(Vec::len).sum();
     let kept = |of: fn(&FaceLightmap) -> bool| maps.iter().any(|m| !m.styles.is_empty() && of(m));
-    let mut grey = Vec::with_capacity(luxels);
-    let mut rgb = kept(|m| !m.rgb.is_empty()).then(|| Vec::with_capacity(3 * luxels));
-    let mut hdr = kept(|m| !m.hdr.is_empty()).then(|| Vec::with_capacity(luxels));
-    let mut dirs = kept(|m| !m.directions.is_empty()).then(|| Vec::with_capacity(3 * luxels));
+    let mut data = LuxelWriter {
+        grey: Vec::with_capacity(luxels),
+        rgb: kept(|m| !m.rgb.is_empty()).then(|| Vec::with_capacity(3 * luxels)),
+        hdr: kept(|m| !m.hdr.is_empty()).then(|| Vec::with_capacity(luxels)),
+        dirs: kept(|m| !m.directions.is_empty()).then(|| Vec::with_capacity(3 * luxels)),
+    };
     for f in &mut bsp.faces {
         f.styles = [NO_STYLE; 4];
         f.light_offset = -1;
     }
     for m in maps {
         let face = &mut bsp.faces[m.face];
-        face.light_offset = grey.len() as i32;
+        face.light_offset = data.push(m);
         for (slot, &s) in m.styles.iter().enumerate() {
             face.styles[slot] = s;
         }
-        for g in &m.grey {
-            grey.extend_from_slice(g);
-        }
-        if let Some(rgb) = &mut rgb {
-            rgb.extend(m.rgb.iter().flatten().flatten());
-        }
-        if let Some(hdr) = &mut hdr {
-            hdr.extend(m.hdr.iter().flatten());
-        }
-        if let Some(dirs) = &mut dirs {
-            dirs.extend(m.directions.iter().flatten().flatten());
-        }
     }
+    bsp.remove_bspx_lump(DECOUPLED_LM);
+    if !own_grids.is_empty() {
+        let mut records = vec![NO_OWN_GRID; bsp.faces.len()];
+        for (face, own) in own_grids {
+            let m = &own.lightmap;
+            records[face] = DecoupledLightmap {
+                // Faces wider than 16 bits get no grid of their own (`LuxelGrid::world_aligned`).
+                width: u16::try_from(m.width).unwrap_or(u16::MAX),
+                height: u16::try_from(m.height).unwrap_or(u16::MAX),
+                offset: data.push(m),
+                world_to_luxel: own.world_to_luxel,
+            };
+        }
+        bsp.set_decoupled_lightmaps(&records);
+    }
+    let LuxelWriter {
+        grey,
+        rgb,
+        hdr,
+        dirs,
+    } = data;
     bsp.lighting = if outputs.grey_lump { grey } else { Vec::new() };
     for name in [RGBLIGHTING, LIGHTINGDIR, LIGHTING_E5BGR9] {
         bsp.remove_bspx_lump(name);
@@ -339,6 +419,42 @@ pub fn write_lighting(bsp: &mut Bsp, maps: &[FaceLightmap], outputs: &Outputs) -
         rgb,
         hdr,
         directions: dirs,
+    }
+}
+
+/// The `DECOUPLED_LM` record of a face without a lightmap.
+const NO_OWN_GRID: DecoupledLightmap = DecoupledLightmap {
+    width: 0,
+    height: 0,
+    offset: -1,
+    world_to_luxel: [[0.0; 4]; 2],
+};
+
+/// The lighting data being written, each form luxel for luxel.
+struct LuxelWriter {
+    grey: Vec<u8>,
+    rgb: Option<Vec<u8>>,
+    hdr: Option<Vec<u32>>,
+    dirs: Option<Vec<u8>>,
+}
+
+impl LuxelWriter {
+    /// Appends `m`'s lightmaps; returns where they start (in luxels).
+    fn push(&mut self, m: &FaceLightmap) -> i32 {
+        let start = self.grey.len() as i32;
+        for g in &m.grey {
+            self.grey.extend_from_slice(g);
+        }
+        if let Some(rgb) = &mut self.rgb {
+            rgb.extend(m.rgb.iter().flatten().flatten());
+        }
+        if let Some(hdr) = &mut self.hdr {
+            hdr.extend(m.hdr.iter().flatten());
+        }
+        if let Some(dirs) = &mut self.dirs {
+            dirs.extend(m.directions.iter().flatten().flatten());
+        }
+        start
     }
 }
 

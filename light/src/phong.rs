@@ -210,7 +210,7 @@ pub fn interpolate(face: &FaceGeom, corners: &[DVec3], p: DVec3) -> DVec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use quake_formats::extents::LightmapExtents;
+    use quake_formats::extents::{LightmapExtents, LuxelGrid};
     use quake_formats::geom::Plane;
 
     fn square() -> FaceGeom {
@@ -230,6 +230,11 @@ mod tests {
             vecs: [[0.0; 4]; 2],
             origin: DVec3::ZERO,
             extents: LightmapExtents::from_points(&[], &[[0.0; 4]; 2]),
+            grid: LuxelGrid::vanilla(
+                &LightmapExtents::from_points(&[], &[[0.0; 4]; 2]),
+                &[[0.0; 4]; 2],
+            ),
+            world_to_luxel: None,
         }
     }
 

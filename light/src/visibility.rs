@@ -185,7 +185,7 @@ mod tests {
     use super::*;
     use crate::faces::FaceGeom;
     use quake_formats::bsp::{Leaf, Model};
-    use quake_formats::extents::LightmapExtents;
+    use quake_formats::extents::{LightmapExtents, LuxelGrid};
     use quake_formats::geom::Plane;
 
     fn face(index: usize, model: usize) -> FaceGeom {
@@ -199,6 +199,11 @@ mod tests {
             vecs: [[0.0; 4]; 2],
             origin: DVec3::ZERO,
             extents: LightmapExtents::from_points(&[], &[[0.0; 4]; 2]),
+            grid: LuxelGrid::vanilla(
+                &LightmapExtents::from_points(&[], &[[0.0; 4]; 2]),
+                &[[0.0; 4]; 2],
+            ),
+            world_to_luxel: None,
         }
     }
 

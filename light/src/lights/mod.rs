@@ -101,6 +101,8 @@ pub struct MapLights {
     pub phong: HashMap<usize, f64>,
     /// Offset of each brush model with an `origin` key (rotating entities).
     pub model_origins: HashMap<usize, DVec3>,
+    /// Brush models with their own `_world_units_per_luxel` (used when the map's is set).
+    pub model_units_per_luxel: HashMap<usize, f64>,
     /// The map-wide settings, resolved (the command line's, else worldspawn's, else the
     /// defaults).
     pub settings: Settings,
@@ -112,6 +114,20 @@ pub struct MapLights {
 }
 
 impl MapLights {
+    /// Map units per luxel of model `model`'s own lightmap grids: its `_world_units_per_luxel`,
+    /// else the map's; 0 (Quake's grid) while the map's is unset, as in ericw-tools.
+    pub fn units_per_luxel(&self, model: usize) -> f64 {
+        let map = self.settings.world_units_per_luxel;
+        if map <= 0.0 {
+            return 0.0;
+        }
+        self.model_units_per_luxel
+            .get(&model)
+            .copied()
+            .filter(|&u| u > 0.0)
+            .unwrap_or(map)
+    }
+
     /// True if any light, sun or minlight is darkened by dirt.
     pub fn uses_dirt(&self) -> bool {
         self.points.iter().any(|l| l.dirt.is_some())
@@ -165,6 +181,7 @@ pub fn parse_lights(
         dirt: dirt_sampling(&settings),
         phong: HashMap::new(),
         model_origins: HashMap::new(),
+        model_units_per_luxel: HashMap::new(),
         switchable_styles,
         settings,
         warnings,

@@ -1,6 +1,7 @@
 //! Brush models' lighting keys: which cast shadows (`_shadow`, `_shadowself`), which take no
-//! dirt (`_dirt -1`), light (`_lightignore`) or reflect (`_bounce 0`), their own minlight,
-//! their `origin` offset, and `_phong` smoothing (worldspawn's too, as model 0).
+//! dirt (`_dirt -1`), light (`_lightignore`) or reflect (`_bounce 0`), their own minlight and
+//! lightmap spacing (`_world_units_per_luxel`), their `origin` offset, and `_phong` smoothing
+//! (worldspawn's too, as model 0).
 
 use quake_formats::bsp::phong;
 use quake_formats::entities::Entity;
@@ -64,6 +65,9 @@ pub fn read_models(
         }
         if let Some(o) = k.vec3("origin")? {
             out.model_origins.insert(model, o);
+        }
+        if let Some(units) = k.float("_world_units_per_luxel")? {
+            out.model_units_per_luxel.insert(model, units);
         }
         if k.float("_dirt")? == Some(-1.0) {
             out.no_dirt_models.push(model);
