@@ -1797,22 +1797,7 @@ fn on_own_grids(quality: Quality, units: f64) -> Options {
 
 /// `lighting` with each face's lightmaps on its own grid in place of its 16-texel ones.
 fn own_grid_lightmaps(lighting: &crate::Lighting) -> crate::Lighting {
-    let mut own = lighting.clone();
-    own.lightmaps = lighting
-        .lightmaps
-        .iter()
-        .map(|m| {
-            let o = m
-                .own_grid
-                .as_deref()
-                .expect("a lightmap on the face's own grid");
-            crate::output::FaceLightmap {
-                face: m.face,
-                ..o.lightmap.clone()
-            }
-        })
-        .collect();
-    own
+    crate::own_grids(lighting).expect("lightmaps on the faces' own grids")
 }
 
 #[test]
