@@ -148,8 +148,8 @@ pub struct ReferenceComparison {
     /// Against the reference through the same `--soft` filter (it blurs on purpose), when the
     /// run filters.
     pub error_filtered: Option<ErrorStats>,
-    /// Against the reference on the faces' own grids (`--world_units_per_luxel`), when they
-    /// have them; `error` then measures the 16-texel lightmaps read from those.
+    /// Against the reference on the faces' own grids (`--world_units_per_luxel`, `_lmscale`),
+    /// when they have them; `error` then measures the 16-texel lightmaps read from those.
     pub error_own_grids: Option<ErrorStats>,
     /// The reference's own time and rays.
     pub reference_seconds: f64,

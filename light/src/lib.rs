@@ -8,7 +8,8 @@
 //! 1. Settings ([`settings`]): each map-wide setting from the command line, else worldspawn,
 //!    else its default; values that do not read warn and fall back.
 //! 2. Preparation (`prepare`): faces as world-space geometry with their lightmap extents and
-//!    the grid they are lit on, Quake's or their own (`--world_units_per_luxel`) (`faces`);
+//!    the grid they are lit on, Quake's or their own (`--world_units_per_luxel`, `_lmscale`)
+//!    (`faces`);
 //!    the Embree scene of everything opaque, sky faces as their own geometry and a small scene
 //!    per `_shadowself` model (`scene`); lights, suns, sky domes, minlight and
 //!    switchable styles from the entity lump (`lights`), `_surface` templates copied over

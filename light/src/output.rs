@@ -7,11 +7,12 @@ use std::borrow::Cow;
 
 use quake_formats::Bsp;
 use quake_formats::bsp::light_lumps::{
-    DECOUPLED_LM, DecoupledLightmap, LIGHTING_E5BGR9, LIGHTINGDIR, RGBLIGHTING,
+    DECOUPLED_LM, DecoupledLightmap, LIGHTING_E5BGR9, LIGHTINGDIR, LMOFFSET, LMSHIFT, RGBLIGHTING,
 };
 use quake_formats::bsp::limits::MAX_LIGHTMAPS;
 use quake_formats::lit::pack_e5bgr9;
 
+use crate::faces::OwnGrid;
 use crate::settings::Settings;
 use crate::trace::FaceLight;
 
@@ -100,18 +101,19 @@ pub struct FaceLightmap {
     pub hdr: Vec<Vec<u32>>,
     /// Per style, each luxel's direction bytes, when deluxemaps are asked for (else empty).
     pub directions: Vec<Vec<[u8; 3]>>,
-    /// The face's lightmaps on its own grid (`--world_units_per_luxel`), the same styles in
-    /// the same order; these ones are then read from that grid.
+    /// The face's lightmaps on its own grid (`--world_units_per_luxel`, `_lmscale`), the same
+    /// styles in the same order; these ones are then read from that grid.
     pub own_grid: Option<Box<OwnGridLightmap>>,
 }
 
-/// A face's lightmaps on its own world-aligned grid: its `DECOUPLED_LM` record's contents.
+/// A face's lightmaps on its own grid: what its `DECOUPLED_LM` record, or its `LMSHIFT` and
+/// `LMOFFSET`, describe.
 #[derive(Debug, Clone, PartialEq)]
 pub struct OwnGridLightmap {
     /// The lightmaps (their `face` and `own_grid` are the owner's and `None`).
     pub lightmap: FaceLightmap,
-    /// Model space to luxel coordinates of the grid.
-    pub world_to_luxel: [[f32; 4]; 2],
+    /// The grid.
+    pub grid: OwnGrid,
 }
 
 /// How light units become bytes.
@@ -231,7 +233,7 @@ pub fn finish_face(light: &FaceLight, finish: &Finish) -> (FaceLightmap, usize) 
 pub fn finish_face_on_own_grid(
     vanilla: &FaceLight,
     own: &FaceLight,
-    world_to_luxel: [[f32; 4]; 2],
+    grid: OwnGrid,
     finish: &Finish,
 ) -> (FaceLightmap, usize) {
     let (own_maps, dropped) = keep_styles(style_maps(own, finish));
@@ -246,7 +248,7 @@ pub fn finish_face_on_own_grid(
     let mut lightmap = lightmap_of(vanilla, maps, finish);
     lightmap.own_grid = Some(Box::new(OwnGridLightmap {
         lightmap: lightmap_of(own, own_maps, finish),
-        world_to_luxel,
+        grid,
     }));
     (lightmap, dropped)
 }
@@ -345,9 +347,9 @@ pub struct LuxelData {
 }
 
 /// Replaces the lighting data with `maps` (faces not listed get no lightmap): the grey lump
-/// unless `outputs` leave it out, the BSPX lumps `outputs` ask for, and `DECOUPLED_LM` when
-/// faces have lightmaps on their own grids (those follow the 16-texel ones in the same data);
-/// earlier lumps of those names are removed. Returns every luxel's RGB, HDR and direction data
+/// unless `outputs` leave it out, the BSPX lumps `outputs` ask for, and `DECOUPLED_LM` or
+/// `LMSHIFT` and `LMOFFSET` when faces have lightmaps on their own grids (those follow the
+/// 16-texel ones in the same data); earlier lumps of those names are removed. Returns every luxel's RGB, HDR and direction data
 /// the maps kept, for the files beside the BSP.
 pub fn write_lighting(bsp: &mut Bsp, maps: &[FaceLightmap], outputs: &Outputs) -> LuxelData {
     let own_grids: Vec<(usize, &OwnGridLightmap)> = maps
@@ -378,20 +380,40 @@ pub fn write_lighting(bsp: &mut Bsp, maps: &[FaceLightmap], outputs: &Outputs) -
             face.styles[slot] = s;
         }
     }
-    bsp.remove_bspx_lump(DECOUPLED_LM);
-    if !own_grids.is_empty() {
-        let mut records = vec![NO_OWN_GRID; bsp.faces.len()];
-        for (face, own) in own_grids {
-            let m = &own.lightmap;
-            records[face] = DecoupledLightmap {
-                // Faces wider than 16 bits get no grid of their own (`LuxelGrid::world_aligned`).
-                width: u16::try_from(m.width).unwrap_or(u16::MAX),
-                height: u16::try_from(m.height).unwrap_or(u16::MAX),
-                offset: data.push(m),
-                world_to_luxel: own.world_to_luxel,
-            };
+    for name in [DECOUPLED_LM, LMSHIFT, LMOFFSET] {
+        bsp.remove_bspx_lump(name);
+    }
+    let mut records: Option<Vec<DecoupledLightmap>> = None;
+    let mut shifts: Option<(Vec<u8>, Vec<i32>)> = None;
+    for (face, own) in own_grids {
+        let m = &own.lightmap;
+        let offset = data.push(m);
+        match own.grid {
+            OwnGrid::Decoupled(world_to_luxel) => {
+                let records = records.get_or_insert_with(|| vec![NO_OWN_GRID; bsp.faces.len()]);
+                records[face] = DecoupledLightmap {
+                    // Wider grids are never made (`LuxelGrid::world_aligned`).
+                    width: u16::try_from(m.width).unwrap_or(u16::MAX),
+                    height: u16::try_from(m.height).unwrap_or(u16::MAX),
+                    offset,
+                    world_to_luxel,
+                };
+            }
+            OwnGrid::Shifted(shift) => {
+                // Faces on Quake's grid keep shift 4 and their 16-texel lightmap.
+                let (shifts, offsets) = shifts.get_or_insert_with(|| {
+                    let offsets = bsp.faces.iter().map(|f| f.light_offset).collect();
+                    (vec![QUAKE_SHIFT; bsp.faces.len()], offsets)
+                });
+                (shifts[face], offsets[face]) = (shift, offset);
+            }
         }
+    }
+    if let Some(records) = records {
         bsp.set_decoupled_lightmaps(&records);
+    }
+    if let Some((shifts, offsets)) = shifts {
+        bsp.set_shifted_lightmaps(&shifts, &offsets);
     }
     let LuxelWriter {
         grey,
@@ -421,6 +443,9 @@ pub fn write_lighting(bsp: &mut Bsp, maps: &[FaceLightmap], outputs: &Outputs) -
         directions: dirs,
     }
 }
+
+/// The `LMSHIFT` of Quake's 16-texel grid.
+const QUAKE_SHIFT: u8 = 4;
 
 /// The `DECOUPLED_LM` record of a face without a lightmap.
 const NO_OWN_GRID: DecoupledLightmap = DecoupledLightmap {

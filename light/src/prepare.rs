@@ -102,7 +102,7 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
             .copied()
             .unwrap_or(DVec3::ZERO)
     };
-    let faces = face_geometry(bsp, origin_of, |m| map_lights.units_per_luxel(m))?;
+    let faces = face_geometry(bsp, origin_of, |m| map_lights.spacing(m))?;
     let scene = TraceScene::build(
         &device,
         &faces,

@@ -1,7 +1,7 @@
 //! Light on one luxel grid read at points of another: bounced light reads the light of the
 //! faces it meets between their luxels, and a face lit on its own grid
-//! (`--world_units_per_luxel`) gives engines that read only Quake's 16-texel lightmap that
-//! lightmap from its own, as ericw-tools does.
+//! (`--world_units_per_luxel`, `_lmscale`) gives engines that read only Quake's 16-texel
+//! lightmap that lightmap from its own, as ericw-tools does.
 
 use crate::faces::FaceGeom;
 use crate::samples::vanilla_on_own_grid;

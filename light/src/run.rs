@@ -14,7 +14,7 @@ use rayon::prelude::*;
 
 use crate::bounce::{self, BounceCounts, Density, Field, Receivers, StyleLuxels};
 use crate::error::LightError;
-use crate::faces::FaceGeom;
+use crate::faces::{FaceGeom, OwnGrid};
 use crate::lightgrid::{GridSources, RawGrid, finish_grid, trace_grid};
 use crate::lighting::{Lighting, RawLighting, Stats};
 use crate::lights::assign_switchable_styles;
@@ -336,10 +336,10 @@ fn finish_faces(
             let bounce = bounced.get(light.face).map_or(&[][..], |b| &b[..]);
             let light = light.finish(bounce);
             let geom = &geoms[light.face];
-            match geom.world_to_luxel {
-                Some(rows) => (
+            match geom.own_grid {
+                Some(grid) => (
                     resample::vanilla_from_own(geom, &light),
-                    Some((light, rows)),
+                    Some((light, grid)),
                 ),
                 None => (light, None),
             }
@@ -373,8 +373,8 @@ struct Keep<'a> {
     samples: bool,
 }
 
-/// A face's light on its own grid and that grid's projection.
-type OwnGridLight = (FaceLight, [[f32; 4]; 2]);
+/// A face's light on its own grid, and that grid.
+type OwnGridLight = (FaceLight, OwnGrid);
 
 /// Direct light of `faces` at `quality`.
 fn trace_faces(
@@ -538,7 +538,7 @@ pub fn finish_lighting(raw: &RawLighting, soft_radius: usize) -> Lighting {
         .enumerate()
         .map(
             |(i, light)| match raw.own_grids.get(i).and_then(Option::as_ref) {
-                Some((own, rows)) => finish_face_on_own_grid(light, own, *rows, &finish),
+                Some((own, grid)) => finish_face_on_own_grid(light, own, *grid, &finish),
                 None => finish_face(light, &finish),
             },
         )

@@ -10,7 +10,7 @@ use quake_formats::geom::DVec3Ext;
 use quake_formats::miptex::{MipTex, TextureLump};
 
 use crate::dirt::DirtMode;
-use crate::faces::{FaceKind, face_geometry};
+use crate::faces::{FaceKind, Spacing, face_geometry};
 use crate::samples::{FaceRegion, face_samples};
 use crate::scene::TraceScene;
 use crate::{
@@ -225,7 +225,7 @@ fn samples_behind_a_wall_are_pulled_back_and_do_not_bleed() {
     polys.extend(box_faces([100.0, -50.0, -50.0], [140.0, 150.0, 200.0]));
     let ents = "{ \"classname\" \"worldspawn\" }\n{ \"classname\" \"light\" \"origin\" \"180 50 40\" \"delay\" \"3\" }\n";
     let bsp = synthetic_bsp(&polys, ents);
-    let faces = face_geometry(&bsp, |_| DVec3::ZERO, |_| 0.0).expect("faces");
+    let faces = face_geometry(&bsp, |_| DVec3::ZERO, |_| Spacing::Quake).expect("faces");
     let device = crate::embree::Device::new(1).expect("device");
     let scene = TraceScene::build(&device, &faces, &[], &[]).expect("scene");
     let (samples, counts) = face_samples(&faces[0], 1, &scene, &bsp);
@@ -269,7 +269,7 @@ fn sample_points_invert_an_angled_projection() {
     };
     let mut bsp = synthetic_bsp(&[poly], "{ \"classname\" \"worldspawn\" }");
     bsp.texinfo[0].vecs = [[0.9, 0.1, 0.0, 5.5], [0.05, -0.7, -0.3, -3.25]];
-    let faces = face_geometry(&bsp, |_| DVec3::ZERO, |_| 0.0).expect("faces");
+    let faces = face_geometry(&bsp, |_| DVec3::ZERO, |_| Spacing::Quake).expect("faces");
     let device = crate::embree::Device::new(1).expect("device");
     let scene = TraceScene::build(&device, &faces, &[], &[]).expect("scene");
     let (samples, _) = face_samples(&faces[0], 1, &scene, &bsp);
@@ -790,7 +790,7 @@ fn overhang_scene(model_keys: &str, sun: bool) -> Bsp {
 /// The grey style-0 value of the luxel of `face` at texture coordinates
 /// `(s, t)` (the luxel whose centre grid point is nearest).
 fn luxel_at(bsp: &Bsp, lighting: &crate::Lighting, face: usize, s: f64, t: f64) -> u8 {
-    let faces = face_geometry(bsp, |_| DVec3::ZERO, |_| 0.0).expect("faces");
+    let faces = face_geometry(bsp, |_| DVec3::ZERO, |_| Spacing::Quake).expect("faces");
     let mins = faces[face].extents.tex_mins;
     let m = lighting
         .lightmaps
@@ -1875,6 +1875,34 @@ fn eight_units_per_luxel_are_no_further_from_the_reference_than_sixteen_texels()
 /// dark at every spacing, on its own grid and in the 16-texel lightmap read from it.
 #[test]
 fn no_light_reaches_under_a_thin_wall_at_any_spacing() {
+    let bsp = thin_wall_scene();
+    let world_units = [8.0, 4.0].map(|u| on_own_grids(Quality::Default, u));
+    let texels = [8.0, 4.0].map(|t| {
+        let mut o = options(Quality::Default);
+        o.overrides.lightmap_scale = Some(t);
+        o
+    });
+    for options in world_units.iter().chain(&texels) {
+        let lighting = compute_lighting(&bsp, options).expect("light");
+        let own = own_grid_lightmaps(&lighting);
+        for l in [&lighting, &own] {
+            assert!(
+                face_grey(l, 0).iter().all(|&v| v == 0),
+                "{:?}: light bled under the wall: {:?}",
+                options.overrides,
+                face_grey(l, 0)
+            );
+            assert!(
+                face_grey(l, 1).iter().all(|&v| v > 0),
+                "{:?}: far floor lit",
+                options.overrides
+            );
+        }
+    }
+}
+
+/// Two floors either side of a thin wall standing between them, a light over the far one.
+fn thin_wall_scene() -> Bsp {
     let near = quad(
         [0.0, 0.0, 0.0],
         [0.0, 100.0, 0.0],
@@ -1892,45 +1920,37 @@ fn no_light_reaches_under_a_thin_wall_at_any_spacing() {
     let mut polys = vec![near, far];
     polys.extend(box_faces([100.0, -50.0, -50.0], [104.0, 150.0, 200.0]));
     let ents = "{ \"classname\" \"worldspawn\" }\n{ \"classname\" \"light\" \"origin\" \"150 50 40\" \"delay\" \"3\" }\n";
-    let bsp = synthetic_bsp(&polys, ents);
-    for units in [8.0, 4.0] {
-        let lighting =
-            compute_lighting(&bsp, &on_own_grids(Quality::Default, units)).expect("light");
-        let own = own_grid_lightmaps(&lighting);
-        for l in [&lighting, &own] {
-            assert!(
-                face_grey(l, 0).iter().all(|&v| v == 0),
-                "{units} units: light bled under the wall: {:?}",
-                face_grey(l, 0)
-            );
-            assert!(
-                face_grey(l, 1).iter().all(|&v| v > 0),
-                "{units} units: far floor lit"
-            );
-        }
-    }
+    synthetic_bsp(&polys, ents)
 }
 
 #[test]
 fn own_grids_give_the_same_bytes_on_one_and_two_threads() {
     let bsp = demo_bsp_with_sun();
-    let mut options = on_own_grids(Quality::Default, 8.0);
-    let o = &mut options.overrides;
-    (o.dirt, o.bounce, o.sunsamples, o.bspxlit) = (Some(true), Some(1), Some(16), Some(true));
-    let lit_bytes = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .expect("thread pool");
-        let lighting = pool
-            .install(|| compute_lighting(&bsp, &options))
-            .expect("light");
-        let mut lit = bsp.clone();
-        apply_lighting(&mut lit, &lighting);
-        lit.write().expect("BSP encodes")
-    };
-    let one = lit_bytes(1);
-    assert!(one == lit_bytes(2), "1 and 2 threads differ");
+    let world_units = on_own_grids(Quality::Default, 8.0);
+    let mut texels = options(Quality::Default);
+    texels.overrides.lightmap_scale = Some(8.0);
+    for mut options in [world_units, texels] {
+        let o = &mut options.overrides;
+        (o.dirt, o.bounce, o.sunsamples, o.bspxlit) = (Some(true), Some(1), Some(16), Some(true));
+        let lit_bytes = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("thread pool");
+            let lighting = pool
+                .install(|| compute_lighting(&bsp, &options))
+                .expect("light");
+            let mut lit = bsp.clone();
+            apply_lighting(&mut lit, &lighting);
+            lit.write().expect("BSP encodes")
+        };
+        let one = lit_bytes(1);
+        assert!(
+            one == lit_bytes(2),
+            "{:?}: 1 and 2 threads differ",
+            options.overrides
+        );
+    }
 }
 
 /// A brush entity's own `_world_units_per_luxel` wins over the map's, and counts only while
@@ -1960,4 +1980,54 @@ fn brush_entities_set_their_own_spacing() {
         vec![Some(5), Some(17)]
     );
     assert_eq!(sizes(&options(Quality::Default)), vec![None, None]);
+}
+
+/// `_lmscale` on a brush entity lights its faces at a fraction of 16 texels, written as
+/// `LMSHIFT` and `LMOFFSET`; the world keeps Quake's grid (shift 4, its 16-texel lightmap).
+#[test]
+fn lmscale_writes_lmshift_and_lmoffset() {
+    let world = [floor(64.0)];
+    let model = [quad(
+        [0.0, 0.0, 32.0],
+        [0.0, 64.0, 32.0],
+        [64.0, 64.0, 32.0],
+        [64.0, 0.0, 32.0],
+        [0.0, 0.0, 1.0],
+    )];
+    let ents = "{ \"classname\" \"worldspawn\" }\n{ \"classname\" \"func_wall\" \"model\" \"*1\" \"_lmscale\" \"0.25\" }\n{ \"classname\" \"light\" \"origin\" \"32 32 100\" }\n";
+    let mut bsp = synthetic_bsp_models(&[&world, &model], ents);
+    let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
+    apply_lighting(&mut bsp, &lighting);
+    assert_eq!(
+        bsp.lightmap_shifts().expect("LMSHIFT reads"),
+        Some(vec![4, 2])
+    );
+    let offsets = bsp
+        .lightmap_offsets()
+        .expect("LMOFFSET reads")
+        .expect("LMOFFSET");
+    assert_eq!(offsets[0], bsp.faces[0].light_offset);
+    let own = lighting.lightmaps[1].own_grid.as_deref().expect("own grid");
+    // 64 units at 4 texels a luxel: 17 across, where Quake's grid has 5.
+    assert_eq!((own.lightmap.width, lighting.lightmaps[1].width), (17, 5));
+    let at = usize::try_from(offsets[1]).expect("an offset");
+    assert_eq!(bsp.lighting[at..at + 17 * 17], own.lightmap.grey[0][..]);
+    assert!(own.lightmap.grey[0].iter().all(|&v| v > 0));
+    let problems: Vec<_> = quake_formats::validate(&bsp)
+        .into_iter()
+        .filter(|p| {
+            use quake_formats::bsp::light_lumps::{LMOFFSET, LMSHIFT};
+            p.lump == LMSHIFT || p.lump == LMOFFSET
+        })
+        .collect();
+    assert!(problems.is_empty(), "{problems:?}");
+    // -lmscale (texels) overrides every model's `_lmscale`.
+    let mut o = options(Quality::Default);
+    o.overrides.lightmap_scale = Some(8.0);
+    let lighting = compute_lighting(&bsp, &o).expect("light");
+    apply_lighting(&mut bsp, &lighting);
+    assert_eq!(
+        bsp.lightmap_shifts().expect("LMSHIFT reads"),
+        Some(vec![3, 3])
+    );
 }

@@ -203,7 +203,7 @@ mod tests {
                 &LightmapExtents::from_points(&[], &[[0.0; 4]; 2]),
                 &[[0.0; 4]; 2],
             ),
-            world_to_luxel: None,
+            own_grid: None,
         }
     }
 

@@ -129,23 +129,11 @@ fn differences(frame: &Frame, expected: &[[u8; 3]]) -> (f64, f64) {
     )
 }
 
-/// The demo lit on world-aligned grids of 8 units (`DECOUPLED_LM`): the viewer draws every lit
-/// face from its own grid, and the picture stays close to the one lit on Quake's grid (the same
-/// light, sampled twice as finely).
+/// The demo lit on grids of its own, world-aligned at 8 units (`DECOUPLED_LM`) and every 8
+/// texels (`LMSHIFT`): the viewer draws every lit face from its own grid, and the picture stays
+/// close to the one lit on Quake's grid (the same light, sampled twice as finely).
 #[test]
 fn demo_lit_on_its_own_grids_draws_close_to_quakes_grid() {
-    let mut options = light::Options::default();
-    options.overrides.world_units_per_luxel = Some(8.0);
-    let (bsp, lit) = build_demo(2, &options);
-    let (world, _, frame) = render_demo(&bsp, lit);
-    let lit_surfaces = world
-        .surfaces
-        .iter()
-        .flatten()
-        .filter(|s| s.light.is_some());
-    assert!(lit_surfaces.clone().count() > 0);
-    assert!(lit_surfaces.clone().all(|s| s.free_lightmap.is_some()));
-    assert!(frame.faces.iter().all(|&f| f != NO_FACE));
     let (quake_bsp, quake_lit) = build_demo(2, &light::Options::default());
     let (_, _, quake) = render_demo(&quake_bsp, quake_lit);
     let quake: Vec<[u8; 3]> = quake
@@ -153,12 +141,28 @@ fn demo_lit_on_its_own_grids_draws_close_to_quakes_grid() {
         .iter()
         .map(|&c| runtime_viewer::textures::unpack(c))
         .collect();
-    let (mean, fraction) = differences(&frame, &quake);
-    println!(
-        "8-unit grids against Quake's: mean {mean:.3}, {:.2}% of pixels off",
-        fraction * 100.0
-    );
-    assert!(mean < MAX_MEAN_DIFF, "mean difference {mean:.3}");
+    let mut world_units = light::Options::default();
+    world_units.overrides.world_units_per_luxel = Some(8.0);
+    let mut texels = light::Options::default();
+    texels.overrides.lightmap_scale = Some(8.0);
+    for (grid, options) in [("8 units", world_units), ("8 texels", texels)] {
+        let (bsp, lit) = build_demo(2, &options);
+        let (world, _, frame) = render_demo(&bsp, lit);
+        let lit_surfaces = world
+            .surfaces
+            .iter()
+            .flatten()
+            .filter(|s| s.light.is_some());
+        assert!(lit_surfaces.clone().count() > 0);
+        assert!(lit_surfaces.clone().all(|s| s.free_lightmap.is_some()));
+        assert!(frame.faces.iter().all(|&f| f != NO_FACE));
+        let (mean, fraction) = differences(&frame, &quake);
+        println!(
+            "{grid} against Quake's grid: mean {mean:.3}, {:.2}% of pixels off",
+            fraction * 100.0
+        );
+        assert!(mean < MAX_MEAN_DIFF, "{grid}: mean difference {mean:.3}");
+    }
 }
 
 #[test]

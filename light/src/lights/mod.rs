@@ -21,6 +21,7 @@ use quake_formats::entities::Entity;
 
 use crate::dirt::{DirtResponse, DirtSampling};
 use crate::error::LightError;
+use crate::faces::Spacing;
 use crate::settings::{Overrides, SettingWarning, Settings, World};
 pub use point::{Falloff, PointLight, Spot, angle_factor};
 pub use styles::assign_switchable_styles;
@@ -103,6 +104,8 @@ pub struct MapLights {
     pub model_origins: HashMap<usize, DVec3>,
     /// Brush models with their own `_world_units_per_luxel` (used when the map's is set).
     pub model_units_per_luxel: HashMap<usize, f64>,
+    /// The world (0) and brush models with their own `_lmscale`.
+    pub model_lmscale: HashMap<usize, f64>,
     /// The map-wide settings, resolved (the command line's, else worldspawn's, else the
     /// defaults).
     pub settings: Settings,
@@ -114,18 +117,24 @@ pub struct MapLights {
 }
 
 impl MapLights {
-    /// Map units per luxel of model `model`'s own lightmap grids: its `_world_units_per_luxel`,
-    /// else the map's; 0 (Quake's grid) while the map's is unset, as in ericw-tools.
-    pub fn units_per_luxel(&self, model: usize) -> f64 {
+    /// The spacing model `model`'s faces are lit at, as in ericw-tools: with the map's
+    /// `_world_units_per_luxel` set, world-aligned grids at the model's own
+    /// `_world_units_per_luxel`, else the map's; else `-lmscale` / `_lightmap_scale` (texels)
+    /// for every model; else the model's `_lmscale` (a fraction of 16 texels); else Quake's.
+    pub fn spacing(&self, model: usize) -> Spacing {
         let map = self.settings.world_units_per_luxel;
-        if map <= 0.0 {
-            return 0.0;
+        if map > 0.0 {
+            let own = self.model_units_per_luxel.get(&model).copied();
+            return Spacing::WorldUnits(own.filter(|&u| u > 0.0).unwrap_or(map));
         }
-        self.model_units_per_luxel
-            .get(&model)
-            .copied()
-            .filter(|&u| u > 0.0)
-            .unwrap_or(map)
+        let texels = match self.settings.lightmap_scale {
+            t if t > 0.0 => t,
+            _ => 16.0 * self.model_lmscale.get(&model).copied().unwrap_or(0.0),
+        };
+        match shift_of_texels(texels) {
+            Some(shift) => Spacing::Shift(shift),
+            None => Spacing::Quake,
+        }
     }
 
     /// True if any light, sun or minlight is darkened by dirt.
@@ -182,6 +191,7 @@ pub fn parse_lights(
         phong: HashMap::new(),
         model_origins: HashMap::new(),
         model_units_per_luxel: HashMap::new(),
+        model_lmscale: HashMap::new(),
         switchable_styles,
         settings,
         warnings,
@@ -189,10 +199,26 @@ pub fn parse_lights(
     if let Some(m) = worldspawn::world_minlight(&out.settings, &global) {
         out.minlight.insert(0, m);
     }
-    models::read_phong(entities, world, &mut out)?;
+    models::read_world_and_model_keys(entities, world, &mut out)?;
     models::read_models(entities, &global, &mut out)?;
     entities::read_lights(entities, &global, &mut out)?;
     Ok(out)
+}
+
+/// The `LMSHIFT` of a lightmap spacing of `texels`, as ericw-tools' qbsp takes it: the whole
+/// texels, halved down to a power of two. `None` for less than one texel (unset).
+fn shift_of_texels(texels: f64) -> Option<u8> {
+    // Whole texels as ericw-tools truncates them; past 2^30 no engine's arithmetic holds.
+    let mut whole = texels.min(f64::from(1u32 << 30)) as u32;
+    if whole == 0 {
+        return None;
+    }
+    let mut shift = 0;
+    while whole > 1 {
+        whole /= 2;
+        shift += 1;
+    }
+    Some(shift)
 }
 
 #[cfg(test)]
@@ -328,5 +354,15 @@ mod tests {
         for l in &lights.points[1..] {
             assert!(l.origin.length() <= 8.0 + 1e-9);
         }
+    }
+    #[test]
+    fn lmscale_rounds_down_to_a_power_of_two_texels() {
+        assert_eq!(shift_of_texels(16.0), Some(4));
+        assert_eq!(shift_of_texels(8.0), Some(3));
+        assert_eq!(shift_of_texels(12.0), Some(3));
+        assert_eq!(shift_of_texels(16.0 * 0.3), Some(2));
+        assert_eq!(shift_of_texels(1.0), Some(0));
+        assert_eq!(shift_of_texels(0.5), None);
+        assert_eq!(shift_of_texels(-8.0), None);
     }
 }
