@@ -347,7 +347,8 @@ pub struct LuxelData {
 }
 
 /// Replaces the lighting data with `maps` (faces not listed get no lightmap): the grey lump
-/// unless `outputs` leave it out, the BSPX lumps `outputs` ask for, and `DECOUPLED_LM` or
+/// unless `outputs` leave it out (and with it the 16-texel lightmaps of faces that have their
+/// own), the BSPX lumps `outputs` ask for, and `DECOUPLED_LM` or
 /// `LMSHIFT` and `LMOFFSET` when faces have lightmaps on their own grids (those follow the
 /// 16-texel ones in the same data); earlier lumps of those names are removed. Returns every luxel's RGB, HDR and direction data
 /// the maps kept, for the files beside the BSP.
@@ -375,7 +376,10 @@ pub fn write_lighting(bsp: &mut Bsp, maps: &[FaceLightmap], outputs: &Outputs) -
     }
     for m in maps {
         let face = &mut bsp.faces[m.face];
-        face.light_offset = data.push(m);
+        // Without the grey lump (`--novanilla`) a face lit on its own grid keeps only that
+        // lightmap, as ericw-tools writes it: the 16-texel one is a fallback for old engines.
+        let fallback = outputs.grey_lump || m.own_grid.is_none();
+        face.light_offset = if fallback { data.push(m) } else { -1 };
         for (slot, &s) in m.styles.iter().enumerate() {
             face.styles[slot] = s;
         }

@@ -2031,3 +2031,34 @@ fn lmscale_writes_lmshift_and_lmoffset() {
         Some(vec![3, 3])
     );
 }
+
+/// With `--novanilla`, faces lit on their own grids keep only those lightmaps (no 16-texel
+/// fallback), as ericw-tools writes them.
+#[test]
+fn novanilla_keeps_only_the_own_grid_lightmaps() {
+    let mut bsp = shadow_scene("\"light\" \"300\"");
+    let mut options = on_own_grids(Quality::Default, 8.0);
+    options.overrides.novanilla = Some(true);
+    let lighting = compute_lighting(&bsp, &options).expect("light");
+    apply_lighting(&mut bsp, &lighting);
+    assert!(bsp.faces.iter().all(|f| f.light_offset == -1));
+    let records = bsp
+        .decoupled_lightmaps()
+        .expect("DECOUPLED_LM reads")
+        .expect("DECOUPLED_LM");
+    let luxels: usize = lighting
+        .lightmaps
+        .iter()
+        .map(|m| {
+            let own = &m.own_grid.as_deref().expect("own grid").lightmap;
+            own.styles.len() * own.width * own.height
+        })
+        .sum();
+    assert_eq!(bsp.luxel_count(), luxels, "no 16-texel lightmaps written");
+    assert!(records.iter().all(|r| r.offset >= 0));
+    let problems: Vec<_> = quake_formats::validate(&bsp)
+        .into_iter()
+        .filter(|p| p.lump == quake_formats::bsp::light_lumps::DECOUPLED_LM)
+        .collect();
+    assert!(problems.is_empty(), "{problems:?}");
+}
