@@ -1877,9 +1877,10 @@ fn eight_units_per_luxel_are_no_further_from_the_reference_than_sixteen_texels()
 fn no_light_reaches_under_a_thin_wall_at_any_spacing() {
     let bsp = thin_wall_scene();
     let world_units = [8.0, 4.0].map(|u| on_own_grids(Quality::Default, u));
-    let texels = [8.0, 4.0].map(|t| {
+    // 8 and 4 texels.
+    let texels = [3, 2].map(|shift| {
         let mut o = options(Quality::Default);
-        o.overrides.lightmap_scale = Some(t);
+        o.overrides.lmshift = Some(shift);
         o
     });
     for options in world_units.iter().chain(&texels) {
@@ -1928,7 +1929,7 @@ fn own_grids_give_the_same_bytes_on_one_and_two_threads() {
     let bsp = demo_bsp_with_sun();
     let world_units = on_own_grids(Quality::Default, 8.0);
     let mut texels = options(Quality::Default);
-    texels.overrides.lightmap_scale = Some(8.0);
+    texels.overrides.lmshift = Some(3);
     for mut options in [world_units, texels] {
         let o = &mut options.overrides;
         (o.dirt, o.bounce, o.sunsamples, o.bspxlit) = (Some(true), Some(1), Some(16), Some(true));
@@ -2021,15 +2022,21 @@ fn lmscale_writes_lmshift_and_lmoffset() {
         })
         .collect();
     assert!(problems.is_empty(), "{problems:?}");
-    // -lmscale (texels) overrides every model's `_lmscale`.
+    // -lmshift overrides every model's `_lmscale`.
     let mut o = options(Quality::Default);
-    o.overrides.lightmap_scale = Some(8.0);
+    o.overrides.lmshift = Some(3);
     let lighting = compute_lighting(&bsp, &o).expect("light");
     apply_lighting(&mut bsp, &lighting);
     assert_eq!(
         bsp.lightmap_shifts().expect("LMSHIFT reads"),
         Some(vec![3, 3])
     );
+    // 4, the default, leaves each model its `_lmscale`.
+    o.overrides.lmshift = Some(4);
+    let lighting = compute_lighting(&bsp, &o).expect("light");
+    apply_lighting(&mut bsp, &lighting);
+    let shifts = bsp.lightmap_shifts().expect("LMSHIFT reads");
+    assert_eq!(shifts, Some(vec![4, 2]));
 }
 
 /// With `--novanilla`, faces lit on their own grids keep only those lightmaps (no 16-texel

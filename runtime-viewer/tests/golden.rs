@@ -144,7 +144,7 @@ fn demo_lit_on_its_own_grids_draws_close_to_quakes_grid() {
     let mut world_units = light::Options::default();
     world_units.overrides.world_units_per_luxel = Some(8.0);
     let mut texels = light::Options::default();
-    texels.overrides.lightmap_scale = Some(8.0);
+    texels.overrides.lmshift = Some(3);
     for (grid, options) in [("8 units", world_units), ("8 texels", texels)] {
         let (bsp, lit) = build_demo(2, &options);
         let (world, _, frame) = render_demo(&bsp, lit);

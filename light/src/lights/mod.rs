@@ -119,22 +119,24 @@ pub struct MapLights {
 impl MapLights {
     /// The spacing model `model`'s faces are lit at, as in ericw-tools: with the map's
     /// `_world_units_per_luxel` set, world-aligned grids at the model's own
-    /// `_world_units_per_luxel`, else the map's; else `-lmscale` / `_lightmap_scale` (texels)
-    /// for every model; else the model's `_lmscale` (a fraction of 16 texels); else Quake's.
+    /// `_world_units_per_luxel`, else the map's; else `-lmshift` for every model when it is
+    /// not 4; else the model's `_lmscale` (a fraction of 16 texels, as ericw-tools' qbsp reads
+    /// it); else Quake's.
     pub fn spacing(&self, model: usize) -> Spacing {
         let map = self.settings.world_units_per_luxel;
         if map > 0.0 {
             let own = self.model_units_per_luxel.get(&model).copied();
             return Spacing::WorldUnits(own.filter(|&u| u > 0.0).unwrap_or(map));
         }
-        let texels = match self.settings.lightmap_scale {
-            t if t > 0.0 => t,
-            _ => 16.0 * self.model_lmscale.get(&model).copied().unwrap_or(0.0),
+        let shift = match self.settings.lmshift {
+            QUAKE_SHIFT => {
+                let scale = self.model_lmscale.get(&model).copied().unwrap_or(0.0);
+                shift_of_texels(16.0 * scale)
+            }
+            // The setting's range holds it to 30.
+            shift => u8::try_from(shift).ok(),
         };
-        match shift_of_texels(texels) {
-            Some(shift) => Spacing::Shift(shift),
-            None => Spacing::Quake,
-        }
+        shift.map_or(Spacing::Quake, Spacing::Shift)
     }
 
     /// True if any light, sun or minlight is darkened by dirt.
@@ -204,6 +206,9 @@ pub fn parse_lights(
     entities::read_lights(entities, &global, &mut out)?;
     Ok(out)
 }
+
+/// `-lmshift`'s default: Quake's 16 texels, leaving each model its `_lmscale`.
+const QUAKE_SHIFT: usize = 4;
 
 /// The `LMSHIFT` of a lightmap spacing of `texels`, as ericw-tools' qbsp takes it: the whole
 /// texels, halved down to a power of two. `None` for less than one texel (unset).
