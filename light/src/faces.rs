@@ -87,6 +87,7 @@ impl OwnGrid {
         normal: DVec3,
     ) -> Option<(OwnGrid, LuxelGrid)> {
         match spacing {
+            // Shift 4 is Quake's 16 texels.
             Spacing::Quake | Spacing::Shift(4) => None,
             Spacing::WorldUnits(units) => {
                 let (rows, grid) = LuxelGrid::world_aligned(points, normal.to_array(), units)?;

@@ -1,10 +1,10 @@
 //! Sample points: where on (just in front of) each face light is measured.
 //!
-//! One point per luxel of the face's grid (Quake's 16 texels, or the face's own
-//! world-aligned spacing), or `n x n` per luxel when supersampling, found by
-//! inverting the grid's projection onto the face's plane. A point
-//! that falls outside the face (luxels past its edge, e.g. under a wall
-//! standing on a floor) moves to the nearest point of the face, kept
+//! One point per luxel of the face's grid (Quake's 16 texels, or the face's own:
+//! world-aligned, or another power of two texels), or `n x n` per luxel when
+//! supersampling, found by inverting the grid's projection onto the face's
+//! plane. A point that falls outside the face (luxels past its edge, e.g. under
+//! a wall standing on a floor) moves to the nearest point of the face, kept
 //! [`FACE_INSET`] inside its edges, so light from the far side of the wall
 //! does not bleed under it and the point stays over the part of the face it
 //! stands for. Points are then pushed [`SURFACE_OFFSET`] units off the

@@ -360,6 +360,7 @@ mod tests {
             assert!(l.origin.length() <= 8.0 + 1e-9);
         }
     }
+
     #[test]
     fn lmscale_rounds_down_to_a_power_of_two_texels() {
         assert_eq!(shift_of_texels(16.0), Some(4));
