@@ -58,7 +58,7 @@ quake_formats::ericw_accepted! {
         debugleak: bool => "the pointfile and the leak message name the hole",
         notriggermodels: bool => "trigger models are written as for every game",
         includeskip: bool => "skip faces are always left out",
-        lmscale: Option<String> => "lightmaps are on the 16-texel grid",
+        lmscale: Option<String> => "light reads `_lmscale` from the entities; `slipgate light --lmshift N` sets every model's spacing",
         missing_textures_as_zero_size: bool => "missing textures become 64x64 placeholders",
         nodefaultpaths: bool => "WADs are found as docs/mapping.md says",
         defaultpaths: bool => "WADs are found as docs/mapping.md says",

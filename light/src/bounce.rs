@@ -19,7 +19,6 @@
 
 use glam::{DVec3, Vec3};
 use quake_formats::Bsp;
-use quake_formats::bsp::limits::LIGHTMAP_SCALE;
 
 use quake_formats::palette::Palette;
 
@@ -226,32 +225,13 @@ impl<'a> Field<'a> {
     }
 }
 
-/// The light of `face` at world point `q`, bilinear between luxel centres.
+/// The light of `face` at world point `q`, bilinear between the luxels of its grid.
 fn light_at(face: &FaceGeom, luxels: &[[f32; 3]], q: DVec3) -> [f32; 3] {
-    let [w, h] = face.extents.luxel_size();
-    let coord = |axis: usize, size: usize| {
-        let v = face.vecs[axis];
-        let dir = DVec3::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2]));
-        let st = dir.dot(q - face.origin) + f64::from(v[3]);
-        let f = ((st - f64::from(face.extents.tex_mins[axis])) / f64::from(LIGHTMAP_SCALE))
-            .clamp(0.0, size.saturating_sub(1) as f64);
-        // `f` is clamped at 0, so truncation is the floor (`floor` is a libm call on x86-64).
-        let i = (f as usize).min(size.saturating_sub(1));
-        (
-            i,
-            (i + 1).min(size.saturating_sub(1)),
-            (f - i as f64) as f32,
-        )
-    };
-    let (x0, x1, fx) = coord(0, w);
-    let (y0, y1, fy) = coord(1, h);
-    let at = |x: usize, y: usize| luxels.get(y * w + x).copied().unwrap_or_default();
-    let (a, b, c, d) = (at(x0, y0), at(x1, y0), at(x0, y1), at(x1, y1));
-    std::array::from_fn(|k| {
-        let top = a[k] + (b[k] - a[k]) * fx;
-        let bottom = c[k] + (d[k] - c[k]) * fx;
-        top + (bottom - top) * fy
-    })
+    crate::resample::bilinear(
+        luxels,
+        face.grid.size,
+        face.grid.luxel_at((q - face.origin).to_array()),
+    )
 }
 
 /// Rays go no further than this.

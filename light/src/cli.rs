@@ -347,6 +347,13 @@ fn measurements(
         };
         report("--reference", &c.error);
         extra.insert("error_vs_reference".into(), serde_json::to_value(c.error)?);
+        if let Some(e) = &c.error_own_grids {
+            report("--reference on the faces' own grids", e);
+            extra.insert(
+                "error_own_grids_vs_reference".into(),
+                serde_json::to_value(e)?,
+            );
+        }
         if let Some(e) = &c.error_filtered {
             report("--reference with the same --soft filter", e);
             extra.insert(

@@ -106,6 +106,7 @@ pub fn lightmaps_in(bsp: &Bsp, faces: &[usize]) -> Lighting {
             rgb: Vec::new(),
             hdr: Vec::new(),
             directions: Vec::new(),
+            own_grid: None,
         });
     }
     Lighting {
@@ -119,6 +120,26 @@ pub fn lightmaps_in(bsp: &Bsp, faces: &[usize]) -> Lighting {
     }
 }
 
+/// `lighting` with the lightmaps of faces lit on their own grids in place of their 16-texel
+/// ones, the other faces left out; `None` when no face has its own grid.
+pub fn own_grids(lighting: &Lighting) -> Option<Lighting> {
+    let lightmaps: Vec<FaceLightmap> = lighting
+        .lightmaps
+        .iter()
+        .filter_map(|m| {
+            let own = m.own_grid.as_deref()?;
+            Some(FaceLightmap {
+                face: m.face,
+                ..own.lightmap.clone()
+            })
+        })
+        .collect();
+    (!lightmaps.is_empty()).then(|| Lighting {
+        lightmaps,
+        ..lighting.clone()
+    })
+}
+
 /// A lighting against the reference of the same faces (`--compare-reference`).
 #[derive(Debug, Clone, Copy, serde::Serialize)]
 pub struct ReferenceComparison {
@@ -127,6 +148,9 @@ pub struct ReferenceComparison {
     /// Against the reference through the same `--soft` filter (it blurs on purpose), when the
     /// run filters.
     pub error_filtered: Option<ErrorStats>,
+    /// Against the reference on the faces' own grids (`--world_units_per_luxel`, `_lmscale`),
+    /// when they have them; `error` then measures the 16-texel lightmaps read from those.
+    pub error_own_grids: Option<ErrorStats>,
     /// The reference's own time and rays.
     pub reference_seconds: f64,
     /// Rays the reference cast.
@@ -154,6 +178,9 @@ pub fn compare_with_reference(
         error: compare(lighting, &exact),
         error_filtered: (raw.soft_radius > 0)
             .then(|| compare(lighting, &finish_lighting(&raw, raw.soft_radius))),
+        error_own_grids: own_grids(lighting)
+            .zip(own_grids(&exact))
+            .map(|(a, r)| compare(&a, &r)),
         reference_seconds: r.seconds_total,
         reference_rays: r.shadow_rays + r.sun_rays + r.dirt_rays + r.placement_rays,
     })

@@ -6,7 +6,7 @@ use std::collections::HashMap;
 use glam::{DVec3, Vec3};
 use quake_formats::Bsp;
 use quake_formats::bsp::texinfo_flags;
-use quake_formats::extents::LightmapExtents;
+use quake_formats::extents::{LightmapExtents, LuxelGrid};
 use quake_formats::geom::Plane;
 use rayon::prelude::*;
 
@@ -54,6 +54,56 @@ pub struct FaceGeom {
     /// The lit faces of the same model on the same plane that share an edge with this one, as
     /// polygons: where a luxel past this face's edge finds the surface it stands over.
     pub continuations: Vec<Vec<DVec3>>,
+    /// The grid light samples the face on: Quake's 16-texel one over `extents`, or its own.
+    pub grid: LuxelGrid,
+    /// What its own grid is, when it has one; the lightmap over `extents` is then taken from
+    /// that grid.
+    pub own_grid: Option<OwnGrid>,
+}
+
+/// The spacing a brush model's faces are lit at.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Spacing {
+    /// Quake's 16 texels.
+    Quake,
+    /// A world-aligned grid, one luxel every so many map units (`DECOUPLED_LM`).
+    WorldUnits(f64),
+    /// One luxel every `1 << shift` texels of the face's texture projection (`LMSHIFT`).
+    Shift(u8),
+}
+
+/// A face's own grid, as the BSP describes it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum OwnGrid {
+    /// World-aligned: the model-space-to-luxel projection of its `DECOUPLED_LM` record.
+    Decoupled([[f32; 4]; 2]),
+    /// On the texture projection, one luxel every `1 << shift` texels (its `LMSHIFT`).
+    Shifted(u8),
+}
+
+impl OwnGrid {
+    /// The grid `spacing` gives a face with `points` (model space), texture projection `vecs`
+    /// and outward `normal`; `None` for Quake's, or a spacing the face cannot take (a grid
+    /// past the lump's sizes).
+    fn of(
+        spacing: Spacing,
+        points: &[[f32; 3]],
+        vecs: &[[f32; 4]; 2],
+        normal: DVec3,
+    ) -> Option<(OwnGrid, LuxelGrid)> {
+        match spacing {
+            // Shift 4 is Quake's 16 texels.
+            Spacing::Quake | Spacing::Shift(4) => None,
+            Spacing::WorldUnits(units) => {
+                let (rows, grid) = LuxelGrid::world_aligned(points, normal.to_array(), units)?;
+                Some((OwnGrid::Decoupled(rows), grid))
+            }
+            Spacing::Shift(shift) => Some((
+                OwnGrid::Shifted(shift),
+                LuxelGrid::shifted(points, vecs, shift)?,
+            )),
+        }
+    }
 }
 
 impl FaceGeom {
@@ -65,13 +115,15 @@ impl FaceGeom {
     }
 }
 
-/// Every face of `bsp` with its model; `origins` gives per-model offsets.
+/// Every face of `bsp` with its model; `origin_of` gives per-model offsets, `spacing_of` the
+/// spacing a model's faces are lit at.
 ///
 /// # Errors
 /// [`LightError::BadFace`] for a face whose indices run outside the file.
 pub fn face_geometry(
     bsp: &Bsp,
     origin_of: impl Fn(usize) -> DVec3 + Sync,
+    spacing_of: impl Fn(usize) -> Spacing + Sync,
 ) -> Result<Vec<FaceGeom>, LightError> {
     let mut model_of = vec![0usize; bsp.faces.len()];
     for (m, model) in bsp.models.iter().enumerate() {
@@ -124,6 +176,8 @@ pub fn face_geometry(
                 plane = plane.flipped();
             }
             plane.dist += plane.normal.dot(origin);
+            let extents = LightmapExtents::from_points(&verts, &ti.vecs);
+            let own = OwnGrid::of(spacing_of(model), &verts, &ti.vecs, plane.normal);
             Ok(FaceGeom {
                 index,
                 model,
@@ -136,8 +190,10 @@ pub fn face_geometry(
                 plane,
                 vecs: ti.vecs,
                 origin,
-                extents: LightmapExtents::from_points(&verts, &ti.vecs),
+                extents,
                 continuations: Vec::new(),
+                grid: own.map_or_else(|| LuxelGrid::vanilla(&extents, &ti.vecs), |(_, g)| g),
+                own_grid: own.map(|(kind, _)| kind),
             })
         })
         .collect();

@@ -1,5 +1,5 @@
-//! Slipgate's `light`: lightmaps on Quake's 16-texel grid from a BSP's light entities, with
-//! shadows traced by Embree.
+//! Slipgate's `light`: lightmaps on Quake's 16-texel grid (and on faces' own grids) from a
+//! BSP's light entities, with shadows traced by Embree.
 //!
 //! [`compute_lighting`] reads a BSP and returns its lightmaps; [`apply_lighting`] writes them
 //! into it (the grey lump and the BSPX lumps asked for) and gives the files beside it (`.lit`,
@@ -7,9 +7,11 @@
 //!
 //! 1. Settings ([`settings`]): each map-wide setting from the command line, else worldspawn,
 //!    else its default; values that do not read warn and fall back.
-//! 2. Preparation (`prepare`): faces as world-space geometry with their lightmap extents
-//!    (`faces`); the Embree scene of everything opaque, sky faces as their own geometry and a
-//!    small scene per `_shadowself` model (`scene`); lights, suns, sky domes, minlight and
+//! 2. Preparation (`prepare`): faces as world-space geometry with their lightmap extents and
+//!    the grid they are lit on, Quake's or their own (`--world_units_per_luxel`, `_lmscale`)
+//!    (`faces`);
+//!    the Embree scene of everything opaque, sky faces as their own geometry and a small scene
+//!    per `_shadowself` model (`scene`); lights, suns, sky domes, minlight and
 //!    switchable styles from the entity lump (`lights`), `_surface` templates copied over
 //!    their faces (`surface`); the PVS for culling (`visibility`); `_phong` normals (`phong`).
 //! 3. Direct light (`trace`), face by face in parallel: sample points per luxel (`--extra`:
@@ -19,7 +21,8 @@
 //!    the face sees; dirt measured where light that takes it arrived (`dirt`); minlight.
 //! 4. Bounced light (`bounce`), when asked for: each pass gathers, at a grid of receivers per
 //!    face, what the light of the pass before gives off from the faces it sees.
-//! 5. Finishing (`output`): bounce added, floors applied, samples averaged to luxels, the
+//! 5. Finishing (`output`): bounce added, floors applied, samples averaged to luxels (a face lit
+//!    on its own grid gets its 16-texel lightmap read from that one, `resample`), the
 //!    `--soft` filter, range scale, gamma and clamping to bytes, at most four styles a face.
 //!
 //! Sky faces block point lights (the sky brush is solid) and are what sun rays look for;
@@ -51,6 +54,7 @@ mod phong;
 mod prepare;
 mod quality;
 mod reach;
+mod resample;
 mod run;
 mod samples;
 mod scene;
@@ -61,7 +65,9 @@ mod visibility;
 
 pub use bench::{BareOcclusion, bare_occlusion};
 pub use bounce::Density as BounceDensity;
-pub use compare::{ErrorStats, ReferenceComparison, compare, compare_with_reference, lightmaps_in};
+pub use compare::{
+    ErrorStats, ReferenceComparison, compare, compare_with_reference, lightmaps_in, own_grids,
+};
 pub use embree::CONFIG_ENV as EMBREE_CONFIG_ENV;
 pub use error::LightError;
 pub use lighting::{Lighting, RawLighting, Stats};

@@ -84,6 +84,9 @@ pub struct Stats {
 pub struct RawLighting {
     /// Each lit face's light per luxel and style.
     pub faces: Vec<FaceLight>,
+    /// Beside each of `faces`, its light on its own grid and that grid, when it has one
+    /// (`--world_units_per_luxel`, `_lmscale`; its light in `faces` is then read from this).
+    pub own_grids: Vec<Option<(FaceLight, crate::faces::OwnGrid)>>,
     /// The entity lump with the styles given to switchable lights (`None`: unchanged).
     pub entity_text: Option<String>,
     /// Some light is coloured: a `.lit` is needed.

@@ -6,10 +6,13 @@
 use std::borrow::Cow;
 
 use quake_formats::Bsp;
-use quake_formats::bsp::light_lumps::{LIGHTING_E5BGR9, LIGHTINGDIR, RGBLIGHTING};
+use quake_formats::bsp::light_lumps::{
+    DECOUPLED_LM, DecoupledLightmap, LIGHTING_E5BGR9, LIGHTINGDIR, LMOFFSET, LMSHIFT, RGBLIGHTING,
+};
 use quake_formats::bsp::limits::MAX_LIGHTMAPS;
 use quake_formats::lit::pack_e5bgr9;
 
+use crate::faces::OwnGrid;
 use crate::settings::Settings;
 use crate::trace::FaceLight;
 
@@ -98,6 +101,19 @@ pub struct FaceLightmap {
     pub hdr: Vec<Vec<u32>>,
     /// Per style, each luxel's direction bytes, when deluxemaps are asked for (else empty).
     pub directions: Vec<Vec<[u8; 3]>>,
+    /// The face's lightmaps on its own grid (`--world_units_per_luxel`, `_lmscale`), the same
+    /// styles in the same order; these ones are then read from that grid.
+    pub own_grid: Option<Box<OwnGridLightmap>>,
+}
+
+/// A face's lightmaps on its own grid: what its `DECOUPLED_LM` record, or its `LMSHIFT` and
+/// `LMOFFSET`, describe.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OwnGridLightmap {
+    /// The lightmaps (their `face` and `own_grid` are the owner's and `None`).
+    pub lightmap: FaceLightmap,
+    /// The grid.
+    pub grid: OwnGrid,
 }
 
 impl FaceLightmap {
@@ -214,6 +230,39 @@ fn grey_of(c: [u8; 3]) -> u8 {
 /// Finishes one face. Returns the lightmap and how many styles were dropped
 /// for exceeding four.
 pub fn finish_face(light: &FaceLight, finish: &Finish) -> (FaceLightmap, usize) {
+    let (maps, dropped) = keep_styles(style_maps(light, finish));
+    (lightmap_of(light, maps, finish), dropped)
+}
+
+/// Finishes a face lit on its own grid: `own` is its light there, `vanilla` the 16-texel light
+/// read from it. The styles are chosen on its own grid (as ericw-tools chooses them) and both
+/// lightmaps keep those, so one `styles` list describes both. Returns the 16-texel lightmap
+/// carrying the other, and how many styles were dropped for exceeding four.
+pub fn finish_face_on_own_grid(
+    vanilla: &FaceLight,
+    own: &FaceLight,
+    grid: OwnGrid,
+    finish: &Finish,
+) -> (FaceLightmap, usize) {
+    let (own_maps, dropped) = keep_styles(style_maps(own, finish));
+    let mut all = style_maps(vanilla, finish);
+    let maps = own_maps
+        .iter()
+        .filter_map(|o| {
+            let at = all.iter().position(|m| m.style == o.style)?;
+            Some(all.swap_remove(at))
+        })
+        .collect();
+    let mut lightmap = lightmap_of(vanilla, maps, finish);
+    lightmap.own_grid = Some(Box::new(OwnGridLightmap {
+        lightmap: lightmap_of(own, own_maps, finish),
+        grid,
+    }));
+    (lightmap, dropped)
+}
+
+/// Each style of `light` as bytes, in its order.
+fn style_maps(light: &FaceLight, finish: &Finish) -> Vec<StyleMap> {
     let (w, h) = (light.width, light.height);
     let mut maps: Vec<StyleMap> = Vec::with_capacity(light.styles.len());
     for (style, luxels) in &light.styles {
@@ -246,25 +295,35 @@ pub fn finish_face(light: &FaceLight, finish: &Finish) -> (FaceLightmap, usize) 
                 None => vec![NO_DIRECTION; filtered.len()],
             };
         }
-        // A style dark all over is not written, style 0 included: engines draw a face without
-        // a lightmap black (as ericw-tools writes it: style 255, no light offset).
-        if map.energy > 0 {
-            maps.push(map);
-        }
+        maps.push(map);
     }
-    // Brightest first, as ericw-tools orders them; the four brightest are kept.
+    maps
+}
+
+/// The styles a face keeps of `maps`: those lit anywhere, brightest first, four at most, as
+/// ericw-tools keeps them (a style dark all over is not written, style 0 included: a face
+/// with none gets no lightmap, style 255 and no light offset). Also says how many lit styles
+/// were dropped.
+fn keep_styles(maps: Vec<StyleMap>) -> (Vec<StyleMap>, usize) {
+    let mut maps: Vec<StyleMap> = maps.into_iter().filter(|m| m.energy > 0).collect();
     maps.sort_by_key(|m| std::cmp::Reverse(m.energy));
     let dropped = maps.len().saturating_sub(MAX_LIGHTMAPS);
     maps.truncate(MAX_LIGHTMAPS);
+    (maps, dropped)
+}
+
+/// The lightmap of `light`'s face made of `maps`.
+fn lightmap_of(light: &FaceLight, maps: Vec<StyleMap>, finish: &Finish) -> FaceLightmap {
     let mut lightmap = FaceLightmap {
         face: light.face,
-        width: w,
-        height: h,
+        width: light.width,
+        height: light.height,
         styles: Vec::with_capacity(maps.len()),
         grey: Vec::with_capacity(maps.len()),
         rgb: Vec::new(),
         hdr: Vec::new(),
         directions: Vec::new(),
+        own_grid: None,
     };
     for map in maps {
         lightmap.styles.push(map.style);
@@ -279,7 +338,7 @@ pub fn finish_face(light: &FaceLight, finish: &Finish) -> (FaceLightmap, usize) 
             lightmap.directions.push(map.directions);
         }
     }
-    (lightmap, dropped)
+    lightmap
 }
 
 /// What [`write_lighting`] gives back for files beside the BSP.
@@ -294,41 +353,86 @@ pub struct LuxelData {
 }
 
 /// Replaces the lighting data with `maps` (faces not listed, or without a style, get no
-/// lightmap): the grey lump
-/// unless `outputs` leave it out, and the BSPX lumps `outputs` ask for (earlier ones of those
-/// names are removed). Returns every luxel's RGB, HDR and direction data the maps kept, for the
-/// files beside the BSP.
+/// lightmap): the grey lump unless `outputs` leave it out (and with it the 16-texel lightmaps of
+/// faces that have their own), the BSPX lumps `outputs` ask for, and `DECOUPLED_LM` or `LMSHIFT`
+/// and `LMOFFSET` when faces have lightmaps on their own grids (those follow the 16-texel ones in
+/// the same data); earlier lumps of those names are removed. Returns every luxel's RGB, HDR and
+/// direction data the maps kept, for the files beside the BSP.
 pub fn write_lighting(bsp: &mut Bsp, maps: &[FaceLightmap], outputs: &Outputs) -> LuxelData {
+    // A face without a lit style gets no lightmap on either grid.
+    let own_grids: Vec<(usize, &OwnGridLightmap)> = maps
+        .iter()
+        .filter(|m| !m.styles.is_empty())
+        .filter_map(|m| Some((m.face, m.own_grid.as_deref()?)))
+        .collect();
+    let all = || {
+        maps.iter()
+            .chain(own_grids.iter().map(|(_, o)| &o.lightmap))
+    };
     // Sized up front: growing them copied into fresh pages, which the kernel zeroes first.
-    let luxels: usize = maps.iter().flat_map(|m| &m.grey).map(Vec::len).sum();
+    let luxels: usize = all().flat_map(|m| &m.grey).map(Vec::len).sum();
     let kept = |of: fn(&FaceLightmap) -> bool| maps.iter().any(|m| !m.styles.is_empty() && of(m));
-    let mut grey = Vec::with_capacity(luxels);
-    let mut rgb = kept(|m| !m.rgb.is_empty()).then(|| Vec::with_capacity(3 * luxels));
-    let mut hdr = kept(|m| !m.hdr.is_empty()).then(|| Vec::with_capacity(luxels));
-    let mut dirs = kept(|m| !m.directions.is_empty()).then(|| Vec::with_capacity(3 * luxels));
+    let mut data = LuxelWriter {
+        grey: Vec::with_capacity(luxels),
+        rgb: kept(|m| !m.rgb.is_empty()).then(|| Vec::with_capacity(3 * luxels)),
+        hdr: kept(|m| !m.hdr.is_empty()).then(|| Vec::with_capacity(luxels)),
+        dirs: kept(|m| !m.directions.is_empty()).then(|| Vec::with_capacity(3 * luxels)),
+    };
     for f in &mut bsp.faces {
         f.styles = [NO_STYLE; 4];
         f.light_offset = -1;
     }
     for m in maps.iter().filter(|m| !m.styles.is_empty()) {
         let face = &mut bsp.faces[m.face];
-        face.light_offset = grey.len() as i32;
+        // Without the grey lump (`--novanilla`) a face lit on its own grid keeps only that
+        // lightmap, as ericw-tools writes it: the 16-texel one is a fallback for old engines.
+        let fallback = outputs.grey_lump || m.own_grid.is_none();
+        face.light_offset = if fallback { data.push(m) } else { -1 };
         for (slot, &s) in m.styles.iter().enumerate() {
             face.styles[slot] = s;
         }
-        for g in &m.grey {
-            grey.extend_from_slice(g);
-        }
-        if let Some(rgb) = &mut rgb {
-            rgb.extend(m.rgb.iter().flatten().flatten());
-        }
-        if let Some(hdr) = &mut hdr {
-            hdr.extend(m.hdr.iter().flatten());
-        }
-        if let Some(dirs) = &mut dirs {
-            dirs.extend(m.directions.iter().flatten().flatten());
+    }
+    for name in [DECOUPLED_LM, LMSHIFT, LMOFFSET] {
+        bsp.remove_bspx_lump(name);
+    }
+    let mut records: Option<Vec<DecoupledLightmap>> = None;
+    let mut shifts: Option<(Vec<u8>, Vec<i32>)> = None;
+    for (face, own) in own_grids {
+        let m = &own.lightmap;
+        let offset = data.push(m);
+        match own.grid {
+            OwnGrid::Decoupled(world_to_luxel) => {
+                let records = records.get_or_insert_with(|| vec![NO_OWN_GRID; bsp.faces.len()]);
+                records[face] = DecoupledLightmap {
+                    // Wider grids are never made (`LuxelGrid::world_aligned`).
+                    width: u16::try_from(m.width).unwrap_or(u16::MAX),
+                    height: u16::try_from(m.height).unwrap_or(u16::MAX),
+                    offset,
+                    world_to_luxel,
+                };
+            }
+            OwnGrid::Shifted(shift) => {
+                // Faces on Quake's grid keep shift 4 and their 16-texel lightmap.
+                let (shifts, offsets) = shifts.get_or_insert_with(|| {
+                    let offsets = bsp.faces.iter().map(|f| f.light_offset).collect();
+                    (vec![QUAKE_SHIFT; bsp.faces.len()], offsets)
+                });
+                (shifts[face], offsets[face]) = (shift, offset);
+            }
         }
     }
+    if let Some(records) = records {
+        bsp.set_decoupled_lightmaps(&records);
+    }
+    if let Some((shifts, offsets)) = shifts {
+        bsp.set_shifted_lightmaps(&shifts, &offsets);
+    }
+    let LuxelWriter {
+        grey,
+        rgb,
+        hdr,
+        dirs,
+    } = data;
     bsp.lighting = if outputs.grey_lump { grey } else { Vec::new() };
     for name in [RGBLIGHTING, LIGHTINGDIR, LIGHTING_E5BGR9] {
         bsp.remove_bspx_lump(name);
@@ -349,6 +453,45 @@ pub fn write_lighting(bsp: &mut Bsp, maps: &[FaceLightmap], outputs: &Outputs) -
         rgb,
         hdr,
         directions: dirs,
+    }
+}
+
+/// The `LMSHIFT` of Quake's 16-texel grid.
+const QUAKE_SHIFT: u8 = 4;
+
+/// The `DECOUPLED_LM` record of a face without a lightmap.
+const NO_OWN_GRID: DecoupledLightmap = DecoupledLightmap {
+    width: 0,
+    height: 0,
+    offset: -1,
+    world_to_luxel: [[0.0; 4]; 2],
+};
+
+/// The lighting data being written, each form luxel for luxel.
+struct LuxelWriter {
+    grey: Vec<u8>,
+    rgb: Option<Vec<u8>>,
+    hdr: Option<Vec<u32>>,
+    dirs: Option<Vec<u8>>,
+}
+
+impl LuxelWriter {
+    /// Appends `m`'s lightmaps; returns where they start (in luxels).
+    fn push(&mut self, m: &FaceLightmap) -> i32 {
+        let start = self.grey.len() as i32;
+        for g in &m.grey {
+            self.grey.extend_from_slice(g);
+        }
+        if let Some(rgb) = &mut self.rgb {
+            rgb.extend(m.rgb.iter().flatten().flatten());
+        }
+        if let Some(hdr) = &mut self.hdr {
+            hdr.extend(m.hdr.iter().flatten());
+        }
+        if let Some(dirs) = &mut self.dirs {
+            dirs.extend(m.directions.iter().flatten().flatten());
+        }
+        start
     }
 }
 

@@ -210,7 +210,7 @@ pub fn interpolate(face: &FaceGeom, corners: &[DVec3], p: DVec3) -> DVec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use quake_formats::extents::LightmapExtents;
+    use quake_formats::extents::{LightmapExtents, LuxelGrid};
     use quake_formats::geom::Plane;
 
     fn square() -> FaceGeom {
@@ -231,6 +231,11 @@ mod tests {
             origin: DVec3::ZERO,
             extents: LightmapExtents::from_points(&[], &[[0.0; 4]; 2]),
             continuations: Vec::new(),
+            grid: LuxelGrid::vanilla(
+                &LightmapExtents::from_points(&[], &[[0.0; 4]; 2]),
+                &[[0.0; 4]; 2],
+            ),
+            own_grid: None,
         }
     }
 

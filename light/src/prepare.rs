@@ -126,7 +126,7 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
             .copied()
             .unwrap_or(DVec3::ZERO)
     };
-    let faces = face_geometry(bsp, origin_of)?;
+    let faces = face_geometry(bsp, origin_of, |m| map_lights.spacing(m))?;
     let solids = faceless_solids(bsp, &faces, &map_lights.shadow_models, origin_of);
     let scene = TraceScene::build(
         &device,

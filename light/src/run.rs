@@ -15,16 +15,17 @@ use rayon::prelude::*;
 
 use crate::bounce::{self, BounceCounts, Density, Field, Receivers, StyleLuxels};
 use crate::error::LightError;
-use crate::faces::FaceGeom;
+use crate::faces::{FaceGeom, OwnGrid};
 use crate::lightgrid::{GridSources, RawGrid, finish_grid, trace_grid};
 use crate::lighting::{Lighting, RawLighting, Stats};
 use crate::lights::assign_switchable_styles;
 use crate::options::Options;
-use crate::output::{self, Finish, Outputs, finish_face};
+use crate::output::{self, Finish, Outputs, finish_face, finish_face_on_own_grid};
 use crate::phong;
 use crate::prepare::{Prepared, face_rules, prepare};
 use crate::quality::Quality;
 use crate::reach::{LightReaches, light_reaches};
+use crate::resample;
 use crate::samples::{FaceSamples, PlacementCounts, face_samples};
 use crate::trace::{FaceLight, SampleLight, TraceCounts, TraceScratch, TraceSetup, trace_face};
 
@@ -61,7 +62,7 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
         stats.grid_rays = g.rays;
         stats.seconds_lightgrid = (grid_done - bounce_done).as_secs_f64();
     }
-    let faces = finish_faces(traced, &bounced, &prep.faces);
+    let (faces, own_grids) = finish_faces(traced, &bounced, &prep.faces);
     stats.luxels = faces.iter().map(|l| (l.width * l.height) as u64).sum();
     stats.faces_lit = faces.len();
     if plan.bouncing {
@@ -86,6 +87,7 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
     let settings = &prep.lights.settings;
     Ok(RawLighting {
         faces,
+        own_grids,
         entity_text: prep.entity_text.clone(),
         coloured: stats.coloured,
         outputs: Outputs::from_settings(settings),
@@ -319,26 +321,35 @@ impl<'a> Plan<'a> {
 }
 
 /// Each wanted face's light with its bounced light added, floors applied and samples averaged
-/// to luxels.
+/// to luxels: on its 16-texel grid, and beside it the light on its own grid when it was lit
+/// there (the 16-texel light is then read from that).
 fn finish_faces(
     traced: Vec<Traced>,
     bounced: &[StyleLuxels],
-    geometry: &[FaceGeom],
-) -> Vec<FaceLight> {
+    geoms: &[FaceGeom],
+) -> (Vec<FaceLight>, Vec<Option<OwnGridLight>>) {
     // Gathered first, into room for all, so no vector here grows in steps (each step takes
     // fresh pages) and the parallel collect knows its length.
     let mut lit: Vec<SampleLight> = Vec::with_capacity(traced.len());
     lit.extend(traced.into_iter().filter_map(|t| t.light));
     let buried: Vec<bool> = lit.iter().map(SampleLight::buried).collect();
-    let mut faces: Vec<FaceLight> = lit
+    let (mut faces, own): (Vec<FaceLight>, Vec<Option<OwnGridLight>>) = lit
         .into_par_iter()
         .map(|light| {
             let bounce = bounced.get(light.face).map_or(&[][..], |b| &b[..]);
-            light.finish(bounce)
+            let light = light.finish(bounce);
+            let geom = &geoms[light.face];
+            match geom.own_grid {
+                Some(grid) => (
+                    resample::vanilla_from_own(geom, &light),
+                    Some((light, grid)),
+                ),
+                None => (light, None),
+            }
         })
-        .collect();
-    light_buried_faces(&mut faces, &buried, geometry);
-    faces
+        .unzip();
+    light_buried_faces(&mut faces, &buried, geoms);
+    (faces, own)
 }
 
 /// A brush model's face with every sample inside solid (a door's face in the wall it slides
@@ -409,6 +420,9 @@ struct Keep<'a> {
     bouncing: bool,
     samples: bool,
 }
+
+/// A face's light on its own grid, and that grid.
+type OwnGridLight = (FaceLight, OwnGrid);
 
 /// Direct light of `faces` at `quality`.
 fn trace_faces(
@@ -540,11 +554,7 @@ fn gather_faces<'t>(
 }
 
 /// The `_phong` normal at each of `samples`, from its face's corner normals `corners`.
-fn phong_normals(
-    samples: &FaceSamples,
-    geom: &crate::faces::FaceGeom,
-    corners: &[glam::DVec3],
-) -> Vec<[f32; 3]> {
+fn phong_normals(samples: &FaceSamples, geom: &FaceGeom, corners: &[glam::DVec3]) -> Vec<[f32; 3]> {
     samples
         .points
         .iter()
@@ -573,7 +583,13 @@ pub fn finish_lighting(raw: &RawLighting, soft_radius: usize) -> Lighting {
     let (lightmaps, dropped): (Vec<_>, Vec<usize>) = raw
         .faces
         .par_iter()
-        .map(|light| finish_face(light, &finish))
+        .enumerate()
+        .map(
+            |(i, light)| match raw.own_grids.get(i).and_then(Option::as_ref) {
+                Some((own, grid)) => finish_face_on_own_grid(light, own, *grid, &finish),
+                None => finish_face(light, &finish),
+            },
+        )
         .unzip();
     stats.faces_with_dropped_styles += dropped.iter().filter(|&&d| d > 0).count() as u64;
     stats.seconds_total += start.elapsed().as_secs_f64();

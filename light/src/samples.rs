@@ -1,11 +1,12 @@
 //! Sample points: where on (just in front of) each face light is measured.
 //!
-//! One point per luxel (16 texels), or `n x n` per luxel when supersampling,
-//! found by inverting the face's texture projection onto its plane. A point
-//! past the face's edge that lands on a face continuing it (same model, same
-//! plane, a shared edge) stays there, as ericw-tools places it. Another point
-//! that falls outside the face (luxels past its edge, e.g. under a wall
-//! standing on a floor) moves to the nearest point of the face, kept
+//! One point per luxel of the face's grid (Quake's 16 texels, or the face's own:
+//! world-aligned, or another power of two texels), or `n x n` per luxel when
+//! supersampling, found by inverting the grid's projection onto the face's
+//! plane. A point past the face's edge that lands on a face continuing it (same
+//! model, same plane, a shared edge) stays there, as ericw-tools places it.
+//! Another point that falls outside the face (luxels past its edge, e.g. under
+//! a wall standing on a floor) moves to the nearest point of the face, kept
 //! [`FACE_INSET`] inside its edges, so light from the far side of the wall
 //! does not bleed under it and the point stays over the part of the face it
 //! stands for. Points are then pushed [`SURFACE_OFFSET`] units off the
@@ -22,8 +23,7 @@
 use glam::{DMat3, DVec3, Vec3};
 use quake_formats::Bsp;
 use quake_formats::bsp::contents;
-use quake_formats::bsp::limits::LIGHTMAP_SCALE;
-use quake_formats::extents::LightmapExtents;
+use quake_formats::extents::LuxelGrid;
 use quake_formats::geom::DVec3Ext;
 use quake_formats::geom::{Plane, Winding};
 
@@ -145,7 +145,7 @@ impl PlacementCounts {
 }
 
 /// Solves `[s_axis; t_axis; normal] p = rhs` for model-space `p`: the point
-/// on the face plane with texture coordinates (s, t).
+/// on the face plane with grid coordinates (s, t) of a projection `axes`.
 #[derive(Debug, Clone)]
 struct TextureToWorld {
     /// Columns: the world-space steps per unit of s, of t and of plane distance.
@@ -156,9 +156,9 @@ struct TextureToWorld {
 }
 
 impl TextureToWorld {
-    fn new(face: &FaceGeom) -> Option<TextureToWorld> {
-        let axis = |v: [f32; 4]| DVec3::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2]));
-        let (s, t, n) = (axis(face.vecs[0]), axis(face.vecs[1]), face.plane.normal);
+    fn new(face: &FaceGeom, axes: &[[f64; 4]; 2]) -> Option<TextureToWorld> {
+        let axis = |v: [f64; 4]| DVec3::new(v[0], v[1], v[2]);
+        let (s, t, n) = (axis(axes[0]), axis(axes[1]), face.plane.normal);
         let det = s.dot(t.cross(n));
         if det.abs() < 1e-9 {
             return None; // texture axes parallel to the plane
@@ -169,8 +169,8 @@ impl TextureToWorld {
         let c2 = s.cross(t) / det;
         Some(TextureToWorld {
             inverse: DMat3::from_cols(c0, c1, c2),
-            s_offset: f64::from(face.vecs[0][3]),
-            t_offset: f64::from(face.vecs[1][3]),
+            s_offset: axes[0][3],
+            t_offset: axes[1][3],
             plane_dist: face.plane.dist - n.dot(face.origin),
         })
     }
@@ -276,7 +276,7 @@ impl FaceRegion {
     }
 }
 
-/// Where a face's texture coordinates land: the point of the face's plane
+/// Where a face's grid coordinates land: the point of the face's plane
 /// with those (s, t), moved onto the face (inside its inset outline) and
 /// lifted [`SURFACE_OFFSET`] off it. Also knows the square of texture space
 /// each sample stands for, so later passes can spread points over it.
@@ -289,7 +289,7 @@ pub struct SurfaceMap {
     continuations: Vec<FaceRegion>,
     origin: DVec3,
     lift: DVec3,
-    extents: LightmapExtents,
+    grid: LuxelGrid,
     per_axis: usize,
     /// Half-diagonal of one sample's square, in world units.
     footprint_radius: f64,
@@ -297,8 +297,8 @@ pub struct SurfaceMap {
 
 impl SurfaceMap {
     pub fn new(face: &FaceGeom, per_axis: usize) -> SurfaceMap {
-        let to_world = TextureToWorld::new(face);
-        let step = f64::from(LIGHTMAP_SCALE) / per_axis as f64;
+        let to_world = TextureToWorld::new(face, &face.grid.axes);
+        let step = face.grid.scale / per_axis as f64;
         let footprint_radius = to_world.as_ref().map_or(0.0, |m| {
             (m.inverse.x_axis.length() + m.inverse.y_axis.length()) * step / 2.0
         });
@@ -314,7 +314,7 @@ impl SurfaceMap {
                 .collect(),
             origin: face.origin,
             lift: face.plane.normal * SURFACE_OFFSET,
-            extents: face.extents,
+            grid: face.grid,
             per_axis,
             footprint_radius,
         }
@@ -325,7 +325,7 @@ impl SurfaceMap {
         self.region.centre() + self.lift
     }
 
-    /// The lifted point for texture coordinates (s, t), and whether it had
+    /// The lifted point for grid coordinates (s, t), and whether it had
     /// to move onto the face. Without a usable projection: the centre.
     pub fn point(&self, s: f64, t: f64) -> (DVec3, bool) {
         let Some(m) = &self.to_world else {
@@ -356,9 +356,10 @@ impl SurfaceMap {
         )
     }
 
-    /// Texels along each axis one sample stands for.
+    /// Grid units (texels, or luxels of a face's own grid) along each axis one sample stands
+    /// for.
     pub fn sample_step(&self) -> f64 {
-        f64::from(LIGHTMAP_SCALE) / self.per_axis as f64
+        self.grid.scale / self.per_axis as f64
     }
 
     /// Half-diagonal of one sample's square, in world units.
@@ -370,14 +371,14 @@ impl SurfaceMap {
     /// the middle of its square.
     pub fn sample_st(&self, i: usize) -> [f64; 2] {
         let per_luxel = self.per_axis * self.per_axis;
-        let width = self.extents.luxel_size()[0];
+        let width = self.grid.size[0];
         let (luxel, sub) = (i / per_luxel, i % per_luxel);
-        let [s0, t0] = self.extents.luxel_st(luxel % width, luxel / width);
+        let [s0, t0] = self.grid.luxel_st(luxel % width, luxel / width);
         if self.per_axis == 1 {
             return [s0, t0];
         }
         let step = self.sample_step();
-        let first = -f64::from(LIGHTMAP_SCALE) / 2.0 + step / 2.0;
+        let first = -self.grid.scale / 2.0 + step / 2.0;
         [
             s0 + first + step * (sub % self.per_axis) as f64,
             t0 + first + step * (sub / self.per_axis) as f64,
@@ -397,8 +398,25 @@ impl SurfaceMap {
     }
 }
 
-/// Places the sample points of `face`: `per_axis²` per luxel, spread evenly
-/// over the luxel's 16x16-texel square. `bsp` is consulted for world faces to
+/// Where each luxel of `face`'s 16-texel lightmap lies on its own grid (continuous luxel
+/// coordinates, row by row): the point of its plane at the luxel's texture coordinates,
+/// projected onto the grid. Without a usable texture projection: the grid's first luxel.
+pub fn vanilla_on_own_grid(face: &FaceGeom) -> Vec<[f64; 2]> {
+    let [w, h] = face.extents.luxel_size();
+    let vecs = face.vecs.map(|row| row.map(f64::from));
+    let Some(to_world) = TextureToWorld::new(face, &vecs) else {
+        return vec![[0.0; 2]; w * h];
+    };
+    (0..w * h)
+        .map(|i| {
+            let [s, t] = face.extents.luxel_st(i % w, i / w);
+            face.grid.luxel_at(to_world.point(s, t).to_array())
+        })
+        .collect()
+}
+
+/// Places the sample points of `face`: `per_axis²` per luxel of its grid,
+/// spread evenly over the luxel's square. `bsp` is consulted for world faces to
 /// catch points that are still inside solid after the pull-back.
 pub fn face_samples(
     face: &FaceGeom,
@@ -406,7 +424,7 @@ pub fn face_samples(
     scene: &TraceScene,
     bsp: &Bsp,
 ) -> (FaceSamples, PlacementCounts) {
-    let [width, height] = face.extents.luxel_size();
+    let [width, height] = face.grid.size;
     let map = SurfaceMap::new(face, per_axis);
     let centre = map.centre();
     let mut counts = PlacementCounts::default();

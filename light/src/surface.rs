@@ -76,6 +76,11 @@ mod tests {
     /// group, and a template without one not from grouped brushes.
     #[test]
     fn templates_go_only_on_faces_of_their_group() {
+        let extents = quake_formats::extents::LightmapExtents {
+            tex_mins: [0, -64],
+            extents: [64, 64],
+        };
+        let vecs = [[1.0, 0.0, 0.0, 0.0], [0.0, -1.0, 0.0, 0.0]];
         let face = |index: usize, model: usize| FaceGeom {
             index,
             model,
@@ -88,13 +93,12 @@ mod tests {
                 DVec3::new(64.0, 0.0, 0.0),
             ],
             plane: Plane::new(DVec3::Z, 0.0),
-            vecs: [[1.0, 0.0, 0.0, 0.0], [0.0, -1.0, 0.0, 0.0]],
+            vecs,
             origin: DVec3::ZERO,
-            extents: quake_formats::extents::LightmapExtents {
-                tex_mins: [0, -64],
-                extents: [64, 64],
-            },
+            extents,
             continuations: Vec::new(),
+            grid: quake_formats::extents::LuxelGrid::vanilla(&extents, &vecs),
+            own_grid: None,
         };
         let faces = [face(0, 0), face(1, 1), face(2, 2)];
         let template = |group: i64| SurfaceTemplate {

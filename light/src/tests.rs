@@ -10,7 +10,7 @@ use quake_formats::geom::DVec3Ext;
 use quake_formats::miptex::{MipTex, TextureLump};
 
 use crate::dirt::DirtMode;
-use crate::faces::{FaceKind, face_geometry};
+use crate::faces::{FaceKind, Spacing, face_geometry};
 use crate::samples::{FaceRegion, face_samples};
 use crate::scene::TraceScene;
 use crate::{
@@ -225,7 +225,7 @@ fn samples_behind_a_wall_are_pulled_back_and_do_not_bleed() {
     polys.extend(box_faces([100.0, -50.0, -50.0], [140.0, 150.0, 200.0]));
     let ents = "{ \"classname\" \"worldspawn\" }\n{ \"classname\" \"light\" \"origin\" \"180 50 40\" \"delay\" \"3\" }\n";
     let bsp = synthetic_bsp(&polys, ents);
-    let faces = face_geometry(&bsp, |_| DVec3::ZERO).expect("faces");
+    let faces = face_geometry(&bsp, |_| DVec3::ZERO, |_| Spacing::Quake).expect("faces");
     let device = crate::embree::Device::new(1).expect("device");
     let scene = TraceScene::build(&device, &faces, &[], &[], &[]).expect("scene");
     let (samples, counts) = face_samples(&faces[0], 1, &scene, &bsp);
@@ -273,7 +273,7 @@ fn samples_past_an_edge_land_on_the_face_that_continues_it() {
         [0.0, 0.0, 1.0],
     );
     let bsp = synthetic_bsp(&[strip, rest], "{ \"classname\" \"worldspawn\" }");
-    let faces = face_geometry(&bsp, |_| DVec3::ZERO).expect("faces");
+    let faces = face_geometry(&bsp, |_| DVec3::ZERO, |_| Spacing::Quake).expect("faces");
     assert_eq!(faces[0].continuations.len(), 1);
     let device = crate::embree::Device::new(1).expect("device");
     let scene = TraceScene::build(&device, &faces, &[], &[], &[]).expect("scene");
@@ -303,7 +303,7 @@ fn sample_points_invert_an_angled_projection() {
     };
     let mut bsp = synthetic_bsp(&[poly], "{ \"classname\" \"worldspawn\" }");
     bsp.texinfo[0].vecs = [[0.9, 0.1, 0.0, 5.5], [0.05, -0.7, -0.3, -3.25]];
-    let faces = face_geometry(&bsp, |_| DVec3::ZERO).expect("faces");
+    let faces = face_geometry(&bsp, |_| DVec3::ZERO, |_| Spacing::Quake).expect("faces");
     let device = crate::embree::Device::new(1).expect("device");
     let scene = TraceScene::build(&device, &faces, &[], &[], &[]).expect("scene");
     let (samples, _) = face_samples(&faces[0], 1, &scene, &bsp);
@@ -824,7 +824,7 @@ fn overhang_scene(model_keys: &str, sun: bool) -> Bsp {
 /// The grey style-0 value of the luxel of `face` at texture coordinates
 /// `(s, t)` (the luxel whose centre grid point is nearest).
 fn luxel_at(bsp: &Bsp, lighting: &crate::Lighting, face: usize, s: f64, t: f64) -> u8 {
-    let faces = face_geometry(bsp, |_| DVec3::ZERO).expect("faces");
+    let faces = face_geometry(bsp, |_| DVec3::ZERO, |_| Spacing::Quake).expect("faces");
     let mins = faces[face].extents.tex_mins;
     let m = lighting
         .lightmaps
@@ -1958,4 +1958,291 @@ fn lit_liquids_get_lightmaps_and_let_light_through() {
             luxel_at(&open, &without_water, 0, s, 128.0)
         );
     }
+}
+
+/// `options` with faces lit on their own grids, `units` map units per luxel.
+fn on_own_grids(quality: Quality, units: f64) -> Options {
+    let mut o = options(quality);
+    o.overrides.world_units_per_luxel = Some(units);
+    o
+}
+
+/// `lighting` with each face's lightmaps on its own grid in place of its 16-texel ones.
+fn own_grid_lightmaps(lighting: &crate::Lighting) -> crate::Lighting {
+    crate::own_grids(lighting).expect("lightmaps on the faces' own grids")
+}
+
+#[test]
+fn qbsp_reads_the_decoupled_lightmaps_as_written() {
+    let mut bsp = shadow_scene("\"light\" \"300\"");
+    let lighting = compute_lighting(&bsp, &on_own_grids(Quality::Default, 8.0)).expect("light");
+    apply_lighting(&mut bsp, &lighting);
+    let ours = bsp
+        .decoupled_lightmaps()
+        .expect("DECOUPLED_LM reads")
+        .expect("DECOUPLED_LM is written");
+    // The floor, 256 units square: 33 luxels each way at 8 units, and still its 17x17
+    // lightmap of 16 texels at `light_offset`.
+    let floor = &ours[0];
+    assert_eq!((floor.width, floor.height), (33, 33));
+    let vanilla = &lighting.lightmaps[0];
+    assert_eq!((vanilla.face, vanilla.width, vanilla.height), (0, 17, 17));
+    assert!(bsp.faces[0].light_offset >= 0 && floor.offset >= 0);
+    assert_ne!(
+        i64::from(bsp.faces[0].light_offset),
+        i64::from(floor.offset)
+    );
+    let problems: Vec<_> = quake_formats::validate(&bsp)
+        .into_iter()
+        .filter(|p| p.lump == quake_formats::bsp::light_lumps::DECOUPLED_LM)
+        .collect();
+    assert!(problems.is_empty(), "{problems:?}");
+    let bytes = bsp.write().expect("BSP encodes");
+    let theirs = qbsp::BspData::parse(qbsp::BspParseInput {
+        bsp: &bytes,
+        lit: None,
+        settings: qbsp::BspParseSettings::default(),
+    })
+    .expect("qbsp reads the BSP");
+    let records = theirs.bspx.decoupled_lm.expect("qbsp reads DECOUPLED_LM");
+    assert_eq!(records.len(), ours.len());
+    for (face, (t, o)) in records.iter().zip(&ours).enumerate() {
+        assert_eq!([t.size.x, t.size.y], [o.width, o.height], "face {face}");
+        assert_eq!(t.offset.pixels, o.offset, "face {face}");
+        let p = &t.projection;
+        // qbsp shifts the projection half a luxel, as FTE does when it draws the lump.
+        let rows = [
+            [p.u_axis.x, p.u_axis.y, p.u_axis.z, p.u_offset - 0.5],
+            [p.v_axis.x, p.v_axis.y, p.v_axis.z, p.v_offset - 0.5],
+        ];
+        assert_eq!(rows, o.world_to_luxel, "face {face}");
+    }
+    // Every face with light has its own grid (sky-less scene); a face no light reaches has
+    // none on either grid.
+    for (face, r) in bsp.faces.iter().zip(&ours) {
+        assert_eq!(r.offset >= 0, face.styles[0] != 255, "{r:?}");
+    }
+}
+
+#[test]
+fn eight_units_per_luxel_are_no_further_from_the_reference_than_sixteen_texels() {
+    // Linear falloff with the default angle term: smooth gradients plus one hard shadow.
+    let bsp = shadow_scene("\"light\" \"300\"");
+    let run = |o: &Options| compute_lighting(&bsp, o).expect("light");
+    let e16 = compare(
+        &run(&options(Quality::Default)),
+        &run(&options(Quality::Reference)),
+    );
+    let default8 = run(&on_own_grids(Quality::Default, 8.0));
+    let reference8 = run(&on_own_grids(Quality::Reference, 8.0));
+    let e8 = compare(
+        &own_grid_lightmaps(&default8),
+        &own_grid_lightmaps(&reference8),
+    );
+    // The 16-texel lightmap read from the 8-unit one, against the 16-texel reference.
+    let e8_vanilla = compare(&default8, &run(&options(Quality::Reference)));
+    eprintln!("16 texels: {e16:?}\n8 units: {e8:?}\n8 units read at 16 texels: {e8_vanilla:?}");
+    assert!(e8.rmse <= e16.rmse, "{e8:?} against {e16:?}");
+    assert!(e8.max <= e16.max, "{e8:?} against {e16:?}");
+}
+
+/// A floor lit by a light on the far side of a thin wall standing on it: the near floor stays
+/// dark at every spacing, on its own grid and in the 16-texel lightmap read from it.
+#[test]
+fn no_light_reaches_under_a_thin_wall_at_any_spacing() {
+    let bsp = thin_wall_scene();
+    let world_units = [8.0, 4.0].map(|u| on_own_grids(Quality::Default, u));
+    // 8 and 4 texels.
+    let texels = [3, 2].map(|shift| {
+        let mut o = options(Quality::Default);
+        o.overrides.lmshift = Some(shift);
+        o
+    });
+    for options in world_units.iter().chain(&texels) {
+        let lighting = compute_lighting(&bsp, options).expect("light");
+        let own = own_grid_lightmaps(&lighting);
+        for l in [&lighting, &own] {
+            assert!(
+                face_grey(l, 0).iter().all(|&v| v == 0),
+                "{:?}: light bled under the wall: {:?}",
+                options.overrides,
+                face_grey(l, 0)
+            );
+            assert!(
+                face_grey(l, 1).iter().all(|&v| v > 0),
+                "{:?}: far floor lit",
+                options.overrides
+            );
+        }
+    }
+}
+
+/// Two floors either side of a thin wall standing between them, a light over the far one.
+fn thin_wall_scene() -> Bsp {
+    let near = quad(
+        [0.0, 0.0, 0.0],
+        [0.0, 100.0, 0.0],
+        [100.0, 100.0, 0.0],
+        [100.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0],
+    );
+    let far = quad(
+        [104.0, 0.0, 0.0],
+        [104.0, 100.0, 0.0],
+        [200.0, 100.0, 0.0],
+        [200.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0],
+    );
+    let mut polys = vec![near, far];
+    polys.extend(box_faces([100.0, -50.0, -50.0], [104.0, 150.0, 200.0]));
+    let ents = "{ \"classname\" \"worldspawn\" }\n{ \"classname\" \"light\" \"origin\" \"150 50 40\" \"delay\" \"3\" }\n";
+    synthetic_bsp(&polys, ents)
+}
+
+#[test]
+fn own_grids_give_the_same_bytes_on_one_and_two_threads() {
+    let bsp = demo_bsp_with_sun();
+    let world_units = on_own_grids(Quality::Default, 8.0);
+    let mut texels = options(Quality::Default);
+    texels.overrides.lmshift = Some(3);
+    for mut options in [world_units, texels] {
+        let o = &mut options.overrides;
+        (o.dirt, o.bounce, o.sunsamples, o.bspxlit) = (Some(true), Some(1), Some(16), Some(true));
+        let lit_bytes = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("thread pool");
+            let lighting = pool
+                .install(|| compute_lighting(&bsp, &options))
+                .expect("light");
+            let mut lit = bsp.clone();
+            apply_lighting(&mut lit, &lighting);
+            lit.write().expect("BSP encodes")
+        };
+        let one = lit_bytes(1);
+        assert!(
+            one == lit_bytes(2),
+            "{:?}: 1 and 2 threads differ",
+            options.overrides
+        );
+    }
+}
+
+/// A brush entity's own `_world_units_per_luxel` wins over the map's, and counts only while
+/// the map's is set (as in ericw-tools).
+#[test]
+fn brush_entities_set_their_own_spacing() {
+    let world = [floor(64.0)];
+    let model = [quad(
+        [0.0, 0.0, 32.0],
+        [0.0, 64.0, 32.0],
+        [64.0, 64.0, 32.0],
+        [64.0, 0.0, 32.0],
+        [0.0, 0.0, 1.0],
+    )];
+    let ents = "{ \"classname\" \"worldspawn\" }\n{ \"classname\" \"func_wall\" \"model\" \"*1\" \"_world_units_per_luxel\" \"4\" }\n{ \"classname\" \"light\" \"origin\" \"32 32 100\" }\n";
+    let bsp = synthetic_bsp_models(&[&world, &model], ents);
+    let sizes = |o: &Options| {
+        let lighting = compute_lighting(&bsp, o).expect("light");
+        lighting
+            .lightmaps
+            .iter()
+            .map(|m| m.own_grid.as_deref().map(|g| g.lightmap.width))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(
+        sizes(&on_own_grids(Quality::Default, 16.0)),
+        vec![Some(5), Some(17)]
+    );
+    assert_eq!(sizes(&options(Quality::Default)), vec![None, None]);
+}
+
+/// `_lmscale` on a brush entity lights its faces at a fraction of 16 texels, written as
+/// `LMSHIFT` and `LMOFFSET`; the world keeps Quake's grid (shift 4, its 16-texel lightmap).
+#[test]
+fn lmscale_writes_lmshift_and_lmoffset() {
+    let world = [floor(64.0)];
+    let model = [quad(
+        [0.0, 0.0, 32.0],
+        [0.0, 64.0, 32.0],
+        [64.0, 64.0, 32.0],
+        [64.0, 0.0, 32.0],
+        [0.0, 0.0, 1.0],
+    )];
+    let ents = "{ \"classname\" \"worldspawn\" }\n{ \"classname\" \"func_wall\" \"model\" \"*1\" \"_lmscale\" \"0.25\" }\n{ \"classname\" \"light\" \"origin\" \"32 32 100\" }\n";
+    let mut bsp = synthetic_bsp_models(&[&world, &model], ents);
+    let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
+    apply_lighting(&mut bsp, &lighting);
+    assert_eq!(
+        bsp.lightmap_shifts().expect("LMSHIFT reads"),
+        Some(vec![4, 2])
+    );
+    let offsets = bsp
+        .lightmap_offsets()
+        .expect("LMOFFSET reads")
+        .expect("LMOFFSET");
+    assert_eq!(offsets[0], bsp.faces[0].light_offset);
+    let own = lighting.lightmaps[1].own_grid.as_deref().expect("own grid");
+    // 64 units at 4 texels a luxel: 17 across, where Quake's grid has 5.
+    assert_eq!((own.lightmap.width, lighting.lightmaps[1].width), (17, 5));
+    let at = usize::try_from(offsets[1]).expect("an offset");
+    assert_eq!(bsp.lighting[at..at + 17 * 17], own.lightmap.grey[0][..]);
+    assert!(own.lightmap.grey[0].iter().all(|&v| v > 0));
+    let problems: Vec<_> = quake_formats::validate(&bsp)
+        .into_iter()
+        .filter(|p| {
+            use quake_formats::bsp::light_lumps::{LMOFFSET, LMSHIFT};
+            p.lump == LMSHIFT || p.lump == LMOFFSET
+        })
+        .collect();
+    assert!(problems.is_empty(), "{problems:?}");
+    // -lmshift overrides every model's `_lmscale`.
+    let mut o = options(Quality::Default);
+    o.overrides.lmshift = Some(3);
+    let lighting = compute_lighting(&bsp, &o).expect("light");
+    apply_lighting(&mut bsp, &lighting);
+    assert_eq!(
+        bsp.lightmap_shifts().expect("LMSHIFT reads"),
+        Some(vec![3, 3])
+    );
+    // 4, the default, leaves each model its `_lmscale`.
+    o.overrides.lmshift = Some(4);
+    let lighting = compute_lighting(&bsp, &o).expect("light");
+    apply_lighting(&mut bsp, &lighting);
+    let shifts = bsp.lightmap_shifts().expect("LMSHIFT reads");
+    assert_eq!(shifts, Some(vec![4, 2]));
+}
+
+/// With `--novanilla`, faces lit on their own grids keep only those lightmaps (no 16-texel
+/// fallback), as ericw-tools writes them.
+#[test]
+fn novanilla_keeps_only_the_own_grid_lightmaps() {
+    let mut bsp = shadow_scene("\"light\" \"300\"");
+    let mut options = on_own_grids(Quality::Default, 8.0);
+    options.overrides.novanilla = Some(true);
+    let lighting = compute_lighting(&bsp, &options).expect("light");
+    apply_lighting(&mut bsp, &lighting);
+    assert!(bsp.faces.iter().all(|f| f.light_offset == -1));
+    let records = bsp
+        .decoupled_lightmaps()
+        .expect("DECOUPLED_LM reads")
+        .expect("DECOUPLED_LM");
+    let luxels: usize = lighting
+        .lightmaps
+        .iter()
+        .map(|m| {
+            let own = &m.own_grid.as_deref().expect("own grid").lightmap;
+            own.styles.len() * own.width * own.height
+        })
+        .sum();
+    assert_eq!(bsp.luxel_count(), luxels, "no 16-texel lightmaps written");
+    for (face, r) in bsp.faces.iter().zip(&records) {
+        assert_eq!(r.offset >= 0, face.styles[0] != 255, "{r:?}");
+    }
+    let problems: Vec<_> = quake_formats::validate(&bsp)
+        .into_iter()
+        .filter(|p| p.lump == quake_formats::bsp::light_lumps::DECOUPLED_LM)
+        .collect();
+    assert!(problems.is_empty(), "{problems:?}");
 }

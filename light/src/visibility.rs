@@ -185,7 +185,7 @@ mod tests {
     use super::*;
     use crate::faces::FaceGeom;
     use quake_formats::bsp::{Leaf, Model};
-    use quake_formats::extents::LightmapExtents;
+    use quake_formats::extents::{LightmapExtents, LuxelGrid};
     use quake_formats::geom::Plane;
 
     fn face(index: usize, model: usize) -> FaceGeom {
@@ -200,6 +200,11 @@ mod tests {
             origin: DVec3::ZERO,
             extents: LightmapExtents::from_points(&[], &[[0.0; 4]; 2]),
             continuations: Vec::new(),
+            grid: LuxelGrid::vanilla(
+                &LightmapExtents::from_points(&[], &[[0.0; 4]; 2]),
+                &[[0.0; 4]; 2],
+            ),
+            own_grid: None,
         }
     }
 

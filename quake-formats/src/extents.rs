@@ -125,6 +125,30 @@ fn grid_lines(
     (lo, hi)
 }
 
+/// Two unit world axes across the axis `normal` leans on most (the first of equals), ordered so
+/// that the first crossed with the second points the way the normal does along that axis.
+fn world_axes(normal: [f64; 3]) -> [[f64; 3]; 2] {
+    let mut axis = 0;
+    for k in 1..3 {
+        if normal[k].abs() > normal[axis].abs() {
+            axis = k;
+        }
+    }
+    let sign = if normal[axis] > 0.0 { 1.0 } else { -1.0 };
+    let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
+    // The snapped normal crossed with unit axes a and b.
+    let mut first = [0.0; 3];
+    first[b] = sign;
+    let mut second = [0.0; 3];
+    second[a] = -sign;
+    // first × second = sign² · (e_b × -e_a) = e_axis, so the pair faces +axis: swap for -axis.
+    if sign > 0.0 {
+        [first, second]
+    } else {
+        [second, first]
+    }
+}
+
 /// The texture coordinate of `p` along axis row `v`, as QuakeSpasm computes it (products summed in
 /// `f64`, the sum kept as `f32`).
 fn quakespasm_coord(p: &[f32; 3], v: &[f32; 4]) -> f32 {
@@ -189,6 +213,44 @@ impl LuxelGrid {
             mins: [0.0; 2],
             size,
         }
+    }
+
+    /// The world-aligned grid ericw-tools' `-world_units_per_luxel` gives a face (its
+    /// `DECOUPLED_LM` record): one luxel every `units` map units along the two world axes
+    /// across the axis `normal` leans on most, turned so that the first row crossed with the
+    /// second points along the normal, the projection shifted so the face's smallest luxel
+    /// coordinates are whole numbers from 0. Returns the projection (as the lump stores it) and
+    /// the grid; `None` for a spacing that is not a positive number or a grid wider than the
+    /// lump's 16-bit sizes.
+    pub fn world_aligned(
+        points: &[[f32; 3]],
+        normal: [f64; 3],
+        units: f64,
+    ) -> Option<([[f32; 4]; 2], LuxelGrid)> {
+        if !(units.is_finite() && units > 0.0) || points.is_empty() {
+            return None;
+        }
+        let rows = world_axes(normal).map(|axis| axis.map(|c| (c / units) as f32));
+        let mut lo = [f64::INFINITY; 2];
+        let mut hi = [f64::NEG_INFINITY; 2];
+        for p in points {
+            for (axis, row) in rows.iter().enumerate() {
+                let v = (0..3)
+                    .map(|k| f64::from(row[k]) * f64::from(p[k]))
+                    .sum::<f64>();
+                lo[axis] = lo[axis].min(v.floor());
+                hi[axis] = hi[axis].max(v.ceil());
+            }
+        }
+        let size: [usize; 2] = std::array::from_fn(|axis| (hi[axis] - lo[axis]) as usize + 1);
+        if !lo.iter().chain(&hi).all(|v| v.is_finite()) || size.iter().any(|&n| n > 0xffff) {
+            return None;
+        }
+        let world_to_luxel: [[f32; 4]; 2] = std::array::from_fn(|axis| {
+            let r = rows[axis];
+            [r[0], r[1], r[2], -lo[axis] as f32]
+        });
+        Some((world_to_luxel, LuxelGrid::in_luxels(&world_to_luxel, size)))
     }
 
     /// Luxels in one style's lightmap.
@@ -335,6 +397,46 @@ mod tests {
         assert_eq!(fine.mins, [0.0, -8.0]);
         assert_eq!(fine.size, [5, 5]);
         assert_eq!(LuxelGrid::shifted(&pts, &AXIAL, 31), None);
+    }
+
+    #[test]
+    fn world_aligned_grids_face_their_normal_and_hold_the_face() {
+        use glam::DVec3;
+        let floor = [
+            [8.0, 4.0, 0.0],
+            [40.0, 4.0, 0.0],
+            [40.0, 20.0, 0.0],
+            [8.0, 20.0, 0.0],
+        ];
+        for (normal, units) in [([0.0, 0.0, 1.0], 8.0), ([0.0, 0.0, -1.0], 4.0)] {
+            let (rows, grid) = LuxelGrid::world_aligned(&floor, normal, units).expect("grid");
+            let axis = |r: [f32; 4]| DVec3::new(r[0].into(), r[1].into(), r[2].into());
+            let facing = axis(rows[0]).cross(axis(rows[1])).dot(DVec3::from(normal));
+            assert!(facing > 0.0, "{normal:?}");
+            let coords: Vec<[f64; 2]> = floor
+                .iter()
+                .map(|p| grid.luxel_at(p.map(f64::from)))
+                .collect();
+            for axis in 0..2 {
+                let min = coords.iter().map(|c| c[axis]).fold(f64::INFINITY, f64::min);
+                let max = coords
+                    .iter()
+                    .map(|c| c[axis])
+                    .fold(f64::NEG_INFINITY, f64::max);
+                // The grid's first and last luxels are the face's, rounded outward.
+                let last = (grid.size[axis] - 1) as f64;
+                assert!((0.0..1.0).contains(&min), "{normal:?}: {min}");
+                assert!(max <= last && max > last - 1.0, "{normal:?}: {max}");
+            }
+        }
+        let (_, grid) = LuxelGrid::world_aligned(&floor, [0.0, 0.0, 1.0], 8.0).expect("grid");
+        // The first row runs along y (4..20: 0.5..2.5 luxels, 0..3 snapped), the second along -x.
+        assert_eq!(grid.size, [4, 5]);
+        assert_eq!(LuxelGrid::world_aligned(&floor, [0.0, 0.0, 1.0], 0.0), None);
+        assert_eq!(
+            LuxelGrid::world_aligned(&floor, [0.0, 0.0, 1.0], 1e-4),
+            None
+        );
     }
 
     #[test]

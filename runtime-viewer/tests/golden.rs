@@ -35,8 +35,9 @@ fn golden_path() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden/demo.png")
 }
 
-/// The lit BSP and `.lit` RGB (when coloured) of `maps/demo.map`, computed on `threads` threads.
-fn build_demo(threads: usize) -> (Vec<u8>, Option<Vec<u8>>) {
+/// The lit BSP and `.lit` RGB (when coloured) of `maps/demo.map`, computed on `threads` threads
+/// and lit with `options`.
+fn build_demo(threads: usize, options: &light::Options) -> (Vec<u8>, Option<Vec<u8>>) {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -46,8 +47,7 @@ fn build_demo(threads: usize) -> (Vec<u8>, Option<Vec<u8>>) {
         let compiled = compile(&source, &CompileOptions::default()).expect("demo.map compiles");
         assert!(compiled.leak.is_none(), "demo.map leaks");
         let mut bsp = compiled.bsp;
-        let lighting =
-            light::compute_lighting(&bsp, &light::Options::default()).expect("demo.map lights");
+        let lighting = light::compute_lighting(&bsp, options).expect("demo.map lights");
         let lit = light::apply_lighting(&mut bsp, &lighting);
         let bytes = bsp.write().expect("BSP encodes");
         let rgb = lit
@@ -110,11 +110,67 @@ fn variance(frame: &Frame) -> f64 {
     lum.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / lum.len() as f64
 }
 
+/// The mean absolute difference per channel between `frame` and `expected`, and the fraction of
+/// pixels with a channel off by more than [`PIXEL_THRESHOLD`].
+fn differences(frame: &Frame, expected: &[[u8; 3]]) -> (f64, f64) {
+    let (mut total, mut differing) = (0u64, 0usize);
+    for (&c, e) in frame.pixels.iter().zip(expected) {
+        let got = runtime_viewer::textures::unpack(c);
+        let diffs: Vec<u32> = (0..3)
+            .map(|k| (got[k] as u32).abs_diff(e[k] as u32))
+            .collect();
+        total += diffs.iter().sum::<u32>() as u64;
+        differing += usize::from(diffs.iter().any(|&d| d > PIXEL_THRESHOLD));
+    }
+    let pixels = frame.pixels.len();
+    (
+        total as f64 / (3 * pixels) as f64,
+        differing as f64 / pixels as f64,
+    )
+}
+
+/// The demo lit on grids of its own, world-aligned at 8 units (`DECOUPLED_LM`) and every 8
+/// texels (`LMSHIFT`): the viewer draws every lit face from its own grid, and the picture stays
+/// close to the one lit on Quake's grid (the same light, sampled twice as finely).
+#[test]
+fn demo_lit_on_its_own_grids_draws_close_to_quakes_grid() {
+    let (quake_bsp, quake_lit) = build_demo(2, &light::Options::default());
+    let (_, _, quake) = render_demo(&quake_bsp, quake_lit);
+    let quake: Vec<[u8; 3]> = quake
+        .pixels
+        .iter()
+        .map(|&c| runtime_viewer::textures::unpack(c))
+        .collect();
+    let mut world_units = light::Options::default();
+    world_units.overrides.world_units_per_luxel = Some(8.0);
+    let mut texels = light::Options::default();
+    texels.overrides.lmshift = Some(3);
+    for (grid, options) in [("8 units", world_units), ("8 texels", texels)] {
+        let (bsp, lit) = build_demo(2, &options);
+        let (world, _, frame) = render_demo(&bsp, lit);
+        let lit_surfaces = world
+            .surfaces
+            .iter()
+            .flatten()
+            .filter(|s| s.light.is_some());
+        assert!(lit_surfaces.clone().count() > 0);
+        assert!(lit_surfaces.clone().all(|s| s.free_lightmap.is_some()));
+        assert!(frame.faces.iter().all(|&f| f != NO_FACE));
+        let (mean, fraction) = differences(&frame, &quake);
+        println!(
+            "{grid} against Quake's grid: mean {mean:.3}, {:.2}% of pixels off",
+            fraction * 100.0
+        );
+        assert!(mean < MAX_MEAN_DIFF, "{grid}: mean difference {mean:.3}");
+    }
+}
+
 #[test]
 fn demo_map_matches_its_golden_picture() {
     // The pipeline must not depend on how many threads run it.
-    let (bsp, lit) = build_demo(2);
-    let (bsp_single, lit_single) = build_demo(1);
+    let options = light::Options::default();
+    let (bsp, lit) = build_demo(2, &options);
+    let (bsp_single, lit_single) = build_demo(1, &options);
     assert!(
         bsp == bsp_single && lit == lit_single,
         "compiling and lighting on 1 and 2 threads gave different files"
@@ -148,17 +204,7 @@ fn demo_map_matches_its_golden_picture() {
         );
     };
     assert_eq!((width, height), (WIDTH, HEIGHT), "golden picture size");
-    let (mut total, mut differing) = (0u64, 0usize);
-    for (&c, e) in frame.pixels.iter().zip(&expected) {
-        let got = runtime_viewer::textures::unpack(c);
-        let diffs: Vec<u32> = (0..3)
-            .map(|k| (got[k] as u32).abs_diff(e[k] as u32))
-            .collect();
-        total += diffs.iter().sum::<u32>() as u64;
-        differing += usize::from(diffs.iter().any(|&d| d > PIXEL_THRESHOLD));
-    }
-    let mean = total as f64 / (3 * frame.pixels.len()) as f64;
-    let fraction = differing as f64 / frame.pixels.len() as f64;
+    let (mean, fraction) = differences(&frame, &expected);
     println!(
         "against {}: mean difference {mean:.3} per channel, {:.2}% of pixels off by more than {PIXEL_THRESHOLD}",
         golden.display(),

@@ -21,6 +21,7 @@ use quake_formats::entities::Entity;
 
 use crate::dirt::{DirtResponse, DirtSampling};
 use crate::error::LightError;
+use crate::faces::Spacing;
 use crate::settings::{Overrides, SettingWarning, Settings, World};
 pub use point::{Falloff, PointLight, Spot, angle_factor};
 pub use styles::assign_switchable_styles;
@@ -106,6 +107,10 @@ pub struct MapLights {
     pub model_origins: HashMap<usize, DVec3>,
     /// Brush models with a non-zero `_surflight_group`, and that group.
     pub surflight_groups: HashMap<usize, i64>,
+    /// Brush models with their own `_world_units_per_luxel` (used when the map's is set).
+    pub model_units_per_luxel: HashMap<usize, f64>,
+    /// The world (0) and brush models with their own `_lmscale`.
+    pub model_lmscale: HashMap<usize, f64>,
     /// The map-wide settings, resolved (the command line's, else worldspawn's, else the
     /// defaults).
     pub settings: Settings,
@@ -117,6 +122,28 @@ pub struct MapLights {
 }
 
 impl MapLights {
+    /// The spacing model `model`'s faces are lit at, as in ericw-tools: with the map's
+    /// `_world_units_per_luxel` set, world-aligned grids at the model's own
+    /// `_world_units_per_luxel`, else the map's; else `-lmshift` for every model when it is
+    /// not 4; else the model's `_lmscale` (a fraction of 16 texels, as ericw-tools' qbsp reads
+    /// it); else Quake's.
+    pub fn spacing(&self, model: usize) -> Spacing {
+        let map = self.settings.world_units_per_luxel;
+        if map > 0.0 {
+            let own = self.model_units_per_luxel.get(&model).copied();
+            return Spacing::WorldUnits(own.filter(|&u| u > 0.0).unwrap_or(map));
+        }
+        let shift = match self.settings.lmshift {
+            QUAKE_SHIFT => {
+                let scale = self.model_lmscale.get(&model).copied().unwrap_or(0.0);
+                shift_of_texels(16.0 * scale)
+            }
+            // The setting's range holds it to 30.
+            shift => u8::try_from(shift).ok(),
+        };
+        shift.map_or(Spacing::Quake, Spacing::Shift)
+    }
+
     /// True if any light, sun or minlight is darkened by dirt.
     pub fn uses_dirt(&self) -> bool {
         self.points.iter().any(|l| l.dirt.is_some())
@@ -171,6 +198,8 @@ pub fn parse_lights(
         phong: HashMap::new(),
         model_origins: HashMap::new(),
         surflight_groups: HashMap::new(),
+        model_units_per_luxel: HashMap::new(),
+        model_lmscale: HashMap::new(),
         switchable_styles,
         settings,
         warnings,
@@ -178,10 +207,29 @@ pub fn parse_lights(
     if let Some(m) = worldspawn::world_minlight(&out.settings, &global) {
         out.minlight.insert(0, m);
     }
-    models::read_phong(entities, world, &mut out)?;
+    models::read_world_and_model_keys(entities, world, &mut out)?;
     models::read_models(entities, &global, &mut out)?;
     entities::read_lights(entities, &global, &mut out)?;
     Ok(out)
+}
+
+/// `-lmshift`'s default: Quake's 16 texels, leaving each model its `_lmscale`.
+const QUAKE_SHIFT: usize = 4;
+
+/// The `LMSHIFT` of a lightmap spacing of `texels`, as ericw-tools' qbsp takes it: the whole
+/// texels, halved down to a power of two. `None` for less than one texel (unset).
+fn shift_of_texels(texels: f64) -> Option<u8> {
+    // Whole texels as ericw-tools truncates them; past 2^30 no engine's arithmetic holds.
+    let mut whole = texels.min(f64::from(1u32 << 30)) as u32;
+    if whole == 0 {
+        return None;
+    }
+    let mut shift = 0;
+    while whole > 1 {
+        whole /= 2;
+        shift += 1;
+    }
+    Some(shift)
 }
 
 #[cfg(test)]
@@ -346,5 +394,16 @@ mod tests {
         for l in &lights.points[1..] {
             assert!(l.origin.length() <= 8.0 + 1e-9);
         }
+    }
+
+    #[test]
+    fn lmscale_rounds_down_to_a_power_of_two_texels() {
+        assert_eq!(shift_of_texels(16.0), Some(4));
+        assert_eq!(shift_of_texels(8.0), Some(3));
+        assert_eq!(shift_of_texels(12.0), Some(3));
+        assert_eq!(shift_of_texels(16.0 * 0.3), Some(2));
+        assert_eq!(shift_of_texels(1.0), Some(0));
+        assert_eq!(shift_of_texels(0.5), None);
+        assert_eq!(shift_of_texels(-8.0), None);
     }
 }

@@ -1,6 +1,7 @@
 //! Brush models' lighting keys: which cast shadows (`_shadow`, `_shadowself`), which take no
-//! dirt (`_dirt -1`), light (`_lightignore`) or reflect (`_bounce 0`), their own minlight,
-//! their `origin` offset, and `_phong` smoothing (worldspawn's too, as model 0).
+//! dirt (`_dirt -1`), light (`_lightignore`) or reflect (`_bounce 0`), their own minlight and
+//! lightmap spacing (`_world_units_per_luxel`), their `origin` offset, and `_phong` smoothing
+//! and `_lmscale` (worldspawn's too, as model 0).
 
 use quake_formats::bsp::phong;
 use quake_formats::entities::Entity;
@@ -15,12 +16,12 @@ pub fn model_index(e: &Entity) -> Option<usize> {
     e.get("model")?.strip_prefix('*')?.parse().ok()
 }
 
-/// `_phong` and `_phong_angle` of worldspawn (`world`, as model 0) and every brush model, into
-/// `out.phong`.
+/// `_phong` and `_phong_angle` (into `out.phong`) and `_lmscale` (into `out.model_lmscale`) of
+/// worldspawn (`world`, as model 0) and every brush model.
 ///
 /// # Errors
 /// [`LightError::Entity`] for a key that does not read as a number.
-pub fn read_phong(
+pub fn read_world_and_model_keys(
     entities: &[Entity],
     world: Option<usize>,
     out: &mut MapLights,
@@ -33,6 +34,9 @@ pub fn read_phong(
         };
         if let Some(model) = model {
             let k = Keys { entity: e, index };
+            if let Some(scale) = k.float("_lmscale")? {
+                out.model_lmscale.insert(model, scale);
+            }
             let keys = (k.float("_phong")?, k.float("_phong_angle")?);
             if let Some(angle) = phong::angle_from_keys(keys.0, keys.1) {
                 out.phong.insert(model, angle);
@@ -67,6 +71,9 @@ pub fn read_models(
         }
         if let Some(group) = k.float("_surflight_group")?.filter(|g| *g != 0.0) {
             out.surflight_groups.insert(model, group as i64);
+        }
+        if let Some(units) = k.float("_world_units_per_luxel")? {
+            out.model_units_per_luxel.insert(model, units);
         }
         if k.float("_dirt")? == Some(-1.0) {
             out.no_dirt_models.push(model);

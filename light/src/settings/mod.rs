@@ -151,6 +151,18 @@ settings! {
     /// light is not in it).
     lightgrid: bool = false, flag "lightgrid", keys ["_lightgrid"], range Range::Any;
 
+    /// Light each face on a world-aligned grid of its own, one luxel every N map units, written
+    /// as the BSPX `DECOUPLED_LM` lump (FTE, QuakeSpasm-Spiked), with the 16-texel
+    /// lightmaps taken from it for other engines; brush entities may set their own
+    /// `_world_units_per_luxel`. 0: off.
+    world_units_per_luxel: f64 = 0.0, flag "world_units_per_luxel", keys ["_world_units_per_luxel"], range Range::AtLeast(0.0);
+
+    /// Light every face one luxel every 2^N texels, written as the BSPX `LMSHIFT` and
+    /// `LMOFFSET` lumps (FTE, QuakeSpasm-Spiked), with the 16-texel lightmaps taken from those
+    /// for other engines; in place of the `_lmscale` of worldspawn and brush entities (a
+    /// fraction of 16 texels each). 4 (Quake's 16 texels): each model's `_lmscale`.
+    lmshift: usize = 4, flag "lmshift", keys [], range Range::Clamp(0.0, 30.0);
+
     /// Map units between light grid points (one number, or one per axis; at least 1).
     lightgrid_dist: Spacing = Spacing::EVEN_32, flag "lightgrid_dist", keys ["_lightgrid_dist"], range Range::Any;
 }
