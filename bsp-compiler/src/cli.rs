@@ -15,19 +15,9 @@ use std::path::{Path, PathBuf};
 
 quake_formats::ericw_accepted! {
     /// ericw-tools' qbsp options that Slipgate's compiler accepts without acting on them.
-    pub struct EricwOnly {
-        verbose: bool => "the summary is the same either way",
-        noverbose: bool => "the summary is the same either way",
-        quiet: bool => "the summary is the same either way",
-        nopercent: bool => "progress is drawn only when standard error is a terminal",
-        noprogress: bool => "progress is drawn only when standard error is a terminal",
-        nostat: bool => "the summary is the same either way",
-        nocolor: bool => "Slipgate writes no colour codes",
-        log: bool => "Slipgate writes no log file; redirect its output",
-        nolog: bool => "Slipgate writes no log file",
+    pub struct EricwOnly with reporting {
         loghulls: bool => "the summary counts every hull's nodes",
         logbmodels: bool => "the summary is the same either way",
-        lowpriority: bool => "Slipgate runs at the priority it is started with (use nice)",
         oldaxis: bool => "standard-format texture axes are always id's",
         nooldaxis: bool => "standard-format texture axes are always id's; alignment may differ",
         chop: bool => "brushes are never chopped; CSG happens in the BSP tree",

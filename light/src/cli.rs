@@ -15,17 +15,7 @@ use crate::{LightFiles, Lighting, Options, Quality, compare_with_reference, comp
 
 quake_formats::ericw_accepted! {
     /// ericw-tools' light options that Slipgate's light accepts without acting on them.
-    pub struct EricwOnly {
-        verbose: bool => "the summary is the same either way",
-        noverbose: bool => "the summary is the same either way",
-        quiet: bool => "the summary is the same either way",
-        nopercent: bool => "progress is drawn only when standard error is a terminal",
-        noprogress: bool => "progress is drawn only when standard error is a terminal",
-        nostat: bool => "the summary is the same either way",
-        nocolor: bool => "Slipgate writes no colour codes",
-        log: bool => "Slipgate writes no log file; redirect its output",
-        nolog: bool => "Slipgate writes no log file",
-        lowpriority: bool => "Slipgate runs at the priority it is started with (use nice)",
+    pub struct EricwOnly with reporting {
         defaultpaths: bool => "the palette is found as --palette says",
         nodefaultpaths: bool => "the palette is found as --palette says",
         novisapprox: bool => "lights are culled by the PVS, which never cuts light off early",

@@ -25,8 +25,29 @@ impl<T> Given for Option<T> {
 /// `bool` flag or an `Option<String>` value) with the note printed when it is given, saying
 /// what Slipgate does instead. Flatten the struct into the stage's arguments and print
 /// `notes()` when the stage runs.
+///
+/// Every ericw-tools tool takes the same options for how it reports (`-verbose`, `-nopercent`,
+/// `-nolog`, `-lowpriority`...); `struct Name with reporting { ... }` adds them to the list.
 #[macro_export]
 macro_rules! ericw_accepted {
+    ($(#[$meta:meta])* $vis:vis struct $name:ident with reporting { $($rest:tt)* }) => {
+        $crate::ericw_accepted! {
+            $(#[$meta])*
+            $vis struct $name {
+                verbose: bool => "the summary is the same either way",
+                noverbose: bool => "the summary is the same either way",
+                quiet: bool => "the summary is the same either way",
+                nopercent: bool => "progress is drawn only when standard error is a terminal",
+                noprogress: bool => "progress is drawn only when standard error is a terminal",
+                nostat: bool => "the summary is the same either way",
+                nocolor: bool => "Slipgate writes no colour codes",
+                log: bool => "Slipgate writes no log file; redirect its output",
+                nolog: bool => "Slipgate writes no log file",
+                lowpriority: bool => "Slipgate runs at the priority it is started with (use nice)",
+                $($rest)*
+            }
+        }
+    };
     ($(#[$meta:meta])* $vis:vis struct $name:ident {
         $( $field:ident : $ty:ty => $note:literal ),* $(,)?
     }) => {

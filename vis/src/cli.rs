@@ -14,17 +14,7 @@ use std::time::{Duration, Instant};
 
 quake_formats::ericw_accepted! {
     /// ericw-tools' vis options that Slipgate's vis accepts without acting on them.
-    pub struct EricwOnly {
-        verbose: bool => "the summary is the same either way",
-        noverbose: bool => "the summary is the same either way",
-        quiet: bool => "the summary is the same either way",
-        nopercent: bool => "progress is drawn only when standard error is a terminal",
-        noprogress: bool => "progress is drawn only when standard error is a terminal",
-        nostat: bool => "the summary is the same either way",
-        nocolor: bool => "Slipgate writes no colour codes",
-        log: bool => "Slipgate writes no log file; redirect its output",
-        nolog: bool => "Slipgate writes no log file",
-        lowpriority: bool => "Slipgate runs at the priority it is started with (use nice)",
+    pub struct EricwOnly with reporting {
         nostate: bool => "saved state is read only with --resume",
         noautoclean: bool => "state files are removed once vis finishes",
         phsonly: bool => "Quake maps have no PHS",
