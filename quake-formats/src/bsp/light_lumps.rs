@@ -212,27 +212,10 @@ impl Bsp {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bsp::Face;
-
-    fn with_faces(n: usize) -> Bsp {
-        let face = Face {
-            plane: 0,
-            side: 0,
-            first_edge: 0,
-            num_edges: 0,
-            texinfo: 0,
-            styles: [255; 4],
-            light_offset: -1,
-        };
-        Bsp {
-            faces: vec![face; n],
-            ..Bsp::default()
-        }
-    }
 
     #[test]
     fn per_face_lumps_round_trip_through_the_file() {
-        let mut bsp = with_faces(2);
+        let mut bsp = crate::bsp::bsp_with_faces(2);
         assert_eq!(bsp.decoupled_lightmaps().expect("none"), None);
         let records = [
             DecoupledLightmap {
@@ -264,7 +247,7 @@ mod tests {
 
     #[test]
     fn per_face_lumps_of_the_wrong_length_are_errors() {
-        let mut bsp = with_faces(2);
+        let mut bsp = crate::bsp::bsp_with_faces(2);
         bsp.set_bspx_lump(LMSHIFT, vec![4; 3]);
         assert!(bsp.lightmap_shifts().is_err());
         bsp.set_bspx_lump(LMOFFSET, vec![0; 7]);
@@ -278,7 +261,7 @@ mod tests {
 
     #[test]
     fn without_a_grey_lump_the_luxels_are_rgblighting_s() {
-        let mut bsp = with_faces(0);
+        let mut bsp = crate::bsp::bsp_with_faces(0);
         assert_eq!(bsp.luxel_count(), 0);
         bsp.set_bspx_lump(RGBLIGHTING, vec![0; 30]);
         assert_eq!(bsp.luxel_count(), 10);

@@ -533,6 +533,24 @@ fn read_bspx(data: &[u8], lumps_end: usize) -> Result<Option<BspxSegments>> {
     Ok(Some(((dir_ofs, 8 + BSPX_ENTRY_LEN * count), lumps)))
 }
 
+/// A BSP of `n` faces without light or geometry, for tests of per-face lumps.
+#[cfg(test)]
+pub(crate) fn bsp_with_faces(n: usize) -> Bsp {
+    let face = Face {
+        plane: 0,
+        side: 0,
+        first_edge: 0,
+        num_edges: 0,
+        texinfo: 0,
+        styles: [255; 4],
+        light_offset: -1,
+    };
+    Bsp {
+        faces: vec![face; n],
+        ..Bsp::default()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

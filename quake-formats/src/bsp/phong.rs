@@ -105,27 +105,10 @@ impl Bsp {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bsp::Face;
-
-    fn with_faces(n: usize) -> Bsp {
-        let face = Face {
-            plane: 0,
-            side: 0,
-            first_edge: 0,
-            num_edges: 0,
-            texinfo: 0,
-            styles: [255; 4],
-            light_offset: -1,
-        };
-        Bsp {
-            faces: vec![face; n],
-            ..Bsp::default()
-        }
-    }
 
     #[test]
     fn records_round_trip_through_the_file() {
-        let mut bsp = with_faces(3);
+        let mut bsp = crate::bsp::bsp_with_faces(3);
         assert_eq!(bsp.phong_faces().expect("no lump"), None);
         let records = [
             FacePhong::default(),
@@ -149,7 +132,7 @@ mod tests {
 
     #[test]
     fn damaged_lumps_are_errors() {
-        let mut bsp = with_faces(2);
+        let mut bsp = crate::bsp::bsp_with_faces(2);
         let grouped = FacePhong {
             group: 1,
             angle: 89.0,
