@@ -105,7 +105,11 @@ pub(crate) fn gather(
         g.brushes += ent.brushes.len();
         g.bad_brushes += bad;
         skipped_hint += hints;
-        g.add(model, built, options);
+        let hulls = match brush_class {
+            EntityBrushes::Submodel => HullMask::of(ent, index, warnings),
+            _ => HullMask::ALL,
+        };
+        g.add(model, built, hulls, options);
     }
     progress.finish();
     if skipped_hint > 0 {
@@ -118,8 +122,15 @@ pub(crate) fn gather(
 
 impl Gathered {
     /// Add the brushes `built` (each with whether it is a clip brush) to model `model`, grown
-    /// for each clip hull when they collide; clip brushes exist only grown.
-    fn add(&mut self, model: usize, built: Vec<(Brush, bool)>, options: &CompileOptions) {
+    /// for each clip hull when they collide; clip brushes exist only grown. A hull `hulls`
+    /// leaves out gets none of them.
+    fn add(
+        &mut self,
+        model: usize,
+        built: Vec<(Brush, bool)>,
+        hulls: HullMask,
+        options: &CompileOptions,
+    ) {
         if options.brush_list {
             self.listed.resize_with(self.models.len(), Vec::new);
             self.listed[model].extend(
@@ -136,13 +147,14 @@ impl Gathered {
             );
             for (hull, (mins, maxs)) in HULL_BOXES.iter().enumerate() {
                 if options.clip_hulls
+                    && hulls.has(hull + 1)
                     && (collides || clip)
                     && let Some(g) = expand_brush(&brush, &mut self.planes, *mins, *maxs)
                 {
                     m.hull_brushes[hull].push(g);
                 }
             }
-            if clip {
+            if clip || !hulls.has(0) {
                 m.clip_bounds = m.clip_bounds.union(&brush.bounds);
             } else {
                 m.brushes.push(brush);
@@ -209,6 +221,42 @@ impl ModelInput {
             hull_brushes: [Vec::new(), Vec::new()],
             clip_bounds: Bounds::EMPTY,
         }
+    }
+}
+
+/// The hulls a brush entity's brushes are in: its `_hulls` key, bit N for hull N (ericw-tools'
+/// convention; 0 or no key: every hull). Without hull 0 the model has no faces and point traces
+/// pass through it, like a clip brush; without hull 1 or 2 the player or the large monsters walk
+/// through it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct HullMask(u32);
+
+impl HullMask {
+    pub(crate) const ALL: HullMask = HullMask(0b111);
+
+    /// Entity `index`'s mask; a value that is not a whole number warns and leaves every hull.
+    fn of(ent: &MapEntity, index: usize, warnings: &mut Vec<Warning>) -> HullMask {
+        let Some(text) = ent.entity.get("_hulls") else {
+            return HullMask::ALL;
+        };
+        match text.trim().parse::<u32>() {
+            Ok(0) => HullMask::ALL,
+            Ok(bits) => HullMask(bits & HullMask::ALL.0),
+            Err(_) => {
+                warnings.push(Warning::BadKey {
+                    entity: index,
+                    line: ent.line,
+                    key: "_hulls".into(),
+                    value: text.into(),
+                    used: "every hull".into(),
+                });
+                HullMask::ALL
+            }
+        }
+    }
+
+    fn has(self, hull: usize) -> bool {
+        self.0 & (1 << hull) != 0
     }
 }
 

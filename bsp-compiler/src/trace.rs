@@ -122,11 +122,17 @@ impl Hull<'_> {
     }
 }
 
-/// The contents of clip hull `hull` (1 player, 2 shambler; hull 0 is made of nodes, not clip
-/// nodes) of `model` at `p`, which is where the hull box's origin would be.
+/// The contents of hull `hull` of `model` at `p`: hull 0 (points; its nodes and leaves) or a
+/// clip hull (1 player, 2 shambler), where `p` is where the hull box's origin would be.
 pub fn hull_point_contents(bsp: &Bsp, model: usize, hull: usize, p: [f32; 3]) -> i32 {
-    debug_assert!((1..4).contains(&hull));
-    Hull { bsp }.contents(bsp.models[model].head_nodes[hull], p)
+    debug_assert!(hull < 4);
+    let head = bsp.models[model].head_nodes[hull];
+    if hull > 0 {
+        return Hull { bsp }.contents(head, p);
+    }
+    bsp.leaf_from(head, p)
+        .and_then(|leaf| bsp.leafs.get(leaf))
+        .map_or(contents::SOLID, |leaf| leaf.contents)
 }
 
 /// Move the box of clip hull `hull` (1 or 2) of `model` from `start` to `end`: where it stops.

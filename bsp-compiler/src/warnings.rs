@@ -90,6 +90,15 @@ pub enum Warning {
         faces: usize,
         widest: i32,
     },
+    /// An entity key whose value the compiler cannot read: `used` is what it does instead.
+    BadKey {
+        entity: usize,
+        /// The entity's line in the `.map`.
+        line: usize,
+        key: String,
+        value: String,
+        used: String,
+    },
     /// Something the compiler does not do yet; the map compiles without it.
     Unsupported {
         what: String,
@@ -211,6 +220,16 @@ impl std::fmt::Display for Warning {
                  {widest}): WinQuake refuses the map with \"Bad surface extents\" (GLQuake \
                  above {GLQUAKE_MAX_SURFACE_EXTENT}); QuakeSpasm, vkQuake and Ironwail take up \
                  to {QUAKESPASM_MAX_SURFACE_EXTENT}"
+            ),
+            Warning::BadKey {
+                entity,
+                line,
+                key,
+                value,
+                used,
+            } => write!(
+                f,
+                "line {line}: entity {entity}: \"{key}\" \"{value}\" is not a valid value; using {used}"
             ),
             Warning::Unsupported { what } => write!(f, "not supported yet: {what}"),
         }

@@ -153,3 +153,57 @@ fn the_feature_map_compiles_clean() {
     let cap = bsp.leaf_at([-208.0, 0.0, 68.0]).expect("leaf");
     assert_eq!(bsp.leafs[cap].contents, contents::SOLID);
 }
+
+/// A func_wall of one 32-unit box at `centre` with `_hulls` set to `hulls`.
+fn wall_in_hulls(centre: [f64; 3], hulls: &str) -> String {
+    let [x, y, z] = centre;
+    let brush = box_brush(
+        [x - 16.0, y - 16.0, z - 16.0],
+        [x + 16.0, y + 16.0, z + 16.0],
+        "wall",
+    );
+    format!("{{\n\"classname\" \"func_wall\"\n\"_hulls\" \"{hulls}\"\n{brush}}}\n")
+}
+
+#[test]
+fn hulls_key_picks_the_hulls_a_brush_model_is_in() {
+    // As ericw-tools' `q1_hulls` test: 5 (hulls 0 and 2) stops line traces and shamblers but
+    // lets the player through; 6 (hulls 1 and 2) stops the player and shamblers, has no faces
+    // and lets point traces through.
+    let (a, b) = ([-64.0, 0.0, -64.0], [64.0, 0.0, -64.0]);
+    let map = room_map_with(
+        false,
+        "",
+        &(wall_in_hulls(a, "5") + &wall_in_hulls(b, "6") + &wall_in_hulls(b, "0")),
+    );
+    let out = compile_text(&map);
+    assert_eq!(errors(&out.bsp), Vec::<String>::new());
+    let bsp = &out.bsp;
+    let at = |p: [f64; 3]| p.map(|c| c as f32);
+    let in_hulls =
+        |model: usize, p| [0, 1, 2].map(|hull| hull_point_contents(bsp, model, hull, at(p)));
+    let (solid, empty) = (contents::SOLID, contents::EMPTY);
+    assert_eq!(in_hulls(1, a), [solid, empty, solid]);
+    assert_eq!(in_hulls(2, b), [empty, solid, solid]);
+    assert_eq!(in_hulls(3, b), [solid, solid, solid]);
+    let faces = |model: usize| bsp.models[model].num_faces;
+    assert!(faces(1) > 0 && faces(3) > 0);
+    assert_eq!(faces(2), 0);
+}
+
+#[test]
+fn a_hulls_key_that_is_not_a_number_warns_and_keeps_every_hull() {
+    let map = room_map_with(false, "", &wall_in_hulls([0.0; 3], "player"));
+    let out = compile_text(&map);
+    let warned: Vec<String> = out.warnings.iter().map(|w| w.to_string()).collect();
+    assert!(
+        warned
+            .iter()
+            .any(|w| w.contains("\"_hulls\" \"player\"") && w.contains("every hull")),
+        "{warned:?}"
+    );
+    assert_eq!(
+        [0, 1, 2].map(|hull| hull_point_contents(&out.bsp, 1, hull, [0.0; 3])),
+        [contents::SOLID; 3]
+    );
+}
