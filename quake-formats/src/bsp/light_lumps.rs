@@ -191,7 +191,12 @@ impl Bsp {
     }
 
     /// Checks that a per-face lump of `len` bytes holds one `record`-byte record per face.
-    fn per_face_records(&self, lump: &'static str, len: usize, record: usize) -> Result<()> {
+    pub(crate) fn per_face_records(
+        &self,
+        lump: &'static str,
+        len: usize,
+        record: usize,
+    ) -> Result<()> {
         if !len.is_multiple_of(record) {
             return Err(FormatError::LumpSize {
                 lump,

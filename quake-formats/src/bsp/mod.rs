@@ -6,6 +6,7 @@
 //! [`phong`] reads and writes Slipgate's own one, [`light_lumps`] those that carry light (coloured,
 //! directional, HDR, at other spacings) and [`lightgrid`] the light grid.
 
+pub mod face_flags;
 pub mod light_lumps;
 pub mod lightgrid;
 pub mod limits;

@@ -49,20 +49,8 @@ impl Bsp {
         let Some(data) = self.bspx_lump(LUMP_NAME) else {
             return Ok(None);
         };
-        if data.len() % RECORD_LEN != 0 {
-            return Err(FormatError::LumpSize {
-                lump: LUMP_NAME,
-                length: data.len(),
-                record: RECORD_LEN,
-            });
-        }
-        let count = data.len() / RECORD_LEN;
-        if count != self.faces.len() {
-            return Err(FormatError::BadLump {
-                lump: LUMP_NAME,
-                detail: format!("{count} records for {} faces", self.faces.len()),
-            });
-        }
+        self.per_face_records(LUMP_NAME, data.len(), RECORD_LEN)?;
+        let count = self.faces.len();
         let mut r = Reader::new(data, LUMP_NAME);
         (0..count)
             .map(|i| {
