@@ -27,7 +27,7 @@ pub struct FaceFlags {
 
 impl FaceFlags {
     fn byte(self) -> u8 {
-        u8::from(self.no_shadow) * NO_SHADOW | u8::from(self.no_ambient) * NO_AMBIENT
+        (u8::from(self.no_shadow) * NO_SHADOW) | (u8::from(self.no_ambient) * NO_AMBIENT)
     }
 
     fn from_byte(b: u8) -> FaceFlags {
