@@ -529,7 +529,7 @@ fn square_up_projections(
             squared += 1;
             let name = table.names[info.texture as usize].clone();
             let vecs = quake.vecs(&Plane::new(normal, 0.0));
-            f.texinfo = table.intern(&name, vecs, info.phong, info.lit_water);
+            f.texinfo = table.intern(&name, vecs, info.keys());
             let squared_info = FaceTexInfo {
                 vecs,
                 role: info.role,

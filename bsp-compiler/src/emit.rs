@@ -208,6 +208,7 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
     let mut leaf_growth: HashMap<(usize, u32), Bounds> = HashMap::new();
     let mut model_faces: Vec<(u32, u32)> = vec![(0, 0); input.models.len()];
     let mut phong = Vec::with_capacity(pending.len());
+    let mut flags = Vec::with_capacity(pending.len());
     let pieces = pending.iter().zip(polygons).flat_map(|(pf, poly)| {
         let max = max_face_edges(
             input.max_edges,
@@ -256,6 +257,7 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
             light_offset: -1,
         });
         phong.push(input.texinfos[f.texinfo as usize].phong);
+        flags.push(input.texinfos[f.texinfo as usize].flags);
         let range = node_faces
             .entry((pf.model, f.node))
             .or_insert((face_index, 0));
@@ -344,6 +346,7 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
         .collect();
     bsp.texinfo = textures.out_infos;
     bsp.set_phong_faces(&phong);
+    bsp.set_face_flags(&flags);
     bsp.planes = planes.planes;
     bsp.set_entity_text(&write_entities(input.entities));
 

@@ -20,6 +20,7 @@ use crate::tree::{DETAIL_WALL, FENCE, ILLUSIONARY, VISBLOCKER, engine_contents, 
 use crate::warnings::{DroppedFace, Warning};
 use glam::DVec3;
 use quake_formats::bsp::contents;
+use quake_formats::bsp::face_flags::FaceFlags;
 use quake_formats::bsp::phong::{self, FacePhong};
 use quake_formats::geom::{Bounds, POINT_EPSILON};
 use std::collections::HashMap;
@@ -94,10 +95,13 @@ pub(crate) fn gather(
             first_source: g.first_source[index],
             class: brush_class,
             origin: origin.unwrap_or(DVec3::ZERO),
-            phong: merged_phong(ent, index, brush_class),
+            keys: FaceKeys {
+                phong: merged_phong(ent, index, brush_class),
+                lit_water: lit_water(&map.entities, ent, options.lit_water),
+                flags: merged_face_flags(ent, index, brush_class),
+            },
             transwater: options.transwater,
             bmodel_contents: options.bmodel_contents,
-            lit_water: lit_water(&map.entities, ent, options.lit_water),
             table: &mut g.table,
             warnings,
         };
@@ -189,12 +193,32 @@ pub struct MapTexInfo {
     /// Liquid faces get lightmaps ([`crate::CompileOptions::lit_water`], or the entity's
     /// `_litwater`).
     pub lit_water: bool,
+    /// What the world-merged entity's keys say of its faces' shadows and ambient sound.
+    pub flags: FaceFlags,
+}
+
+/// What a face's entity says about the face, beyond its brush: one of these per entity.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct FaceKeys {
+    pub phong: FacePhong,
+    /// Whether its liquids are lit (only liquids' texinfos carry it).
+    pub lit_water: bool,
+    pub flags: FaceFlags,
 }
 
 impl MapTexInfo {
     /// Written with `TEX_SPECIAL`: no lightmap, never subdivided.
     pub fn is_special(&self) -> bool {
         self.role.is_special(self.lit_water)
+    }
+
+    /// The entity keys it was interned with.
+    pub(crate) fn keys(&self) -> FaceKeys {
+        FaceKeys {
+            phong: self.phong,
+            lit_water: self.lit_water,
+            flags: self.flags,
+        }
     }
 }
 
@@ -309,20 +333,18 @@ pub(crate) struct TexInfoTable {
     pub names: Vec<String>,
     name_index: HashMap<String, u32>,
     pub infos: Vec<MapTexInfo>,
-    info_index: HashMap<([u64; 8], u32, u32, bool), u32>,
+    info_index: HashMap<([u64; 8], u32, u32, bool, FaceFlags), u32>,
 }
 
 impl TexInfoTable {
-    /// The texinfo of `name` projected by `vecs` on a face of `phong`'s group, a liquid lit
-    /// or not by `lit_water` (faces of different groups or lighting never share one, so they
-    /// never merge).
-    pub fn intern(
-        &mut self,
-        name: &str,
-        vecs: [[f64; 4]; 2],
-        phong: FacePhong,
-        lit_water: bool,
-    ) -> u32 {
+    /// The texinfo of `name` projected by `vecs` on a face whose entity gives it `keys` (faces
+    /// of different phong groups, lighting or flags never share one, so they never merge).
+    pub(crate) fn intern(&mut self, name: &str, vecs: [[f64; 4]; 2], keys: FaceKeys) -> u32 {
+        let FaceKeys {
+            phong,
+            lit_water,
+            flags,
+        } = keys;
         let key = name.to_ascii_lowercase();
         let texture = match self.name_index.get(&key) {
             Some(&i) => i,
@@ -337,7 +359,7 @@ impl TexInfoTable {
         let role = TextureRole::of(name);
         // Only liquids' texinfos depend on it; others stay shared.
         let lit_water = lit_water && matches!(role, TextureRole::Liquid(_));
-        let key = (bits, texture, phong.group, lit_water);
+        let key = (bits, texture, phong.group, lit_water, flags);
         if let Some(&i) = self.info_index.get(&key) {
             return i;
         }
@@ -348,6 +370,7 @@ impl TexInfoTable {
             role,
             phong,
             lit_water,
+            flags,
         });
         self.info_index.insert(key, i);
         i
@@ -398,6 +421,21 @@ fn lit_water(entities: &[MapEntity], ent: &MapEntity, default: bool) -> bool {
     key(ent)
         .or_else(|| entities.first().and_then(key))
         .unwrap_or(default)
+}
+
+/// What the keys of an entity merged into the world say of its faces' shadows and sound:
+/// `_shadow -1` casts none, and `func_detail_illusionary` casts none unless `_shadow 1` (as in
+/// ericw-tools); `_noambient 1` gives no ambient sound. Brush models' keys are light's to read.
+fn merged_face_flags(ent: &MapEntity, index: usize, class: EntityBrushes) -> FaceFlags {
+    if index == 0 || class == EntityBrushes::Submodel {
+        return FaceFlags::default();
+    }
+    let shadow = ent.entity.get_float("_shadow");
+    FaceFlags {
+        no_shadow: shadow == Some(-1.0)
+            || (class == EntityBrushes::Illusionary && shadow != Some(1.0)),
+        no_ambient: ent.entity.get_float("_noambient").is_some_and(|v| v != 0.0),
+    }
 }
 
 /// The `_phong` group of entity `index` if it is merged into the world (its
@@ -475,14 +513,12 @@ struct EntityContext<'a> {
     first_source: u32,
     class: EntityBrushes,
     origin: DVec3,
-    phong: FacePhong,
+    keys: FaceKeys,
     /// Liquids are seen through (ericw-tools' `-transwater`): they are detail, which vis does
     /// not cut into clusters; otherwise structural in any entity, as vis's boundaries.
     transwater: bool,
     /// A brush model's liquid brushes keep their contents ([`CompileOptions::bmodel_contents`]).
     bmodel_contents: bool,
-    /// Its liquids get lightmaps (`_litwater`, else the worldspawn's, else the option).
-    lit_water: bool,
     table: &'a mut TexInfoTable,
     warnings: &'a mut Vec<Warning>,
 }
@@ -533,9 +569,7 @@ impl EntityContext<'_> {
                     texture: f.texture.clone(),
                 });
             }
-            let texinfo = self
-                .table
-                .intern(&f.texture, vecs, self.phong, self.lit_water);
+            let texinfo = self.table.intern(&f.texture, vecs, self.keys);
             out.roles.push(role);
             out.lines.push(f.line);
             out.planes.push(BrushPlane {
@@ -685,17 +719,36 @@ mod tests {
     }
 
     #[test]
-    fn faces_of_different_phong_groups_get_different_texinfos() {
+    fn faces_of_different_phong_groups_or_flags_get_different_texinfos() {
         let mut table = TexInfoTable::default();
         let vecs = [[1.0, 0.0, 0.0, 0.0], [0.0, -1.0, 0.0, 0.0]];
         let grouped = FacePhong {
             group: 3,
             angle: 89.0,
         };
-        let plain = table.intern("wall", vecs, FacePhong::default(), true);
-        let a = table.intern("wall", vecs, grouped, true);
+        let keys = |phong, flags| FaceKeys {
+            phong,
+            lit_water: true,
+            flags,
+        };
+        let plain = table.intern(
+            "wall",
+            vecs,
+            keys(FacePhong::default(), FaceFlags::default()),
+        );
+        let a = table.intern("wall", vecs, keys(grouped, FaceFlags::default()));
         assert_ne!(plain, a);
-        assert_eq!(table.intern("wall", vecs, grouped, true), a);
+        assert_eq!(
+            table.intern("wall", vecs, keys(grouped, FaceFlags::default())),
+            a
+        );
+        let shadowless = FaceFlags {
+            no_shadow: true,
+            no_ambient: false,
+        };
+        let b = table.intern("wall", vecs, keys(grouped, shadowless));
+        assert_ne!(a, b);
+        assert_eq!(table.infos[b as usize].flags, shadowless);
         assert_eq!(table.infos[a as usize].phong, grouped);
         assert_eq!(table.names.len(), 1, "one texture either way");
     }

@@ -8,6 +8,7 @@ use bsp_compiler::trace::hull_point_contents;
 use common::*;
 use quake_formats::Bsp;
 use quake_formats::bsp::contents;
+use quake_formats::bsp::face_flags::FaceFlags;
 use quake_formats::prt::PortalFile;
 
 /// The centre of the brushes these tests mirror.
@@ -205,5 +206,51 @@ fn a_hulls_key_that_is_not_a_number_warns_and_keeps_every_hull() {
     assert_eq!(
         [0, 1, 2].map(|hull| hull_point_contents(&out.bsp, 1, hull, [0.0; 3])),
         [contents::SOLID; 3]
+    );
+}
+
+#[test]
+fn merged_entities_keys_for_shadow_and_sound_reach_their_faces() {
+    let flagged = |classname: &str, keys: &str| {
+        let brush = box_brush([-32.0, -32.0, -128.0], [32.0, 32.0, -64.0], "*water1");
+        let entity = format!("{{\n\"classname\" \"{classname}\"\n{keys}\n{brush}}}\n");
+        let bsp = compile_text(&room_map_with(false, "", &entity)).bsp;
+        let flags = bsp.face_flags().expect("lump").unwrap_or_default();
+        let water: Vec<_> = (0..bsp.faces.len())
+            .filter(|&f| face_texture(&bsp, f) == "*water1")
+            .map(|f| flags.get(f).copied().unwrap_or_default())
+            .collect();
+        assert!(!water.is_empty());
+        assert!(water.windows(2).all(|w| w[0] == w[1]), "{water:?}");
+        let others = (0..bsp.faces.len()).filter(|&f| face_texture(&bsp, f) != "*water1");
+        assert!(
+            others
+                .into_iter()
+                .all(|f| flags.get(f).is_none_or(|g| *g == FaceFlags::default()))
+        );
+        water[0]
+    };
+    let flags = |no_shadow, no_ambient| FaceFlags {
+        no_shadow,
+        no_ambient,
+    };
+    assert_eq!(flagged("func_detail", ""), flags(false, false));
+    assert_eq!(
+        flagged("func_detail", "\"_noambient\" \"1\""),
+        flags(false, true)
+    );
+    assert_eq!(
+        flagged("func_group", "\"_shadow\" \"-1\""),
+        flags(true, false)
+    );
+    assert_eq!(flagged("func_detail_illusionary", ""), flags(true, false));
+    assert_eq!(
+        flagged("func_detail_illusionary", "\"_shadow\" \"1\""),
+        flags(false, false)
+    );
+    // A brush model's keys are light's to read from its entity.
+    assert_eq!(
+        flagged("func_wall", "\"_shadow\" \"-1\""),
+        flags(false, false)
     );
 }

@@ -32,9 +32,9 @@ pub enum LightError {
     /// Embree failed (starting the device or building the scene).
     #[error(transparent)]
     Embree(#[from] EmbreeError),
-    /// A damaged `SLIPGATE_PHONG` lump (the message names it).
+    /// A damaged `SLIPGATE_PHONG` or `SLIPGATE_FACEFLAGS` lump (the message names it).
     #[error("{0}")]
-    PhongLump(quake_formats::FormatError),
+    SlipgateLump(quake_formats::FormatError),
     /// `--lightgrid_dist` so fine for the map that the grid would hold too many points.
     #[error(
         "the light grid would hold {points} points (at most {most}): give --lightgrid_dist a wider spacing"

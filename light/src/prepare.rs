@@ -103,6 +103,13 @@ fn faceless_solids(
     out
 }
 
+/// Per face, whether it casts no shadow (the compiler's `SLIPGATE_FACEFLAGS`); empty when the
+/// file has no such lump.
+fn shadowless_faces(bsp: &Bsp) -> Result<Vec<bool>, LightError> {
+    let flags = bsp.face_flags().map_err(LightError::SlipgateLump)?;
+    Ok(flags.map_or_else(Vec::new, |f| f.iter().map(|f| f.no_shadow).collect()))
+}
+
 /// Reads faces, entities and visibility and builds the Embree scene.
 ///
 /// # Errors
@@ -128,15 +135,17 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
     };
     let faces = face_geometry(bsp, origin_of, |m| map_lights.spacing(m))?;
     let solids = faceless_solids(bsp, &faces, &map_lights.shadow_models, origin_of);
+    let shadowless = shadowless_faces(bsp)?;
     let scene = TraceScene::build(
         &device,
         &faces,
+        &shadowless,
         &map_lights.shadow_models,
         &map_lights.self_shadow_models,
         &solids,
     )?;
     let vis = Visibility::new(bsp, &faces);
-    let lump = bsp.phong_faces().map_err(LightError::PhongLump)?;
+    let lump = bsp.phong_faces().map_err(LightError::SlipgateLump)?;
     let groups = phong::groups(&faces, &map_lights.phong, lump.as_deref());
     let phong = phong::corner_normals(&faces, &groups);
     let surface = surface::expand_templates(

@@ -75,7 +75,8 @@ impl Mesh {
 }
 
 impl TraceScene {
-    /// Builds the scene from `faces`: world faces, and faces of the brush
+    /// Builds the scene from `faces`: world faces (but those `shadowless` marks, by face
+    /// index; it may be empty), and faces of the brush
     /// models in `shadow_models`, and the polygons `solids` (world space: the
     /// solid of shadow-casting models without faces); each model in
     /// `self_shadow_models` that is not also in `shadow_models` gets a scene of
@@ -86,11 +87,15 @@ impl TraceScene {
     pub fn build(
         device: &Device,
         faces: &[FaceGeom],
+        shadowless: &[bool],
         shadow_models: &[usize],
         self_shadow_models: &[usize],
         solids: &[Vec<DVec3>],
     ) -> Result<TraceScene, LightError> {
-        let casts = |f: &FaceGeom| f.model == 0 || shadow_models.contains(&f.model);
+        let casts = |f: &FaceGeom| {
+            let world = f.model == 0 && !shadowless.get(f.index).copied().unwrap_or(false);
+            world || shadow_models.contains(&f.model)
+        };
         let mut opaque =
             Mesh::with_room_for(faces.iter().filter(|f| f.kind == FaceKind::Lit && casts(f)));
         let mut sky = Mesh::default();

@@ -227,7 +227,7 @@ fn samples_behind_a_wall_are_pulled_back_and_do_not_bleed() {
     let bsp = synthetic_bsp(&polys, ents);
     let faces = face_geometry(&bsp, |_| DVec3::ZERO, |_| Spacing::Quake).expect("faces");
     let device = crate::embree::Device::new(1).expect("device");
-    let scene = TraceScene::build(&device, &faces, &[], &[], &[]).expect("scene");
+    let scene = TraceScene::build(&device, &faces, &[], &[], &[], &[]).expect("scene");
     let (samples, counts) = face_samples(&faces[0], 1, &scene, &bsp);
     assert_eq!(samples.width, 8, "grid 0..112 has 8 luxels across");
     assert!(counts.clamped >= 8, "{counts:?}");
@@ -276,7 +276,7 @@ fn samples_past_an_edge_land_on_the_face_that_continues_it() {
     let faces = face_geometry(&bsp, |_| DVec3::ZERO, |_| Spacing::Quake).expect("faces");
     assert_eq!(faces[0].continuations.len(), 1);
     let device = crate::embree::Device::new(1).expect("device");
-    let scene = TraceScene::build(&device, &faces, &[], &[], &[]).expect("scene");
+    let scene = TraceScene::build(&device, &faces, &[], &[], &[], &[]).expect("scene");
     let (samples, _) = face_samples(&faces[0], 1, &scene, &bsp);
     // Luxel rows at y 0 and 16: the second stands over the other face and stays there.
     assert_eq!(samples.height, 2);
@@ -305,7 +305,7 @@ fn sample_points_invert_an_angled_projection() {
     bsp.texinfo[0].vecs = [[0.9, 0.1, 0.0, 5.5], [0.05, -0.7, -0.3, -3.25]];
     let faces = face_geometry(&bsp, |_| DVec3::ZERO, |_| Spacing::Quake).expect("faces");
     let device = crate::embree::Device::new(1).expect("device");
-    let scene = TraceScene::build(&device, &faces, &[], &[], &[]).expect("scene");
+    let scene = TraceScene::build(&device, &faces, &[], &[], &[], &[]).expect("scene");
     let (samples, _) = face_samples(&faces[0], 1, &scene, &bsp);
     let ext = faces[0].extents;
     assert_eq!([samples.width, samples.height], ext.luxel_size());
@@ -1099,10 +1099,10 @@ fn door_faces_inside_a_wall_are_not_black() {
     assert!(top_grey.iter().all(|&v| v > 10), "{top_grey:?}");
 }
 
-/// The sealed room of [`detail_column_bsp`] with a `func_wall` slab of `skip` brushes (x, y
-/// -32..32, z -64..-48) keyed `wall_keys` above the floor, and a light over it, compiled by the
-/// bsp compiler: the slab's model has no faces.
-fn skip_slab_bsp(wall_keys: &str) -> Bsp {
+/// The sealed room of [`detail_column_bsp`] with a slab (x, y -32..32, z -64..-48) of
+/// `texture` brushes in a `classname` entity keyed `keys` above the floor, and a light over it,
+/// compiled by the bsp compiler.
+fn slab_bsp(classname: &str, keys: &str, texture: &str) -> Bsp {
     let (lo, hi, t) = (-128.0, 128.0, 16.0);
     let (a, b) = (lo - t, hi + t);
     let mut world = String::new();
@@ -1116,15 +1116,15 @@ fn skip_slab_bsp(wall_keys: &str) -> Bsp {
     ] {
         world += &map_box(l, h);
     }
-    let slab = map_box([-32.0, -32.0, -64.0], [32.0, 32.0, -48.0]).replace("wall", "skip");
+    let slab = map_box([-32.0, -32.0, -64.0], [32.0, 32.0, -48.0]).replace("wall", texture);
     let text = format!(
         "{{\n\"classname\" \"worldspawn\"\n{world}}}\n\
-         {{\n\"classname\" \"func_wall\"\n{wall_keys}\n{slab}}}\n\
+         {{\n\"classname\" \"{classname}\"\n{keys}\n{slab}}}\n\
          {{\n\"classname\" \"light\"\n\"origin\" \"0 0 64\"\n}}\n\
          {{\n\"classname\" \"info_player_start\"\n\"origin\" \"-90 -90 -100\"\n}}\n"
     );
     let source = bsp_compiler::MapSource {
-        path: std::path::PathBuf::from("skip_slab.map"),
+        path: std::path::PathBuf::from("slab.map"),
         text,
     };
     let out =
@@ -1133,39 +1133,57 @@ fn skip_slab_bsp(wall_keys: &str) -> Bsp {
     out.bsp
 }
 
+/// The light on the floor's luxel under the middle of [`slab_bsp`]'s slab.
+fn floor_under_slab(bsp: &Bsp) -> u8 {
+    let lighting = compute_lighting(bsp, &options(Quality::Default)).expect("light");
+    let prep = crate::prepare::prepare(bsp, &Options::default()).expect("prepare");
+    let floor = prep
+        .faces
+        .iter()
+        .find(|f| {
+            f.model == 0
+                && f.plane.normal.z > 0.99
+                && f.centroid().x.abs() < 64.0
+                && f.centroid().z < -100.0
+        })
+        .expect("floor");
+    let mins = floor.extents.tex_mins;
+    let m = lighting
+        .lightmaps
+        .iter()
+        .find(|m| m.face == floor.index)
+        .expect("lit floor");
+    // The luxel under the slab's middle (world x, y 0: s = x, t = -y).
+    let (col, row) = (
+        (-f64::from(mins[0]) / 16.0).round() as usize,
+        (-f64::from(mins[1]) / 16.0).round() as usize,
+    );
+    m.style_grey(0).map_or(0, |g| g[row * m.width + col])
+}
+
 /// Regression: a brush model of `skip` brushes with `_shadow 1` cast no shadow (it has no faces
 /// to trace); its solid comes from the BSP's tree, as in ericw-tools.
 #[test]
 fn a_skip_model_with_shadow_casts_its_shadow() {
-    let floor_under_slab = |keys: &str| {
-        let bsp = skip_slab_bsp(keys);
+    let skip_slab = |keys: &str| {
+        let bsp = slab_bsp("func_wall", keys, "skip");
         assert_eq!(bsp.models[1].num_faces, 0, "the slab has no faces");
-        let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
-        let prep = crate::prepare::prepare(&bsp, &Options::default()).expect("prepare");
-        let floor = prep
-            .faces
-            .iter()
-            .find(|f| f.model == 0 && f.plane.normal.z > 0.99 && f.centroid().x.abs() < 64.0)
-            .expect("floor");
-        let mins = floor.extents.tex_mins;
-        let m = lighting
-            .lightmaps
-            .iter()
-            .find(|m| m.face == floor.index)
-            .expect("lit floor");
-        // The luxel under the slab's middle (world x, y 0: s = x, t = -y).
-        let (col, row) = (
-            (-f64::from(mins[0]) / 16.0).round() as usize,
-            (-f64::from(mins[1]) / 16.0).round() as usize,
-        );
-        m.style_grey(0).map_or(0, |g| g[row * m.width + col])
+        floor_under_slab(&bsp)
     };
-    assert!(floor_under_slab("") > 20, "no shadow without _shadow");
-    assert_eq!(
-        floor_under_slab("\"_shadow\" \"1\""),
-        0,
-        "shadow of the skip slab"
-    );
+    assert!(skip_slab("") > 20, "no shadow without _shadow");
+    assert_eq!(skip_slab("\"_shadow\" \"1\""), 0, "shadow of the skip slab");
+}
+
+/// ericw-tools' `_shadow -1` on world brushes, and its shadowless `func_detail_illusionary`:
+/// the compiler marks the faces (`SLIPGATE_FACEFLAGS`) and light leaves them out of the scene.
+#[test]
+fn world_brushes_cast_no_shadow_where_their_entity_says_so() {
+    let slab = |classname: &str, keys: &str| floor_under_slab(&slab_bsp(classname, keys, "wall"));
+    assert_eq!(slab("func_detail", ""), 0, "a detail slab shadows");
+    assert!(slab("func_detail", "\"_shadow\" \"-1\"") > 20);
+    assert!(slab("func_group", "\"_shadow\" \"-1\"") > 20);
+    assert!(slab("func_detail_illusionary", "") > 20);
+    assert_eq!(slab("func_detail_illusionary", "\"_shadow\" \"1\""), 0);
 }
 
 #[test]

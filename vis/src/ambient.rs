@@ -102,42 +102,53 @@ impl Default for Channels {
     }
 }
 
+/// Per face, whether its entity asked for no ambient sound (`_noambient`, carried in the
+/// compiler's `SLIPGATE_FACEFLAGS`); empty when the file has no such lump.
+fn silent_faces(bsp: &Bsp) -> Result<Vec<bool>, VisError> {
+    let flags = bsp.face_flags().map_err(VisError::FaceFlags)?;
+    Ok(flags.map_or_else(Vec::new, |f| f.iter().map(|f| f.no_ambient).collect()))
+}
+
+/// The sound sources of leaf `l`: channel and bounds. A liquid or sky leaf sounds as a whole (its
+/// surfaces may be named unlike liquids and skies, or be missing), and so does every face in it
+/// with a liquid or sky texture; faces `silent` marks make no sound, and a leaf with one is
+/// silent as a whole too (it is inside the silenced brushes).
+fn leaf_sources(bsp: &Bsp, l: usize, silent: &[bool]) -> Vec<(Ambient, Bounds)> {
+    let leaf = &bsp.leafs[l];
+    let first = leaf.first_marksurface as usize;
+    let marks = bsp
+        .marksurfaces
+        .get(first..first + leaf.num_marksurfaces as usize)
+        .unwrap_or(&[]);
+    let is_silent = |f: u32| silent.get(f as usize).copied().unwrap_or(false);
+    let volume = ambient_of_contents(leaf.contents)
+        .filter(|_| !marks.iter().any(|&f| is_silent(f)))
+        .map(|kind| (kind, leaf_bounds(leaf.mins, leaf.maxs)));
+    let faces = marks.iter().filter(|&&f| !is_silent(f)).filter_map(|&f| {
+        let face = bsp.faces.get(f as usize)?;
+        let texinfo = bsp.texinfo.get(face.texinfo as usize)?;
+        let tex = bsp
+            .textures
+            .textures
+            .get(texinfo.miptex as usize)?
+            .as_ref()?;
+        let kind = ambient_of_texture(&tex.name())?;
+        let mut b = Bounds::EMPTY;
+        for v in bsp.face_vertices(face)? {
+            b.add_point(Vec3::from(v).as_dvec3());
+        }
+        Some((kind, b))
+    });
+    volume.into_iter().chain(faces).collect()
+}
+
 /// Fill `Leaf::ambient` of every vis leaf from the sound surfaces of the leaves it sees, on the
 /// channels `channels` has on. Returns how many leaves hear anything.
 pub fn ambient_levels(bsp: &mut Bsp, pvs: &Pvs, channels: Channels) -> Result<usize, VisError> {
     crate::lump::check_portals_match(bsp, pvs.num_leafs())?;
-    // Each vis leaf's sound sources: channel and bounds. A liquid or sky leaf sounds as a
-    // whole (its surfaces may be named unlike liquids and skies, or be missing), and so does
-    // every face of it with a liquid or sky texture.
+    let silent = silent_faces(bsp)?;
     let sources: Vec<Vec<(Ambient, Bounds)>> = (1..=pvs.num_leafs())
-        .map(|l| {
-            let leaf = &bsp.leafs[l];
-            let first = leaf.first_marksurface as usize;
-            let marks = bsp
-                .marksurfaces
-                .get(first..first + leaf.num_marksurfaces as usize)
-                .unwrap_or(&[]);
-            let volume = ambient_of_contents(leaf.contents)
-                .map(|kind| (kind, leaf_bounds(leaf.mins, leaf.maxs)));
-            volume
-                .into_iter()
-                .chain(marks.iter().filter_map(|&f| {
-                    let face = bsp.faces.get(f as usize)?;
-                    let texinfo = bsp.texinfo.get(face.texinfo as usize)?;
-                    let tex = bsp
-                        .textures
-                        .textures
-                        .get(texinfo.miptex as usize)?
-                        .as_ref()?;
-                    let kind = ambient_of_texture(&tex.name())?;
-                    let mut b = Bounds::EMPTY;
-                    for v in bsp.face_vertices(face)? {
-                        b.add_point(Vec3::from(v).as_dvec3());
-                    }
-                    Some((kind, b))
-                }))
-                .collect()
-        })
+        .map(|l| leaf_sources(bsp, l, &silent))
         .collect();
     let levels: Vec<[u8; 4]> = (0..pvs.num_leafs())
         .into_par_iter()

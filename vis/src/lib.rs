@@ -73,6 +73,9 @@ pub enum VisError {
     /// The BSP has no world model.
     #[error("the BSP has no models, so no world model to compute visibility for")]
     NoWorldModel,
+    /// A damaged `SLIPGATE_FACEFLAGS` lump (the message names it).
+    #[error("{0}")]
+    FaceFlags(quake_formats::FormatError),
     /// The world model's vis leaf count is negative or beyond the BSP's leaves.
     #[error("the world model claims {vis_leafs} vis leaves but the BSP has {leafs} leaves")]
     BadVisLeafs {

@@ -1,6 +1,7 @@
 //! Vis on synthetic worlds whose visibility is known.
 
 use quake_formats::Bsp;
+use quake_formats::bsp::face_flags::FaceFlags;
 use quake_formats::bsp::{Face, TexInfo};
 use quake_formats::miptex::MipTex;
 use quake_formats::prt::PortalFile;
@@ -288,6 +289,17 @@ fn leaves_that_see_water_hear_it_fading_with_distance() {
     let hearing = vis::ambient::ambient_levels(&mut bsp, &pvs, quiet).expect("ambient");
     assert_eq!(hearing, 0);
     assert!(bsp.leafs.iter().all(|l| l.ambient == [0; 4]));
+    // A face whose entity has `_noambient 1` (the compiler's face flags) is silent, and so is a
+    // liquid leaf it is in.
+    let silent = FaceFlags {
+        no_ambient: true,
+        ..FaceFlags::default()
+    };
+    bsp.set_face_flags(&[silent]);
+    bsp.leafs[1].contents = quake_formats::bsp::contents::WATER;
+    let hearing =
+        vis::ambient::ambient_levels(&mut bsp, &pvs, vis::ambient::Channels::ALL).expect("ambient");
+    assert_eq!(hearing, 0);
 }
 
 #[test]

@@ -1,5 +1,6 @@
-//! The BSPX lumps that carry light, checked as the core lumps are: sizes against the luxel and
-//! face counts, lightmaps inside the lighting data, projections finite, the light grid whole.
+//! The BSPX lumps that carry light or what light and vis read, checked as the core lumps are:
+//! sizes against the luxel and face counts, lightmaps inside the lighting data, projections
+//! finite, the light grid whole.
 
 use super::surfaces::lightmaps_of;
 use super::{Checker, Rule};
@@ -9,6 +10,7 @@ use crate::bsp::light_lumps::{
 };
 use crate::bsp::lightgrid::LIGHTGRID_OCTREE;
 use crate::bsp::limits::LMSHIFT_MAX_LIGHTMAP_SIZE;
+use crate::bsp::{face_flags, phong};
 use crate::extents::LuxelGrid;
 
 pub(super) fn check(c: &mut Checker) {
@@ -18,6 +20,17 @@ pub(super) fn check(c: &mut Checker) {
     check_decoupled(c);
     if let Err(e) = c.bsp.light_grid() {
         c.report(Rule::LightGrid, LIGHTGRID_OCTREE, 0, e.to_string());
+    }
+    if let Err(e) = c.bsp.phong_faces() {
+        c.report(Rule::BspxFaceRecords, phong::LUMP_NAME, 0, e.to_string());
+    }
+    if let Err(e) = c.bsp.face_flags() {
+        c.report(
+            Rule::BspxFaceRecords,
+            face_flags::LUMP_NAME,
+            0,
+            e.to_string(),
+        );
     }
 }
 
