@@ -27,7 +27,7 @@ pub struct Stats {
     pub surface_lights: usize,
     /// Directions of suns and sky domes.
     pub sun_directions: usize,
-    /// Switchable light names given a style.
+    /// Switchable styles given out (to switchable lights' names and switchable shadows).
     pub switchable_styles: usize,
     /// Some light is coloured (a `.lit` is written).
     pub coloured: bool,

@@ -14,7 +14,7 @@ use crate::lights::{MapLights, PointLight, parse_lights};
 use crate::options::Options;
 use crate::phong;
 use crate::reach::LightReaches;
-use crate::scene::TraceScene;
+use crate::scene::{Casters, TraceScene};
 use crate::surface;
 use crate::trace::{FaceRules, TraceSetup};
 use crate::visibility::Visibility;
@@ -125,7 +125,7 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
     let device = device?;
     let mut entities = parse_entities(&bsp.entity_text())?;
     let map_lights = parse_lights(&mut entities, &options.overrides)?;
-    let entity_text = (!map_lights.switchable_styles.is_empty()).then(|| write_entities(&entities));
+    let entity_text = (map_lights.switchable.count > 0).then(|| write_entities(&entities));
     let origin_of = |m: usize| {
         map_lights
             .model_origins
@@ -136,14 +136,14 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
     let faces = face_geometry(bsp, origin_of, |m| map_lights.spacing(m))?;
     let solids = faceless_solids(bsp, &faces, &map_lights.shadow_models, origin_of);
     let shadowless = shadowless_faces(bsp)?;
-    let scene = TraceScene::build(
-        &device,
-        &faces,
-        &shadowless,
-        &map_lights.shadow_models,
-        &map_lights.self_shadow_models,
-        &solids,
-    )?;
+    let casters = Casters {
+        shadowless: &shadowless,
+        models: &map_lights.shadow_models,
+        self_shadow_models: &map_lights.self_shadow_models,
+        solids: &solids,
+        switchable: &map_lights.switchable.shadows,
+    };
+    let scene = TraceScene::build(&device, &faces, &casters)?;
     let vis = Visibility::new(bsp, &faces);
     let lump = bsp.phong_faces().map_err(LightError::SlipgateLump)?;
     let groups = phong::groups(&faces, &map_lights.phong, lump.as_deref());

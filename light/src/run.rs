@@ -297,7 +297,7 @@ impl<'a> Plan<'a> {
             point_lights: prep.lights.points.len(),
             surface_lights: prep.surface_lights,
             sun_directions: prep.lights.suns.len(),
-            switchable_styles: prep.lights.switchable_styles.len(),
+            switchable_styles: prep.lights.switchable.count,
             coloured: prep.lights.is_coloured(),
             fullbright: self.fullbright,
             shadow_rays: counts.shadow_rays,
@@ -649,9 +649,9 @@ pub fn apply_lighting(bsp: &mut Bsp, lighting: &Lighting) -> LightFiles {
     }
 }
 
-/// `--onlyents`: gives switchable lights their styles in the entity lump (the lump `slipgate bsp
-/// --onlyents` just replaced) without relighting; the lightmaps stay as they are. Returns how many
-/// switchable light names got a style.
+/// `--onlyents`: gives switchable lights and shadows their styles in the entity lump (the lump
+/// `slipgate bsp --onlyents` just replaced) without relighting; the lightmaps stay as they are.
+/// Returns how many switchable styles were given out.
 ///
 /// # Errors
 /// An entity lump that does not parse, a `style` that is not a number, or more switchable lights
@@ -659,8 +659,8 @@ pub fn apply_lighting(bsp: &mut Bsp, lighting: &Lighting) -> LightFiles {
 pub fn update_entities_only(bsp: &mut Bsp) -> Result<usize, LightError> {
     let mut entities = parse_entities(&bsp.entity_text())?;
     let assigned = assign_switchable_styles(&mut entities)?;
-    if !assigned.is_empty() {
+    if assigned.count > 0 {
         bsp.set_entity_text(&write_entities(&entities));
     }
-    Ok(assigned.len())
+    Ok(assigned.count)
 }

@@ -2,7 +2,9 @@
 //! and of shadow-casting brush models, plus the sky faces as a separate
 //! geometry so a ray can tell "reached the sky" from "hit a wall".
 //! A `_shadowself` model gets a small scene of its own, which only rays
-//! from that model's faces are tested against.
+//! from that model's faces are tested against. `_switchableshadow` models
+//! get a scene per style, apart from the rest: what they block of style-0
+//! light goes on their style ([`TraceScene::switchable_blocks16`]).
 
 use std::collections::HashMap;
 
@@ -29,6 +31,8 @@ pub struct TraceScene {
     opaque_faces: Vec<u32>,
     /// Per `_shadowself` model (not already in `scene`): its own faces.
     own: HashMap<usize, Scene>,
+    /// Per switchable shadow style, the faces of its models.
+    switchable: Vec<(u8, Scene)>,
     /// Triangles in the scene (opaque + sky) and the `_shadowself` scenes.
     pub triangles: usize,
 }
@@ -58,6 +62,13 @@ impl Mesh {
         }
     }
 
+    /// A scene of this mesh alone.
+    fn commit(&self, device: &Device) -> Result<Scene, LightError> {
+        let mut builder = SceneBuilder::new(device)?;
+        builder.add_triangle_mesh(&self.vertices, &self.triangles)?;
+        Ok(builder.commit()?)
+    }
+
     fn add(&mut self, face: &FaceGeom) {
         self.add_polygon(&face.points, face.index as u32);
     }
@@ -74,33 +85,69 @@ impl Mesh {
     }
 }
 
+/// What blocks light besides the world's faces.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Casters<'a> {
+    /// Per face index, a world face that casts no shadow (it may be empty).
+    pub shadowless: &'a [bool],
+    /// Brush models whose faces shadow everything (`_shadow 1`).
+    pub models: &'a [usize],
+    /// Brush models whose faces shadow only their own model (`_shadowself 1`).
+    pub self_shadow_models: &'a [usize],
+    /// Polygons in world space: the solid of shadow-casting models without faces.
+    pub solids: &'a [Vec<DVec3>],
+    /// Brush models whose shadow is switchable, and its style.
+    pub switchable: &'a [(usize, u8)],
+}
+
 impl TraceScene {
-    /// Builds the scene from `faces`: world faces (but those `shadowless` marks, by face
-    /// index; it may be empty), and faces of the brush
-    /// models in `shadow_models`, and the polygons `solids` (world space: the
-    /// solid of shadow-casting models without faces); each model in
-    /// `self_shadow_models` that is not also in `shadow_models` gets a scene of
-    /// its own faces. Liquids are left out (they let light through).
+    /// Builds the scene from `faces`: world faces (but those `casters.shadowless` marks), faces
+    /// of `casters.models` and the polygons `casters.solids`; each of
+    /// `casters.self_shadow_models` that is not also in `casters.models` gets a scene of its own
+    /// faces, and each switchable style one of its models' faces. Liquids are left out (they
+    /// let light through).
     ///
     /// # Errors
     /// The Embree error if building fails.
     pub fn build(
         device: &Device,
         faces: &[FaceGeom],
-        shadowless: &[bool],
-        shadow_models: &[usize],
-        self_shadow_models: &[usize],
-        solids: &[Vec<DVec3>],
+        casters: &Casters,
     ) -> Result<TraceScene, LightError> {
+        let Casters {
+            shadowless,
+            models: shadow_models,
+            self_shadow_models,
+            solids,
+            switchable,
+        } = *casters;
         let casts = |f: &FaceGeom| {
             let world = f.model == 0 && !shadowless.get(f.index).copied().unwrap_or(false);
             world || shadow_models.contains(&f.model)
+        };
+        let switchable_style = |f: &FaceGeom| {
+            switchable
+                .iter()
+                .find(|(m, _)| *m == f.model)
+                .map(|&(_, s)| s)
         };
         let mut opaque =
             Mesh::with_room_for(faces.iter().filter(|f| f.kind == FaceKind::Lit && casts(f)));
         let mut sky = Mesh::default();
         let mut own_meshes: HashMap<usize, Mesh> = HashMap::new();
+        let mut switchable_meshes: Vec<(u8, Mesh)> = Vec::new();
         for f in faces {
+            if let (FaceKind::Lit, Some(style)) = (f.kind, switchable_style(f)) {
+                let at = match switchable_meshes.iter().position(|(s, _)| *s == style) {
+                    Some(at) => at,
+                    None => {
+                        switchable_meshes.push((style, Mesh::default()));
+                        switchable_meshes.len() - 1
+                    }
+                };
+                switchable_meshes[at].1.add(f);
+                continue;
+            }
             match f.kind {
                 FaceKind::Lit if casts(f) => opaque.add(f),
                 FaceKind::Lit if self_shadow_models.contains(&f.model) => {
@@ -116,17 +163,18 @@ impl TraceScene {
         let mut triangles = opaque.triangles.len() + sky.triangles.len();
         let mut own = HashMap::with_capacity(own_meshes.len());
         for (model, mesh) in own_meshes {
-            let mut builder = SceneBuilder::new(device)?;
-            builder.add_triangle_mesh(&mesh.vertices, &mesh.triangles)?;
             triangles += mesh.triangles.len();
-            own.insert(model, builder.commit()?);
+            own.insert(model, mesh.commit(device)?);
+        }
+        let mut switchable = Vec::with_capacity(switchable_meshes.len());
+        for (style, mesh) in switchable_meshes {
+            triangles += mesh.triangles.len();
+            switchable.push((style, mesh.commit(device)?));
         }
         let sky_only = if sky.triangles.is_empty() {
             None
         } else {
-            let mut builder = SceneBuilder::new(device)?;
-            builder.add_triangle_mesh(&sky.vertices, &sky.triangles)?;
-            Some(builder.commit()?)
+            Some(sky.commit(device)?)
         };
         let mut builder = SceneBuilder::new(device)?;
         builder.add_triangle_mesh(&opaque.vertices, &opaque.triangles)?;
@@ -137,8 +185,28 @@ impl TraceScene {
             sky_only,
             opaque_faces: opaque.faces,
             own,
+            switchable,
             triangles,
         })
+    }
+
+    /// The styles of switchable shadows, in the order [`TraceScene::switchable_blocks16`]
+    /// numbers them.
+    pub fn switchable_styles(&self) -> impl Iterator<Item = u8> + '_ {
+        self.switchable.iter().map(|(s, _)| *s)
+    }
+
+    /// Lanes of `packet` (each up to its current `tfar`) that the models of switchable shadow
+    /// number `k` block.
+    pub fn switchable_blocks16(&self, packet: &mut RayPacket16, k: usize) -> u16 {
+        self.switchable[k].1.occluded16(packet, true)
+    }
+
+    /// Lanes of `packet` any switchable shadow blocks: sunlight takes them as fixed shadows.
+    fn any_switchable_blocks16(&self, packet: &mut RayPacket16) -> u16 {
+        self.switchable
+            .iter()
+            .fold(0, |m, (_, scene)| m | scene.occluded16(packet, true))
     }
 
     /// Bit `i` set if lane `i` of `packet`, cast from a face of brush model
@@ -174,7 +242,7 @@ impl TraceScene {
         // Just short of the sky hit, so the sky face itself does not block.
         packet.keep_shortened(sky, SKY_HIT_SHORTEN);
         let blocked = self.scene.occluded16(packet, true);
-        sky & !blocked & !self.own_occluded16(packet, model)
+        sky & !blocked & !self.own_occluded16(packet, model) & !self.any_switchable_blocks16(packet)
     }
 
     /// For each active lane of `packet`, cast from a face of `model`, the

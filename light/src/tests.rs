@@ -12,7 +12,7 @@ use quake_formats::miptex::{MipTex, TextureLump};
 use crate::dirt::DirtMode;
 use crate::faces::{FaceKind, Spacing, face_geometry};
 use crate::samples::{FaceRegion, face_samples};
-use crate::scene::TraceScene;
+use crate::scene::{Casters, TraceScene};
 use crate::{
     Options, Quality, apply_lighting, compare, compute_lighting, trace_lighting,
     update_entities_only,
@@ -227,7 +227,7 @@ fn samples_behind_a_wall_are_pulled_back_and_do_not_bleed() {
     let bsp = synthetic_bsp(&polys, ents);
     let faces = face_geometry(&bsp, |_| DVec3::ZERO, |_| Spacing::Quake).expect("faces");
     let device = crate::embree::Device::new(1).expect("device");
-    let scene = TraceScene::build(&device, &faces, &[], &[], &[], &[]).expect("scene");
+    let scene = TraceScene::build(&device, &faces, &Casters::default()).expect("scene");
     let (samples, counts) = face_samples(&faces[0], 1, &scene, &bsp);
     assert_eq!(samples.width, 8, "grid 0..112 has 8 luxels across");
     assert!(counts.clamped >= 8, "{counts:?}");
@@ -276,7 +276,7 @@ fn samples_past_an_edge_land_on_the_face_that_continues_it() {
     let faces = face_geometry(&bsp, |_| DVec3::ZERO, |_| Spacing::Quake).expect("faces");
     assert_eq!(faces[0].continuations.len(), 1);
     let device = crate::embree::Device::new(1).expect("device");
-    let scene = TraceScene::build(&device, &faces, &[], &[], &[], &[]).expect("scene");
+    let scene = TraceScene::build(&device, &faces, &Casters::default()).expect("scene");
     let (samples, _) = face_samples(&faces[0], 1, &scene, &bsp);
     // Luxel rows at y 0 and 16: the second stands over the other face and stays there.
     assert_eq!(samples.height, 2);
@@ -305,7 +305,7 @@ fn sample_points_invert_an_angled_projection() {
     bsp.texinfo[0].vecs = [[0.9, 0.1, 0.0, 5.5], [0.05, -0.7, -0.3, -3.25]];
     let faces = face_geometry(&bsp, |_| DVec3::ZERO, |_| Spacing::Quake).expect("faces");
     let device = crate::embree::Device::new(1).expect("device");
-    let scene = TraceScene::build(&device, &faces, &[], &[], &[], &[]).expect("scene");
+    let scene = TraceScene::build(&device, &faces, &Casters::default()).expect("scene");
     let (samples, _) = face_samples(&faces[0], 1, &scene, &bsp);
     let ext = faces[0].extents;
     assert_eq!([samples.width, samples.height], ext.luxel_size());
@@ -1135,6 +1135,11 @@ fn slab_bsp(classname: &str, keys: &str, texture: &str) -> Bsp {
 
 /// The light on the floor's luxel under the middle of [`slab_bsp`]'s slab.
 fn floor_under_slab(bsp: &Bsp) -> u8 {
+    floor_under_slab_in(bsp, 0)
+}
+
+/// [`floor_under_slab`] in `style` (0 where the floor has no lightmap of that style).
+fn floor_under_slab_in(bsp: &Bsp, style: u8) -> u8 {
     let lighting = compute_lighting(bsp, &options(Quality::Default)).expect("light");
     let prep = crate::prepare::prepare(bsp, &Options::default()).expect("prepare");
     let floor = prep
@@ -1158,7 +1163,7 @@ fn floor_under_slab(bsp: &Bsp) -> u8 {
         (-f64::from(mins[0]) / 16.0).round() as usize,
         (-f64::from(mins[1]) / 16.0).round() as usize,
     );
-    m.style_grey(0).map_or(0, |g| g[row * m.width + col])
+    m.style_grey(style).map_or(0, |g| g[row * m.width + col])
 }
 
 /// Regression: a brush model of `skip` brushes with `_shadow 1` cast no shadow (it has no faces
@@ -1172,6 +1177,26 @@ fn a_skip_model_with_shadow_casts_its_shadow() {
     };
     assert!(skip_slab("") > 20, "no shadow without _shadow");
     assert_eq!(skip_slab("\"_shadow\" \"1\""), 0, "shadow of the skip slab");
+}
+
+/// A `_switchableshadow` model's shadow is on a style of its own: the light it blocks goes
+/// there (the game turns the style off to show the shadow), and its style is written into the
+/// entity as `switchshadstyle`.
+#[test]
+fn a_switchable_shadow_puts_the_light_it_blocks_on_its_own_style() {
+    let open = floor_under_slab(&slab_bsp("func_wall", "\"_shadow\" \"-1\"", "wall"));
+    assert!(open > 20, "no shadow at all: {open}");
+    let bsp = slab_bsp("func_wall", "\"_switchableshadow\" \"1\"", "wall");
+    assert_eq!(floor_under_slab_in(&bsp, 0), 0, "shadow in style 0");
+    let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
+    let text = lighting.entity_text.as_deref().expect("entities rewritten");
+    assert!(text.contains("\"switchshadstyle\" \"32\""), "{text}");
+    assert_eq!(
+        floor_under_slab_in(&bsp, 32),
+        open,
+        "the blocked light, in style 32"
+    );
+    assert_eq!(lighting.stats.switchable_styles, 1);
 }
 
 /// ericw-tools' `_shadow -1` on world brushes, and its shadowless `func_detail_illusionary`:

@@ -48,7 +48,11 @@ pub fn read_lights(
             continue;
         }
         let k = Keys { entity: e, index };
-        if k.float("_nostaticlight")? == Some(1.0) {
+        // A `_switchableshadow_target` light only lends its style to a shadow.
+        let shadow_only = e
+            .get("_switchableshadow_target")
+            .is_some_and(|t| !t.is_empty());
+        if shadow_only || k.float("_nostaticlight")? == Some(1.0) {
             continue;
         }
         read_light(&k, &origins, global, out)?;

@@ -24,7 +24,7 @@ use crate::error::LightError;
 use crate::faces::Spacing;
 use crate::settings::{Overrides, SettingWarning, Settings, World};
 pub use point::{Falloff, PointLight, Spot, angle_factor};
-pub use styles::assign_switchable_styles;
+pub use styles::{SwitchableStyles, assign_switchable_styles};
 pub use sun::SunLight;
 pub use worldspawn::dirt_sampling;
 
@@ -116,9 +116,9 @@ pub struct MapLights {
     pub settings: Settings,
     /// Worldspawn values light did not take as given.
     pub warnings: Vec<SettingWarning>,
-    /// Styles given to switchable lights (`targetname` -> style), also
-    /// written back into the entities as `style`.
-    pub switchable_styles: Vec<(String, u8)>,
+    /// Styles given to switchable lights and switchable shadows, also written back into the
+    /// entities (`style`, `switchshadstyle`).
+    pub switchable: SwitchableStyles,
 }
 
 impl MapLights {
@@ -173,7 +173,7 @@ pub fn parse_lights(
     entities: &mut [Entity],
     overrides: &Overrides,
 ) -> Result<MapLights, LightError> {
-    let switchable_styles = assign_switchable_styles(entities)?;
+    let switchable = assign_switchable_styles(entities)?;
     let world = entities.iter().position(|e| e.classname() == "worldspawn");
     let (settings, warnings) = Settings::resolve(
         world.map(|index| World {
@@ -200,7 +200,7 @@ pub fn parse_lights(
         surflight_groups: HashMap::new(),
         model_units_per_luxel: HashMap::new(),
         model_lmscale: HashMap::new(),
-        switchable_styles,
+        switchable,
         settings,
         warnings,
     };
@@ -209,6 +209,10 @@ pub fn parse_lights(
     }
     models::read_world_and_model_keys(entities, world, &mut out)?;
     models::read_models(entities, &global, &mut out)?;
+    // A switchable shadow is one the game turns on and off, never a fixed one.
+    let switchable = &out.switchable.shadows;
+    out.shadow_models
+        .retain(|m| !switchable.iter().any(|(s, _)| s == m));
     entities::read_lights(entities, &global, &mut out)?;
     Ok(out)
 }
@@ -273,7 +277,7 @@ mod tests {
         assert!(close(spot.cos_outer, 30f64.to_radians().cos()));
         assert_eq!(ents[2].get("style"), Some("32"));
         assert_eq!(ents[4].get("style"), Some("5"));
-        assert_eq!(lights.switchable_styles, vec![("door".to_string(), 32)]);
+        assert_eq!(lights.switchable.names, vec![("door".to_string(), 32)]);
         assert_eq!(lights.templates.len(), 1);
         assert_eq!(lights.templates[0].texture, "sky4");
         assert_eq!(lights.suns.len(), 1, "no penumbra: one direction");

@@ -1,45 +1,149 @@
-//! Switchable lights: a light with a `targetname` and no `style` of its own gets a style from
-//! [`FIRST_SWITCHABLE_STYLE`] up (lights sharing a name share it), written into the entity so
-//! the game's switching code finds it.
+//! Switchable styles, given out from [`FIRST_SWITCHABLE_STYLE`] up and written into the
+//! entities so the game's switching code finds them:
+//!
+//! - a light with a `targetname` and no `style` of its own gets a style (lights sharing a name
+//!   share it), written as its `style`;
+//! - a brush model with `_switchableshadow 1` gets one too (shared with every light and model of
+//!   its `targetname`; a model without one gets a style of its own), written as
+//!   `switchshadstyle`: the light of style 0 its shadow blocks goes on that style, which the game
+//!   turns off to show the shadow and on to hide it;
+//! - a light with `_switchableshadow_target T` lights nothing itself; the brush models named `T`
+//!   cast such a shadow on the light's own style.
 
 use quake_formats::entities::Entity;
 
 use super::keys::Keys;
+use super::models::model_index;
 use crate::error::LightError;
-
-/// Gives each `targetname` of a light entity without an explicit `style` its
-/// own style from 32 up (lights sharing a name share it) and writes it into
-/// the entity, so the game's switching code finds it.
-pub fn assign_switchable_styles(entities: &mut [Entity]) -> Result<Vec<(String, u8)>, LightError> {
-    let mut assigned: Vec<(String, u8)> = Vec::new();
-    for (index, e) in entities.iter_mut().enumerate() {
-        if !e.classname().starts_with("light") {
-            continue;
-        }
-        let Some(name) = e.get("targetname").filter(|n| !n.is_empty()) else {
-            continue;
-        };
-        let k = Keys { entity: e, index };
-        if k.style()? != 0 {
-            continue;
-        }
-        let style = match assigned.iter().find(|(n, _)| n == name) {
-            Some(&(_, s)) => s,
-            None => {
-                let next = FIRST_SWITCHABLE_STYLE as usize + assigned.len();
-                let s = u8::try_from(next)
-                    .ok()
-                    .filter(|s| *s <= quake_formats::bsp::limits::MAX_LIGHTSTYLE)
-                    .ok_or(LightError::TooManySwitchableLights)?;
-                assigned.push((name.to_string(), s));
-                s
-            }
-        };
-        e.set("style", style.to_string());
-    }
-    Ok(assigned)
-}
 
 /// First style given to switchable lights (styles below are the engine's
 /// animated presets).
 pub const FIRST_SWITCHABLE_STYLE: u8 = 32;
+
+/// The styles [`assign_switchable_styles`] gave out.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SwitchableStyles {
+    /// Each `targetname` that got a style, and the style.
+    pub names: Vec<(String, u8)>,
+    /// Brush models whose shadow is switchable, and its style.
+    pub shadows: Vec<(usize, u8)>,
+    /// Styles given out in all (names and models without one).
+    pub count: usize,
+}
+
+impl SwitchableStyles {
+    /// The style of `name` (a new one for a name not seen yet; a new one every time for none).
+    fn style_for(&mut self, name: Option<&str>) -> Result<u8, LightError> {
+        if let Some(&(_, s)) = name.and_then(|n| self.names.iter().find(|(m, _)| m == n)) {
+            return Ok(s);
+        }
+        let s = u8::try_from(FIRST_SWITCHABLE_STYLE as usize + self.count)
+            .ok()
+            .filter(|s| *s <= quake_formats::bsp::limits::MAX_LIGHTSTYLE)
+            .ok_or(LightError::TooManySwitchableLights)?;
+        self.count += 1;
+        if let Some(n) = name {
+            self.names.push((n.to_string(), s));
+        }
+        Ok(s)
+    }
+}
+
+/// Gives out the switchable styles of lights and switchable shadows (see the module comment)
+/// and writes them into the entities.
+///
+/// # Errors
+/// A `style` that does not read, or more switchable names than styles.
+pub fn assign_switchable_styles(entities: &mut [Entity]) -> Result<SwitchableStyles, LightError> {
+    let mut out = SwitchableStyles::default();
+    let is_light = |e: &Entity| e.classname().starts_with("light") && model_index(e).is_none();
+    let name_of = |e: &Entity| {
+        e.get("targetname")
+            .filter(|n| !n.is_empty())
+            .map(String::from)
+    };
+    for (index, e) in entities.iter_mut().enumerate() {
+        let Some(name) = name_of(e).filter(|_| is_light(e)) else {
+            continue;
+        };
+        if (Keys { entity: e, index }).style()? == 0 {
+            let style = out.style_for(Some(&name))?;
+            e.set("style", style.to_string());
+        }
+    }
+    for (index, e) in entities.iter_mut().enumerate() {
+        let Some(model) = model_index(e).filter(|&m| m > 0) else {
+            continue;
+        };
+        if (Keys { entity: e, index }).float("_switchableshadow")? == Some(1.0) {
+            let style = out.style_for(name_of(e).as_deref())?;
+            e.set("switchshadstyle", style.to_string());
+            out.shadows.push((model, style));
+        }
+    }
+    for index in 0..entities.len() {
+        let e = &entities[index];
+        let Some(target) = e.get("_switchableshadow_target").filter(|t| !t.is_empty()) else {
+            continue;
+        };
+        if !is_light(e) {
+            continue;
+        }
+        let target = target.to_string();
+        let style = match (Keys { entity: e, index }).style()? {
+            0 => {
+                let style = out.style_for(None)?;
+                entities[index].set("style", style.to_string());
+                style
+            }
+            s => s,
+        };
+        for e in entities.iter() {
+            let Some(model) = model_index(e).filter(|&m| m > 0) else {
+                continue;
+            };
+            let named = e.get("targetname") == Some(target.as_str());
+            if named && !out.shadows.iter().any(|&(m, _)| m == model) {
+                out.shadows.push((model, style));
+            }
+        }
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use quake_formats::entities::parse_entities;
+
+    #[test]
+    fn shadows_share_their_targetname_s_style_and_targets_take_the_light_s() {
+        let text = r#"
+{ "classname" "worldspawn" }
+{ "classname" "light" "origin" "0 0 0" "targetname" "door" }
+{ "classname" "func_door" "model" "*1" "targetname" "door" "_switchableshadow" "1" }
+{ "classname" "func_wall" "model" "*2" "_switchableshadow" "1" }
+{ "classname" "func_door" "model" "*3" "targetname" "gate" }
+{ "classname" "light" "origin" "0 0 0" "targetname" "gate_light" "_switchableshadow_target" "gate" }
+{ "classname" "light" "origin" "0 0 0" "_switchableshadow_target" "gate" }
+"#;
+        let mut ents = parse_entities(text).expect("parse");
+        let styles = assign_switchable_styles(&mut ents).expect("styles");
+        assert_eq!(ents[1].get("style"), Some("32"));
+        assert_eq!(ents[2].get("switchshadstyle"), Some("32"), "shares door's");
+        assert_eq!(
+            ents[3].get("switchshadstyle"),
+            Some("34"),
+            "unnamed: its own"
+        );
+        assert_eq!(ents[5].get("style"), Some("33"));
+        assert_eq!(
+            ents[6].get("style"),
+            Some("35"),
+            "a target light without a name"
+        );
+        // The gate takes the first target light's style; the second finds it taken.
+        assert_eq!(styles.shadows, vec![(1, 32), (2, 34), (3, 33)]);
+        assert_eq!(styles.count, 4);
+    }
+}

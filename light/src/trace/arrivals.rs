@@ -12,7 +12,12 @@ use crate::lights::{Falloff, PointLight, SunLight};
 /// Where light arriving at a sample comes from.
 #[derive(Debug, Clone, Copy)]
 pub enum Source {
-    Light(usize),
+    /// A point light, and the style its light arrives in (its own, or the switchable shadow's
+    /// that blocks it).
+    Light {
+        light: usize,
+        style: u8,
+    },
     Sun(usize),
 }
 
@@ -71,21 +76,21 @@ impl Arrivals {
         }
     }
 
-    /// [`Arrivals::add`] for light `li` arriving at each `(sample, value)` of `arrived`, in
-    /// one go when nothing waits.
+    /// [`Arrivals::add`] for light `li` arriving in `style` at each `(sample, value)` of
+    /// `arrived`, in one go when nothing waits.
     pub fn add_light(
         &mut self,
-        li: usize,
-        light: &PointLight,
+        (li, light, style): (usize, &PointLight, u8),
         arrived: impl Iterator<Item = (usize, f64)> + Clone,
         (dirty, gated): (bool, bool),
         out: &mut SampleLight,
     ) {
         if self.wait {
+            let source = Source::Light { light: li, style };
             self.waiting
-                .extend(arrived.map(|(i, v)| Arrival::new(Source::Light(li), i, v, dirty, gated)));
+                .extend(arrived.map(|(i, v)| Arrival::new(source, i, v, dirty, gated)));
         } else {
-            deposit(light, arrived, out);
+            deposit(light, style, arrived, out);
         }
     }
 
@@ -103,7 +108,7 @@ impl Arrivals {
         for a in &self.waiting {
             let i = a.sample as usize;
             let response = match a.source {
-                Source::Light(li) => lights[li].dirt,
+                Source::Light { light, .. } => lights[light].dirt,
                 Source::Sun(si) => suns[si].dirt,
             };
             let v = a.value * dirt.get(response).map_or(1.0, |d| f64::from(d[i]));
@@ -125,7 +130,9 @@ fn settle(
 ) {
     let i = a.sample as usize;
     match a.source {
-        Source::Light(li) => deposit(&lights[li], std::iter::once((i, value)), out),
+        Source::Light { light, style } => {
+            deposit(&lights[light], style, std::iter::once((i, value)), out);
+        }
         Source::Sun(si) => {
             let sun = &suns[si];
             let slot = &mut out.sums.get(sun.style)[i];
@@ -139,12 +146,13 @@ fn settle(
     }
 }
 
-/// Adds `value` of `light` (its colour) to sample `i` for each `(i, value)`
+/// Adds `value` of `light` (its colour) in `style` to sample `i` for each `(i, value)`
 /// of `arrived`, or for a local minlight raises the sample's floor to it.
 /// Light of a `_bounce 0` light is also kept in `no_bounce`, so it can be
 /// taken out of what reflects.
 fn deposit(
     light: &PointLight,
+    style: u8,
     arrived: impl Iterator<Item = (usize, f64)> + Clone,
     out: &mut SampleLight,
 ) {
@@ -155,7 +163,7 @@ fn deposit(
     } else {
         &mut out.sums
     };
-    let buffer = target.get(light.style);
+    let buffer = target.get(style);
     for (i, value) in arrived.clone() {
         for (o, c) in buffer[i].iter_mut().zip(color) {
             let add = (value * c) as f32;
@@ -165,13 +173,13 @@ fn deposit(
     if let Some(d) = out.directions.as_mut().filter(|_| !local_min) {
         let weight = brightness(light.color);
         for (i, value) in arrived.clone() {
-            d.add_from_point(light.style, i, light.origin, value * weight);
+            d.add_from_point(style, i, light.origin, value * weight);
         }
     }
     if !local_min && !light.bounce {
         let len = out.sums.len;
         let kept = out.no_bounce.get_or_insert_with(|| StyleBuffers::new(len));
-        let buffer = kept.get(light.style);
+        let buffer = kept.get(style);
         for (i, value) in arrived {
             for (o, c) in buffer[i].iter_mut().zip(color) {
                 *o += (value * c) as f32;

@@ -12,6 +12,7 @@ use quake_formats::geom::DVec3Ext;
 
 use super::footprints::Closeness;
 use super::{FaceTrace, LIGHT_CLEARANCE};
+use crate::lights::Falloff;
 use crate::reach::box_distance_squared;
 
 impl FaceTrace<'_> {
@@ -59,7 +60,7 @@ impl FaceTrace<'_> {
     }
 
     /// Light `li` on every sample: values and shadow rays, then the arrivals of those it
-    /// reaches.
+    /// reaches (in a switchable shadow's style where one blocks it).
     fn point_light(&mut self, li: usize, closeness: Closeness) {
         let (setup, samples, face) = (self.setup, self.samples, self.face);
         let light = &self.lights[li];
@@ -79,11 +80,30 @@ impl FaceTrace<'_> {
             &mut self.packet,
             |p| !setup.scene.occluded16(p, face.model),
         );
+        let switchable = light.style == 0
+            && light.falloff != Falloff::LocalMin
+            && setup.scene.switchable_styles().next().is_some();
+        let n = scratch.value.len();
+        let arrive_in = switchable.then(|| {
+            let mut arrive_in = vec![0; n];
+            self.switchable_shadows(&mut arrive_in);
+            arrive_in
+        });
+        // The light's own style first, then any switchable shadow's.
+        let shadow_styles = arrive_in.as_deref().map_or_else(Vec::new, styles_in);
+        let styles = std::iter::once(light.style)
+            .chain(shadow_styles.into_iter().filter(|&s| s != light.style));
+        let scratch = &mut *self.scratch;
         let (lit, value) = (&scratch.visibility.lit, &scratch.value);
-        let arrived = (0..value.len()).filter(|&i| lit[i]).map(|i| (i, value[i]));
-        scratch
-            .arrivals
-            .add_light(li, light, arrived, (dirty, true), &mut self.out);
+        for style in styles {
+            let arrived = (0..value.len())
+                .filter(|&i| lit[i] && arrive_in.as_ref().is_none_or(|a| a[i] == style))
+                .map(|i| (i, value[i]));
+            scratch
+                .arrivals
+                .add_light((li, light, style), arrived, (dirty, true), &mut self.out);
+        }
+        let scratch = &mut *self.scratch;
         if !scratch.near.is_empty() {
             let footprints = &mut scratch.footprints;
             footprints.clear();
@@ -92,13 +112,52 @@ impl FaceTrace<'_> {
             }
             self.counts.shadow_rays += footprints.trace(setup.scene, face.model, &mut self.packet);
             scratch.arrivals.add_light(
-                li,
-                light,
+                (li, light, light.style),
                 footprints.means(),
                 (dirty, false),
                 &mut self.out,
             );
         }
+    }
+
+    /// For a style-0 light whose shadow rays the world let through (`visibility.lit`): the
+    /// samples a switchable shadow blocks take its style in `arrive_in` instead (the first
+    /// switchable shadow on the ray, in style order).
+    fn switchable_shadows(&mut self, arrive_in: &mut [u8]) {
+        let (setup, samples) = (self.setup, self.samples);
+        let styles: Vec<u8> = setup.scene.switchable_styles().collect();
+        let scratch = &mut *self.scratch;
+        let reached = scratch.visibility.lit.clone();
+        let mut open = reached.clone();
+        let mut values = scratch.value.clone();
+        let shadow_rays = &scratch.to_light;
+        let ray = |i: usize| {
+            let (dir, length) = shadow_rays[i];
+            (samples.points[i], dir, length)
+        };
+        for (k, &style) in styles.iter().enumerate() {
+            for (v, o) in values.iter_mut().zip(&open) {
+                if !o {
+                    *v = 0.0;
+                }
+            }
+            self.counts.shadow_rays += scratch.visibility.trace(
+                samples,
+                setup.adaptive,
+                &values,
+                ray,
+                &mut self.packet,
+                |p| !setup.scene.switchable_blocks16(p, k),
+            );
+            for (i, passes) in scratch.visibility.lit.iter().enumerate() {
+                if open[i] && !passes && values[i] != 0.0 {
+                    open[i] = false;
+                    arrive_in[i] = style;
+                }
+            }
+        }
+        // Whatever the world let through arrives, in style 0 or a shadow's.
+        scratch.visibility.lit = reached;
     }
 
     /// Light `li`'s value at each sample (0 below the gate) and its shadow ray, into the
@@ -134,4 +193,15 @@ impl FaceTrace<'_> {
             }
         }
     }
+}
+
+/// The distinct styles of `arrive_in`, in first-seen order.
+fn styles_in(arrive_in: &[u8]) -> Vec<u8> {
+    let mut styles: Vec<u8> = Vec::new();
+    for &s in arrive_in {
+        if !styles.contains(&s) {
+            styles.push(s);
+        }
+    }
+    styles
 }
