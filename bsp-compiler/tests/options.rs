@@ -679,3 +679,26 @@ fn two_psb_writes_rmqs_bsp2_variant() {
     assert_eq!(bsp.faces, bsp29.faces);
     assert_eq!(bsp.nodes, bsp29.nodes);
 }
+
+/// A 2PSB compile whose node and leaf bounds do not fit its 16-bit integers is written as BSP2,
+/// with a warning naming the bound, as BSP29 gives way past its limits.
+#[test]
+fn two_psb_gives_way_to_bsp2_past_16_bit_bounds() {
+    use quake_formats::BspVersion;
+    let text = format!(
+        "{{\n\"classname\" \"worldspawn\"\n\"wad\" \"none.wad\"\n{}}}\n{{\n\"classname\" \"info_player_start\"\n\"origin\" \"32928 32928 32900\"\n}}\n",
+        room(32_800.0, 33_056.0, 16.0, false)
+    );
+    let options = CompileOptions {
+        version: BspVersion::Bsp2Psb,
+        ..CompileOptions::default()
+    };
+    let out = try_compile_with(&text, &options).expect("compile");
+    assert!(out.leak.is_none(), "{:?}", out.warnings);
+    assert_eq!(out.bsp.version, BspVersion::Bsp2);
+    let warned = out
+        .warnings
+        .iter()
+        .any(|w| w.to_string().contains("2PSB limit exceeded"));
+    assert!(warned, "{:?}", out.warnings);
+}
