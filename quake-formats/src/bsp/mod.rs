@@ -208,8 +208,8 @@ impl Bsp {
         }
     }
 
-    /// Parse a BSP29, BSP2 or 2PSB file. Structural damage (truncation, lumps outside the file, sizes
-    /// that are not whole records) is an error; bad indices are left to [`validate`].
+    /// Parse a BSP29, BSP2 or 2PSB file. Structural damage (truncation, lumps outside the file,
+    /// sizes that are not whole records) is an error; bad indices are left to [`validate`].
     pub fn read(data: &[u8]) -> Result<Bsp> {
         let mut r = Reader::new(data, "BSP header");
         let magic = r.array::<4>()?;
