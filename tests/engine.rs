@@ -78,6 +78,12 @@ fn project_maps() -> &'static MapSet {
             bsp_options: &["--bsp2"],
             ..Case::new(repo().join("maps/demo.map"), wads())
         });
+        // RMQ's 2PSB (32-bit indices, 16-bit bounds), which both engines read; a small map.
+        cases.push(Case {
+            name: "sealed_2psb".to_string(),
+            bsp_options: &["--2psb"],
+            ..Case::new(repo().join("maps/leak/sealed.map"), wads())
+        });
         // LibreQuake's release light settings, with coloured bounce: a `.lit` the engines load.
         cases.push(Case {
             name: "demo_bounce".to_string(),

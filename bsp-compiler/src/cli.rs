@@ -1,4 +1,4 @@
-//! The command line: `slipgate-bsp [--bsp2] [--wad-dir DIR]... IN.map [OUT.bsp]`.
+//! The command line: `slipgate-bsp [--bsp2 | --2psb] [--wad-dir DIR]... IN.map [OUT.bsp]`.
 
 use crate::convert::{MapFormat, convert_map};
 use crate::map::parse_map;
@@ -8,9 +8,9 @@ use crate::outside::FillType;
 use crate::tree::MID_SPLIT_SIZE;
 use crate::{CompileOptions, MapSource, SplitHeuristic, compile};
 use anyhow::{Context, Result};
-use quake_formats::Bsp;
 use quake_formats::fsutil::write_atomic;
 use quake_formats::pts::write_pointfile;
+use quake_formats::{Bsp, BspVersion};
 use std::path::{Path, PathBuf};
 
 quake_formats::ericw_accepted! {
@@ -64,6 +64,10 @@ pub struct Args {
     /// Write BSP2 (BSP29 is used unless a limit is exceeded)
     #[arg(long)]
     pub bsp2: bool,
+    /// Write 2PSB, RMQ's first BSP2: 32-bit indices, but 16-bit integer node and leaf bounds
+    /// (BSP2 is written instead when a bound does not fit them)
+    #[arg(long = "2psb", conflicts_with = "bsp2")]
+    pub bsp2psb: bool,
     /// A directory to search for the WADs worldspawn names (repeatable; ericw-tools spells it
     /// -wadpath). A WAD named with a path is looked for with that path joined onto each
     /// directory, then by its file name alone; the map's own directory and the working
@@ -216,7 +220,13 @@ impl Args {
         .map(|(_, class)| class.to_string())
         .collect();
         CompileOptions {
-            bsp2: self.bsp2,
+            version: if self.bsp2 {
+                BspVersion::Bsp2
+            } else if self.bsp2psb {
+                BspVersion::Bsp2Psb
+            } else {
+                BspVersion::Bsp29
+            },
             wad_dirs: self.wad_dirs.clone(),
             xwad_dirs: self.xwad_dirs.clone(),
             heuristic: self.heuristic,

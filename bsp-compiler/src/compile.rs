@@ -207,11 +207,6 @@ pub fn compile(
         &wad_search(source, options),
         &mut warnings,
     );
-    let version = if options.bsp2 {
-        BspVersion::Bsp2
-    } else {
-        BspVersion::Bsp29
-    };
     let emitted = emit(EmitInput {
         models: &outputs,
         planes: &planes,
@@ -219,7 +214,7 @@ pub fn compile(
         texture_names: &table.names,
         wads: &wads,
         entities: &lump_entities(&map, &left_out, options),
-        version,
+        version: options.version,
         transwater: options.transwater,
         max_edges: options.max_edges,
         warnings: &mut warnings,
@@ -235,9 +230,8 @@ pub fn compile(
             t.mips = None;
         }
     }
-    if bsp.version == BspVersion::Bsp29
-        && let Err(e) = bsp.check_bsp29_limits()
-    {
+    // BSP2 holds any map; BSP29 and 2PSB give way to it.
+    if let Err(e) = bsp.check_version_limits() {
         warnings.push(Warning::Unsupported {
             what: format!("{e}; switching to BSP2 automatically"),
         });

@@ -12,7 +12,6 @@
 //! their own while the texinfo limit allows.
 
 use quake_formats::Bsp;
-use quake_formats::BspVersion;
 use quake_formats::bsp::limits::{BSP29_MAX_TEXINFO, MAX_SURFACE_EXTENT};
 use quake_formats::bsp::texinfo_flags;
 use quake_formats::extents::LightmapExtents;
@@ -72,7 +71,7 @@ pub fn agree_on_lightmap_grid(bsp: &mut Bsp) -> LightmapGridStats {
             .or_default()
             .push(LitFace { index, points });
     }
-    let limit = if bsp.version == BspVersion::Bsp2 || bsp.texinfo.len() > BSP29_MAX_TEXINFO {
+    let limit = if bsp.version.has_wide_indices() || bsp.texinfo.len() > BSP29_MAX_TEXINFO {
         usize::MAX
     } else {
         BSP29_MAX_TEXINFO
@@ -194,6 +193,7 @@ fn nudged(vecs: &[[f32; 4]; 2], steps: [usize; 2]) -> [[f32; 4]; 2] {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use quake_formats::BspVersion;
     use quake_formats::bsp::{Face, TexInfo};
 
     /// s along a texture turned 10 degrees; t constant (0.5) on the z = 0 plane.

@@ -2,6 +2,7 @@
 
 use crate::outside::{FillType, Reach};
 use crate::tree::{MID_SPLIT_SIZE, SplitHeuristic};
+use quake_formats::BspVersion;
 use quake_formats::bsp::limits::QUAKESPASM_MAX_UNLIT_FACE_VERTS;
 use quake_formats::progress::Progress;
 use std::path::PathBuf;
@@ -12,8 +13,9 @@ pub const DEFAULT_MAX_EDGES: usize = QUAKESPASM_MAX_UNLIT_FACE_VERTS;
 
 #[derive(Debug, Clone)]
 pub struct CompileOptions {
-    /// Write BSP2 even when BSP29 would do.
-    pub bsp2: bool,
+    /// The BSP version to write: BSP29 (the default), BSP2 (`-bsp2`) or 2PSB (`-2psb`). BSP29
+    /// and 2PSB give way to BSP2, with a warning, when the map does not fit them.
+    pub version: BspVersion,
     /// Directories searched for WADs (then `xwad_dirs`, the map's own directory and the working
     /// directory; see [`crate::wad_lookup::WadSearch`]).
     pub wad_dirs: Vec<PathBuf>,
@@ -78,7 +80,7 @@ impl CompileOptions {
 impl Default for CompileOptions {
     fn default() -> Self {
         CompileOptions {
-            bsp2: false,
+            version: BspVersion::Bsp29,
             wad_dirs: Vec::new(),
             xwad_dirs: Vec::new(),
             heuristic: SplitHeuristic::default(),

@@ -632,3 +632,73 @@ fn ericw_tools_only_options_are_accepted_with_a_note() {
     let only = parsed_args(&["-bspxonly", "x.map"]).compile_options();
     assert!(only.brush_list && !only.clip_hulls);
 }
+
+/// `-2psb` (ericw-tools' spelling; `--2psb` too) writes RMQ's 2PSB: its magic leads the file,
+/// which reads back as 2PSB, valid, with the faces a BSP29 compile gets.
+#[test]
+fn two_psb_writes_rmqs_bsp2_variant() {
+    use quake_formats::BspVersion;
+    assert_eq!(parsed_options(&["x.map"]).version, BspVersion::Bsp29);
+    assert_eq!(
+        parsed_options(&["-bsp2", "x.map"]).version,
+        BspVersion::Bsp2
+    );
+    for spelling in ["-2psb", "--2psb"] {
+        assert_eq!(
+            parsed_options(&[spelling, "x.map"]).version,
+            BspVersion::Bsp2Psb
+        );
+    }
+
+    let dir = temp_dir("2psb");
+    let map = dir.join("room.map");
+    std::fs::write(&map, room_map(false, "")).expect("write");
+    let out = Command::new(env!("CARGO_BIN_EXE_slipgate-bsp"))
+        .arg("-2psb")
+        .arg(&map)
+        .output()
+        .expect("run slipgate-bsp");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("(2PSB)"), "{stdout}");
+    let bytes = std::fs::read(map.with_extension("bsp")).expect("read the BSP");
+    assert_eq!(&bytes[..4], b"2PSB");
+    let bsp = Bsp::read(&bytes).expect("2PSB reads back");
+    assert_eq!(bsp.version, BspVersion::Bsp2Psb);
+    let errors: Vec<_> = validate(&bsp)
+        .into_iter()
+        .filter(|p| p.severity == Severity::Error)
+        .collect();
+    assert!(errors.is_empty(), "{errors:?}");
+    let bsp29 = compile_options(&room_map(false, ""), CompileOptions::default());
+    assert_eq!(bsp29.version, BspVersion::Bsp29);
+    assert_eq!(bsp.faces, bsp29.faces);
+    assert_eq!(bsp.nodes, bsp29.nodes);
+}
+
+/// A 2PSB compile whose node and leaf bounds do not fit its 16-bit integers is written as BSP2,
+/// with a warning naming the bound, as BSP29 gives way past its limits.
+#[test]
+fn two_psb_gives_way_to_bsp2_past_16_bit_bounds() {
+    use quake_formats::BspVersion;
+    let text = format!(
+        "{{\n\"classname\" \"worldspawn\"\n\"wad\" \"none.wad\"\n{}}}\n{{\n\"classname\" \"info_player_start\"\n\"origin\" \"32928 32928 32900\"\n}}\n",
+        room(32_800.0, 33_056.0, 16.0, false)
+    );
+    let options = CompileOptions {
+        version: BspVersion::Bsp2Psb,
+        ..CompileOptions::default()
+    };
+    let out = try_compile_with(&text, &options).expect("compile");
+    assert!(out.leak.is_none(), "{:?}", out.warnings);
+    assert_eq!(out.bsp.version, BspVersion::Bsp2);
+    let warned = out
+        .warnings
+        .iter()
+        .any(|w| w.to_string().contains("2PSB limit exceeded"));
+    assert!(warned, "{:?}", out.warnings);
+}

@@ -45,7 +45,7 @@ pub fn bsp_read(data: &[u8]) {
         Bsp::read(&bytes).expect("a BSP that was read rewrites readably");
     }
     if usable {
-        for version in [BspVersion::Bsp29, BspVersion::Bsp2] {
+        for version in [BspVersion::Bsp29, BspVersion::Bsp2, BspVersion::Bsp2Psb] {
             if let Ok(converted) = bsp.converted(version) {
                 let _ = converted.write();
             }

@@ -76,19 +76,23 @@ macro_rules! ericw_accepted {
     };
 }
 
-/// ericw-tools writes long options with one dash (`-extra4`); clap wants two. Negative numbers
-/// and short flags (`-h`) are left alone. The first word (the program name) is kept as it is.
+/// ericw-tools writes long options with one dash (`-extra4`, `-2psb`); clap wants two. Negative
+/// numbers (`-100`, `-1e5`) and short flags (`-h`) are left alone. The first word (the program
+/// name) is kept as it is.
 pub fn normalise_single_dash(args: impl Iterator<Item = String>) -> Vec<String> {
     args.enumerate()
         .map(|(i, a)| {
+            let name = a.strip_prefix('-').unwrap_or_default();
             let is_ericw_long = i > 0
-                && a.len() > 2
-                && a.starts_with('-')
-                && !a.starts_with("--")
-                && a[1..].starts_with(|c: char| c.is_ascii_alphabetic())
-                && a[1..]
+                && name.len() > 1
+                && !name.starts_with('-')
+                && name
                     .chars()
-                    .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
+                    .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+                && (name.starts_with(|c: char| c.is_ascii_alphabetic())
+                    // A name may start with a digit (`-2psb`) as long as it is not a number.
+                    || (name.contains(|c: char| c.is_ascii_alphabetic())
+                        && name.parse::<f64>().is_err()));
             if is_ericw_long { format!("-{a}") } else { a }
         })
         .collect()
@@ -147,13 +151,15 @@ mod tests {
     #[test]
     fn single_dash_long_options_become_double_dash() {
         let args = [
-            "slipgate", "light", "-extra4", "-soft", "-h", "--pos", "-100", "x.bsp",
+            "slipgate", "light", "-extra4", "-soft", "-h", "--pos", "-100", "-1e5", "-2psb",
+            "x.bsp",
         ];
         let out = normalise_single_dash(args.iter().map(|s| s.to_string()));
         assert_eq!(
             out,
             [
-                "slipgate", "light", "--extra4", "--soft", "-h", "--pos", "-100", "x.bsp"
+                "slipgate", "light", "--extra4", "--soft", "-h", "--pos", "-100", "-1e5", "--2psb",
+                "x.bsp"
             ]
         );
     }

@@ -18,9 +18,9 @@ pub enum FormatError {
         /// Length of the data read from, in bytes.
         len: usize,
     },
-    /// The first four bytes are neither BSP29's version 29 nor `BSP2`; holds them as a
+    /// The first four bytes are neither BSP29's version 29, `BSP2` nor `2PSB`; holds them as a
     /// little-endian number.
-    #[error("not a BSP file: version {0:#010x} is neither 29 nor \"BSP2\"")]
+    #[error("not a BSP file: version {0:#010x} is neither 29, \"BSP2\" nor \"2PSB\"")]
     UnknownBspVersion(u32),
     /// A header entry places its lump (partly) outside the file.
     #[error(
@@ -65,6 +65,21 @@ pub enum FormatError {
         count: usize,
         /// The most BSP29 allows.
         max: usize,
+    },
+    /// A node or leaf bound, rounded outward to whole units, does not fit the 16-bit integer
+    /// BSP29 and 2PSB store bounds in; BSP2 stores floats.
+    #[error(
+        "{version} limit exceeded: {record} {index}'s bound {value} does not fit a 16-bit integer (-32768 to 32767 map units); write BSP2 instead (--bsp2)"
+    )]
+    ShortBound {
+        /// The version being written (BSP29 or 2PSB).
+        version: crate::bsp::BspVersion,
+        /// `"node"` or `"leaf"`.
+        record: &'static str,
+        /// The record's index in its lump.
+        index: usize,
+        /// The bound as the model holds it, before rounding.
+        value: f32,
     },
     /// The file does not start with `WAD2`; holds the four bytes it starts with.
     #[error("not a WAD2 file: magic {0:?}")]

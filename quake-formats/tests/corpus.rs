@@ -101,8 +101,19 @@ fn corpus_bsps_convert_between_versions() {
         let bsp = Bsp::read(&std::fs::read(&path).expect("read")).expect("parse");
         let other = match bsp.version {
             BspVersion::Bsp29 => BspVersion::Bsp2,
-            BspVersion::Bsp2 => BspVersion::Bsp29,
+            BspVersion::Bsp2 | BspVersion::Bsp2Psb => BspVersion::Bsp29,
         };
+        // 2PSB holds BSP29's bounds and BSP2's indices.
+        if let Ok(psb) = bsp.converted(BspVersion::Bsp2Psb) {
+            let bytes = psb.write().expect("write 2PSB");
+            let back = Bsp::read(&bytes).expect("read 2PSB");
+            assert_eq!(back.faces, bsp.faces, "{}", path.display());
+            assert_eq!(back.clipnodes, bsp.clipnodes, "{}", path.display());
+            if bsp.version == BspVersion::Bsp29 {
+                assert_eq!(back.nodes, bsp.nodes, "{}", path.display());
+                assert_eq!(back.leafs, bsp.leafs, "{}", path.display());
+            }
+        }
         let Ok(converted) = bsp.converted(other) else {
             continue;
         };

@@ -23,8 +23,6 @@ pub const BSP29_MAX_MARKSURFACES: usize = 65536;
 pub const BSP29_MAX_TEXINFO: usize = 32768;
 /// Faces store their edge count in a signed 16-bit field.
 pub const BSP29_MAX_FACE_EDGES: usize = 32767;
-/// Node and leaf bounds are signed 16-bit integers.
-pub const BSP29_MAX_COORD: f32 = 32767.0;
 
 /// Models the original engine can precache (world, brush entities and the game code's models);
 /// protocol 15 also sends a model index in one byte.

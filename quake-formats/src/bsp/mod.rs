@@ -1,7 +1,7 @@
-//! BSP29 and BSP2 files: one typed model, two on-disk encodings.
+//! BSP29, BSP2 and 2PSB files: one typed model, three on-disk encodings.
 //!
-//! The model stores every index as `u32`/`i32` and every bound as `f32`, wide enough for both
-//! versions. Each record type knows its encoding per version (`records::Record`); lumps are
+//! The model stores every index as `u32`/`i32` and every bound as `f32`, wide enough for every
+//! version. Each record type knows its encoding per version (`records::Record`); lumps are
 //! read and written by one generic pair of functions. Trailing BSPX lumps are kept as named byte blobs;
 //! [`phong`] reads and writes Slipgate's own one, [`light_lumps`] those that carry light (coloured,
 //! directional, HDR, at other spacings) and [`lightgrid`] the light grid.
@@ -29,7 +29,7 @@ use crate::error::{FormatError, Result};
 use crate::layout::{Layout, place};
 use crate::miptex::TextureLump;
 use limits::*;
-use records::Record;
+use records::{BoundEnd, Record, short_bound};
 
 /// Which on-disk encoding a BSP uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -38,6 +38,22 @@ pub enum BspVersion {
     Bsp29,
     /// The "BSP2" extension: 32-bit indices, float bounds.
     Bsp2,
+    /// RMQ's first BSP2 ("2PSB", ericw-tools' `bsp2rmq`): BSP2's 32-bit indices, but nodes and
+    /// leaves keep BSP29's 16-bit integer bounds.
+    Bsp2Psb,
+}
+
+impl BspVersion {
+    /// Whether indices and counts are 32-bit (BSP2, 2PSB) rather than BSP29's 16-bit ones.
+    pub fn has_wide_indices(self) -> bool {
+        matches!(self, BspVersion::Bsp2 | BspVersion::Bsp2Psb)
+    }
+
+    /// Whether node and leaf bounds are stored as 16-bit integers (BSP29, 2PSB) rather than
+    /// BSP2's floats.
+    pub fn has_short_bounds(self) -> bool {
+        matches!(self, BspVersion::Bsp29 | BspVersion::Bsp2Psb)
+    }
 }
 
 impl std::fmt::Display for BspVersion {
@@ -45,12 +61,15 @@ impl std::fmt::Display for BspVersion {
         f.write_str(match self {
             BspVersion::Bsp29 => "BSP29",
             BspVersion::Bsp2 => "BSP2",
+            BspVersion::Bsp2Psb => "2PSB",
         })
     }
 }
 
 const BSP29_MAGIC: [u8; 4] = 29i32.to_le_bytes();
 const BSP2_MAGIC: [u8; 4] = *b"BSP2";
+/// RMQ's magic: the int `('B' << 24) | ('S' << 16) | ('P' << 8) | '2'`, little-endian.
+const BSP2PSB_MAGIC: [u8; 4] = *b"2PSB";
 const BSPX_MAGIC: [u8; 4] = *b"BSPX";
 const HEADER_LEN: usize = 4 + 15 * 8;
 const BSPX_ENTRY_LEN: usize = 24 + 8;
@@ -190,14 +209,15 @@ impl Bsp {
         }
     }
 
-    /// Parse a BSP29 or BSP2 file. Structural damage (truncation, lumps outside the file, sizes
-    /// that are not whole records) is an error; bad indices are left to [`validate`].
+    /// Parse a BSP29, BSP2 or 2PSB file. Structural damage (truncation, lumps outside the file,
+    /// sizes that are not whole records) is an error; bad indices are left to [`validate`].
     pub fn read(data: &[u8]) -> Result<Bsp> {
         let mut r = Reader::new(data, "BSP header");
         let magic = r.array::<4>()?;
         let version = match magic {
             BSP29_MAGIC => BspVersion::Bsp29,
             BSP2_MAGIC => BspVersion::Bsp2,
+            BSP2PSB_MAGIC => BspVersion::Bsp2Psb,
             _ => return Err(FormatError::UnknownBspVersion(u32::from_le_bytes(magic))),
         };
         let mut entries = [LumpEntry { offset: 0, len: 0 }; 15];
@@ -252,12 +272,11 @@ impl Bsp {
     }
 
     /// Encode in `self.version`. A file read and written back unchanged is byte-identical.
-    /// Writing BSP29 fails with [`FormatError::Bsp29Limit`] when the data does not fit it.
+    /// Writing BSP29 fails with [`FormatError::Bsp29Limit`] when the data does not fit it, and
+    /// BSP29 or 2PSB with [`FormatError::ShortBound`] when a node or leaf bound does not.
     pub fn write(&self) -> Result<Vec<u8>> {
         let v = self.version;
-        if v == BspVersion::Bsp29 {
-            self.check_bsp29_limits()?;
-        }
+        self.check_version_limits()?;
         // Lumps held as bytes already are borrowed, not copied.
         let owned = |bytes: Vec<u8>| Cow::Owned(bytes);
         let lumps: [Cow<[u8]>; 15] = [
@@ -300,6 +319,7 @@ impl Bsp {
         header.extend_from_slice(match v {
             BspVersion::Bsp29 => &BSP29_MAGIC,
             BspVersion::Bsp2 => &BSP2_MAGIC,
+            BspVersion::Bsp2Psb => &BSP2PSB_MAGIC,
         });
         for (lump, bytes) in lumps.iter().enumerate() {
             let slot = FILE_ORDER.iter().position(|&i| i == lump).unwrap_or(0);
@@ -321,17 +341,26 @@ impl Bsp {
         Ok(placement.assemble(&header, &segments))
     }
 
-    /// Same data in another encoding; fails when converting to BSP29 would exceed its limits.
+    /// Same data in another encoding; fails when the data does not fit it (BSP29's limits, or a
+    /// bound outside BSP29's and 2PSB's 16-bit integers).
     pub fn converted(&self, version: BspVersion) -> Result<Bsp> {
         let mut out = self.clone();
         out.version = version;
-        if version == BspVersion::Bsp29 {
-            out.check_bsp29_limits()?;
-        }
+        out.check_version_limits()?;
         Ok(out)
     }
 
-    /// Every BSP29 format limit, checked before any record is narrowed.
+    /// The limits of `self.version`, checked before any record is narrowed: BSP29's counts and
+    /// bounds, 2PSB's bounds; BSP2 has none.
+    pub fn check_version_limits(&self) -> Result<()> {
+        match self.version {
+            BspVersion::Bsp29 => self.check_bsp29_limits(),
+            BspVersion::Bsp2Psb => self.check_short_bounds(),
+            BspVersion::Bsp2 => Ok(()),
+        }
+    }
+
+    /// Every BSP29 format limit: its counts, then its bounds ([`Bsp::check_short_bounds`]).
     pub fn check_bsp29_limits(&self) -> Result<()> {
         let counts = [
             ("the node count", self.nodes.len(), BSP29_MAX_NODES),
@@ -367,21 +396,26 @@ impl Bsp {
                 max: BSP29_MAX_FACE_EDGES,
             });
         }
-        let out_of_range = |b: &[f32; 3]| b.iter().any(|c| c.abs() > BSP29_MAX_COORD);
-        let bounds_ok = self
-            .nodes
-            .iter()
-            .map(|n| (n.mins, n.maxs))
-            .chain(self.leafs.iter().map(|l| (l.mins, l.maxs)))
-            .all(|(a, b)| !out_of_range(&a) && !out_of_range(&b));
-        if !bounds_ok {
-            return Err(FormatError::Bsp29Limit {
-                what: "a node or leaf bound (map units from the origin)",
-                count: 32768,
-                max: BSP29_MAX_COORD as usize,
-            });
+        self.check_short_bounds()
+    }
+
+    /// Every node and leaf bound, rounded outward to whole units, fits the 16-bit integers
+    /// BSP29 and 2PSB store bounds in.
+    pub fn check_short_bounds(&self) -> Result<()> {
+        let node = first_long_bound(self.nodes.iter().map(|n| (n.mins, n.maxs)));
+        let leaf = || first_long_bound(self.leafs.iter().map(|l| (l.mins, l.maxs)));
+        let found = node
+            .map(|at| ("node", at))
+            .or_else(|| leaf().map(|at| ("leaf", at)));
+        match found {
+            Some((record, (index, value))) => Err(FormatError::ShortBound {
+                version: self.version,
+                record,
+                index,
+                value,
+            }),
+            None => Ok(()),
         }
-        Ok(())
     }
 
     /// The entity lump as text (Quake text is Latin-1, not UTF-8), without the trailing NUL.
@@ -477,6 +511,20 @@ impl Bsp {
     }
 }
 
+/// The first box (its index) with a bound (its value) that does not fit a 16-bit integer once
+/// rounded outward.
+fn first_long_bound(boxes: impl Iterator<Item = ([f32; 3], [f32; 3])>) -> Option<(usize, f32)> {
+    boxes.enumerate().find_map(|(index, (mins, maxs))| {
+        let lower = mins
+            .into_iter()
+            .find(|&c| short_bound(c, BoundEnd::Lower).is_none());
+        let upper = maxs
+            .into_iter()
+            .find(|&c| short_bound(c, BoundEnd::Upper).is_none());
+        lower.or(upper).map(|value| (index, value))
+    })
+}
+
 fn read_records<T: Record>(data: &[u8], v: BspVersion) -> Result<Vec<T>> {
     let size = T::size(v);
     if !data.len().is_multiple_of(size) {
@@ -557,8 +605,8 @@ mod tests {
     use super::*;
 
     #[test]
-    fn empty_bsp_round_trips_in_both_versions() {
-        for v in [BspVersion::Bsp29, BspVersion::Bsp2] {
+    fn empty_bsp_round_trips_in_every_version() {
+        for v in [BspVersion::Bsp29, BspVersion::Bsp2, BspVersion::Bsp2Psb] {
             let mut bsp = Bsp::new(v);
             bsp.set_entity_text("{\n\"classname\" \"worldspawn\"\n}\n");
             let bytes = bsp.write().expect("write");
@@ -597,5 +645,156 @@ mod tests {
                 .write()
                 .is_ok()
         );
+    }
+
+    /// A small tree whose indices need 32 bits and whose bounds are whole units.
+    fn wide_bsp(version: BspVersion) -> Bsp {
+        let big = 70_000u32;
+        let mut bsp = Bsp::new(version);
+        bsp.set_entity_text("{\n\"classname\" \"worldspawn\"\n}\n");
+        bsp.planes = vec![BspPlane {
+            normal: [1.0, 0.0, 0.0],
+            dist: 8.0,
+            kind: 0,
+        }];
+        bsp.vertices = vec![[0.0, 0.0, 0.0], [64.0, 0.0, 0.0], [0.0, 64.0, 0.0]];
+        bsp.nodes = vec![Node {
+            plane: 0,
+            children: [-(big as i32), -2],
+            mins: [-32768.0, -16.0, 0.0],
+            maxs: [32767.0, 16.0, 128.0],
+            first_face: big,
+            num_faces: 3,
+        }];
+        bsp.leafs = vec![
+            Leaf::SHARED_SOLID,
+            Leaf {
+                contents: contents::EMPTY,
+                vis_offset: -1,
+                mins: [-64.0, -16.0, 0.0],
+                maxs: [64.0, 16.0, 128.0],
+                first_marksurface: big,
+                num_marksurfaces: 2,
+                ambient: [1, 2, 3, 4],
+            },
+        ];
+        bsp.clipnodes = vec![ClipNode {
+            plane: 0,
+            children: [big as i32, contents::SOLID],
+        }];
+        bsp.faces = vec![Face {
+            plane: big,
+            side: 1,
+            first_edge: 0,
+            num_edges: 3,
+            texinfo: big,
+            styles: [0, 255, 255, 255],
+            light_offset: -1,
+        }];
+        bsp.marksurfaces = vec![big, 0];
+        bsp.edges = vec![[0, 0], [big, 1], [1, 2]];
+        bsp.surfedges = vec![1, 2, -1];
+        bsp
+    }
+
+    #[test]
+    fn bsp2psb_round_trips_with_wide_indices_and_short_bounds() {
+        let bsp = wide_bsp(BspVersion::Bsp2Psb);
+        let bytes = bsp.write().expect("write 2PSB");
+        assert_eq!(&bytes[..4], b"2PSB");
+        assert_eq!(
+            u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]),
+            (u32::from(b'B') << 24)
+                | (u32::from(b'S') << 16)
+                | (u32::from(b'P') << 8)
+                | u32::from(b'2')
+        );
+        // 32-byte nodes and leaves (BSP2's indices, BSP29's bounds), BSP2's other records.
+        let lump_len = |lump: usize| {
+            let at = 4 + 8 * lump + 4;
+            i32::from_le_bytes(bytes[at..at + 4].try_into().expect("4 bytes")) as usize
+        };
+        assert_eq!(lump_len(5), 32, "one node");
+        assert_eq!(lump_len(10), 2 * 32, "two leaves");
+        assert_eq!(lump_len(9), 12, "one clip node");
+        assert_eq!(lump_len(7), 28, "one face");
+        assert_eq!(lump_len(11), 2 * 4, "two mark surfaces");
+        assert_eq!(lump_len(12), 3 * 8, "three edges");
+        let mut back = Bsp::read(&bytes).expect("read 2PSB");
+        assert_eq!(back.write().expect("rewrite"), bytes);
+        back.layout = None;
+        assert_eq!(back, bsp);
+        // The same data converts to the other versions and back unchanged.
+        let via_bsp2 = Bsp::read(
+            &bsp.converted(BspVersion::Bsp2)
+                .expect("to BSP2")
+                .write()
+                .expect("write BSP2"),
+        )
+        .expect("read BSP2");
+        let mut again = via_bsp2
+            .converted(BspVersion::Bsp2Psb)
+            .expect("back to 2PSB");
+        again.layout = None;
+        assert_eq!(again, bsp);
+        let bsp29 = bsp.converted(BspVersion::Bsp29).and_then(|b| b.write());
+        assert!(bsp29.is_err(), "indices past 16 bits");
+    }
+
+    #[test]
+    fn bsp2psb_rounds_bounds_outward() {
+        let mut bsp = wide_bsp(BspVersion::Bsp2Psb);
+        bsp.nodes[0].mins = [-0.5, 1.5, -32767.9];
+        bsp.nodes[0].maxs = [0.5, 1.5, 32766.1];
+        let back = Bsp::read(&bsp.write().expect("write")).expect("read");
+        assert_eq!(back.nodes[0].mins, [-1.0, 1.0, -32768.0]);
+        assert_eq!(back.nodes[0].maxs, [1.0, 2.0, 32767.0]);
+    }
+
+    #[test]
+    fn bound_outside_16_bits_is_an_error_not_a_panic() {
+        let cases = [
+            (BspVersion::Bsp2Psb, "node 0", 32767.5, f32::NAN),
+            (BspVersion::Bsp2Psb, "leaf 1", -32768.5, -40_000.0),
+            (BspVersion::Bsp29, "node 0", f32::INFINITY, 1e9),
+        ];
+        for (version, record, node_max, leaf_min) in cases {
+            let mut bsp = wide_bsp(BspVersion::Bsp2);
+            bsp.faces.clear();
+            bsp.edges.clear();
+            bsp.marksurfaces.clear();
+            bsp.nodes[0].first_face = 0;
+            bsp.leafs[1].first_marksurface = 0;
+            if record == "node 0" {
+                bsp.nodes[0].maxs[2] = node_max;
+            } else {
+                bsp.leafs[1].mins[0] = leaf_min;
+            }
+            assert!(bsp.write().is_ok(), "BSP2 holds float bounds");
+            let err = bsp.converted(version).expect_err("bound outside i16");
+            assert!(matches!(err, FormatError::ShortBound { .. }), "{err}");
+            let text = err.to_string();
+            assert!(text.contains(&version.to_string()), "{text}");
+            assert!(text.contains(record), "{text}");
+            assert!(text.contains("BSP2"), "{text}");
+            bsp.version = version;
+            assert!(bsp.write().is_err(), "{version}: {record}");
+        }
+    }
+
+    #[test]
+    fn truncated_or_mislabelled_2psb_is_an_error_not_a_panic() {
+        let bytes = wide_bsp(BspVersion::Bsp2Psb).write().expect("write");
+        for len in 0..bytes.len() {
+            let _ = Bsp::read(&bytes[..len]);
+        }
+        for len in 0..HEADER_LEN {
+            assert!(Bsp::read(&bytes[..len]).is_err(), "{len}-byte header");
+        }
+        // Read as BSP2, its 32-byte nodes are not whole 44-byte records.
+        let mut as_bsp2 = bytes.clone();
+        as_bsp2[..4].copy_from_slice(b"BSP2");
+        let err = Bsp::read(&as_bsp2).expect_err("BSP2 record sizes");
+        assert!(matches!(err, FormatError::LumpSize { .. }), "{err}");
     }
 }

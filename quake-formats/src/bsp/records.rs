@@ -92,43 +92,82 @@ impl Record for [f32; 3] {
     }
 }
 
-/// Bounds stored as `i16` in BSP29 and `f32` in BSP2.
+/// Which end of a box a bound is, and so which way it is rounded to whole units.
+#[derive(Debug, Clone, Copy)]
+pub(super) enum BoundEnd {
+    /// A `mins` coordinate, rounded down.
+    Lower,
+    /// A `maxs` coordinate, rounded up.
+    Upper,
+}
+
+/// `value` rounded outward to the whole units BSP29 and 2PSB store bounds in, so that the box
+/// stays conservative; `None` when that does not fit their 16 bits (or is not a number).
+pub(super) fn short_bound(value: f32, end: BoundEnd) -> Option<i16> {
+    let rounded = match end {
+        BoundEnd::Lower => value.floor(),
+        BoundEnd::Upper => value.ceil(),
+    };
+    // NaN fails both comparisons.
+    (rounded >= f32::from(i16::MIN) && rounded <= f32::from(i16::MAX)).then_some(rounded as i16)
+}
+
+/// Bounds stored as `i16` in BSP29 and 2PSB, `f32` in BSP2.
 fn read_bounds(r: &mut Reader, v: BspVersion) -> Result<([f32; 3], [f32; 3])> {
-    match v {
-        BspVersion::Bsp29 => {
-            let mut b = [0f32; 6];
-            for c in &mut b {
-                *c = r.i16()? as f32;
-            }
-            Ok(([b[0], b[1], b[2]], [b[3], b[4], b[5]]))
+    if v.has_short_bounds() {
+        let mut b = [0f32; 6];
+        for c in &mut b {
+            *c = r.i16()? as f32;
         }
-        BspVersion::Bsp2 => Ok((r.f32x3()?, r.f32x3()?)),
+        Ok(([b[0], b[1], b[2]], [b[3], b[4], b[5]]))
+    } else {
+        Ok((r.f32x3()?, r.f32x3()?))
     }
 }
 
-fn write_bounds(out: &mut Vec<u8>, v: BspVersion, mins: [f32; 3], maxs: [f32; 3]) {
-    match v {
-        BspVersion::Bsp29 => {
-            // Outward rounding keeps the box conservative; limits were checked beforehand.
-            for c in mins {
-                out.put_i16(c.floor().clamp(-32768.0, 32767.0) as i16);
-            }
-            for c in maxs {
-                out.put_i16(c.ceil().clamp(-32768.0, 32767.0) as i16);
-            }
-        }
-        BspVersion::Bsp2 => {
-            out.put_f32x3(mins);
-            out.put_f32x3(maxs);
-        }
+fn write_bounds(
+    out: &mut Vec<u8>,
+    v: BspVersion,
+    mins: [f32; 3],
+    maxs: [f32; 3],
+    lump: &'static str,
+) -> Result<()> {
+    if !v.has_short_bounds() {
+        out.put_f32x3(mins);
+        out.put_f32x3(maxs);
+        return Ok(());
     }
+    // `Bsp::check_short_bounds` runs before any record is written, so this error is a backstop.
+    let corners = mins
+        .map(|c| (c, BoundEnd::Lower))
+        .into_iter()
+        .chain(maxs.map(|c| (c, BoundEnd::Upper)));
+    for (c, end) in corners {
+        let short = short_bound(c, end).ok_or_else(|| FormatError::BadLump {
+            lump,
+            detail: format!("bound {c} does not fit {v}'s 16-bit integer bounds; write BSP2"),
+        })?;
+        out.put_i16(short);
+    }
+    Ok(())
 }
 
-/// A 16-bit (BSP29) or 32-bit (BSP2) signed child or index.
+/// Bytes of an index or count: 2 in BSP29, 4 in BSP2 and 2PSB.
+fn wide_size(v: BspVersion) -> usize {
+    if v.has_wide_indices() { 4 } else { 2 }
+}
+
+/// Bytes of one bound coordinate: 2 (`i16`) in BSP29 and 2PSB, 4 (`f32`) in BSP2.
+fn bound_size(v: BspVersion) -> usize {
+    if v.has_short_bounds() { 2 } else { 4 }
+}
+
+/// A 16-bit (BSP29) or 32-bit (BSP2, 2PSB) signed child or index.
 fn read_wide_i(r: &mut Reader, v: BspVersion) -> Result<i32> {
-    match v {
-        BspVersion::Bsp29 => Ok(r.i16()? as i32),
-        BspVersion::Bsp2 => r.i32(),
+    if v.has_wide_indices() {
+        r.i32()
+    } else {
+        Ok(r.i16()? as i32)
     }
 }
 
@@ -139,18 +178,20 @@ fn write_wide_i(
     lump: &'static str,
     field: &'static str,
 ) -> Result<()> {
-    match v {
-        BspVersion::Bsp29 => out.put_i16(narrow(value as i64, lump, field)?),
-        BspVersion::Bsp2 => out.put_i32(value),
+    if v.has_wide_indices() {
+        out.put_i32(value);
+    } else {
+        out.put_i16(narrow(value as i64, lump, field)?);
     }
     Ok(())
 }
 
-/// A 16-bit (BSP29) or 32-bit (BSP2) unsigned index.
+/// A 16-bit (BSP29) or 32-bit (BSP2, 2PSB) unsigned index.
 fn read_wide_u(r: &mut Reader, v: BspVersion) -> Result<u32> {
-    match v {
-        BspVersion::Bsp29 => Ok(r.u16()? as u32),
-        BspVersion::Bsp2 => r.u32(),
+    if v.has_wide_indices() {
+        r.u32()
+    } else {
+        Ok(r.u16()? as u32)
     }
 }
 
@@ -161,9 +202,10 @@ fn write_wide_u(
     lump: &'static str,
     field: &'static str,
 ) -> Result<()> {
-    match v {
-        BspVersion::Bsp29 => out.put_u16(narrow(value as i64, lump, field)?),
-        BspVersion::Bsp2 => out.put_u32(value),
+    if v.has_wide_indices() {
+        out.put_u32(value);
+    } else {
+        out.put_u16(narrow(value as i64, lump, field)?);
     }
     Ok(())
 }
@@ -189,10 +231,8 @@ pub struct Node {
 impl Record for Node {
     const LUMP: &'static str = "nodes";
     fn size(v: BspVersion) -> usize {
-        match v {
-            BspVersion::Bsp29 => 24,
-            BspVersion::Bsp2 => 44,
-        }
+        // plane, 2 children, 6 bounds, first face, face count.
+        4 + 2 * wide_size(v) + 6 * bound_size(v) + 2 * wide_size(v)
     }
     fn read(r: &mut Reader, v: BspVersion) -> Result<Self> {
         let plane = r.u32()?;
@@ -212,7 +252,7 @@ impl Record for Node {
         for c in self.children {
             write_wide_i(out, v, c, Self::LUMP, "child")?;
         }
-        write_bounds(out, v, self.mins, self.maxs);
+        write_bounds(out, v, self.mins, self.maxs, Self::LUMP)?;
         write_wide_u(out, v, self.first_face, Self::LUMP, "first face")?;
         write_wide_u(out, v, self.num_faces, Self::LUMP, "face count")
     }
@@ -255,10 +295,8 @@ impl Leaf {
 impl Record for Leaf {
     const LUMP: &'static str = "leafs";
     fn size(v: BspVersion) -> usize {
-        match v {
-            BspVersion::Bsp29 => 28,
-            BspVersion::Bsp2 => 44,
-        }
+        // contents, vis offset, 6 bounds, first mark surface, mark surface count, 4 ambients.
+        4 + 4 + 6 * bound_size(v) + 2 * wide_size(v) + 4
     }
     fn read(r: &mut Reader, v: BspVersion) -> Result<Self> {
         let contents = r.i32()?;
@@ -277,7 +315,7 @@ impl Record for Leaf {
     fn write(&self, out: &mut Vec<u8>, v: BspVersion) -> Result<()> {
         out.put_i32(self.contents);
         out.put_i32(self.vis_offset);
-        write_bounds(out, v, self.mins, self.maxs);
+        write_bounds(out, v, self.mins, self.maxs, Self::LUMP)?;
         write_wide_u(
             out,
             v,
@@ -309,10 +347,7 @@ pub struct ClipNode {
 impl Record for ClipNode {
     const LUMP: &'static str = "clipnodes";
     fn size(v: BspVersion) -> usize {
-        match v {
-            BspVersion::Bsp29 => 8,
-            BspVersion::Bsp2 => 12,
-        }
+        4 + 2 * wide_size(v)
     }
     fn read(r: &mut Reader, v: BspVersion) -> Result<Self> {
         Ok(ClipNode {
@@ -392,10 +427,8 @@ pub struct Face {
 impl Record for Face {
     const LUMP: &'static str = "faces";
     fn size(v: BspVersion) -> usize {
-        match v {
-            BspVersion::Bsp29 => 20,
-            BspVersion::Bsp2 => 28,
-        }
+        // plane, side, first edge (always 32-bit), edge count, texinfo, 4 styles, light offset.
+        4 * wide_size(v) + 4 + 4 + 4
     }
     fn read(r: &mut Reader, v: BspVersion) -> Result<Self> {
         Ok(Face {
@@ -423,10 +456,7 @@ impl Record for Face {
 impl Record for u32 {
     const LUMP: &'static str = "marksurfaces";
     fn size(v: BspVersion) -> usize {
-        match v {
-            BspVersion::Bsp29 => 2,
-            BspVersion::Bsp2 => 4,
-        }
+        wide_size(v)
     }
     fn read(r: &mut Reader, v: BspVersion) -> Result<Self> {
         read_wide_u(r, v)
