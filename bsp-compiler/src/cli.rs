@@ -55,6 +55,7 @@ quake_formats::ericw_accepted! {
     }
 }
 
+/// The compiler's command line, shared by `slipgate bsp` and `slipgate-bsp`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct Args {
     /// The .map file to compile

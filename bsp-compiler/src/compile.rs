@@ -37,11 +37,14 @@ use std::time::Instant;
 /// A `.map` file's text and where it came from (for messages and WAD lookup).
 #[derive(Debug, Clone)]
 pub struct MapSource {
+    /// The file's path.
     pub path: PathBuf,
+    /// The file's text.
     pub text: String,
 }
 
 impl MapSource {
+    /// Reads the `.map` file at `path`.
     pub fn read(path: &Path) -> Result<MapSource, CompileError> {
         let text = read_map_text(path).map_err(|source| CompileError::Io {
             path: path.to_path_buf(),
@@ -54,20 +57,32 @@ impl MapSource {
     }
 }
 
+/// Why a map could not be compiled.
 #[derive(Debug, thiserror::Error)]
 pub enum CompileError {
+    /// The `.map` text does not parse.
     #[error(transparent)]
     Map(#[from] MapError),
+    /// A `misc_external_map` prefab could not be spliced in.
     #[error(transparent)]
     Prefab(#[from] PrefabError),
+    /// A file could not be read.
     #[error("{}: {source}", path.display())]
     Io {
+        /// The file.
         path: PathBuf,
+        /// The error reading it.
         #[source]
         source: std::io::Error,
     },
+    /// The map's first entity is not `worldspawn`.
     #[error("{}: the first entity must be worldspawn, found {found:?}", path.display())]
-    NoWorldspawn { path: PathBuf, found: String },
+    NoWorldspawn {
+        /// The `.map` file.
+        path: PathBuf,
+        /// The first entity's classname.
+        found: String,
+    },
     /// Nothing in the world to draw or see (id's qbsp stopped here too: "Entity with no valid
     /// brushes").
     #[error(
@@ -75,44 +90,73 @@ pub enum CompileError {
         path.display()
     )]
     EmptyWorld {
+        /// The `.map` file.
         path: PathBuf,
         /// Why the brushes the map gives it, if any, were left out.
         detail: String,
     },
+    /// The BSP could not be encoded.
     #[error("writing the BSP: {0}")]
     Format(#[from] FormatError),
     /// The compiled BSP breaks a rule every later stage refuses (`quake_formats::check_usable`),
     /// e.g. a face whose texture scale makes its lightmap extents huge.
     #[error("{}: the compiled BSP would be {refused}", path.display())]
-    Unusable { path: PathBuf, refused: FormatError },
+    Unusable {
+        /// The `.map` file.
+        path: PathBuf,
+        /// The rule the BSP breaks.
+        refused: FormatError,
+    },
 }
 
 /// Counts and timings of one compile.
 #[derive(Debug, Clone, Default, serde::Serialize)]
 pub struct CompileStats {
+    /// The BSP version written (`BSP29` or `BSP2`).
     pub version: String,
+    /// How the tree's splitting planes were chosen.
     pub heuristic: SplitHeuristic,
+    /// Entities in the map, prefabs and added maps included.
     pub entities: usize,
+    /// Models in the BSP (the world first).
     pub models: usize,
+    /// Brushes of the entities compiled.
     pub brushes: usize,
+    /// Brushes that could not be built and were skipped.
     pub bad_brushes: usize,
+    /// Planes in the BSP.
     pub planes: usize,
+    /// Nodes in the BSP.
     pub nodes: usize,
+    /// Leaves in the BSP.
     pub leaves: usize,
+    /// Faces in the BSP.
     pub faces: usize,
+    /// Times a brush was split in two while building the models' trees.
     pub splits: usize,
+    /// Clip nodes in the BSP.
     pub clipnodes: usize,
+    /// Portals between the models' leaves.
     pub portals: usize,
+    /// Portals in the `.prt` file.
     pub vis_portals: usize,
     /// Vis clusters (PRT2), or vis leaves when the world has no detail (PRT1).
     pub clusters: usize,
+    /// Vertices in the BSP.
     pub vertices: usize,
+    /// Edges in the BSP.
     pub edges: usize,
+    /// Texinfos in the BSP.
     pub texinfo: usize,
+    /// Textures in the BSP.
     pub textures: usize,
+    /// Leaves the outside fill made solid.
     pub filled_leaves: usize,
+    /// Vertices added to faces' edges to close T-junctions.
     pub tjunction_vertices: usize,
+    /// The world is open to the void.
     pub leaked: bool,
+    /// How many faces each face phase made.
     pub face_stats: FaceStats,
     /// Texture offsets nudged so QuakeSpasm and DarkPlaces size every lightmap alike.
     pub lightmap_grid: LightmapGridStats,
@@ -123,10 +167,15 @@ pub struct CompileStats {
 /// Everything a compile produces.
 #[derive(Debug, Clone)]
 pub struct CompileOutput {
+    /// The compiled BSP.
     pub bsp: Bsp,
+    /// The `.prt` file for vis.
     pub portals: PortalFile,
+    /// Where the world leaks, if it does.
     pub leak: Option<LeakReport>,
+    /// What the compile worked around.
     pub warnings: Vec<Warning>,
+    /// Counts and timings.
     pub stats: CompileStats,
 }
 

@@ -23,6 +23,7 @@ pub enum MapFormat {
 }
 
 impl MapFormat {
+    /// The format's name on the command line.
     pub fn name(self) -> &'static str {
         match self {
             MapFormat::Quake => "quake",

@@ -20,17 +20,22 @@ const GRID: f64 = 64.0;
 /// A vertex lying inside another face's edge.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TJunction {
+    /// The model whose faces these are.
     pub model: usize,
     /// The face whose edge the vertex splits.
     pub face: usize,
+    /// The edge's vertex indices, in the face's winding order.
     pub edge: [u32; 2],
+    /// The vertex lying inside the edge.
     pub vertex: u32,
+    /// That vertex's position.
     pub position: [f32; 3],
 }
 
 /// Everything [`find_cracks`] found.
 #[derive(Debug, Default, Clone, PartialEq)]
 pub struct CrackReport {
+    /// Vertices lying inside another face's edge.
     pub tjunctions: Vec<TJunction>,
     /// `(model, [from, to], faces)`: a directed edge used by more than two faces, and by more
     /// or fewer than its reverse.
@@ -40,6 +45,7 @@ pub struct CrackReport {
 }
 
 impl CrackReport {
+    /// Nothing was found.
     pub fn is_empty(&self) -> bool {
         self.tjunctions.is_empty()
             && self.overused_edges.is_empty()

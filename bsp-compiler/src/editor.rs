@@ -14,12 +14,12 @@ use quake_formats::entities::Entity;
 use std::collections::HashMap;
 
 /// Whether `key` is one only an editor reads.
-pub fn is_editor_key(key: &str) -> bool {
+pub(crate) fn is_editor_key(key: &str) -> bool {
     key.starts_with("_tb_")
 }
 
 /// `entity` without its editor keys.
-pub fn without_editor_keys(entity: &Entity) -> Entity {
+pub(crate) fn without_editor_keys(entity: &Entity) -> Entity {
     Entity {
         pairs: entity
             .pairs
@@ -42,7 +42,7 @@ pub struct OmittedLayer {
 }
 
 /// The entities of `map` in layers marked "Omit From Export" (by entity index), and those layers.
-pub fn omitted_layers(map: &MapFile) -> (Vec<bool>, Vec<OmittedLayer>) {
+pub(crate) fn omitted_layers(map: &MapFile) -> (Vec<bool>, Vec<OmittedLayer>) {
     let entities = &map.entities;
     let id_of = |kind: &str| -> HashMap<&str, usize> {
         entities

@@ -20,7 +20,7 @@ use std::rc::Rc;
 
 /// A face of one model, before vertices and edges are shared.
 #[derive(Debug, Clone, PartialEq)]
-pub struct ModelFace {
+pub(crate) struct ModelFace {
     /// The tree node whose plane the face lies on.
     pub node: u32,
     pub plane: PlaneId,
@@ -51,23 +51,26 @@ impl ModelFace {
 
 /// What face making needs to know about a map texinfo.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FaceTexInfo {
+pub(crate) struct FaceTexInfo {
     pub vecs: [[f64; 4]; 2],
     pub role: TextureRole,
-    /// Written with `TEX_SPECIAL` ([`crate::MapTexInfo::is_special`]).
+    /// Written with `TEX_SPECIAL` ([`crate::gather::MapTexInfo::is_special`]).
     pub special: bool,
 }
 
 /// Face counts for the summary.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
 pub struct FaceStats {
+    /// Faces made from portals, before merging.
     pub from_portals: usize,
     /// Portal faces whose texture had to be guessed (no brush side of the leaf on the portal:
     /// the nearest side's).
     pub untextured: usize,
+    /// Faces left after merging.
     pub after_merge: usize,
     /// Merged faces whose texture met them edge-on, given Quake's projection for their plane.
     pub squared_up: usize,
+    /// Faces left after subdivision.
     pub after_subdivide: usize,
 }
 
@@ -362,7 +365,7 @@ impl ViewingLeaves<'_> {
 
 /// Faces on every portal between leaves of different contents, seen from each side that can see
 /// them, textured by the stronger side's brushes.
-pub fn faces_from_portals(
+pub(crate) fn faces_from_portals(
     tree: &Tree,
     portals: &Portals,
     planes: &PlaneSet,
@@ -494,7 +497,7 @@ fn simplify_convex(mut points: Vec<DVec3>, normal: DVec3) -> Option<Winding> {
 
 /// Merge faces that share a node, side, texinfo and the contents they are seen from wherever
 /// the union stays convex.
-pub fn merge_faces(
+pub(crate) fn merge_faces(
     mut faces: Vec<ModelFace>,
     plane_of: impl Fn(&ModelFace) -> Plane,
 ) -> Vec<ModelFace> {
@@ -553,14 +556,14 @@ fn f32_vecs(vecs: &[[f64; 4]; 2]) -> [[f32; 4]; 2] {
 }
 
 /// Lightmap extents of a winding as engines will compute them from the written file.
-pub fn winding_extents(w: &Winding, vecs: &[[f64; 4]; 2]) -> LightmapExtents {
+pub(crate) fn winding_extents(w: &Winding, vecs: &[[f64; 4]; 2]) -> LightmapExtents {
     let points: Vec<[f32; 3]> = w.points.iter().map(|p| p.as_vec3().to_array()).collect();
     LightmapExtents::from_points(&points, &f32_vecs(vecs))
 }
 
 /// Cut a lit face so each piece spans at most `size` texels along s and t, and its lightmap
 /// extents stay within the engine limit.
-pub fn subdivide(w: Winding, vecs: &[[f64; 4]; 2], size: f64, out: &mut Vec<Winding>) {
+pub(crate) fn subdivide(w: Winding, vecs: &[[f64; 4]; 2], size: f64, out: &mut Vec<Winding>) {
     let within = |w: &Winding| {
         let e = winding_extents(w, vecs);
         e.extents[0] <= MAX_SURFACE_EXTENT && e.extents[1] <= MAX_SURFACE_EXTENT
@@ -582,7 +585,12 @@ pub fn subdivide(w: Winding, vecs: &[[f64; 4]; 2], size: f64, out: &mut Vec<Wind
 }
 
 /// `face` as it is written: cut by [`subdivide`] when lit, whole when special (sky, liquids).
-pub fn cut_for_lightmaps(face: ModelFace, info: &FaceTexInfo, size: f64, out: &mut Vec<ModelFace>) {
+pub(crate) fn cut_for_lightmaps(
+    face: ModelFace,
+    info: &FaceTexInfo,
+    size: f64,
+    out: &mut Vec<ModelFace>,
+) {
     // A size of 0 asks for no subdivision at all (ericw-tools' `-subdivide 0`).
     if info.special || size <= 0.0 {
         out.push(face);

@@ -47,10 +47,12 @@ const TRIES_PER_TRACE: usize = 200;
 /// Disagreements kept as examples.
 const EXAMPLES: usize = 10;
 
+/// What [`hull_agreement`] traces.
 #[derive(Debug, Clone)]
 pub struct HullCheckOptions {
     /// Moves to trace.
     pub traces: usize,
+    /// Seed of the random starts, directions and lengths.
     pub seed: u64,
     /// 1 (player) or 2 (shambler).
     pub hull: usize,
@@ -72,10 +74,13 @@ impl Default for HullCheckOptions {
 /// One move on which the hull and the brushes disagree.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct HullDisagreement {
+    /// Where the move starts.
     pub start: [f64; 3],
+    /// Where the move would end unblocked.
     pub end: [f64; 3],
-    /// Where the hull trace stopped (its `start_solid` and `all_solid` flags are in `hull_trace`).
+    /// Where the hull trace stopped.
     pub hull_end: [f64; 3],
+    /// The hull trace called the start solid.
     pub hull_start_solid: bool,
     /// Where the exact sweep stopped.
     pub exact_end: [f64; 3],
@@ -97,10 +102,13 @@ pub struct HullAgreement {
     pub examples: Vec<HullDisagreement>,
 }
 
+/// Why [`hull_agreement`] could not measure.
 #[derive(Debug, thiserror::Error)]
 pub enum HullCheckError {
+    /// The hull asked for is not 1 or 2.
     #[error("hull {0} is not a clip hull (1 or 2)")]
     NotAClipHull(usize),
+    /// The BSP fails `quake_formats::check_usable`.
     #[error(transparent)]
     Unusable(#[from] FormatError),
 }

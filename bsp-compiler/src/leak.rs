@@ -6,16 +6,22 @@ use glam::DVec3;
 /// A map brush: its entity, its number within the entity and its line, as a mapper finds it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct MapBrushRef {
+    /// The entity's index in the map.
     pub entity: usize,
+    /// The brush's index within its entity.
     pub brush: usize,
+    /// The brush's line in the `.map`.
     pub line: usize,
 }
 
 /// A leak as the mapper reads it: the entity, the path, and the brush faces where it leaves.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LeakReport {
+    /// The entity's index in the map.
     pub entity: usize,
+    /// The entity's classname.
     pub classname: String,
+    /// The entity's origin.
     pub origin: DVec3,
     /// The entity's line in the `.map`.
     pub line: usize,

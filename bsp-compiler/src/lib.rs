@@ -1,30 +1,32 @@
 //! Slipgate: .map to BSP29/BSP2 compiler.
 //!
 //! Stages, each a module with typed input and output: [`map`] (parsing), [`texinfo`] and
-//! [`wad_lookup`] (textures), [`brush`] (brush windings), [`csg`] (hidden sides), [`tree`] (the
+//! [`wad_lookup`] (textures), `brush` (brush windings), `csg` (hidden sides), `tree` (the
 //! BSP tree: structural brushes first, its leaves the vis clusters, then detail below them),
-//! [`portals`], [`outside`] (filling and leaks), [`faces`] (faces from portals,
-//! merging, subdivision), [`hulls`] (clip hulls) and [`surface_tree`] (their trees rebuilt after
-//! filling), [`weld`] (shared vertices, T-junctions), `emit` and [`lightmap_grid`] (texture
+//! `portals`, [`outside`] (filling and leaks), [`faces`] (faces from portals,
+//! merging, subdivision), `hulls` (clip hulls) and `surface_tree` (their trees rebuilt after
+//! filling), `weld` (shared vertices, T-junctions), `emit` and [`lightmap_grid`] (texture
 //! offsets nudged so engines agree on lightmap sizes). [`compile()`] runs them all;
 //! [`cracks`] checks a written BSP for T-junctions and unshared edges;
 //! [`trace`] moves a hull's box through a written BSP as engines do, and [`hull_check`] measures
 //! whether those moves stop where the map's brushes say.
 
-pub mod brush;
-pub mod brushlist;
+#![warn(missing_docs)]
+
+mod brush;
+mod brushlist;
 #[cfg(feature = "cli")]
 pub mod cli;
 mod compile;
 pub mod convert;
 pub mod cracks;
-pub mod csg;
+mod csg;
 pub mod editor;
 mod emit;
 pub mod faces;
 mod gather;
 pub mod hull_check;
-pub mod hulls;
+mod hulls;
 pub mod leak;
 pub mod lightmap_grid;
 pub mod map;
@@ -32,22 +34,20 @@ mod model;
 pub mod onlyents;
 mod options;
 pub mod outside;
-pub mod planes;
-pub mod portals;
+mod planes;
+mod portals;
 pub mod prefab;
 mod region;
-pub mod surface_tree;
+mod surface_tree;
 pub mod texinfo;
 pub mod trace;
-pub mod tree;
+mod tree;
 pub mod wad_lookup;
 pub mod warnings;
-pub mod weld;
+mod weld;
 
 pub use compile::{CompileError, CompileOutput, CompileStats, MapSource, compile, wad_search};
-pub use gather::MapTexInfo;
 pub use options::CompileOptions;
-pub use outside::Leak;
 pub use quake_formats::progress::{Progress, ProgressEvent};
 pub use tree::SplitHeuristic;
 pub use warnings::Warning;

@@ -31,7 +31,7 @@ pub const NUDGE_STEPS: [f32; 8] = [
     -1.0 / 8.0,
 ];
 
-/// What [`agree_on_lightmap_grid`] changed, for the compile summary.
+/// What `agree_on_lightmap_grid` changed, for the compile summary.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
 pub struct LightmapGridStats {
     /// Lit faces whose extents the engines computed differently before.
@@ -53,7 +53,7 @@ struct LitFace {
 
 /// Nudge the texture offsets of `bsp` until QuakeSpasm and DarkPlaces agree on every lit face's
 /// lightmap extents (see the module documentation).
-pub fn agree_on_lightmap_grid(bsp: &mut Bsp) -> LightmapGridStats {
+pub(crate) fn agree_on_lightmap_grid(bsp: &mut Bsp) -> LightmapGridStats {
     let mut stats = LightmapGridStats::default();
     let mut by_texinfo: BTreeMap<u32, Vec<LitFace>> = BTreeMap::new();
     for (index, face) in bsp.faces.iter().enumerate() {

@@ -1,7 +1,7 @@
 //! `.map` parsing: the standard Quake format and Valve 220, into entities with brushes.
 //!
 //! Syntax errors name the file, line and column plus the entity and brush being read. Brush
-//! geometry is not checked here (see [`crate::brush`]).
+//! geometry is not checked here (see `crate::brush`).
 
 use crate::texinfo::Projection;
 use glam::DVec3;
@@ -13,20 +13,30 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{}:{line}:{column}: {message} (entity {entity}{})", file.display(), brush.map(|b| format!(", brush {b}")).unwrap_or_default())]
 pub struct MapError {
+    /// The file being parsed.
     pub file: PathBuf,
+    /// The line of the error (from 1).
     pub line: usize,
+    /// The column of the error (from 1).
     pub column: usize,
+    /// The index of the entity being read.
     pub entity: usize,
+    /// The index within the entity of the brush being read, if one is.
     pub brush: Option<usize>,
+    /// What is wrong.
     pub message: String,
 }
 
 /// One brush face as written: three points, a texture name and its projection.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MapFace {
+    /// Three points on the face's plane, clockwise seen from outside the brush.
     pub points: [DVec3; 3],
+    /// The texture's name.
     pub texture: String,
+    /// How the texture is projected onto the face.
     pub projection: Projection,
+    /// The face's line in the `.map`.
     pub line: usize,
 }
 
@@ -39,22 +49,30 @@ impl MapFace {
     }
 }
 
+/// One brush as written: its faces, in order.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MapBrush {
+    /// The brush's faces.
     pub faces: Vec<MapFace>,
+    /// The brush's line in the `.map`.
     pub line: usize,
 }
 
+/// One entity as written: its keys and its brushes.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct MapEntity {
+    /// The entity's keys and values.
     pub entity: Entity,
+    /// The entity's brushes.
     pub brushes: Vec<MapBrush>,
+    /// The entity's line in the `.map`.
     pub line: usize,
 }
 
 /// A parsed `.map` file.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct MapFile {
+    /// The entities in file order; worldspawn first in a valid map.
     pub entities: Vec<MapEntity>,
 }
 

@@ -9,17 +9,23 @@ use crate::options::CompileOptions;
 use quake_formats::Bsp;
 use quake_formats::entities::{Entity, parse_entities, write_entities};
 
+/// Why a BSP's entities could not be replaced.
 #[derive(Debug, thiserror::Error)]
 pub enum OnlyEntsError {
+    /// The `.map` could not be read.
     #[error(transparent)]
     Map(#[from] CompileError),
+    /// The `.map`'s brush entities no longer match the BSP's models.
     #[error(
         "--onlyents: the .map has {map} brush entities but the BSP has {bsp} ({detail}); \
          recompile it without --onlyents"
     )]
     ModelsChanged {
+        /// Entities of the `.map` that get a model.
         map: usize,
+        /// Submodels in the BSP.
         bsp: usize,
+        /// The first model whose entity changed, or which models are new or gone.
         detail: String,
     },
 }

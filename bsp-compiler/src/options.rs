@@ -11,6 +11,7 @@ use std::path::PathBuf;
 /// and unlit faces into.
 pub const DEFAULT_MAX_EDGES: usize = QUAKESPASM_MAX_UNLIT_FACE_VERTS;
 
+/// What a compile is asked to do.
 #[derive(Debug, Clone)]
 pub struct CompileOptions {
     /// The BSP version to write: BSP29 (the default), BSP2 (`-bsp2`) or 2PSB (`-2psb`). BSP29
@@ -22,6 +23,7 @@ pub struct CompileOptions {
     /// Directories searched for WADs whose textures are not embedded: only their names and
     /// sizes go into the BSP, for engines that load them from elsewhere (`-xwadpath`).
     pub xwad_dirs: Vec<PathBuf>,
+    /// How the tree's splitting planes are chosen.
     pub heuristic: SplitHeuristic,
     /// Nodes spanning more than this are cut near their middle first (0: never).
     pub max_node_size: f64,
@@ -58,7 +60,7 @@ pub struct CompileOptions {
     pub omit: Vec<String>,
     /// Write texture pixels (off: names and sizes only, for engines that have the textures).
     pub texture_data: bool,
-    /// Write the BSPX `BRUSHLIST` lump (see [`crate::brushlist`]).
+    /// Write the BSPX `BRUSHLIST` lump (see `crate::brushlist`).
     pub brush_list: bool,
     /// Keep editor-only keys (TrenchBroom's `_tb_*`) in the entity lump ([`crate::editor`]).
     pub keep_editor_keys: bool,

@@ -1,12 +1,12 @@
 //! Outside filling: flood from the void through open portals; if that reaches a point entity the
 //! map leaks (report it with a path to the void), otherwise every flooded leaf becomes solid.
 //! Then, as ericw-tools does by default, the space no point entity reaches (a closed room, the
-//! inside of a closed box) is filled too ([`fill_unreached`]).
+//! inside of a closed box) is filled too (`fill_unreached`).
 //!
 //! The flood runs over the structural leaves (vis clusters) with their structural contents:
 //! detail brushes never seal a map, as in ericw-tools. An entity lying on a brush face (within
 //! `ON_EPSILON` of a node plane, between a sealing cluster and an open one) is placed on the
-//! sealing side in hull 0 ([`OnPlane`]): a light set on the outer face of a ceiling does not leak.
+//! sealing side in hull 0 (`OnPlane`): a light set on the outer face of a ceiling does not leak.
 
 use crate::leak::{LeakReport, MapBrushRef};
 use crate::planes::PlaneSet;
@@ -21,7 +21,7 @@ use std::collections::{BinaryHeap, VecDeque};
 
 /// A point entity that marks open space.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Occupant {
+pub(crate) struct Occupant {
     pub entity: usize,
     pub classname: String,
     pub origin: DVec3,
@@ -31,7 +31,7 @@ pub struct Occupant {
 
 /// A map open to the void: the first entity the flood from outside reaches, and how.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Leak {
+pub(crate) struct Leak {
     pub occupant: Occupant,
     /// From the entity through portal centres to the outside box (what the `.pts` file holds).
     pub pointfile: Vec<DVec3>,
@@ -44,11 +44,11 @@ pub struct Leak {
 }
 
 /// How many brush faces a leak names.
-pub const EXIT_FACES: usize = 3;
+pub(crate) const EXIT_FACES: usize = 3;
 
 /// A brush face beside a leak's path.
 #[derive(Debug, Clone, PartialEq)]
-pub struct ExitFace {
+pub(crate) struct ExitFace {
     /// [`crate::brush::Brush::source`] of the brush.
     pub brush: u32,
     /// The face's texinfo (`None` for a face the compiler made).
@@ -86,7 +86,7 @@ impl Leak {
 }
 
 #[derive(Debug, Clone, PartialEq)]
-pub enum FillOutcome {
+pub(crate) enum FillOutcome {
     /// The outside was filled; this many leaves became solid.
     Sealed {
         filled: usize,
@@ -99,7 +99,7 @@ pub enum FillOutcome {
 /// Which side an entity lying on a node plane (within [`quake_formats::geom::ON_EPSILON`]) is
 /// placed on, when one side seals the map and the other is open.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum OnPlane {
+pub(crate) enum OnPlane {
     /// The sealing side: hull 0, where an entity standing exactly on a brush face of the map's
     /// outside (a light on a ceiling's top) must not leak.
     Sealing,
@@ -138,7 +138,7 @@ fn place(
 
 /// Flood `tree` from the outside and fill it unless an occupant is reached. `portals` are its
 /// cluster portals ([`crate::portals::make_cluster_portals`]).
-pub fn fill_outside(
+pub(crate) fn fill_outside(
     tree: &mut Tree,
     planes: &PlaneSet,
     portals: &Portals,
@@ -262,7 +262,7 @@ impl std::str::FromStr for FillType {
     }
 }
 
-/// What [`fill_unreached`] floods over.
+/// What `fill_unreached` floods over.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Reach {
     /// Vis clusters by their structural contents: detail neither blocks the flood nor is filled
@@ -277,7 +277,7 @@ pub enum Reach {
 /// occupant reaches through open ones: `portals` are between those units. An occupant reaches
 /// every open unit within [`quake_formats::geom::ON_EPSILON`] of it (a light on a floor holds
 /// the room above). Returns how many leaves became solid.
-pub fn fill_unreached(
+pub(crate) fn fill_unreached(
     tree: &mut Tree,
     planes: &PlaneSet,
     portals: &Portals,

@@ -51,14 +51,6 @@ impl PlaneSet {
         self.planes.len()
     }
 
-    pub fn is_empty(&self) -> bool {
-        self.planes.is_empty()
-    }
-
-    pub fn iter(&self) -> impl Iterator<Item = &Plane> {
-        self.planes.iter()
-    }
-
     /// The id of `plane`'s canonical form, and whether `plane` faces the other way.
     pub fn insert(&mut self, plane: &Plane) -> (PlaneId, bool) {
         let (canon, flipped) = canonical(plane);

@@ -11,7 +11,7 @@ use glam::{DAffine3, DMat3, DVec3};
 
 use std::path::{Path, PathBuf};
 
-pub const PREFAB_CLASSNAME: &str = "misc_external_map";
+pub(crate) const PREFAB_CLASSNAME: &str = "misc_external_map";
 const KEY_FILE: &str = "_external_map";
 const KEY_CLASSNAME: &str = "_external_map_classname";
 const KEY_ANGLES: &str = "_external_map_angles";
@@ -24,8 +24,11 @@ const KEY_SCALE: &str = "_external_map_scale";
 pub struct PrefabError {
     /// The map holding the `misc_external_map`.
     pub file: PathBuf,
+    /// The entity's line in that map.
     pub line: usize,
+    /// The entity's index in that map.
     pub entity: usize,
+    /// What is wrong.
     pub message: String,
 }
 

@@ -9,14 +9,20 @@ use quake_formats::geom::Plane;
 pub enum Projection {
     /// Quake's format: axes picked from the face normal, then rotated, scaled and shifted.
     Standard {
+        /// Texels added to s and t.
         shift: [f64; 2],
+        /// Degrees the axes are turned by.
         rotation: f64,
+        /// World units per texel along s and t (0 means 1).
         scale: [f64; 2],
     },
     /// Valve 220: explicit axes with offsets, then scaled.
     Valve {
+        /// The s axis, then its offset in texels.
         u: [f64; 4],
+        /// The t axis, then its offset in texels.
         v: [f64; 4],
+        /// World units per texel along s and t (0 means 1).
         scale: [f64; 2],
     },
 }
@@ -57,7 +63,7 @@ const BASE_AXES: [[DVec3; 3]; 6] = [
 
 /// The s and t axes Quake projects a face with `normal` onto, before rotation and scale: those
 /// of the closest base direction (earlier entries win ties, as in Quake).
-pub fn base_axes(normal: DVec3) -> [DVec3; 2] {
+pub(crate) fn base_axes(normal: DVec3) -> [DVec3; 2] {
     let mut best = 0;
     let mut best_dot = 0.0;
     for (i, axes) in BASE_AXES.iter().enumerate() {
@@ -119,7 +125,7 @@ impl Projection {
 
 /// What a texture name tells the compiler about a face and its brush.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum TextureRole {
+pub(crate) enum TextureRole {
     /// Drawn and lit.
     Normal,
     /// `sky*`: drawn unlit, makes its brush sky.
@@ -196,7 +202,10 @@ impl TextureRole {
 pub enum FaceContents {
     /// Any other texture, `skip` and `trigger` included: the brush is solid.
     Solid,
+    /// `sky*`: the brush is sky.
     Sky,
+    /// `*name`: the brush is a liquid (water, slime or lava, as a
+    /// `quake_formats::bsp::contents` value).
     Liquid(i32),
     /// `clip`: the brush only exists in the clip hulls.
     Clip,
@@ -205,7 +214,7 @@ pub enum FaceContents {
 impl FaceContents {
     /// The contents a face of `role` gives its brush; `None` for faces that give none (hint,
     /// hintskip, origin).
-    pub fn of(role: TextureRole) -> Option<FaceContents> {
+    pub(crate) fn of(role: TextureRole) -> Option<FaceContents> {
         match role {
             TextureRole::Sky => Some(FaceContents::Sky),
             TextureRole::Liquid(c) => Some(FaceContents::Liquid(c)),
@@ -234,7 +243,7 @@ impl std::fmt::Display for FaceContents {
 /// A brush's contents from its faces' textures, as id's and ericw-tools' compilers decide them:
 /// the first face that gives any decides (solid when none does). When a later face gives other
 /// contents, that face's index comes too, for a warning.
-pub fn brush_contents(roles: &[TextureRole]) -> (FaceContents, Option<usize>) {
+pub(crate) fn brush_contents(roles: &[TextureRole]) -> (FaceContents, Option<usize>) {
     let mut faces = roles
         .iter()
         .enumerate()
@@ -250,7 +259,7 @@ pub fn brush_contents(roles: &[TextureRole]) -> (FaceContents, Option<usize>) {
 /// share. Frames `0`-`9` are the main cycle, `a`-`j` the alternate one engines show on an
 /// entity whose frame is 1 (a pressed button).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct AnimationFrame<'a> {
+pub(crate) struct AnimationFrame<'a> {
     pub base: &'a str,
     pub alternate: bool,
     /// 0 to 9 within its cycle.

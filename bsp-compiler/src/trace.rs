@@ -13,6 +13,7 @@ const TRACE_EPSILON: f32 = 0.03125;
 pub struct HullTrace {
     /// Part of the way travelled: 1 when nothing was hit.
     pub fraction: f32,
+    /// Where the box's centre stopped.
     pub end: [f32; 3],
     /// The normal of the plane hit, facing the way the trace came from.
     pub normal: [f32; 3],

@@ -14,7 +14,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// How the splitting plane of a node is chosen among the node's unused brush side planes.
 ///
-/// Both first cut nodes larger than [`MID_SPLIT_SIZE`] by the axial candidate nearest the middle
+/// Both first cut nodes larger than `MID_SPLIT_SIZE` by the axial candidate nearest the middle
 /// of their longest axis, as Quake's qbsp does, which keeps big maps' trees shallow.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
 pub enum SplitHeuristic {

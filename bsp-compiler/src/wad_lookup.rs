@@ -37,7 +37,7 @@ pub struct WadSearch {
 
 /// The WAD names worldspawn's `wad` (or `_wad`) key lists (`;`-separated, paths in any style,
 /// `\` read as `/`).
-pub fn wad_names(worldspawn: &Entity) -> Vec<String> {
+pub(crate) fn wad_names(worldspawn: &Entity) -> Vec<String> {
     let key = ["wad", "_wad"]
         .iter()
         .find_map(|k| worldspawn.get(k).filter(|v| !v.trim().is_empty()))
@@ -131,7 +131,7 @@ impl WadSet {
     /// The texture lump for the textures faces use (`used`, in the order texinfos refer to
     /// them): those textures, then the other frames engines need to link their animations.
     /// Textures no WAD holds become placeholders, with a warning.
-    pub fn texture_lump(&self, used: &[&str], warnings: &mut Vec<Warning>) -> Vec<MipTex> {
+    pub(crate) fn texture_lump(&self, used: &[&str], warnings: &mut Vec<Warning>) -> Vec<MipTex> {
         let mut entries = Vec::with_capacity(used.len());
         for &name in used {
             let lump = lump_name(name);
@@ -256,7 +256,7 @@ fn placeholder_size(name: &str) -> (u32, u32) {
 /// missing animation frames and may load a replacement image of that name; and id-derived
 /// engines, which clear the texinfo's special flag for an absent miptex, do not then reject a
 /// large unsubdivided sky or liquid face ("Bad surface extents").
-pub fn placeholder(name: &str, (w, h): (u32, u32)) -> MipTex {
+pub(crate) fn placeholder(name: &str, (w, h): (u32, u32)) -> MipTex {
     let mips = std::array::from_fn(|level| {
         let (lw, lh) = (w >> level, h >> level);
         let cell = (8 >> level).max(1);

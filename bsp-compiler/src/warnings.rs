@@ -10,67 +10,95 @@ use quake_formats::bsp::limits::{
 
 use std::path::PathBuf;
 
+/// Something wrong with a map that the compiler works around.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Warning {
     /// A brush that cannot be built; it is skipped.
     BadBrush {
+        /// The entity's index in the map.
         entity: usize,
+        /// The brush's index within its entity.
         brush: usize,
+        /// The brush's line in the `.map`.
         line: usize,
+        /// Why it cannot be built.
         reason: String,
     },
     /// A brush face that cannot be used: it is dropped and the brush built from the others.
     DroppedFace {
+        /// The entity's index in the map.
         entity: usize,
+        /// The brush's index within its entity.
         brush: usize,
+        /// The face's line in the `.map`.
         line: usize,
+        /// Why it is dropped.
         reason: DroppedFace,
     },
     /// A brush whose faces' textures give different contents (sky and solid, say): the first
     /// face's are used, as in id's and ericw-tools' compilers. `line` is the first face that
     /// differs.
     MixedContents {
+        /// The entity's index in the map.
         entity: usize,
+        /// The brush's index within its entity.
         brush: usize,
+        /// The line of the first face whose contents differ.
         line: usize,
+        /// The contents the brush gets.
         used: FaceContents,
     },
-    /// A WAD worldspawn names that is nowhere it was looked for (`looked`, in order).
     /// An editor layer marked "Omit From Export": left out with everything in it.
     OmittedLayer(OmittedLayer),
+    /// A WAD worldspawn names that is nowhere it was looked for (`looked`, in order).
     MissingWad {
+        /// The name worldspawn gives.
         name: String,
+        /// The paths tried.
         looked: Vec<PathBuf>,
     },
+    /// A WAD file that cannot be read or parsed; its textures are not used.
     UnreadableWad {
+        /// The WAD file.
         path: PathBuf,
+        /// Why it cannot be used.
         reason: String,
     },
-    /// The face gets a placeholder texture.
+    /// A texture that is in no WAD: the face gets a placeholder texture.
     MissingTexture {
+        /// The texture's name.
         name: String,
     },
     /// A frame below one the map uses is in no WAD: a placeholder fills the gap, since engines
     /// refuse an animation with a missing frame.
     MissingAnimationFrame {
+        /// The missing frame's texture name.
         name: String,
     },
     /// A `+` name whose frame is not `0`-`9` or `a`-`j`: QuakeSpasm refuses to load the map.
     BadAnimationName {
+        /// The texture's name.
         name: String,
     },
     /// A brush side whose texture axes meet its plane edge-on (degenerate Valve 220 axes): its
     /// faces get Quake's own projection of the texture instead.
     DegenerateTextureAxes {
+        /// The entity's index in the map.
         entity: usize,
+        /// The brush's index within its entity.
         brush: usize,
+        /// The side's line in the `.map`.
         line: usize,
+        /// The side's texture name.
         texture: String,
     },
     /// A point entity whose origin is inside a solid or sky brush (it does not flood).
     EntityInSolid {
+        /// The entity's index in the map.
         entity: usize,
+        /// The entity's classname.
         classname: String,
+        /// The entity's origin.
         origin: DVec3,
         /// The entity's line in the `.map`.
         line: usize,
@@ -81,13 +109,17 @@ pub enum Warning {
     NoEntitiesToFlood,
     /// A brush entity with no usable brushes.
     EmptyBrushEntity {
+        /// The entity's index in the map.
         entity: usize,
+        /// The entity's classname.
         classname: String,
     },
     /// Faces without `TEX_SPECIAL` wider than WinQuake's limit (only with subdivision off or
     /// coarser than it): `faces` of them, the widest spanning `widest` texels.
     WideFaces {
+        /// How many faces are too wide.
         faces: usize,
+        /// The widest one's span in texels.
         widest: i32,
     },
     /// An entity key whose value the compiler cannot read: `used` is what it does instead.
@@ -101,6 +133,7 @@ pub enum Warning {
     },
     /// Something the compiler does not do yet; the map compiles without it.
     Unsupported {
+        /// What is not done.
         what: String,
     },
 }
