@@ -124,11 +124,15 @@ pub enum Warning {
     },
     /// An entity key whose value the compiler cannot read: `used` is what it does instead.
     BadKey {
+        /// The entity's index in the `.map`.
         entity: usize,
         /// The entity's line in the `.map`.
         line: usize,
+        /// The key.
         key: String,
+        /// Its value as written.
         value: String,
+        /// What the compiler does instead.
         used: String,
     },
     /// Something the compiler does not do yet; the map compiles without it.
