@@ -220,7 +220,9 @@ fn blocks_world_hulls(class: EntityBrushes, brush: &MapBrush) -> bool {
         EntityBrushes::Illusionary | EntityBrushes::VisBlocker => false,
         _ => {
             roles.contains(&TextureRole::Sky)
-                || !roles.iter().any(|r| matches!(r, TextureRole::Liquid(_)))
+                || !roles
+                    .iter()
+                    .any(|r| matches!(r, TextureRole::Liquid(_) | TextureRole::LiquidSkip(_)))
         }
     }
 }

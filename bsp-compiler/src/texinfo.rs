@@ -132,6 +132,9 @@ pub(crate) enum TextureRole {
     Sky,
     /// `*name`: drawn unlit and warped, makes its brush a liquid (water, slime or lava).
     Liquid(i32),
+    /// `*waterskip`, `*slimeskip`, `*lavaskip`: makes its brush that liquid, and is not drawn
+    /// (an invisible liquid, as in ericw-tools).
+    LiquidSkip(i32),
     /// `clip`: the brush only exists in the clip hulls.
     Clip,
     /// `skip`: the face is dropped.
@@ -149,6 +152,12 @@ pub(crate) enum TextureRole {
 impl TextureRole {
     pub fn of(name: &str) -> TextureRole {
         let lower = name.to_ascii_lowercase();
+        match lower.as_str() {
+            "*waterskip" => return TextureRole::LiquidSkip(contents::WATER),
+            "*slimeskip" => return TextureRole::LiquidSkip(contents::SLIME),
+            "*lavaskip" => return TextureRole::LiquidSkip(contents::LAVA),
+            _ => {}
+        }
         if lower.starts_with("sky") {
             TextureRole::Sky
         } else if let Some(rest) = lower.strip_prefix('*') {
@@ -178,7 +187,7 @@ impl TextureRole {
     pub fn is_special(self, lit_water: bool) -> bool {
         match self {
             TextureRole::Sky => true,
-            TextureRole::Liquid(_) => !lit_water,
+            TextureRole::Liquid(_) | TextureRole::LiquidSkip(_) => !lit_water,
             _ => false,
         }
     }
@@ -189,6 +198,7 @@ impl TextureRole {
             self,
             TextureRole::Clip
                 | TextureRole::Skip
+                | TextureRole::LiquidSkip(_)
                 | TextureRole::Trigger
                 | TextureRole::Hint
                 | TextureRole::HintSkip
@@ -217,7 +227,7 @@ impl FaceContents {
     pub(crate) fn of(role: TextureRole) -> Option<FaceContents> {
         match role {
             TextureRole::Sky => Some(FaceContents::Sky),
-            TextureRole::Liquid(c) => Some(FaceContents::Liquid(c)),
+            TextureRole::Liquid(c) | TextureRole::LiquidSkip(c) => Some(FaceContents::Liquid(c)),
             TextureRole::Clip => Some(FaceContents::Clip),
             TextureRole::Hint | TextureRole::HintSkip | TextureRole::Origin => None,
             TextureRole::Normal | TextureRole::Skip | TextureRole::Trigger => {
@@ -422,6 +432,17 @@ mod tests {
         assert!(!TextureRole::of("*slime0").is_special(true));
         assert!(TextureRole::of("sky4").is_special(true));
         assert!(!TextureRole::of("skip").is_drawn());
+        // ericw-tools' invisible liquids, by their exact names only.
+        assert_eq!(
+            TextureRole::of("*WaterSkip"),
+            TextureRole::LiquidSkip(contents::WATER)
+        );
+        assert!(!TextureRole::of("*lavaskip").is_drawn());
+        assert_eq!(
+            FaceContents::of(TextureRole::of("*slimeskip")),
+            Some(FaceContents::Liquid(contents::SLIME))
+        );
+        assert!(TextureRole::of("*teleskip").is_drawn());
     }
 
     proptest::proptest! {

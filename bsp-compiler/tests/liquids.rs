@@ -1,11 +1,12 @@
 //! Liquids and vis: with transparent water (the default, ericw-tools' `-transwater`) liquids are
 //! detail, so a pool does not cut its room into clusters; `-notranswater` makes them structural
-//! and opaque to vis.
+//! and opaque to vis. `*waterskip` and its kin are liquids without faces.
 
 mod common;
 
 use bsp_compiler::CompileOptions;
 use common::*;
+use quake_formats::bsp::contents;
 use quake_formats::prt::PortalFile;
 
 /// A room half full of water, with a corridor leaving it below the water line (-x) and one
@@ -129,4 +130,18 @@ fn opaque_water_is_structural_and_closed_to_vis() {
         !sees(c[2], c[3]),
         "the corridors see each other through the water line"
     );
+}
+
+/// ericw-tools' invisible liquids: a `*waterskip` brush is water without faces of its own.
+#[test]
+fn waterskip_is_water_that_is_not_drawn() {
+    let pool = box_brush([-64.0, -64.0, -128.0], [64.0, 64.0, -64.0], "*waterskip");
+    let out = compile_text(&room_map(false, &pool));
+    let bsp = &out.bsp;
+    assert_eq!(errors(bsp), Vec::<String>::new());
+    assert!((0..bsp.faces.len()).all(|f| face_texture(bsp, f) != "*waterskip"));
+    let leaf = bsp.leaf_at([0.0, 0.0, -96.0]).expect("leaf");
+    assert_eq!(bsp.leafs[leaf].contents, contents::WATER);
+    // The floor under it is drawn, seen from inside the water.
+    assert!(!faces_at(bsp, 0, [0.0, 0.0, -128.0], Some([0.0, 0.0, 1.0])).is_empty());
 }
