@@ -303,8 +303,8 @@ fn a_stage_killed_at_any_moment_leaves_the_old_outputs_or_the_new_ones() {
 
 /// Why `lit` would colour `bsp` wrongly, if it would: engines check only its header and size (3
 /// bytes a luxel after an 8-byte header), so a `.lit` from another run of the same size passes
-/// them; its grey (the rounded mean of each luxel's colour, as `slipgate light` writes the lump)
-/// gives it away.
+/// them; its grey (each luxel's brightest channel, as `slipgate light` writes the lump) gives it
+/// away.
 fn lit_mismatch(bsp: &Bsp, lit: &[u8]) -> Option<String> {
     let rgb = match quake_formats::lit::read_lit(lit, bsp.lighting.len()) {
         Ok(rgb) => rgb,
@@ -313,9 +313,7 @@ fn lit_mismatch(bsp: &Bsp, lit: &[u8]) -> Option<String> {
     let off = rgb
         .chunks_exact(3)
         .zip(&bsp.lighting)
-        .filter(|(c, grey)| {
-            (c.iter().map(|&b| u16::from(b)).sum::<u16>() + 1) / 3 != u16::from(**grey)
-        })
+        .filter(|(c, grey)| quake_formats::lit::grey_level([c[0], c[1], c[2]]) != **grey)
         .count();
     (off > 0).then(|| {
         format!(

@@ -10,7 +10,7 @@ use quake_formats::bsp::light_lumps::{
     DECOUPLED_LM, DecoupledLightmap, LIGHTING_E5BGR9, LIGHTINGDIR, LMOFFSET, LMSHIFT, RGBLIGHTING,
 };
 use quake_formats::bsp::limits::MAX_LIGHTMAPS;
-use quake_formats::lit::pack_e5bgr9;
+use quake_formats::lit::{grey_level, pack_e5bgr9};
 
 use crate::faces::OwnGrid;
 use crate::settings::Settings;
@@ -91,7 +91,7 @@ pub struct FaceLightmap {
     pub height: usize,
     /// Style of each lightmap, brightest first; empty when no light reaches the face.
     pub styles: Vec<u8>,
-    /// One byte per luxel per style: the mean of the RGB channels.
+    /// One byte per luxel per style: the brightest of the RGB channels.
     pub grey: Vec<Vec<u8>>,
     /// The channels themselves, per style, when the light is coloured or RGB output is asked
     /// for (else empty).
@@ -222,11 +222,6 @@ struct StyleMap {
     energy: u64,
 }
 
-/// The mean of a luxel's channels, rounded.
-fn grey_of(c: [u8; 3]) -> u8 {
-    ((u16::from(c[0]) + u16::from(c[1]) + u16::from(c[2]) + 1) / 3) as u8
-}
-
 /// Finishes one face. Returns the lightmap and how many styles were dropped
 /// for exceeding four.
 pub fn finish_face(light: &FaceLight, finish: &Finish) -> (FaceLightmap, usize) {
@@ -281,7 +276,7 @@ fn style_maps(light: &FaceLight, finish: &Finish) -> Vec<StyleMap> {
             let levels = to_levels(c, finish);
             let bytes = levels_to_bytes(levels);
             map.energy += bytes.iter().map(|&b| u64::from(b)).sum::<u64>();
-            map.grey.push(grey_of(bytes));
+            map.grey.push(grey_level(bytes));
             if finish.rgb {
                 map.rgb.push(bytes);
             }
@@ -622,7 +617,9 @@ mod tests {
     }
 
     #[test]
-    fn grey_is_the_rounded_channel_mean() {
+    /// ericw-tools' grey: a coloured luxel is as bright in the grey lump as its brightest
+    /// channel (a red light as bright as a white one in engines without colour).
+    fn grey_is_the_brightest_channel() {
         let light = FaceLight {
             face: 0,
             width: 1,
@@ -632,7 +629,7 @@ mod tests {
         };
         let (out, _) = finish_face(&light, &PLAIN);
         assert_eq!(out.rgb[0], vec![[20, 10, 10]]);
-        assert_eq!(out.grey[0], vec![13]);
+        assert_eq!(out.grey[0], vec![20]);
     }
 
     #[test]

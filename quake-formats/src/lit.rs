@@ -147,8 +147,16 @@ pub fn read_lit(data: &[u8], lighting_len: usize) -> Result<Vec<u8>> {
     Ok(rgb.to_vec())
 }
 
-/// How far a luxel's grey (the mean of its r, g, b) may sit from the lighting lump's byte and
-/// still be the same light: tools derive the grey lump in their own ways (rounding, weights).
+/// The grey lighting lump's byte for a luxel of colour `c`: its brightest channel, as
+/// ericw-tools writes it, so coloured light is as bright in engines that read only the grey
+/// lump as in those that read the colour.
+pub fn grey_level(c: [u8; 3]) -> u8 {
+    c[0].max(c[1]).max(c[2])
+}
+
+/// How far a luxel's grey may sit outside the span from the mean of its r, g, b to its brightest
+/// channel and still be the same light: tools derive the grey lump in their own ways (the mean,
+/// the brightest channel, rounding, weights).
 pub const LIT_GREY_TOLERANCE: u8 = 24;
 /// The share of luxels beyond [`LIT_GREY_TOLERANCE`] above which a `.lit` is another light's.
 pub const LIT_MISMATCH_SHARE: f64 = 0.1;
@@ -161,7 +169,9 @@ pub fn grey_disagreements(rgb: &[u8], lighting: &[u8]) -> usize {
         .zip(lighting)
         .filter(|(c, grey)| {
             let mean = (u32::from(c[0]) + u32::from(c[1]) + u32::from(c[2]) + 1) / 3;
-            mean.abs_diff(u32::from(**grey)) > u32::from(LIT_GREY_TOLERANCE)
+            let brightest = u32::from(grey_level([c[0], c[1], c[2]]));
+            let (grey, tolerance) = (u32::from(**grey), u32::from(LIT_GREY_TOLERANCE));
+            grey + tolerance < mean || grey > brightest + tolerance
         })
         .count()
 }
@@ -169,6 +179,18 @@ pub fn grey_disagreements(rgb: &[u8], lighting: &[u8]) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn grey_is_the_brightest_channel_and_either_convention_agrees() {
+        assert_eq!(grey_level([255, 0, 0]), 255);
+        assert_eq!(grey_level([10, 200, 30]), 200);
+        // A red luxel: ericw-tools' grey (255) and the mean (85) both agree with it.
+        let rgb = [255, 0, 0, 255, 0, 0, 255, 0, 0];
+        assert_eq!(grey_disagreements(&rgb, &[255, 85, 40]), 1);
+        // White: one grey only.
+        assert_eq!(grey_disagreements(&[100, 100, 100], &[100]), 0);
+        assert_eq!(grey_disagreements(&[100, 100, 100], &[130]), 1);
+    }
 
     #[test]
     fn round_trip_and_size_check() {
