@@ -148,11 +148,22 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
     let lump = bsp.phong_faces().map_err(LightError::SlipgateLump)?;
     let groups = phong::groups(&faces, &map_lights.phong, lump.as_deref());
     let phong = phong::corner_normals(&faces, &groups);
+    let in_liquid = |p: DVec3| {
+        let leaf = bsp.leaf_at(p.as_vec3().to_array());
+        let contents = leaf.and_then(|l| bsp.leafs.get(l)).map(|l| l.contents);
+        matches!(
+            contents,
+            Some(quake_formats::bsp::contents::WATER)
+                | Some(quake_formats::bsp::contents::SLIME)
+                | Some(quake_formats::bsp::contents::LAVA)
+        )
+    };
     let surface = surface::expand_templates(
         &map_lights.templates,
         &faces,
         &map_lights.surflight_groups,
         surface::DEFAULT_SPACING,
+        &in_liquid,
     );
     let surface_lights = surface.len();
     let mut point_lights = map_lights.points.clone();

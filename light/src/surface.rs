@@ -1,6 +1,7 @@
 //! `_surface` lights: a light entity used as a template, copied over every
 //! face with the named texture, one copy per piece of the face after cutting
-//! it on a grid of `spacing` units, placed `offset` units in front of it.
+//! it on the lines of a grid of `spacing` units (as ericw-tools does), placed
+//! `offset` units in front of the piece's middle.
 //! A template with a `_surflight_group` only goes on faces of brush models
 //! with that group (and one without on faces of models without one).
 
@@ -15,17 +16,20 @@ use crate::lights::{PointLight, Spot, SurfaceTemplate};
 /// Default grid spacing of surface light copies (ericw-tools' 128).
 pub const DEFAULT_SPACING: f64 = 128.0;
 
-/// Cuts `w` on axial planes until no piece spans more than `spacing` on any axis.
+/// Pieces thinner than this along an axis are not cut off.
+const MIN_PIECE: f64 = 8.0;
+
+/// Cuts `w` as Quake's warped-surface subdivision does (and ericw-tools places its surface
+/// lights by): along each axis, on the line of the `spacing` grid nearest the piece's middle,
+/// unless that leaves a part thinner than [`MIN_PIECE`]; then the parts again. Pieces end no
+/// wider than `spacing`, and a face across a grid line is cut there however small it is.
 fn subdivide(w: Winding, spacing: f64, out: &mut Vec<Winding>) {
     let b = w.bounds();
     for axis in 0..3 {
         let (lo, hi) = (b.mins[axis], b.maxs[axis]);
-        if hi - lo <= spacing {
+        let cut = spacing * ((lo + hi) / 2.0 / spacing + 0.5).floor();
+        if hi - cut < MIN_PIECE || cut - lo < MIN_PIECE {
             continue;
-        }
-        let mut cut = ((lo / spacing).floor() + 1.0) * spacing;
-        if cut <= lo + 1.0 || cut >= hi - 1.0 {
-            cut = (lo + hi) / 2.0;
         }
         let mut normal = DVec3::ZERO;
         normal[axis] = 1.0;
@@ -39,20 +43,27 @@ fn subdivide(w: Winding, spacing: f64, out: &mut Vec<Winding>) {
 }
 
 /// The lights every template puts on the faces using its texture, in its group (`groups`:
-/// brush models with a non-zero `_surflight_group`).
+/// brush models with a non-zero `_surflight_group`). A liquid's faces seen from inside it (those
+/// `in_liquid` says look into liquid from their middle) get none, as in ericw-tools.
 pub fn expand_templates(
     templates: &[SurfaceTemplate],
     faces: &[FaceGeom],
     groups: &HashMap<usize, i64>,
     spacing: f64,
+    in_liquid: &dyn Fn(DVec3) -> bool,
 ) -> Vec<PointLight> {
     let group_of = |model: usize| groups.get(&model).copied().unwrap_or(0);
+    let underwater_side = |f: &FaceGeom| {
+        let middle = Winding::new(f.points.clone()).center();
+        f.texture.starts_with('*') && in_liquid(middle + f.plane.normal)
+    };
     let mut out = Vec::new();
     for t in templates {
-        for f in faces
-            .iter()
-            .filter(|f| f.texture.eq_ignore_ascii_case(&t.texture) && group_of(f.model) == t.group)
-        {
+        for f in faces.iter().filter(|f| {
+            f.texture.eq_ignore_ascii_case(&t.texture)
+                && group_of(f.model) == t.group
+                && !underwater_side(f)
+        }) {
             let mut pieces = Vec::new();
             subdivide(Winding::new(f.points.clone()), spacing, &mut pieces);
             for piece in pieces {
@@ -122,10 +133,40 @@ mod tests {
             group,
         };
         let groups = HashMap::from([(1, 7)]);
-        let on = |t: SurfaceTemplate| expand_templates(&[t], &faces, &groups, 128.0).len();
+        let on =
+            |t: SurfaceTemplate| expand_templates(&[t], &faces, &groups, 128.0, &|_| false).len();
         assert_eq!(on(template(0)), 2, "the world's face and model 2's");
         assert_eq!(on(template(7)), 1, "model 1's face only");
         assert_eq!(on(template(3)), 0);
+    }
+
+    /// As ericw-tools' `-surflight_dump` shows: a 64-unit square across the origin is cut into
+    /// four on the grid's lines, one off them is not cut.
+    #[test]
+    fn small_faces_are_cut_where_grid_lines_cross_them() {
+        let square = |lo: f64| {
+            let hi = lo + 64.0;
+            Winding::new(vec![
+                DVec3::new(lo, lo, 0.0),
+                DVec3::new(lo, hi, 0.0),
+                DVec3::new(hi, hi, 0.0),
+                DVec3::new(hi, lo, 0.0),
+            ])
+        };
+        let pieces = |w: Winding| {
+            let mut out = Vec::new();
+            subdivide(w, 128.0, &mut out);
+            out
+        };
+        let across = pieces(square(-32.0));
+        assert_eq!(across.len(), 4);
+        for p in &across {
+            let c = p.center();
+            assert_eq!((c.x.abs(), c.y.abs()), (16.0, 16.0));
+        }
+        assert_eq!(pieces(square(10.0)).len(), 1);
+        // 4 units over a grid line: too thin a part to cut off.
+        assert_eq!(pieces(square(-4.0)).len(), 1);
     }
 
     #[test]
