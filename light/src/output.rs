@@ -223,7 +223,7 @@ struct StyleMap {
 }
 
 /// The mean of a luxel's channels, rounded.
-fn grey_of(c: [u8; 3]) -> u8 {
+pub(crate) fn grey_of(c: [u8; 3]) -> u8 {
     ((u16::from(c[0]) + u16::from(c[1]) + u16::from(c[2]) + 1) / 3) as u8
 }
 
@@ -457,7 +457,7 @@ pub fn write_lighting(bsp: &mut Bsp, maps: &[FaceLightmap], outputs: &Outputs) -
 }
 
 /// The `LMSHIFT` of Quake's 16-texel grid.
-const QUAKE_SHIFT: u8 = 4;
+pub(crate) const QUAKE_SHIFT: u8 = 4;
 
 /// The `DECOUPLED_LM` record of a face without a lightmap.
 const NO_OWN_GRID: DecoupledLightmap = DecoupledLightmap {
