@@ -7,7 +7,7 @@ mod command;
 use std::path::Path;
 
 /// Every setting `slipgate report` measures, as its tables name them.
-const SETTINGS: [(&str, &str); 13] = [
+const SETTINGS: [(&str, &str); 16] = [
     ("bsp", "default"),
     ("vis", "fast"),
     ("vis", "full"),
@@ -17,6 +17,9 @@ const SETTINGS: [(&str, &str); 13] = [
     ("light", "--soft"),
     ("light", "--bounce"),
     ("light", "--extra4 --soft --bounce"),
+    ("light", "--world_units_per_luxel 8"),
+    ("light", "--lightgrid"),
+    ("light", "--bspxlit --lux --hdr"),
     ("view", "span step 1"),
     ("view", "span step 8"),
     ("view", "span step 16"),
@@ -123,6 +126,19 @@ fn report_measures_every_stage_and_setting_and_draws_its_plots() {
                 // lightmap would be far off.
                 if row["setting"] == "--extra4" {
                     assert!(figures["light"]["rmse"].as_f64() < Some(1.0), "{row}");
+                }
+                // The grid's own cost is read from light's --stats, and only its run has one.
+                let grid_cost = &figures["light"]["grid_cost"];
+                if row["setting"] == "--lightgrid" {
+                    assert_eq!(figures["light"]["measured"], "light_grid", "{row}");
+                    assert!(grid_cost["seconds"].as_f64() > Some(0.0), "{row}");
+                    assert!(grid_cost["share"].as_f64() < Some(1.0), "{row}");
+                } else {
+                    assert!(grid_cost.is_null(), "{row}");
+                }
+                if row["setting"] == "--world_units_per_luxel 8" {
+                    let own = &figures["light"]["measured"]["own_grids"];
+                    assert_eq!(own["world_units_per_luxel"], 8.0, "{row}");
                 }
                 figures["light"]["rmse"].as_f64()
             }

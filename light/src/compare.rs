@@ -4,13 +4,16 @@
 use std::collections::HashMap;
 
 use quake_formats::Bsp;
+use quake_formats::bsp::lightgrid::{GridSample, LightGrid};
+use quake_formats::extents::{LightmapExtents, LuxelGrid};
 
 use crate::error::LightError;
 use crate::lighting::{Lighting, Stats};
 use crate::options::Options;
-use crate::output::FaceLightmap;
+use crate::output::{FaceLightmap, QUAKE_SHIFT};
 use crate::quality::Quality;
 use crate::run::{finish_lighting, trace_lighting};
+use quake_formats::lit::grey_level;
 
 /// Per-luxel difference between two lightings of the same faces, in 8-bit levels.
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
@@ -31,17 +34,49 @@ pub struct ErrorStats {
     pub black_over_2: u64,
 }
 
+/// [`ErrorStats`] being gathered, one pair of grey levels at a time.
+#[derive(Default)]
+struct Tally {
+    e: ErrorStats,
+    squares: f64,
+}
+
+impl Tally {
+    /// One luxel: `x` here, `y` in the reference.
+    fn add(&mut self, x: u8, y: u8) {
+        let d = x.abs_diff(y);
+        let e = &mut self.e;
+        e.luxels += 1;
+        self.squares += f64::from(d) * f64::from(d);
+        e.max = e.max.max(d);
+        e.over_8 += u64::from(d > 8);
+        e.over_2 += u64::from(d > 2);
+        e.black += u64::from(x == 0 && y > 0);
+        e.black_over_2 += u64::from(x == 0 && y > 2);
+    }
+
+    fn finish(self) -> ErrorStats {
+        ErrorStats {
+            rmse: (self.squares / self.e.luxels.max(1) as f64).sqrt(),
+            ..self.e
+        }
+    }
+}
+
 /// Compares grey lightmaps face by face and style by style (a style only one
-/// side has counts against zero).
+/// side has counts against zero). Faces whose lightmaps differ in size are not on the same
+/// grid (another tool's own grids) and are left out.
 pub fn compare(a: &Lighting, reference: &Lighting) -> ErrorStats {
     let by_face: HashMap<usize, &FaceLightmap> =
         reference.lightmaps.iter().map(|m| (m.face, m)).collect();
-    let mut e = ErrorStats::default();
-    let mut sq = 0.0f64;
+    let mut tally = Tally::default();
     for m in &a.lightmaps {
         let Some(r) = by_face.get(&m.face) else {
             continue;
         };
+        if (m.width, m.height) != (r.width, r.height) {
+            continue;
+        }
         let mut styles: Vec<u8> = m.styles.clone();
         styles.extend(r.styles.iter().filter(|s| !m.styles.contains(s)));
         let zeros = vec![0u8; m.width * m.height];
@@ -53,62 +88,122 @@ pub fn compare(a: &Lighting, reference: &Lighting) -> ErrorStats {
                     .map_or(zeros.clone(), |i| f.grey[i].clone())
             };
             for (x, y) in pick(m).iter().zip(pick(r).iter()) {
-                let d = x.abs_diff(*y);
-                e.luxels += 1;
-                sq += f64::from(d) * f64::from(d);
-                e.max = e.max.max(d);
-                e.over_8 += u64::from(d > 8);
-                e.over_2 += u64::from(d > 2);
-                e.black += u64::from(*x == 0 && *y > 0);
-                e.black_over_2 += u64::from(*x == 0 && *y > 2);
+                tally.add(*x, *y);
             }
         }
     }
-    e.rmse = (sq / e.luxels.max(1) as f64).sqrt();
-    e
+    tally.finish()
+}
+
+/// Compares two light grids (`LIGHTGRID_OCTREE`) point by point, in grey levels of the points'
+/// colours: each style of each point open in both grids counts as one luxel of the
+/// [`ErrorStats`] (a style only one side has counts against zero). `None` when the grids'
+/// points are not the same (spacing, origin or size differ).
+pub fn compare_grids(grid: &LightGrid, reference: &LightGrid) -> Option<ErrorStats> {
+    let same_points =
+        (grid.spacing, grid.mins, grid.size) == (reference.spacing, reference.mins, reference.size);
+    if !same_points {
+        return None;
+    }
+    let [w, h, d] = grid.size;
+    let mut tally = Tally::default();
+    for index in (0..d).flat_map(|z| (0..h).flat_map(move |y| (0..w).map(move |x| [x, y, z]))) {
+        let (Some(Some(a)), Some(Some(r))) = (grid.point(index), reference.point(index)) else {
+            continue;
+        };
+        let grey = |samples: &[GridSample], style: u8| {
+            samples
+                .iter()
+                .find(|s| s.style == style)
+                .map_or(0, |s| grey_level(s.rgb))
+        };
+        let mut styles: Vec<u8> = a.iter().chain(r).map(|s| s.style).collect();
+        styles.sort_unstable();
+        styles.dedup();
+        for style in styles {
+            tally.add(grey(a, style), grey(r, style));
+        }
+    }
+    Some(tally.finish())
 }
 
 /// The lightmaps `bsp` already holds for `faces` (grey bytes of every style), as a [`Lighting`]
 /// to [`compare`]: how another run or another tool's light is measured against ours. Faces
 /// without a lightmap or with indices out of range are left out.
 pub fn lightmaps_in(bsp: &Bsp, faces: &[usize]) -> Lighting {
-    let mut lightmaps = Vec::new();
-    for &f in faces {
-        let Some(face) = bsp.faces.get(f) else {
-            continue;
-        };
-        let (Some(verts), Some(ti)) = (
-            bsp.face_vertices(face),
-            bsp.texinfo.get(face.texinfo as usize),
-        ) else {
-            continue;
-        };
-        if face.light_offset < 0 {
-            continue;
+    let lightmaps = faces.iter().filter_map(|&f| {
+        let face = bsp.faces.get(f)?;
+        let verts = bsp.face_vertices(face)?;
+        let ti = bsp.texinfo.get(face.texinfo as usize)?;
+        let size = LightmapExtents::from_points(&verts, &ti.vecs).luxel_size();
+        stored_lightmap(bsp, f, face.light_offset, size)
+    });
+    lighting_of(lightmaps.collect())
+}
+
+/// The lightmaps `bsp` holds for `faces` on the faces' own grids, as their `DECOUPLED_LM`
+/// records (`--world_units_per_luxel`) or their `LMSHIFT` and `LMOFFSET` (`--lmshift`,
+/// `_lmscale`) place and size them, as a [`Lighting`] to [`compare`] with [`own_grids`] of a
+/// run. Faces without a lightmap on a grid of their own, or with indices out of range, are
+/// left out.
+///
+/// # Errors
+/// [`LightError::LightLump`] when one of those lumps is damaged.
+pub fn own_grid_lightmaps_in(bsp: &Bsp, faces: &[usize]) -> Result<Lighting, LightError> {
+    let decoupled = bsp.decoupled_lightmaps().map_err(LightError::LightLump)?;
+    let shifts = bsp.lightmap_shifts().map_err(LightError::LightLump)?;
+    let offsets = bsp.lightmap_offsets().map_err(LightError::LightLump)?;
+    let own_grid = |f: usize| -> Option<(i32, [usize; 2])> {
+        if let Some(record) = decoupled.as_ref().and_then(|d| d.get(f)) {
+            return Some((record.offset, record.grid().size));
         }
-        let [w, h] =
-            quake_formats::extents::LightmapExtents::from_points(&verts, &ti.vecs).luxel_size();
-        let styles: Vec<u8> = face.styles.iter().copied().filter(|&s| s != 255).collect();
-        let grey = (0..styles.len())
-            .map(|k| {
-                let at = face.light_offset as usize + k * w * h;
-                bsp.lighting
-                    .get(at..at + w * h)
-                    .map_or(vec![0; w * h], <[u8]>::to_vec)
-            })
-            .collect();
-        lightmaps.push(FaceLightmap {
-            face: f,
-            width: w,
-            height: h,
-            styles,
-            grey,
-            rgb: Vec::new(),
-            hdr: Vec::new(),
-            directions: Vec::new(),
-            own_grid: None,
-        });
-    }
+        let shift = *shifts.as_ref()?.get(f)?;
+        let offset = *offsets.as_ref()?.get(f)?;
+        let face = bsp.faces.get(f)?;
+        let verts = bsp.face_vertices(face)?;
+        let ti = bsp.texinfo.get(face.texinfo as usize)?;
+        // Faces left on Quake's grid keep shift 4 and their 16-texel lightmap.
+        (shift != QUAKE_SHIFT).then_some(())?;
+        Some((offset, LuxelGrid::shifted(&verts, &ti.vecs, shift)?.size))
+    };
+    let lightmaps = faces.iter().filter_map(|&f| {
+        let (offset, size) = own_grid(f)?;
+        stored_lightmap(bsp, f, offset, size)
+    });
+    Ok(lighting_of(lightmaps.collect()))
+}
+
+/// Face `f`'s lightmaps of `size` luxels from `offset` in `bsp`'s lighting data, one per style
+/// the face lists; `None` without a lightmap (offset -1) or a style. A lightmap past the data's
+/// end reads as black.
+fn stored_lightmap(bsp: &Bsp, f: usize, offset: i32, size: [usize; 2]) -> Option<FaceLightmap> {
+    let face = bsp.faces.get(f)?;
+    let offset = usize::try_from(offset).ok()?;
+    let [w, h] = size;
+    let styles: Vec<u8> = face.styles.iter().copied().filter(|&s| s != 255).collect();
+    let grey = (0..styles.len())
+        .map(|k| {
+            let at = offset + k * w * h;
+            bsp.lighting
+                .get(at..at + w * h)
+                .map_or(vec![0; w * h], <[u8]>::to_vec)
+        })
+        .collect();
+    Some(FaceLightmap {
+        face: f,
+        width: w,
+        height: h,
+        styles,
+        grey,
+        rgb: Vec::new(),
+        hdr: Vec::new(),
+        directions: Vec::new(),
+        own_grid: None,
+    })
+}
+
+/// Lightmaps read from a BSP as a [`Lighting`] of nothing else.
+fn lighting_of(lightmaps: Vec<FaceLightmap>) -> Lighting {
     Lighting {
         lightmaps,
         entity_text: None,

@@ -66,7 +66,8 @@ mod visibility;
 pub use bench::{BareOcclusion, bare_occlusion};
 pub use bounce::Density as BounceDensity;
 pub use compare::{
-    ErrorStats, ReferenceComparison, compare, compare_with_reference, lightmaps_in, own_grids,
+    ErrorStats, ReferenceComparison, compare, compare_grids, compare_with_reference, lightmaps_in,
+    own_grid_lightmaps_in, own_grids,
 };
 pub use embree::CONFIG_ENV as EMBREE_CONFIG_ENV;
 pub use error::LightError;

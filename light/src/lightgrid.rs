@@ -5,7 +5,8 @@
 //! light and sun whose ray reaches it, without the angle term, and the world's minlight as a
 //! floor under style 0. Bounced light and dirt are not gathered. Points inside solid or sky
 //! are marked occluded; engines then use their neighbours. As for faces, the PVS culls lights
-//! and sun directions that cannot reach a point's leaf.
+//! and sun directions that cannot reach a point's leaf. The reference (`--reference`) samples
+//! the same points without that culling and through every direction of every sun.
 
 use glam::DVec3;
 use quake_formats::Bsp;
@@ -68,6 +69,12 @@ pub struct GridSources<'a> {
     pub gate: f64,
     /// Length of sun rays.
     pub sun_distance: f32,
+    /// Skip lights and sun directions the PVS says cannot reach a point (off for the reference
+    /// and `--no-cull`).
+    pub cull: bool,
+    /// Trace every direction of a soft sun or sky dome, not [`GRID_SUN_DIRECTIONS`] of them
+    /// (the reference).
+    pub every_sun_direction: bool,
 }
 
 /// Points of a grid row traced together (a packet of rays).
@@ -131,7 +138,11 @@ pub fn trace_grid(sources: &GridSources, spacing: DVec3) -> Result<RawGrid, Ligh
             most: MAX_GRID_POINTS,
         });
     }
-    let suns = grid_suns(sources.suns);
+    let suns = if sources.every_sun_direction {
+        sources.suns.to_vec()
+    } else {
+        grid_suns(sources.suns)
+    };
     let sources = &GridSources {
         suns: &suns,
         ..*sources
@@ -384,7 +395,7 @@ fn trace_run(src: &GridSources, sky: &LeafSky, points: &[DVec3]) -> (Vec<RawPoin
                 let Some(leaf) = places[i] else {
                     continue;
                 };
-                if !src.vis.may_reach_leafs(light_leaf, leaf.as_slice()) {
+                if src.cull && !src.vis.may_reach_leafs(light_leaf, leaf.as_slice()) {
                     continue;
                 }
                 let Some((dist, dir)) = (light.origin - p).length_and_direction() else {
@@ -406,7 +417,15 @@ fn trace_run(src: &GridSources, sky: &LeafSky, points: &[DVec3]) -> (Vec<RawPoin
         }
         let directions: Vec<Option<&[bool]>> = places
             .iter()
-            .map(|place| place.map(|leaf| sky.directions(src.bsp, src.vis, leaf)))
+            .map(|place| {
+                place.map(|leaf| {
+                    if src.cull {
+                        sky.directions(src.bsp, src.vis, leaf)
+                    } else {
+                        &sky.all
+                    }
+                })
+            })
             .collect();
         for (si, sun) in src.suns.iter().enumerate() {
             lanes.clear();

@@ -452,7 +452,7 @@ pub fn write_lighting(bsp: &mut Bsp, maps: &[FaceLightmap], outputs: &Outputs) -
 }
 
 /// The `LMSHIFT` of Quake's 16-texel grid.
-const QUAKE_SHIFT: u8 = 4;
+pub(crate) const QUAKE_SHIFT: u8 = 4;
 
 /// The `DECOUPLED_LM` record of a face without a lightmap.
 const NO_OWN_GRID: DecoupledLightmap = DecoupledLightmap {

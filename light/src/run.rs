@@ -159,14 +159,22 @@ impl<'a> Plan<'a> {
         self.options.quality == Quality::Reference
     }
 
-    /// What tracing the run's faces reads: no culling for the reference or with `--no-cull`,
-    /// and no adaptive sampling for the reference.
+    /// No culling for the reference or with `--no-cull`.
+    fn cull(&self) -> bool {
+        !self.options.no_cull && !self.reference()
+    }
+
+    /// What tracing the run's faces reads: culled as [`Plan::cull`] says, and no adaptive
+    /// sampling for the reference.
     fn setup(&self) -> TraceSetup<'_> {
-        let reference = self.reference();
-        let cull = !self.options.no_cull && !reference;
         let gate = self.prep.lights.settings.gate;
-        self.prep
-            .trace_setup(self.bsp, &self.reaches, gate, cull, !reference)
+        self.prep.trace_setup(
+            self.bsp,
+            &self.reaches,
+            gate,
+            self.cull(),
+            !self.reference(),
+        )
     }
 
     /// What tracing the reference's bounce emitters reads: culled and adaptive, as `--extra4`.
@@ -274,6 +282,8 @@ impl<'a> Plan<'a> {
             minlight: prep.lights.minlight.get(&0),
             gate: settings.gate,
             sun_distance: prep.sun_distance,
+            cull: self.cull(),
+            every_sun_direction: self.reference(),
         };
         trace_grid(&sources, settings.lightgrid_dist.0).map(Some)
     }

@@ -2089,6 +2089,57 @@ fn eight_units_per_luxel_are_no_further_from_the_reference_than_sixteen_texels()
     assert!(e8.max <= e16.max, "{e8:?} against {e16:?}");
 }
 
+/// What a lit BSP file holds on the faces' own grids reads back as the run lit it, through
+/// `DECOUPLED_LM` and through `LMSHIFT` and `LMOFFSET`.
+#[test]
+fn own_grid_lightmaps_read_back_from_the_lit_file_as_lit() {
+    let mut shifted = options(Quality::Default);
+    shifted.overrides.lmshift = Some(3);
+    for options in [on_own_grids(Quality::Default, 8.0), shifted] {
+        let mut bsp = shadow_scene("\"light\" \"300\"");
+        let lighting = compute_lighting(&bsp, &options).expect("light");
+        apply_lighting(&mut bsp, &lighting);
+        let lit = Bsp::read(&bsp.write().expect("BSP encodes")).expect("BSP decodes");
+        let faces: Vec<usize> = (0..lit.faces.len()).collect();
+        let read = crate::own_grid_lightmaps_in(&lit, &faces).expect("own-grid lumps read");
+        let lit_own = own_grid_lightmaps(&lighting);
+        let as_lit = |l: &crate::Lighting| -> Vec<_> {
+            let with_light = l.lightmaps.iter().filter(|m| !m.styles.is_empty());
+            with_light
+                .map(|m| (m.face, m.width, m.height, m.styles.clone(), m.grey.clone()))
+                .collect()
+        };
+        assert_eq!(as_lit(&read), as_lit(&lit_own), "{:?}", options.overrides);
+        assert!(!read.lightmaps.is_empty());
+    }
+    let unlit = shadow_scene("\"light\" \"300\"");
+    let read = crate::own_grid_lightmaps_in(&unlit, &[0, 1]).expect("no lumps to read");
+    assert!(read.lightmaps.is_empty(), "no face has its own grid");
+}
+
+/// Without a sun to thin or a PVS to cull by, the reference samples the grid as a run does;
+/// grids of other points do not compare.
+#[test]
+fn the_light_grid_reference_of_a_sunless_map_is_the_grid() {
+    let (bsp, grid, _) = shadow_scene_grid();
+    let mut reference = options(Quality::Reference);
+    reference.overrides.lightgrid = Some(true);
+    reference.only_faces = Some(Vec::new());
+    let exact = compute_lighting(&bsp, &reference).expect("light");
+    assert!(
+        exact.lightmaps.iter().all(|m| m.styles.is_empty()),
+        "no face lit"
+    );
+    let exact = exact.light_grid.expect("the reference samples the grid");
+    let e = crate::compare_grids(&grid, &exact).expect("the same points");
+    assert!(e.luxels > 0 && e.rmse == 0.0, "{e:?}");
+    let wider = quake_formats::bsp::lightgrid::LightGrid {
+        spacing: [64.0; 3],
+        ..exact
+    };
+    assert_eq!(crate::compare_grids(&grid, &wider), None);
+}
+
 /// A floor lit by a light on the far side of a thin wall standing on it: the near floor stays
 /// dark at every spacing, on its own grid and in the 16-texel lightmap read from it.
 #[test]

@@ -21,10 +21,10 @@ mod settings;
 use std::path::PathBuf;
 
 pub use machine::Machine;
-pub use measure::{BspFigures, LightFigures, ViewFigures, VisFigures};
+pub use measure::{BspFigures, GridCost, LightFigures, ViewFigures, VisFigures};
 pub use process::Timing;
 pub use run::run;
-pub use settings::{Stage, Tool};
+pub use settings::{LightMeasure, Stage, Tool};
 
 /// What to measure and where to write it.
 #[derive(Debug, Clone)]
@@ -70,7 +70,7 @@ pub struct Report {
     pub anchor: Option<PathBuf>,
     /// The maps measured.
     pub maps: Vec<PathBuf>,
-    /// Per map: every Nth face lit by the light reference, and how long the references took.
+    /// Per map: every Nth face lit by light's references, and how long each reference took.
     pub light_references: Vec<LightReference>,
     /// Every stage at every setting on every map, by each tool.
     pub rows: Vec<Row>,
@@ -85,10 +85,17 @@ pub struct LightReference {
     pub face_stride: usize,
     /// Faces the reference lit.
     pub faces: usize,
-    /// Seconds the reference took for direct light.
-    pub seconds_direct: f64,
-    /// Seconds the reference with one bounce took; `None` when no setting bounces.
-    pub seconds_bounce: Option<f64>,
+    /// Each reference the settings asked for, and its seconds.
+    pub references: Vec<ReferenceSeconds>,
+}
+
+/// How long one of light's references took on one map.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct ReferenceSeconds {
+    /// What the reference computed, as the settings measured against it measure it.
+    pub measure: LightMeasure,
+    /// Seconds it took.
+    pub seconds: f64,
 }
 
 /// One stage at one setting on one map by one tool.

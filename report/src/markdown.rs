@@ -101,20 +101,34 @@ fn stage_note(report: &Report, stage: Stage) -> String {
                 .light_references
                 .iter()
                 .map(|r| {
+                    let seconds: Vec<String> = r
+                        .references
+                        .iter()
+                        .map(|t| format!("{} {:.2} s", t.measure.reference_name(), t.seconds))
+                        .collect();
                     format!(
-                        "{} every {} faces ({} faces; reference {:.1} s{})",
+                        "{} every {} faces ({} faces; references: {})",
                         r.map,
                         r.face_stride,
                         r.faces,
-                        r.seconds_direct,
-                        r.seconds_bounce
-                            .map_or(String::new(), |b| format!(", with bounce {b:.1} s"))
+                        seconds.join(", ")
                     )
                 })
                 .collect();
             format!(
                 "Grey lightmap bytes of every style against `--reference` (16x16 samples per \
-                 luxel; with bounce for the bouncing settings), in 8-bit levels, on {}.",
+                 luxel, no culling; with bounce for the bouncing settings), in 8-bit levels, on \
+                 {}. `--world_units_per_luxel 8` is measured on the faces' own grids (its \
+                 `DECOUPLED_LM` lightmaps) against the reference lit on the same grids; \
+                 `--lightgrid` on its grid's points (grey of each style at each open point of \
+                 `LIGHTGRID_OCTREE`) against the reference's grid of the same points, which \
+                 traces every direction of soft suns and sky domes and culls nothing by the PVS \
+                 (the grid takes one ray per light and at most 16 directions per sun); a grid of \
+                 other points is not measured (ericw-tools puts its points on whole units, \
+                 where floors lie; ours sit half a unit off); the \
+                 output-only modes (`--bspxlit --lux --hdr`) as the default light. The light \
+                 grid column is the grid's own time in light's run (its `--stats`), beside that \
+                 run's time lighting the faces and the grid's share of the whole run.",
                 faces.join("; ")
             )
         }
@@ -145,7 +159,7 @@ fn table(stage: Stage, rows: &[&Row]) -> String {
             "seen, not in PVS",
             "PVS / sampled",
         ],
-        Stage::Light => &["RMSE", "max", "> 2 levels", "luxels"],
+        Stage::Light => &["RMSE", "max", "> 2 levels", "compared", "light grid"],
         Stage::View => &["fps", "mean diff", "max diff", "other face"],
     };
     let mut s = String::from("| map | setting | tool | wall | CPU | peak memory |");
@@ -206,7 +220,17 @@ fn figure_cells(f: &Figures) -> Vec<String> {
             format!("{:.3}", l.rmse),
             l.max.to_string(),
             format!("{:.2} %", 100.0 * l.over_2_share),
-            l.luxels.to_string(),
+            format!("{} {}", l.luxels, l.measured.counted()),
+            l.grid_cost.map_or("—".into(), |g| {
+                format!(
+                    "{:.3} s ({:.1} % of the run; faces {:.3} s), {} of {} points open",
+                    g.seconds,
+                    100.0 * g.share,
+                    g.lightmap_seconds,
+                    g.open_points,
+                    g.points
+                )
+            }),
         ],
         Figures::View(v) => vec![
             format!("{:.1}", v.fps),

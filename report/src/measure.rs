@@ -3,12 +3,17 @@
 
 use std::path::Path;
 
-use light::{Lighting, Options, Quality, compare, finish_lighting, lightmaps_in, trace_lighting};
+use light::{
+    Lighting, Options, Quality, compare, compare_grids, finish_lighting, lightmaps_in,
+    own_grid_lightmaps_in, own_grids, trace_lighting,
+};
 use quake_formats::Bsp;
+use quake_formats::bsp::lightgrid::LightGrid;
 use quake_formats::prt::PortalFile;
 use runtime_viewer::{Comparison, ViewSummary};
 
 use crate::ReportError;
+use crate::settings::LightMeasure;
 
 pub fn read_bsp(path: &Path) -> Result<Bsp, ReportError> {
     let bytes = std::fs::read(path).map_err(ReportError::io(path))?;
@@ -155,60 +160,70 @@ pub fn vis_figures(bsp_path: &Path, pairs: usize) -> Result<VisFigures, ReportEr
     })
 }
 
-/// Light's references of one BSP on every Nth face: direct light, and with one bounce.
+/// Light's references of one BSP on every Nth face, each taken the first time a setting asks
+/// for it.
 pub struct LightReferences {
     pub face_stride: usize,
     pub faces: Vec<usize>,
-    pub direct: Lighting,
-    pub seconds_direct: f64,
-    /// Computed the first time a bouncing setting asks for it.
-    pub bounce: Option<(Lighting, f64)>,
+    /// Each reference taken: what it measures, its lighting and its seconds.
+    pub taken: Vec<(LightMeasure, Lighting, f64)>,
     bsp: Bsp,
     bsp_path: std::path::PathBuf,
 }
 
 impl LightReferences {
-    /// The direct reference of about `faces_wanted` faces of `bsp_path` (every Nth face).
+    /// References of about `faces_wanted` faces of `bsp_path` (every Nth face).
     pub fn new(bsp_path: &Path, faces_wanted: usize) -> Result<LightReferences, ReportError> {
         let bsp = read_bsp(bsp_path)?;
         let face_stride = bsp.faces.len().div_ceil(faces_wanted.max(1)).max(1);
         let faces: Vec<usize> = (0..bsp.faces.len()).step_by(face_stride).collect();
-        let (direct, seconds_direct) = reference(&bsp, bsp_path, &faces, false)?;
         Ok(LightReferences {
             face_stride,
             faces,
-            direct,
-            seconds_direct,
-            bounce: None,
+            taken: Vec::new(),
             bsp,
             bsp_path: bsp_path.to_path_buf(),
         })
     }
 
-    /// The reference a setting is measured against.
-    pub fn for_setting(&mut self, bounces: bool) -> Result<&Lighting, ReportError> {
-        if !bounces {
-            return Ok(&self.direct);
-        }
-        if self.bounce.is_none() {
-            self.bounce = Some(reference(&self.bsp, &self.bsp_path, &self.faces, true)?);
-        }
-        Ok(&self.bounce.as_ref().expect("computed just above").0)
+    /// The reference a setting's `measure` is measured against.
+    pub fn for_measure(&mut self, measure: LightMeasure) -> Result<&Lighting, ReportError> {
+        let at = match self.taken.iter().position(|(m, ..)| *m == measure) {
+            Some(at) => at,
+            None => {
+                let (lighting, seconds) =
+                    reference(&self.bsp, &self.bsp_path, &self.faces, measure)?;
+                self.taken.push((measure, lighting, seconds));
+                self.taken.len() - 1
+            }
+        };
+        Ok(&self.taken[at].1)
     }
 }
 
+/// Light's reference of `faces` for `measure` (the light grid's samples no face), and its
+/// seconds.
 fn reference(
     bsp: &Bsp,
     path: &Path,
     faces: &[usize],
-    bounce: bool,
+    measure: LightMeasure,
 ) -> Result<(Lighting, f64), ReportError> {
     let mut options = Options {
         quality: Quality::Reference,
         only_faces: Some(faces.to_vec()),
         ..Options::default()
     };
-    options.overrides.bounce = bounce.then_some(1);
+    match measure {
+        LightMeasure::Lightmaps { bounce } => options.overrides.bounce = bounce.then_some(1),
+        LightMeasure::OwnGrids {
+            world_units_per_luxel,
+        } => options.overrides.world_units_per_luxel = Some(world_units_per_luxel),
+        LightMeasure::LightGrid => {
+            options.overrides.lightgrid = Some(true);
+            options.only_faces = Some(Vec::new());
+        }
+    }
     let start = std::time::Instant::now();
     let raw = trace_lighting(bsp, &options).map_err(|source| ReportError::Light {
         path: path.to_path_buf(),
@@ -217,10 +232,13 @@ fn reference(
     Ok((finish_lighting(&raw, 0), start.elapsed().as_secs_f64()))
 }
 
-/// A lit BSP's lightmaps against light's reference, in 8-bit grey levels.
-#[derive(Debug, Clone, Default, serde::Serialize)]
+/// A lit BSP's light against light's reference, in 8-bit grey levels.
+#[derive(Debug, Clone, serde::Serialize)]
 pub struct LightFigures {
-    /// Luxels compared: those of the faces the reference lit.
+    /// What was compared.
+    pub measured: LightMeasure,
+    /// Luxels compared: those of the faces the reference lit (for the light grid: each style
+    /// of each grid point open in both).
     pub luxels: u64,
     /// Root mean square difference from the reference, in levels.
     pub rmse: f64,
@@ -228,17 +246,114 @@ pub struct LightFigures {
     pub max: u8,
     /// Share of luxels more than 2 levels off (0 to 1).
     pub over_2_share: f64,
+    /// What sampling the light grid cost the run, when it sampled one and said so (Slipgate's
+    /// `--stats`).
+    pub grid_cost: Option<GridCost>,
 }
 
-pub fn light_figures(lit_path: &Path, reference: &Lighting) -> Result<LightFigures, ReportError> {
+/// What sampling the light grid cost one light run, from its own timings.
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct GridCost {
+    /// Grid points.
+    pub points: u64,
+    /// Grid points in the open (the rest are in solid).
+    pub open_points: u64,
+    /// Seconds sampling the grid.
+    pub seconds: f64,
+    /// Seconds lighting the faces (direct and bounced light) in the same run.
+    pub lightmap_seconds: f64,
+    /// The grid's share of the run's whole time in light (setup, faces, grid), 0 to 1.
+    pub share: f64,
+}
+
+/// The figures of light's `--stats` file that give the grid's cost.
+#[derive(serde::Deserialize)]
+struct LightRunStats {
+    grid_points: u64,
+    grid_points_open: u64,
+    seconds_lightgrid: f64,
+    seconds_trace: f64,
+    seconds_bounce: f64,
+    seconds_total: f64,
+}
+
+/// The grid's cost from the `--stats` file light wrote at `path`; `None` when it sampled no
+/// grid.
+pub fn grid_cost(path: &Path) -> Result<Option<GridCost>, ReportError> {
+    let text = std::fs::read(path).map_err(ReportError::io(path))?;
+    let s: LightRunStats = serde_json::from_slice(&text).map_err(|e| ReportError::Measure {
+        path: path.to_path_buf(),
+        what: e.to_string(),
+    })?;
+    Ok((s.grid_points > 0).then(|| GridCost {
+        points: s.grid_points,
+        open_points: s.grid_points_open,
+        seconds: s.seconds_lightgrid,
+        lightmap_seconds: s.seconds_trace + s.seconds_bounce,
+        share: s.seconds_lightgrid / s.seconds_total.max(f64::MIN_POSITIVE),
+    }))
+}
+
+/// The light of `lit_path` that `measure` names against `reference` (its reference).
+pub fn light_figures(
+    lit_path: &Path,
+    measure: LightMeasure,
+    reference: &Lighting,
+) -> Result<LightFigures, ReportError> {
     let lit = read_bsp(lit_path)?;
+    let cannot = |what: &str| ReportError::Measure {
+        path: lit_path.to_path_buf(),
+        what: what.into(),
+    };
     let faces: Vec<usize> = reference.lightmaps.iter().map(|m| m.face).collect();
-    let e = compare(&lightmaps_in(&lit, &faces), reference);
+    let e = match measure {
+        LightMeasure::Lightmaps { .. } => compare(&lightmaps_in(&lit, &faces), reference),
+        LightMeasure::OwnGrids { .. } => {
+            let ours =
+                own_grid_lightmaps_in(&lit, &faces).map_err(|source| ReportError::Light {
+                    path: lit_path.to_path_buf(),
+                    source,
+                })?;
+            let exact = own_grids(reference)
+                .ok_or_else(|| cannot("the reference lit no face on its own grid"))?;
+            compare(&ours, &exact)
+        }
+        LightMeasure::LightGrid => {
+            let grid = lit.light_grid().map_err(|source| ReportError::Format {
+                path: lit_path.to_path_buf(),
+                source,
+            })?;
+            let grid = grid.ok_or_else(|| cannot("no LIGHTGRID_OCTREE lump"))?;
+            let exact = (reference.light_grid.as_ref())
+                .ok_or_else(|| cannot("the reference sampled no light grid"))?;
+            let points = |g: &LightGrid| {
+                format!(
+                    "{:?} apart from {:?}, {:?} of them",
+                    g.spacing, g.mins, g.size
+                )
+            };
+            compare_grids(&grid, exact).ok_or_else(|| {
+                cannot(&format!(
+                    "its light grid's points ({}) are not the reference's ({})",
+                    points(&grid),
+                    points(exact)
+                ))
+            })?
+        }
+    };
+    if e.luxels == 0 {
+        return Err(cannot(&format!(
+            "no {} in common with the reference",
+            measure.counted()
+        )));
+    }
     Ok(LightFigures {
+        measured: measure,
         luxels: e.luxels,
         rmse: e.rmse,
         max: e.max,
-        over_2_share: e.over_2 as f64 / e.luxels.max(1) as f64,
+        over_2_share: e.over_2 as f64 / e.luxels as f64,
+        grid_cost: None,
     })
 }
 

@@ -10,7 +10,9 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use crate::measure::{self, LightReferences, ViewFigures};
 use crate::process::{Timing, run_timed};
 use crate::settings::{Setting, Stage, Tool, all_settings};
-use crate::{Figures, LightReference, Machine, Options, Report, ReportError, Row};
+use crate::{
+    Figures, LightReference, Machine, Options, ReferenceSeconds, Report, ReportError, Row,
+};
 
 /// One map and the folder its intermediate files go to.
 struct MapWork {
@@ -87,8 +89,7 @@ pub fn run(options: &Options) -> Result<Report, ReportError> {
                 ));
                 let mut result = time_step(options, map, setting, tool);
                 if let (Ok(_), Stage::View) = (&result, setting.stage) {
-                    let stats = map.dir.join(format!("{}.json", setting.key()));
-                    match measure::flythrough_fps(&stats) {
+                    match measure::flythrough_fps(&stats_file(map, setting)) {
                         Ok(f) => {
                             let best = fps.entry((m, s)).or_insert(0.0);
                             *best = best.max(f);
@@ -154,8 +155,11 @@ pub fn run(options: &Options) -> Result<Report, ReportError> {
                 map: map.name.clone(),
                 face_stride: r.face_stride,
                 faces: r.faces.len(),
-                seconds_direct: r.seconds_direct,
-                seconds_bounce: r.bounce.as_ref().map(|b| b.1),
+                references: r
+                    .taken
+                    .iter()
+                    .map(|&(measure, _, seconds)| ReferenceSeconds { measure, seconds })
+                    .collect(),
             });
         }
     }
@@ -247,6 +251,11 @@ fn output_file(map: &MapWork, setting: &Setting, tool: Tool) -> PathBuf {
     map.dir.join(format!("{prefix}{}.bsp", setting.key()))
 }
 
+/// The `--stats` file a step of ours writes: light's own timings, the viewer's flythrough.
+fn stats_file(map: &MapWork, setting: &Setting) -> PathBuf {
+    output_file(map, setting, Tool::Slipgate).with_extension("json")
+}
+
 /// What each stage reads: our compile for vis, our full vis for light, our default light for
 /// the viewer, so both tools work on the same input.
 fn input_file(map: &MapWork, stage: Stage) -> PathBuf {
@@ -299,9 +308,14 @@ fn slipgate_command(
                 c.arg("--wad-dir").arg(dir);
             }
         }
-        Stage::Vis | Stage::Light => {
+        Stage::Vis => {
             copy_stage_input(setting.stage, input, out)?;
             c.arg(out);
+        }
+        Stage::Light => {
+            copy_stage_input(setting.stage, input, out)?;
+            // Light's own timings, for what the light grid cost.
+            c.arg(out).arg("--stats").arg(stats_file(map, setting));
         }
         Stage::View => {
             let (w, h) = options.view_size;
@@ -311,7 +325,7 @@ fn slipgate_command(
                 .arg("--size")
                 .arg(format!("{w}x{h}"))
                 .arg("--stats")
-                .arg(out.with_extension("json"));
+                .arg(stats_file(map, setting));
         }
     }
     c.args(&setting.ours);
@@ -390,8 +404,12 @@ fn measure_step(
                 path: input_file(map, Stage::Light),
                 what: format!("light's reference: {e}"),
             })?;
-            let reference = refs.for_setting(setting.bounces())?;
-            Figures::Light(measure::light_figures(&out, reference)?)
+            let measure = setting.light_measure();
+            let mut figures = measure::light_figures(&out, measure, refs.for_measure(measure)?)?;
+            if tool == Tool::Slipgate {
+                figures.grid_cost = measure::grid_cost(&stats_file(map, setting))?;
+            }
+            Figures::Light(figures)
         }
         Stage::View => Figures::View(view_figures(options, map, setting, best_fps)?),
     })

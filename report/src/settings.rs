@@ -90,20 +90,85 @@ impl Setting {
         format!("{}-{}", self.stage.name(), words.join("-"))
     }
 
-    /// Whether light's reference for this setting must bounce too.
-    pub fn bounces(&self) -> bool {
-        self.ours.iter().any(|o| o.starts_with("--bounce"))
+    /// What of a light setting's output is measured, and so which reference it is measured
+    /// against.
+    pub fn light_measure(&self) -> LightMeasure {
+        let value_of = |flag: &str| {
+            let at = self.ours.iter().position(|o| o == flag)?;
+            self.ours.get(at + 1)?.parse().ok()
+        };
+        if let Some(world_units_per_luxel) = value_of("--world_units_per_luxel") {
+            LightMeasure::OwnGrids {
+                world_units_per_luxel,
+            }
+        } else if self.ours.iter().any(|o| o == "--lightgrid") {
+            LightMeasure::LightGrid
+        } else {
+            LightMeasure::Lightmaps {
+                bounce: self.ours.iter().any(|o| o.starts_with("--bounce")),
+            }
+        }
     }
 }
 
-/// Light's settings: each mode alone, and `slipgate build --final`'s combination.
-pub const LIGHT_SETTINGS: [&str; 6] = [
+/// What of a light run's output is measured, against a reference that computes the same with
+/// light's `Quality::Reference`.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LightMeasure {
+    /// The 16-texel lightmaps, against the reference's (with one bounce when the setting
+    /// bounces).
+    Lightmaps {
+        /// The setting bounces light.
+        bounce: bool,
+    },
+    /// The lightmaps on the faces' own world-aligned grids (`DECOUPLED_LM`), against the
+    /// reference lit on the same grids.
+    OwnGrids {
+        /// Map units per luxel of those grids.
+        world_units_per_luxel: f64,
+    },
+    /// The light grid's points (`LIGHTGRID_OCTREE`), against the reference's grid of the same
+    /// points.
+    LightGrid,
+}
+
+impl LightMeasure {
+    /// The reference's name in the report's text.
+    pub fn reference_name(self) -> String {
+        match self {
+            LightMeasure::Lightmaps { bounce: false } => "direct".into(),
+            LightMeasure::Lightmaps { bounce: true } => "with bounce".into(),
+            LightMeasure::OwnGrids {
+                world_units_per_luxel,
+            } => format!("on own grids of {world_units_per_luxel} units"),
+            LightMeasure::LightGrid => "light grid".into(),
+        }
+    }
+
+    /// What one unit of the measure's count is, as its table cell says.
+    pub fn counted(self) -> &'static str {
+        match self {
+            LightMeasure::Lightmaps { .. } => "luxels",
+            LightMeasure::OwnGrids { .. } => "own-grid luxels",
+            LightMeasure::LightGrid => "grid samples",
+        }
+    }
+}
+
+/// Light's settings: each quality mode alone, `slipgate build --final`'s combination, and the
+/// modes of today's engines: lightmaps on the faces' own grids, the light grid, and the
+/// output-only lumps and files (measured as the default light).
+pub const LIGHT_SETTINGS: [&str; 9] = [
     "default",
     "--extra",
     "--extra4",
     "--soft",
     "--bounce",
     "--extra4 --soft --bounce",
+    "--world_units_per_luxel 8",
+    "--lightgrid",
+    "--bspxlit --lux --hdr",
 ];
 
 /// The viewer's span steps (pixels between exact perspective divides; 1 divides every pixel).
@@ -117,8 +182,11 @@ pub fn all_settings() -> Vec<Setting> {
             .map(str::to_string)
             .collect()
     };
-    // ericw-tools spells long options with one dash.
-    let single_dash = |s: &str| -> Vec<String> { words(s).iter().map(|w| w[1..].into()).collect() };
+    // ericw-tools spells long options with one dash; values stay as they are.
+    let single_dash = |s: &str| -> Vec<String> {
+        let one_dash = |w: &String| w.strip_prefix('-').unwrap_or(w).to_string();
+        words(s).iter().map(one_dash).collect()
+    };
     let mut all = vec![Setting {
         stage: Stage::Bsp,
         name: "default".into(),
@@ -173,7 +241,34 @@ mod tests {
             final_light.theirs.as_deref(),
             Some(&["-extra4".to_string(), "-soft".into(), "-bounce".into()][..])
         );
-        assert!(final_light.bounces());
+        assert_eq!(
+            final_light.light_measure(),
+            LightMeasure::Lightmaps { bounce: true }
+        );
+        let decoupled = all
+            .iter()
+            .find(|s| s.key() == "light-world_units_per_luxel-8")
+            .expect("decoupled lightmaps");
+        assert_eq!(
+            decoupled.theirs.as_deref(),
+            Some(&["-world_units_per_luxel".to_string(), "8".into()][..])
+        );
+        assert_eq!(
+            decoupled.light_measure(),
+            LightMeasure::OwnGrids {
+                world_units_per_luxel: 8.0
+            }
+        );
+        let grid = all.iter().find(|s| s.key() == "light-lightgrid");
+        assert_eq!(
+            grid.map(Setting::light_measure),
+            Some(LightMeasure::LightGrid)
+        );
+        let outputs = all.iter().find(|s| s.key() == "light-bspxlit-lux-hdr");
+        assert_eq!(
+            outputs.map(Setting::light_measure),
+            Some(LightMeasure::Lightmaps { bounce: false })
+        );
         let fast = all
             .iter()
             .find(|s| s.key() == "vis-fast")
