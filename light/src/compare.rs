@@ -148,11 +148,11 @@ pub fn lightmaps_in(bsp: &Bsp, faces: &[usize]) -> Lighting {
 /// left out.
 ///
 /// # Errors
-/// [`LightError::LightLump`] when one of those lumps is damaged.
+/// [`LightError::BspxLump`] when one of those lumps is damaged.
 pub fn own_grid_lightmaps_in(bsp: &Bsp, faces: &[usize]) -> Result<Lighting, LightError> {
-    let decoupled = bsp.decoupled_lightmaps().map_err(LightError::LightLump)?;
-    let shifts = bsp.lightmap_shifts().map_err(LightError::LightLump)?;
-    let offsets = bsp.lightmap_offsets().map_err(LightError::LightLump)?;
+    let decoupled = bsp.decoupled_lightmaps().map_err(LightError::BspxLump)?;
+    let shifts = bsp.lightmap_shifts().map_err(LightError::BspxLump)?;
+    let offsets = bsp.lightmap_offsets().map_err(LightError::BspxLump)?;
     let own_grid = |f: usize| -> Option<(i32, [usize; 2])> {
         if let Some(record) = decoupled.as_ref().and_then(|d| d.get(f)) {
             return Some((record.offset, record.grid().size));

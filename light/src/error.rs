@@ -32,13 +32,10 @@ pub enum LightError {
     /// Embree failed (starting the device or building the scene).
     #[error(transparent)]
     Embree(#[from] EmbreeError),
-    /// A damaged `SLIPGATE_PHONG` or `SLIPGATE_FACEFLAGS` lump (the message names it).
+    /// A damaged BSPX lump light reads: the compiler's `SLIPGATE_PHONG` or `SLIPGATE_FACEFLAGS`,
+    /// or a lit BSP's `DECOUPLED_LM`, `LMSHIFT` or `LMOFFSET` (the message names it).
     #[error("{0}")]
-    SlipgateLump(quake_formats::FormatError),
-    /// A damaged `DECOUPLED_LM`, `LMSHIFT` or `LMOFFSET` lump read back from a lit BSP (the
-    /// message names it).
-    #[error("{0}")]
-    LightLump(quake_formats::FormatError),
+    BspxLump(quake_formats::FormatError),
     /// `--lightgrid_dist` so fine for the map that the grid would hold too many points.
     #[error(
         "the light grid would hold {points} points (at most {most}): give --lightgrid_dist a wider spacing"

@@ -106,7 +106,7 @@ fn faceless_solids(
 /// Per face, whether it casts no shadow (the compiler's `SLIPGATE_FACEFLAGS`); empty when the
 /// file has no such lump.
 fn shadowless_faces(bsp: &Bsp) -> Result<Vec<bool>, LightError> {
-    let flags = bsp.face_flags().map_err(LightError::SlipgateLump)?;
+    let flags = bsp.face_flags().map_err(LightError::BspxLump)?;
     Ok(flags.map_or_else(Vec::new, |f| f.iter().map(|f| f.no_shadow).collect()))
 }
 
@@ -145,7 +145,7 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
     };
     let scene = TraceScene::build(&device, &faces, &casters)?;
     let vis = Visibility::new(bsp, &faces);
-    let lump = bsp.phong_faces().map_err(LightError::SlipgateLump)?;
+    let lump = bsp.phong_faces().map_err(LightError::BspxLump)?;
     let groups = phong::groups(&faces, &map_lights.phong, lump.as_deref());
     let phong = phong::corner_normals(&faces, &groups);
     let in_liquid = |p: DVec3| {
