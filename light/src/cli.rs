@@ -377,6 +377,12 @@ fn print_summary(lighting: &Lighting) {
     }
     let s = &lighting.stats;
     let rays = s.shadow_rays + s.sun_rays + s.dirt_rays + s.placement_rays;
+    if s.lights_nudged > 0 {
+        eprintln!(
+            "light: {} lights moved out of solid (or off the surface they lay on)",
+            s.lights_nudged
+        );
+    }
     eprintln!(
         "light: {} of {} faces, {} luxels ({} samples), {} point + {} surface lights, {} sun directions",
         s.faces_lit,

@@ -48,6 +48,7 @@ mod hull;
 mod lightgrid;
 mod lighting;
 mod lights;
+mod nudge;
 mod options;
 mod output;
 mod phong;

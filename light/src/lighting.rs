@@ -25,6 +25,8 @@ pub struct Stats {
     pub point_lights: usize,
     /// Copies of `_surface` templates.
     pub surface_lights: usize,
+    /// Lights moved out of solid (or off the surface they lay on).
+    pub lights_nudged: usize,
     /// Directions of suns and sky domes.
     pub sun_directions: usize,
     /// Switchable styles given out (to switchable lights' names and switchable shadows).

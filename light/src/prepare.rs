@@ -11,10 +11,12 @@ use crate::error::LightError;
 use crate::faces::{FaceGeom, FaceKind, face_geometry};
 use crate::hull;
 use crate::lights::{MapLights, PointLight, parse_lights};
+use crate::nudge;
 use crate::options::Options;
 use crate::phong;
 use crate::reach::LightReaches;
 use crate::scene::{Casters, TraceScene};
+use crate::settings::{Given, SettingWarning};
 use crate::surface;
 use crate::trace::{FaceRules, TraceSetup};
 use crate::visibility::Visibility;
@@ -37,6 +39,8 @@ pub struct Prepared {
     pub sun_distance: f32,
     /// How many of `point_lights` are surface-light copies.
     pub surface_lights: usize,
+    /// Lights moved out of solid ([`nudge`]).
+    pub lights_nudged: usize,
     /// The entity lump with switchable lights' styles (`None`: unchanged).
     pub entity_text: Option<String>,
     /// Per face: `_phong` corner normals, for faces of smoothed models.
@@ -124,7 +128,7 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
     usable.map_err(LightError::Unusable)?;
     let device = device?;
     let mut entities = parse_entities(&bsp.entity_text())?;
-    let map_lights = parse_lights(&mut entities, &options.overrides)?;
+    let mut map_lights = parse_lights(&mut entities, &options.overrides)?;
     let entity_text = (map_lights.switchable.count > 0).then(|| write_entities(&entities));
     let origin_of = |m: usize| {
         map_lights
@@ -168,6 +172,28 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
     let surface_lights = surface.len();
     let mut point_lights = map_lights.points.clone();
     point_lights.extend(surface);
+    let nudges = nudge::nudge_out_of_solid(bsp, &mut point_lights, &map_lights.no_nudge);
+    for &entity in &nudges.stuck {
+        map_lights.warnings.push(SettingWarning {
+            given: Given::Key {
+                entity,
+                classname: entities
+                    .get(entity)
+                    .map_or("", |e| e.classname())
+                    .to_string(),
+                key: "origin",
+            },
+            value: entities
+                .get(entity)
+                .and_then(|e| e.get("origin"))
+                .unwrap_or("")
+                .to_string(),
+            problem: format!(
+                "the light is in solid and no step of {} units frees it; it lights nothing",
+                nudge::NUDGE
+            ),
+        });
+    }
     let light_leafs = point_lights
         .iter()
         .map(|l| vis.open_leaf_at(bsp, l.origin))
@@ -190,6 +216,7 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
         light_leafs,
         sun_distance: (diagonal * 2.0 + 1024.0) as f32,
         surface_lights,
+        lights_nudged: nudges.moved,
         entity_text,
         phong,
     })

@@ -306,6 +306,7 @@ impl<'a> Plan<'a> {
             scene_triangles: prep.scene.triangles,
             point_lights: prep.lights.points.len(),
             surface_lights: prep.surface_lights,
+            lights_nudged: prep.lights_nudged,
             sun_directions: prep.lights.suns.len(),
             switchable_styles: prep.lights.switchable.count,
             coloured: prep.lights.is_coloured(),

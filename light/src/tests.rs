@@ -1099,10 +1099,9 @@ fn door_faces_inside_a_wall_are_not_black() {
     assert!(top_grey.iter().all(|&v| v > 10), "{top_grey:?}");
 }
 
-/// The sealed room of [`detail_column_bsp`] with a slab (x, y -32..32, z -64..-48) of
-/// `texture` brushes in a `classname` entity keyed `keys` above the floor, and a light over it,
-/// compiled by the bsp compiler.
-fn slab_bsp(classname: &str, keys: &str, texture: &str) -> Bsp {
+/// A sealed room (inside -128..128 on every axis) with `entities` (entity blocks) after its
+/// worldspawn, compiled by the bsp compiler.
+fn room_bsp(entities: &str) -> Bsp {
     let (lo, hi, t) = (-128.0, 128.0, 16.0);
     let (a, b) = (lo - t, hi + t);
     let mut world = String::new();
@@ -1116,21 +1115,65 @@ fn slab_bsp(classname: &str, keys: &str, texture: &str) -> Bsp {
     ] {
         world += &map_box(l, h);
     }
-    let slab = map_box([-32.0, -32.0, -64.0], [32.0, 32.0, -48.0]).replace("wall", texture);
     let text = format!(
-        "{{\n\"classname\" \"worldspawn\"\n{world}}}\n\
-         {{\n\"classname\" \"{classname}\"\n{keys}\n{slab}}}\n\
-         {{\n\"classname\" \"light\"\n\"origin\" \"0 0 64\"\n}}\n\
+        "{{\n\"classname\" \"worldspawn\"\n{world}}}\n{entities}\
          {{\n\"classname\" \"info_player_start\"\n\"origin\" \"-90 -90 -100\"\n}}\n"
     );
     let source = bsp_compiler::MapSource {
-        path: std::path::PathBuf::from("slab.map"),
+        path: std::path::PathBuf::from("room.map"),
         text,
     };
     let out =
         bsp_compiler::compile(&source, &bsp_compiler::CompileOptions::default()).expect("compile");
     assert!(out.leak.is_none(), "the room leaks");
     out.bsp
+}
+
+/// [`room_bsp`] with a slab (x, y -32..32, z -64..-48) of `texture` brushes in a `classname`
+/// entity keyed `keys` above the floor, and a light over it.
+fn slab_bsp(classname: &str, keys: &str, texture: &str) -> Bsp {
+    let slab = map_box([-32.0, -32.0, -64.0], [32.0, 32.0, -48.0]).replace("wall", texture);
+    room_bsp(&format!(
+        "{{\n\"classname\" \"{classname}\"\n{keys}\n{slab}}}\n\
+         {{\n\"classname\" \"light\"\n\"origin\" \"0 0 64\"\n}}\n"
+    ))
+}
+
+/// ericw-tools moves a light in solid, or lying on a surface, 2 units out: a light on the floor
+/// of [`room_bsp`] lights the floor (from 2 units up), and one sunk a unit into it too; with
+/// `_nonudge 1` neither does.
+#[test]
+fn lights_on_or_in_a_floor_are_moved_out_and_light_it() {
+    let floor_mean = |light_keys: &str| {
+        let bsp = room_bsp(&format!("{{\n\"classname\" \"light\"\n{light_keys}\n}}\n"));
+        let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
+        let prep = crate::prepare::prepare(&bsp, &Options::default()).expect("prepare");
+        let floors: Vec<usize> = prep
+            .faces
+            .iter()
+            .filter(|f| f.plane.normal.z > 0.99 && f.centroid().z < -127.0)
+            .map(|f| f.index)
+            .collect();
+        let bytes: Vec<u8> = lighting
+            .lightmaps
+            .iter()
+            .filter(|m| floors.contains(&m.face))
+            .flat_map(|m| m.style_grey(0).unwrap_or(&[]).to_vec())
+            .collect();
+        (
+            lighting.stats.lights_nudged,
+            bytes.iter().map(|&b| f64::from(b)).sum::<f64>() / bytes.len().max(1) as f64,
+        )
+    };
+    let above = floor_mean("\"origin\" \"0 0 -126\"");
+    assert_eq!(above.0, 0);
+    for sunk in ["\"origin\" \"0 0 -128\"", "\"origin\" \"0 0 -129\""] {
+        let (moved, mean) = floor_mean(sunk);
+        assert_eq!(moved, 1, "{sunk}");
+        assert!(mean > above.1 * 0.8, "{sunk}: {mean} against {}", above.1);
+    }
+    let kept = floor_mean("\"origin\" \"0 0 -129\"\n\"_nonudge\" \"1\"");
+    assert_eq!(kept, (0, 0.0));
 }
 
 /// The light on the floor's luxel under the middle of [`slab_bsp`]'s slab.

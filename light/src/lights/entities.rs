@@ -55,6 +55,9 @@ pub fn read_lights(
         if shadow_only || k.float("_nostaticlight")? == Some(1.0) {
             continue;
         }
+        if k.float("_nonudge")? == Some(1.0) {
+            out.no_nudge.push(index);
+        }
         read_light(&k, &origins, global, out)?;
     }
     Ok(())

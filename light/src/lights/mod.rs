@@ -97,6 +97,8 @@ pub struct MapLights {
     pub lightignore_models: Vec<usize>,
     /// Brush models whose faces do not reflect light (`_bounce 0`).
     pub no_bounce_models: Vec<usize>,
+    /// Light entities that stay where they are even in solid (`_nonudge 1`).
+    pub no_nudge: Vec<usize>,
     /// Diffuse interreflection (`_bounce` and its keys).
     pub bounce: BounceSettings,
     /// How dirt occlusion is measured (used only when something takes dirt).
@@ -193,6 +195,7 @@ pub fn parse_lights(
         no_dirt_models: Vec::new(),
         lightignore_models: Vec::new(),
         no_bounce_models: Vec::new(),
+        no_nudge: Vec::new(),
         bounce: worldspawn::bounce(&settings, &global),
         dirt: dirt_sampling(&settings),
         phong: HashMap::new(),

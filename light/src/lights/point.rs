@@ -94,9 +94,10 @@ impl Spot {
 }
 
 /// The angle-of-incidence term: `scale * cos + (1 - scale)` for a surface
-/// facing the light (`cos > 0`), else 0.
+/// facing the light or grazed by it (`cos >= 0`, as in ericw-tools: a light level with the
+/// samples still lights them), else 0.
 pub fn angle_factor(cos_incidence: f64, anglescale: f64) -> f64 {
-    if cos_incidence <= 0.0 {
+    if cos_incidence < 0.0 {
         0.0
     } else {
         anglescale * cos_incidence + (1.0 - anglescale)
@@ -293,6 +294,7 @@ mod tests {
         assert_eq!(angle_factor(1.0, 0.5), 1.0);
         assert!(close(angle_factor(0.0001, 0.5), 0.50005));
         assert_eq!(angle_factor(-0.1, 0.5), 0.0);
+        assert_eq!(angle_factor(0.0, 0.5), 0.5, "grazing light counts");
         assert!(close(angle_factor(0.5, 1.0), 0.5));
         assert_eq!(angle_factor(0.3, 0.0), 1.0);
     }

@@ -50,7 +50,7 @@ impl FaceTrace<'_> {
         // A light behind the plane of a `_phong` face can still be in front of the smoothed
         // normals of some of its samples: only flat faces are culled by their plane.
         let behind =
-            self.samples.normals.is_empty() && self.face.plane.distance(reach.origin) <= 0.0;
+            self.samples.normals.is_empty() && self.face.plane.distance(reach.origin) < 0.0;
         behind
             || box_distance_squared(&self.bounds, reach.origin) > reach.range_squared
             || !self

@@ -1,0 +1,90 @@
+//! Lights placed in solid, or on a surface, are moved out before anything is traced, as
+//! ericw-tools does: id's maps and many since have lights whose origin lies on a floor or just
+//! inside a wall, which light nothing where they stand (their rays start in solid, or below the
+//! samples, which sit a unit off their faces).
+//!
+//! A light counts as in solid when the world's tree puts it in a solid leaf, a point on a plane
+//! going to the plane's back: so a light on a floor is in the floor. It moves [`NUDGE`] units
+//! along the first axis direction (−x, +x, −y, +y, −z, +z) that leaves it in the open; a light
+//! that no such step frees stays where it is, with a warning. `_nonudge 1` keeps a light where
+//! the mapper put it.
+
+use glam::DVec3;
+use quake_formats::Bsp;
+use quake_formats::bsp::contents;
+
+use crate::lights::PointLight;
+
+/// How far a light is moved: past the samples, which sit one unit off their faces.
+pub const NUDGE: f64 = 2.0;
+
+/// Whether `p` is in the world's solid, points on a node's plane taken to its back.
+fn in_solid(bsp: &Bsp, p: DVec3) -> bool {
+    let Some(mut node) = bsp
+        .models
+        .first()
+        .and_then(|m| m.head_nodes.first().copied())
+    else {
+        return false;
+    };
+    let mut steps = 0;
+    while node >= 0 {
+        let Some(n) = bsp.nodes.get(node as usize) else {
+            return false;
+        };
+        let Some(plane) = bsp.planes.get(n.plane as usize) else {
+            return false;
+        };
+        let normal = DVec3::from(plane.normal.map(f64::from));
+        let d = normal.dot(p) - f64::from(plane.dist);
+        node = n.children[usize::from(d <= 0.0)];
+        steps += 1;
+        if steps > bsp.nodes.len() {
+            return false; // a cycle in a damaged file
+        }
+    }
+    let leaf = (-(node + 1)) as usize;
+    bsp.leafs
+        .get(leaf)
+        .is_some_and(|l| l.contents == contents::SOLID)
+}
+
+/// The first step from `origin` that lies in the open, if any.
+fn nudged(bsp: &Bsp, origin: DVec3) -> Option<DVec3> {
+    let steps = [DVec3::X, DVec3::Y, DVec3::Z]
+        .into_iter()
+        .flat_map(|axis| [-axis, axis])
+        .map(|step| origin + step * NUDGE);
+    steps.into_iter().find(|&p| !in_solid(bsp, p))
+}
+
+/// What [`nudge_out_of_solid`] did.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Nudges {
+    /// Lights moved.
+    pub moved: usize,
+    /// Entity indices of lights in solid that no step frees.
+    pub stuck: Vec<usize>,
+}
+
+/// Moves every light of `lights` (but those of the entities in `keep`, and those that give no
+/// light) out of solid; see the module comment.
+pub fn nudge_out_of_solid(bsp: &Bsp, lights: &mut [PointLight], keep: &[usize]) -> Nudges {
+    let mut out = Nudges::default();
+    for light in lights
+        .iter_mut()
+        .filter(|l| l.light != 0.0 && !keep.contains(&l.entity))
+    {
+        if !in_solid(bsp, light.origin) {
+            continue;
+        }
+        match nudged(bsp, light.origin) {
+            Some(p) => {
+                light.origin = p;
+                out.moved += 1;
+            }
+            None => out.stuck.push(light.entity),
+        }
+    }
+    out
+}
