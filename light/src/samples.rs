@@ -11,7 +11,9 @@
 //! does not bleed under it and the point stays over the part of the face it
 //! stands for. Points are then pushed [`SURFACE_OFFSET`] units off the
 //! surface; one that something still hides from the face centre (an object
-//! resting on the face) is pulled back towards the centre into the open.
+//! resting on the face) is pulled back towards the centre into the open. When
+//! the centre itself is covered (a fixture on the middle of a wall), a point left
+//! in solid is occluded instead, as in ericw-tools.
 //! A brush model's point inside the world's solid (a door's face in the wall it
 //! slides into) is nudged half a unit along each axis into the open when that
 //! frees it, else it is occluded: as in ericw-tools, it takes no light of its
@@ -436,10 +438,10 @@ pub fn face_samples(
         })
         .unzip();
     counts.clamped += clamped.iter().filter(|&&c| c).count() as u64;
-    let (mut points, pulled) =
+    let (mut points, pulled, occluded) =
         into_open(&on_face, centre, face.model == 0, scene, bsp, &mut counts);
     let occluded = if face.model == 0 {
-        Vec::new()
+        occluded
     } else {
         nudge_out_of_solid(bsp, &mut points)
     };
@@ -496,8 +498,11 @@ fn nudge_out_of_solid(bsp: &Bsp, points: &mut [[f32; 3]]) -> Vec<bool> {
 
 /// Each of `points` if nothing stands between it and `centre`, else pulled
 /// back along that line to [`WALL_CLEARANCE`] in front of the obstacle;
-/// onto `centre` if it is still in a solid world leaf. Also says which
-/// moved. The rays all leave the centre, so they go 16 to a coherent packet.
+/// onto `centre` if it is still in a solid world leaf, unless the centre is in
+/// solid too (a fixture covering the middle of a wall): such a point is
+/// occluded, as in ericw-tools. Also says which moved and which are occluded
+/// (empty when none is). The rays all leave the centre, so they go 16 to a
+/// coherent packet.
 fn into_open(
     points: &[DVec3],
     centre: DVec3,
@@ -505,7 +510,7 @@ fn into_open(
     scene: &TraceScene,
     bsp: &Bsp,
     counts: &mut PlacementCounts,
-) -> (Vec<[f32; 3]>, Vec<bool>) {
+) -> (Vec<[f32; 3]>, Vec<bool>, Vec<bool>) {
     let c = centre.as_vec3().to_array();
     let mut out: Vec<[f32; 3]> = points.iter().map(|p| p.as_vec3().to_array()).collect();
     let mut moved = vec![false; points.len()];
@@ -541,17 +546,23 @@ fn into_open(
             counts.pulled_back += 1;
         }
     }
+    let mut occluded = Vec::new();
     if check_leaf {
         let solid = solid_points(bsp, &out);
-        for ((p, m), solid) in out.iter_mut().zip(&mut moved).zip(solid) {
-            if solid {
-                counts.to_centre += 1;
-                *p = c;
-                *m = true;
+        let centre_in_solid = solid.contains(&true) && solid_points(bsp, &[c])[0];
+        if centre_in_solid {
+            occluded = solid;
+        } else {
+            for ((p, m), solid) in out.iter_mut().zip(&mut moved).zip(solid) {
+                if solid {
+                    counts.to_centre += 1;
+                    *p = c;
+                    *m = true;
+                }
             }
         }
     }
-    (out, moved)
+    (out, moved, occluded)
 }
 
 /// How far (units) a cluster's bounding box must clear a node's plane for

@@ -1139,6 +1139,37 @@ fn slab_bsp(classname: &str, keys: &str, texture: &str) -> Bsp {
     ))
 }
 
+/// Regression: LibreQuake start's face 543 is a wall whose middle a light fixture covers (a
+/// detail brush one unit thick, `_surface` lights in front of it). Its luxels under the
+/// fixture were lit as if they stood in front of it (their samples fell back onto the face's
+/// covered middle, two units from a surface light's copy): a block of 255 making a bright
+/// fringe round the fixture in engines that filter lightmaps. As in ericw-tools they now take no
+/// light of their own.
+#[test]
+#[ignore = "slow: run with --release -- --ignored"]
+fn luxels_under_a_wall_fixture_take_no_light_of_the_fixture_s_lights() {
+    let path = corpus().join("librequake/start.bsp");
+    let Ok(data) = std::fs::read(&path) else {
+        eprintln!("SKIPPED: {} not found", path.display());
+        return;
+    };
+    let bsp = Bsp::read(&data).expect("read");
+    let o = Options {
+        only_faces: Some(vec![543]),
+        ..options(Quality::Default)
+    };
+    let lighting = compute_lighting(&bsp, &o).expect("light");
+    let m = lighting
+        .lightmaps
+        .iter()
+        .find(|m| m.face == 543)
+        .expect("face 543 lit");
+    let brightest = m
+        .style_grey(0)
+        .map_or(0, |g| g.iter().copied().max().unwrap_or(0));
+    assert!(brightest < 128, "face 543's brightest luxel: {brightest}");
+}
+
 /// ericw-tools moves a light in solid, or lying on a surface, 2 units out: a light on the floor
 /// of [`room_bsp`] lights the floor (from 2 units up), and one sunk a unit into it too; with
 /// `_nonudge 1` neither does.
