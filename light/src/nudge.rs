@@ -20,32 +20,8 @@ pub const NUDGE: f64 = 2.0;
 
 /// Whether `p` is in the world's solid, points on a node's plane taken to its back.
 fn in_solid(bsp: &Bsp, p: DVec3) -> bool {
-    let Some(mut node) = bsp
-        .models
-        .first()
-        .and_then(|m| m.head_nodes.first().copied())
-    else {
-        return false;
-    };
-    let mut steps = 0;
-    while node >= 0 {
-        let Some(n) = bsp.nodes.get(node as usize) else {
-            return false;
-        };
-        let Some(plane) = bsp.planes.get(n.plane as usize) else {
-            return false;
-        };
-        let normal = DVec3::from(plane.normal.map(f64::from));
-        let d = normal.dot(p) - f64::from(plane.dist);
-        node = n.children[usize::from(d <= 0.0)];
-        steps += 1;
-        if steps > bsp.nodes.len() {
-            return false; // a cycle in a damaged file
-        }
-    }
-    let leaf = (-(node + 1)) as usize;
-    bsp.leafs
-        .get(leaf)
+    bsp.leaf_at_behind_planes(p.as_vec3().to_array())
+        .and_then(|leaf| bsp.leafs.get(leaf))
         .is_some_and(|l| l.contents == contents::SOLID)
 }
 

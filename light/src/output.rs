@@ -616,9 +616,9 @@ mod tests {
         }
     }
 
-    #[test]
     /// ericw-tools' grey: a coloured luxel is as bright in the grey lump as its brightest
     /// channel (a red light as bright as a white one in engines without colour).
+    #[test]
     fn grey_is_the_brightest_channel() {
         let light = FaceLight {
             face: 0,
@@ -660,15 +660,7 @@ mod tests {
 
     fn one_face_bsp() -> Bsp {
         let mut bsp = Bsp::default();
-        bsp.faces.push(quake_formats::bsp::Face {
-            plane: 0,
-            side: 0,
-            first_edge: 0,
-            num_edges: 0,
-            texinfo: 0,
-            styles: [NO_STYLE; 4],
-            light_offset: -1,
-        });
+        bsp.faces.push(face_without_light());
         bsp
     }
 

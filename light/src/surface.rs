@@ -54,8 +54,8 @@ pub fn expand_templates(
 ) -> Vec<PointLight> {
     let group_of = |model: usize| groups.get(&model).copied().unwrap_or(0);
     let underwater_side = |f: &FaceGeom| {
-        let middle = Winding::new(f.points.clone()).center();
-        f.texture.starts_with('*') && in_liquid(middle + f.plane.normal)
+        let middle = || f.points.iter().sum::<DVec3>() / f.points.len().max(1) as f64;
+        f.texture.starts_with('*') && in_liquid(middle() + f.plane.normal)
     };
     let mut out = Vec::new();
     for t in templates {
