@@ -1,6 +1,6 @@
 //! End-to-end: maps compiled by Slipgate, played in real engines with real game code.
 //!
-//! Every project map (`maps/*.map`, `maps/test/`, `maps/leak/sealed.map`, `demo.map` again as
+//! Every project map (`maps/*.map`, `maps/test/`, `maps/leak/sealed.map`, the compiler's test maps, `demo.map` again as
 //! BSP2, and the `maps/hard/` maps that compile) and, in the release run (`--ignored`), every
 //! corpus map, goes through `slipgate bsp`, `vis` and `light` (`support/maps.rs`), then into
 //! QuakeSpasm and DarkPlaces with LibreQuake's game code from `../shared/engine`
@@ -71,6 +71,12 @@ fn project_maps() -> &'static MapSet {
         // Prefabs (nested, turned, scaled), `_mirrorinside` water and a visblocker.
         cases.push(Case::new(
             repo().join("bsp-compiler/tests/maps/features.map"),
+            wads(),
+        ));
+        // ericw-tools' keys: `_hulls`, `_shadow -1`, `_noambient`, switchable shadows,
+        // `*waterskip`, a light on the floor, `_surface` lights on a wall fixture.
+        cases.push(Case::new(
+            repo().join("bsp-compiler/tests/maps/ericw_keys.map"),
             wads(),
         ));
         cases.push(Case {
