@@ -30,7 +30,7 @@ use quake_formats::geom::DVec3Ext;
 use quake_formats::geom::{Plane, Winding};
 
 use crate::embree::{RayPacket16, sys};
-use crate::faces::FaceGeom;
+use crate::faces::{FaceGeom, FaceKind};
 use crate::scene::TraceScene;
 
 /// Distance of sample points in front of their face, in map units.
@@ -56,6 +56,9 @@ pub struct FaceSamples {
     pub points: Vec<[f32; 3]>,
     /// Per-sample shading normals (`_phong`), or empty: the face normal everywhere.
     pub normals: Vec<[f32; 3]>,
+    /// Lit from behind as from in front: a lit liquid's surface, which ericw-tools lights from
+    /// both sides (a light under water brightens the surface seen from above).
+    pub two_sided: bool,
     /// Per sample: it is not where the texture grid puts it (moved onto the
     /// face, pulled back into the open or onto the centre).
     pub moved: Vec<bool>,
@@ -91,6 +94,13 @@ impl FaceSamples {
         self.normals
             .get(i)
             .map_or(self.normal, |&n| Vec3::from(n).as_dvec3())
+    }
+
+    /// The cosine of the angle of incidence of light arriving along unit `to_light` at sample
+    /// `i`: negative from behind, but on a two-sided face the light's side counts as the front.
+    pub fn incidence(&self, i: usize, to_light: DVec3) -> f64 {
+        let cos = self.normal_at(i).dot(to_light);
+        if self.two_sided { cos.abs() } else { cos }
     }
 }
 
@@ -455,6 +465,7 @@ pub fn face_samples(
             normal: face.plane.normal,
             points,
             normals: Vec::new(),
+            two_sided: face.kind == FaceKind::LitLiquid,
             moved,
             pulled,
             occluded,

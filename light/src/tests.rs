@@ -2077,6 +2077,51 @@ fn lit_liquids_get_lightmaps_and_let_light_through() {
     }
 }
 
+/// A lit liquid's surface is lit from both sides, as ericw-tools lights it: a light under the
+/// water lights the surface seen from above about as a light as far above it would, where a solid
+/// face on the same plane takes nothing from below.
+#[test]
+fn lit_liquid_surfaces_take_light_from_under_them() {
+    let surface = || {
+        quad(
+            [0.0, 0.0, 64.0],
+            [0.0, 256.0, 64.0],
+            [256.0, 256.0, 64.0],
+            [256.0, 0.0, 64.0],
+            [0.0, 0.0, 1.0],
+        )
+    };
+    let scene = |light_z: f32, texture: &str| {
+        let ents = format!(
+            "{{ \"classname\" \"worldspawn\" }}\n\
+             {{ \"classname\" \"light\" \"origin\" \"128 128 {light_z}\" \"light\" \"300\" }}\n"
+        );
+        let mut bsp = synthetic_bsp(&[floor(256.0), surface()], &ents);
+        bsp.textures.textures.push(Some(mip(texture)));
+        let info = &mut bsp.texinfo[bsp.faces[1].texinfo as usize];
+        info.miptex = bsp.textures.textures.len() as u32 - 1;
+        info.flags = 0;
+        bsp
+    };
+    let opts = options(Quality::Default);
+    let surface_luxel = |bsp: &Bsp| {
+        let lighting = compute_lighting(bsp, &opts).expect("light");
+        lighting
+            .lightmaps
+            .iter()
+            .any(|m| m.face == 1)
+            .then(|| luxel_at(bsp, &lighting, 1, 128.0, 128.0))
+    };
+    let from_below = surface_luxel(&scene(32.0, "*water0"));
+    let from_above = surface_luxel(&scene(96.0, "*water0"));
+    let (Some(below), Some(above)) = (from_below, from_above) else {
+        panic!("lit from below {from_below:?}, from above {from_above:?}");
+    };
+    // The samples stand a little in front of the surface.
+    assert!(below > 40 && below.abs_diff(above) <= 2, "{below} {above}");
+    assert_eq!(surface_luxel(&scene(32.0, "metal1")).unwrap_or(0), 0);
+}
+
 /// `options` with faces lit on their own grids, `units` map units per luxel.
 fn on_own_grids(quality: Quality, units: f64) -> Options {
     let mut o = options(quality);

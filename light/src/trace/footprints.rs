@@ -115,12 +115,17 @@ impl Closeness {
     }
 }
 
-/// What `light` adds at `p` on a surface with unit `normal`, unshadowed.
-fn unshadowed(light: &PointLight, p: DVec3, normal: DVec3) -> Option<(f64, DVec3, f64)> {
+/// What `light` adds at `p`, unshadowed, on a surface whose cosine of incidence for light
+/// arriving along a unit direction is `incidence`.
+fn unshadowed(
+    light: &PointLight,
+    p: DVec3,
+    incidence: impl Fn(DVec3) -> f64,
+) -> Option<(f64, DVec3, f64)> {
     let to_light = light.origin - p;
     let dist = to_light.length();
     let dir = to_light.normalized()?;
-    Some((light.contribution(dist, -dir, normal.dot(dir)), dir, dist))
+    Some((light.contribution(dist, -dir, incidence(dir)), dir, dist))
 }
 
 /// A ray's origin, direction and length.
@@ -209,7 +214,6 @@ impl Footprints {
         cells: usize,
         light: &PointLight,
     ) {
-        let normal = samples.normal_at(i);
         if self.placed.is_empty() {
             self.placed.resize(samples.points.len(), None);
         }
@@ -223,7 +227,8 @@ impl Footprints {
         };
         let first = self.values.len();
         for &q in &self.points[placed] {
-            let Some((value, dir, dist)) = unshadowed(light, q, normal) else {
+            let Some((value, dir, dist)) = unshadowed(light, q, |dir| samples.incidence(i, dir))
+            else {
                 self.values.push(0.0);
                 self.rays.push(None);
                 continue;

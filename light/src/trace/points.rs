@@ -48,9 +48,10 @@ impl FaceTrace<'_> {
     fn culled(&self, li: usize) -> bool {
         let reach = &self.setup.light_reaches[li];
         // A light behind the plane of a `_phong` face can still be in front of the smoothed
-        // normals of some of its samples: only flat faces are culled by their plane.
-        let behind =
-            self.samples.normals.is_empty() && self.face.plane.distance(reach.origin) < 0.0;
+        // normals of some of its samples: only flat one-sided faces are culled by their plane.
+        let behind = self.samples.normals.is_empty()
+            && !self.samples.two_sided
+            && self.face.plane.distance(reach.origin) < 0.0;
         behind
             || box_distance_squared(&self.bounds, reach.origin) > reach.range_squared
             || !self
@@ -187,7 +188,7 @@ impl FaceTrace<'_> {
                 dir.as_vec3().to_array(),
                 (dist as f32 - LIGHT_CLEARANCE).max(0.0),
             );
-            let v = light.contribution(dist, -dir, samples.normal_at(i).dot(dir));
+            let v = light.contribution(dist, -dir, samples.incidence(i, dir));
             if v.abs() >= self.setup.gate {
                 scratch.value[i] = v;
             }

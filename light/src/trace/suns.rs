@@ -98,20 +98,20 @@ impl FaceTrace<'_> {
         let scratch = &mut *self.scratch;
         let value = &mut scratch.value;
         let dir = sun.to_sun.as_vec3().to_array();
-        let sun_value = |normal: DVec3| {
-            let v = sun.light * angle_factor(normal.dot(sun.to_sun), sun.anglescale);
+        let sun_value = |i: usize| {
+            let v = sun.light * angle_factor(samples.incidence(i, sun.to_sun), sun.anglescale);
             if v.abs() < setup.gate { 0.0 } else { v }
         };
         if samples.normals.is_empty() {
             // A flat face: the same value at every sample (none when the sun is behind it).
-            let v = sun_value(samples.normal);
+            let v = sun_value(0);
             if v == 0.0 {
                 return;
             }
             value.fill(v);
         } else {
             for (i, v) in value.iter_mut().enumerate() {
-                *v = sun_value(samples.normal_at(i));
+                *v = sun_value(i);
             }
         }
         let ray = |i: usize| (samples.points[i], dir, setup.sun_distance);
