@@ -27,7 +27,9 @@ use crate::quality::Quality;
 use crate::reach::{LightReaches, light_reaches};
 use crate::resample;
 use crate::samples::{FaceSamples, PlacementCounts, face_samples};
-use crate::trace::{FaceLight, SampleLight, TraceCounts, TraceScratch, TraceSetup, trace_face};
+use crate::trace::{
+    FaceLight, HiddenLuxels, SampleLight, TraceCounts, TraceScratch, TraceSetup, trace_face,
+};
 
 /// Lights every lit face of `bsp` (or `options.only_faces`).
 ///
@@ -343,12 +345,22 @@ fn finish_faces(
     // fresh pages) and the parallel collect knows its length.
     let mut lit: Vec<SampleLight> = Vec::with_capacity(traced.len());
     lit.extend(traced.into_iter().filter_map(|t| t.light));
-    let buried: Vec<bool> = lit.iter().map(SampleLight::buried).collect();
-    let (mut faces, own): (Vec<FaceLight>, Vec<Option<OwnGridLight>>) = lit
+    let hidden: Vec<Vec<bool>> = lit.iter().map(SampleLight::hidden_luxels).collect();
+    let mut finished: Vec<FaceLight> = lit
         .into_par_iter()
         .map(|light| {
             let bounce = bounced.get(light.face).map_or(&[][..], |b| &b[..]);
-            let light = light.finish(bounce);
+            let fill = match geoms[light.face].model {
+                0 => HiddenLuxels::FromNeighbours,
+                _ => HiddenLuxels::Later,
+            };
+            light.finish(bounce, fill)
+        })
+        .collect();
+    fill_hidden_luxels(&mut finished, &hidden, geoms);
+    finished
+        .into_par_iter()
+        .map(|light| {
             let geom = &geoms[light.face];
             match geom.own_grid {
                 Some(grid) => (
@@ -358,51 +370,62 @@ fn finish_faces(
                 None => (light, None),
             }
         })
-        .unzip();
-    light_buried_faces(&mut faces, &buried, geoms);
-    (faces, own)
+        .unzip()
 }
 
-/// A brush model's face with every sample inside solid (a door's face in the wall it slides
-/// into) takes, per style, the mean luxel of its model's other faces: its own rays, traced from
-/// inside the wall, say nothing, and ericw-tools too gives such a face one value across it
-/// rather than black.
-fn light_buried_faces(faces: &mut [FaceLight], buried: &[bool], geometry: &[FaceGeom]) {
-    if !buried.contains(&true) {
+/// The luxels of a brush model's faces whose every sample is inside solid (a door's edge or
+/// face in the wall it slides into) take, per style, the mean of the model's open luxels, all
+/// its faces' together (zero where a face has no light of that style): their own rays, traced
+/// from inside the wall, say nothing, and ericw-tools gives them the model's mean so, rather
+/// than the light of the luxels beside them.
+fn fill_hidden_luxels(faces: &mut [FaceLight], hidden: &[Vec<bool>], geometry: &[FaceGeom]) {
+    let model_of = |light: &FaceLight| geometry[light.face].model;
+    let in_brush_model = |(light, _): &(&FaceLight, &Vec<bool>)| model_of(light) != 0;
+    if !faces
+        .iter()
+        .zip(hidden)
+        .filter(in_brush_model)
+        .any(|(_, h)| h.contains(&true))
+    {
         return;
     }
-    let model_of = |light: &FaceLight| geometry[light.face].model;
-    let mut means: BTreeMap<(usize, u8), ([f64; 3], usize)> = BTreeMap::new();
-    for light in faces
-        .iter()
-        .zip(buried)
-        .filter(|(_, b)| !**b)
-        .map(|(l, _)| l)
-    {
+    let mut open_luxels: BTreeMap<usize, usize> = BTreeMap::new();
+    let mut sums: BTreeMap<(usize, u8), [f64; 3]> = BTreeMap::new();
+    for (light, hidden) in faces.iter().zip(hidden).filter(in_brush_model) {
+        let model = model_of(light);
+        let open = |i: usize| !hidden.get(i).copied().unwrap_or(false);
+        *open_luxels.entry(model).or_default() +=
+            (0..light.width * light.height).filter(|&i| open(i)).count();
         for (style, luxels) in &light.styles {
-            let (sum, count) = means.entry((model_of(light), *style)).or_default();
-            for l in luxels {
+            let sum = sums.entry((model, *style)).or_default();
+            for (_, l) in luxels.iter().enumerate().filter(|(i, _)| open(*i)) {
                 for k in 0..3 {
                     sum[k] += f64::from(l[k]);
                 }
             }
-            *count += luxels.len();
         }
     }
-    for light in faces
-        .iter_mut()
-        .zip(buried)
-        .filter(|(_, b)| **b)
-        .map(|(l, _)| l)
-    {
-        let (model, n) = (model_of(light), light.width * light.height);
-        light.styles = means
-            .range((model, 0)..=(model, u8::MAX))
-            .filter(|(_, (_, count))| *count > 0)
-            .map(|(&(_, style), (sum, count))| {
-                (style, vec![sum.map(|s| (s / *count as f64) as f32); n])
-            })
-            .collect();
+    for (light, hidden) in faces.iter_mut().zip(hidden) {
+        let model = model_of(light);
+        let count = open_luxels.get(&model).copied().unwrap_or(0);
+        if model == 0 || count == 0 || !hidden.contains(&true) {
+            continue;
+        }
+        let n = light.width * light.height;
+        for (&(_, style), sum) in sums.range((model, 0)..=(model, u8::MAX)) {
+            let mean = sum.map(|s| (s / count as f64) as f32);
+            if !light.styles.iter().any(|(s, _)| *s == style) {
+                light.styles.push((style, vec![[0.0; 3]; n]));
+            }
+            let Some((_, luxels)) = light.styles.iter_mut().find(|(s, _)| *s == style) else {
+                continue;
+            };
+            for (l, _) in luxels.iter_mut().zip(hidden).filter(|(_, h)| **h) {
+                *l = mean;
+            }
+        }
+        // Style 0 first, as everywhere.
+        light.styles.sort_by_key(|(s, _)| *s != 0);
     }
 }
 

@@ -14,10 +14,11 @@
 //! resting on the face) is pulled back towards the centre into the open. When
 //! the centre itself is covered (a fixture on the middle of a wall), a point left
 //! in solid is occluded instead, as in ericw-tools.
-//! A brush model's point inside the world's solid (a door's face in the wall it
-//! slides into) is nudged half a unit along each axis into the open when that
-//! frees it, else it is occluded: as in ericw-tools, it takes no light of its
-//! own and its luxel takes its neighbours'.
+//! A brush model's points are not pulled back: one inside the world's solid (a
+//! door's face in the wall it slides into) is nudged half a unit along each axis
+//! into the open when that frees it, else it is occluded: as in ericw-tools, it
+//! takes no light of its own, and a luxel with no other sample takes the mean
+//! light of the whole model.
 //!
 //! [`FaceSamples`] is kept as its own structure so later passes (bounce
 //! lighting) can reuse the same points.
@@ -448,12 +449,12 @@ pub fn face_samples(
         })
         .unzip();
     counts.clamped += clamped.iter().filter(|&&c| c).count() as u64;
-    let (mut points, pulled, occluded) =
-        into_open(&on_face, centre, face.model == 0, scene, bsp, &mut counts);
-    let occluded = if face.model == 0 {
-        occluded
+    let (points, pulled, occluded) = if face.model == 0 {
+        into_open(&on_face, centre, scene, bsp, &mut counts)
     } else {
-        nudge_out_of_solid(bsp, &mut points)
+        let mut points: Vec<[f32; 3]> = on_face.iter().map(|p| p.as_vec3().to_array()).collect();
+        let occluded = nudge_out_of_solid(bsp, &mut points);
+        (points, vec![false; count], occluded)
     };
     let moved = clamped.iter().zip(&pulled).map(|(&c, &p)| c || p).collect();
     (
@@ -517,7 +518,6 @@ fn nudge_out_of_solid(bsp: &Bsp, points: &mut [[f32; 3]]) -> Vec<bool> {
 fn into_open(
     points: &[DVec3],
     centre: DVec3,
-    check_leaf: bool,
     scene: &TraceScene,
     bsp: &Bsp,
     counts: &mut PlacementCounts,
@@ -558,18 +558,16 @@ fn into_open(
         }
     }
     let mut occluded = Vec::new();
-    if check_leaf {
-        let solid = solid_points(bsp, &out);
-        let centre_in_solid = solid.contains(&true) && solid_points(bsp, &[c])[0];
-        if centre_in_solid {
-            occluded = solid;
-        } else {
-            for ((p, m), solid) in out.iter_mut().zip(&mut moved).zip(solid) {
-                if solid {
-                    counts.to_centre += 1;
-                    *p = c;
-                    *m = true;
-                }
+    let solid = solid_points(bsp, &out);
+    let centre_in_solid = solid.contains(&true) && solid_points(bsp, &[c])[0];
+    if centre_in_solid {
+        occluded = solid;
+    } else {
+        for ((p, m), solid) in out.iter_mut().zip(&mut moved).zip(solid) {
+            if solid {
+                counts.to_centre += 1;
+                *p = c;
+                *m = true;
             }
         }
     }

@@ -41,8 +41,8 @@ use crate::visibility::Visibility;
 use arrivals::Arrivals;
 use footprints::Footprints;
 use sample_light::Directions;
-pub use sample_light::SampleLight;
 use sample_light::StyleBuffers;
+pub use sample_light::{HiddenLuxels, SampleLight};
 use shadows::VisibilityScratch;
 
 /// Shadow rays stop this far short of the light, so a light sitting right

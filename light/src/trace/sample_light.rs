@@ -144,16 +144,29 @@ fn luxel_means(values: Vec<[f32; 3]>, per: usize) -> Vec<[f32; 3]> {
         .collect()
 }
 
-/// Luxel means of per-sample values over the samples not `occluded`; a luxel with none takes
-/// the mean of its neighbours that have (over and over, until every luxel has a value), as
-/// ericw-tools fills them. A face with every sample occluded keeps the means of all of them.
+/// What a luxel whose every sample is occluded takes when its face is finished.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HiddenLuxels {
+    /// The mean of its neighbours that have light (over and over, until every luxel has a
+    /// value), as ericw-tools fills a world face's; a face with every sample occluded keeps the
+    /// means of all of them.
+    FromNeighbours,
+    /// Nothing yet (zero): a brush model's are filled from the whole model afterwards.
+    Later,
+}
+
+/// Luxel means of per-sample values over the samples not `occluded`; a luxel with none is
+/// filled as `hidden` says.
 fn open_luxel_means(
     values: Vec<[f32; 3]>,
     per: usize,
     occluded: &[bool],
     width: usize,
+    hidden: HiddenLuxels,
 ) -> Vec<[f32; 3]> {
-    if !occluded.contains(&true) || occluded.iter().all(|&o| o) {
+    if !occluded.contains(&true)
+        || (hidden == HiddenLuxels::FromNeighbours && occluded.iter().all(|&o| o))
+    {
         return luxel_means(values, per);
     }
     let mut luxels: Vec<Option<[f32; 3]>> = values
@@ -177,6 +190,9 @@ fn open_luxel_means(
             })
         })
         .collect();
+    if hidden == HiddenLuxels::Later {
+        return luxels.into_iter().map(Option::unwrap_or_default).collect();
+    }
     let height = luxels.len() / width.max(1);
     while luxels.contains(&None) {
         let before = luxels.clone();
@@ -203,9 +219,15 @@ fn open_luxel_means(
 }
 
 impl SampleLight {
-    /// Every sample is inside solid: the face's own light means nothing.
-    pub fn buried(&self) -> bool {
-        !self.occluded.is_empty() && self.occluded.iter().all(|&o| o)
+    /// Per luxel, whether its every sample is inside solid (empty when no sample is).
+    pub fn hidden_luxels(&self) -> Vec<bool> {
+        if !self.occluded.contains(&true) {
+            return Vec::new();
+        }
+        self.occluded
+            .chunks(self.per_luxel)
+            .map(|o| o.iter().all(|&o| o))
+            .collect()
     }
 
     /// Per style, the luxel means of the light that reflects: lights and
@@ -236,8 +258,9 @@ impl SampleLight {
 
     /// Adds `bounce` (per style, per luxel (given to each of the luxel's
     /// samples) or per sample, times each sample's dirt factor), applies
-    /// minlight and the floors, and averages samples to luxels.
-    pub fn finish(mut self, bounce: &[(u8, Vec<[f32; 3]>)]) -> FaceLight {
+    /// minlight and the floors, and averages samples to luxels, filling luxels whose every
+    /// sample is occluded as `hidden` says.
+    pub fn finish(mut self, bounce: &[(u8, Vec<[f32; 3]>)], hidden: HiddenLuxels) -> FaceLight {
         let per = self.per_luxel;
         if let Some(min) = &self.added_minlight {
             for (s, m) in self.sums.get(0).iter_mut().zip(min) {
@@ -273,7 +296,10 @@ impl SampleLight {
             .sums
             .styles
             .into_iter()
-            .map(|(style, values)| (style, open_luxel_means(values, per, occluded, width)))
+            .map(|(style, values)| {
+                let means = open_luxel_means(values, per, occluded, width, hidden);
+                (style, means)
+            })
             .collect();
         FaceLight {
             face: self.face,
