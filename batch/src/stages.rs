@@ -360,12 +360,13 @@ const LIGHT_KEYS_COMPILED: [&str; 3] = ["classname", "origin", "targetname"];
 
 /// The keys of worldspawn the compiler reads (its others, `_sunlight`, `light`, `_dirt`,
 /// `_bounce`..., are light's). A new key the compiler reads must be added here.
-const WORLDSPAWN_KEYS_COMPILED: [&str; 8] = [
+const WORLDSPAWN_KEYS_COMPILED: [&str; 9] = [
     "classname",
     "wad",
     "_phong",
     "_phong_angle",
     "_mirrorinside",
+    "_noclipfaces",
     "_litwater",
     "origin",
     "targetname",
@@ -588,6 +589,12 @@ mod tests {
             // Regression: worldspawn's `_litwater` decides which liquids get lightmaps.
             map(
                 "\"wad\" \"a.wad\"\n\"_litwater\" \"0\"\n",
+                "\"origin\" \"2 2 2\"\n",
+                "",
+            ),
+            // Worldspawn's `_noclipfaces` keeps faces between its brushes.
+            map(
+                "\"wad\" \"a.wad\"\n\"_noclipfaces\" \"1\"\n",
                 "\"origin\" \"2 2 2\"\n",
                 "",
             ),

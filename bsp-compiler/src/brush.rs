@@ -70,6 +70,9 @@ pub struct Brush {
     /// The entity's `_mirrorinside`: whether its faces are also drawn seen from inside it
     /// (`None`: the default for its contents, see [`crate::faces`]).
     pub mirror_inside: Option<bool>,
+    /// The entity's `_noclipfaces`: where the brush touches or overlaps brushes of its contents,
+    /// the faces of both are kept instead of clipped away (see [`crate::faces`]).
+    pub no_clip_faces: bool,
 }
 
 /// A plane of a brush being built, with the texinfo of its map face.
@@ -170,6 +173,7 @@ impl Brush {
             source,
             kind,
             mirror_inside: None,
+            no_clip_faces: false,
         };
         (brush.volume() >= MIN_VOLUME).then_some(brush)
     }
@@ -299,19 +303,19 @@ impl Brush {
             used: true,
             buried: false,
         });
-        match (
-            Brush::with_sides(front_sides, self.contents, self.source, self.kind).map(|b| Brush {
-                mirror_inside: self.mirror_inside,
-                ..b
-            }),
-            Brush::with_sides(back_sides, self.contents, self.source, self.kind).map(|b| Brush {
-                mirror_inside: self.mirror_inside,
-                ..b
-            }),
-        ) {
+        match (self.part_with(front_sides), self.part_with(back_sides)) {
             (Some(front), Some(back)) => (Some(front), Some(back)),
             _ => self.on_both_sides(),
         }
+    }
+
+    /// A part of this brush bounded by `sides`, keeping what the entity said of it.
+    fn part_with(&self, sides: Vec<Side>) -> Option<Brush> {
+        Brush::with_sides(sides, self.contents, self.source, self.kind).map(|b| Brush {
+            mirror_inside: self.mirror_inside,
+            no_clip_faces: self.no_clip_faces,
+            ..b
+        })
     }
 
     /// The brush reaches past a plane on both sides but one part is too thin to build: each side

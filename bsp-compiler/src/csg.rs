@@ -1,7 +1,8 @@
 //! CSG between brushes: a side buried inside other brushes of at least its contents strength
 //! (solid > detail wall > fence > sky > lava > slime > water > illusionary) can never be seen,
 //! so it never splits the tree; but illusionary brushes stay seen inside liquids. Detail brushes
-//! only hide the sides of other detail brushes. Faces between touching or overlapping brushes
+//! only hide the sides of other detail brushes, and brushes of one contents where either has
+//! `_noclipfaces` hide none of each other's. Faces between touching or overlapping brushes
 //! disappear that way, and trees (above all the clip hulls, whose grown brushes overlap a lot)
 //! get far fewer splits.
 //!
@@ -10,7 +11,7 @@
 
 use crate::brush::{Brush, Side};
 use crate::planes::PlaneSet;
-use crate::tree::{contents_priority, shows_inside};
+use crate::tree::{contents_priority, keeps_sides_inside};
 use glam::DVec3;
 use quake_formats::geom::{Bounds, ON_EPSILON, PlaneSide, Split, Winding};
 use rayon::prelude::*;
@@ -46,12 +47,13 @@ pub fn mark_hidden_sides(brushes: &mut [Brush], planes: &PlaneSet) -> usize {
                 .copied()
                 .filter(|&j| {
                     // Structure must not depend on detail: only detail is hidden by detail.
-                    // Illusionary brushes stay seen inside liquids.
+                    // Illusionary brushes stay seen inside liquids, `_noclipfaces` ones inside
+                    // brushes of their contents.
                     j != i
                         && padded[j].intersects(&padded[i])
                         && contents_priority(brushes[j].contents) >= prio
                         && (me.is_detail() || !brushes[j].is_detail())
-                        && !shows_inside(brushes[j].contents, me.contents)
+                        && !keeps_sides_inside(&brushes[j], me)
                 })
                 .collect();
             covers.sort_unstable();
@@ -175,6 +177,49 @@ mod tests {
                 .count(),
             2
         );
+    }
+
+    /// Touching brushes of one contents keep their sides (and so the faces between them) when
+    /// either has `_noclipfaces`; a plain pair hides both.
+    #[test]
+    fn noclipfaces_brushes_hide_none_of_their_contents_sides() {
+        let mut planes = PlaneSet::new();
+        for (first, second, hidden) in [(false, false, 2), (true, false, 0), (false, true, 0)] {
+            let mut brushes = vec![
+                cube(
+                    &mut planes,
+                    DVec3::ZERO,
+                    DVec3::new(64.0, 64.0, 64.0),
+                    contents::SOLID,
+                ),
+                cube(
+                    &mut planes,
+                    DVec3::new(64.0, 0.0, 0.0),
+                    DVec3::new(128.0, 64.0, 64.0),
+                    contents::SOLID,
+                ),
+            ];
+            brushes[0].no_clip_faces = first;
+            brushes[1].no_clip_faces = second;
+            assert_eq!(mark_hidden_sides(&mut brushes, &planes), hidden);
+        }
+        // A stronger brush still hides a `_noclipfaces` one's sides.
+        let mut brushes = vec![
+            cube(
+                &mut planes,
+                DVec3::ZERO,
+                DVec3::new(128.0, 128.0, 128.0),
+                contents::SOLID,
+            ),
+            cube(
+                &mut planes,
+                DVec3::new(32.0, 32.0, 32.0),
+                DVec3::new(64.0, 64.0, 64.0),
+                contents::WATER,
+            ),
+        ];
+        brushes[1].no_clip_faces = true;
+        assert_eq!(mark_hidden_sides(&mut brushes, &planes), 6);
     }
 
     #[test]

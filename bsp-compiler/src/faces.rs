@@ -3,7 +3,7 @@
 
 use crate::brush::{Brush, BrushKind, Side};
 use crate::planes::{PlaneId, PlaneSet};
-use crate::portals::Portals;
+use crate::portals::{Portal, Portals};
 use crate::texinfo::TextureRole;
 use crate::tree::{
     Tree, TreeNode, VISBLOCKER, contents_priority, engine_contents, is_see_through,
@@ -364,7 +364,8 @@ impl ViewingLeaves<'_> {
 }
 
 /// Faces on every portal between leaves of different contents, seen from each side that can see
-/// them, textured by the stronger side's brushes.
+/// them, textured by the stronger side's brushes; and on portals between leaves of one contents
+/// whose brushes keep their faces there ([`keeps_faces_between`]).
 pub(crate) fn faces_from_portals(
     tree: &Tree,
     portals: &Portals,
@@ -372,21 +373,22 @@ pub(crate) fn faces_from_portals(
     texinfos: &[FaceTexInfo],
     stats: &mut FaceStats,
 ) -> Vec<ModelFace> {
-    let search = TextureSearch {
-        tree,
-        portals,
-        planes,
+    let mut maker = FaceMaker {
+        search: TextureSearch {
+            tree,
+            portals,
+            planes,
+        },
+        viewing: ViewingLeaves {
+            tree,
+            portals,
+            around: HashMap::new(),
+        },
+        texinfos,
+        stats,
+        faces: Vec::new(),
     };
-    let mut viewing = ViewingLeaves {
-        tree,
-        portals,
-        around: HashMap::new(),
-    };
-    let mut faces = Vec::new();
     for p in &portals.portals {
-        let (Some(node), Some(plane)) = (p.on_node, p.plane_id) else {
-            continue;
-        };
         let [a, b] = p.nodes;
         if a == portals.outside || b == portals.outside {
             continue;
@@ -395,42 +397,114 @@ pub(crate) fn faces_from_portals(
             tree.nodes[a as usize].contents,
             tree.nodes[b as usize].contents,
         );
-        if contents_priority(ca) == contents_priority(cb) {
-            continue;
+        if ca == cb && keeps_faces_between(tree, a, b) {
+            // Each leaf's own faces on the portal, looking into the other.
+            for owner_is_front in [true, false] {
+                maker.faces_on(p, owner_is_front, PortalFace::Kept);
+            }
+        } else if contents_priority(ca) != contents_priority(cb) {
+            maker.faces_on(
+                p,
+                contents_priority(ca) > contents_priority(cb),
+                PortalFace::Boundary,
+            );
         }
-        let owner_is_front = contents_priority(ca) > contents_priority(cb);
-        let owner = if owner_is_front { a } else { b };
-        let owner_node = &tree.nodes[owner as usize];
-        // The owner's side looks out of it: backwards along the plane when it is in front.
-        let exact = owner_node
-            .brushes
+    }
+    maker.faces
+}
+
+/// Whether the faces between leaves `a` and `b`, of one contents, are kept: a brush of that
+/// contents in either has `_noclipfaces`.
+fn keeps_faces_between(tree: &Tree, a: u32, b: u32) -> bool {
+    [a, b].into_iter().any(|leaf| {
+        let leaf = &tree.nodes[leaf as usize];
+        leaf.brushes
             .iter()
-            .flat_map(|br| br.sides.iter())
-            .any(|s| s.plane == plane && s.flipped == owner_is_front && s.texinfo.is_some());
-        for part in search.paint(owner, plane, owner_is_front, &p.winding) {
+            .any(|br| br.contents == leaf.contents && br.no_clip_faces)
+    })
+}
+
+/// Whether any of `brushes` has a map face on `plane` facing out of it as `flipped` says.
+fn side_on<'a>(
+    brushes: impl IntoIterator<Item = &'a Brush>,
+    plane: PlaneId,
+    flipped: bool,
+) -> bool {
+    brushes
+        .into_iter()
+        .flat_map(|b| &b.sides)
+        .any(|s| s.plane == plane && s.flipped == flipped && s.texinfo.is_some())
+}
+
+/// Why a portal has faces.
+#[derive(Clone, Copy, PartialEq)]
+enum PortalFace {
+    /// Contents change across it: its face is textured from the nearest side when no side of
+    /// its owner lies on it, and the other leaf sees it only if faces behind it show
+    /// ([`seen_from`]).
+    Boundary,
+    /// `_noclipfaces` keeps the faces between leaves of one contents: made only where a side of
+    /// the owner lies on the portal (else every split inside a brush would become a face), seen
+    /// from the other leaf whatever it is (the mapper asked for them).
+    Kept,
+}
+
+/// Makes the faces of one model's portals.
+struct FaceMaker<'a> {
+    search: TextureSearch<'a>,
+    viewing: ViewingLeaves<'a>,
+    texinfos: &'a [FaceTexInfo],
+    stats: &'a mut FaceStats,
+    faces: Vec<ModelFace>,
+}
+
+impl FaceMaker<'_> {
+    /// The faces on portal `p` looking out of its leaf in front of the plane (`owner_is_front`)
+    /// or behind it, painted from that leaf's brushes, each seen from the other leaf and, when
+    /// mirrored, from the owner, as `why` allows.
+    fn faces_on(&mut self, p: &Portal, owner_is_front: bool, why: PortalFace) {
+        let (Some(node), Some(plane)) = (p.on_node, p.plane_id) else {
+            return;
+        };
+        let tree = self.search.tree;
+        let [a, b] = p.nodes;
+        let owner = if owner_is_front { a } else { b };
+        // The owner's side looks out of it: backwards along the plane when it is in front.
+        let exact = match why {
+            PortalFace::Boundary => {
+                side_on(&tree.nodes[owner as usize].brushes, plane, owner_is_front)
+            }
+            PortalFace::Kept => side_on(self.search.own_brushes(owner), plane, owner_is_front),
+        };
+        if !exact && why == PortalFace::Kept {
+            return;
+        }
+        for part in self.search.paint(owner, plane, owner_is_front, &p.winding) {
             let Painted {
                 winding,
                 texinfo,
                 mirrored,
             } = part;
-            if !texinfos[texinfo as usize].role.is_drawn() {
+            if !self.texinfos[texinfo as usize].role.is_drawn() {
                 continue;
             }
             for (viewer, front) in [(a, true), (b, false)] {
                 let viewer_contents = tree.nodes[viewer as usize].contents;
-                if !seen_from(mirrored, viewer_contents, viewer == owner) {
+                let own_side = viewer == owner;
+                let asked = why == PortalFace::Kept && !own_side;
+                if !(asked || seen_from(mirrored, viewer_contents, own_side)) {
                     continue;
                 }
-                let (leaves, stored) = viewing.of(viewer);
+                let (leaves, stored) = self.viewing.of(viewer);
                 // A face behind a fence is seen from the open leaves around it.
                 let seen_from = leaves
                     .iter()
                     .map(|&l| engine_contents(tree.nodes[l as usize].contents))
                     .find(|&c| c != contents::SOLID)
                     .unwrap_or(engine_contents(viewer_contents));
-                stats.from_portals += 1;
-                stats.untextured += usize::from(!exact);
-                faces.push(ModelFace {
+                self.stats.from_portals += 1;
+                self.stats.untextured += usize::from(!exact);
+                self.faces.push(ModelFace {
                     node,
                     plane,
                     back: !front,
@@ -447,7 +521,6 @@ pub(crate) fn faces_from_portals(
             }
         }
     }
-    faces
 }
 
 /// The two polygons joined along a shared edge, if the result is convex.

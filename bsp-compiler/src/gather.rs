@@ -621,6 +621,10 @@ impl EntityContext<'_> {
         let mut out = Vec::new();
         let (mut bad, mut hints) = (0, 0);
         let mirror_inside = ent.entity.get_float("_mirrorinside").map(|v| v != 0.0);
+        let no_clip_faces = ent
+            .entity
+            .get_float("_noclipfaces")
+            .is_some_and(|v| v != 0.0);
         for (bi, mb) in ent.brushes.iter().enumerate() {
             if is_origin_brush(mb) {
                 continue;
@@ -660,6 +664,7 @@ impl EntityContext<'_> {
                         b.kind = self.class.kind();
                     }
                     b.mirror_inside = mirror_inside;
+                    b.no_clip_faces = no_clip_faces;
                     out.push((b, textured == FaceContents::Clip));
                 }
                 Err(e) => {

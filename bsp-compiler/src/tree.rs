@@ -719,8 +719,9 @@ impl Builder<'_> {
 
 /// Whether a fragment of the strongest contents fills the region: it decides the region whatever
 /// lies inside, and splitting further would only cut up space of one contents. Above the
-/// structural leaves only a structural fragment may end the structure. Brushes that show inside
-/// the strongest ([`shows_inside`]) must fill the region too, or their sides split it further.
+/// structural leaves only a structural fragment may end the structure. Brushes that keep their
+/// sides inside the filler ([`keeps_sides_inside`]) must fill the region too, or their sides
+/// split it further.
 fn strongest_fills(brushes: &[Brush], phase: Phase) -> bool {
     let strongest = brushes.iter().map(|b| contents_priority(b.contents)).max();
     let Some(filler) = brushes.iter().find(|b| {
@@ -730,7 +731,16 @@ fn strongest_fills(brushes: &[Brush], phase: Phase) -> bool {
     };
     brushes
         .iter()
-        .all(|b| !shows_inside(filler.contents, b.contents) || b.fills_node())
+        .all(|b| !keeps_sides_inside(filler, b) || b.fills_node())
+}
+
+/// Whether brush `inner` keeps its sides (and so its faces) inside brush `outer`, stronger or
+/// as strong: it shows inside it ([`shows_inside`]), or they are of one contents and either has
+/// `_noclipfaces` (treating a junction of such a brush and a plain one as if both had it, as
+/// ericw-tools does).
+pub fn keeps_sides_inside(outer: &Brush, inner: &Brush) -> bool {
+    shows_inside(outer.contents, inner.contents)
+        || (outer.contents == inner.contents && (outer.no_clip_faces || inner.no_clip_faces))
 }
 
 /// The contents of a region holding `brushes`: the strongest, with any shown inside it

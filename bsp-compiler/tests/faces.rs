@@ -246,3 +246,169 @@ fn faces_seen_through_a_fence_are_listed_in_the_open_leaves_around_it() {
         assert!(open, "face {f} ({})", face_texture(bsp, f));
     }
 }
+
+/// A box brush textured `skip` but for its face `face` (0..6: +x, -x, +y, -y, +z, -z), which
+/// gets `texture`.
+fn box_with_face(mins: [f64; 3], maxs: [f64; 3], face: usize, texture: &str) -> String {
+    let mut lines: Vec<String> = box_brush(mins, maxs, "skip")
+        .lines()
+        .map(String::from)
+        .collect();
+    // Line 0 is the opening brace.
+    lines[face + 1] = lines[face + 1].replace("skip", texture);
+    lines.join("\n") + "\n"
+}
+
+/// A brush entity of class `classname`, with `_noclipfaces 1` when `no_clip` and the extra keys
+/// `keys` (lines of `"key" "value"`), holding `brushes`.
+fn entity_with(classname: &str, no_clip: bool, keys: &str, brushes: &str) -> String {
+    let key = if no_clip {
+        "\"_noclipfaces\" \"1\"\n"
+    } else {
+        ""
+    };
+    format!("{{\n\"classname\" \"{classname}\"\n{key}{keys}{brushes}}}\n")
+}
+
+/// The faces of model 0 textured `texture`.
+fn textured(bsp: &quake_formats::Bsp, texture: &str) -> Vec<usize> {
+    (0..bsp.models[0].num_faces as usize)
+        .map(|f| f + bsp.models[0].first_face as usize)
+        .filter(|&f| face_texture(bsp, f) == texture)
+        .collect()
+}
+
+const MINUS_Y: Option<[f32; 3]> = Some([0.0, -1.0, 0.0]);
+
+/// A T of two `func_detail_illusionary` brushes, each with one `{trigger` face (the bar's facing
+/// the stem, the stem's at its far end), the rest skip: with `_noclipfaces` the bar's face is
+/// kept whole where the stem touches it, one face, as in ericw-tools (`noclipfaces`); with
+/// `_mirrorinside` too each face is also drawn from inside (`noclipfacesMirrorinside`). Without
+/// the key the stem clips the bar's face around the contact.
+#[test]
+fn noclipfaces_keeps_the_face_a_brush_of_its_contents_touches() {
+    let bar = box_with_face([-64.0, 0.0, -64.0], [64.0, 8.0, 0.0], 3, "{trigger");
+    let stem = box_with_face([-4.0, -64.0, -64.0], [4.0, 0.0, 0.0], 3, "{trigger");
+    for (no_clip, mirror) in [(true, false), (true, true), (false, false)] {
+        let keys = if mirror {
+            "\"_mirrorinside\" \"1\"\n"
+        } else {
+            ""
+        };
+        let entity = entity_with(
+            "func_detail_illusionary",
+            no_clip,
+            keys,
+            &format!("{stem}{bar}"),
+        );
+        let out = compile_text(&room_map_with(false, "", &entity));
+        let bsp = &out.bsp;
+        let case = format!("_noclipfaces {no_clip}, _mirrorinside {mirror}");
+        assert_eq!(errors(bsp), Vec::<String>::new(), "{case}");
+        assert!(out.leak.is_none(), "{case}: {:?}", out.warnings);
+        let contact = faces_at(bsp, 0, [0.0, 0.0, -32.0], MINUS_Y);
+        if !no_clip {
+            assert_eq!(contact, Vec::<usize>::new(), "{case}");
+            continue;
+        }
+        let expected = if mirror { 4 } else { 2 };
+        assert_eq!(textured(bsp, "{trigger").len(), expected, "{case}");
+        // Whole: the same face on both sides of the contact and across it.
+        assert_eq!(contact.len(), 1, "{case}");
+        for x in [-48.0, 48.0] {
+            assert_eq!(
+                faces_at(bsp, 0, [x, 0.0, -32.0], MINUS_Y),
+                contact,
+                "{case}"
+            );
+        }
+        let inside = faces_at(bsp, 0, [0.0, 0.0, -32.0], Some([0.0, 1.0, 0.0]));
+        assert_eq!(inside.len(), usize::from(mirror), "{case}");
+    }
+}
+
+/// Two `func_detail_wall` boxes touching, the first with `_noclipfaces`: both faces at the
+/// junction are kept, each box's own, as if both had the key (ericw-tools'
+/// `noclipfacesJunction`); without the key neither is.
+#[test]
+fn noclipfaces_keeps_both_faces_where_it_meets_a_plain_entity() {
+    let first = box_brush([-64.0, -32.0, -64.0], [0.0, 32.0, 0.0], "{trigger");
+    let second = box_brush([0.0, -32.0, -64.0], [64.0, 32.0, 0.0], "blood1");
+    for no_clip in [true, false] {
+        let entities = entity_with("func_detail_wall", no_clip, "", &first)
+            + &entity_with("func_detail_wall", false, "", &second);
+        let out = compile_text(&room_map_with(false, "", &entities));
+        let bsp = &out.bsp;
+        assert_eq!(errors(bsp), Vec::<String>::new(), "{no_clip}");
+        assert!(out.leak.is_none(), "{no_clip}: {:?}", out.warnings);
+        let junction = |normal: [f32; 3]| -> Vec<String> {
+            faces_at(bsp, 0, [0.0, 0.0, -32.0], Some(normal))
+                .iter()
+                .map(|&f| face_texture(bsp, f))
+                .collect()
+        };
+        let kept = if no_clip { 6 } else { 5 };
+        assert_eq!(textured(bsp, "{trigger").len(), kept, "{no_clip}");
+        assert_eq!(textured(bsp, "blood1").len(), kept, "{no_clip}");
+        if no_clip {
+            assert_eq!(junction([1.0, 0.0, 0.0]), ["{trigger"]);
+            assert_eq!(junction([-1.0, 0.0, 0.0]), ["blood1"]);
+        } else {
+            assert_eq!(junction([1.0, 0.0, 0.0]), Vec::<String>::new());
+            assert_eq!(junction([-1.0, 0.0, 0.0]), Vec::<String>::new());
+        }
+    }
+}
+
+/// A cross of two `func_detail_illusionary` brushes overlapping: with `_noclipfaces` each keeps
+/// its faces inside the other (ericw-tools' `detailIllusionaryNoclipfacesIntersecting`), without
+/// it they are clipped away (`detailIllusionaryIntersecting`); the top where both lie is drawn
+/// either way.
+#[test]
+fn noclipfaces_keeps_faces_inside_an_overlapping_brush() {
+    let along_y = box_brush([-4.0, -64.0, -64.0], [4.0, 64.0, 0.0], "{trigger");
+    let along_x = box_brush([-64.0, -4.0, -64.0], [64.0, 4.0, 0.0], "{trigger");
+    for no_clip in [true, false] {
+        let entity = entity_with(
+            "func_detail_illusionary",
+            no_clip,
+            "",
+            &format!("{along_y}{along_x}"),
+        );
+        let out = compile_text(&room_map_with(false, "", &entity));
+        let bsp = &out.bsp;
+        assert_eq!(errors(bsp), Vec::<String>::new(), "{no_clip}");
+        assert!(out.leak.is_none(), "{no_clip}: {:?}", out.warnings);
+        let interior = faces_at(bsp, 0, [0.0, -4.0, -32.0], MINUS_Y);
+        assert_eq!(interior.len(), usize::from(no_clip), "{no_clip}");
+        let top = faces_at(bsp, 0, [0.0, 2.0, 0.0], UP).len();
+        assert!((1..=2).contains(&top), "{no_clip}: {top} faces on top");
+    }
+}
+
+/// The panes of a translucent `func_wall` touching end to end, with `_noclipfaces`: the face of
+/// each where the other meets it is kept in the entity's model.
+#[test]
+fn noclipfaces_keeps_faces_between_a_func_walls_panes() {
+    let left = box_brush([-64.0, -2.0, -96.0], [0.0, 2.0, -32.0], "glass_a");
+    let right = box_brush([0.0, -2.0, -96.0], [64.0, 2.0, -32.0], "glass_b");
+    for no_clip in [true, false] {
+        let entity = entity_with(
+            "func_wall",
+            no_clip,
+            "\"alpha\" \"0.5\"\n",
+            &format!("{left}{right}"),
+        );
+        let out = compile_text(&room_map_with(false, "", &entity));
+        let bsp = &out.bsp;
+        assert_eq!(errors(bsp), Vec::<String>::new(), "{no_clip}");
+        for (normal, name) in [([1.0, 0.0, 0.0], "glass_a"), ([-1.0, 0.0, 0.0], "glass_b")] {
+            let names: Vec<String> = faces_at(bsp, 1, [0.0, 0.0, -64.0], Some(normal))
+                .iter()
+                .map(|&f| face_texture(bsp, f))
+                .collect();
+            let expected: &[&str] = if no_clip { &[name] } else { &[] };
+            assert_eq!(names, expected, "{no_clip}");
+        }
+    }
+}
