@@ -61,6 +61,18 @@ pub struct FaceGeom {
     pub own_grid: Option<OwnGrid>,
 }
 
+impl FaceGeom {
+    /// Whether light writes a lightmap for the face: of a kind that has one, and not textured
+    /// `trigger` or `skip` (faces of brush models engines never draw, which ericw-tools gives
+    /// none either).
+    pub fn has_lightmap(&self) -> bool {
+        self.kind.has_lightmap()
+            && !["trigger", "skip"]
+                .iter()
+                .any(|t| self.texture.eq_ignore_ascii_case(t))
+    }
+}
+
 /// The spacing a brush model's faces are lit at.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Spacing {

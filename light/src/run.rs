@@ -141,7 +141,7 @@ impl<'a> Plan<'a> {
             vec![None; n]
         };
         let to_trace = (0..n)
-            .filter(|&f| !fullbright && prep.faces[f].kind.has_lightmap())
+            .filter(|&f| !fullbright && prep.faces[f].has_lightmap())
             .filter(|&f| bouncing || wanted[f])
             .collect();
         Plan {

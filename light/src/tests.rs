@@ -2079,6 +2079,24 @@ fn lit_liquids_get_lightmaps_and_let_light_through() {
     }
 }
 
+/// Faces textured `trigger` or `skip` (brush models engines never draw) get no lightmap, as in
+/// ericw-tools, and lit faces beside them are lit as before.
+#[test]
+fn trigger_and_skip_faces_get_no_lightmap() {
+    let ents = "{ \"classname\" \"worldspawn\" }\n\
+                { \"classname\" \"light\" \"origin\" \"128 128 64\" \"light\" \"300\" }\n";
+    let opts = options(Quality::Default);
+    for name in ["trigger", "SKIP"] {
+        let mut bsp = synthetic_bsp(&[floor(256.0), floor(256.0)], ents);
+        bsp.textures.textures.push(Some(mip(name)));
+        let info = &mut bsp.texinfo[bsp.faces[1].texinfo as usize];
+        info.miptex = bsp.textures.textures.len() as u32 - 1;
+        let lighting = compute_lighting(&bsp, &opts).expect("light");
+        let lit: Vec<usize> = lighting.lightmaps.iter().map(|m| m.face).collect();
+        assert_eq!(lit, [0], "{name}");
+    }
+}
+
 /// A lit liquid's surface is lit from both sides, as ericw-tools lights it: a light under the
 /// water lights the surface seen from above about as a light as far above it would, where a solid
 /// face on the same plane takes nothing from below.
