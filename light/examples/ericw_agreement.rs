@@ -1,9 +1,10 @@
 //! Per-face agreement of two lightings of the same BSP: `ericw_agreement OURS.bsp THEIRS.bsp
 //! [WORST]`, where both files are one compiled, vised BSP lit by two tools (ours, and
 //! ericw-tools' `light` at the same setting; `bench/light_agreement.sh` runs both). For every
-//! face it takes the mean of each style's grey lightmap, and counts the faces whose styles and
-//! means agree within 5 levels, the faces one tool lights and the other leaves without a
-//! lightmap, and the faces whose styles differ; then it lists the WORST faces (default 20) that
+//! face it takes the mean of each style's grey lightmap, and counts the faces with the same
+//! styles (in whichever order each tool wrote them: both put the brightest first, and near ties
+//! fall either way) whose means agree within 5 levels style by style, the faces one tool lights
+//! and the other leaves without a lightmap, and the faces whose styles differ; then it lists the WORST faces (default 20) that
 //! differ most, with their model, texture and centre, to look at in the map.
 
 use light::{FaceLightmap, lightmaps_in};
@@ -24,12 +25,14 @@ fn style_means(map: &FaceLightmap) -> Vec<(u8, f64)> {
         .collect()
 }
 
-/// Each face's style means, `None` for a face without a lightmap.
+/// Each face's style means in order of style, `None` for a face without a lightmap.
 fn faces_means(bsp: &Bsp) -> Vec<Option<Vec<(u8, f64)>>> {
     let all: Vec<usize> = (0..bsp.faces.len()).collect();
     let mut out = vec![None; bsp.faces.len()];
     for map in lightmaps_in(bsp, &all).lightmaps {
-        out[map.face] = Some(style_means(&map));
+        let mut means = style_means(&map);
+        means.sort_by_key(|&(style, _)| style);
+        out[map.face] = Some(means);
     }
     out
 }
@@ -99,7 +102,13 @@ fn main() -> anyhow::Result<()> {
                     continue;
                 }
                 same_styles += 1;
-                let (mx, my) = (x[0].1, y[0].1);
+                // The style whose means differ most speaks for the face.
+                let (mx, my) = x
+                    .iter()
+                    .zip(y)
+                    .map(|(x, y)| (x.1, y.1))
+                    .max_by(|p, q| (p.0 - p.1).abs().total_cmp(&(q.0 - q.1).abs()))
+                    .unwrap_or_default();
                 sum_ours += mx;
                 sum_theirs += my;
                 let d = mx - my;

@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# The BSPs bench/light_agreement.sh compares on, compiled and vised by ericw-tools' own qbsp and
+# vis (../shared/anchors/ericw-tools), written to OUT (default /tmp/agree):
+#   e1m1.bsp  id's e1m1 (full vis). Its WAD (id1's gfx/base.wad) is not free, so the map is
+#             compiled with a placeholder WAD of flat grey 16x16 textures under its texture names:
+#             light needs the names (liquids, sky) and not the pictures.
+#   e1m3.bsp  LibreQuake e1m3 with the corpus WADs (vis -fast).
+#   start.bsp LibreQuake start, the corpus BSP itself.
+# Usage: bench/agreement_bsps.sh [OUT]
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+shared="$root/../shared"
+anchor="$shared/anchors/ericw-tools/bin"
+[ -x "$anchor/qbsp" ] || { echo "SKIPPED: $anchor/qbsp not found" >&2; exit 0; }
+out="${1:-/tmp/agree}"
+mkdir -p "$out"
+cargo build --release --manifest-path "$root/Cargo.toml" -p slipgate >/dev/null
+slipgate="${CARGO_TARGET_DIR:-$root/target}/release/slipgate"
+
+# A 16x16 grey picture as an uncompressed 24-bit TGA.
+grey_tga() {
+  printf '\0\0\2\0\0\0\0\0\0\0\0\0\20\0\20\0\30\0'
+  head -c 768 /dev/zero | tr '\0' '\200'
+}
+
+pictures=$(mktemp -d)
+trap 'rm -rf "$pictures"' EXIT
+# Texture names: the word after a map face's three points.
+sed -n 's/^ *(.*) *(.*) *(.*) *\([^ ]*\) .*/\1/p' "$shared/corpus/public/maps/id/e1m1.map" \
+  | sort -u | while read -r name; do
+    grey_tga > "$pictures/${name/\*/#}.tga"
+  done
+"$slipgate" wad build "$pictures" "$out/e1m1-placeholder.wad" >/dev/null 2>&1
+sed "s#\"wad\"[[:space:]]*\"[^\"]*\"#\"wad\" \"$out/e1m1-placeholder.wad\"#" \
+  "$shared/corpus/public/maps/id/e1m1.map" > "$out/e1m1.map"
+(cd "$out" && "$anchor/qbsp" e1m1.map >/dev/null && "$anchor/vis" e1m1.bsp >/dev/null)
+
+sed 's#\.\./\.\./\.\./\.\./texture-wads/##g' "$shared/corpus/public/maps/librequake/e1m3.map" \
+  > "$out/e1m3.map"
+(cd "$out" && "$anchor/qbsp" -wadpath "$shared/corpus/wads/librequake" e1m3.map >/dev/null \
+  && "$anchor/vis" -fast e1m3.bsp >/dev/null)
+
+cp "$shared/corpus/public/bsp/librequake/start.bsp" "$out/start.bsp"
+echo "$out/e1m1.bsp $out/e1m3.bsp $out/start.bsp"
