@@ -903,6 +903,20 @@ impl RayPacket16 {
         self.valid.0[lane] = if ok { -1 } else { 0 };
     }
 
+    /// The ray in `lane`: origin, direction, near and far ends; `None` for an inactive lane.
+    #[must_use]
+    pub fn segment(&self, lane: usize) -> Option<([f32; 3], [f32; 3], f32, f32)> {
+        let r = &self.rayhit.ray;
+        (self.valid.0[lane] != 0).then(|| {
+            (
+                [r.org_x[lane], r.org_y[lane], r.org_z[lane]],
+                [r.dir_x[lane], r.dir_y[lane], r.dir_z[lane]],
+                r.tnear[lane],
+                r.tfar[lane],
+            )
+        })
+    }
+
     /// The far end of `lane`'s segment: after [`Scene::first_hit_geom16`],
     /// the distance of the lane's hit (if it hit).
     #[must_use]

@@ -43,6 +43,7 @@ mod dirt;
 mod embree;
 mod error;
 mod faces;
+mod fence;
 mod grid;
 mod hull;
 mod lightgrid;

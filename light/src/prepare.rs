@@ -9,6 +9,7 @@ use quake_formats::geom::Bounds;
 use crate::embree::Device;
 use crate::error::LightError;
 use crate::faces::{FaceGeom, FaceKind, face_geometry};
+use crate::fence::fence_masks;
 use crate::hull;
 use crate::lights::{MapLights, PointLight, parse_lights};
 use crate::nudge;
@@ -140,12 +141,14 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
     let faces = face_geometry(bsp, origin_of, |m| map_lights.spacing(m))?;
     let solids = faceless_solids(bsp, &faces, &map_lights.shadow_models, origin_of);
     let shadowless = shadowless_faces(bsp)?;
+    let fences = fence_masks(bsp, &faces);
     let casters = Casters {
         shadowless: &shadowless,
         models: &map_lights.shadow_models,
         self_shadow_models: &map_lights.self_shadow_models,
         solids: &solids,
         switchable: &map_lights.switchable.shadows,
+        fences: &fences,
     };
     let scene = TraceScene::build(&device, &faces, &casters)?;
     let vis = Visibility::new(bsp, &faces);

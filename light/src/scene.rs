@@ -5,14 +5,18 @@
 //! from that model's faces are tested against. `_switchableshadow` models
 //! get a scene per style, apart from the rest: what they block of style-0
 //! light goes on their style ([`TraceScene::switchable_blocks16`]).
+//! Fence faces are kept apart too, so light can pass their open texels
+//! ([`crate::fence`]).
 
 use std::collections::HashMap;
+use std::sync::Arc;
 
 use glam::DVec3;
 
 use crate::embree::{Device, RayPacket16, Scene, SceneBuilder, sys};
 use crate::error::LightError;
 use crate::faces::{FaceGeom, FaceKind};
+use crate::fence::{Fences, TexelMask};
 
 /// The face of a triangle that blocks light but is no face of the BSP (a faceless model's
 /// solid, see [`crate::hull`]).
@@ -33,6 +37,8 @@ pub struct TraceScene {
     own: HashMap<usize, Scene>,
     /// Per switchable shadow style, the faces of its models.
     switchable: Vec<(u8, Scene)>,
+    /// The shadow-casting fence faces, whose open texels let light through.
+    fences: Option<Fences>,
     /// Triangles in the scene (opaque + sky) and the `_shadowself` scenes.
     pub triangles: usize,
 }
@@ -98,6 +104,8 @@ pub struct Casters<'a> {
     pub solids: &'a [Vec<DVec3>],
     /// Brush models whose shadow is switchable, and its style.
     pub switchable: &'a [(usize, u8)],
+    /// Faces with a fence texture and the mask of its open texels: light passes those.
+    pub fences: &'a [(usize, Arc<TexelMask>)],
 }
 
 impl TraceScene {
@@ -120,7 +128,14 @@ impl TraceScene {
             self_shadow_models,
             solids,
             switchable,
+            fences,
         } = *casters;
+        let fence_mask = |f: &FaceGeom| {
+            fences
+                .iter()
+                .find(|(face, _)| *face == f.index)
+                .map(|(_, mask)| mask.clone())
+        };
         let casts = |f: &FaceGeom| {
             let world = f.model == 0 && !shadowless.get(f.index).copied().unwrap_or(false);
             world || shadow_models.contains(&f.model)
@@ -133,6 +148,7 @@ impl TraceScene {
         };
         let mut opaque =
             Mesh::with_room_for(faces.iter().filter(|f| f.kind == FaceKind::Lit && casts(f)));
+        let mut fence_faces = Vec::new();
         let mut sky = Mesh::default();
         let mut own_meshes: HashMap<usize, Mesh> = HashMap::new();
         let mut switchable_meshes: Vec<(u8, Mesh)> = Vec::new();
@@ -149,7 +165,10 @@ impl TraceScene {
                 continue;
             }
             match f.kind {
-                FaceKind::Lit if casts(f) => opaque.add(f),
+                FaceKind::Lit if casts(f) => match fence_mask(f) {
+                    Some(mask) => fence_faces.push((f, mask)),
+                    None => opaque.add(f),
+                },
                 FaceKind::Lit if self_shadow_models.contains(&f.model) => {
                     own_meshes.entry(f.model).or_default().add(f);
                 }
@@ -161,6 +180,7 @@ impl TraceScene {
             opaque.add_polygon(polygon, NO_FACE);
         }
         let mut triangles = opaque.triangles.len() + sky.triangles.len();
+        let fences = Fences::build(device, &fence_faces)?;
         let mut own = HashMap::with_capacity(own_meshes.len());
         for (model, mesh) in own_meshes {
             triangles += mesh.triangles.len();
@@ -186,6 +206,7 @@ impl TraceScene {
             opaque_faces: opaque.faces,
             own,
             switchable,
+            fences,
             triangles,
         })
     }
@@ -212,9 +233,16 @@ impl TraceScene {
     /// Bit `i` set if lane `i` of `packet`, cast from a face of brush model
     /// `model`, is blocked (sky blocks too).
     pub fn occluded16(&self, packet: &mut RayPacket16, model: usize) -> u16 {
-        let blocked = self.scene.occluded16(packet, true);
+        // Before the opaque test, which rewrites the segments of the lanes it blocks.
+        let fenced = self.fences_block16(packet);
+        let blocked = self.scene.occluded16(packet, true) | fenced;
         // Embree sets tfar of blocked lanes to -inf, so the second query skips them.
         blocked | self.own_occluded16(packet, model)
+    }
+
+    /// Lanes of `packet` a fence face blocks at an opaque texel.
+    fn fences_block16(&self, packet: &RayPacket16) -> u16 {
+        self.fences.as_ref().map_or(0, |f| f.blocks16(packet))
     }
 
     /// Lanes of `packet` (each up to its current `tfar`) that `model`'s own
@@ -241,7 +269,8 @@ impl TraceScene {
             .fold(0, |m, i| m | (1 << i));
         // Just short of the sky hit, so the sky face itself does not block.
         packet.keep_shortened(sky, SKY_HIT_SHORTEN);
-        let blocked = self.scene.occluded16(packet, true);
+        let fenced = self.fences_block16(packet);
+        let blocked = self.scene.occluded16(packet, true) | fenced;
         sky & !blocked & !self.own_occluded16(packet, model) & !self.any_switchable_blocks16(packet)
     }
 

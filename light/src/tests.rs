@@ -2079,6 +2079,46 @@ fn lit_liquids_get_lightmaps_and_let_light_through() {
     }
 }
 
+/// Light passes the open texels (index 255) of fence textures, as in ericw-tools: under a grate
+/// of open and opaque stripes the floor is lit in stripes; a fence texture with no open texel
+/// shadows like any face.
+#[test]
+fn light_passes_the_open_texels_of_fence_textures() {
+    let ents = "{ \"classname\" \"worldspawn\" }\n\
+                { \"classname\" \"light\" \"origin\" \"128 128 192\" \"light\" \"300\" }\n";
+    let grate = || {
+        quad(
+            [32.0, 32.0, 64.0],
+            [32.0, 224.0, 64.0],
+            [224.0, 224.0, 64.0],
+            [224.0, 32.0, 64.0],
+            [0.0, 0.0, 1.0],
+        )
+    };
+    let floor_under = |texels: Vec<u8>| {
+        let mut bsp = synthetic_bsp(&[floor(256.0), grate()], ents);
+        let mips = [texels, vec![1; 64], vec![1; 16], vec![1; 4]];
+        bsp.textures
+            .textures
+            .push(Some(MipTex::new("{grate", 16, 16, mips)));
+        let info = &mut bsp.texinfo[bsp.faces[1].texinfo as usize];
+        info.miptex = bsp.textures.textures.len() as u32 - 1;
+        info.vecs = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0]];
+        let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
+        (64..=192)
+            .step_by(16)
+            .map(|s| luxel_at(&bsp, &lighting, 0, f64::from(s), 128.0))
+            .collect::<Vec<u8>>()
+    };
+    // Texel columns 0..8 open, 8..16 opaque.
+    let stripes: Vec<u8> = (0..256).map(|i| if i % 16 < 8 { 255 } else { 1 }).collect();
+    let striped = floor_under(stripes);
+    assert!(striped.iter().any(|&v| v > 20), "{striped:?}");
+    assert!(striped.iter().any(|&v| v < 5), "{striped:?}");
+    let solid = floor_under(vec![1; 256]);
+    assert!(solid.iter().all(|&v| v < 5), "{solid:?}");
+}
+
 /// Faces textured `trigger` or `skip` (brush models engines never draw) get no lightmap, as in
 /// ericw-tools, and lit faces beside them are lit as before.
 #[test]

@@ -1,0 +1,201 @@
+//! Fence textures (names starting with `{`) are drawn with holes where their texels are palette
+//! index 255, and light goes through those holes, as in ericw-tools: a grate's shadow is a
+//! grate. Fence faces that cast shadows are kept out of the opaque scene, in a scene of their
+//! own. A shadow ray meets them there: at an opaque texel it is blocked; at an open one it goes
+//! on from just past the face, to the next fence face or its end.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use glam::{DVec3, Vec3};
+use quake_formats::Bsp;
+use quake_formats::miptex::MipTex;
+
+use crate::embree::{Device, RayPacket16, Scene, SceneBuilder, sys};
+use crate::error::LightError;
+use crate::faces::FaceGeom;
+
+/// The palette index fence textures leave transparent.
+const OPEN_TEXEL: u8 = 255;
+
+/// How many fence faces one ray may pass through before it counts as blocked.
+const MAX_LAYERS: usize = 16;
+
+/// How far past an open texel a ray goes on from, so it does not meet the same face again.
+const STEP_PAST: f32 = 0.01;
+
+/// Which texels of a fence texture's full-size picture are open.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TexelMask {
+    width: usize,
+    height: usize,
+    open: Vec<bool>,
+}
+
+impl TexelMask {
+    /// The mask of `mip`'s first level; `None` when the texture has no pixels in the BSP (an
+    /// external WAD's), or no open texel (it then blocks light like any face).
+    pub fn of(mip: &MipTex) -> Option<TexelMask> {
+        let (width, height) = (mip.width as usize, mip.height as usize);
+        let pixels = mip
+            .mips
+            .as_ref()?
+            .first()
+            .filter(|p| p.len() == width * height)?;
+        let open: Vec<bool> = pixels.iter().map(|&p| p == OPEN_TEXEL).collect();
+        open.contains(&true).then_some(TexelMask {
+            width,
+            height,
+            open,
+        })
+    }
+
+    /// Whether the texel at texture coordinates (`s`, `t`) is open (the texture tiles).
+    fn is_open(&self, s: f64, t: f64) -> bool {
+        let x = (s.floor() as i64).rem_euclid(self.width as i64) as usize;
+        let y = (t.floor() as i64).rem_euclid(self.height as i64) as usize;
+        self.open[y * self.width + x]
+    }
+}
+
+/// The texel masks of the fence textures of `bsp`'s faces, by face index.
+pub fn fence_masks(bsp: &Bsp, faces: &[FaceGeom]) -> Vec<(usize, Arc<TexelMask>)> {
+    let mut by_texture: HashMap<&str, Option<Arc<TexelMask>>> = HashMap::new();
+    let mut out = Vec::new();
+    for f in faces.iter().filter(|f| f.texture.starts_with('{')) {
+        let mask = by_texture.entry(&f.texture).or_insert_with(|| {
+            let index = bsp.textures.find(&f.texture)?;
+            let mip = bsp.textures.textures.get(index)?.as_ref()?;
+            TexelMask::of(mip).map(Arc::new)
+        });
+        if let Some(mask) = mask {
+            out.push((f.index, mask.clone()));
+        }
+    }
+    out
+}
+
+/// One fence face: where its texture lies on it.
+#[derive(Debug)]
+struct FenceFace {
+    mask: Arc<TexelMask>,
+    /// Texture projection in model space.
+    vecs: [[f32; 4]; 2],
+    /// Model space is world space less this.
+    origin: DVec3,
+}
+
+impl FenceFace {
+    fn is_open_at(&self, p: DVec3) -> bool {
+        let q = p - self.origin;
+        let st = |row: &[f32; 4]| {
+            Vec3::new(row[0], row[1], row[2]).as_dvec3().dot(q) + f64::from(row[3])
+        };
+        self.mask.is_open(st(&self.vecs[0]), st(&self.vecs[1]))
+    }
+}
+
+/// The shadow-casting fence faces, in a scene of their own.
+pub struct Fences {
+    scene: Scene,
+    /// The fence face of each triangle (by primitive id).
+    triangles: Vec<u32>,
+    faces: Vec<FenceFace>,
+}
+
+impl Fences {
+    /// A scene of `faces`, each with its texel mask; `None` when there are none.
+    pub fn build(
+        device: &Device,
+        faces: &[(&FaceGeom, Arc<TexelMask>)],
+    ) -> Result<Option<Fences>, LightError> {
+        if faces.is_empty() {
+            return Ok(None);
+        }
+        let (mut vertices, mut indices, mut triangles) = (Vec::new(), Vec::new(), Vec::new());
+        let mut fence_faces = Vec::with_capacity(faces.len());
+        for (k, (face, mask)) in faces.iter().enumerate() {
+            let base = vertices.len() as u32;
+            vertices.extend(face.points.iter().map(|p| p.as_vec3().to_array()));
+            for i in 1..(face.points.len() as u32).saturating_sub(1) {
+                indices.push([base, base + i, base + i + 1]);
+                triangles.push(k as u32);
+            }
+            fence_faces.push(FenceFace {
+                mask: mask.clone(),
+                vecs: face.vecs,
+                origin: face.origin,
+            });
+        }
+        let mut builder = SceneBuilder::new(device)?;
+        builder.add_triangle_mesh(&vertices, &indices)?;
+        Ok(Some(Fences {
+            scene: builder.commit()?,
+            triangles,
+            faces: fence_faces,
+        }))
+    }
+
+    /// Lanes of `packet` (each over its segment) that a fence face blocks at an opaque texel.
+    /// `packet` itself is left as it was.
+    pub fn blocks16(&self, packet: &RayPacket16) -> u16 {
+        let segments: [Option<_>; 16] = std::array::from_fn(|lane| packet.segment(lane));
+        let mut probe = *packet;
+        let mut blocked = 0u16;
+        for _ in 0..MAX_LAYERS {
+            let hits = self.scene.first_hits16(&mut probe, false);
+            let mut again = 0u16;
+            for (lane, &(geom, prim)) in hits.iter().enumerate() {
+                let Some((org, dir, _, far)) = segments[lane] else {
+                    continue;
+                };
+                if geom == sys::RTC_INVALID_GEOMETRY_ID {
+                    continue;
+                }
+                let t = probe.tfar(lane);
+                let at = Vec3::from(org).as_dvec3() + Vec3::from(dir).as_dvec3() * f64::from(t);
+                let open = self
+                    .triangles
+                    .get(prim as usize)
+                    .and_then(|&k| self.faces.get(k as usize))
+                    .is_some_and(|f| f.is_open_at(at));
+                if open {
+                    again |= 1 << lane;
+                    probe.set(lane, org, dir, t + STEP_PAST, far);
+                } else {
+                    blocked |= 1 << lane;
+                }
+            }
+            if again == 0 {
+                return blocked;
+            }
+            probe.keep_shortened(again, 1.0);
+        }
+        // Still passing through fences after so many: count it as blocked.
+        blocked | probe.active_mask()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn masks_tile_and_need_an_open_texel() {
+        let mut pixels = vec![1u8; 16 * 16];
+        pixels[0] = OPEN_TEXEL;
+        let mip = |pixels: Vec<u8>| {
+            MipTex::new(
+                "{grate",
+                16,
+                16,
+                [pixels, vec![0; 64], vec![0; 16], vec![0; 4]],
+            )
+        };
+        let mask = TexelMask::of(&mip(pixels)).expect("one open texel");
+        assert!(mask.is_open(0.5, 0.5));
+        assert!(mask.is_open(16.5, -15.5), "the texture tiles");
+        assert!(!mask.is_open(1.5, 0.5));
+        assert_eq!(TexelMask::of(&mip(vec![1u8; 256])), None);
+    }
+}
