@@ -1,8 +1,9 @@
 //! Fence textures (names starting with `{`) are drawn with holes where their texels are palette
 //! index 255, and light goes through those holes, as in ericw-tools: a grate's shadow is a
 //! grate. Fence faces that cast shadows are kept out of the opaque scene, in a scene of their
-//! own. A shadow ray meets them there: at an opaque texel it is blocked; at an open one it goes
-//! on from just past the face, to the next fence face or its end.
+//! own. A shadow or sun ray meets them there: at an opaque texel it is blocked; at an open one
+//! it goes on from just past the face, to the next fence face or its end. Dirt and bounced light
+//! look at the opaque scene only, so fences neither darken corners nor reflect light.
 
 use std::collections::HashMap;
 use std::sync::Arc;

@@ -130,12 +130,9 @@ impl TraceScene {
             switchable,
             fences,
         } = *casters;
-        let fence_mask = |f: &FaceGeom| {
-            fences
-                .iter()
-                .find(|(face, _)| *face == f.index)
-                .map(|(_, mask)| mask.clone())
-        };
+        let fence_masks: HashMap<usize, &Arc<TexelMask>> =
+            fences.iter().map(|(face, mask)| (*face, mask)).collect();
+        let fence_mask = |f: &FaceGeom| fence_masks.get(&f.index).map(|&mask| mask.clone());
         let casts = |f: &FaceGeom| {
             let world = f.model == 0 && !shadowless.get(f.index).copied().unwrap_or(false);
             world || shadow_models.contains(&f.model)
