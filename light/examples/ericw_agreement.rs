@@ -4,37 +4,116 @@
 //! face it takes the mean of each style's grey lightmap, and counts the faces with the same
 //! styles (in whichever order each tool wrote them: both put the brightest first, and near ties
 //! fall either way) whose means agree within 5 levels style by style, the faces one tool lights
-//! and the other leaves without a lightmap, and the faces whose styles differ; then it lists the WORST faces (default 20) that
-//! differ most, with their model, texture and centre, to look at in the map.
+//! and the other leaves without a lightmap, and the faces whose styles differ. It counts again
+//! over the luxels engines draw: those within a luxel of the face (bilinear filtering reads no
+//! further), leaving out the corners of a triangle's lightmap that no pixel shows. Then it
+//! lists the WORST faces (default 20) that differ most, with their model, texture and centre,
+//! to look at in the map.
 
 use light::{FaceLightmap, lightmaps_in};
 use quake_formats::Bsp;
+use quake_formats::extents::LightmapExtents;
 
 /// Per-face means within this many levels count as agreeing.
 const AGREE_LEVELS: f64 = 5.0;
 
-/// The mean of each style's lightmap of one face.
-fn style_means(map: &FaceLightmap) -> Vec<(u8, f64)> {
+/// Texels between luxels on Quake's lightmap grid.
+const LUXEL: f64 = 16.0;
+
+/// The mean of each style's lightmap of one face, over the luxels `seen` marks (all when it
+/// is `None` or does not fit).
+fn style_means(map: &FaceLightmap, seen: Option<&[bool]>) -> Vec<(u8, f64)> {
+    let seen = seen.filter(|s| s.len() == map.width * map.height && s.contains(&true));
     map.styles
         .iter()
         .zip(&map.grey)
         .map(|(&style, grey)| {
-            let sum: u64 = grey.iter().map(|&v| u64::from(v)).sum();
-            (style, sum as f64 / grey.len().max(1) as f64)
+            let (sum, n) = grey
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| seen.is_none_or(|s| s[*i]))
+                .fold((0u64, 0u64), |(sum, n), (_, &v)| {
+                    (sum + u64::from(v), n + 1)
+                });
+            (style, sum as f64 / n.max(1) as f64)
         })
         .collect()
 }
 
-/// Each face's style means in order of style, `None` for a face without a lightmap.
-fn faces_means(bsp: &Bsp) -> Vec<Option<Vec<(u8, f64)>>> {
+/// Each face's style means in order of style, `None` for a face without a lightmap; over the
+/// luxels engines draw when `drawn_only`.
+fn faces_means(bsp: &Bsp, drawn_only: bool) -> Vec<Option<Vec<(u8, f64)>>> {
     let all: Vec<usize> = (0..bsp.faces.len()).collect();
     let mut out = vec![None; bsp.faces.len()];
     for map in lightmaps_in(bsp, &all).lightmaps {
-        let mut means = style_means(&map);
+        let seen = drawn_only.then(|| drawn_luxels(bsp, map.face)).flatten();
+        let mut means = style_means(&map, seen.as_deref());
         means.sort_by_key(|&(style, _)| style);
         out[map.face] = Some(means);
     }
     out
+}
+
+/// Per luxel of `face`'s 16-texel grid, whether bilinear filtering reads it anywhere on the face:
+/// the square one luxel either side of its centre meets the face in texture space.
+fn drawn_luxels(bsp: &Bsp, face: usize) -> Option<Vec<bool>> {
+    let f = bsp.faces.get(face)?;
+    let vecs = bsp.texinfo.get(f.texinfo as usize)?.vecs;
+    let points = bsp.face_vertices(f)?;
+    let extents = LightmapExtents::from_points(&points, &vecs);
+    let st = |p: &[f32; 3], row: &[f32; 4]| {
+        f64::from(p[0] * row[0] + p[1] * row[1] + p[2] * row[2] + row[3])
+    };
+    let polygon: Vec<[f64; 2]> = points
+        .iter()
+        .map(|p| [st(p, &vecs[0]), st(p, &vecs[1])])
+        .collect();
+    let [width, height] = extents.extents.map(|e| (e / 16 + 1) as usize);
+    let [s0, t0] = extents.tex_mins.map(f64::from);
+    Some(
+        (0..width * height)
+            .map(|i| {
+                let centre = [
+                    s0 + LUXEL * (i % width) as f64,
+                    t0 + LUXEL * (i / width) as f64,
+                ];
+                meets_square(&polygon, centre, LUXEL)
+            })
+            .collect(),
+    )
+}
+
+/// Whether the convex `polygon` and the square of half-side `half` around `centre` share some
+/// area: the polygon clipped to the square keeps a part.
+fn meets_square(polygon: &[[f64; 2]], centre: [f64; 2], half: f64) -> bool {
+    let mut clipped = polygon.to_vec();
+    for (axis, sign) in [(0, 1.0), (0, -1.0), (1, 1.0), (1, -1.0)] {
+        // Keep the side where sign * (p[axis] - centre[axis]) <= half.
+        let inside = |p: &[f64; 2]| sign * (p[axis] - centre[axis]) <= half;
+        let mut next = Vec::with_capacity(clipped.len() + 1);
+        for (k, p) in clipped.iter().enumerate() {
+            let q = &clipped[(k + 1) % clipped.len()];
+            if inside(p) {
+                next.push(*p);
+            }
+            if inside(p) != inside(q) {
+                let limit = centre[axis] + sign * half;
+                let u = (limit - p[axis]) / (q[axis] - p[axis]);
+                next.push([p[0] + u * (q[0] - p[0]), p[1] + u * (q[1] - p[1])]);
+            }
+        }
+        clipped = next;
+        if clipped.len() < 3 {
+            return false;
+        }
+    }
+    let area: f64 = (0..clipped.len())
+        .map(|k| {
+            let (p, q) = (clipped[k], clipped[(k + 1) % clipped.len()]);
+            p[0] * q[1] - q[0] * p[1]
+        })
+        .sum();
+    area.abs() > 1e-6
 }
 
 /// The model each face belongs to.
@@ -70,6 +149,62 @@ fn describe(bsp: &Bsp, models: &[usize], face: usize) -> String {
     )
 }
 
+/// Counts of one comparison of per-face means.
+#[derive(Default)]
+struct Tally {
+    same_styles: u32,
+    agree: u32,
+    darker: u32,
+    brighter: u32,
+    only_ours: u32,
+    only_theirs: u32,
+    style_differs: u32,
+    neither: u32,
+    sum_ours: f64,
+    sum_theirs: f64,
+    /// Per face with the same styles: the difference, the face, and both means.
+    differences: Vec<(f64, usize, f64, f64)>,
+}
+
+impl Tally {
+    fn of(a: &[Option<Vec<(u8, f64)>>], b: &[Option<Vec<(u8, f64)>>]) -> Tally {
+        let mut t = Tally::default();
+        for (face, pair) in a.iter().zip(b).enumerate() {
+            match pair {
+                (None, None) => t.neither += 1,
+                (Some(_), None) => t.only_ours += 1,
+                (None, Some(_)) => t.only_theirs += 1,
+                (Some(x), Some(y)) => {
+                    if x.iter().map(|s| s.0).ne(y.iter().map(|s| s.0)) {
+                        t.style_differs += 1;
+                        continue;
+                    }
+                    t.same_styles += 1;
+                    // The style whose means differ most speaks for the face.
+                    let (mx, my) = x
+                        .iter()
+                        .zip(y)
+                        .map(|(x, y)| (x.1, y.1))
+                        .max_by(|p, q| (p.0 - p.1).abs().total_cmp(&(q.0 - q.1).abs()))
+                        .unwrap_or_default();
+                    t.sum_ours += mx;
+                    t.sum_theirs += my;
+                    let d = mx - my;
+                    if d.abs() <= AGREE_LEVELS {
+                        t.agree += 1;
+                    } else if d < 0.0 {
+                        t.darker += 1;
+                    } else {
+                        t.brighter += 1;
+                    }
+                    t.differences.push((d.abs(), face, mx, my));
+                }
+            }
+        }
+        t
+    }
+}
+
 fn main() -> anyhow::Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let (ours, theirs, worst) = match &args[..] {
@@ -86,55 +221,33 @@ fn main() -> anyhow::Result<()> {
         theirs.faces.len()
     );
     let models = face_models(&ours);
-    let (a, b) = (faces_means(&ours), faces_means(&theirs));
-    let (mut same_styles, mut agree, mut darker, mut brighter) = (0, 0, 0, 0);
-    let (mut only_ours, mut only_theirs, mut style_differs, mut neither) = (0, 0, 0, 0);
-    let (mut sum_ours, mut sum_theirs) = (0.0, 0.0);
-    let mut differences: Vec<(f64, usize, f64, f64)> = Vec::new();
-    for face in 0..a.len() {
-        match (&a[face], &b[face]) {
-            (None, None) => neither += 1,
-            (Some(_), None) => only_ours += 1,
-            (None, Some(_)) => only_theirs += 1,
-            (Some(x), Some(y)) => {
-                if x.iter().map(|s| s.0).ne(y.iter().map(|s| s.0)) {
-                    style_differs += 1;
-                    continue;
-                }
-                same_styles += 1;
-                // The style whose means differ most speaks for the face.
-                let (mx, my) = x
-                    .iter()
-                    .zip(y)
-                    .map(|(x, y)| (x.1, y.1))
-                    .max_by(|p, q| (p.0 - p.1).abs().total_cmp(&(q.0 - q.1).abs()))
-                    .unwrap_or_default();
-                sum_ours += mx;
-                sum_theirs += my;
-                let d = mx - my;
-                if d.abs() <= AGREE_LEVELS {
-                    agree += 1;
-                } else if d < 0.0 {
-                    darker += 1;
-                } else {
-                    brighter += 1;
-                }
-                differences.push((d.abs(), face, mx, my));
-            }
-        }
-    }
-    let n = f64::from(same_styles.max(1));
+    let whole = Tally::of(&faces_means(&ours, false), &faces_means(&theirs, false));
+    let drawn = Tally::of(&faces_means(&ours, true), &faces_means(&theirs, true));
+    let n = f64::from(whole.same_styles.max(1));
     println!(
-        "{same_styles} faces with the same styles: {agree} ({:.1}%) within {AGREE_LEVELS} levels, \
-         {darker} darker, {brighter} brighter; mean {:.1} (ours) against {:.1}",
-        100.0 * f64::from(agree) / n,
-        sum_ours / n,
-        sum_theirs / n
+        "{} faces with the same styles: {} ({:.1}%) within {AGREE_LEVELS} levels, \
+         {} darker, {} brighter; mean {:.1} (ours) against {:.1}",
+        whole.same_styles,
+        whole.agree,
+        100.0 * f64::from(whole.agree) / n,
+        whole.darker,
+        whole.brighter,
+        whole.sum_ours / n,
+        whole.sum_theirs / n
     );
     println!(
-        "lightmap only in ours: {only_ours}, only in theirs: {only_theirs}, styles differ: \
-         {style_differs}, neither: {neither}"
+        "lightmap only in ours: {}, only in theirs: {}, styles differ: {}, neither: {}",
+        whole.only_ours, whole.only_theirs, whole.style_differs, whole.neither
     );
+    println!(
+        "over the luxels engines draw: {} ({:.1}%) within {AGREE_LEVELS} levels, {} darker, \
+         {} brighter",
+        drawn.agree,
+        100.0 * f64::from(drawn.agree) / f64::from(drawn.same_styles.max(1)),
+        drawn.darker,
+        drawn.brighter
+    );
+    let mut differences = whole.differences;
     differences.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
     for &(_, face, mx, my) in differences.iter().take(worst) {
         println!(
