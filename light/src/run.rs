@@ -376,8 +376,8 @@ fn finish_faces(
 /// The luxels of a brush model's faces whose every sample is inside solid (a door's edge or
 /// face in the wall it slides into) take, per style, the mean of the model's open luxels, all
 /// its faces' together (zero where a face has no light of that style): their own rays, traced
-/// from inside the wall, say nothing, and ericw-tools gives them the model's mean so, rather
-/// than the light of the luxels beside them.
+/// from inside the wall, say nothing. On a door half in a wall ericw-tools writes the same
+/// bytes (one value for all such luxels of the model, not the light of the luxels beside them).
 fn fill_hidden_luxels(faces: &mut [FaceLight], hidden: &[Vec<bool>], geometry: &[FaceGeom]) {
     let model_of = |light: &FaceLight| geometry[light.face].model;
     let in_brush_model = |(light, _): &(&FaceLight, &Vec<bool>)| model_of(light) != 0;
