@@ -103,19 +103,6 @@ impl FaceSamples {
         let cos = self.normal_at(i).dot(to_light);
         if self.two_sided { cos.abs() } else { cos }
     }
-
-    /// [`FaceSamples::incidence`] of a point light `height` units in front of the face: one
-    /// nearer the face than its samples stand off it (a `_surface` copy beside a thin fixture)
-    /// is behind them but in front of the face, and lights the face as it would from as far
-    /// on the samples' side.
-    pub fn point_incidence(&self, i: usize, to_light: DVec3, height: f64) -> f64 {
-        let cos = self.incidence(i, to_light);
-        if height > 0.0 && height < SURFACE_OFFSET {
-            cos.abs()
-        } else {
-            cos
-        }
-    }
 }
 
 /// Per point, the first of `points` at exactly the same place (itself when there is none).

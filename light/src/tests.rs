@@ -2079,24 +2079,6 @@ fn lit_liquids_get_lightmaps_and_let_light_through() {
     }
 }
 
-/// A light nearer a face than its samples stand off it (a `_surface` copy half a unit off a wall
-/// beside a thin fixture) lights the face around it, as one as far on the samples' side would.
-#[test]
-fn a_light_between_a_face_and_its_samples_lights_the_face() {
-    let luxel_under = |z: f32| {
-        let ents = format!(
-            "{{ \"classname\" \"worldspawn\" }}\n\
-             {{ \"classname\" \"light\" \"origin\" \"120 120 {z}\" \"light\" \"200\" }}\n"
-        );
-        let bsp = synthetic_bsp(&[floor(256.0)], &ents);
-        let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
-        luxel_at(&bsp, &lighting, 0, 128.0, 128.0)
-    };
-    let (between, above) = (luxel_under(0.5), luxel_under(1.5));
-    assert!(between > 10, "{between} {above}");
-    assert!(between.abs_diff(above) <= 3, "{between} {above}");
-}
-
 /// Light passes the open texels (index 255) of fence textures, as in ericw-tools: under a grate
 /// of open and opaque stripes the floor is lit in stripes; a fence texture with no open texel
 /// shadows like any face.

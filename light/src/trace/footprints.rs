@@ -14,7 +14,7 @@ use quake_formats::geom::DVec3Ext;
 use super::LIGHT_CLEARANCE;
 use crate::embree::RayPacket16;
 use crate::lights::PointLight;
-use crate::samples::{FaceSamples, SURFACE_OFFSET, WalkStart, solid_points_from};
+use crate::samples::{FaceSamples, WalkStart, solid_points_from};
 use crate::scene::TraceScene;
 
 /// With supersampling, sub-cells per axis are chosen so each is no wider than
@@ -227,10 +227,7 @@ impl Footprints {
         };
         let first = self.values.len();
         for &q in &self.points[placed] {
-            // The light's height over the face: `q` stands the samples' offset off it.
-            let height = (light.origin - q).dot(samples.normal) + SURFACE_OFFSET;
-            let Some((value, dir, dist)) =
-                unshadowed(light, q, |dir| samples.point_incidence(i, dir, height))
+            let Some((value, dir, dist)) = unshadowed(light, q, |dir| samples.incidence(i, dir))
             else {
                 self.values.push(0.0);
                 self.rays.push(None);

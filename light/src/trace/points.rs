@@ -167,7 +167,6 @@ impl FaceTrace<'_> {
     fn unshadowed_values(&mut self, li: usize, closeness: Closeness) {
         let samples = self.samples;
         let light = &self.lights[li];
-        let height = self.face.plane.distance(light.origin);
         let scratch = &mut *self.scratch;
         scratch.near.clear();
         for (i, &p) in samples.points.iter().enumerate() {
@@ -189,7 +188,7 @@ impl FaceTrace<'_> {
                 dir.as_vec3().to_array(),
                 (dist as f32 - LIGHT_CLEARANCE).max(0.0),
             );
-            let v = light.contribution(dist, -dir, samples.point_incidence(i, dir, height));
+            let v = light.contribution(dist, -dir, samples.incidence(i, dir));
             if v.abs() >= self.setup.gate {
                 scratch.value[i] = v;
             }
