@@ -16,7 +16,7 @@ use crate::options::CompileOptions;
 use crate::outside::Occupant;
 use crate::planes::PlaneSet;
 use crate::texinfo::{self, FaceContents, TextureRole};
-use crate::tree::{DETAIL_WALL, FENCE, ILLUSIONARY, VISBLOCKER, engine_contents, is_liquid};
+use crate::tree::{DETAIL_WALL, FENCE, ILLUSIONARY, VISBLOCKER, engine_contents};
 use crate::warnings::{DroppedFace, Warning};
 use glam::DVec3;
 use quake_formats::bsp::contents;
@@ -655,7 +655,7 @@ impl EntityContext<'_> {
                         }
                     } else if brush_contents == contents::SKY {
                         b.kind = BrushKind::Structural;
-                    } else if is_liquid(brush_contents) {
+                    } else if contents::is_liquid(brush_contents) {
                         b.kind = match self.transwater {
                             true => BrushKind::Detail,
                             false => BrushKind::Structural,

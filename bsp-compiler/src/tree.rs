@@ -207,16 +207,11 @@ pub fn contents_priority(c: i32) -> u8 {
     }
 }
 
-/// Whether `c` is a liquid's contents (water, slime, lava).
-pub fn is_liquid(c: i32) -> bool {
-    matches!(c, contents::WATER | contents::SLIME | contents::LAVA)
-}
-
 /// What vis may look between when liquids are opaque (`-notranswater`): leaves of one liquid,
 /// or leaves of no liquid.
 pub fn vis_class(c: i32) -> i32 {
     let engine = engine_contents(c);
-    if is_liquid(engine) {
+    if contents::is_liquid(engine) {
         engine
     } else {
         contents::EMPTY
@@ -227,7 +222,7 @@ pub fn vis_class(c: i32) -> i32 {
 /// stronger contents `outer`: an illusionary brush is drawn under a liquid's surface, which
 /// players see through.
 pub fn shows_inside(outer: i32, inner: i32) -> bool {
-    inner == ILLUSIONARY && is_liquid(outer)
+    inner == ILLUSIONARY && contents::is_liquid(outer)
 }
 
 /// The contents of a region whose strongest brush is of contents `strongest`, when
@@ -258,7 +253,7 @@ pub fn shows_faces_behind(c: i32) -> bool {
 /// surfaces instead of cutting the world in two at every waterline (with `-notranswater` the
 /// portal file keeps liquids apart, see [`vis_class`]). Fences have holes.
 pub fn is_see_through(c: i32) -> bool {
-    is_liquid(engine_contents(c)) || matches!(c, contents::EMPTY | FENCE | ILLUSIONARY)
+    contents::is_liquid(engine_contents(c)) || matches!(c, contents::EMPTY | FENCE | ILLUSIONARY)
 }
 
 /// A node of the flattened tree; a leaf has no plane.

@@ -280,6 +280,27 @@ fn textured(bsp: &quake_formats::Bsp, texture: &str) -> Vec<usize> {
 
 const MINUS_Y: Option<[f32; 3]> = Some([0.0, -1.0, 0.0]);
 
+/// `text` compiled, with no BSP errors and no leak (`case` names the case in failures).
+fn compile_sealed(text: &str, case: &str) -> bsp_compiler::CompileOutput {
+    let out = compile_text(text);
+    assert_eq!(errors(&out.bsp), Vec::<String>::new(), "{case}");
+    assert!(out.leak.is_none(), "{case}: {:?}", out.warnings);
+    out
+}
+
+/// The textures of model `model`'s faces holding `p`, seen along `normal` ([`faces_at`]).
+fn textures_at(
+    bsp: &quake_formats::Bsp,
+    model: usize,
+    p: [f32; 3],
+    normal: [f32; 3],
+) -> Vec<String> {
+    faces_at(bsp, model, p, Some(normal))
+        .iter()
+        .map(|&f| face_texture(bsp, f))
+        .collect()
+}
+
 /// A T of two `func_detail_illusionary` brushes, each with one `{trigger` face (the bar's facing
 /// the stem, the stem's at its far end), the rest skip: with `_noclipfaces` the bar's face is
 /// kept whole where the stem touches it, one face, as in ericw-tools (`noclipfaces`); with
@@ -301,11 +322,9 @@ fn noclipfaces_keeps_the_face_a_brush_of_its_contents_touches() {
             keys,
             &format!("{stem}{bar}"),
         );
-        let out = compile_text(&room_map_with(false, "", &entity));
-        let bsp = &out.bsp;
         let case = format!("_noclipfaces {no_clip}, _mirrorinside {mirror}");
-        assert_eq!(errors(bsp), Vec::<String>::new(), "{case}");
-        assert!(out.leak.is_none(), "{case}: {:?}", out.warnings);
+        let out = compile_sealed(&room_map_with(false, "", &entity), &case);
+        let bsp = &out.bsp;
         let contact = faces_at(bsp, 0, [0.0, 0.0, -32.0], MINUS_Y);
         if !no_clip {
             assert_eq!(contact, Vec::<usize>::new(), "{case}");
@@ -337,16 +356,9 @@ fn noclipfaces_keeps_both_faces_where_it_meets_a_plain_entity() {
     for no_clip in [true, false] {
         let entities = entity_with("func_detail_wall", no_clip, "", &first)
             + &entity_with("func_detail_wall", false, "", &second);
-        let out = compile_text(&room_map_with(false, "", &entities));
+        let out = compile_sealed(&room_map_with(false, "", &entities), &no_clip.to_string());
         let bsp = &out.bsp;
-        assert_eq!(errors(bsp), Vec::<String>::new(), "{no_clip}");
-        assert!(out.leak.is_none(), "{no_clip}: {:?}", out.warnings);
-        let junction = |normal: [f32; 3]| -> Vec<String> {
-            faces_at(bsp, 0, [0.0, 0.0, -32.0], Some(normal))
-                .iter()
-                .map(|&f| face_texture(bsp, f))
-                .collect()
-        };
+        let junction = |normal: [f32; 3]| textures_at(bsp, 0, [0.0, 0.0, -32.0], normal);
         let kept = if no_clip { 6 } else { 5 };
         assert_eq!(textured(bsp, "{trigger").len(), kept, "{no_clip}");
         assert_eq!(textured(bsp, "blood1").len(), kept, "{no_clip}");
@@ -375,10 +387,8 @@ fn noclipfaces_keeps_faces_inside_an_overlapping_brush() {
             "",
             &format!("{along_y}{along_x}"),
         );
-        let out = compile_text(&room_map_with(false, "", &entity));
+        let out = compile_sealed(&room_map_with(false, "", &entity), &no_clip.to_string());
         let bsp = &out.bsp;
-        assert_eq!(errors(bsp), Vec::<String>::new(), "{no_clip}");
-        assert!(out.leak.is_none(), "{no_clip}: {:?}", out.warnings);
         let interior = faces_at(bsp, 0, [0.0, -4.0, -32.0], MINUS_Y);
         assert_eq!(interior.len(), usize::from(no_clip), "{no_clip}");
         let top = faces_at(bsp, 0, [0.0, 2.0, 0.0], UP).len();
@@ -399,14 +409,10 @@ fn noclipfaces_keeps_faces_between_a_func_walls_panes() {
             "\"alpha\" \"0.5\"\n",
             &format!("{left}{right}"),
         );
-        let out = compile_text(&room_map_with(false, "", &entity));
+        let out = compile_sealed(&room_map_with(false, "", &entity), &no_clip.to_string());
         let bsp = &out.bsp;
-        assert_eq!(errors(bsp), Vec::<String>::new(), "{no_clip}");
         for (normal, name) in [([1.0, 0.0, 0.0], "glass_a"), ([-1.0, 0.0, 0.0], "glass_b")] {
-            let names: Vec<String> = faces_at(bsp, 1, [0.0, 0.0, -64.0], Some(normal))
-                .iter()
-                .map(|&f| face_texture(bsp, f))
-                .collect();
+            let names = textures_at(bsp, 1, [0.0, 0.0, -64.0], normal);
             let expected: &[&str] = if no_clip { &[name] } else { &[] };
             assert_eq!(names, expected, "{no_clip}");
         }

@@ -10,15 +10,20 @@
 //! lists the WORST faces (default 20) that differ most, with their model, texture and centre,
 //! to look at in the map.
 
+use glam::DVec3;
 use light::{FaceLightmap, lightmaps_in};
 use quake_formats::Bsp;
 use quake_formats::extents::LightmapExtents;
+use quake_formats::geom::{Plane, Winding};
 
 /// Per-face means within this many levels count as agreeing.
 const AGREE_LEVELS: f64 = 5.0;
 
 /// Texels between luxels on Quake's lightmap grid.
 const LUXEL: f64 = 16.0;
+
+/// Least area (square texels) a face shares with a luxel's square for the luxel to be drawn.
+const MIN_SHARED_AREA: f64 = 1e-6;
 
 /// The mean of each style's lightmap of one face, over the luxels `seen` marks (all when it
 /// is `None` or does not fit).
@@ -64,10 +69,12 @@ fn drawn_luxels(bsp: &Bsp, face: usize) -> Option<Vec<bool>> {
     let st = |p: &[f32; 3], row: &[f32; 4]| {
         f64::from(p[0] * row[0] + p[1] * row[1] + p[2] * row[2] + row[3])
     };
-    let polygon: Vec<[f64; 2]> = points
-        .iter()
-        .map(|p| [st(p, &vecs[0]), st(p, &vecs[1])])
-        .collect();
+    let polygon = Winding::new(
+        points
+            .iter()
+            .map(|p| DVec3::new(st(p, &vecs[0]), st(p, &vecs[1]), 0.0))
+            .collect(),
+    );
     let [width, height] = extents.extents.map(|e| (e / 16 + 1) as usize);
     let [s0, t0] = extents.tex_mins.map(f64::from);
     Some(
@@ -83,37 +90,18 @@ fn drawn_luxels(bsp: &Bsp, face: usize) -> Option<Vec<bool>> {
     )
 }
 
-/// Whether the convex `polygon` and the square of half-side `half` around `centre` share some
-/// area: the polygon clipped to the square keeps a part.
-fn meets_square(polygon: &[[f64; 2]], centre: [f64; 2], half: f64) -> bool {
-    let mut clipped = polygon.to_vec();
-    for (axis, sign) in [(0, 1.0), (0, -1.0), (1, 1.0), (1, -1.0)] {
-        // Keep the side where sign * (p[axis] - centre[axis]) <= half.
-        let inside = |p: &[f64; 2]| sign * (p[axis] - centre[axis]) <= half;
-        let mut next = Vec::with_capacity(clipped.len() + 1);
-        for (k, p) in clipped.iter().enumerate() {
-            let q = &clipped[(k + 1) % clipped.len()];
-            if inside(p) {
-                next.push(*p);
-            }
-            if inside(p) != inside(q) {
-                let limit = centre[axis] + sign * half;
-                let u = (limit - p[axis]) / (q[axis] - p[axis]);
-                next.push([p[0] + u * (q[0] - p[0]), p[1] + u * (q[1] - p[1])]);
-            }
-        }
-        clipped = next;
-        if clipped.len() < 3 {
-            return false;
-        }
-    }
-    let area: f64 = (0..clipped.len())
-        .map(|k| {
-            let (p, q) = (clipped[k], clipped[(k + 1) % clipped.len()]);
-            p[0] * q[1] - q[0] * p[1]
+/// Whether the convex `polygon` (in the plane z = 0) and the square of half-side `half` around
+/// `centre` share some area: the polygon clipped to the square keeps a part.
+fn meets_square(polygon: &Winding, centre: [f64; 2], half: f64) -> bool {
+    let sides = [(DVec3::X, 0), (-DVec3::X, 0), (DVec3::Y, 1), (-DVec3::Y, 1)];
+    sides
+        .iter()
+        .try_fold(polygon.clone(), |w, &(inward, axis)| {
+            // The square's side facing `inward`: its front is inside the square.
+            let edge = centre[axis] - half * inward[axis];
+            w.clip_front(&Plane::new(inward, edge * inward[axis]), false)
         })
-        .sum();
-    area.abs() > 1e-6
+        .is_some_and(|w| w.area() > MIN_SHARED_AREA)
 }
 
 /// The model each face belongs to.

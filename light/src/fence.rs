@@ -12,9 +12,10 @@ use glam::{DVec3, Vec3};
 use quake_formats::Bsp;
 use quake_formats::miptex::MipTex;
 
-use crate::embree::{Device, RayPacket16, Scene, SceneBuilder, sys};
+use crate::embree::{Device, RayPacket16, Scene, sys};
 use crate::error::LightError;
 use crate::faces::FaceGeom;
+use crate::scene::Mesh;
 
 /// The palette index fence textures leave transparent.
 const OPEN_TEXEL: u8 = 255;
@@ -99,7 +100,7 @@ impl FenceFace {
 /// The shadow-casting fence faces, in a scene of their own.
 pub struct Fences {
     scene: Scene,
-    /// The fence face of each triangle (by primitive id).
+    /// The place in `faces` of each triangle's face (by primitive id).
     triangles: Vec<u32>,
     faces: Vec<FenceFace>,
 }
@@ -113,26 +114,19 @@ impl Fences {
         if faces.is_empty() {
             return Ok(None);
         }
-        let (mut vertices, mut indices, mut triangles) = (Vec::new(), Vec::new(), Vec::new());
+        let mut mesh = Mesh::default();
         let mut fence_faces = Vec::with_capacity(faces.len());
         for (k, (face, mask)) in faces.iter().enumerate() {
-            let base = vertices.len() as u32;
-            vertices.extend(face.points.iter().map(|p| p.as_vec3().to_array()));
-            for i in 1..(face.points.len() as u32).saturating_sub(1) {
-                indices.push([base, base + i, base + i + 1]);
-                triangles.push(k as u32);
-            }
+            mesh.add_polygon(&face.points, k as u32);
             fence_faces.push(FenceFace {
                 mask: mask.clone(),
                 vecs: face.vecs,
                 origin: face.origin,
             });
         }
-        let mut builder = SceneBuilder::new(device)?;
-        builder.add_triangle_mesh(&vertices, &indices)?;
         Ok(Some(Fences {
-            scene: builder.commit()?,
-            triangles,
+            scene: mesh.commit(device)?,
+            triangles: mesh.faces,
             faces: fence_faces,
         }))
     }

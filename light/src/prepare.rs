@@ -157,13 +157,8 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
     let phong = phong::corner_normals(&faces, &groups);
     let in_liquid = |p: DVec3| {
         let leaf = bsp.leaf_at(p.as_vec3().to_array());
-        let contents = leaf.and_then(|l| bsp.leafs.get(l)).map(|l| l.contents);
-        matches!(
-            contents,
-            Some(quake_formats::bsp::contents::WATER)
-                | Some(quake_formats::bsp::contents::SLIME)
-                | Some(quake_formats::bsp::contents::LAVA)
-        )
+        leaf.and_then(|l| bsp.leafs.get(l))
+            .is_some_and(|l| quake_formats::bsp::contents::is_liquid(l.contents))
     };
     let surface = surface::expand_templates(
         &map_lights.templates,

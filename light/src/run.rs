@@ -414,13 +414,17 @@ fn fill_hidden_luxels(faces: &mut [FaceLight], hidden: &[Vec<bool>], geometry: &
         let n = light.width * light.height;
         for (&(_, style), sum) in sums.range((model, 0)..=(model, u8::MAX)) {
             let mean = sum.map(|s| (s / count as f64) as f32);
-            if !light.styles.iter().any(|(s, _)| *s == style) {
+            let at = light.styles.iter().position(|(s, _)| *s == style);
+            let at = at.unwrap_or_else(|| {
                 light.styles.push((style, vec![[0.0; 3]; n]));
-            }
-            let Some((_, luxels)) = light.styles.iter_mut().find(|(s, _)| *s == style) else {
-                continue;
-            };
-            for (l, _) in luxels.iter_mut().zip(hidden).filter(|(_, h)| **h) {
+                light.styles.len() - 1
+            });
+            for (l, _) in light.styles[at]
+                .1
+                .iter_mut()
+                .zip(hidden)
+                .filter(|(_, h)| **h)
+            {
                 *l = mean;
             }
         }

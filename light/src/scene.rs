@@ -45,11 +45,11 @@ pub struct TraceScene {
 
 /// Fan-triangulated faces as Embree buffers.
 #[derive(Default)]
-struct Mesh {
+pub(crate) struct Mesh {
     vertices: Vec<[f32; 3]>,
     triangles: Vec<[u32; 3]>,
     /// The face each triangle comes from.
-    faces: Vec<u32>,
+    pub(crate) faces: Vec<u32>,
 }
 
 impl Mesh {
@@ -69,7 +69,7 @@ impl Mesh {
     }
 
     /// A scene of this mesh alone.
-    fn commit(&self, device: &Device) -> Result<Scene, LightError> {
+    pub(crate) fn commit(&self, device: &Device) -> Result<Scene, LightError> {
         let mut builder = SceneBuilder::new(device)?;
         builder.add_triangle_mesh(&self.vertices, &self.triangles)?;
         Ok(builder.commit()?)
@@ -80,7 +80,7 @@ impl Mesh {
     }
 
     /// A convex polygon, fan-triangulated, its triangles marked as `face`'s.
-    fn add_polygon(&mut self, points: &[DVec3], face: u32) {
+    pub(crate) fn add_polygon(&mut self, points: &[DVec3], face: u32) {
         let base = self.vertices.len() as u32;
         self.vertices
             .extend(points.iter().map(|p| p.as_vec3().to_array()));

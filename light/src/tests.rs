@@ -513,8 +513,17 @@ fn sun_reaches_only_what_sees_the_sky() {
     }
 }
 
-fn corpus() -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/corpus/public/bsp")
+/// The corpus BSP at `path` (under `../shared/corpus/public/bsp`), or `None` with a note that
+/// the test is skipped when the corpus is not there.
+fn corpus_bsp(path: &str) -> Option<Bsp> {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../shared/corpus/public/bsp")
+        .join(path);
+    let Ok(data) = std::fs::read(&path) else {
+        eprintln!("SKIPPED: {} not found", path.display());
+        return None;
+    };
+    Some(Bsp::read(&data).expect("read"))
 }
 
 /// Default against reference on a sample of start.bsp's faces. Slow in
@@ -522,12 +531,9 @@ fn corpus() -> std::path::PathBuf {
 #[test]
 #[ignore = "slow: run with --release -- --ignored"]
 fn start_bsp_default_against_reference() {
-    let path = corpus().join("librequake/start.bsp");
-    let Ok(data) = std::fs::read(&path) else {
-        eprintln!("SKIPPED: {} not found", path.display());
+    let Some(bsp) = corpus_bsp("librequake/start.bsp") else {
         return;
     };
-    let bsp = Bsp::read(&data).expect("read");
     let only: Vec<usize> = (0..bsp.faces.len()).step_by(8).collect();
     let run = |quality| {
         let o = Options {
@@ -555,12 +561,9 @@ fn start_bsp_default_against_reference() {
 /// (breaking no rule but the missing clip hulls it was compiled without).
 #[test]
 fn q1_cube_without_lights_stays_fullbright_and_round_trips() {
-    let path = corpus().join("ericw-tools/q1_cube.bsp");
-    let Ok(data) = std::fs::read(&path) else {
-        eprintln!("SKIPPED: {} not found", path.display());
+    let Some(mut bsp) = corpus_bsp("ericw-tools/q1_cube.bsp") else {
         return;
     };
-    let mut bsp = Bsp::read(&data).expect("read");
     let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
     assert!(lighting.stats.fullbright);
     assert!(
@@ -1149,12 +1152,9 @@ fn slab_bsp(classname: &str, keys: &str, texture: &str) -> Bsp {
 #[test]
 #[ignore = "slow: run with --release -- --ignored"]
 fn luxels_under_a_wall_fixture_take_no_light_of_the_fixture_s_lights() {
-    let path = corpus().join("librequake/start.bsp");
-    let Ok(data) = std::fs::read(&path) else {
-        eprintln!("SKIPPED: {} not found", path.display());
+    let Some(bsp) = corpus_bsp("librequake/start.bsp") else {
         return;
     };
-    let bsp = Bsp::read(&data).expect("read");
     let o = Options {
         only_faces: Some(vec![543]),
         ..options(Quality::Default)

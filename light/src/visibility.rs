@@ -100,10 +100,9 @@ impl Visibility {
     }
 
     fn is_liquid(&self, leaf: u32) -> bool {
-        matches!(
-            self.leaf_contents.get(leaf as usize),
-            Some(&(contents::WATER | contents::SLIME | contents::LAVA))
-        )
+        self.leaf_contents
+            .get(leaf as usize)
+            .is_some_and(|&c| contents::is_liquid(c))
     }
 
     /// False only if vis data proves nothing in `light_leaf` can see `face`.

@@ -18,6 +18,11 @@ pub mod contents {
     pub const LAVA: i32 = -5;
     /// The inside of sky brushes; faces towards it are drawn as scrolling sky.
     pub const SKY: i32 = -6;
+
+    /// Whether `c` is water, slime or lava.
+    pub fn is_liquid(c: i32) -> bool {
+        matches!(c, WATER | SLIME | LAVA)
+    }
 }
 
 /// Texinfo flags.
