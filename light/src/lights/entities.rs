@@ -11,7 +11,7 @@ use quake_formats::geom::DVec3Ext;
 use super::keys::Keys;
 use super::models::model_index;
 use super::point::{DEFAULT_SPOT_ANGLE, Falloff, PointLight, Spot, split_light};
-use super::sun::{SunLight, dome_pole, spread};
+use super::sun::{SunLight, dome, spread};
 use super::worldspawn::Global;
 use super::{MapLights, SurfaceTemplate};
 use crate::directions::mangle_to_vec;
@@ -99,18 +99,14 @@ fn read_light(
         out.suns.extend(spread(sun, c.deviance, global.sunsamples));
         return Ok(());
     }
-    let mut dome = false;
+    let mut is_dome = false;
     for (key, upper) in [("_sunlight2", true), ("_sunlight3", false)] {
         if k.float(key)? == Some(1.0) {
-            let sun = SunLight {
-                to_sun: dome_pole(upper),
-                ..sun.clone()
-            };
-            out.suns.extend(spread(sun, 90.0, global.sunsamples));
-            dome = true;
+            out.suns.extend(dome(sun.clone(), upper, global.sunsamples));
+            is_dome = true;
         }
     }
-    if dome {
+    if is_dome {
         return Ok(());
     }
     point_light(k, c, global, out)

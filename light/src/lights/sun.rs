@@ -1,6 +1,6 @@
 //! Suns and sky domes: parallel light from sky faces. Worldspawn's `_sunlight` (spread over
 //! `_sunlight_penumbra` degrees), `_sunlight2` and `_sunlight3` (domes from above and below,
-//! each spread evenly over its hemisphere), and light entities with `_sun 1`, `_sunlight2 1` or
+//! laid out in rings as ericw-tools lays them: see [`dome`]), and light entities with `_sun 1`, `_sunlight2 1` or
 //! `_sunlight3 1`. A sun or dome spread over many directions is one [`SunLight`] per direction,
 //! sharing its light.
 
@@ -43,9 +43,40 @@ pub fn spread(sun: SunLight, degrees: f64, sunsamples: usize) -> Vec<SunLight> {
         .collect()
 }
 
-/// The pole of a sky dome: straight up for `_sunlight2`, down for `_sunlight3`.
-pub fn dome_pole(upper: bool) -> DVec3 {
-    DVec3::new(0.0, 0.0, if upper { 1.0 } else { -1.0 })
+/// A sky dome (`_sunlight2` when `upper`, else `_sunlight3`): `sun`'s light shared by
+/// directions on rings of equal elevation steps, each ring with as many directions, and one
+/// at the pole, as ericw-tools (after q3map2) lays its dome out, about `sunsamples` in all.
+/// Rings crowd towards the pole, so the dome's sky is brighter overhead than at the horizon
+/// (a courtyard's floor takes more of it than an even sky would give): maps lit with
+/// ericw-tools are tuned to that.
+pub fn dome(sun: SunLight, upper: bool, sunsamples: usize) -> Vec<SunLight> {
+    let rings = ((sunsamples.saturating_sub(1) as f64 / 4.0).sqrt().round() as usize).max(1);
+    let per_ring = rings * 4;
+    let step = std::f64::consts::FRAC_PI_2 / (rings + 1) as f64;
+    let azimuth_step = std::f64::consts::TAU / per_ring as f64;
+    let up = if upper { 1.0 } else { -1.0 };
+    let mut dirs = Vec::with_capacity(rings * per_ring + 1);
+    for ring in 0..rings {
+        let elevation = step * (ring as f64 + 0.5);
+        // Each ring turns a little further, so directions do not line up ring over ring.
+        let turn = azimuth_step * ring as f64 / rings as f64;
+        let (rise, flat) = elevation.sin_cos();
+        for k in 0..per_ring {
+            let (s, c) = (azimuth_step * k as f64 + turn).sin_cos();
+            dirs.push(DVec3::new(c * flat, s * flat, up * rise));
+        }
+    }
+    dirs.push(DVec3::new(0.0, 0.0, up));
+    let each = sun.light / dirs.len() as f64;
+    let directions = dirs.len();
+    dirs.into_iter()
+        .map(|to_sun| SunLight {
+            to_sun,
+            light: each,
+            directions,
+            ..sun.clone()
+        })
+        .collect()
 }
 
 /// The sun and domes worldspawn's settings ask for, in that order.
@@ -70,8 +101,8 @@ pub fn world_suns(settings: &Settings, global: &Global) -> Vec<SunLight> {
         (settings.sunlight3, settings.sunlight3_color, false),
     ] {
         if light != 0.0 {
-            let dome = SunLight {
-                to_sun: dome_pole(upper),
+            let sky = SunLight {
+                to_sun: DVec3::ZERO,
                 light,
                 color: color.0,
                 style: 0,
@@ -79,8 +110,66 @@ pub fn world_suns(settings: &Settings, global: &Global) -> Vec<SunLight> {
                 dirt: dome_dirt,
                 directions: 1,
             };
-            out.extend(spread(dome, 90.0, global.sunsamples));
+            out.extend(dome(sky, upper, global.sunsamples));
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sky(light: f64) -> SunLight {
+        SunLight {
+            to_sun: DVec3::ZERO,
+            light,
+            color: DVec3::ONE,
+            style: 0,
+            anglescale: 0.5,
+            dirt: None,
+            directions: 1,
+        }
+    }
+
+    /// ericw-tools' layout for its default of 100 samples: 5 rings of 20 directions, 15
+    /// degrees apart from 7.5 degrees up, and the pole; each takes an even share.
+    #[test]
+    fn a_dome_has_rings_of_equal_elevation_steps_and_its_pole() {
+        let suns = dome(sky(202.0), true, 100);
+        assert_eq!(suns.len(), 101);
+        for s in &suns {
+            assert!((s.light - 2.0).abs() < 1e-12 && s.directions == 101);
+            assert!((s.to_sun.length() - 1.0).abs() < 1e-12);
+        }
+        let elevation = |s: &SunLight| s.to_sun.z.asin().to_degrees();
+        for (ring, chunk) in suns[..100].chunks(20).enumerate() {
+            let want = 7.5 + 15.0 * ring as f64;
+            assert!(chunk.iter().all(|s| (elevation(s) - want).abs() < 1e-9));
+        }
+        assert_eq!(suns[100].to_sun, DVec3::Z);
+        let lower = dome(sky(1.0), false, 100);
+        for (a, b) in suns.iter().zip(&lower) {
+            assert_eq!(a.to_sun.truncate(), b.to_sun.truncate());
+            assert_eq!(a.to_sun.z, -b.to_sun.z);
+        }
+    }
+
+    /// Rings crowd towards the pole: more of the dome's light comes from within 30 degrees of
+    /// it than an even sky's 13% (1 - sin 60°), so a courtyard's floor, which sees only the
+    /// high sky, takes more of it.
+    #[test]
+    fn a_dome_is_brighter_overhead_than_an_even_sky() {
+        for samples in [64, 100, 300] {
+            let suns = dome(sky(1.0), true, samples);
+            let high: f64 = suns
+                .iter()
+                .filter(|s| s.to_sun.z > 60f64.to_radians().sin())
+                .map(|s| s.light)
+                .sum();
+            assert!(high > 0.18, "{samples}: {high}");
+            let total: f64 = suns.iter().map(|s| s.light).sum();
+            assert!((total - 1.0).abs() < 1e-12);
+        }
+    }
 }

@@ -78,7 +78,7 @@ settings! {
     /// `1`/`-1`: dirt on sunlight on/off.
     sunlight_dirt: DirtToggle = DirtToggle::AsDirt, keys ["_sunlight_dirt"], range Range::Any;
 
-    /// Brightness of a sky dome lighting from above.
+    /// Brightness of a sky dome lighting from above: `--sunsamples` directions on rings of equal elevation steps and one straight down, laid out as ericw-tools lays them, so its sky is brighter overhead than at the horizon.
     sunlight2: f64 = 0.0, keys ["_sunlight2"], range Range::Any;
 
     /// Colour of the upper sky dome.
