@@ -191,7 +191,7 @@ fn vis_figures(r: &vis::VisReport) -> String {
 }
 
 fn light_figures(s: &light::Stats) -> String {
-    let rays = s.shadow_rays + s.sun_rays + s.dirt_rays + s.placement_rays + s.bounce_rays;
+    let rays = s.shadow_rays + s.sun_rays + s.dirt_rays + s.bounce_rays;
     format!(
         "{:.2} M rays, {:.1} Mrays/s",
         rays as f64 / 1e6,

@@ -46,7 +46,7 @@ fn main() -> anyhow::Result<()> {
         for _ in 0..3 {
             let s = compute_lighting(&bsp, &options)?.stats;
             best = best.min(s.seconds_trace);
-            rays = s.shadow_rays + s.sun_rays + s.dirt_rays + s.placement_rays;
+            rays = s.shadow_rays + s.sun_rays + s.dirt_rays;
         }
         let part = compute_lighting(
             &bsp,

@@ -42,7 +42,7 @@ pub fn bare_occlusion(
     let gate = prep.lights.settings.gate;
     let mut rays: Vec<Ray> = Vec::new();
     'faces: for face in prep.faces.iter().filter(|f| f.has_lightmap()) {
-        let (samples, _) = face_samples(face, 1, &prep.scene, bsp);
+        let (samples, _) = face_samples(face, 1, bsp);
         for light in &prep.point_lights {
             if face.plane.distance(light.origin) <= 0.0 {
                 continue;

@@ -376,7 +376,7 @@ fn print_summary(lighting: &Lighting) {
         eprintln!("light: warning: {w}");
     }
     let s = &lighting.stats;
-    let rays = s.shadow_rays + s.sun_rays + s.dirt_rays + s.placement_rays;
+    let rays = s.shadow_rays + s.sun_rays + s.dirt_rays;
     if s.lights_nudged > 0 {
         eprintln!(
             "light: {} lights moved out of solid (or off the surface they lay on)",
@@ -394,11 +394,10 @@ fn print_summary(lighting: &Lighting) {
         s.sun_directions
     );
     eprintln!(
-        "light: {rays} rays ({} shadow, {} sun, {} dirt, {} placement) in {:.2} s trace + {:.2} s setup: {:.2} Mrays/s",
+        "light: {rays} rays ({} shadow, {} sun, {} dirt) in {:.2} s trace + {:.2} s setup: {:.2} Mrays/s",
         s.shadow_rays,
         s.sun_rays,
         s.dirt_rays,
-        s.placement_rays,
         s.seconds_trace,
         s.seconds_setup,
         s.rays_per_second / 1e6

@@ -15,7 +15,7 @@
 //!    switchable styles from the entity lump (`lights`), `_surface` templates copied over
 //!    their faces (`surface`); the PVS for culling (`visibility`); `_phong` normals (`phong`).
 //! 3. Direct light (`trace`), face by face in parallel: sample points per luxel (`--extra`:
-//!    2×2, `--extra4`: 4×4, `--reference`: 16×16), pulled out of solid (`samples`); the lights
+//!    2×2, `--extra4`: 4×4, `--reference`: 16×16), nudged out of solid (`samples`); the lights
 //!    that may reach the face (`reach`, culled by plane, range and PVS) traced in 16-ray
 //!    packets, close lights averaged over each sample's square; suns and domes towards the sky
 //!    the face sees; dirt measured where light that takes it arrived (`dirt`); minlight.

@@ -42,20 +42,19 @@ pub struct Stats {
     pub sun_rays: u64,
     /// Ambient-occlusion rays (`_dirt`).
     pub dirt_rays: u64,
-    /// Rays placing sample points in the open.
-    pub placement_rays: u64,
     /// Bounce passes run.
     pub bounce_passes: usize,
     /// Rays cast gathering bounced light.
     pub bounce_rays: u64,
     /// Time gathering bounced light.
     pub seconds_bounce: f64,
-    /// Points outside their face moved onto it (inset from its edges).
+    /// Points outside their face moved onto its edge.
     pub points_clamped_to_face: u64,
-    /// Points pulled back because something stood between them and their face's centre.
-    pub points_pulled_back: u64,
-    /// Points still in solid after that, moved onto their face's centre.
-    pub points_moved_to_centre: u64,
+    /// Points in solid nudged half a unit into the open.
+    pub points_nudged: u64,
+    /// Points that take no light of their own: in solid however nudged, or far past the
+    /// face's edge.
+    pub points_occluded: u64,
     /// Face/light pairs looked at.
     pub face_light_pairs: u64,
     /// Of those, the pairs culling skipped.

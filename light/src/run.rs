@@ -80,11 +80,7 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
     stats.seconds_trace = (trace_done - setup_done).as_secs_f64();
     stats.seconds_bounce = (bounce_done - trace_done).as_secs_f64();
     stats.seconds_total = start.elapsed().as_secs_f64();
-    let rays = stats.shadow_rays
-        + stats.sun_rays
-        + stats.dirt_rays
-        + stats.placement_rays
-        + stats.bounce_rays;
+    let rays = stats.shadow_rays + stats.sun_rays + stats.dirt_rays + stats.bounce_rays;
     stats.rays_per_second = rays as f64 / (stats.seconds_trace + stats.seconds_bounce).max(1e-9);
     let settings = &prep.lights.settings;
     Ok(RawLighting {
@@ -316,10 +312,9 @@ impl<'a> Plan<'a> {
             shadow_rays: counts.shadow_rays,
             sun_rays: counts.sun_rays,
             dirt_rays: counts.dirt_rays,
-            placement_rays: placement.rays,
             points_clamped_to_face: placement.clamped,
-            points_pulled_back: placement.pulled_back,
-            points_moved_to_centre: placement.to_centre,
+            points_nudged: placement.nudged,
+            points_occluded: placement.occluded,
             face_light_pairs: counts.pairs,
             face_light_pairs_culled: counts.pairs_culled,
             bounce_passes: if self.bouncing {
@@ -350,8 +345,11 @@ fn finish_faces(
         .into_par_iter()
         .map(|light| {
             let bounce = bounced.get(light.face).map_or(&[][..], |b| &b[..]);
+            // As in ericw-tools, hidden luxels take their neighbours' light, but a brush
+            // model's face with no open luxel at all takes its model's (filled below).
             let fill = match geoms[light.face].model {
                 0 => HiddenLuxels::FromNeighbours,
+                _ if !all_hidden(&light.hidden_luxels()) => HiddenLuxels::FromNeighbours,
                 _ => HiddenLuxels::Later,
             };
             light.finish(bounce, fill)
@@ -373,9 +371,14 @@ fn finish_faces(
         .unzip()
 }
 
-/// The luxels of a brush model's faces whose every sample is inside solid (a door's edge or
-/// face in the wall it slides into) take, per style, the mean of the model's open luxels, all
-/// its faces' together (zero where a face has no light of that style): their own rays, traced
+/// Whether a face's every luxel is hidden ([`SampleLight::hidden_luxels`]).
+fn all_hidden(hidden: &[bool]) -> bool {
+    !hidden.is_empty() && hidden.iter().all(|&h| h)
+}
+
+/// The luxels of a brush model's faces with no open luxel at all (a door's edge or face in
+/// the wall it slides into) take, per style, the mean of the model's open luxels, all its
+/// faces' together (zero where a face has no light of that style): their own rays, traced
 /// from inside the wall, say nothing. On a door half in a wall ericw-tools writes the same
 /// bytes (one value for all such luxels of the model, not the light of the luxels beside them).
 fn fill_hidden_luxels(faces: &mut [FaceLight], hidden: &[Vec<bool>], geometry: &[FaceGeom]) {
@@ -408,7 +411,7 @@ fn fill_hidden_luxels(faces: &mut [FaceLight], hidden: &[Vec<bool>], geometry: &
     for (light, hidden) in faces.iter_mut().zip(hidden) {
         let model = model_of(light);
         let count = open_luxels.get(&model).copied().unwrap_or(0);
-        if model == 0 || count == 0 || !hidden.contains(&true) {
+        if model == 0 || count == 0 || !all_hidden(hidden) {
             continue;
         }
         let n = light.width * light.height;
@@ -478,7 +481,7 @@ fn trace_faces(
         .par_iter()
         .map_init(TraceScratch::default, |reuse, &f| {
             let geom = &prep.faces[f];
-            let (mut samples, placement) = face_samples(geom, per_axis, &prep.scene, bsp);
+            let (mut samples, placement) = face_samples(geom, per_axis, bsp);
             if let Some(corners) = &prep.phong[f] {
                 samples.normals = phong_normals(&samples, geom, corners);
             }

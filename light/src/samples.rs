@@ -1,24 +1,19 @@
-//! Sample points: where on (just in front of) each face light is measured.
+//! Sample points: where on (just in front of) each face light is measured, placed as
+//! ericw-tools places them.
 //!
 //! One point per luxel of the face's grid (Quake's 16 texels, or the face's own:
 //! world-aligned, or another power of two texels), or `n x n` per luxel when
 //! supersampling, found by inverting the grid's projection onto the face's
 //! plane. A point past the face's edge that lands on a face continuing it (same
-//! model, same plane, a shared edge) stays there, as ericw-tools places it.
-//! Another point that falls outside the face (luxels past its edge, e.g. under
-//! a wall standing on a floor) moves to the nearest point of the face, kept
-//! [`FACE_INSET`] inside its edges, so light from the far side of the wall
-//! does not bleed under it and the point stays over the part of the face it
-//! stands for. Points are then pushed [`SURFACE_OFFSET`] units off the
-//! surface; one that something still hides from the face centre (an object
-//! resting on the face) is pulled back towards the centre into the open. When
-//! the centre itself is covered (a fixture on the middle of a wall), a point left
-//! in solid is occluded instead, as in ericw-tools.
-//! A brush model's points are not pulled back: one inside the world's solid (a
-//! door's face in the wall it slides into) is nudged half a unit along each axis
-//! into the open when that frees it, else it is occluded: as in ericw-tools, it
-//! takes no light of its own, and a luxel with no other sample takes the mean
-//! light of the whole model.
+//! model, same plane, a shared edge) stays there. Another point outside the face
+//! (a luxel past its edge, e.g. under a wall standing on a floor) moves to the
+//! nearest point of the face's outline, unless that is more than a luxel away (the far
+//! corners of a triangle's lightmap, which no pixel shows): such a point is occluded.
+//! Points are then lifted [`SURFACE_OFFSET`] units off the surface. One that is then
+//! inside the world's solid (on the edge under the wall, behind a fixture on the face)
+//! is nudged half a unit along each axis into the open when that frees it, else it is
+//! occluded. An occluded sample takes no light of its own: its luxel takes the mean of
+//! its open samples, or else of its neighbours (see `trace::HiddenLuxels`).
 //!
 //! [`FaceSamples`] is kept as its own structure so later passes (bounce
 //! lighting) can reuse the same points.
@@ -28,19 +23,11 @@ use quake_formats::Bsp;
 use quake_formats::bsp::contents;
 use quake_formats::extents::LuxelGrid;
 use quake_formats::geom::DVec3Ext;
-use quake_formats::geom::{Plane, Winding};
 
-use crate::embree::{RayPacket16, sys};
 use crate::faces::{FaceGeom, FaceKind};
-use crate::scene::TraceScene;
 
 /// Distance of sample points in front of their face, in map units.
 pub const SURFACE_OFFSET: f64 = 1.0;
-/// Clearance kept between a pulled-back point and the wall that blocked it.
-const WALL_CLEARANCE: f32 = 1.0;
-/// How far inside the face's edges points moved onto the face stay (less
-/// on faces too narrow for it).
-pub const FACE_INSET: f64 = 0.5;
 
 /// The sample points of one face.
 #[derive(Debug, Clone)]
@@ -61,14 +48,13 @@ pub struct FaceSamples {
     /// both sides (a light under water brightens the surface seen from above).
     pub two_sided: bool,
     /// Per sample: it is not where the texture grid puts it (moved onto the
-    /// face, pulled back into the open or onto the centre).
+    /// face, or nudged out of solid: never more than a luxel away).
     pub moved: Vec<bool>,
-    /// Per sample: pulled back into the open or onto the centre (moved for
-    /// something other than overhanging the face's edge, so possibly far
-    /// from its neighbours).
-    pub pulled: Vec<bool>,
-    /// Per sample: inside solid (a brush model's point in the world's solid), so its light
-    /// does not count (empty: no sample is).
+    /// Per sample: on the face's edge (where a wall may stand on it) or nudged out of solid
+    /// beside one, so its neighbours' shadows and dirt do not tell its own.
+    pub apart: Vec<bool>,
+    /// Per sample: no place to measure light (inside solid, or far past the face's edge), so
+    /// its light does not count (empty: no sample is).
     pub occluded: Vec<bool>,
     /// Where the samples' texture coordinates land on the face.
     pub map: SurfaceMap,
@@ -138,22 +124,19 @@ fn first_at_same_point(points: &[[f32; 3]], moved: &[bool]) -> Vec<usize> {
 /// Counts from placing sample points.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct PlacementCounts {
-    /// Rays cast from the face centre to check points are in the open.
-    pub rays: u64,
-    /// Points outside the face moved onto it.
+    /// Points outside the face moved onto its edge.
     pub clamped: u64,
-    /// Points pulled back because something stood between them and the centre.
-    pub pulled_back: u64,
-    /// Points still in solid afterwards, moved onto the face centre.
-    pub to_centre: u64,
+    /// Points in solid nudged into the open.
+    pub nudged: u64,
+    /// Points occluded: in solid however nudged, or too far past the face's edge.
+    pub occluded: u64,
 }
 
 impl PlacementCounts {
     pub fn add(&mut self, o: &PlacementCounts) {
-        self.rays += o.rays;
         self.clamped += o.clamped;
-        self.pulled_back += o.pulled_back;
-        self.to_centre += o.to_centre;
+        self.nudged += o.nudged;
+        self.occluded += o.occluded;
     }
 }
 
@@ -228,24 +211,9 @@ impl FaceRegion {
         }
     }
 
-    /// The face's polygon shrunk by [`FACE_INSET`] (halved until the face
-    /// has room for it; the polygon itself if it never has).
-    pub fn inset(face: &FaceGeom) -> FaceRegion {
-        let normal = face.plane.normal;
-        let outline = FaceRegion::from_points(face.points.clone(), normal);
-        let mut inset = FACE_INSET;
-        while inset >= 1.0 / 64.0 {
-            let mut w = Some(Winding::new(face.points.clone()));
-            for (i, m) in outline.inward.iter().enumerate() {
-                let plane = Plane::new(*m, m.dot(outline.points[i]) + inset);
-                w = w.and_then(|w| w.clip_front(&plane, false));
-            }
-            if let Some(w) = w.filter(|w| !w.is_tiny()) {
-                return FaceRegion::from_points(w.points, normal);
-            }
-            inset /= 2.0;
-        }
-        outline
+    /// The face's polygon.
+    pub fn of_face(face: &FaceGeom) -> FaceRegion {
+        FaceRegion::from_points(face.points.clone(), face.plane.normal)
     }
 
     /// Mean of the corners (inside: the region is convex).
@@ -260,6 +228,12 @@ impl FaceRegion {
             .iter()
             .zip(&self.inward)
             .all(|(&a, m)| m.dot(p - a) >= -slack)
+    }
+
+    /// Whether `p` (a point of the region) lies on its outline.
+    fn on_edge(&self, p: DVec3) -> bool {
+        let slack = 1e-3;
+        (self.points.iter().zip(&self.inward)).any(|(&a, m)| m.dot(p - a) < slack)
     }
 
     /// `p` (a point on the face's plane) if it is inside, else the nearest
@@ -290,15 +264,14 @@ impl FaceRegion {
 }
 
 /// Where a face's grid coordinates land: the point of the face's plane
-/// with those (s, t), moved onto the face (inside its inset outline) and
+/// with those (s, t), moved onto the face's outline when it is outside and
 /// lifted [`SURFACE_OFFSET`] off it. Also knows the square of texture space
 /// each sample stands for, so later passes can spread points over it.
 #[derive(Debug, Clone)]
 pub struct SurfaceMap {
     to_world: Option<TextureToWorld>,
-    region: FaceRegion,
-    /// The face itself and the faces continuing it past its edges ([`FaceGeom::continuations`]).
     outline: FaceRegion,
+    /// The faces continuing this one past its edges ([`FaceGeom::continuations`]).
     continuations: Vec<FaceRegion>,
     origin: DVec3,
     lift: DVec3,
@@ -306,6 +279,19 @@ pub struct SurfaceMap {
     per_axis: usize,
     /// Half-diagonal of one sample's square, in world units.
     footprint_radius: f64,
+}
+
+/// A sample point as [`SurfaceMap::place`] puts it.
+#[derive(Debug, Clone, Copy)]
+pub struct Placed {
+    /// The point, lifted off the face.
+    pub at: DVec3,
+    /// It was outside the face and moved onto its edge.
+    pub moved: bool,
+    /// It lies on the face's edge.
+    pub on_edge: bool,
+    /// It was more than a luxel outside the face: no pixel shows its light.
+    pub beyond: bool,
 }
 
 impl SurfaceMap {
@@ -318,8 +304,7 @@ impl SurfaceMap {
         let normal = face.plane.normal;
         SurfaceMap {
             to_world,
-            region: FaceRegion::inset(face),
-            outline: FaceRegion::from_points(face.points.clone(), normal),
+            outline: FaceRegion::of_face(face),
             continuations: face
                 .continuations
                 .iter()
@@ -335,23 +320,46 @@ impl SurfaceMap {
 
     /// The lifted centre of the face (inside it).
     pub fn centre(&self) -> DVec3 {
-        self.region.centre() + self.lift
+        self.outline.centre() + self.lift
     }
 
-    /// The lifted point for grid coordinates (s, t), and whether it had
-    /// to move onto the face. Without a usable projection: the centre.
-    pub fn point(&self, s: f64, t: f64) -> (DVec3, bool) {
+    /// Where the sample for grid coordinates (s, t) goes. Without a usable projection: the
+    /// centre.
+    pub fn place(&self, s: f64, t: f64) -> Placed {
         let Some(m) = &self.to_world else {
-            return (self.centre(), false);
+            return Placed {
+                at: self.centre(),
+                moved: false,
+                on_edge: false,
+                beyond: false,
+            };
         };
         let on_plane = m.point(s, t) + self.origin;
         if !self.outline.contains(on_plane)
             && self.continuations.iter().any(|c| c.contains(on_plane))
         {
-            return (on_plane + self.lift, false);
+            return Placed {
+                at: on_plane + self.lift,
+                moved: false,
+                on_edge: false,
+                beyond: false,
+            };
         }
-        let on_face = self.region.nearest(on_plane);
-        (on_face + self.lift, on_face != on_plane)
+        let on_face = self.outline.nearest(on_plane);
+        let step = on_face - on_plane;
+        let along = |axis: [f64; 4]| DVec3::new(axis[0], axis[1], axis[2]).dot(step);
+        let [ds, dt] = self.grid.axes.map(along);
+        Placed {
+            at: on_face + self.lift,
+            moved: on_face != on_plane,
+            on_edge: self.outline.on_edge(on_face),
+            beyond: ds.hypot(dt) > self.grid.scale,
+        }
+    }
+
+    /// The lifted point for grid coordinates (s, t) ([`SurfaceMap::place`]).
+    pub fn point(&self, s: f64, t: f64) -> DVec3 {
+        self.place(s, t).at
     }
 
     /// A box holding every point [`SurfaceMap::point`] gives (a little
@@ -359,7 +367,7 @@ impl SurfaceMap {
     pub fn bounds(&self) -> ([f32; 3], [f32; 3]) {
         let (mut lo, mut hi) = (self.centre(), self.centre());
         let continued = self.continuations.iter().flat_map(|c| &c.points);
-        for &p in self.region.points.iter().chain(continued) {
+        for &p in self.outline.points.iter().chain(continued) {
             lo = lo.min(p + self.lift);
             hi = hi.max(p + self.lift);
         }
@@ -399,14 +407,14 @@ impl SurfaceMap {
     }
 
     /// `n x n` points spread evenly over sample `i`'s square, each placed as
-    /// a sample point would be (onto the face, lifted; not pulled back).
+    /// a sample point would be (onto the face, lifted; not nudged).
     pub fn footprint_points(&self, i: usize, n: usize) -> impl Iterator<Item = DVec3> + '_ {
         let [s, t] = self.sample_st(i);
         let sub = self.sample_step() / n as f64;
         let first = -self.sample_step() / 2.0 + sub / 2.0;
         (0..n * n).map(move |k| {
             let (ks, kt) = ((k % n) as f64, (k / n) as f64);
-            self.point(s + first + sub * ks, t + first + sub * kt).0
+            self.point(s + first + sub * ks, t + first + sub * kt)
         })
     }
 }
@@ -429,34 +437,45 @@ pub fn vanilla_on_own_grid(face: &FaceGeom) -> Vec<[f64; 2]> {
 }
 
 /// Places the sample points of `face`: `per_axis²` per luxel of its grid,
-/// spread evenly over the luxel's square. `bsp` is consulted for world faces to
-/// catch points that are still inside solid after the pull-back.
-pub fn face_samples(
-    face: &FaceGeom,
-    per_axis: usize,
-    scene: &TraceScene,
-    bsp: &Bsp,
-) -> (FaceSamples, PlacementCounts) {
+/// spread evenly over the luxel's square; `bsp` tells which are inside solid.
+pub fn face_samples(face: &FaceGeom, per_axis: usize, bsp: &Bsp) -> (FaceSamples, PlacementCounts) {
     let [width, height] = face.grid.size;
     let map = SurfaceMap::new(face, per_axis);
-    let centre = map.centre();
-    let mut counts = PlacementCounts::default();
     let count = width * height * per_axis * per_axis;
-    let (on_face, clamped): (Vec<DVec3>, Vec<bool>) = (0..count)
+    let placed: Vec<Placed> = (0..count)
         .map(|i| {
             let [s, t] = map.sample_st(i);
-            map.point(s, t)
+            map.place(s, t)
         })
-        .unzip();
-    counts.clamped += clamped.iter().filter(|&&c| c).count() as u64;
-    let (points, pulled, occluded) = if face.model == 0 {
-        into_open(&on_face, centre, scene, bsp, &mut counts)
-    } else {
-        let mut points: Vec<[f32; 3]> = on_face.iter().map(|p| p.as_vec3().to_array()).collect();
-        let occluded = nudge_out_of_solid(bsp, &mut points);
-        (points, vec![false; count], occluded)
+        .collect();
+    let mut points: Vec<[f32; 3]> = placed.iter().map(|p| p.at.as_vec3().to_array()).collect();
+    let mut moved: Vec<bool> = placed.iter().map(|p| p.moved).collect();
+    let mut apart: Vec<bool> = placed.iter().map(|p| p.on_edge).collect();
+    let mut counts = PlacementCounts {
+        clamped: moved.iter().filter(|&&m| m).count() as u64,
+        ..PlacementCounts::default()
     };
-    let moved = clamped.iter().zip(&pulled).map(|(&c, &p)| c || p).collect();
+    let solid = solid_points(bsp, &points);
+    let mut occluded = vec![false; count];
+    for i in 0..count {
+        if placed[i].beyond {
+            occluded[i] = true;
+        } else if solid[i] {
+            match nudged(bsp, points[i]) {
+                Some(p) => {
+                    points[i] = p;
+                    moved[i] = true;
+                    apart[i] = true;
+                    counts.nudged += 1;
+                }
+                None => occluded[i] = true,
+            }
+        }
+    }
+    counts.occluded = occluded.iter().filter(|&&o| o).count() as u64;
+    if counts.occluded == 0 {
+        occluded.clear();
+    }
     (
         FaceSamples {
             face: face.index,
@@ -468,7 +487,7 @@ pub fn face_samples(
             normals: Vec::new(),
             two_sided: face.kind == FaceKind::LitLiquid,
             moved,
-            pulled,
+            apart,
             occluded,
             map,
         },
@@ -488,96 +507,24 @@ const NUDGES: [[f32; 3]; 8] = [
     [0.5, 0.5, 0.5],
 ];
 
-/// Moves each of `points` inside a solid world leaf to the first of its [`NUDGES`] that is
-/// in the open; says which stay inside (empty when none does).
-fn nudge_out_of_solid(bsp: &Bsp, points: &mut [[f32; 3]]) -> Vec<bool> {
-    let solid = solid_points(bsp, points);
-    if !solid.contains(&true) {
-        return Vec::new();
-    }
-    let mut occluded = vec![false; points.len()];
-    for (i, _) in solid.iter().enumerate().filter(|(_, s)| **s) {
-        let p = points[i];
-        let tries = NUDGES.map(|d| [p[0] + d[0], p[1] + d[1], p[2] + d[2]]);
-        let free = solid_points(bsp, &tries).iter().position(|s| !s);
-        match free {
-            Some(k) => points[i] = tries[k],
-            None => occluded[i] = true,
-        }
-    }
-    occluded
+/// The first of `p`'s [`NUDGES`] that is in the open, if any.
+fn nudged(bsp: &Bsp, p: [f32; 3]) -> Option<[f32; 3]> {
+    NUDGES
+        .iter()
+        .map(|d| [p[0] + d[0], p[1] + d[1], p[2] + d[2]])
+        .find(|&t| !solid_at(bsp, t))
 }
 
-/// Each of `points` if nothing stands between it and `centre`, else pulled
-/// back along that line to [`WALL_CLEARANCE`] in front of the obstacle;
-/// onto `centre` if it is still in a solid world leaf, unless the centre is in
-/// solid too (a fixture covering the middle of a wall): such a point is
-/// occluded, as in ericw-tools. Also says which moved and which are occluded
-/// (empty when none is). The rays all leave the centre, so they go 16 to a
-/// coherent packet.
-fn into_open(
-    points: &[DVec3],
-    centre: DVec3,
-    scene: &TraceScene,
-    bsp: &Bsp,
-    counts: &mut PlacementCounts,
-) -> (Vec<[f32; 3]>, Vec<bool>, Vec<bool>) {
-    let c = centre.as_vec3().to_array();
-    let mut out: Vec<[f32; 3]> = points.iter().map(|p| p.as_vec3().to_array()).collect();
-    let mut moved = vec![false; points.len()];
-    let away: Vec<usize> = (0..points.len())
-        .filter(|&i| (points[i] - centre).length() > 1e-3)
-        .collect();
-    let mut packet = RayPacket16::new();
-    for chunk in away.chunks(16) {
-        packet.clear();
-        let mut lens = [0.0f32; 16];
-        let mut dirs = [[0.0f32; 3]; 16];
-        for (lane, &i) in chunk.iter().enumerate() {
-            let d = points[i] - centre;
-            let len = d.length();
-            lens[lane] = len as f32;
-            dirs[lane] = (d / len).as_vec3().to_array();
-            packet.set(lane, c, dirs[lane], 0.0, len as f32 + WALL_CLEARANCE);
-        }
-        counts.rays += u64::from(packet.active_mask().count_ones());
-        let ids = scene.scene.first_hit_geom16(&mut packet, true);
-        for (lane, &i) in chunk.iter().enumerate() {
-            if ids[lane] == sys::RTC_INVALID_GEOMETRY_ID {
-                continue;
-            }
-            let keep = (packet.tfar(lane) - WALL_CLEARANCE).clamp(0.0, lens[lane]);
-            let dir = dirs[lane];
-            out[i] = [
-                c[0] + dir[0] * keep,
-                c[1] + dir[1] * keep,
-                c[2] + dir[2] * keep,
-            ];
-            moved[i] = true;
-            counts.pulled_back += 1;
-        }
-    }
-    let mut occluded = Vec::new();
-    let solid = solid_points(bsp, &out);
-    let centre_in_solid = solid.contains(&true) && solid_points(bsp, &[c])[0];
-    if centre_in_solid {
-        occluded = solid;
-    } else {
-        for ((p, m), solid) in out.iter_mut().zip(&mut moved).zip(solid) {
-            if solid {
-                counts.to_centre += 1;
-                *p = c;
-                *m = true;
-            }
-        }
-    }
-    (out, moved, occluded)
-}
+/// How near a node's plane (units) a point counts as lying on it, and is in solid when the
+/// plane's either side is there: ericw-tools' test for a sample point in solid, so a point on
+/// a solid's surface (the edge of a floor where a wall stands on it, the front of a fixture a
+/// unit thick) is nudged off it.
+const ON_PLANE: f32 = 0.1;
 
 /// How far (units) a cluster's bounding box must clear a node's plane for
-/// every point to go down one side: far above the f32 rounding of the
-/// per-point test, so the shared walk ends in the leaf `Bsp::leaf_at` finds.
-const SHARED_WALK_MARGIN: f32 = 0.1;
+/// every point to go down one side: beyond [`ON_PLANE`] and far above the f32 rounding of
+/// the per-point test, so the shared walk ends where [`solid_at`]'s would.
+const SHARED_WALK_MARGIN: f32 = 0.25;
 
 /// How much wider than its points a face's box of close-light footprint points is (units): the
 /// points are rounded to f32 after the box is taken.
@@ -619,7 +566,42 @@ impl WalkStart {
     }
 }
 
-/// Whether each of `points` is in a solid world leaf. The points share the
+/// Whether `p` is in a solid (or sky) world leaf, a point within [`ON_PLANE`] of a node's
+/// plane being in solid when either side of it holds it.
+pub fn solid_at(bsp: &Bsp, p: [f32; 3]) -> bool {
+    WalkStart::root(bsp).is_some_and(|root| solid_below(bsp, root.node, p, 0))
+}
+
+/// [`solid_at`] below `node`; `depth` nodes above it were walked (a broken tree's cycle ends
+/// the walk, open).
+fn solid_below(bsp: &Bsp, mut node: i32, p: [f32; 3], mut depth: usize) -> bool {
+    while node >= 0 && depth <= bsp.nodes.len() {
+        let Some(n) = bsp.nodes.get(node as usize) else {
+            return false;
+        };
+        let Some(plane) = bsp.planes.get(n.plane as usize) else {
+            return false;
+        };
+        let d =
+            plane.normal[0] * p[0] + plane.normal[1] * p[1] + plane.normal[2] * p[2] - plane.dist;
+        depth += 1;
+        node = if d > ON_PLANE {
+            n.children[0]
+        } else if d < -ON_PLANE {
+            n.children[1]
+        } else {
+            return solid_below(bsp, n.children[0], p, depth)
+                || solid_below(bsp, n.children[1], p, depth);
+        };
+    }
+    node < 0
+        && bsp
+            .leafs
+            .get((-(node + 1)) as usize)
+            .is_some_and(|l| l.contents == contents::SOLID || l.contents == contents::SKY)
+}
+
+/// Whether each of `points` is in solid ([`solid_at`]). The points share the
 /// walk from the root down to the first node whose plane passes between
 /// them, so a cluster (a face's samples, a luxel's square) costs about one
 /// walk instead of one each.
@@ -633,10 +615,6 @@ pub fn solid_points(bsp: &Bsp, points: &[[f32; 3]]) -> Vec<bool> {
 /// [`solid_points`], with the walk starting at `start` when it holds all
 /// of `points` (else at the root).
 pub fn solid_points_from(bsp: &Bsp, start: &WalkStart, points: &[[f32; 3]]) -> Vec<bool> {
-    let solid = |leaf: Option<usize>| {
-        leaf.and_then(|l| bsp.leafs.get(l))
-            .is_some_and(|l| l.contents == contents::SOLID)
-    };
     if points.is_empty() {
         return Vec::new();
     }
@@ -656,12 +634,9 @@ pub fn solid_points_from(bsp: &Bsp, start: &WalkStart, points: &[[f32; 3]]) -> V
         }
     };
     let node = shared_walk(bsp, from, lo, hi);
-    if node < 0 {
-        return vec![solid(bsp.leaf_from(node, [0.0; 3])); points.len()];
-    }
     points
         .iter()
-        .map(|&p| solid(bsp.leaf_from(node, p)))
+        .map(|&p| solid_below(bsp, node, p, 0))
         .collect()
 }
 

@@ -12,7 +12,6 @@ use quake_formats::miptex::{MipTex, TextureLump};
 use crate::dirt::DirtMode;
 use crate::faces::{FaceKind, Spacing, face_geometry};
 use crate::samples::{FaceRegion, face_samples};
-use crate::scene::{Casters, TraceScene};
 use crate::{
     Options, Quality, apply_lighting, compare, compute_lighting, trace_lighting,
     update_entities_only,
@@ -218,7 +217,7 @@ fn box_shadow_has_the_projected_size() {
 }
 
 #[test]
-fn samples_behind_a_wall_are_pulled_back_and_do_not_bleed() {
+fn samples_by_a_wall_stay_on_their_side_and_do_not_bleed() {
     // A 100-unit floor (its luxel grid reaches x = 112) against a wall at x = 100,
     // a light on the wall's far side.
     let mut polys = vec![floor(100.0)];
@@ -226,17 +225,15 @@ fn samples_behind_a_wall_are_pulled_back_and_do_not_bleed() {
     let ents = "{ \"classname\" \"worldspawn\" }\n{ \"classname\" \"light\" \"origin\" \"180 50 40\" \"delay\" \"3\" }\n";
     let bsp = synthetic_bsp(&polys, ents);
     let faces = face_geometry(&bsp, |_| DVec3::ZERO, |_| Spacing::Quake).expect("faces");
-    let device = crate::embree::Device::new(1).expect("device");
-    let scene = TraceScene::build(&device, &faces, &Casters::default()).expect("scene");
-    let (samples, counts) = face_samples(&faces[0], 1, &scene, &bsp);
+    let (samples, counts) = face_samples(&faces[0], 1, &bsp);
     assert_eq!(samples.width, 8, "grid 0..112 has 8 luxels across");
     assert!(counts.clamped >= 8, "{counts:?}");
     for p in &samples.points {
-        // One unit of clearance along the (diagonal) pull-back line.
-        assert!(p[0] <= 99.5, "sample {p:?} left behind the wall");
+        // Moved onto the floor's edge, and half a unit back from the wall if that is solid.
+        assert!(p[0] <= 100.0, "sample {p:?} left behind the wall");
         assert!(
-            (p[2] - 1.0).abs() < 1e-4,
-            "sample {p:?} stays 1 unit above the floor"
+            (p[2] - 1.0).abs() < 1e-4 || (p[2] - 0.5).abs() < 1e-4,
+            "sample {p:?} stands a unit above the floor, or half a unit when nudged"
         );
     }
     let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
@@ -275,9 +272,7 @@ fn samples_past_an_edge_land_on_the_face_that_continues_it() {
     let bsp = synthetic_bsp(&[strip, rest], "{ \"classname\" \"worldspawn\" }");
     let faces = face_geometry(&bsp, |_| DVec3::ZERO, |_| Spacing::Quake).expect("faces");
     assert_eq!(faces[0].continuations.len(), 1);
-    let device = crate::embree::Device::new(1).expect("device");
-    let scene = TraceScene::build(&device, &faces, &Casters::default()).expect("scene");
-    let (samples, _) = face_samples(&faces[0], 1, &scene, &bsp);
+    let (samples, _) = face_samples(&faces[0], 1, &bsp);
     // Luxel rows at y 0 and 16: the second stands over the other face and stays there.
     assert_eq!(samples.height, 2);
     let over_rest: Vec<&[f32; 3]> = samples.points.iter().filter(|p| p[1] > 8.0).collect();
@@ -304,14 +299,12 @@ fn sample_points_invert_an_angled_projection() {
     let mut bsp = synthetic_bsp(&[poly], "{ \"classname\" \"worldspawn\" }");
     bsp.texinfo[0].vecs = [[0.9, 0.1, 0.0, 5.5], [0.05, -0.7, -0.3, -3.25]];
     let faces = face_geometry(&bsp, |_| DVec3::ZERO, |_| Spacing::Quake).expect("faces");
-    let device = crate::embree::Device::new(1).expect("device");
-    let scene = TraceScene::build(&device, &faces, &Casters::default()).expect("scene");
-    let (samples, _) = face_samples(&faces[0], 1, &scene, &bsp);
+    let (samples, _) = face_samples(&faces[0], 1, &bsp);
     let ext = faces[0].extents;
     assert_eq!([samples.width, samples.height], ext.luxel_size());
     let v = bsp.texinfo[0].vecs;
     let n = faces[0].plane.normal;
-    let region = FaceRegion::inset(&faces[0]);
+    let region = FaceRegion::of_face(&faces[0]);
     let mut exact = 0;
     for y in 0..samples.height {
         for x in 0..samples.width {
@@ -546,15 +539,16 @@ fn start_bsp_default_against_reference() {
     let reference = run(Quality::Reference);
     let e = compare(&run(Quality::Default), &reference);
     eprintln!("start.bsp default vs reference: {e:?}");
-    // The largest differences are next to the `_surface` copies 2 units off their faces, whose
-    // 1/x² light changes a lot across a luxel's square: default averages it over the square
-    // in fewer points than the reference.
-    assert!(e.rmse < 3.0, "{e:?}");
-    assert!(e.max <= 80, "{e:?}");
     let e4 = compare(&run(Quality::Extra4), &reference);
     eprintln!("start.bsp extra4 vs reference: {e4:?}");
-    // A few luxels beside those copies differ most; over the map 4x4 samples stay close.
-    assert!(e4.rmse < 1.5, "{e4:?}");
+    // Samples stand where ericw-tools puts them: one per luxel, on the face's edge or nudged
+    // half a unit out of solid beside it. The largest differences are where that one point
+    // takes a light a few units away (the `_surface` copies beside start's fixtures) or
+    // misses it, and on the 16-unit strips at the tops of its walls, where the reference's
+    // 256 points per luxel find light that one point, 16 points and ericw-tools do not.
+    assert!(e.rmse < 12.5, "{e:?}");
+    assert!(e4.rmse < 5.5, "{e4:?}");
+    assert!(e4.rmse < e.rmse, "{e4:?} {e:?}");
 }
 
 /// ericw-tools' cube has no light entity: it stays fullbright, and the file still round-trips
@@ -587,7 +581,16 @@ fn q1_cube_without_lights_stays_fullbright_and_round_trips() {
 /// Floor 0..256 with a wall block standing on its far end (x 192..256), lit
 /// evenly (constant falloff, no angle term) from above.
 fn corner_scene(world_keys: &str, light_keys: &str) -> Bsp {
-    let mut polys = vec![floor(256.0)];
+    // The floor ends at the wall's foot, as the compiler cuts it (these BSPs have no tree to
+    // tell that a sample under the wall is in solid).
+    let floor = quad(
+        [0.0, 0.0, 0.0],
+        [0.0, 256.0, 0.0],
+        [192.0, 256.0, 0.0],
+        [192.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0],
+    );
+    let mut polys = vec![floor];
     polys.extend(box_faces([192.0, -64.0, 0.0], [320.0, 320.0, 256.0]));
     let ents = format!(
         "{{ \"classname\" \"worldspawn\" {world_keys} }}\n{{ \"classname\" \"light\" \"origin\" \"96 128 200\" \"light\" \"200\" \"delay\" \"3\" \"_anglescale\" \"0\" {light_keys} }}\n"
@@ -614,7 +617,7 @@ fn dirt_darkens_the_corner_but_not_the_open_floor() {
         let keys = format!("\"_dirt\" \"1\" \"_dirtmode\" \"{mode}\"");
         let dirty = floor_row(&corner_scene(&keys, ""), &options(Quality::Default), 8);
         // Luxel 11 is 16 units from the wall's foot; luxels 0..=3 are over 128 units away.
-        assert!(dirty[11] < 80, "mode {mode}: corner {dirty:?}");
+        assert!(dirty[11] < 90, "mode {mode}: corner {dirty:?}");
         assert!(
             dirty[11] < dirty[9] && dirty[9] < dirty[6],
             "mode {mode}: {dirty:?}"
@@ -723,7 +726,7 @@ fn edge_jumps(world_keys: &str) -> Vec<f64> {
     let rows: Vec<Vec<(DVec3, f64)>> = (1..=8)
         .map(|f| {
             let geom = &prep.faces[f];
-            let (mut samples, _) = face_samples(geom, 1, &prep.scene, &bsp);
+            let (mut samples, _) = face_samples(geom, 1, &bsp);
             if let Some(corners) = &prep.phong[f] {
                 samples.normals = samples
                     .points
@@ -902,7 +905,7 @@ fn dirt_cone_follows_the_phong_normal() {
     // The floor of the corner scene: the wall stands at x = 192.
     let bsp = corner_scene("", "");
     let prep = crate::prepare::prepare(&bsp, &Options::default()).expect("prepare");
-    let (mut samples, _) = face_samples(&prep.faces[0], 1, &prep.scene, &bsp);
+    let (mut samples, _) = face_samples(&prep.faces[0], 1, &bsp);
     let sampling = crate::lights::dirt_sampling(&crate::settings::Settings::default());
     let occlusion = |samples: &crate::samples::FaceSamples| {
         let all: Vec<usize> = (0..samples.points.len()).collect();
@@ -1071,8 +1074,9 @@ fn door_in_wall_bsp() -> Bsp {
 
 /// Regression: a door's faces inside the wall it slides into were black (their rays start in
 /// the wall's solid), so they showed black once the door moved. As in ericw-tools, samples in
-/// the world's solid are occluded: a luxel with some open samples keeps their mean, and one
-/// with none takes its model's mean, on a face half in the wall as on one wholly in it.
+/// the world's solid are occluded: a luxel with some open samples keeps their mean, one with
+/// none its open neighbours' (on a face half in the wall), and a face with no open luxel at
+/// all takes its model's mean.
 #[test]
 fn door_faces_inside_a_wall_are_not_black() {
     let bsp = door_in_wall_bsp();
@@ -1097,10 +1101,37 @@ fn door_faces_inside_a_wall_are_not_black() {
         "{end_grey:?}"
     );
     assert!(face_grey(&lighting, front).iter().all(|&v| v > 10));
-    // The top's luxels over the wall (x beyond 128) take the model's mean too.
+    // The top's luxels over the wall (x beyond 128) take their neighbours' light.
     let top_grey = face_grey(&lighting, top);
     assert!(top_grey.iter().all(|&v| v > 10), "{top_grey:?}");
-    assert!(top_grey.contains(&end_grey[0]), "{top_grey:?} {end_grey:?}");
+    let width = top_grey.len() / 3;
+    for row in top_grey.chunks(width) {
+        assert_eq!(row[width - 1], row[width - 2], "{top_grey:?}");
+    }
+}
+
+/// As in ericw-tools, a sample point within a tenth of a unit of a node's plane is in solid
+/// when either side of it is: on the room's floor or within 0.1 over it, it is; 0.2 over it,
+/// or in the room's middle, it is not. A sample lifted onto the floor's plane is nudged into the
+/// room.
+#[test]
+fn a_point_on_a_solid_surface_is_in_solid() {
+    let bsp = room_bsp("");
+    let solid = |z: f32| crate::samples::solid_at(&bsp, [0.0, 0.0, z]);
+    assert!(solid(-128.0) && solid(-127.95) && solid(-128.05));
+    assert!(!solid(-127.8) && !solid(0.0));
+    let floor = crate::prepare::prepare(&bsp, &Options::default())
+        .expect("prepare")
+        .faces
+        .into_iter()
+        .find(|f| f.model == 0 && f.plane.normal.z > 0.99)
+        .expect("the floor");
+    let (samples, counts) = face_samples(&floor, 1, &bsp);
+    assert!(counts.nudged > 0, "{counts:?}");
+    for (i, p) in samples.points.iter().enumerate() {
+        let occluded = samples.occluded.get(i).copied().unwrap_or(false);
+        assert!(occluded || !crate::samples::solid_at(&bsp, *p), "{p:?}");
+    }
 }
 
 /// A sealed room (inside -128..128 on every axis) with `entities` (entity blocks) after its
@@ -1143,15 +1174,15 @@ fn slab_bsp(classname: &str, keys: &str, texture: &str) -> Bsp {
     ))
 }
 
-/// Regression: LibreQuake start's face 543 is a wall whose middle a light fixture covers (a
-/// detail brush one unit thick, `_surface` lights in front of it). Its luxels under the
-/// fixture were lit as if they stood in front of it (their samples fell back onto the face's
-/// covered middle, two units from a surface light's copy): a block of 255 making a bright
-/// fringe round the fixture in engines that filter lightmaps. As in ericw-tools they now take no
-/// light of their own.
+/// LibreQuake start's face 543 is a wall whose middle a light fixture covers (a detail brush
+/// one unit thick, `_surface` lights 2 units in front of it). The sample of the luxel behind
+/// the fixture's middle lies on the fixture's front, is in solid, and is nudged half a unit
+/// out in front of it, where the copy there lights it: ericw-tools writes 254 for it (the
+/// glow round the fixture in engines that filter lightmaps), and the luxels beside the
+/// fixture keep the room's dim light.
 #[test]
 #[ignore = "slow: run with --release -- --ignored"]
-fn luxels_under_a_wall_fixture_take_no_light_of_the_fixture_s_lights() {
+fn the_luxel_behind_a_wall_fixture_is_lit_as_in_ericw_tools() {
     let Some(bsp) = corpus_bsp("librequake/start.bsp") else {
         return;
     };
@@ -1165,10 +1196,11 @@ fn luxels_under_a_wall_fixture_take_no_light_of_the_fixture_s_lights() {
         .iter()
         .find(|m| m.face == 543)
         .expect("face 543 lit");
-    let brightest = m
-        .style_grey(0)
-        .map_or(0, |g| g.iter().copied().max().unwrap_or(0));
-    assert!(brightest < 128, "face 543's brightest luxel: {brightest}");
+    let grey = m.style_grey(0).expect("style 0");
+    assert_eq!([m.width, m.height], [7, 6]);
+    let at = |x: usize, y: usize| grey[y * m.width + x];
+    assert!(at(3, 3) > 200, "{grey:?}");
+    assert!((0..3).all(|x| at(x, 2) < 40), "{grey:?}");
 }
 
 /// ericw-tools moves a light in solid, or lying on a surface, 2 units out: a light on the floor
@@ -1375,7 +1407,7 @@ fn lit_faces(
         .iter()
         .filter(|f| f.kind == FaceKind::Lit)
         .map(|geom| {
-            let (samples, _) = face_samples(geom, per_axis, &prep.scene, bsp);
+            let (samples, _) = face_samples(geom, per_axis, bsp);
             let mut scratch = crate::trace::TraceScratch::default();
             let (raw, counts) = crate::trace::trace_face(&setup, &samples, rules, &mut scratch);
             rays += counts.shadow_rays + counts.sun_rays + counts.dirt_rays;
@@ -1476,7 +1508,7 @@ fn dirt_occlusion_does_not_depend_on_the_rays_traced_beside_it() {
         prep.lights.dirt.mode = mode;
         for geom in prep.faces.iter().filter(|f| f.kind == FaceKind::Lit) {
             for per_axis in [1, 2] {
-                let (samples, _) = face_samples(geom, per_axis, &prep.scene, &bsp);
+                let (samples, _) = face_samples(geom, per_axis, &bsp);
                 let all: Vec<usize> = (0..samples.points.len()).collect();
                 let measure = |indices: &[usize]| {
                     crate::dirt::occlusion_at(
@@ -1589,11 +1621,7 @@ fn shared_leaf_walk_agrees_with_walking_each_point() {
     // Clusters of points (a luxel's square) inside the room, inside the
     // column, inside the walls and straddling their faces.
     let bsp = detail_column_bsp("");
-    let per_point = |p: &[f32; 3]| {
-        bsp.leaf_at(*p)
-            .and_then(|l| bsp.leafs.get(l))
-            .is_some_and(|l| l.contents == quake_formats::bsp::contents::SOLID)
-    };
+    let per_point = |p: &[f32; 3]| crate::samples::solid_at(&bsp, *p);
     let mut solid_seen = 0;
     for cx in (-160..=160).step_by(20) {
         for cz in (-160..=160).step_by(20) {

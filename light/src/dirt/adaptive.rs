@@ -8,10 +8,9 @@
 //! [`DIRT_SMOOTH`] (or [`DIRT_SMOOTH_SUPERSAMPLED`]) takes their bilinear mean, first in the
 //! coarse cell, else in the fine one; so does one whose fine corners the coarse cell predicts
 //! to within as much (a steady slope away from a wall). The others (corners, edges of
-//! objects) are measured, as is every sample off the grid: pulled ones
-//! ([`FaceSamples::pulled`]), and when supersampling every moved one (a luxel's sub-samples are
-//! close together; in the default mode a sample moved onto the face from past its edge stays
-//! beside its grid position and is interpolated like the others).
+//! objects) are measured, as is every sample that stands apart: on the face's edge or nudged
+//! out of solid ([`FaceSamples::apart`]), and when supersampling every moved one (a luxel's
+//! sub-samples are close together).
 //!
 //! Only samples some light that takes dirt reaches need a value ([`DirtNeed`]), and a needed
 //! sample's value never depends on which others are needed: interpolation reads measured
@@ -237,7 +236,7 @@ impl<'a> Adaptive<'a> {
                 let off_grid = if self.supersampled() {
                     self.samples.moved[i]
                 } else {
-                    self.samples.pulled[i]
+                    self.samples.apart[i]
                 };
                 if off_grid && !self.bounce_only(i) {
                     off.push(i);
@@ -284,8 +283,7 @@ impl<'a> Adaptive<'a> {
 
     /// The bilinear mean at `at` of its cell's corners in `grid` and how much they differ,
     /// when all four are measured (only measured values: a needed sample's value must not
-    /// depend on which others are needed) and none was pulled (possibly far from its grid
-    /// position; a sample moved onto the face from past its edge stays beside it).
+    /// depend on which others are needed) and none stands apart ([`FaceSamples::apart`]).
     fn bilinear(
         &self,
         known: &[Option<f32>],
@@ -295,7 +293,7 @@ impl<'a> Adaptive<'a> {
         let (corners, fx, fy) = grid.cell(gx, gy);
         let values = corners.map(|c| {
             let c = self.index(c);
-            known[c].filter(|_| !self.samples.pulled[c])
+            known[c].filter(|_| !self.samples.apart[c])
         });
         let [Some(a), Some(b), Some(c), Some(d)] = values else {
             return None;

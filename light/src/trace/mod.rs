@@ -269,6 +269,14 @@ impl<'a> FaceTrace<'a> {
         for a in self.scratch.arrivals.waiting.iter().filter(|a| a.dirty) {
             needed[a.sample as usize] = DirtNeed::Light;
         }
+        // An occluded sample's light does not count (unless every sample of the face is
+        // occluded); its dirt, measured from inside solid, would spoil its neighbours'.
+        let occluded = &self.samples.occluded;
+        if occluded.contains(&false) {
+            for (n, _) in needed.iter_mut().zip(occluded).filter(|(_, o)| **o) {
+                *n = DirtNeed::No;
+            }
+        }
         let (values, rays) = face_occlusion(
             FaceDirt {
                 scene: self.setup.scene,

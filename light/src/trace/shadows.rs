@@ -121,8 +121,8 @@ impl VisibilityScratch {
     /// [`VisibilityScratch::trace`] for one of many directions of a sun or
     /// dome, one sample per luxel (the default mode): probes first, at the
     /// positions of `grid` (every [`super::suns`]'s stride-th luxel along each axis
-    /// and the last row and column); a luxel between them that was not pulled
-    /// back ([`FaceSamples::pulled`]) takes the answer of its cell's probes
+    /// and the last row and column); a luxel between them that does not stand apart
+    /// ([`FaceSamples::apart`]) takes the answer of its cell's probes
     /// when all of them got through or all were blocked; the others are
     /// traced. A shadow narrower than the cell can slip between the probes,
     /// but each direction carries at most a small part of its
@@ -140,7 +140,7 @@ impl VisibilityScratch {
         let n = value.len();
         self.start_light(n);
         let w = samples.width;
-        let probe = |i: usize| value[i] != 0.0 && !samples.pulled[i];
+        let probe = |i: usize| value[i] != 0.0 && !samples.apart[i];
         for &y in &grid.ys {
             self.todo.extend(
                 grid.xs
@@ -157,7 +157,7 @@ impl VisibilityScratch {
                 continue; // a probe
             }
             let corners = corners.map(|(x, y)| y * w + x);
-            let agreed = !samples.pulled[i]
+            let agreed = !samples.apart[i]
                 && corners.iter().all(|&c| probe(c))
                 && corners.iter().all(|&c| self.lit[c] == self.lit[corners[0]]);
             if agreed {
