@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # The BSPs bench/light_agreement.sh compares on, compiled and vised by ericw-tools' own qbsp and
 # vis (../shared/anchors/ericw-tools), written to OUT (default /tmp/agree):
-#   e1m1.bsp  id's e1m1 (full vis). Its WAD (id1's gfx/base.wad) is not free, so the map is
-#             compiled with a placeholder WAD of flat grey 16x16 textures under its texture names:
-#             light needs the names (liquids, sky) and not the pictures.
+#   e1m1.bsp  id's e1m1 (full vis); e1m2.bsp, e2m5.bsp, dm2.bsp the other id maps (vis -fast).
+#             Their WAD (id1's gfx/base.wad) is not free, so each map is compiled with a
+#             placeholder WAD of flat grey 16x16 textures under its texture names: light needs
+#             the names (liquids, sky) and not the pictures.
 #   e1m3.bsp  LibreQuake e1m3 with the corpus WADs (vis -fast).
 #   start.bsp LibreQuake start, the corpus BSP itself.
 # Usage: bench/agreement_bsps.sh [OUT]
@@ -25,15 +26,23 @@ grey_tga() {
 
 pictures=$(mktemp -d)
 trap 'rm -rf "$pictures"' EXIT
-# Texture names: the word after a map face's three points.
-sed -n 's/^ *(.*) *(.*) *(.*) *\([^ ]*\) .*/\1/p' "$shared/corpus/public/maps/id/e1m1.map" \
-  | sort -u | while read -r name; do
-    grey_tga > "$pictures/${name/\*/#}.tga"
-  done
-"$slipgate" wad build "$pictures" "$out/e1m1-placeholder.wad" >/dev/null 2>&1
-sed "s#\"wad\"[[:space:]]*\"[^\"]*\"#\"wad\" \"$out/e1m1-placeholder.wad\"#" \
-  "$shared/corpus/public/maps/id/e1m1.map" > "$out/e1m1.map"
-(cd "$out" && "$anchor/qbsp" e1m1.map >/dev/null && "$anchor/vis" e1m1.bsp >/dev/null)
+# id map NAME compiled with a placeholder WAD of its texture names, then vised with the vis
+# options that follow NAME.
+id_map() {
+  local name=$1; shift
+  rm -f "$pictures"/*
+  # Texture names: the word after a map face's three points.
+  sed -n 's/^ *(.*) *(.*) *(.*) *\([^ ]*\) .*/\1/p' "$shared/corpus/public/maps/id/$name.map" \
+    | sort -u | while read -r texture; do
+      grey_tga > "$pictures/${texture/\*/#}.tga"
+    done
+  "$slipgate" wad build "$pictures" "$out/$name-placeholder.wad" >/dev/null 2>&1
+  sed "s#\"wad\"[[:space:]]*\"[^\"]*\"#\"wad\" \"$out/$name-placeholder.wad\"#" \
+    "$shared/corpus/public/maps/id/$name.map" > "$out/$name.map"
+  (cd "$out" && "$anchor/qbsp" "$name.map" >/dev/null && "$anchor/vis" "$@" "$name.bsp" >/dev/null)
+}
+id_map e1m1
+for name in e1m2 e2m5 dm2; do id_map "$name" -fast; done
 
 sed 's#\.\./\.\./\.\./\.\./texture-wads/##g' "$shared/corpus/public/maps/librequake/e1m3.map" \
   > "$out/e1m3.map"
@@ -41,4 +50,4 @@ sed 's#\.\./\.\./\.\./\.\./texture-wads/##g' "$shared/corpus/public/maps/librequ
   && "$anchor/vis" -fast e1m3.bsp >/dev/null)
 
 cp "$shared/corpus/public/bsp/librequake/start.bsp" "$out/start.bsp"
-echo "$out/e1m1.bsp $out/e1m3.bsp $out/start.bsp"
+echo "$out/e1m1.bsp $out/e1m2.bsp $out/e2m5.bsp $out/dm2.bsp $out/e1m3.bsp $out/start.bsp"
