@@ -13,8 +13,9 @@
 //! inside the world's solid (on the edge under the wall, behind a fixture on the face)
 //! is nudged half a unit along each axis into the open when that frees it, else it is
 //! occluded; a point within `ON_PLANE` of a node's plane is in solid when either side
-//! is, as in ericw-tools, so one on a solid's surface is nudged off it. An occluded sample takes no light of its own: its luxel takes the mean of
-//! its open samples, or else of its neighbours (see `trace::HiddenLuxels`).
+//! is, as in ericw-tools, so one on a solid's surface is nudged off it. An occluded sample
+//! takes no light of its own: its luxel takes the mean of its open samples, or else of its
+//! neighbours (see `trace::HiddenLuxels`).
 //!
 //! [`FaceSamples`] is kept as its own structure so later passes (bounce
 //! lighting) can reuse the same points.
