@@ -1,8 +1,8 @@
 //! Suns and sky domes: parallel light from sky faces. Worldspawn's `_sunlight` (spread over
 //! `_sunlight_penumbra` degrees), `_sunlight2` and `_sunlight3` (domes from above and below,
-//! laid out in rings as ericw-tools lays them: see [`dome`]), and light entities with `_sun 1`, `_sunlight2 1` or
-//! `_sunlight3 1`. A sun or dome spread over many directions is one [`SunLight`] per direction,
-//! sharing its light.
+//! laid out in rings as ericw-tools lays them: see [`dome`]), and light entities with `_sun 1`,
+//! `_sunlight2 1` or `_sunlight3 1`. A sun or dome spread over many directions is one
+//! [`SunLight`] per direction, sharing its light.
 
 use glam::DVec3;
 
