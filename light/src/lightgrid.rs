@@ -206,9 +206,7 @@ fn walk_row(bsp: &Bsp, node: i32, points: &[[f32; 3]], out: &mut [Option<usize>]
         return;
     }
     // The same sum as `leaf_at`'s, so both put a point on the same side.
-    let behind = |p: &[f32; 3]| {
-        plane.normal[0] * p[0] + plane.normal[1] * p[1] + plane.normal[2] * p[2] - plane.dist < 0.0
-    };
+    let behind = |p: &[f32; 3]| plane.distance(*p) < 0.0;
     let first_behind = behind(&points[0]);
     let split = points.partition_point(|p| behind(p) == first_behind);
     let (near, far) = points.split_at(split);

@@ -343,13 +343,14 @@ fn finish_faces(
     let hidden: Vec<Vec<bool>> = lit.iter().map(SampleLight::hidden_luxels).collect();
     let mut finished: Vec<FaceLight> = lit
         .into_par_iter()
-        .map(|light| {
+        .zip(hidden.par_iter())
+        .map(|(light, hidden)| {
             let bounce = bounced.get(light.face).map_or(&[][..], |b| &b[..]);
             // As in ericw-tools, hidden luxels take their neighbours' light, but a brush
             // model's face with no open luxel at all takes its model's (filled below).
             let fill = match geoms[light.face].model {
                 0 => HiddenLuxels::FromNeighbours,
-                _ if !all_hidden(&light.hidden_luxels()) => HiddenLuxels::FromNeighbours,
+                _ if !all_hidden(hidden) => HiddenLuxels::FromNeighbours,
                 _ => HiddenLuxels::Later,
             };
             light.finish(bounce, fill)

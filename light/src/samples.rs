@@ -31,6 +31,10 @@ use crate::faces::{FaceGeom, FaceKind};
 /// Distance of sample points in front of their face, in map units.
 pub const SURFACE_OFFSET: f64 = 1.0;
 
+/// How near a face's edge (units) a sample point lies on it: a point moved onto the edge,
+/// or one the grid puts there, where a wall standing on the face begins.
+const ON_EDGE: f64 = 1e-3;
+
 /// The sample points of one face.
 #[derive(Debug, Clone)]
 pub struct FaceSamples {
@@ -232,10 +236,9 @@ impl FaceRegion {
             .all(|(&a, m)| m.dot(p - a) >= -slack)
     }
 
-    /// Whether `p` (a point of the region) lies on its outline.
+    /// Whether `p` (a point of the region) lies on its outline (within [`ON_EDGE`]).
     fn on_edge(&self, p: DVec3) -> bool {
-        let slack = 1e-3;
-        (self.points.iter().zip(&self.inward)).any(|(&a, m)| m.dot(p - a) < slack)
+        (self.points.iter().zip(&self.inward)).any(|(&a, m)| m.dot(p - a) < ON_EDGE)
     }
 
     /// `p` (a point on the face's plane) if it is inside, else the nearest
@@ -584,8 +587,7 @@ fn solid_below(bsp: &Bsp, mut node: i32, p: [f32; 3], mut depth: usize) -> bool 
         let Some(plane) = bsp.planes.get(n.plane as usize) else {
             return false;
         };
-        let d =
-            plane.normal[0] * p[0] + plane.normal[1] * p[1] + plane.normal[2] * p[2] - plane.dist;
+        let d = plane.distance(p);
         depth += 1;
         node = if d > ON_PLANE {
             n.children[0]

@@ -154,11 +154,16 @@ fn add_poly(bsp: &mut Bsp, p: &Poly) {
 }
 
 fn floor(size: f32) -> Poly {
+    floor_rect(size, size)
+}
+
+/// An upward floor over x 0..`x`, y 0..`y` at z 0.
+fn floor_rect(x: f32, y: f32) -> Poly {
     quad(
         [0.0, 0.0, 0.0],
-        [0.0, size, 0.0],
-        [size, size, 0.0],
-        [size, 0.0, 0.0],
+        [0.0, y, 0.0],
+        [x, y, 0.0],
+        [x, 0.0, 0.0],
         [0.0, 0.0, 1.0],
     )
 }
@@ -255,13 +260,7 @@ fn samples_by_a_wall_stay_on_their_side_and_do_not_bleed() {
 /// of the surface it stands over; ericw-tools places it on the continuing face.
 #[test]
 fn samples_past_an_edge_land_on_the_face_that_continues_it() {
-    let strip = quad(
-        [0.0, 0.0, 0.0],
-        [0.0, 8.0, 0.0],
-        [256.0, 8.0, 0.0],
-        [256.0, 0.0, 0.0],
-        [0.0, 0.0, 1.0],
-    );
+    let strip = floor_rect(256.0, 8.0);
     let rest = quad(
         [0.0, 8.0, 0.0],
         [0.0, 256.0, 0.0],
@@ -578,19 +577,11 @@ fn q1_cube_without_lights_stays_fullbright_and_round_trips() {
     );
 }
 
-/// Floor 0..256 with a wall block standing on its far end (x 192..256), lit
-/// evenly (constant falloff, no angle term) from above.
+/// A floor (x 0..192, y 0..256) ending at the foot of a wall block (x from 192), lit evenly
+/// (constant falloff, no angle term) from above. The floor ends at the wall, as the compiler
+/// cuts it: these BSPs have no tree to tell that a sample under the wall is in solid.
 fn corner_scene(world_keys: &str, light_keys: &str) -> Bsp {
-    // The floor ends at the wall's foot, as the compiler cuts it (these BSPs have no tree to
-    // tell that a sample under the wall is in solid).
-    let floor = quad(
-        [0.0, 0.0, 0.0],
-        [0.0, 256.0, 0.0],
-        [192.0, 256.0, 0.0],
-        [192.0, 0.0, 0.0],
-        [0.0, 0.0, 1.0],
-    );
-    let mut polys = vec![floor];
+    let mut polys = vec![floor_rect(192.0, 256.0)];
     polys.extend(box_faces([192.0, -64.0, 0.0], [320.0, 320.0, 256.0]));
     let ents = format!(
         "{{ \"classname\" \"worldspawn\" {world_keys} }}\n{{ \"classname\" \"light\" \"origin\" \"96 128 200\" \"light\" \"200\" \"delay\" \"3\" \"_anglescale\" \"0\" {light_keys} }}\n"

@@ -26,11 +26,15 @@ pub struct SunLight {
     pub directions: usize,
 }
 
-/// `sun` spread over `degrees` around its direction (a cone's half-angle; 90 for a dome's
-/// hemisphere): `sunsamples` directions, each with its share of the light (one direction for
-/// no spread).
+/// `sun` spread over `degrees` around its direction (a cone's half-angle): `sunsamples`
+/// directions, each with its share of the light (one direction for no spread).
 pub fn spread(sun: SunLight, degrees: f64, sunsamples: usize) -> Vec<SunLight> {
     let dirs = cap_directions(sun.to_sun, degrees, sunsamples);
+    shared_out(&sun, dirs)
+}
+
+/// One copy of `sun` towards each of `dirs`, each with an even share of its light.
+fn shared_out(sun: &SunLight, dirs: Vec<DVec3>) -> Vec<SunLight> {
     let each = sun.light / dirs.len().max(1) as f64;
     let directions = dirs.len();
     dirs.into_iter()
@@ -67,16 +71,7 @@ pub fn dome(sun: SunLight, upper: bool, sunsamples: usize) -> Vec<SunLight> {
         }
     }
     dirs.push(DVec3::new(0.0, 0.0, up));
-    let each = sun.light / dirs.len() as f64;
-    let directions = dirs.len();
-    dirs.into_iter()
-        .map(|to_sun| SunLight {
-            to_sun,
-            light: each,
-            directions,
-            ..sun.clone()
-        })
-        .collect()
+    shared_out(&sun, dirs)
 }
 
 /// The sun and domes worldspawn's settings ask for, in that order.

@@ -510,10 +510,7 @@ impl Bsp {
         while node >= 0 {
             let n = self.nodes.get(node as usize)?;
             let plane = self.planes.get(n.plane as usize)?;
-            let d = plane.normal[0] * point[0]
-                + plane.normal[1] * point[1]
-                + plane.normal[2] * point[2]
-                - plane.dist;
+            let d = plane.distance(point);
             let back = d < 0.0 || (on_plane_back && d == 0.0);
             node = n.children[usize::from(back)];
             steps += 1;

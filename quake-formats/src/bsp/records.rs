@@ -63,6 +63,14 @@ pub struct Plane {
     pub kind: i32,
 }
 
+impl Plane {
+    /// How far `p` lies in front of the plane (negative behind), summed as engines' and our
+    /// own leaf walks sum it, so every walk puts a point on the same side.
+    pub fn distance(&self, p: [f32; 3]) -> f32 {
+        self.normal[0] * p[0] + self.normal[1] * p[1] + self.normal[2] * p[2] - self.dist
+    }
+}
+
 impl Record for Plane {
     const LUMP: &'static str = "planes";
     fn size(_: BspVersion) -> usize {
