@@ -162,7 +162,7 @@ fn check_light(map: &MapFile, bsp: &quake_formats::Bsp) -> Result<(), Failure> {
         ));
     }
     let byte_bound = (bound * raw.rangescale).ceil().min(255.0) as u8;
-    let finished = light::finish_lighting(&raw, 0);
+    let finished = light::finish_lighting(&raw);
     let brightest_byte = finished
         .lightmaps
         .iter()

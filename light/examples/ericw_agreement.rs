@@ -16,7 +16,6 @@ use light::{FaceLightmap, lightmaps_in};
 use quake_formats::Bsp;
 use quake_formats::extents::LightmapExtents;
 use quake_formats::geom::{Plane, Winding};
-use quake_formats::palette::FIRST_FULLBRIGHT;
 
 /// Per-face means within this many levels count as agreeing.
 const AGREE_LEVELS: f64 = 5.0;
@@ -53,7 +52,12 @@ fn faces_means(bsp: &Bsp, drawn_only: bool) -> Vec<Option<Vec<(u8, f64)>>> {
     let all: Vec<usize> = (0..bsp.faces.len()).collect();
     let mut out = vec![None; bsp.faces.len()];
     for map in lightmaps_in(bsp, &all).lightmaps {
-        if drawn_only && drawn_unlit(bsp, map.face) {
+        let face = &bsp.faces[map.face];
+        if drawn_only
+            && bsp
+                .face_texture(face)
+                .is_some_and(|t| t.is_all_fullbright())
+        {
             continue;
         }
         let seen = drawn_only.then(|| drawn_luxels(bsp, map.face)).flatten();
@@ -62,19 +66,6 @@ fn faces_means(bsp: &Bsp, drawn_only: bool) -> Vec<Option<Vec<(u8, f64)>>> {
         out[map.face] = Some(means);
     }
     out
-}
-
-/// Whether every texel of `face`'s texture is fullbright (palette index 224 and up), so
-/// engines draw none of its lightmap (a light fixture's texture).
-fn drawn_unlit(bsp: &Bsp, face: usize) -> bool {
-    let texture = bsp
-        .faces
-        .get(face)
-        .and_then(|f| bsp.texinfo.get(f.texinfo as usize))
-        .and_then(|t| bsp.textures.textures.get(t.miptex as usize))
-        .and_then(Option::as_ref);
-    let pixels = texture.and_then(|t| t.mips.as_ref()).map(|m| &m[0]);
-    pixels.is_some_and(|p| !p.is_empty() && p.iter().all(|&i| i >= FIRST_FULLBRIGHT))
 }
 
 /// Per luxel of `face`'s 16-texel grid, whether bilinear filtering reads it anywhere on the face:

@@ -3,7 +3,10 @@
 //! Time (best of 3) and rays are for the whole map; RMSE and max error
 //! (8-bit levels) are against `--reference` on every STRIDE-th face.
 
-use light::{Options, Quality, compare, compute_lighting, finish_lighting, trace_lighting};
+use light::settings::SoftRadius;
+use light::{
+    Options, Quality, RawLighting, compare, compute_lighting, finish_lighting, trace_lighting,
+};
 
 fn main() -> anyhow::Result<()> {
     let mut args = std::env::args().skip(1);
@@ -26,21 +29,22 @@ fn main() -> anyhow::Result<()> {
         "reference on every {stride}th face: {:.1} s",
         reference.stats.seconds_trace
     );
+    let (none, half) = (SoftRadius::Samples(0), SoftRadius::HalfLuxel);
     let modes = [
-        ("default", Quality::Default, 0),
-        ("--extra", Quality::Extra, 0),
-        ("--extra4", Quality::Extra4, 0),
-        ("--soft", Quality::Default, 1),
-        ("--extra4 --soft", Quality::Extra4, 1),
+        ("default", Quality::Default, none),
+        ("--extra", Quality::Extra, none),
+        ("--extra4", Quality::Extra4, none),
+        ("--soft 1", Quality::Default, SoftRadius::Samples(1)),
+        ("--extra4 --soft", Quality::Extra4, half),
     ];
     println!("| mode | trace time | rays | RMSE | max | RMSE / max vs filtered reference |");
     println!("|---|---|---|---|---|---|");
-    for (name, quality, soft_radius) in modes {
+    for (name, quality, soft) in modes {
         let mut options = Options {
             quality,
             ..Options::default()
         };
-        options.overrides.soft = Some(soft_radius);
+        options.overrides.soft = Some(soft);
         let mut best = f64::INFINITY;
         let mut rays = 0;
         for _ in 0..3 {
@@ -55,13 +59,18 @@ fn main() -> anyhow::Result<()> {
                 ..options.clone()
             },
         )?;
-        let e = compare(&part, &finish_lighting(&reference, 0));
-        let filtered = if soft_radius > 0 {
-            let f = compare(&part, &finish_lighting(&reference, soft_radius));
-            format!("{:.2} / {}", f.rmse, f.max)
-        } else {
-            String::new()
+        let e = compare(&part, &finish_lighting(&reference));
+        let per_axis = quality.samples_per_axis();
+        let soft_reference = RawLighting {
+            soft,
+            ..reference.clone()
         };
+        let filtered = soft_reference
+            .softened(per_axis)
+            .map_or(String::new(), |r| {
+                let f = compare(&part, &finish_lighting(&r));
+                format!("{:.2} / {}", f.rmse, f.max)
+            });
         println!(
             "| {name} | {best:.2} s | {:.1} M | {:.2} | {} | {filtered} |",
             rays as f64 / 1e6,

@@ -267,12 +267,13 @@ pub fn compare_with_reference(
         ..options.clone()
     };
     let raw = trace_lighting(bsp, &reference)?;
-    let exact = finish_lighting(&raw, 0);
+    let exact = finish_lighting(&raw);
     let r = &exact.stats;
     Ok(ReferenceComparison {
         error: compare(lighting, &exact),
-        error_filtered: (raw.soft_radius > 0)
-            .then(|| compare(lighting, &finish_lighting(&raw, raw.soft_radius))),
+        error_filtered: raw
+            .softened(options.quality.samples_per_axis())
+            .map(|soft| compare(lighting, &finish_lighting(&soft))),
         error_own_grids: own_grids(lighting)
             .zip(own_grids(&exact))
             .map(|(a, r)| compare(&a, &r)),

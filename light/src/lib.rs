@@ -21,9 +21,10 @@
 //!    the face sees; dirt measured where light that takes it arrived (`dirt`); minlight.
 //! 4. Bounced light (`bounce`), when asked for: each pass gathers, at a grid of receivers per
 //!    face, what the light of the pass before gives off from the faces it sees.
-//! 5. Finishing (`output`): bounce added, floors applied, samples averaged to luxels (a face lit
-//!    on its own grid gets its 16-texel lightmap read from that one, `resample`), the
-//!    `--soft` filter, range scale, gamma and clamping to bytes, at most four styles a face.
+//! 5. Finishing: bounce added, floors applied, samples turned into luxels with occluded samples
+//!    filled and the `--soft` blur (`luxels`; a face lit on its own grid gets its 16-texel
+//!    lightmap read from that one, `resample`); range scale, gamma and clamping to bytes, at
+//!    most four styles a face (`output`).
 //!
 //! Sky faces block point lights (the sky brush is solid) and are what sun rays look for;
 //! liquids (`*` textures) let light through, as in id's tool. Results depend on neither the
@@ -49,6 +50,7 @@ mod hull;
 mod lightgrid;
 mod lighting;
 mod lights;
+mod luxels;
 mod nudge;
 mod options;
 mod output;

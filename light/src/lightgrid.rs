@@ -538,7 +538,6 @@ mod tests {
         let finish = Finish {
             rangescale: 1.0,
             gamma: 1.0,
-            soft_radius: 0,
             rgb: true,
             hdr: false,
             directions: false,

@@ -4,8 +4,9 @@
 use quake_formats::bsp::lightgrid::LightGrid;
 
 use crate::lightgrid::RawGrid;
+use crate::luxels::soften_luxels;
 use crate::output::{FaceLightmap, Outputs};
-use crate::settings::SettingWarning;
+use crate::settings::{SettingWarning, SoftRadius};
 use crate::trace::FaceLight;
 
 /// Counts and timings of a run (`--stats`).
@@ -79,8 +80,8 @@ pub struct Stats {
     pub rays_per_second: f64,
 }
 
-/// Lightmaps in light units, before the `--soft` filter and the conversion
-/// to bytes (so one tracing run can be finished more than one way).
+/// Lightmaps in light units, before the conversion to bytes (so one tracing run can be
+/// finished more than one way).
 #[derive(Debug, Clone)]
 pub struct RawLighting {
     /// Each lit face's light per luxel and style.
@@ -100,8 +101,9 @@ pub struct RawLighting {
     pub rangescale: f64,
     /// Gamma applied to the bytes (`_gamma`).
     pub gamma: f64,
-    /// `--soft`: the box filter's radius the run asks for.
-    pub soft_radius: usize,
+    /// `--soft` as the run was given it (its luxels are blurred already, except the
+    /// reference's: [`RawLighting::softened`] blurs those).
+    pub soft: SoftRadius,
     /// Worldspawn or command-line values light did not take as given.
     pub warnings: Vec<SettingWarning>,
     /// Counts and timings.
@@ -126,4 +128,23 @@ pub struct Lighting {
     pub warnings: Vec<SettingWarning>,
     /// Counts and timings.
     pub stats: Stats,
+}
+
+impl RawLighting {
+    /// The faces' light through the `--soft` blur of a run with `per_axis` samples along a
+    /// luxel's side (`None` when that run does not blur): to compare such a run with the
+    /// reference, which does not.
+    pub fn softened(&self, per_axis: usize) -> Option<RawLighting> {
+        let radius = self.soft.samples(per_axis);
+        if radius == 0 {
+            return None;
+        }
+        let mut soft = self.clone();
+        for face in &mut soft.faces {
+            for (_, luxels) in &mut face.styles {
+                *luxels = soften_luxels(luxels, face.width, per_axis, radius);
+            }
+        }
+        Some(soft)
+    }
 }

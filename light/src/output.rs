@@ -1,9 +1,7 @@
-//! From light units to the bytes engines read: the `--soft` filter, range scale, gamma, clamping,
-//! and the lighting lump with each face's `styles` and `light_offset`; beside it, as a run asks
+//! From light units to the bytes engines read: range scale, gamma, clamping, and the lighting
+//! lump with each face's `styles` and `light_offset`; beside it, as a run asks
 //! ([`Outputs`]), the `.lit` colour data, the `RGBLIGHTING`, `LIGHTINGDIR` and `LIGHTING_E5BGR9`
 //! lumps and the `.lux` and HDR `.lit` files.
-
-use std::borrow::Cow;
 
 use quake_formats::Bsp;
 use quake_formats::bsp::light_lumps::{
@@ -129,8 +127,6 @@ impl FaceLightmap {
 pub struct Finish {
     pub rangescale: f64,
     pub gamma: f64,
-    /// `--soft` box filter radius in luxels (0 = off).
-    pub soft_radius: usize,
     /// Keep each luxel's RGB bytes, not only their mean: the light is coloured (for a `.lit`)
     /// or RGB output is asked for.
     pub rgb: bool,
@@ -138,38 +134,6 @@ pub struct Finish {
     pub hdr: bool,
     /// Keep each luxel's direction bytes.
     pub directions: bool,
-}
-
-/// Averages each luxel with its neighbours within `radius` (staying inside the face's grid;
-/// radius 0 borrows the luxels as they are).
-pub fn soft_filter(
-    luxels: &[[f32; 3]],
-    width: usize,
-    height: usize,
-    radius: usize,
-) -> Cow<'_, [[f32; 3]]> {
-    debug_assert_eq!(luxels.len(), width * height);
-    if radius == 0 {
-        return Cow::Borrowed(luxels);
-    }
-    let mut out = Vec::with_capacity(luxels.len());
-    for y in 0..height {
-        for x in 0..width {
-            let mut acc = [0.0f32; 3];
-            let mut count = 0.0f32;
-            for ny in y.saturating_sub(radius)..(y + radius + 1).min(height) {
-                for nx in x.saturating_sub(radius)..(x + radius + 1).min(width) {
-                    let v = luxels[ny * width + nx];
-                    for c in 0..3 {
-                        acc[c] += v[c];
-                    }
-                    count += 1.0;
-                }
-            }
-            out.push(acc.map(|a| a / count));
-        }
-    }
-    Cow::Owned(out)
 }
 
 /// Light units to lightmap levels before clamping: range scale, then gamma.
@@ -258,21 +222,19 @@ pub fn finish_face_on_own_grid(
 
 /// Each style of `light` as bytes, in its order.
 fn style_maps(light: &FaceLight, finish: &Finish) -> Vec<StyleMap> {
-    let (w, h) = (light.width, light.height);
     let mut maps: Vec<StyleMap> = Vec::with_capacity(light.styles.len());
     for (style, luxels) in &light.styles {
-        let filtered = soft_filter(luxels, w, h, finish.soft_radius);
         // One pass, into buffers sized once: this runs for every luxel of the map.
-        let kept = |on: bool| if on { filtered.len() } else { 0 };
+        let kept = |on: bool| if on { luxels.len() } else { 0 };
         let mut map = StyleMap {
             style: *style,
-            grey: Vec::with_capacity(filtered.len()),
+            grey: Vec::with_capacity(luxels.len()),
             rgb: Vec::with_capacity(kept(finish.rgb)),
             hdr: Vec::with_capacity(kept(finish.hdr)),
             directions: Vec::new(),
             energy: 0,
         };
-        for &c in filtered.iter() {
+        for &c in luxels {
             let levels = to_levels(c, finish);
             let bytes = levels_to_bytes(levels);
             map.energy += bytes.iter().map(|&b| u64::from(b)).sum::<u64>();
@@ -287,7 +249,7 @@ fn style_maps(light: &FaceLight, finish: &Finish) -> Vec<StyleMap> {
         if finish.directions {
             map.directions = match light.directions.iter().find(|(s, _)| s == style) {
                 Some((_, d)) => d.iter().map(|&d| direction_bytes(d)).collect(),
-                None => vec![NO_DIRECTION; filtered.len()],
+                None => vec![NO_DIRECTION; luxels.len()],
             };
         }
         maps.push(map);
@@ -504,7 +466,6 @@ mod tests {
     const PLAIN: Finish = Finish {
         rangescale: 0.5,
         gamma: 1.0,
-        soft_radius: 0,
         rgb: true,
         hdr: false,
         directions: false,
@@ -534,16 +495,6 @@ mod tests {
             assert_eq!(round_non_negative(x), x.round(), "{x}");
         }
         assert_eq!(round_non_negative(f64::NAN) as u8, f64::NAN.round() as u8);
-    }
-
-    #[test]
-    fn soft_filter_averages_inside_the_grid() {
-        let mut l = vec![[0.0f32; 3]; 9];
-        l[4] = [9.0; 3];
-        let f = soft_filter(&l, 3, 3, 1);
-        assert_eq!(f[4], [1.0; 3]);
-        assert_eq!(f[0], [9.0 / 4.0; 3], "corner averages 4 luxels");
-        assert_eq!(soft_filter(&l, 3, 3, 0)[..], l[..]);
     }
 
     #[test]

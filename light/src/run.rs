@@ -19,6 +19,7 @@ use crate::faces::{FaceGeom, OwnGrid};
 use crate::lightgrid::{GridSources, RawGrid, finish_grid, trace_grid};
 use crate::lighting::{Lighting, RawLighting, Stats};
 use crate::lights::assign_switchable_styles;
+use crate::luxels::ToLuxels;
 use crate::options::Options;
 use crate::output::{self, Finish, Outputs, finish_face, finish_face_on_own_grid};
 use crate::phong;
@@ -36,8 +37,7 @@ use crate::trace::{
 /// # Errors
 /// A BSP light cannot read safely, bad entities or faces, or an Embree failure.
 pub fn compute_lighting(bsp: &Bsp, options: &Options) -> Result<Lighting, LightError> {
-    let raw = trace_lighting(bsp, options)?;
-    Ok(finish_lighting(&raw, raw.soft_radius))
+    Ok(finish_lighting(&trace_lighting(bsp, options)?))
 }
 
 /// Traces every lit face of `bsp` (or `options.only_faces`): light units per
@@ -64,7 +64,14 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
         stats.grid_rays = g.rays;
         stats.seconds_lightgrid = (grid_done - bounce_done).as_secs_f64();
     }
-    let (faces, own_grids) = finish_faces(traced, &bounced, &prep.faces);
+    let settings = &prep.lights.settings;
+    let to_luxels = match options.quality {
+        Quality::Reference => ToLuxels::OpenMeans,
+        q => ToLuxels::AsEricw {
+            soft_radius: settings.soft.samples(q.samples_per_axis()),
+        },
+    };
+    let (faces, own_grids) = finish_faces(traced, &bounced, &prep.faces, to_luxels);
     stats.luxels = faces.iter().map(|l| (l.width * l.height) as u64).sum();
     stats.faces_lit = faces.len();
     if plan.bouncing {
@@ -82,7 +89,6 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
     stats.seconds_total = start.elapsed().as_secs_f64();
     let rays = stats.shadow_rays + stats.sun_rays + stats.dirt_rays + stats.bounce_rays;
     stats.rays_per_second = rays as f64 / (stats.seconds_trace + stats.seconds_bounce).max(1e-9);
-    let settings = &prep.lights.settings;
     Ok(RawLighting {
         faces,
         own_grids,
@@ -92,7 +98,7 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
         grid,
         rangescale: settings.range,
         gamma: settings.gamma,
-        soft_radius: settings.soft,
+        soft: settings.soft,
         warnings: prep.lights.warnings.clone(),
         stats,
     })
@@ -335,6 +341,7 @@ fn finish_faces(
     traced: Vec<Traced>,
     bounced: &[StyleLuxels],
     geoms: &[FaceGeom],
+    to_luxels: ToLuxels,
 ) -> (Vec<FaceLight>, Vec<Option<OwnGridLight>>) {
     // Gathered first, into room for all, so no vector here grows in steps (each step takes
     // fresh pages) and the parallel collect knows its length.
@@ -353,7 +360,7 @@ fn finish_faces(
                 _ if !all_hidden(hidden) => HiddenLuxels::FromNeighbours,
                 _ => HiddenLuxels::Later,
             };
-            light.finish(bounce, fill)
+            light.finish(bounce, fill, to_luxels)
         })
         .collect();
     fill_hidden_luxels(&mut finished, &hidden, geoms);
@@ -608,15 +615,13 @@ fn phong_normals(samples: &FaceSamples, geom: &FaceGeom, corners: &[glam::DVec3]
         .collect()
 }
 
-/// Filters (`soft_radius`, the `--soft` box radius) and converts `raw` to
-/// lightmap bytes.
-pub fn finish_lighting(raw: &RawLighting, soft_radius: usize) -> Lighting {
+/// Converts `raw` to lightmap bytes.
+pub fn finish_lighting(raw: &RawLighting) -> Lighting {
     let start = Instant::now();
     let outputs = raw.outputs;
     let finish = Finish {
         rangescale: raw.rangescale,
         gamma: raw.gamma,
-        soft_radius,
         rgb: raw.coloured || outputs.rgb_lump,
         hdr: outputs.hdr(),
         directions: outputs.directions(),

@@ -2,6 +2,7 @@
 
 use crate::bytes::{PutLe, Reader, name16_to_string, string_to_name16};
 use crate::error::{FormatError, Result};
+use crate::palette::FIRST_FULLBRIGHT;
 
 /// Bytes of a miptex header: name, width, height and four mip offsets.
 pub const MIPTEX_HEADER_LEN: usize = 40;
@@ -29,6 +30,15 @@ impl MipTex {
             height,
             mips: Some(mips),
         }
+    }
+
+    /// Whether every texel is fullbright (palette index [`FIRST_FULLBRIGHT`] and up), so engines
+    /// draw the texture without its face's lightmap (a light fixture's); `false` for a texture
+    /// stored without pixels.
+    pub fn is_all_fullbright(&self) -> bool {
+        self.mips
+            .as_ref()
+            .is_some_and(|m| !m[0].is_empty() && m[0].iter().all(|&i| i >= FIRST_FULLBRIGHT))
     }
 
     /// The name up to its first NUL, read as Latin-1.
@@ -183,5 +193,22 @@ impl TextureLump {
             t.as_ref()
                 .is_some_and(|t| t.name().eq_ignore_ascii_case(name))
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_texture_is_all_fullbright_only_when_every_texel_of_its_first_mip_is() {
+        let mips = |top: Vec<u8>| [top, vec![0; 4], vec![0], vec![0]];
+        let lamp = MipTex::new("light1", 4, 4, mips(vec![FIRST_FULLBRIGHT; 16]));
+        assert!(lamp.is_all_fullbright());
+        let mut lit = vec![FIRST_FULLBRIGHT; 16];
+        lit[5] = FIRST_FULLBRIGHT - 1;
+        assert!(!MipTex::new("light2", 4, 4, mips(lit)).is_all_fullbright());
+        let external = MipTex { mips: None, ..lamp };
+        assert!(!external.is_all_fullbright());
     }
 }

@@ -229,7 +229,7 @@ fn reference(
         path: path.to_path_buf(),
         source,
     })?;
-    Ok((finish_lighting(&raw, 0), start.elapsed().as_secs_f64()))
+    Ok((finish_lighting(&raw), start.elapsed().as_secs_f64()))
 }
 
 /// A lit BSP's light against light's reference, in 8-bit grey levels.

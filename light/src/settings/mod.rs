@@ -23,11 +23,13 @@ pub use declare::Setting;
 use declare::settings;
 use resolve::{Declared, given, resolve};
 pub use resolve::{Given, SettingWarning, World};
-pub use value::{Color, DirtToggle, Range, SettingValue, Spacing, normalize_color};
+pub use value::{Color, DirtToggle, Range, SettingValue, SoftRadius, Spacing, normalize_color};
 
 settings! {
-    /// Average each luxel with its neighbours within N luxels (`--soft` alone: 1).
-    soft: usize = 0, flag "soft" missing "1", keys [], range Range::Any;
+    /// Blur the light over N samples each way before samples are averaged to luxels, as
+    /// ericw-tools does (`--soft` alone, or -1: half the samples along a luxel's side, which is
+    /// 2 with `--extra4`, 1 with `--extra` and no blur with one sample a luxel).
+    soft: SoftRadius = SoftRadius::Samples(0), flag "soft" missing "-1", keys [], range Range::Any;
 
     /// Light contributions below this many light units count as zero.
     gate: f64 = 0.001, flag "gate", keys [], range Range::Any;

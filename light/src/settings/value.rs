@@ -291,6 +291,44 @@ impl SettingValue for DirtToggle {
     }
 }
 
+/// The `--soft` blur's radius, in samples of the face's oversampled grid.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SoftRadius {
+    /// This many samples each way (0: no blur).
+    Samples(usize),
+    /// `-1` (`--soft` alone): half the samples along a luxel's side, as ericw-tools takes it
+    /// (`--extra`: 1, `--extra4`: 2, one sample a luxel: no blur).
+    HalfLuxel,
+}
+
+impl SoftRadius {
+    /// The radius in samples with `per_axis` samples along a luxel's side.
+    pub fn samples(self, per_axis: usize) -> usize {
+        match self {
+            SoftRadius::Samples(n) => n,
+            SoftRadius::HalfLuxel => per_axis / 2,
+        }
+    }
+}
+
+impl SettingValue for SoftRadius {
+    fn read(text: &str) -> Option<Result<SoftRadius, &'static str>> {
+        const WANT: &str = "-1 or a whole number, 0 or more";
+        Some(number(text)?.map_err(|_| WANT).and_then(|x| match x {
+            -1.0 => Ok(SoftRadius::HalfLuxel),
+            x if x >= 0.0 && x.fract() == 0.0 => Ok(SoftRadius::Samples(x as usize)),
+            _ => Err(WANT),
+        }))
+    }
+
+    fn show(&self) -> String {
+        match self {
+            SoftRadius::Samples(n) => n.to_string(),
+            SoftRadius::HalfLuxel => "-1 (half a luxel)".to_string(),
+        }
+    }
+}
+
 /// `1` random, any other number ordered.
 impl SettingValue for DirtMode {
     fn read(text: &str) -> Option<Result<DirtMode, &'static str>> {
@@ -329,6 +367,11 @@ mod tests {
         assert_eq!(bool::read("-1"), Some(Ok(false)));
         assert_eq!(DirtToggle::read("-1"), Some(Ok(DirtToggle::Off)));
         assert_eq!(DirtToggle::read("0"), Some(Ok(DirtToggle::AsDirt)));
+        assert_eq!(SoftRadius::read("-1"), Some(Ok(SoftRadius::HalfLuxel)));
+        assert_eq!(SoftRadius::read("3"), Some(Ok(SoftRadius::Samples(3))));
+        assert!(matches!(SoftRadius::read("-2"), Some(Err(_))));
+        assert_eq!(SoftRadius::HalfLuxel.samples(4), 2);
+        assert_eq!(SoftRadius::HalfLuxel.samples(1), 0);
         assert_eq!(
             Color::read("255 128 0 9"),
             Some(Ok(Color(DVec3::new(1.0, 128.0 / 255.0, 0.0))))

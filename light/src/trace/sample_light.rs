@@ -6,6 +6,7 @@
 use glam::{DMat3, DVec3, Vec3};
 
 use super::FaceLight;
+use crate::luxels::{ToLuxels, ericw_luxels};
 
 /// Per-sample buffers, one per style (style 0 always present and first).
 #[derive(Debug)]
@@ -147,9 +148,8 @@ fn luxel_means(values: Vec<[f32; 3]>, per: usize) -> Vec<[f32; 3]> {
 /// What a luxel whose every sample is occluded takes when its face is finished.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum HiddenLuxels {
-    /// The mean of its neighbours that have light (over and over, until every luxel has a
-    /// value), as ericw-tools fills a world face's; a face with every sample occluded keeps the
-    /// means of all of them.
+    /// Its neighbours' light, as [`ToLuxels`] fills it (ericw-tools fills a world face's so);
+    /// a face with every sample occluded keeps the means of all of them.
     FromNeighbours,
     /// Nothing yet (zero): a brush model's are filled from the whole model afterwards.
     Later,
@@ -258,9 +258,14 @@ impl SampleLight {
 
     /// Adds `bounce` (per style, per luxel (given to each of the luxel's
     /// samples) or per sample, times each sample's dirt factor), applies
-    /// minlight and the floors, and averages samples to luxels, filling luxels whose every
-    /// sample is occluded as `hidden` says.
-    pub fn finish(mut self, bounce: &[(u8, Vec<[f32; 3]>)], hidden: HiddenLuxels) -> FaceLight {
+    /// minlight and the floors, and turns samples into luxels as `to_luxels` says, filling
+    /// luxels whose every sample is occluded as `hidden` says.
+    pub fn finish(
+        mut self,
+        bounce: &[(u8, Vec<[f32; 3]>)],
+        hidden: HiddenLuxels,
+        to_luxels: ToLuxels,
+    ) -> FaceLight {
         let per = self.per_luxel;
         if let Some(min) = &self.added_minlight {
             for (s, m) in self.sums.get(0).iter_mut().zip(min) {
@@ -292,12 +297,20 @@ impl SampleLight {
             }
         }
         let (occluded, width) = (&self.occluded, self.width);
+        let per_axis = per.isqrt();
         let styles = self
             .sums
             .styles
             .into_iter()
             .map(|(style, values)| {
-                let means = open_luxel_means(values, per, occluded, width, hidden);
+                let means = match (to_luxels, hidden) {
+                    (ToLuxels::AsEricw { soft_radius }, HiddenLuxels::FromNeighbours)
+                        if soft_radius > 0 || occluded.contains(&true) =>
+                    {
+                        ericw_luxels(&values, occluded, width, per_axis, soft_radius)
+                    }
+                    _ => open_luxel_means(values, per, occluded, width, hidden),
+                };
                 (style, means)
             })
             .collect();

@@ -434,6 +434,15 @@ impl Bsp {
         self.entities.push(0);
     }
 
+    /// The texture `face` is drawn with, when its texinfo and texture are there.
+    pub fn face_texture(&self, face: &Face) -> Option<&crate::miptex::MipTex> {
+        let texinfo = self.texinfo.get(face.texinfo as usize)?;
+        self.textures
+            .textures
+            .get(texinfo.miptex as usize)?
+            .as_ref()
+    }
+
     /// The vertices of a face in winding order (edges followed by their direction).
     /// Indices are bounds-checked; a broken face yields `None`.
     pub fn face_vertices(&self, face: &Face) -> Option<Vec<[f32; 3]>> {
