@@ -1,8 +1,8 @@
 //! End-to-end: maps compiled by Slipgate, played in real engines with real game code.
 //!
 //! Every project map (`maps/*.map`, `maps/test/`, `maps/leak/sealed.map`, the compiler's test maps, `demo.map` again as
-//! BSP2, and the `maps/hard/` maps that compile) and, in the release run (`--ignored`), every
-//! corpus map, goes through `slipgate bsp`, `vis` and `light` (`support/maps.rs`), then into
+//! BSP2, and the `maps/hard/` maps that compile) and, with `--include-ignored`, every corpus
+//! map, goes through `slipgate bsp`, `vis` and `light` (`support/maps.rs`), then into
 //! QuakeSpasm and DarkPlaces with LibreQuake's game code from `../shared/engine`
 //! (`support/engines.rs`): each engine's dedicated server spawns the map and runs five seconds of
 //! game time, then its client plays it from the player start (god mode, every weapon, walking,
