@@ -51,8 +51,9 @@ pub struct FaceGeom {
     /// Offset from model space to world space.
     pub origin: DVec3,
     pub extents: LightmapExtents,
-    /// The lit faces of the same model on the same plane that share an edge with this one, as
-    /// polygons: where a luxel past this face's edge finds the surface it stands over.
+    /// The lit faces of the same model on the same plane reached from this one across at most
+    /// [`CONTINUATION_HOPS`] shared edges, as polygons: where a luxel past this face's edge
+    /// finds the surface it stands over.
     pub continuations: Vec<Vec<DVec3>>,
     /// The grid light samples the face on: Quake's 16-texel one over `extents`, or its own.
     pub grid: LuxelGrid,
@@ -218,8 +219,12 @@ pub fn face_geometry(
 /// Corners closer than this (units) are the same corner.
 const SAME_CORNER: f64 = 0.01;
 
+/// How many shared edges a sample past a face's edge may cross to the faces continuing it on
+/// its plane (ericw-tools follows a point across at most three).
+pub const CONTINUATION_HOPS: usize = 3;
+
 /// Fills each lit face's [`FaceGeom::continuations`]: the lit faces of its model on its plane
-/// that share one of its edges.
+/// reached across at most [`CONTINUATION_HOPS`] shared edges.
 fn link_continuations(faces: &mut [FaceGeom]) {
     let key = |p: DVec3| (p / SAME_CORNER).round().as_i64vec3().to_array();
     let mut by_edge: HashMap<([i64; 3], [i64; 3]), Vec<usize>> = HashMap::new();
@@ -237,7 +242,7 @@ fn link_continuations(faces: &mut [FaceGeom]) {
             && a.plane.normal.dot(b.plane.normal) > 1.0 - 1e-6
             && (a.plane.dist - b.plane.dist).abs() < SAME_CORNER
     };
-    let found: Vec<Vec<usize>> = faces
+    let beside: Vec<Vec<usize>> = faces
         .iter()
         .map(|f| {
             if f.kind != FaceKind::Lit {
@@ -256,8 +261,22 @@ fn link_continuations(faces: &mut [FaceGeom]) {
             next
         })
         .collect();
-    for (f, next) in found.into_iter().enumerate() {
-        faces[f].continuations = next.iter().map(|&g| faces[g].points.clone()).collect();
+    for f in 0..faces.len() {
+        let mut reached = vec![f];
+        let mut ring = vec![f];
+        for _ in 0..CONTINUATION_HOPS {
+            ring = ring.iter().flat_map(|&g| &beside[g]).copied().collect();
+            ring.sort_unstable();
+            ring.dedup();
+            ring.retain(|g| !reached.contains(g));
+            reached.extend(&ring);
+        }
+        reached.sort_unstable();
+        faces[f].continuations = reached
+            .into_iter()
+            .filter(|&g| g != f)
+            .map(|g| faces[g].points.clone())
+            .collect();
     }
 }
 

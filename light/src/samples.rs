@@ -5,7 +5,7 @@
 //! world-aligned, or another power of two texels), or `n x n` per luxel when
 //! supersampling, found by inverting the grid's projection onto the face's
 //! plane. A point past the face's edge that lands on a face continuing it (same
-//! model, same plane, a shared edge) stays there. Another point outside the face
+//! model, same plane, at most three shared edges away) stays there. Another point outside the face
 //! (a luxel past its edge, e.g. under a wall standing on a floor) moves to the
 //! nearest point of the face's outline, unless that is more than a luxel away (the far
 //! corners of a triangle's lightmap, which no pixel shows): such a point is occluded.

@@ -317,6 +317,32 @@ fn samples_past_an_edge_land_on_the_face_that_continues_it() {
     assert!(over_rest.iter().all(|p| p[1] == 16.0 && p[2] == 1.0));
 }
 
+/// Regression: only a face sharing an edge counted as continuing one, so a luxel past a thin
+/// strip, over a face two edges away, was moved back onto the strip; ericw-tools follows the
+/// point across up to three faces of the plane.
+#[test]
+fn samples_past_an_edge_follow_the_plane_across_faces() {
+    let strip = |y0: f32, y1: f32| {
+        quad(
+            [0.0, y0, 0.0],
+            [0.0, y1, 0.0],
+            [256.0, y1, 0.0],
+            [256.0, y0, 0.0],
+            [0.0, 0.0, 1.0],
+        )
+    };
+    let polys = [strip(0.0, 4.0), strip(4.0, 8.0), strip(8.0, 256.0)];
+    let bsp = synthetic_bsp(&polys, "{ \"classname\" \"worldspawn\" }");
+    let faces = face_geometry(&bsp, |_| DVec3::ZERO, |_| Spacing::Quake).expect("faces");
+    assert_eq!(faces[0].continuations.len(), 2);
+    let (samples, _) = face_samples(&faces[0], 1, &bsp);
+    // Luxel rows at y 0 and 16: the second stands over the third face and stays there.
+    assert_eq!(samples.height, 2);
+    let far: Vec<&[f32; 3]> = samples.points.iter().filter(|p| p[1] > 8.0).collect();
+    assert_eq!(far.len(), samples.width, "{:?}", samples.points);
+    assert!(far.iter().all(|p| p[1] == 16.0 && p[2] == 1.0));
+}
+
 #[test]
 fn sample_points_invert_an_angled_projection() {
     // A sloped face with a skewed, off-grid texture projection.
@@ -556,9 +582,11 @@ fn corpus_bsp(path: &str) -> Option<Bsp> {
     Some(Bsp::read(&data).expect("read"))
 }
 
-/// Default against reference on a sample of start.bsp's faces, leaving out those whose
-/// texture is fullbright in every texel (engines draw them without their lightmap). Slow in
-/// debug builds: `cargo test -p slipgate-light --release -- --ignored`.
+/// Default against reference on a sample of start.bsp's faces, leaving out those engines do not
+/// draw lit: faces whose texture is fullbright in every texel, and faces whose middle stands in
+/// solid or sky (the walls inside its sky brushes). On those the reference measures only the
+/// few of its 256 points per luxel that a nudge frees into a room beside. Slow in debug builds:
+/// `cargo test -p slipgate-light --release -- --ignored`.
 #[test]
 #[ignore = "slow: run with --release -- --ignored"]
 fn start_bsp_default_against_reference() {
@@ -566,8 +594,20 @@ fn start_bsp_default_against_reference() {
         return;
     };
     let drawn_lit = |&i: &usize| {
-        !bsp.face_texture(&bsp.faces[i])
+        let face = &bsp.faces[i];
+        let Some(points) = bsp.face_vertices(face) else {
+            return false;
+        };
+        let plane = &bsp.planes[face.plane as usize];
+        let side = if face.side == 0 { 1.0 } else { -1.0 };
+        let middle = points
+            .iter()
+            .fold(DVec3::ZERO, |m, p| m + Vec3::from(*p).as_dvec3())
+            / points.len() as f64;
+        let front = middle + Vec3::from(plane.normal).as_dvec3() * side;
+        !bsp.face_texture(face)
             .is_some_and(quake_formats::miptex::MipTex::is_all_fullbright)
+            && !crate::samples::solid_at(&bsp, front.as_vec3().to_array())
     };
     let only: Vec<usize> = (0..bsp.faces.len()).step_by(8).filter(drawn_lit).collect();
     let run = |quality| {
@@ -586,10 +626,9 @@ fn start_bsp_default_against_reference() {
     // Samples stand where ericw-tools puts them: one per luxel, on the face's edge or nudged
     // half a unit out of solid beside it. The largest differences are where that one point
     // takes a light a few units away (the `_surface` copies beside start's fixtures) or
-    // misses it, and on the 16-unit strips at the tops of its walls, where the reference's
-    // 256 points per luxel find light that one point, 16 points and ericw-tools do not.
-    assert!(e.rmse < 11.0, "{e:?}");
-    assert!(e4.rmse < 5.2, "{e4:?}");
+    // misses it.
+    assert!(e.rmse < 10.0, "{e:?}");
+    assert!(e4.rmse < 4.2, "{e4:?}");
     assert!(e4.rmse < e.rmse, "{e4:?} {e:?}");
 }
 
