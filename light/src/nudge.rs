@@ -3,26 +3,23 @@
 //! inside a wall, which light nothing where they stand (their rays start in solid, or below the
 //! samples, which sit a unit off their faces).
 //!
-//! A light counts as in solid when the world's tree puts it in a solid leaf, a point on a plane
-//! going to the plane's back: so a light on a floor is in the floor. It moves [`NUDGE`] units
+//! A light counts as in solid as a sample point does (`samples::solid_at`): in a solid or sky
+//! leaf of the world, or within `ON_PLANE` of a node's plane with solid on either side, so a
+//! light on a floor or on a ceiling is in it. It moves [`NUDGE`] units
 //! along the first axis direction (−x, +x, −y, +y, −z, +z) that leaves it in the open; a light
 //! that no such step frees stays where it is, with a warning. `_nonudge 1` keeps a light where
 //! the mapper put it.
 
 use glam::DVec3;
 use quake_formats::Bsp;
-use quake_formats::bsp::contents;
 
 use crate::lights::PointLight;
 
 /// How far a light is moved: past the samples, which sit one unit off their faces.
 pub const NUDGE: f64 = 2.0;
 
-/// Whether `p` is in the world's solid, points on a node's plane taken to its back.
 fn in_solid(bsp: &Bsp, p: DVec3) -> bool {
-    bsp.leaf_at_behind_planes(p.as_vec3().to_array())
-        .and_then(|leaf| bsp.leafs.get(leaf))
-        .is_some_and(|l| l.contents == contents::SOLID)
+    crate::samples::solid_at(bsp, p.as_vec3().to_array())
 }
 
 /// The first step from `origin` that lies in the open, if any.

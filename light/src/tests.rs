@@ -1285,14 +1285,14 @@ fn the_luxel_behind_a_wall_fixture_is_lit_as_in_ericw_tools() {
 /// `_nonudge 1` neither does.
 #[test]
 fn lights_on_or_in_a_floor_are_moved_out_and_light_it() {
-    let floor_mean = |light_keys: &str| {
+    let mean_of = |light_keys: &str, side: f64| {
         let bsp = room_bsp(&format!("{{\n\"classname\" \"light\"\n{light_keys}\n}}\n"));
         let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
         let prep = crate::prepare::prepare(&bsp, &Options::default()).expect("prepare");
         let floors: Vec<usize> = prep
             .faces
             .iter()
-            .filter(|f| f.plane.normal.z > 0.99 && f.centroid().z < -127.0)
+            .filter(|f| f.plane.normal.z * side > 0.99 && f.centroid().z * side < -127.0)
             .map(|f| f.index)
             .collect();
         let bytes: Vec<u8> = lighting
@@ -1306,6 +1306,7 @@ fn lights_on_or_in_a_floor_are_moved_out_and_light_it() {
             bytes.iter().map(|&b| f64::from(b)).sum::<f64>() / bytes.len().max(1) as f64,
         )
     };
+    let floor_mean = |light_keys: &str| mean_of(light_keys, 1.0);
     let above = floor_mean("\"origin\" \"0 0 -126\"");
     assert_eq!(above.0, 0);
     for sunk in ["\"origin\" \"0 0 -128\"", "\"origin\" \"0 0 -129\""] {
@@ -1315,6 +1316,11 @@ fn lights_on_or_in_a_floor_are_moved_out_and_light_it() {
     }
     let kept = floor_mean("\"origin\" \"0 0 -129\"\n\"_nonudge\" \"1\"");
     assert_eq!(kept, (0, 0.0));
+    // Regression: a light on a ceiling (the back of its plane, as Quake stores it, is the
+    // room) was taken to be in the open, stayed level with the ceiling and lit none of it.
+    let (moved, ceiling) = mean_of("\"origin\" \"0 0 128\"", -1.0);
+    assert_eq!(moved, 1);
+    assert!(ceiling > above.1 * 0.8, "{ceiling} against {}", above.1);
 }
 
 /// The light on the floor's luxel under the middle of [`slab_bsp`]'s slab.
