@@ -145,13 +145,24 @@ pub(crate) fn to_levels(c: [f32; 3], finish: &Finish) -> [f64; 3] {
     v.map(|x| 255.0 * (x / 255.0).powf(1.0 / finish.gamma))
 }
 
-/// Lightmap levels to bytes: all channels scaled down together if the brightest exceeds 255.
-pub(crate) fn levels_to_bytes(mut v: [f64; 3]) -> [u8; 3] {
+/// Lightmap levels with all channels scaled down together if the brightest exceeds 255.
+fn clamped(v: [f64; 3]) -> [f64; 3] {
     let max = v[0].max(v[1]).max(v[2]);
     if max > 255.0 {
-        v = v.map(|x| x * 255.0 / max);
+        v.map(|x| x * 255.0 / max)
+    } else {
+        v
     }
-    v.map(|x| round_non_negative(x).clamp(0.0, 255.0) as u8)
+}
+
+/// Lightmap levels to bytes ([`clamped`], then rounded).
+pub(crate) fn levels_to_bytes(v: [f64; 3]) -> [u8; 3] {
+    clamped(v).map(|x| round_non_negative(x).clamp(0.0, 255.0) as u8)
+}
+
+/// The mean of a luxel's clamped channel levels.
+fn brightness(v: [f64; 3]) -> f64 {
+    clamped(v).iter().sum::<f64>() / 3.0
 }
 
 /// `x.round()` for `x` in 0..2^32 (NaN gives 0, as `round` then `as u8` do): `f64::round`
@@ -176,7 +187,8 @@ fn direction_bytes(d: [f32; 3]) -> [u8; 3] {
 }
 
 /// One style's lightmap of a face: its style, grey and (when kept) RGB, HDR and direction
-/// bytes, and the sum of its channel bytes (0: dark all over).
+/// bytes, the sum of its channel bytes, and the brightness (mean channel level, before
+/// rounding) of its brightest luxel.
 struct StyleMap {
     style: u8,
     grey: Vec<u8>,
@@ -184,7 +196,12 @@ struct StyleMap {
     hdr: Vec<u32>,
     directions: Vec<[u8; 3]>,
     energy: u64,
+    brightest: f64,
 }
+
+/// A style whose brightest luxel is dimmer than this many levels is not written, as
+/// ericw-tools leaves it out: it would round to a lightmap of zeros and ones.
+const DIMMEST_KEPT: f64 = 1.0;
 
 /// Finishes one face. Returns the lightmap and how many styles were dropped
 /// for exceeding four.
@@ -233,9 +250,11 @@ fn style_maps(light: &FaceLight, finish: &Finish) -> Vec<StyleMap> {
             hdr: Vec::with_capacity(kept(finish.hdr)),
             directions: Vec::new(),
             energy: 0,
+            brightest: 0.0,
         };
         for &c in luxels {
             let levels = to_levels(c, finish);
+            map.brightest = map.brightest.max(brightness(levels));
             let bytes = levels_to_bytes(levels);
             map.energy += bytes.iter().map(|&b| u64::from(b)).sum::<u64>();
             map.grey.push(grey_level(bytes));
@@ -257,12 +276,15 @@ fn style_maps(light: &FaceLight, finish: &Finish) -> Vec<StyleMap> {
     maps
 }
 
-/// The styles a face keeps of `maps`: those lit anywhere, brightest first, four at most, as
-/// ericw-tools keeps them (a style dark all over is not written, style 0 included: a face
-/// with none gets no lightmap, style 255 and no light offset). Also says how many lit styles
-/// were dropped.
+/// The styles a face keeps of `maps`: those lit anywhere (a luxel [`DIMMEST_KEPT`] or
+/// brighter), brightest first, four at most, as ericw-tools keeps them (a style dark all over
+/// is not written, style 0 included: a face with none gets no lightmap, style 255 and no light
+/// offset). Also says how many lit styles were dropped.
 fn keep_styles(maps: Vec<StyleMap>) -> (Vec<StyleMap>, usize) {
-    let mut maps: Vec<StyleMap> = maps.into_iter().filter(|m| m.energy > 0).collect();
+    let mut maps: Vec<StyleMap> = maps
+        .into_iter()
+        .filter(|m| m.brightest >= DIMMEST_KEPT)
+        .collect();
     maps.sort_by_key(|m| std::cmp::Reverse(m.energy));
     let dropped = maps.len().saturating_sub(MAX_LIGHTMAPS);
     maps.truncate(MAX_LIGHTMAPS);
@@ -518,6 +540,24 @@ mod tests {
             dropped, 1,
             "one lit style over the limit (the dark ones are not counted)"
         );
+    }
+
+    /// Regression: a style whose brightest luxel was under one level but rounded to a byte of 1
+    /// was written; ericw-tools leaves such a style out.
+    #[test]
+    fn a_style_dimmer_than_one_level_is_not_written() {
+        let face = |units: f32| FaceLight {
+            face: 0,
+            width: 2,
+            height: 1,
+            styles: vec![(0, vec![[units; 3], [0.0; 3]])],
+            directions: Vec::new(),
+        };
+        // Half a light unit per level (PLAIN's range).
+        let (dim, _) = finish_face(&face(1.8), &PLAIN);
+        assert!(dim.styles.is_empty(), "{:?}", dim.grey);
+        let (lit, _) = finish_face(&face(2.0), &PLAIN);
+        assert_eq!((lit.styles, lit.grey), (vec![0], vec![vec![1, 0]]));
     }
 
     /// Regression: a face no light reaches was written as style 0 with a lightmap of zeros;
