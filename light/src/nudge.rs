@@ -6,9 +6,11 @@
 //! A light counts as in solid as a sample point does (`samples::solid_at`): in a solid or sky
 //! leaf of the world, or within `ON_PLANE` of a node's plane with solid on either side, so a
 //! light on a floor or on a ceiling is in it. It moves [`NUDGE`] units
-//! along the first axis direction (−x, +x, −y, +y, −z, +z) that leaves it in the open; a light
-//! that no such step frees stays where it is, with a warning. `_nonudge 1` keeps a light where
-//! the mapper put it.
+//! along the first axis direction (−x, +x, −y, +y, −z, +z) that leaves it in the open. A light
+//! that no such step frees is dropped, with a warning: it lights nothing in ericw-tools, whose
+//! shadow rays meet the outside of the solid it is in, while ours, cast from the light, would
+//! leave that solid through its faces' backs and light the room around it. `_nonudge 1` keeps a
+//! light where the mapper put it.
 
 use glam::DVec3;
 use quake_formats::Bsp;
@@ -36,28 +38,29 @@ fn nudged(bsp: &Bsp, origin: DVec3) -> Option<DVec3> {
 pub struct Nudges {
     /// Lights moved.
     pub moved: usize,
-    /// Entity indices of lights in solid that no step frees.
+    /// Entity indices of lights in solid that no step frees (dropped).
     pub stuck: Vec<usize>,
 }
 
 /// Moves every light of `lights` (but those of the entities in `keep`, and those that give no
-/// light) out of solid; see the module comment.
-pub fn nudge_out_of_solid(bsp: &Bsp, lights: &mut [PointLight], keep: &[usize]) -> Nudges {
+/// light) out of solid, and drops those no step frees; see the module comment.
+pub fn nudge_out_of_solid(bsp: &Bsp, lights: &mut Vec<PointLight>, keep: &[usize]) -> Nudges {
     let mut out = Nudges::default();
-    for light in lights
-        .iter_mut()
-        .filter(|l| l.light != 0.0 && !keep.contains(&l.entity))
-    {
-        if !in_solid(bsp, light.origin) {
-            continue;
+    lights.retain_mut(|light| {
+        if light.light == 0.0 || keep.contains(&light.entity) || !in_solid(bsp, light.origin) {
+            return true;
         }
         match nudged(bsp, light.origin) {
             Some(p) => {
                 light.origin = p;
                 out.moved += 1;
+                true
             }
-            None => out.stuck.push(light.entity),
+            None => {
+                out.stuck.push(light.entity);
+                false
+            }
         }
-    }
+    });
     out
 }

@@ -1323,6 +1323,31 @@ fn lights_on_or_in_a_floor_are_moved_out_and_light_it() {
     assert!(ceiling > above.1 * 0.8, "{ceiling} against {}", above.1);
 }
 
+/// Regression: a light in solid that no step of the nudge frees (here in a room's corner, on
+/// three walls) lit the room, its rays leaving the solid through the backs of its faces, though
+/// the warning said it lit nothing; in ericw-tools it lights nothing, and now it is dropped.
+#[test]
+fn a_light_stuck_in_solid_lights_nothing() {
+    let light = "{\n\"classname\" \"light\"\n\"origin\" \"-128 -128 -128\"\n}\n";
+    let bsp = room_bsp(light);
+    let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
+    let lit: Vec<usize> = lighting
+        .lightmaps
+        .iter()
+        .filter(|m| !m.styles.is_empty())
+        .map(|m| m.face)
+        .collect();
+    assert!(lit.is_empty(), "faces lit: {lit:?}");
+    assert!(
+        lighting
+            .warnings
+            .iter()
+            .any(|w| w.problem.contains("in solid")),
+        "{:?}",
+        lighting.warnings
+    );
+}
+
 /// The light on the floor's luxel under the middle of [`slab_bsp`]'s slab.
 fn floor_under_slab(bsp: &Bsp) -> u8 {
     floor_under_slab_in(bsp, 0)
