@@ -29,7 +29,8 @@ pub struct BuildArgs {
     /// Light with 4x4 samples per luxel
     #[arg(long)]
     extra4: bool,
-    /// Filter lightmaps so shadow edges do not stair-step
+    /// Blur the light over half a luxel's samples so shadow edges do not stair-step (light's
+    /// --soft: with --extra or --extra4; one sample a luxel has nothing to blur)
     #[arg(long)]
     soft: bool,
     /// Ambient occlusion ("dirt") on every light
