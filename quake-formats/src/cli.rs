@@ -111,7 +111,9 @@ pub fn join_optional_values(
     // Numbers the last option may still take.
     let mut open = 0;
     for a in args {
-        let number = !a.is_empty() && a.chars().all(|c| c.is_ascii_digit() || c == '.');
+        // A minus sign may lead: `--soft -1` is ericw-tools' "half a luxel".
+        let digits = a.strip_prefix('-').unwrap_or(&a);
+        let number = !digits.is_empty() && digits.chars().all(|c| c.is_ascii_digit() || c == '.');
         match out.last_mut() {
             Some(prev) if open > 0 && number => {
                 prev.push(if prev.contains('=') { ' ' } else { '=' });
@@ -146,6 +148,9 @@ mod tests {
         let three = ["light", "--dist", "16", "16", "32.5", "7", "x.bsp"];
         let out = join_optional_values(three.iter().map(|s| s.to_string()), &options);
         assert_eq!(out, ["light", "--dist=16 16 32.5", "7", "x.bsp"]);
+        let negative = ["light", "--soft", "-1", "x.bsp"];
+        let out = join_optional_values(negative.iter().map(|s| s.to_string()), &options);
+        assert_eq!(out, ["light", "--soft=-1", "x.bsp"]);
     }
 
     #[test]
