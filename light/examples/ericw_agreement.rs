@@ -135,10 +135,7 @@ fn describe(bsp: &Bsp, models: &[usize], face: usize) -> String {
         [s[0] / n, s[1] / n, s[2] / n]
     });
     let texture = bsp
-        .texinfo
-        .get(f.texinfo as usize)
-        .and_then(|ti| bsp.textures.textures.get(ti.miptex as usize))
-        .and_then(Option::as_ref)
+        .face_texture(f)
         .map_or_else(|| "?".to_string(), |t| t.name());
     format!(
         "face {face} (model {}, {texture}) at ({:.0} {:.0} {:.0})",

@@ -20,6 +20,7 @@ use crate::lights::PointLight;
 /// How far a light is moved: past the samples, which sit one unit off their faces.
 pub const NUDGE: f64 = 2.0;
 
+/// Whether a light at `p` is in solid: the sample points' test, ericw-tools' for lights too.
 fn in_solid(bsp: &Bsp, p: DVec3) -> bool {
     crate::samples::solid_at(bsp, p.as_vec3().to_array())
 }

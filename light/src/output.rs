@@ -157,12 +157,12 @@ fn clamped(v: [f64; 3]) -> [f64; 3] {
 
 /// Lightmap levels to bytes ([`clamped`], then rounded).
 pub(crate) fn levels_to_bytes(v: [f64; 3]) -> [u8; 3] {
-    clamped(v).map(|x| round_non_negative(x).clamp(0.0, 255.0) as u8)
+    clamped(v).map(to_byte)
 }
 
-/// The mean of a luxel's clamped channel levels.
-fn brightness(v: [f64; 3]) -> f64 {
-    clamped(v).iter().sum::<f64>() / 3.0
+/// A clamped level as its byte.
+fn to_byte(x: f64) -> u8 {
+    round_non_negative(x).clamp(0.0, 255.0) as u8
 }
 
 /// `x.round()` for `x` in 0..2^32 (NaN gives 0, as `round` then `as u8` do): `f64::round`
@@ -254,8 +254,9 @@ fn style_maps(light: &FaceLight, finish: &Finish) -> Vec<StyleMap> {
         };
         for &c in luxels {
             let levels = to_levels(c, finish);
-            map.brightest = map.brightest.max(brightness(levels));
-            let bytes = levels_to_bytes(levels);
+            let shown = clamped(levels);
+            map.brightest = map.brightest.max(shown.iter().sum::<f64>() / 3.0);
+            let bytes = shown.map(to_byte);
             map.energy += bytes.iter().map(|&b| u64::from(b)).sum::<u64>();
             map.grey.push(grey_level(bytes));
             if finish.rgb {

@@ -293,28 +293,37 @@ fn samples_by_a_wall_stay_on_their_side_and_do_not_bleed() {
     );
 }
 
+/// A floor strip 256 units long, from y `y0` to `y1`.
+fn floor_strip(y0: f32, y1: f32) -> Poly {
+    quad(
+        [0.0, y0, 0.0],
+        [0.0, y1, 0.0],
+        [256.0, y1, 0.0],
+        [256.0, y0, 0.0],
+        [0.0, 0.0, 1.0],
+    )
+}
+
+/// The floor strips `polys` (the first from y 0, under 16 wide) as one plane: how many faces
+/// continue the first, and whether its second luxel row (at y 16, past its edge) stays where
+/// the grid puts it, over the face there.
+fn second_row_over_the_plane(polys: &[Poly]) -> (usize, bool) {
+    let bsp = synthetic_bsp(polys, "{ \"classname\" \"worldspawn\" }");
+    let faces = face_geometry(&bsp, |_| DVec3::ZERO, |_| Spacing::Quake).expect("faces");
+    let (samples, _) = face_samples(&faces[0], 1, &bsp);
+    assert_eq!(samples.height, 2);
+    let past: Vec<&[f32; 3]> = samples.points.iter().filter(|p| p[1] > 8.0).collect();
+    let stays = past.len() == samples.width && past.iter().all(|p| p[1] == 16.0 && p[2] == 1.0);
+    (faces[0].continuations.len(), stays)
+}
+
 /// Regression: a luxel past a face's edge was moved back onto the face even where a face on the
 /// same plane continues it (a thin strip beside a floor), so it measured the strip's edge instead
 /// of the surface it stands over; ericw-tools places it on the continuing face.
 #[test]
 fn samples_past_an_edge_land_on_the_face_that_continues_it() {
-    let strip = floor_rect(256.0, 8.0);
-    let rest = quad(
-        [0.0, 8.0, 0.0],
-        [0.0, 256.0, 0.0],
-        [256.0, 256.0, 0.0],
-        [256.0, 8.0, 0.0],
-        [0.0, 0.0, 1.0],
-    );
-    let bsp = synthetic_bsp(&[strip, rest], "{ \"classname\" \"worldspawn\" }");
-    let faces = face_geometry(&bsp, |_| DVec3::ZERO, |_| Spacing::Quake).expect("faces");
-    assert_eq!(faces[0].continuations.len(), 1);
-    let (samples, _) = face_samples(&faces[0], 1, &bsp);
-    // Luxel rows at y 0 and 16: the second stands over the other face and stays there.
-    assert_eq!(samples.height, 2);
-    let over_rest: Vec<&[f32; 3]> = samples.points.iter().filter(|p| p[1] > 8.0).collect();
-    assert_eq!(over_rest.len(), samples.width, "{:?}", samples.points);
-    assert!(over_rest.iter().all(|p| p[1] == 16.0 && p[2] == 1.0));
+    let polys = [floor_strip(0.0, 8.0), floor_strip(8.0, 256.0)];
+    assert_eq!(second_row_over_the_plane(&polys), (1, true));
 }
 
 /// Regression: only a face sharing an edge counted as continuing one, so a luxel past a thin
@@ -322,25 +331,12 @@ fn samples_past_an_edge_land_on_the_face_that_continues_it() {
 /// point across up to three faces of the plane.
 #[test]
 fn samples_past_an_edge_follow_the_plane_across_faces() {
-    let strip = |y0: f32, y1: f32| {
-        quad(
-            [0.0, y0, 0.0],
-            [0.0, y1, 0.0],
-            [256.0, y1, 0.0],
-            [256.0, y0, 0.0],
-            [0.0, 0.0, 1.0],
-        )
-    };
-    let polys = [strip(0.0, 4.0), strip(4.0, 8.0), strip(8.0, 256.0)];
-    let bsp = synthetic_bsp(&polys, "{ \"classname\" \"worldspawn\" }");
-    let faces = face_geometry(&bsp, |_| DVec3::ZERO, |_| Spacing::Quake).expect("faces");
-    assert_eq!(faces[0].continuations.len(), 2);
-    let (samples, _) = face_samples(&faces[0], 1, &bsp);
-    // Luxel rows at y 0 and 16: the second stands over the third face and stays there.
-    assert_eq!(samples.height, 2);
-    let far: Vec<&[f32; 3]> = samples.points.iter().filter(|p| p[1] > 8.0).collect();
-    assert_eq!(far.len(), samples.width, "{:?}", samples.points);
-    assert!(far.iter().all(|p| p[1] == 16.0 && p[2] == 1.0));
+    let polys = [
+        floor_strip(0.0, 4.0),
+        floor_strip(4.0, 8.0),
+        floor_strip(8.0, 256.0),
+    ];
+    assert_eq!(second_row_over_the_plane(&polys), (2, true));
 }
 
 #[test]
@@ -593,23 +589,20 @@ fn start_bsp_default_against_reference() {
     let Some(bsp) = corpus_bsp("librequake/start.bsp") else {
         return;
     };
-    let drawn_lit = |&i: &usize| {
-        let face = &bsp.faces[i];
-        let Some(points) = bsp.face_vertices(face) else {
-            return false;
-        };
-        let plane = &bsp.planes[face.plane as usize];
-        let side = if face.side == 0 { 1.0 } else { -1.0 };
-        let middle = points
-            .iter()
-            .fold(DVec3::ZERO, |m, p| m + Vec3::from(*p).as_dvec3())
-            / points.len() as f64;
-        let front = middle + Vec3::from(plane.normal).as_dvec3() * side;
-        !bsp.face_texture(face)
+    let prep = crate::prepare::prepare(&bsp, &Options::default()).expect("prepare");
+    let drawn_lit = |f: &&crate::faces::FaceGeom| {
+        let front = f.centroid() + f.plane.normal;
+        !bsp.face_texture(&bsp.faces[f.index])
             .is_some_and(quake_formats::miptex::MipTex::is_all_fullbright)
             && !crate::samples::solid_at(&bsp, front.as_vec3().to_array())
     };
-    let only: Vec<usize> = (0..bsp.faces.len()).step_by(8).filter(drawn_lit).collect();
+    let only: Vec<usize> = prep
+        .faces
+        .iter()
+        .filter(|f| f.index % 8 == 0)
+        .filter(drawn_lit)
+        .map(|f| f.index)
+        .collect();
     let run = |quality| {
         let o = Options {
             quality,

@@ -501,27 +501,12 @@ impl Bsp {
     /// The leaf containing `point`, walking down from `node` (a child
     /// index: negative for a leaf), for callers that know the point lies
     /// below it.
-    pub fn leaf_from(&self, node: i32, point: [f32; 3]) -> Option<usize> {
-        self.walk_to_leaf(node, point, false)
-    }
-
-    /// The world leaf containing `point` with a point lying on a node's plane taken to the
-    /// plane's back, where [`Bsp::leaf_at`] takes it to the front: a point on a floor is then
-    /// in the floor (ericw-tools' test for a light in solid).
-    pub fn leaf_at_behind_planes(&self, point: [f32; 3]) -> Option<usize> {
-        self.walk_to_leaf(*self.models.first()?.head_nodes.first()?, point, true)
-    }
-
-    /// The leaf below `node` holding `point`, a point on a plane going to its back when
-    /// `on_plane_back`.
-    fn walk_to_leaf(&self, mut node: i32, point: [f32; 3], on_plane_back: bool) -> Option<usize> {
+    pub fn leaf_from(&self, mut node: i32, point: [f32; 3]) -> Option<usize> {
         let mut steps = 0;
         while node >= 0 {
             let n = self.nodes.get(node as usize)?;
             let plane = self.planes.get(n.plane as usize)?;
-            let d = plane.distance(point);
-            let back = d < 0.0 || (on_plane_back && d == 0.0);
-            node = n.children[usize::from(back)];
+            node = n.children[usize::from(plane.distance(point) < 0.0)];
             steps += 1;
             if steps > self.nodes.len() {
                 return None; // a cycle in a damaged file
