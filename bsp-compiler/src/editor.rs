@@ -27,6 +27,7 @@ pub(crate) fn without_editor_keys(entity: &Entity) -> Entity {
             .filter(|(k, _)| !is_editor_key(k))
             .cloned()
             .collect(),
+        line: entity.line,
     }
 }
 

@@ -260,6 +260,7 @@ mod tests {
                     .iter()
                     .map(|(k, v)| (k.to_string(), v.to_string()))
                     .collect(),
+                line: 1,
             },
             brushes: Vec::new(),
             line: 1,

@@ -8,16 +8,6 @@ pub enum LightError {
     /// The entity lump does not parse.
     #[error("entity lump: {0}")]
     Entities(#[from] quake_formats::FormatError),
-    /// A key of a light or brush entity that does not read as what it must be.
-    #[error("entity {index} ({classname}): {detail}")]
-    Entity {
-        /// The entity's place in the lump (0 = worldspawn).
-        index: usize,
-        /// Its `classname`.
-        classname: String,
-        /// Which key, what it holds and what was expected.
-        detail: String,
-    },
     /// A face whose indices run outside the file.
     #[error("face {index}: {detail}")]
     BadFace {

@@ -41,6 +41,8 @@ pub mod cli;
 mod compare;
 mod directions;
 mod dirt;
+#[cfg(test)]
+mod docs;
 mod embree;
 mod error;
 mod faces;
@@ -76,6 +78,7 @@ pub use compare::{
 pub use embree::CONFIG_ENV as EMBREE_CONFIG_ENV;
 pub use error::LightError;
 pub use lighting::{Lighting, RawLighting, Stats};
+pub use lights::keys as entity_keys;
 pub use options::Options;
 pub use output::{FaceLightmap, Outputs, grey_lit};
 pub use quality::Quality;

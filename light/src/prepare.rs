@@ -172,20 +172,12 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
     point_lights.extend(surface);
     let nudges = nudge::nudge_out_of_solid(bsp, &mut point_lights, &map_lights.no_nudge);
     for &entity in &nudges.stuck {
+        let Some(e) = entities.get(entity) else {
+            continue;
+        };
         map_lights.warnings.push(SettingWarning {
-            given: Given::Key {
-                entity,
-                classname: entities
-                    .get(entity)
-                    .map_or("", |e| e.classname())
-                    .to_string(),
-                key: "origin",
-            },
-            value: entities
-                .get(entity)
-                .and_then(|e| e.get("origin"))
-                .unwrap_or("")
-                .to_string(),
+            given: Given::key(entity, e, "origin"),
+            value: e.get("origin").unwrap_or("").to_string(),
             problem: format!(
                 "the light is in solid and no step of {} units frees it; it lights nothing",
                 nudge::NUDGE

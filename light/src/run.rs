@@ -701,11 +701,11 @@ pub fn apply_lighting(bsp: &mut Bsp, lighting: &Lighting) -> LightFiles {
 /// Returns how many switchable styles were given out.
 ///
 /// # Errors
-/// An entity lump that does not parse, a `style` that is not a number, or more switchable lights
-/// than styles.
+/// An entity lump that does not parse, or more switchable lights than styles.
 pub fn update_entities_only(bsp: &mut Bsp) -> Result<usize, LightError> {
     let mut entities = parse_entities(&bsp.entity_text())?;
-    let assigned = assign_switchable_styles(&mut entities)?;
+    // Keys that do not read are told when the map is lit; here only styles are given out.
+    let assigned = assign_switchable_styles(&mut entities, &mut Vec::new())?;
     if assigned.count > 0 {
         bsp.set_entity_text(&write_entities(&entities));
     }

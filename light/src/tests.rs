@@ -2652,3 +2652,104 @@ fn novanilla_keeps_only_the_own_grid_lightmaps() {
         .collect();
     assert!(problems.is_empty(), "{problems:?}");
 }
+
+/// Every key light reads, from the settings table and the entity keys' list, with a value that
+/// does not read (or reads only in part): the map is lit, and a warning names the entity and the
+/// key (the first of an entity's repeated keys is the one read, so the bad value comes first).
+/// ericw-tools lights such maps; light once stopped at the first such key.
+#[test]
+fn no_key_value_stops_light() {
+    use crate::entity_keys::{ENTITY_KEYS, Kind};
+    let room = room_bsp(
+        "{\n\"classname\" \"func_wall\"\n\"model\" \"*1\"\n}\n"
+            .replace(
+                "\"model\" \"*1\"\n",
+                &map_box([-16.0, -16.0, -128.0], [16.0, 16.0, -96.0]),
+            )
+            .as_str(),
+    );
+    assert_eq!(room.models.len(), 2, "the room and its func_wall");
+    let bad_values = |kind: Kind| -> &'static [&'static str] {
+        match kind {
+            Kind::Number | Kind::Whole => &["junk", "-", "7x"],
+            Kind::Switch => &["maybe", "2"],
+            Kind::Vector | Kind::Color => &["1 2", "%top", "1 0 0x"],
+            Kind::Brightness => &["bright", "1 2", "150x"],
+            Kind::Text => &[],
+        }
+    };
+    // Keys read only beside another: that one too.
+    let beside = |key: &str| match key {
+        "_samples" => "\"_deviance\" \"8\"\n",
+        "_surface_offset" | "_surface_spotlight" | "_surflight_group" => "\"_surface\" \"wall\"\n",
+        "_minlight_color" | "_mincolor" => "\"_minlight\" \"8\"\n",
+        _ => "",
+    };
+    let light_with = |key: &str, value: &str| {
+        format!(
+            "{{\n\"classname\" \"worldspawn\"\n}}\n\
+             {{\n\"classname\" \"light\"\n\"{key}\" \"{value}\"\n{}\"origin\" \"0 0 0\"\n}}\n\
+             {{\n\"classname\" \"func_wall\"\n\"model\" \"*1\"\n}}\n",
+            beside(key)
+        )
+    };
+    let model_with = |key: &str, value: &str| {
+        format!(
+            "{{\n\"classname\" \"worldspawn\"\n}}\n\
+             {{\n\"classname\" \"light\"\n\"origin\" \"0 0 0\"\n}}\n\
+             {{\n\"classname\" \"func_wall\"\n\"model\" \"*1\"\n\"{key}\" \"{value}\"\n{}}}\n",
+            beside(key)
+        )
+    };
+    let world_with = |key: &str, value: &str| {
+        format!(
+            "{{\n\"classname\" \"worldspawn\"\n\"{key}\" \"{value}\"\n}}\n\
+             {{\n\"classname\" \"light\"\n\"origin\" \"0 0 0\"\n}}\n\
+             {{\n\"classname\" \"func_wall\"\n\"model\" \"*1\"\n}}\n"
+        )
+    };
+    let mut cases: Vec<(String, &str, String)> = Vec::new();
+    for key in ENTITY_KEYS {
+        for value in bad_values(key.kind) {
+            for name in key.names {
+                if key.on.lights() {
+                    cases.push((light_with(name, value), name, value.to_string()));
+                }
+                if key.on.models() {
+                    cases.push((model_with(name, value), name, value.to_string()));
+                }
+            }
+        }
+    }
+    for setting in crate::settings::TABLE {
+        for name in setting.keys {
+            // A text setting takes any value.
+            for value in ["junk", "1 2", "%top"]
+                .into_iter()
+                .filter(|v| (setting.check)(v).is_err())
+            {
+                cases.push((world_with(name, value), name, value.to_string()));
+            }
+        }
+    }
+    assert!(cases.len() > 150, "{} cases", cases.len());
+    let mut bsp = room.clone();
+    for (entities, key, value) in cases {
+        bsp.set_entity_text(&entities);
+        let lighting = compute_lighting(&bsp, &options(Quality::Default))
+            .unwrap_or_else(|e| panic!("\"{key}\" \"{value}\" stopped light: {e}"));
+        let told = lighting
+            .warnings
+            .iter()
+            .map(ToString::to_string)
+            .find(|w| w.contains(&format!("key \"{key}\" is \"{value}\"")));
+        let told = told.unwrap_or_else(|| {
+            panic!(
+                "\"{key}\" \"{value}\": no warning names it: {:?}",
+                lighting.warnings
+            )
+        });
+        assert!(told.starts_with("entity "), "{told}");
+        assert!(told.contains(" line "), "{told}");
+    }
+}

@@ -4,11 +4,24 @@ use crate::error::{FormatError, Result};
 
 /// One entity: its key/value pairs in file order (keys may repeat; the first one wins on lookup,
 /// as in Quake's `ValueForKey`).
-#[derive(Debug, Clone, PartialEq, Eq, Default)]
+///
+/// Two entities are equal when their pairs are: where one was read from is not part of it.
+#[derive(Debug, Clone, Default)]
 pub struct Entity {
     /// Keys and values as written, in file order.
     pub pairs: Vec<(String, String)>,
+    /// The line of the text it was read from where its `{` stands (1 is the first line), for
+    /// messages; 0 for an entity made in code.
+    pub line: usize,
 }
+
+impl PartialEq for Entity {
+    fn eq(&self, other: &Entity) -> bool {
+        self.pairs == other.pairs
+    }
+}
+
+impl Eq for Entity {}
 
 impl Entity {
     /// The value of the first `key`, if there is one.
@@ -81,7 +94,10 @@ pub fn parse_entities(text: &str) -> Result<Vec<Entity>> {
                 if current.is_some() {
                     return Err(syntax(line, "'{' inside an entity"));
                 }
-                current = Some(Entity::default());
+                current = Some(Entity {
+                    pairs: Vec::new(),
+                    line,
+                });
             }
             '}' => {
                 let entity = current
@@ -152,6 +168,7 @@ mod tests {
         assert_eq!(ents.len(), 2);
         assert_eq!(ents[0].classname(), "worldspawn");
         assert_eq!(ents[1].get_floats::<3>("origin"), Some([1.0, 2.0, 3.0]));
+        assert_eq!((ents[0].line, ents[1].line), (1, 5));
     }
 
     #[test]
@@ -165,7 +182,7 @@ mod tests {
     proptest! {
         #[test]
         fn write_then_parse_is_identity(pairs in proptest::collection::vec(("[^\"\\x00]{0,12}", "[^\"\\x00]{0,20}"), 0..8), n in 0usize..4) {
-            let ents: Vec<Entity> = (0..n).map(|_| Entity { pairs: pairs.clone() }).collect();
+            let ents: Vec<Entity> = (0..n).map(|_| Entity { pairs: pairs.clone(), line: 0 }).collect();
             let text = write_entities(&ents);
             prop_assert_eq!(parse_entities(&text).expect("parse"), ents);
         }

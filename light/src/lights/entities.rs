@@ -8,7 +8,7 @@ use glam::DVec3;
 use quake_formats::entities::Entity;
 use quake_formats::geom::DVec3Ext;
 
-use super::keys::Keys;
+use super::keys::{self, Keys};
 use super::models::model_index;
 use super::point::{DEFAULT_SPOT_ANGLE, Falloff, PointLight, Spot, split_light};
 use super::sun::{SunLight, dome, spread};
@@ -16,8 +16,7 @@ use super::worldspawn::Global;
 use super::{MapLights, SurfaceTemplate};
 use crate::directions::mangle_to_vec;
 use crate::dirt::DirtResponse;
-use crate::error::LightError;
-use crate::settings::{DirtToggle, SettingWarning, normalize_color};
+use crate::settings::DirtToggle;
 
 /// `light` value of a light entity without one (or with `light 0`, as
 /// ericw-tools treats it).
@@ -26,15 +25,13 @@ pub const DEFAULT_LIGHT: f64 = 300.0;
 /// Lights a `_deviance` light is split into when `_samples` is absent.
 pub const DEFAULT_DEVIANCE_SAMPLES: usize = 16;
 
-/// Every light entity of `entities`, into `out` (in entity order).
-///
-/// # Errors
-/// [`LightError::Entity`] for a key that does not read.
-pub fn read_lights(
-    entities: &[Entity],
-    global: &Global,
-    out: &mut MapLights,
-) -> Result<(), LightError> {
+/// The most lights one `_deviance` light is split into: more adds nothing a lightmap byte shows
+/// and only costs time and memory.
+pub const MAX_DEVIANCE_SAMPLES: usize = 4096;
+
+/// Every light entity of `entities`, into `out` (in entity order), with a warning for each key
+/// not taken as written.
+pub fn read_lights(entities: &[Entity], global: &Global, out: &mut MapLights) {
     // Where spotlights aim with `target`.
     let origins: HashMap<&str, DVec3> = entities
         .iter()
@@ -47,20 +44,17 @@ pub fn read_lights(
         if model_index(e).is_some_and(|m| m > 0) || !e.classname().starts_with("light") {
             continue;
         }
-        let k = Keys { entity: e, index };
+        let k = Keys::new(e, index);
         // A `_switchableshadow_target` light only lends its style to a shadow.
-        let shadow_only = e
-            .get("_switchableshadow_target")
-            .is_some_and(|t| !t.is_empty());
-        if shadow_only || k.float("_nostaticlight")? == Some(1.0) {
-            continue;
+        let shadow_only = k.text(&keys::SWITCHABLESHADOW_TARGET).is_some();
+        if !shadow_only && k.switch(&keys::NOSTATICLIGHT) != Some(true) {
+            if k.switch(&keys::NONUDGE) == Some(true) {
+                out.no_nudge.push(index);
+            }
+            read_light(&k, &origins, global, out);
         }
-        if k.float("_nonudge")? == Some(1.0) {
-            out.no_nudge.push(index);
-        }
-        read_light(&k, &origins, global, out)?;
+        out.warnings.extend(k.into_warnings());
     }
-    Ok(())
 }
 
 /// What every kind of light entity reads alike.
@@ -77,13 +71,8 @@ struct Common {
 }
 
 /// One light entity, as a sun, domes, or point lights and templates.
-fn read_light(
-    k: &Keys,
-    origins: &HashMap<&str, DVec3>,
-    global: &Global,
-    out: &mut MapLights,
-) -> Result<(), LightError> {
-    let c = common(k, origins, global, &mut out.warnings)?;
+fn read_light(k: &Keys, origins: &HashMap<&str, DVec3>, global: &Global, out: &mut MapLights) {
+    let c = common(k, origins, global);
     let sun = SunLight {
         to_sun: DVec3::ZERO,
         light: c.light,
@@ -93,43 +82,34 @@ fn read_light(
         dirt: c.dirt,
         directions: 1,
     };
-    if k.float("_sun")? == Some(1.0) {
+    if k.switch(&keys::SUN) == Some(true) {
         let to_sun = -c.aim.unwrap_or(DVec3::new(0.0, 0.0, -1.0));
         let sun = SunLight { to_sun, ..sun };
         out.suns.extend(spread(sun, c.deviance, global.sunsamples));
-        return Ok(());
+        return;
     }
     let mut is_dome = false;
-    for (key, upper) in [("_sunlight2", true), ("_sunlight3", false)] {
-        if k.float(key)? == Some(1.0) {
+    for (key, upper) in [(&keys::SUNLIGHT2, true), (&keys::SUNLIGHT3, false)] {
+        if k.switch(key) == Some(true) {
             out.suns.extend(dome(sun.clone(), upper, global.sunsamples));
             is_dome = true;
         }
     }
-    if is_dome {
-        return Ok(());
+    if !is_dome {
+        point_light(k, c, global, out);
     }
-    point_light(k, c, global, out)
 }
 
-/// The keys every light entity reads; values out of range warn (into `warnings`) and take
-/// the default.
-fn common(
-    k: &Keys,
-    origins: &HashMap<&str, DVec3>,
-    global: &Global,
-    warnings: &mut Vec<SettingWarning>,
-) -> Result<Common, LightError> {
-    let origin = k.vec3("origin")?.unwrap_or(DVec3::ZERO);
-    let (light, light_color) = brightness(k, warnings)?;
+/// The keys every light entity reads; values out of range warn and take the default.
+fn common(k: &Keys, origins: &HashMap<&str, DVec3>, global: &Global) -> Common {
+    let origin = k.vector(&keys::ORIGIN).unwrap_or(DVec3::ZERO);
+    let (light, light_color) = k.brightness();
+    // Absent or 0: the default, as ericw-tools takes it.
+    let light = light.filter(|l| *l != 0.0).unwrap_or(DEFAULT_LIGHT);
     // An explicit `_color` wins over the colour of Half-Life's `light` form.
-    let color = match (k.vec3("_color")?, light_color) {
-        (Some(c), _) => normalize_color(c),
-        (None, Some(c)) => c,
-        (None, None) => DVec3::ONE,
-    };
-    let style = k.style()?;
-    let anglescale = match k.float_any(&["_anglescale", "_anglesense"])? {
+    let color = k.color(&keys::COLOR).or(light_color).unwrap_or(DVec3::ONE);
+    let style = style(k);
+    let anglescale = match k.number(&keys::ANGLESCALE) {
         Some(a) if (0.0..=1.0).contains(&a) => a,
         Some(_) => {
             let key = if k.entity.get("_anglescale").is_some() {
@@ -137,31 +117,31 @@ fn common(
             } else {
                 "_anglesense"
             };
-            warnings.push(k.warning(key, "expected 0 to 1; the map's anglescale is used"));
+            k.warn(key, "expected 0 to 1; the map's anglescale is used");
             global.anglescale
         }
         None => global.anglescale,
     };
-    let aim = match (k.vec3("mangle")?, k.entity.get("target")) {
+    let aim = match (k.vector(&keys::MANGLE), k.text(&keys::TARGET)) {
         (Some(m), _) => Some(mangle_to_vec(m.x, m.y)),
         (None, Some(t)) => origins.get(t).and_then(|&to| (to - origin).normalized()),
         (None, None) => None,
     };
     let toggle = k
-        .float("_dirt")?
+        .number(&keys::DIRT)
         .map_or(DirtToggle::AsDirt, DirtToggle::of_number);
     // A light's own `_dirtscale` / `_dirtgain` (non-zero) win over the global ones.
     let response = DirtResponse {
         scale: k
-            .float("_dirtscale")?
+            .number(&keys::DIRTSCALE)
             .filter(|s| *s > 0.0)
             .unwrap_or(global.response.scale),
         gain: k
-            .float("_dirtgain")?
+            .number(&keys::DIRTGAIN)
             .filter(|g| *g > 0.0)
             .unwrap_or(global.response.gain),
     };
-    Ok(Common {
+    Common {
         origin,
         light,
         color,
@@ -169,62 +149,45 @@ fn common(
         anglescale,
         aim,
         dirt: global.dirt_with(toggle, response),
-        deviance: k.float("_deviance")?.unwrap_or(0.0).max(0.0),
-    })
+        deviance: k.number(&keys::DEVIANCE).unwrap_or(0.0).max(0.0),
+    }
 }
 
-/// `light`: a brightness, or Half-Life's `R G B I` (colour in 0..255 or 0..1, then brightness).
-/// Absent or 0 is [`DEFAULT_LIGHT`]; another count of numbers warns and takes it too.
-fn brightness(
-    k: &Keys,
-    warnings: &mut Vec<SettingWarning>,
-) -> Result<(f64, Option<DVec3>), LightError> {
-    let Some(text) = k.entity.get("light").filter(|t| !t.trim().is_empty()) else {
-        return Ok((DEFAULT_LIGHT, None));
-    };
-    let numbers: Option<Vec<f64>> = text
-        .split_whitespace()
-        .map(|w| w.parse().ok().filter(|v: &f64| v.is_finite()))
-        .collect();
-    let or_default = |l: f64| if l == 0.0 { DEFAULT_LIGHT } else { l };
-    match numbers.as_deref() {
-        Some(&[l]) => Ok((or_default(l), None)),
-        Some(&[r, g, b, l]) => Ok((or_default(l), Some(normalize_color(DVec3::new(r, g, b))))),
-        Some(_) => {
-            warnings.push(k.warning(
-                "light",
-                &format!("expected a brightness or R G B brightness; {DEFAULT_LIGHT} is used"),
-            ));
-            Ok((DEFAULT_LIGHT, None))
-        }
-        None => Err(k.bad("light", "numbers")),
+/// `style`, held to the styles a lightmap can name (with a warning outside them).
+pub(super) fn style(k: &Keys) -> u8 {
+    let most = quake_formats::bsp::limits::MAX_LIGHTSTYLE;
+    match k.whole(&keys::STYLE) {
+        None => 0,
+        Some(s) => u8::try_from(s)
+            .ok()
+            .filter(|s| *s <= most)
+            .unwrap_or_else(|| {
+                let held = if s < 0 { 0 } else { most };
+                k.warn("style", &format!("outside 0–{most}; {held} is used"));
+                held
+            }),
     }
 }
 
 /// A point light or spotlight: one, `_samples` copies spread over its `_deviance`, or a
 /// `_surface` template.
-fn point_light(
-    k: &Keys,
-    c: Common,
-    global: &Global,
-    out: &mut MapLights,
-) -> Result<(), LightError> {
-    let delay = k.float("delay")?.unwrap_or(0.0);
-    let falloff = Falloff::from_delay(delay as i64)
-        .filter(|_| delay.fract() == 0.0)
-        .unwrap_or_else(|| {
-            let problem = "expected 0, 1, 2, 3, 4 or 5; linear falloff (0) is used";
-            out.warnings.push(k.warning("delay", problem));
-            Falloff::Linear
-        });
-    let wait = k.float("wait")?.filter(|w| *w > 0.0).unwrap_or(1.0);
+fn point_light(k: &Keys, c: Common, global: &Global, out: &mut MapLights) {
+    let delay = k.whole(&keys::DELAY).unwrap_or(0);
+    let Some(falloff) = Falloff::from_delay(delay) else {
+        k.warn(
+            "delay",
+            "names no falloff (0 to 5); the light lights nothing, as in ericw-tools",
+        );
+        return;
+    };
+    let wait = k.number(&keys::WAIT).filter(|w| *w > 0.0).unwrap_or(1.0);
     // `_falloff` (linear only): reaches zero exactly that many units out.
-    let atten = match k.float("_falloff")?.filter(|f| *f > 0.0) {
+    let atten = match k.number(&keys::FALLOFF).filter(|f| *f > 0.0) {
         Some(reach) if falloff == Falloff::Linear => c.light.abs() / reach,
         _ => wait * global.scaledist,
     };
-    let angle = k.float("angle")?.unwrap_or(DEFAULT_SPOT_ANGLE);
-    let softangle = k.float("_softangle")?.unwrap_or(0.0);
+    let angle = k.number(&keys::ANGLE).unwrap_or(DEFAULT_SPOT_ANGLE);
+    let softangle = k.number(&keys::SOFTANGLE).unwrap_or(0.0);
     let point = PointLight {
         origin: c.origin,
         light: c.light,
@@ -235,29 +198,33 @@ fn point_light(
         spot: c.aim.map(|dir| Spot::new(dir, angle, softangle)),
         anglescale: c.anglescale,
         dirt: c.dirt,
-        bounce: k.float("_bounce")?.is_none_or(|b| b > 0.0),
+        bounce: k.number(&keys::BOUNCE).is_none_or(|b| b > 0.0),
         entity: k.index,
     };
-    match k.entity.get("_surface").filter(|t| !t.is_empty()) {
+    match k.text(&keys::SURFACE) {
         Some(texture) => out.templates.push(SurfaceTemplate {
             texture: texture.to_string(),
             light: PointLight {
                 spot: None,
                 ..point
             },
-            offset: k.float("_surface_offset")?.unwrap_or(2.0),
-            spotlight: k.float("_surface_spotlight")? == Some(1.0),
+            offset: k.number(&keys::SURFACE_OFFSET).unwrap_or(2.0),
+            spotlight: k.switch(&keys::SURFACE_SPOTLIGHT) == Some(true),
             spot_angle: angle,
-            group: k.float("_surflight_group")?.unwrap_or(0.0) as i64,
+            group: k.whole(&keys::SURFLIGHT_GROUP).unwrap_or(0),
         }),
         None if c.deviance > 0.0 => {
-            let count = k
-                .float("_samples")?
-                .filter(|n| *n >= 1.0)
-                .map_or(DEFAULT_DEVIANCE_SAMPLES, |n| n as usize);
+            let count = match k.whole(&keys::SAMPLES) {
+                Some(n) if n > MAX_DEVIANCE_SAMPLES as i64 => {
+                    let problem = format!("more than {MAX_DEVIANCE_SAMPLES}; that many are used");
+                    k.warn("_samples", &problem);
+                    MAX_DEVIANCE_SAMPLES
+                }
+                Some(n) if n >= 1 => n as usize,
+                _ => DEFAULT_DEVIANCE_SAMPLES,
+            };
             out.points.extend(split_light(&point, c.deviance, count));
         }
         None => out.points.push(point),
     }
-    Ok(())
 }

@@ -2,12 +2,12 @@
 //! models' keys and light entities, read in that order by [`parse_lights`].
 //!
 //! Keys follow ericw-tools' documented meanings. Worldspawn's map-wide keys are settings
-//! ([`crate::settings`]): the command line may override them, and a value that does not read
-//! is a warning. A light's or brush model's key that does not read is an error naming the
-//! entity and key.
+//! ([`crate::settings`]): the command line may override them. The keys of lights and brush
+//! models are declared in [`keys`]. A value that does not read, anywhere, is a warning naming
+//! the entity and key, never an error.
 
 mod entities;
-mod keys;
+pub mod keys;
 mod models;
 mod point;
 mod styles;
@@ -170,20 +170,22 @@ impl MapLights {
 /// entities).
 ///
 /// # Errors
-/// [`LightError::Entity`] for a key of a light or brush entity that does not read.
+/// [`LightError::TooManySwitchableLights`]: more switchable names than styles.
 pub fn parse_lights(
     entities: &mut [Entity],
     overrides: &Overrides,
 ) -> Result<MapLights, LightError> {
-    let switchable = assign_switchable_styles(entities)?;
+    let mut style_warnings = Vec::new();
+    let switchable = assign_switchable_styles(entities, &mut style_warnings)?;
     let world = entities.iter().position(|e| e.classname() == "worldspawn");
-    let (settings, warnings) = Settings::resolve(
+    let (settings, mut warnings) = Settings::resolve(
         world.map(|index| World {
             index,
             entity: &entities[index],
         }),
         overrides,
     );
+    warnings.extend(style_warnings);
     let global = worldspawn::Global::new(&settings);
     let mut out = MapLights {
         points: Vec::new(),
@@ -210,13 +212,13 @@ pub fn parse_lights(
     if let Some(m) = worldspawn::world_minlight(&out.settings, &global) {
         out.minlight.insert(0, m);
     }
-    models::read_world_and_model_keys(entities, world, &mut out)?;
-    models::read_models(entities, &global, &mut out)?;
+    models::read_world_and_model_keys(entities, world, &mut out);
+    models::read_models(entities, &global, &mut out);
     // A switchable shadow is one the game turns on and off, never a fixed one.
     let switchable = &out.switchable.shadows;
     out.shadow_models
         .retain(|m| !switchable.iter().any(|(s, _)| s == m));
-    entities::read_lights(entities, &global, &mut out)?;
+    entities::read_lights(entities, &global, &mut out);
     Ok(out)
 }
 
@@ -292,49 +294,61 @@ mod tests {
         assert!(lights.is_coloured());
     }
 
+    /// Regression: a value light could not read stopped the run, where ericw-tools lights the
+    /// map; now it is a warning naming the entity, its line and the key, and the value
+    /// ericw-tools would use is used.
     #[test]
-    fn bad_numbers_name_the_entity() {
-        let mut ents = parse_entities(
-            "{ \"classname\" \"worldspawn\" }\n{ \"classname\" \"light\" \"light\" \"bright\" }",
-        )
-        .expect("parse");
-        let err = parse_lights(&mut ents, &Overrides::default()).expect_err("bad light");
-        let msg = err.to_string();
+    fn unreadable_values_warn_and_take_what_ericw_tools_takes() {
+        let text = "{ \"classname\" \"worldspawn\" }\n\
+                    { \"classname\" \"light\" \"light\" \"bright\" \"_color\" \"%top\" }\n\
+                    { \"classname\" \"light\" \"light\" \"150x\" \"style\" \"abc\" }";
+        let mut ents = parse_entities(text).expect("parse");
+        let lights = parse_lights(&mut ents, &Overrides::default()).expect("lights");
+        assert_eq!(lights.points[0].light, DEFAULT_LIGHT);
+        assert_eq!(lights.points[0].color, DVec3::ONE);
+        assert_eq!(lights.points[1].light, 150.0);
+        assert_eq!(lights.points[1].style, 0);
+        let told: Vec<String> = lights.warnings.iter().map(ToString::to_string).collect();
+        assert_eq!(told.len(), 4, "{told:?}");
         assert!(
-            msg.contains("entity 1") && msg.contains("\"light\""),
-            "{msg}"
+            told[0].starts_with(
+                "entity 1 (light, line 2 of the entity lump): key \"light\" is \"bright\""
+            ),
+            "{told:?}"
         );
+        assert!(told[2].contains("\"150x\": read as \"150\""), "{told:?}");
     }
 
-    /// Regression: `delay 15` and Half-Life's `light "R G B I"` stopped the run, where
-    /// ericw-tools lights the map: a value out of range warns, naming the entity, and the
-    /// default is used.
+    /// Regression: `delay 15` stopped the run, then lit with linear falloff; ericw-tools lights
+    /// nothing from it. Half-Life's `light "R G B I"` is a colour and a brightness.
     #[test]
-    fn out_of_range_light_keys_warn_and_take_the_default() {
+    fn out_of_range_light_keys_warn() {
         let text = r#"
 { "classname" "worldspawn" }
 { "classname" "light" "origin" "0 0 0" "delay" "15" }
 { "classname" "light" "origin" "0 0 0" "light" "255 127 0 200" }
-{ "classname" "light" "origin" "0 0 0" "light" "255 127 0" "_anglescale" "3" }
+{ "classname" "light" "origin" "0 0 0" "light" "255 127" "_anglescale" "3" }
+{ "classname" "light" "origin" "0 0 0" "delay" "2.5" "style" "300" }
 "#;
         let mut ents = parse_entities(text).expect("parse");
         let lights = parse_lights(&mut ents, &Overrides::default()).expect("lights");
-        assert_eq!(lights.points[0].falloff, Falloff::Linear);
-        assert_eq!(lights.points[1].light, 200.0);
-        assert_eq!(lights.points[1].color, DVec3::new(1.0, 127.0 / 255.0, 0.0));
-        assert_eq!(lights.points[2].light, DEFAULT_LIGHT);
-        assert_eq!(lights.points[2].color, DVec3::ONE);
-        assert_eq!(lights.points[2].anglescale, lights.points[0].anglescale);
+        assert_eq!(lights.points.len(), 3, "the delay 15 light lights nothing");
+        assert_eq!(lights.points[0].light, 200.0);
+        assert_eq!(lights.points[0].color, DVec3::new(1.0, 127.0 / 255.0, 0.0));
+        assert_eq!(lights.points[1].light, DEFAULT_LIGHT);
+        assert_eq!(lights.points[1].color, DVec3::ONE);
+        assert_eq!(lights.points[1].anglescale, lights.points[0].anglescale);
+        assert_eq!(lights.points[2].falloff, Falloff::InverseSquare);
+        assert_eq!(lights.points[2].style, 254);
         let told: Vec<String> = lights.warnings.iter().map(ToString::to_string).collect();
-        assert_eq!(told.len(), 3, "{told:?}");
+        assert_eq!(told.len(), 5, "{told:?}");
         assert!(
-            told[0].starts_with("entity 1 (light): key \"delay\" is \"15\""),
+            told[0].starts_with(
+                "entity 1 (light, line 3 of the entity lump): key \"delay\" is \"15\""
+            ),
             "{told:?}"
         );
-        assert!(
-            told[1].starts_with("entity 3 (light): key \"light\""),
-            "{told:?}"
-        );
+        assert!(told[1].contains("(light, line 5"), "{told:?}");
         assert!(told[2].contains("\"_anglescale\" is \"3\""), "{told:?}");
     }
 

@@ -12,9 +12,11 @@
 
 use quake_formats::entities::Entity;
 
-use super::keys::Keys;
+use super::entities::style;
+use super::keys::{self, Keys};
 use super::models::model_index;
 use crate::error::LightError;
+use crate::settings::SettingWarning;
 
 /// First style given to switchable lights (styles below are the engine's
 /// animated presets).
@@ -50,23 +52,24 @@ impl SwitchableStyles {
 }
 
 /// Gives out the switchable styles of lights and switchable shadows (see the module comment)
-/// and writes them into the entities.
+/// and writes them into the entities; the keys not taken as written are warned about into
+/// `warnings`.
 ///
 /// # Errors
-/// A `style` that does not read, or more switchable names than styles.
-pub fn assign_switchable_styles(entities: &mut [Entity]) -> Result<SwitchableStyles, LightError> {
+/// More switchable names than styles.
+pub fn assign_switchable_styles(
+    entities: &mut [Entity],
+    warnings: &mut Vec<SettingWarning>,
+) -> Result<SwitchableStyles, LightError> {
     let mut out = SwitchableStyles::default();
     let is_light = |e: &Entity| e.classname().starts_with("light") && model_index(e).is_none();
-    let name_of = |e: &Entity| {
-        e.get("targetname")
-            .filter(|n| !n.is_empty())
-            .map(String::from)
-    };
+    let name_of = |e: &Entity| Keys::new(e, 0).text(&keys::TARGETNAME).map(String::from);
     for (index, e) in entities.iter_mut().enumerate() {
         let Some(name) = name_of(e).filter(|_| is_light(e)) else {
             continue;
         };
-        if (Keys { entity: e, index }).style()? == 0 {
+        // Warnings about `style` come when the lights are read.
+        if style(&Keys::new(e, index)) == 0 {
             let style = out.style_for(Some(&name))?;
             e.set("style", style.to_string());
         }
@@ -75,7 +78,10 @@ pub fn assign_switchable_styles(entities: &mut [Entity]) -> Result<SwitchableSty
         let Some(model) = model_index(e).filter(|&m| m > 0) else {
             continue;
         };
-        if (Keys { entity: e, index }).float("_switchableshadow")? == Some(1.0) {
+        let k = Keys::new(e, index);
+        let switchable = k.number(&keys::SWITCHABLESHADOW) == Some(1.0);
+        warnings.extend(k.into_warnings());
+        if switchable {
             let style = out.style_for(name_of(e).as_deref())?;
             e.set("switchshadstyle", style.to_string());
             out.shadows.push((model, style));
@@ -83,14 +89,14 @@ pub fn assign_switchable_styles(entities: &mut [Entity]) -> Result<SwitchableSty
     }
     for index in 0..entities.len() {
         let e = &entities[index];
-        let Some(target) = e.get("_switchableshadow_target").filter(|t| !t.is_empty()) else {
+        let Some(target) = Keys::new(e, index).text(&keys::SWITCHABLESHADOW_TARGET) else {
             continue;
         };
         if !is_light(e) {
             continue;
         }
         let target = target.to_string();
-        let style = match (Keys { entity: e, index }).style()? {
+        let style = match style(&Keys::new(e, index)) {
             0 => {
                 let style = out.style_for(None)?;
                 entities[index].set("style", style.to_string());
@@ -128,7 +134,7 @@ mod tests {
 { "classname" "light" "origin" "0 0 0" "_switchableshadow_target" "gate" }
 "#;
         let mut ents = parse_entities(text).expect("parse");
-        let styles = assign_switchable_styles(&mut ents).expect("styles");
+        let styles = assign_switchable_styles(&mut ents, &mut Vec::new()).expect("styles");
         assert_eq!(ents[1].get("style"), Some("32"));
         assert_eq!(ents[2].get("switchshadstyle"), Some("32"), "shares door's");
         assert_eq!(

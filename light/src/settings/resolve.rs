@@ -37,11 +37,25 @@ pub enum Given {
         entity: usize,
         /// Its `classname`.
         classname: String,
+        /// Where it starts in the entity lump's text (0: unknown).
+        line: usize,
         /// The key.
         key: &'static str,
     },
     /// Given to the run (on the command line): its flag with its dashes.
     Run(&'static str),
+}
+
+impl Given {
+    /// Key `key` of `entity`, the `index`th of the lump.
+    pub fn key(index: usize, entity: &Entity, key: &'static str) -> Given {
+        Given::Key {
+            entity: index,
+            classname: entity.classname().to_string(),
+            line: entity.line,
+            key,
+        }
+    }
 }
 
 /// A setting's value light did not take as given, and what it did instead.
@@ -61,10 +75,21 @@ impl fmt::Display for SettingWarning {
             Given::Key {
                 entity,
                 classname,
+                line: 0,
                 key,
             } => write!(
                 f,
                 "entity {entity} ({classname}): key \"{key}\" is \"{}\": {}",
+                self.value, self.problem
+            ),
+            Given::Key {
+                entity,
+                classname,
+                line,
+                key,
+            } => write!(
+                f,
+                "entity {entity} ({classname}, line {line} of the entity lump): key \"{key}\" is \"{}\": {}",
                 self.value, self.problem
             ),
             Given::Run(name) => write!(f, "{name} {}: {}", self.value, self.problem),
@@ -147,11 +172,7 @@ fn first_key<T: SettingValue>(
     keys.iter().find_map(|&key| {
         let text = world.entity.get(key)?;
         let read = T::read(text)?;
-        let at = Given::Key {
-            entity: world.index,
-            classname: world.entity.classname().to_string(),
-            key,
-        };
+        let at = Given::key(world.index, world.entity, key);
         Some((at, text.to_string(), read))
     })
 }

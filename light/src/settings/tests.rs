@@ -44,11 +44,11 @@ fn worldspawn_values_out_of_range_or_unreadable_warn_and_fall_back() {
     assert_eq!(
         messages,
         [
-            "entity 0 (worldspawn): key \"_gamma\" is \"0\": outside > 0; the default 1 is used",
-            "entity 0 (worldspawn): key \"_sunlight_color\" is \"255 200\": expected three numbers; the default white is used",
-            "entity 0 (worldspawn): key \"_dirtangle\" is \"120\": outside 1–90 (clamped); 90 is used",
-            "entity 0 (worldspawn): key \"_bounce\" is \"1.5\": expected a whole number, 0 or more; the default 0 is used",
-            "entity 0 (worldspawn): key \"_bouncescale\" is \"-2\": outside ≥ 0 (clamped); 0 is used",
+            "entity 0 (worldspawn, line 1 of the entity lump): key \"_gamma\" is \"0\": outside > 0; the default 1 is used",
+            "entity 0 (worldspawn, line 1 of the entity lump): key \"_sunlight_color\" is \"255 200\": expected three numbers; the default white is used",
+            "entity 0 (worldspawn, line 1 of the entity lump): key \"_dirtangle\" is \"120\": outside 1–90 (clamped); 90 is used",
+            "entity 0 (worldspawn, line 1 of the entity lump): key \"_bounce\" is \"1.5\": expected a whole number, 0 or more; the default 0 is used",
+            "entity 0 (worldspawn, line 1 of the entity lump): key \"_bouncescale\" is \"-2\": outside ≥ 0 (clamped); 0 is used",
         ]
     );
     let overrides = Overrides {
@@ -95,29 +95,13 @@ fn flags_and_keys_are_each_declared_once() {
     }
 }
 
-const DOCS_START: &str = "<!-- light settings: generated from light/src/settings/mod.rs -->\n";
-const DOCS_END: &str = "<!-- end of light settings -->";
-
 /// `docs/mapping.md` lists every setting with its keys, flag and default as the table declares
-/// them. `SLIPGATE_WRITE_DOCS=1 cargo test -p slipgate-light settings` rewrites the list.
+/// them. `SLIPGATE_WRITE_DOCS=1 cargo test -p slipgate-light docs` rewrites the list.
 #[test]
 fn the_docs_list_every_setting_as_declared() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/mapping.md");
-    let docs = std::fs::read_to_string(&path).expect("docs/mapping.md");
-    let start = docs
-        .find(DOCS_START)
-        .expect("the settings table's start marker")
-        + DOCS_START.len();
-    let end = start + docs[start..].find(DOCS_END).expect("its end marker");
-    let table = markdown_table();
-    if std::env::var_os("SLIPGATE_WRITE_DOCS").is_some() {
-        let written = format!("{}{table}{}", &docs[..start], &docs[end..]);
-        std::fs::write(&path, written).expect("write docs/mapping.md");
-        return;
-    }
-    assert!(
-        docs[start..end] == table,
-        "docs/mapping.md's settings table is not the declared one; rewrite it with \
-         SLIPGATE_WRITE_DOCS=1 cargo test -p slipgate-light settings. Declared:\n{table}"
+    crate::docs::check_generated_table(
+        "light settings: generated from light/src/settings/mod.rs",
+        "light settings",
+        &markdown_table(),
     );
 }
