@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
-use clap::{Arg, ArgAction, ArgMatches, Command, FromArgMatches};
+use clap::{Arg, ArgMatches, Command, FromArgMatches};
 use quake_formats::Bsp;
 use quake_formats::fsutil::{Staged, read_file, write_atomic};
 use quake_formats::palette::Palette;
@@ -93,7 +93,7 @@ pub struct Args {
 /// The settings' flags, one per setting of [`TABLE`] that has one.
 impl clap::Args for Overrides {
     fn augment_args(command: Command) -> Command {
-        command.args(TABLE.iter().filter_map(setting_arg))
+        command.args(TABLE.iter().map(setting_arg))
     }
 
     fn augment_args_for_update(command: Command) -> Command {
@@ -109,13 +109,8 @@ impl FromArgMatches for Overrides {
     }
 
     fn update_from_arg_matches(&mut self, matches: &ArgMatches) -> Result<(), clap::Error> {
-        for s in TABLE.iter().filter(|s| s.flag.is_some()) {
-            let given = if s.switch {
-                matches.get_flag(s.field).then_some("1")
-            } else {
-                matches.get_one::<String>(s.field).map(String::as_str)
-            };
-            if let Some(text) = given {
+        for s in TABLE {
+            if let Some(text) = matches.get_one::<String>(s.field) {
                 self.set(s.field, text)
                     .map_err(|e| clap::Error::raw(clap::error::ErrorKind::ValueValidation, e))?;
             }
@@ -124,35 +119,38 @@ impl FromArgMatches for Overrides {
     }
 }
 
-/// The flag of setting `s`, if it has one: a switch, a value, or a value that may be left out
-/// (`--bounce`), with the setting's help and worldspawn keys.
-fn setting_arg(s: &'static Setting) -> Option<Arg> {
-    let flag = s.flag?;
+/// The flag of setting `s`: a switch (whose value, `0`, `1` or `-1` as ericw-tools takes them,
+/// may follow), a value, or a value that may be left out (`--bounce`), with the setting's help
+/// and worldspawn keys; each of its keys without the underscore is a spelling of it too.
+fn setting_arg(s: &'static Setting) -> Arg {
     let help = s.help.split_whitespace().collect::<Vec<_>>().join(" ");
     let help = help.trim_end_matches('.').to_string();
     let help = match s.keys {
         [] => help,
         keys => format!("{help} [worldspawn {}]", keys.join(", ")),
     };
-    let mut arg = Arg::new(s.field).long(flag).help(help);
-    if let Some(alias) = s.alias {
-        arg = arg.alias(alias);
-    }
-    if s.switch {
-        return Some(arg.action(ArgAction::SetTrue));
-    }
-    arg = arg.value_name("N").value_parser(move |text: &str| {
-        (s.check)(text)
-            .map(|()| text.to_string())
-            .map_err(|expected| format!("expected {expected}"))
-    });
-    if let Some(missing) = s.missing {
+    let mut arg = Arg::new(s.field)
+        .long(s.flag)
+        .aliases(s.aliases())
+        .help(help)
+        .value_name(if s.switch { "0|1" } else { "N" })
+        .value_parser(move |text: &str| {
+            (s.check)(text)
+                .map(|()| text.to_string())
+                .map_err(|expected| format!("expected {expected}"))
+        });
+    if let Some(missing) = optional_value(s) {
         arg = arg
             .num_args(0..=1)
             .require_equals(true)
             .default_missing_value(missing);
     }
-    Some(arg)
+    arg
+}
+
+/// The value setting `s`'s flag means when given without one: on for a switch.
+fn optional_value(s: &Setting) -> Option<&'static str> {
+    if s.switch { Some("1") } else { s.missing }
 }
 
 /// Light's options whose value may be left out (`--bounce [N]`, `--soft [N]`) or is several
@@ -161,8 +159,13 @@ fn setting_arg(s: &'static Setting) -> Option<Arg> {
 pub fn join_optional_values(args: impl IntoIterator<Item = String>) -> Vec<String> {
     let joining: Vec<(String, usize)> = TABLE
         .iter()
-        .filter(|s| s.missing.is_some() || s.words > 1)
-        .filter_map(|s| Some((format!("--{}", s.flag?), s.words)))
+        .filter(|s| optional_value(s).is_some() || s.words > 1)
+        .flat_map(|s| {
+            let names = std::iter::once(s.flag).chain(s.aliases());
+            names
+                .map(|name| (format!("--{name}"), s.words))
+                .collect::<Vec<_>>()
+        })
         .collect();
     let joining: Vec<(&str, usize)> = joining.iter().map(|(f, n)| (f.as_str(), *n)).collect();
     quake_formats::cli::join_optional_values(args, &joining)
@@ -372,6 +375,14 @@ fn measurements(
 
 /// What the run did, and its warnings, on stderr.
 fn print_summary(lighting: &Lighting) {
+    if !lighting.chosen_settings.is_empty() {
+        let chosen: Vec<String> = lighting
+            .chosen_settings
+            .iter()
+            .map(ToString::to_string)
+            .collect();
+        eprintln!("light: settings: {}", chosen.join(", "));
+    }
     for w in &lighting.warnings {
         eprintln!("light: warning: {w}");
     }
@@ -553,6 +564,54 @@ mod tests {
         );
         assert!(cli.args.extra4);
         assert_eq!(cli.args.bsp, PathBuf::from("x.bsp"));
+    }
+
+    /// Every setting is an option, as in ericw-tools 2.0: a worldspawn key without its
+    /// underscore names it, and a switch takes `0`, `1` or `-1` after it or nothing.
+    #[test]
+    fn every_setting_is_an_option_with_ericw_tools_spellings() {
+        use clap::Parser;
+        let parse = |args: &[&str]| {
+            let words = join_optional_values(quake_formats::cli::normalise_single_dash(
+                strings(args).into_iter(),
+            ));
+            LightCli::try_parse_from(words)
+                .unwrap_or_else(|e| panic!("{args:?}: {e}"))
+                .args
+        };
+        let a = parse(&[
+            "light",
+            "-sunlight2",
+            "0",
+            "-minlight_dirt",
+            "0",
+            "-dirt",
+            "0",
+            "-sunlight_color",
+            "255",
+            "0",
+            "0",
+            "-mincolor",
+            "0.5",
+            "0.5",
+            "1",
+            "x.bsp",
+        ]);
+        let o = &a.overrides;
+        assert_eq!(o.sunlight2, Some(0.0));
+        assert_eq!(o.minlight_dirt, Some(crate::settings::DirtToggle::AsDirt));
+        assert_eq!(o.dirt, Some(false));
+        assert_eq!(o.sunlight_color.map(|c| c.0), Some(glam::DVec3::X));
+        assert!(o.minlight_color.is_some());
+        assert_eq!(a.bsp, PathBuf::from("x.bsp"));
+        for (args, on) in [
+            (&["light", "-dirt", "x.bsp"][..], true),
+            (&["light", "-dirt", "1", "x.bsp"][..], true),
+            (&["light", "-dirt", "-1", "x.bsp"][..], false),
+            (&["light", "x.bsp", "-dirt"][..], true),
+        ] {
+            assert_eq!(parse(args).overrides.dirt, Some(on), "{args:?}");
+        }
     }
 
     /// Which run wrote a file of the pair.

@@ -210,6 +210,7 @@ fn lighting_of(lightmaps: Vec<FaceLightmap>) -> Lighting {
         coloured: false,
         outputs: crate::Outputs::default(),
         light_grid: None,
+        chosen_settings: Vec::new(),
         warnings: Vec::new(),
         stats: Stats::default(),
     }

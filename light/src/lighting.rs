@@ -6,7 +6,7 @@ use quake_formats::bsp::lightgrid::LightGrid;
 use crate::lightgrid::RawGrid;
 use crate::luxels::soften_luxels;
 use crate::output::{FaceLightmap, Outputs};
-use crate::settings::{SettingWarning, SoftRadius};
+use crate::settings::{ChosenSetting, SettingWarning, SoftRadius};
 use crate::trace::FaceLight;
 
 /// Counts and timings of a run (`--stats`).
@@ -104,7 +104,9 @@ pub struct RawLighting {
     /// `--soft` as the run was given it (its luxels are blurred already, except the
     /// reference's: [`RawLighting::softened`] blurs those).
     pub soft: SoftRadius,
-    /// Worldspawn or command-line values light did not take as given.
+    /// The settings given a value (on the command line or in worldspawn), and where.
+    pub chosen_settings: Vec<ChosenSetting>,
+    /// Entity, worldspawn or command-line values light did not take as given.
     pub warnings: Vec<SettingWarning>,
     /// Counts and timings.
     pub stats: Stats,
@@ -124,7 +126,9 @@ pub struct Lighting {
     pub outputs: Outputs,
     /// The `LIGHTGRID_OCTREE` lump's grid, when `--lightgrid` asks for it.
     pub light_grid: Option<LightGrid>,
-    /// Worldspawn or command-line values light did not take as given.
+    /// The settings given a value (on the command line or in worldspawn), and where.
+    pub chosen_settings: Vec<ChosenSetting>,
+    /// Entity, worldspawn or command-line values light did not take as given.
     pub warnings: Vec<SettingWarning>,
     /// Counts and timings.
     pub stats: Stats,

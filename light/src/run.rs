@@ -99,6 +99,7 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
         rangescale: settings.range,
         gamma: settings.gamma,
         soft: settings.soft,
+        chosen_settings: prep.lights.chosen_settings.clone(),
         warnings: prep.lights.warnings.clone(),
         stats,
     })
@@ -646,6 +647,7 @@ pub fn finish_lighting(raw: &RawLighting) -> Lighting {
         coloured: raw.coloured,
         outputs,
         light_grid: raw.grid.as_ref().map(|g| finish_grid(g, &finish)),
+        chosen_settings: raw.chosen_settings.clone(),
         warnings: raw.warnings.clone(),
         stats,
     }

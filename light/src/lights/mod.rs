@@ -22,7 +22,7 @@ use quake_formats::entities::Entity;
 use crate::dirt::{DirtResponse, DirtSampling};
 use crate::error::LightError;
 use crate::faces::Spacing;
-use crate::settings::{Overrides, SettingWarning, Settings, World};
+use crate::settings::{ChosenSetting, Overrides, SettingWarning, Settings, World};
 pub use point::{Falloff, PointLight, Spot, angle_factor};
 pub use styles::{SwitchableStyles, assign_switchable_styles};
 pub use sun::SunLight;
@@ -116,7 +116,9 @@ pub struct MapLights {
     /// The map-wide settings, resolved (the command line's, else worldspawn's, else the
     /// defaults).
     pub settings: Settings,
-    /// Worldspawn values light did not take as given.
+    /// The settings given a value, and where.
+    pub chosen_settings: Vec<ChosenSetting>,
+    /// Values light did not take as given.
     pub warnings: Vec<SettingWarning>,
     /// Styles given to switchable lights and switchable shadows, also written back into the
     /// entities (`style`, `switchshadstyle`).
@@ -178,13 +180,14 @@ pub fn parse_lights(
     let mut style_warnings = Vec::new();
     let switchable = assign_switchable_styles(entities, &mut style_warnings)?;
     let world = entities.iter().position(|e| e.classname() == "worldspawn");
-    let (settings, mut warnings) = Settings::resolve(
+    let (settings, told) = Settings::resolve(
         world.map(|index| World {
             index,
             entity: &entities[index],
         }),
         overrides,
     );
+    let mut warnings = told.warnings;
     warnings.extend(style_warnings);
     let global = worldspawn::Global::new(&settings);
     let mut out = MapLights {
@@ -207,6 +210,7 @@ pub fn parse_lights(
         model_lmscale: HashMap::new(),
         switchable,
         settings,
+        chosen_settings: told.chosen,
         warnings,
     };
     if let Some(m) = worldspawn::world_minlight(&out.settings, &global) {

@@ -7,8 +7,9 @@
 pub struct Setting {
     /// The field of [`super::Settings`] and [`super::Overrides`] it fills.
     pub field: &'static str,
-    /// Its command-line flag (`--flag`), if it has one.
-    pub flag: Option<&'static str>,
+    /// Its command-line flag (`--flag`): the declared one, else its first worldspawn key
+    /// without the underscore, as ericw-tools takes every worldspawn key as an option.
+    pub flag: &'static str,
     /// Another spelling of the flag (ericw-tools').
     pub alias: Option<&'static str>,
     /// The flag's value when it is given without one (`--bounce` = `--bounce=1`).
@@ -30,6 +31,32 @@ pub struct Setting {
     pub check: fn(&str) -> Result<(), &'static str>,
 }
 
+impl Setting {
+    /// The flag's other spellings: the declared alias, and each worldspawn key without its
+    /// underscore (`-sunlight2`, `-minlight_dirt`), as ericw-tools takes them.
+    pub fn aliases(&self) -> Vec<&'static str> {
+        let mut out: Vec<&'static str> = Vec::new();
+        let keys = self.keys.iter().map(|k| without_underscore(k));
+        for name in self.alias.into_iter().chain(keys) {
+            if name != self.flag && !out.contains(&name) {
+                out.push(name);
+            }
+        }
+        out
+    }
+}
+
+/// A worldspawn key as a flag: without its leading underscore.
+pub const fn without_underscore(key: &'static str) -> &'static str {
+    match key.as_bytes() {
+        [b'_', rest @ ..] => match std::str::from_utf8(rest) {
+            Ok(name) => name,
+            Err(_) => key,
+        },
+        _ => key,
+    }
+}
+
 /// Declares the settings. Each entry reads
 ///
 /// ```text
@@ -37,8 +64,9 @@ pub struct Setting {
 /// field: Type = default, flag "name" [alias "other"] [missing "value"], keys ["_key", ...], range Range::...;
 /// ```
 ///
-/// with `flag ...,` left out for a setting only worldspawn sets, and `keys []` for one only the
-/// command line sets. `Type` implements [`super::SettingValue`].
+/// with `flag ...,` left out for a setting whose flag is its first key without the underscore,
+/// and `keys []` for one only the command line sets. `Type` implements
+/// [`super::SettingValue`].
 macro_rules! settings {
     ($(
         $(#[doc = $doc:literal])+
@@ -70,7 +98,7 @@ macro_rules! settings {
         /// Every setting, in the order of their declarations.
         pub static TABLE: &[Setting] = &[$(Setting {
             field: stringify!($field),
-            flag: settings!(@opt $($flag)?),
+            flag: settings!(@flag [$($flag)?] [$($key),*]),
             alias: settings!(@opt $($($alias)?)?),
             missing: settings!(@opt $($($missing)?)?),
             keys: &[$($key),*],
@@ -88,26 +116,27 @@ macro_rules! settings {
 
         impl Settings {
             /// Each setting from `overrides`, else from worldspawn (`world`), else its default;
-            /// and the warnings for values that did not read or lay outside their range.
+            /// and the warnings for values that did not read or lay outside their range, and
+            /// where each value not left at its default came from.
             pub fn resolve(
                 world: Option<World>,
                 overrides: &Overrides,
-            ) -> (Settings, Vec<SettingWarning>) {
-                let mut warnings = Vec::new();
+            ) -> (Settings, Told) {
+                let mut told = Told::default();
                 let settings = Settings {
                     $($field: resolve(
                         Declared {
-                            given_as: settings!(@given $field $($flag)?),
+                            given_as: settings!(@flag [$($flag)?] [$($key),*]),
                             keys: &[$($key),*],
                             range: $range,
                         },
                         $default,
                         overrides.$field.clone(),
                         world,
-                        &mut warnings,
+                        &mut told,
                     ),)*
                 };
-                (settings, warnings)
+                (settings, told)
             }
         }
 
@@ -128,8 +157,8 @@ macro_rules! settings {
             }
         }
     };
-    (@given $field:ident) => { stringify!($field) };
-    (@given $field:ident $flag:literal) => { concat!("--", $flag) };
+    (@flag [$flag:literal] [$($key:literal),*]) => { $flag };
+    (@flag [] [$key:literal $(, $rest:literal)*]) => { without_underscore($key) };
     (@opt) => { None };
     (@opt $x:literal) => { Some($x) };
 }

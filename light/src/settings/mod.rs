@@ -20,9 +20,9 @@ use glam::DVec3;
 
 pub use crate::dirt::DirtMode;
 pub use declare::Setting;
-use declare::settings;
+use declare::{settings, without_underscore};
+pub use resolve::{ChosenSetting, Given, SettingWarning, Told, World};
 use resolve::{Declared, given, resolve};
-pub use resolve::{Given, SettingWarning, World};
 pub use value::{Color, DirtToggle, Range, SettingValue, SoftRadius, Spacing, normalize_color};
 
 settings! {
@@ -169,6 +169,11 @@ settings! {
     lightgrid_dist: Spacing = Spacing::EVEN_32, flag "lightgrid_dist", keys ["_lightgrid_dist"], range Range::Any;
 }
 
+/// Whether a default as [`Setting::default`] shows it is words (`white`, `as ...`), not a value.
+fn written_in_words(default: &str) -> bool {
+    default.starts_with("as ") || default == "white" || default == "—"
+}
+
 /// The settings as `docs/mapping.md` tables them: one row per setting, with its worldspawn
 /// keys, its flag, its default, its range and its meaning.
 pub fn markdown_table() -> String {
@@ -185,20 +190,17 @@ pub fn markdown_table() -> String {
                 format!("{} ({})", code(key), others.join(", "))
             }
         };
-        let flag = match s.flag {
-            None => "—".to_string(),
-            Some(flag) => {
-                let value = match (s.switch, s.missing) {
-                    (true, _) => "",
-                    (false, Some(_)) => " [N]",
-                    (false, None) => " N",
-                };
-                let alias = s.alias.map_or(String::new(), |a| format!(" (`--{a}`)"));
-                format!("`--{flag}{value}`{alias}")
-            }
+        let value = match (s.switch, s.missing) {
+            (true, _) => " [0\\|1]",
+            (false, Some(_)) => " [N]",
+            (false, None) => " N",
+        };
+        let flag = match s.alias {
+            Some(alias) => format!("`--{}{value}` (`--{alias}`)", s.flag),
+            None => format!("`--{}{value}`", s.flag),
         };
         let default = (s.default)();
-        let default = if default.starts_with("as ") || default == "white" || default == "—" {
+        let default = if written_in_words(&default) {
             default
         } else {
             code(&default)

@@ -19,8 +19,7 @@ pub struct World<'a> {
 /// What resolving one setting needs of its declaration.
 #[derive(Debug, Clone, Copy)]
 pub struct Declared {
-    /// How a value given to the run is named in warnings: its flag (`--flag`), or its field
-    /// when it has none.
+    /// How a value given to the run is named in warnings: its flag, without dashes.
     pub given_as: &'static str,
     /// Its worldspawn keys, the first present one winning.
     pub keys: &'static [&'static str],
@@ -42,7 +41,7 @@ pub enum Given {
         /// The key.
         key: &'static str,
     },
-    /// Given to the run (on the command line): its flag with its dashes.
+    /// Given to the run (on the command line): its flag, without dashes.
     Run(&'static str),
 }
 
@@ -92,7 +91,30 @@ impl fmt::Display for SettingWarning {
                 "entity {entity} ({classname}, line {line} of the entity lump): key \"{key}\" is \"{}\": {}",
                 self.value, self.problem
             ),
-            Given::Run(name) => write!(f, "{name} {}: {}", self.value, self.problem),
+            Given::Run(name) => write!(f, "--{name} {}: {}", self.value, self.problem),
+        }
+    }
+}
+
+/// A setting that is not at its default, its value and where it was given: what a run tells
+/// of its settings, as ericw-tools' options summary does.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ChosenSetting {
+    /// The setting's flag, without dashes.
+    pub flag: &'static str,
+    /// Its value, as messages write it.
+    pub value: String,
+    /// Where it was given.
+    pub given: Given,
+}
+
+impl fmt::Display for ChosenSetting {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match &self.given {
+            Given::Run(_) => write!(f, "{} {} (command line)", self.flag, self.value),
+            Given::Key { key, .. } => {
+                write!(f, "{} {} (worldspawn \"{key}\")", self.flag, self.value)
+            }
         }
     }
 }
@@ -106,16 +128,26 @@ pub fn given<T: SettingValue>(text: &str) -> Result<T, String> {
     }
 }
 
+/// What resolving the settings tells besides their values.
+#[derive(Debug, Default)]
+pub struct Told {
+    /// Values not taken as given.
+    pub warnings: Vec<SettingWarning>,
+    /// Settings given a value (on the command line or in worldspawn), in the table's order.
+    pub chosen: Vec<ChosenSetting>,
+}
+
 /// The setting `declared`: the value `given` to the run, else the first of its keys present
 /// in `world`, else `default`; a value outside the range is held to it, and one that does not
-/// read leaves the default, each with a warning.
+/// read leaves the default, each with a warning. A value taken is told in `told.chosen`.
 pub fn resolve<T: SettingValue>(
     declared: Declared,
     default: T,
     given: Option<T>,
     world: Option<World>,
-    warnings: &mut Vec<SettingWarning>,
+    told: &mut Told,
 ) -> T {
+    let warnings = &mut told.warnings;
     let (value, given, text) = match given {
         Some(value) => {
             let text = value.show();
@@ -138,8 +170,16 @@ pub fn resolve<T: SettingValue>(
             }
         },
     };
+    let chosen = |value: &T, given: Given| ChosenSetting {
+        flag: declared.given_as,
+        value: value.show(),
+        given,
+    };
     match value.within(declared.range) {
-        Ok(value) => value,
+        Ok(value) => {
+            told.chosen.push(chosen(&value, given));
+            value
+        }
         Err(instead) => {
             let range = declared.range.show();
             let (value, problem) = match instead {
@@ -153,7 +193,8 @@ pub fn resolve<T: SettingValue>(
                     (default, problem)
                 }
             };
-            warnings.push(SettingWarning {
+            told.chosen.push(chosen(&value, given.clone()));
+            told.warnings.push(SettingWarning {
                 given,
                 value: text,
                 problem,

@@ -2,12 +2,39 @@ use super::*;
 use quake_formats::entities::parse_entities;
 
 fn resolve_text(world: &str, overrides: &Overrides) -> (Settings, Vec<SettingWarning>) {
+    let (settings, told) = resolve_told(world, overrides);
+    (settings, told.warnings)
+}
+
+fn resolve_told(world: &str, overrides: &Overrides) -> (Settings, Told) {
     let entities = parse_entities(world).expect("parse");
     let world = World {
         index: 0,
         entity: &entities[0],
     };
     Settings::resolve(Some(world), overrides)
+}
+
+/// The run tells each setting given a value and where it came from, as ericw-tools' options
+/// summary does.
+#[test]
+fn the_settings_chosen_say_where_they_came_from() {
+    let world = r#"{ "classname" "worldspawn" "_sunlight2" "40" "_bounce" "2" }"#;
+    let overrides = Overrides {
+        bounce: Some(1),
+        dirt: Some(true),
+        ..Overrides::default()
+    };
+    let (_, told) = resolve_told(world, &overrides);
+    let said: Vec<String> = told.chosen.iter().map(ToString::to_string).collect();
+    assert_eq!(
+        said,
+        [
+            "sunlight2 40 (worldspawn \"_sunlight2\")",
+            "dirt 1 (command line)",
+            "bounce 1 (command line)"
+        ]
+    );
 }
 
 #[test]
@@ -55,7 +82,8 @@ fn worldspawn_values_out_of_range_or_unreadable_warn_and_fall_back() {
         sunsamples: Some(0),
         ..Overrides::default()
     };
-    let (s, warnings) = Settings::resolve(None, &overrides);
+    let (s, told) = Settings::resolve(None, &overrides);
+    let warnings = told.warnings;
     assert_eq!(s.sunsamples, 1);
     assert_eq!(
         warnings[0].to_string(),
@@ -67,7 +95,7 @@ fn worldspawn_values_out_of_range_or_unreadable_warn_and_fall_back() {
 fn flags_and_keys_are_each_declared_once() {
     let mut names: Vec<&str> = TABLE
         .iter()
-        .flat_map(|s| s.flag.into_iter().chain(s.alias))
+        .flat_map(|s| std::iter::once(s.flag).chain(s.aliases()))
         .collect();
     let mut keys: Vec<&str> = TABLE.iter().flat_map(|s| s.keys.iter().copied()).collect();
     for list in [&mut names, &mut keys] {
@@ -77,14 +105,9 @@ fn flags_and_keys_are_each_declared_once() {
         assert_eq!(list.len(), n, "repeated: {list:?}");
     }
     for s in TABLE {
-        assert!(
-            s.flag.is_some() || !s.keys.is_empty(),
-            "{} has neither flag nor key",
-            s.field
-        );
         assert!(!s.help.trim().is_empty(), "{} has no help", s.field);
         let default = (s.default)();
-        if s.flag.is_some() && !s.switch {
+        if !written_in_words(&default) {
             assert_eq!(
                 (s.check)(&default),
                 Ok(()),

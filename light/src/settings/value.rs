@@ -152,6 +152,8 @@ impl SettingValue for Option<String> {
 
 /// Three numbers, such as a `mangle` (more after them are ignored).
 impl SettingValue for DVec3 {
+    const WORDS: usize = 3;
+
     fn read(text: &str) -> Option<Result<DVec3, &'static str>> {
         if text.trim().is_empty() {
             return None;
@@ -232,6 +234,8 @@ pub fn normalize_color(c: DVec3) -> DVec3 {
 
 /// `r g b`, in 0..255 or all three in 0..1.
 impl SettingValue for Color {
+    const WORDS: usize = 3;
+
     fn read(text: &str) -> Option<Result<Color, &'static str>> {
         Some(DVec3::read(text)?.map(|c| Color(normalize_color(c))))
     }
