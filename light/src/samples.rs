@@ -236,6 +236,22 @@ impl FaceRegion {
             .all(|(&a, m)| m.dot(p - a) >= -slack)
     }
 
+    /// For `p` (a point on the face's plane) inside the region or on its edge, no edge's
+    /// inward distance negative: whether it lies on the outline ([`FaceRegion::on_edge`]);
+    /// `None` for any other point, which [`FaceRegion::nearest`] moves.
+    fn inside_on_edge(&self, p: DVec3) -> Option<bool> {
+        let mut nearest = f64::INFINITY;
+        for (&a, m) in self.points.iter().zip(&self.inward) {
+            let d = m.dot(p - a);
+            // Written so a NaN distance fails it too.
+            if !(d >= 0.0) {
+                return None;
+            }
+            nearest = nearest.min(d);
+        }
+        Some(nearest < ON_EDGE)
+    }
+
     /// Whether `p` (a point of the region) lies on its outline (within [`ON_EDGE`]).
     fn on_edge(&self, p: DVec3) -> bool {
         (self.points.iter().zip(&self.inward)).any(|(&a, m)| m.dot(p - a) < ON_EDGE)
@@ -340,6 +356,16 @@ impl SurfaceMap {
             };
         };
         let on_plane = m.point(s, t) + self.origin;
+        // Most points lie inside the face: then it is where they stay, and one pass over the
+        // edges tells all (the tests below would each find the same).
+        if let Some(on_edge) = self.outline.inside_on_edge(on_plane) {
+            return Placed {
+                at: on_plane + self.lift,
+                moved: false,
+                on_edge,
+                beyond: false,
+            };
+        }
         if !self.outline.contains(on_plane)
             && self.continuations.iter().any(|c| c.contains(on_plane))
         {
@@ -460,7 +486,8 @@ pub fn face_samples(face: &FaceGeom, per_axis: usize, bsp: &Bsp) -> (FaceSamples
         clamped: moved.iter().filter(|&&m| m).count() as u64,
         ..PlacementCounts::default()
     };
-    let solid = solid_points(bsp, &points);
+    // A luxel's samples, or a few luxels of a row, lie close together.
+    let solid = solid_points_in_tiles(bsp, &points, (per_axis * per_axis).max(4));
     let mut occluded = vec![false; count];
     for i in 0..count {
         if placed[i].beyond {
@@ -535,7 +562,7 @@ const SHARED_WALK_MARGIN: f32 = 0.25;
 /// points are rounded to f32 after the box is taken.
 const FOOTPRINT_BOX_SLACK: f64 = 0.01;
 
-/// A node of the world BSP where the shared walk of [`solid_points`]
+/// A node of the world BSP where the shared walk of [`solid_points_in_tiles`]
 /// arrives for every point inside a box: walks of points inside that box
 /// (the close-light footprints of one face) start there instead of at the
 /// root, and end where they would have. A box inside another one is on one
@@ -605,30 +632,35 @@ fn solid_below(bsp: &Bsp, mut node: i32, p: [f32; 3], mut depth: usize) -> bool 
             .is_some_and(|l| l.contents == contents::SOLID || l.contents == contents::SKY)
 }
 
-/// Whether each of `points` is in solid ([`solid_at`]). The points share the
-/// walk from the root down to the first node whose plane passes between
-/// them, so a cluster (a face's samples, a luxel's square) costs about one
-/// walk instead of one each.
-pub fn solid_points(bsp: &Bsp, points: &[[f32; 3]]) -> Vec<bool> {
+/// Whether each of `points` is in solid ([`solid_at`]), for points that lie in tiles of `tile`
+/// consecutive points close together (a luxel's samples). The points share the walk from the
+/// root down to the first node whose plane passes between them; then each tile shares the walk
+/// on down to where its own points part, so a tile inside one leaf costs one walk, not one a
+/// point.
+pub fn solid_points_in_tiles(bsp: &Bsp, points: &[[f32; 3]], tile: usize) -> Vec<bool> {
     match WalkStart::root(bsp) {
-        Some(root) => solid_points_from(bsp, &root, points),
+        Some(root) => solid_points_from_in_tiles(bsp, &root, points, tile),
         None => vec![false; points.len()],
     }
 }
 
-/// [`solid_points`], with the walk starting at `start` when it holds all
+/// [`solid_points_in_tiles`] in one tile, with the walk starting at `start` when it holds all
 /// of `points` (else at the root).
 pub fn solid_points_from(bsp: &Bsp, start: &WalkStart, points: &[[f32; 3]]) -> Vec<bool> {
+    solid_points_from_in_tiles(bsp, start, points, points.len())
+}
+
+/// [`solid_points_from`] in tiles of `tile` points ([`solid_points_in_tiles`]).
+fn solid_points_from_in_tiles(
+    bsp: &Bsp,
+    start: &WalkStart,
+    points: &[[f32; 3]],
+    tile: usize,
+) -> Vec<bool> {
     if points.is_empty() {
         return Vec::new();
     }
-    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    for p in points {
-        for a in 0..3 {
-            lo[a] = lo[a].min(p[a]);
-            hi[a] = hi[a].max(p[a]);
-        }
-    }
+    let (lo, hi) = box_of(points);
     let from = if start.contains(lo, hi) {
         start.node
     } else {
@@ -638,10 +670,25 @@ pub fn solid_points_from(bsp: &Bsp, start: &WalkStart, points: &[[f32; 3]]) -> V
         }
     };
     let node = shared_walk(bsp, from, lo, hi);
-    points
-        .iter()
-        .map(|&p| solid_below(bsp, node, p, 0))
-        .collect()
+    let mut solid = Vec::with_capacity(points.len());
+    for tile in points.chunks(tile.max(1)) {
+        let (lo, hi) = box_of(tile);
+        let node = shared_walk(bsp, node, lo, hi);
+        solid.extend(tile.iter().map(|&p| solid_below(bsp, node, p, 0)));
+    }
+    solid
+}
+
+/// The box of `points` (not empty).
+fn box_of(points: &[[f32; 3]]) -> ([f32; 3], [f32; 3]) {
+    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for p in points {
+        for a in 0..3 {
+            lo[a] = lo[a].min(p[a]);
+            hi[a] = hi[a].max(p[a]);
+        }
+    }
+    (lo, hi)
 }
 
 /// From `node` down, the first node whose plane passes between the corners

@@ -1738,11 +1738,13 @@ fn shared_leaf_walk_agrees_with_walking_each_point() {
                 .collect();
             let expected: Vec<bool> = cluster.iter().map(per_point).collect();
             solid_seen += expected.iter().filter(|&&s| s).count();
-            assert_eq!(
-                crate::samples::solid_points(&bsp, &cluster),
-                expected,
-                "cluster at {cx} {cz}"
-            );
+            for tile in [1, 3, 4, 16] {
+                assert_eq!(
+                    crate::samples::solid_points_in_tiles(&bsp, &cluster, tile),
+                    expected,
+                    "cluster at {cx} {cz} in tiles of {tile}"
+                );
+            }
             // A walk started where a box around the cluster parts ways,
             // and one whose start box misses the cluster (from the root).
             for (lo, hi) in [
@@ -1762,7 +1764,7 @@ fn shared_leaf_walk_agrees_with_walking_each_point() {
         }
     }
     assert!(solid_seen > 0, "some clusters reach into solid");
-    assert!(crate::samples::solid_points(&bsp, &[]).is_empty());
+    assert!(crate::samples::solid_points_in_tiles(&bsp, &[], 4).is_empty());
 }
 
 #[test]
