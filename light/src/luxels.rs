@@ -46,11 +46,16 @@ impl SampleImage {
         let width = luxel_width * per_axis;
         let height = samples.len() / per / luxel_width.max(1) * per_axis;
         let mut out = vec![T::default(); samples.len()];
-        for (i, &v) in samples.iter().enumerate() {
-            let (luxel, sub) = (i / per, i % per);
-            let x = (luxel % luxel_width) * per_axis + sub % per_axis;
-            let y = (luxel / luxel_width) * per_axis + sub / per_axis;
-            out[y * width + x] = v;
+        // Each row of a luxel's samples is a run of one of the image's rows.
+        for (luxel, block) in samples.chunks_exact(per).enumerate() {
+            let (x, y) = (
+                (luxel % luxel_width) * per_axis,
+                (luxel / luxel_width) * per_axis,
+            );
+            for (sub_row, run) in block.chunks_exact(per_axis).enumerate() {
+                let at = (y + sub_row) * width + x;
+                out[at..at + per_axis].copy_from_slice(run);
+            }
         }
         (width, height, out)
     }
@@ -104,35 +109,41 @@ impl SampleImage {
     }
 
     /// Box-blurs the image `radius` samples each way, edges clamped (step 2). The clamped box
-    /// is separable: rows, then columns.
+    /// is separable: rows, then columns. Each sample sums its taps in the same order (the
+    /// nearest edge sample standing in for those past it), tap by tap over a whole row at once.
     fn blur(&mut self, radius: usize) {
-        if radius == 0 {
+        if radius == 0 || self.values.is_empty() {
             return;
         }
         let (w, h) = (self.width, self.height);
         let taps = (2 * radius + 1) as f32;
-        let along = |len: usize, at: &dyn Fn(usize) -> [f32; 3]| -> Vec<[f32; 3]> {
-            (0..len)
-                .map(|i| {
-                    let mut acc = [0.0f32; 3];
-                    for d in 0..=2 * radius {
-                        let j = (i + d).saturating_sub(radius).min(len - 1);
-                        let v = at(j);
-                        for k in 0..3 {
-                            acc[k] += v[k];
-                        }
-                    }
-                    acc.map(|a| a / taps)
-                })
-                .collect()
+        let add = |acc: &mut [f32; 3], v: &[f32; 3]| {
+            for k in 0..3 {
+                acc[k] += v[k];
+            }
         };
-        let mut rows = Vec::with_capacity(self.values.len());
-        for y in 0..h {
-            rows.extend(along(w, &|x| self.values[y * w + x]));
+        let mut rows = vec![[0.0f32; 3]; w * h];
+        for (src, dst) in self.values.chunks_exact(w).zip(rows.chunks_exact_mut(w)) {
+            for d in 0..=2 * radius {
+                for (x, acc) in dst.iter_mut().enumerate() {
+                    add(acc, &src[(x + d).saturating_sub(radius).min(w - 1)]);
+                }
+            }
+            for acc in dst {
+                *acc = acc.map(|a| a / taps);
+            }
         }
-        for x in 0..w {
-            for (y, v) in along(h, &|y| rows[y * w + x]).into_iter().enumerate() {
-                self.values[y * w + x] = v;
+        let mut column_sums = vec![[0.0f32; 3]; w];
+        for (y, dst) in self.values.chunks_exact_mut(w).enumerate() {
+            column_sums.fill([0.0; 3]);
+            for d in 0..=2 * radius {
+                let from = (y + d).saturating_sub(radius).min(h - 1);
+                for (acc, v) in column_sums.iter_mut().zip(&rows[from * w..][..w]) {
+                    add(acc, v);
+                }
+            }
+            for (out, acc) in dst.iter_mut().zip(&column_sums) {
+                *out = acc.map(|a| a / taps);
             }
         }
     }
