@@ -117,33 +117,44 @@ impl SampleImage {
         }
         let (w, h) = (self.width, self.height);
         let taps = (2 * radius + 1) as f32;
-        let add = |acc: &mut [f32; 3], v: &[f32; 3]| {
-            for k in 0..3 {
-                acc[k] += v[k];
+        let add = |acc: &mut [f32], v: &[f32]| {
+            for (a, v) in acc.iter_mut().zip(v) {
+                *a += v;
             }
         };
         let mut rows = vec![[0.0f32; 3]; w * h];
         for (src, dst) in self.values.chunks_exact(w).zip(rows.chunks_exact_mut(w)) {
             for d in 0..=2 * radius {
-                for (x, acc) in dst.iter_mut().enumerate() {
-                    add(acc, &src[(x + d).saturating_sub(radius).min(w - 1)]);
+                // Tap d of sample x reads sample x + d - radius, held to the row.
+                let before = radius.saturating_sub(d).min(w);
+                let past = d.saturating_sub(radius).min(w - before);
+                let (left, rest) = dst.split_at_mut(before);
+                let (middle, right) = rest.split_at_mut(w - before - past);
+                for acc in left {
+                    add(acc, &src[0]);
+                }
+                if !middle.is_empty() {
+                    let from = before + d - radius;
+                    let taps = &src[from..][..middle.len()];
+                    add(middle.as_flattened_mut(), taps.as_flattened());
+                }
+                for acc in right {
+                    add(acc, &src[w - 1]);
                 }
             }
-            for acc in dst {
-                *acc = acc.map(|a| a / taps);
+            for a in dst.as_flattened_mut() {
+                *a /= taps;
             }
         }
-        let mut column_sums = vec![[0.0f32; 3]; w];
+        let mut column_sums = vec![0.0f32; 3 * w];
         for (y, dst) in self.values.chunks_exact_mut(w).enumerate() {
-            column_sums.fill([0.0; 3]);
+            column_sums.fill(0.0);
             for d in 0..=2 * radius {
                 let from = (y + d).saturating_sub(radius).min(h - 1);
-                for (acc, v) in column_sums.iter_mut().zip(&rows[from * w..][..w]) {
-                    add(acc, v);
-                }
+                add(&mut column_sums, rows[from * w..][..w].as_flattened());
             }
-            for (out, acc) in dst.iter_mut().zip(&column_sums) {
-                *out = acc.map(|a| a / taps);
+            for (out, acc) in dst.as_flattened_mut().iter_mut().zip(&column_sums) {
+                *out = acc / taps;
             }
         }
     }
@@ -289,5 +300,55 @@ mod tests {
         assert_eq!(soften_luxels(&luxels, 2, 4, 0), luxels);
         let soft = soften_luxels(&luxels, 2, 4, 2);
         assert!(soft[0][0] > 1.0 && soft[3][0] < 4.0, "{soft:?}");
+    }
+
+    /// The blur as its definition reads: each sample the mean of its clamped taps, summed in
+    /// tap order, rows then columns.
+    fn blur_by_definition(values: &[[f32; 3]], w: usize, h: usize, r: usize) -> Vec<[f32; 3]> {
+        let taps = (2 * r + 1) as f32;
+        let mean = |at: &dyn Fn(usize) -> [f32; 3], i: usize, len: usize| {
+            let mut acc = [0.0f32; 3];
+            for d in 0..=2 * r {
+                let v = at((i + d).saturating_sub(r).min(len - 1));
+                for k in 0..3 {
+                    acc[k] += v[k];
+                }
+            }
+            acc.map(|a| a / taps)
+        };
+        let rows: Vec<[f32; 3]> = (0..w * h)
+            .map(|i| mean(&|x| values[i / w * w + x], i % w, w))
+            .collect();
+        (0..w * h)
+            .map(|i| mean(&|y| rows[y * w + i % w], i / w, h))
+            .collect()
+    }
+
+    proptest::proptest! {
+        /// The blur gives the very bits of its definition, for any size and radius.
+        #[test]
+        fn blur_matches_its_definition_bit_for_bit(
+            w in 1usize..12,
+            h in 1usize..12,
+            r in 1usize..5,
+            seed in proptest::prelude::any::<u64>(),
+        ) {
+            let mut x = seed | 1;
+            let values: Vec<[f32; 3]> = (0..w * h)
+                .map(|_| {
+                    std::array::from_fn(|_| {
+                        x ^= x << 13;
+                        x ^= x >> 7;
+                        x ^= x << 17;
+                        (x % 100_000) as f32 / 7.0
+                    })
+                })
+                .collect();
+            let want = blur_by_definition(&values, w, h, r);
+            let mut image = SampleImage { width: w, height: h, values };
+            image.blur(r);
+            let bits = |v: &[[f32; 3]]| v.iter().flatten().map(|f| f.to_bits()).collect::<Vec<_>>();
+            proptest::prop_assert_eq!(bits(&image.values), bits(&want));
+        }
     }
 }

@@ -191,12 +191,47 @@ pub struct FaceRegion {
     inward: Vec<DVec3>,
     /// Per edge: the step from `points[i]` to the next and its squared length.
     edges: Vec<(DVec3, f64)>,
+    /// The mean of the corners, and the square of a distance from it past which no point is
+    /// [`FaceRegion::contains`]'s (infinite when the corners' angles are too sharp to say).
+    centre: DVec3,
+    reach2: f64,
+}
+
+/// How far outside an edge (units) a point still counts as inside ([`FaceRegion::contains`]).
+const CONTAINS_SLACK: f64 = 1e-6;
+
+/// The square of a distance from `centre` beyond which no point is within [`CONTAINS_SLACK`]
+/// (and the rounding of the edge test) of every edge's inner side: the farthest corner, plus
+/// how far pushing each edge out that much moves a corner (more at a sharper corner), plus room
+/// for rounding. Infinite for a degenerate edge or a corner sharper than a thousandth of a
+/// radian, where no such bound is worth having.
+fn reach2(points: &[DVec3], inward: &[DVec3], centre: DVec3) -> f64 {
+    let n = points.len();
+    if n < 3 || inward.iter().any(|m| *m == DVec3::ZERO) {
+        return f64::INFINITY;
+    }
+    let mut sharpest = f64::INFINITY;
+    for i in 0..n {
+        // The corner at points[i], between edge i - 1 and edge i: half its angle's sine.
+        let (before, after) = (inward[(i + n - 1) % n], inward[i]);
+        let half_sine = ((1.0 + before.dot(after)) / 2.0).max(0.0).sqrt();
+        sharpest = sharpest.min(half_sine);
+    }
+    if !(sharpest > 1e-3) {
+        return f64::INFINITY;
+    }
+    let farthest = points
+        .iter()
+        .map(|p| p.distance(centre))
+        .fold(0.0, f64::max);
+    let reach = farthest + 2.0 * CONTAINS_SLACK / sharpest + 1e-3;
+    reach * reach
 }
 
 impl FaceRegion {
     fn from_points(points: Vec<DVec3>, normal: DVec3) -> FaceRegion {
         let centre = points.iter().fold(DVec3::ZERO, |a, &p| a + p) / points.len().max(1) as f64;
-        let inward = (0..points.len())
+        let inward: Vec<DVec3> = (0..points.len())
             .map(|i| {
                 let a = points[i];
                 let b = points[(i + 1) % points.len()];
@@ -210,10 +245,13 @@ impl FaceRegion {
                 (ab, ab.dot(ab))
             })
             .collect();
+        let reach2 = reach2(&points, &inward, centre);
         FaceRegion {
             points,
             inward,
             edges,
+            centre,
+            reach2,
         }
     }
 
@@ -224,16 +262,14 @@ impl FaceRegion {
 
     /// Mean of the corners (inside: the region is convex).
     pub fn centre(&self) -> DVec3 {
-        self.points.iter().fold(DVec3::ZERO, |a, &p| a + p) / self.points.len().max(1) as f64
+        self.centre
     }
 
     /// Whether `p` (a point on the face's plane) is inside the region or on its edge.
     fn contains(&self, p: DVec3) -> bool {
-        let slack = 1e-6;
-        self.points
-            .iter()
-            .zip(&self.inward)
-            .all(|(&a, m)| m.dot(p - a) >= -slack)
+        // Far from the region, no edge need be looked at.
+        p.distance_squared(self.centre) <= self.reach2
+            && (self.points.iter().zip(&self.inward)).all(|(&a, m)| m.dot(p - a) >= -CONTAINS_SLACK)
     }
 
     /// For `p` (a point on the face's plane) inside the region or on its edge, no edge's
@@ -260,11 +296,23 @@ impl FaceRegion {
     /// `p` (a point on the face's plane) if it is inside, else the nearest
     /// point of the region's outline. Only edges `p` is outside of can hold
     /// that point (or end in it): the region is convex.
+    #[cfg(test)]
     pub fn nearest(&self, p: DVec3) -> DVec3 {
+        self.nearest_on_edge(p).0
+    }
+
+    /// Inward distance of `p` from edge `edge`'s line.
+    fn distance(&self, edge: usize, p: DVec3) -> f64 {
+        self.inward[edge].dot(p - self.points[edge])
+    }
+
+    /// [`FaceRegion::nearest`], and the edge it lies on when `p` moved.
+    fn nearest_on_edge(&self, p: DVec3) -> (DVec3, Option<usize>) {
         let mut best = p;
+        let mut best_edge = None;
         let mut best_d2 = f64::INFINITY;
         let edges = self.points.iter().zip(&self.inward).zip(&self.edges);
-        for ((&a, m), &(ab, len2)) in edges {
+        for (edge, ((&a, m), &(ab, len2))) in edges.enumerate() {
             if m.dot(p - a) >= 0.0 {
                 continue;
             }
@@ -278,9 +326,10 @@ impl FaceRegion {
             if d.dot(d) < best_d2 {
                 best_d2 = d.dot(d);
                 best = q;
+                best_edge = Some(edge);
             }
         }
-        best
+        (best, best_edge)
     }
 }
 
@@ -376,15 +425,19 @@ impl SurfaceMap {
                 beyond: false,
             };
         }
-        let on_face = self.outline.nearest(on_plane);
+        let (on_face, onto) = self.outline.nearest_on_edge(on_plane);
         let step = on_face - on_plane;
         let along = |axis: [f64; 4]| DVec3::new(axis[0], axis[1], axis[2]).dot(step);
         let [ds, dt] = self.grid.axes.map(along);
+        // A point moved onto an edge lies on it: that edge's distance says so without the
+        // others'.
+        let on_edge = onto.is_some_and(|edge| self.outline.distance(edge, on_face) < ON_EDGE)
+            || self.outline.on_edge(on_face);
         Placed {
             at: on_face + self.lift,
             moved: on_face != on_plane,
-            on_edge: self.outline.on_edge(on_face),
-            beyond: ds.hypot(dt) > self.grid.scale,
+            on_edge,
+            beyond: longer_than(ds, dt, self.grid.scale),
         }
     }
 
@@ -450,6 +503,21 @@ impl SurfaceMap {
     }
 }
 
+/// Whether the step `(ds, dt)` is longer than `limit`, as `ds.hypot(dt) > limit` says: the
+/// sum of squares answers all but the steps within a millionth of the limit.
+fn longer_than(ds: f64, dt: f64, limit: f64) -> bool {
+    let (squares, limit2) = (ds * ds + dt * dt, limit * limit);
+    if !(limit > 0.0) {
+        ds.hypot(dt) > limit
+    } else if squares < limit2 * (1.0 - 1e-6) {
+        false
+    } else if squares > limit2 * (1.0 + 1e-6) {
+        true
+    } else {
+        ds.hypot(dt) > limit
+    }
+}
+
 /// Where each luxel of `face`'s 16-texel lightmap lies on its own grid (continuous luxel
 /// coordinates, row by row): the point of its plane at the luxel's texture coordinates,
 /// projected onto the grid. Without a usable texture projection: the grid's first luxel.
@@ -489,11 +557,20 @@ pub fn face_samples(face: &FaceGeom, per_axis: usize, bsp: &Bsp) -> (FaceSamples
     // A luxel's samples, or a few luxels of a row, lie close together.
     let solid = solid_points_in_tiles(bsp, &points, (per_axis * per_axis).max(4));
     let mut occluded = vec![false; count];
+    // The nudges of points in solid walk the tree from where a box round all the points, and
+    // half a unit more, parts.
+    let nudge_start = solid.contains(&true).then(|| {
+        let (lo, hi) = box_of(&points);
+        WalkStart::for_box(bsp, lo.map(|c| c - 1.0), hi.map(|c| c + 1.0))
+    });
     for i in 0..count {
         if placed[i].beyond {
             occluded[i] = true;
         } else if solid[i] {
-            match nudged(bsp, points[i]) {
+            match nudge_start
+                .flatten()
+                .and_then(|start| nudged(bsp, &start, points[i]))
+            {
                 Some(p) => {
                     points[i] = p;
                     moved[i] = true;
@@ -539,12 +616,21 @@ const NUDGES: [[f32; 3]; 8] = [
     [0.5, 0.5, 0.5],
 ];
 
-/// The first of `p`'s [`NUDGES`] that is in the open, if any.
-fn nudged(bsp: &Bsp, p: [f32; 3]) -> Option<[f32; 3]> {
+/// The first of `p`'s [`NUDGES`] that is in the open, if any; the walks start from `start`
+/// when its box holds every nudge.
+fn nudged(bsp: &Bsp, start: &WalkStart, p: [f32; 3]) -> Option<[f32; 3]> {
+    // The nudges' box: the same sums as the nudges' own.
+    let (lo, hi) = (p.map(|c| c - 0.5), p.map(|c| c + 0.5));
+    let from = if start.contains(lo, hi) {
+        start.node
+    } else {
+        WalkStart::root(bsp)?.node
+    };
+    let node = shared_walk(bsp, from, lo, hi);
     NUDGES
         .iter()
         .map(|d| [p[0] + d[0], p[1] + d[1], p[2] + d[2]])
-        .find(|&t| !solid_at(bsp, t))
+        .find(|&t| !solid_below(bsp, node, t, 0))
 }
 
 /// How near a node's plane (units) a point counts as lying on it, and is in solid when the
@@ -684,8 +770,13 @@ fn box_of(points: &[[f32; 3]]) -> ([f32; 3], [f32; 3]) {
     let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
     for p in points {
         for a in 0..3 {
-            lo[a] = lo[a].min(p[a]);
-            hi[a] = hi[a].max(p[a]);
+            // As `min` and `max` take them, a NaN coordinate changing nothing.
+            if p[a] < lo[a] {
+                lo[a] = p[a];
+            }
+            if p[a] > hi[a] {
+                hi[a] = p[a];
+            }
         }
     }
     (lo, hi)
@@ -739,6 +830,21 @@ mod tests {
     }
 
     proptest! {
+        /// The sum of squares answers as the hypotenuse does, near the limit too.
+        #[test]
+        fn longer_than_agrees_with_hypot(
+            ds in -40.0f64..40.0,
+            dt in -40.0f64..40.0,
+            limit in prop_oneof![Just(16.0f64), Just(8.0), Just(0.0), -4.0f64..64.0],
+            scale in prop_oneof![Just(1.0f64), Just(1.0 + 1e-9), Just(1.0 - 1e-9), 0.5f64..1.5],
+        ) {
+            let (ds, dt) = (ds * scale, dt * scale);
+            prop_assert_eq!(longer_than(ds, dt, limit), ds.hypot(dt) > limit);
+            let on = limit / std::f64::consts::SQRT_2;
+            prop_assert_eq!(longer_than(on, on, limit), on.hypot(on) > limit);
+            prop_assert_eq!(longer_than(limit, 0.0, limit), limit.hypot(0.0) > limit);
+        }
+
         /// Looking only at the edges a point is outside of finds the same nearest point.
         #[test]
         fn nearest_looks_only_at_edges_the_point_is_outside_of(
@@ -764,6 +870,33 @@ mod tests {
             } else {
                 let want = nearest_of_every_edge(&region, p);
                 prop_assert!(((p - got).length() - (p - want).length()).abs() < 1e-9);
+            }
+        }
+
+        /// The distance bound never turns away a point the edges take, near the outline too.
+        #[test]
+        fn contains_takes_what_every_edge_takes(
+            mut angles in proptest::collection::vec(0.0f64..std::f64::consts::TAU, 3..9),
+            radius in 1.0f64..500.0,
+            x in -800.0f64..800.0,
+            y in -800.0f64..800.0,
+            toward in 0usize..9,
+            nudge in -1e-5f64..1e-5,
+        ) {
+            angles.sort_by(f64::total_cmp);
+            angles.dedup_by(|a, b| (*a - *b).abs() < 0.01);
+            prop_assume!(angles.len() >= 3);
+            let points: Vec<DVec3> = angles
+                .iter()
+                .map(|a| DVec3::new(radius * a.cos(), radius * a.sin(), 64.0))
+                .collect();
+            let region = FaceRegion::from_points(points, DVec3::Z);
+            // A point anywhere, and one just off a corner.
+            let corner = region.points[toward % region.points.len()];
+            for p in [DVec3::new(x, y, 64.0), corner + DVec3::new(nudge, -nudge, 0.0)] {
+                let by_edges = (region.points.iter().zip(&region.inward))
+                    .all(|(&a, m)| m.dot(p - a) >= -CONTAINS_SLACK);
+                prop_assert_eq!(region.contains(p), by_edges);
             }
         }
 

@@ -204,7 +204,7 @@ impl<'a> FaceTrace<'a> {
             per_luxel: samples.per_luxel(),
             sums: StyleBuffers::new(n),
             // Local-minlight (delay 4) lights raise luxels to a floor instead of adding.
-            floors: StyleBuffers::new(n),
+            floors: StyleBuffers::none_yet(n),
             added_minlight: None,
             no_bounce: None,
             bounce_dirt: Vec::new(),

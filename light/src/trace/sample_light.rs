@@ -23,6 +23,14 @@ impl StyleBuffers {
         }
     }
 
+    /// No style yet: [`StyleBuffers::get`] makes each when first asked for.
+    pub fn none_yet(len: usize) -> StyleBuffers {
+        StyleBuffers {
+            len,
+            styles: Vec::new(),
+        }
+    }
+
     pub fn get(&mut self, style: u8) -> &mut Vec<[f32; 3]> {
         let i = match self.styles.iter().position(|(s, _)| *s == style) {
             Some(i) => i,
@@ -44,6 +52,7 @@ pub struct SampleLight {
     pub height: usize,
     pub(super) per_luxel: usize,
     pub(super) sums: StyleBuffers,
+    /// Per style, the floor under its sums (style 0's is zero until something raises it).
     pub(super) floors: StyleBuffers,
     /// `--addmin` minlight of style 0, added when finishing (it does not bounce).
     pub(super) added_minlight: Option<Vec<[f32; 3]>>,
@@ -285,6 +294,14 @@ impl SampleLight {
                 let f = dirt.get(i).copied().unwrap_or(1.0);
                 for k in 0..3 {
                     s[k] += b[k] * f;
+                }
+            }
+        }
+        // Style 0's floor is zero where nothing raised it: light never sums below none.
+        if !self.floors.styles.iter().any(|(style, _)| *style == 0) {
+            for s in self.sums.get(0) {
+                for c in 0..3 {
+                    s[c] = s[c].max(0.0);
                 }
             }
         }
