@@ -207,7 +207,7 @@ const CONTAINS_SLACK: f64 = 1e-6;
 /// radian, where no such bound is worth having.
 fn reach2(points: &[DVec3], inward: &[DVec3], centre: DVec3) -> f64 {
     let n = points.len();
-    if n < 3 || inward.iter().any(|m| *m == DVec3::ZERO) {
+    if n < 3 || inward.contains(&DVec3::ZERO) {
         return f64::INFINITY;
     }
     let mut sharpest = f64::INFINITY;
@@ -217,7 +217,7 @@ fn reach2(points: &[DVec3], inward: &[DVec3], centre: DVec3) -> f64 {
         let half_sine = ((1.0 + before.dot(after)) / 2.0).max(0.0).sqrt();
         sharpest = sharpest.min(half_sine);
     }
-    if !(sharpest > 1e-3) {
+    if sharpest.is_nan() || sharpest <= 1e-3 {
         return f64::INFINITY;
     }
     let farthest = points
@@ -279,8 +279,7 @@ impl FaceRegion {
         let mut nearest = f64::INFINITY;
         for (&a, m) in self.points.iter().zip(&self.inward) {
             let d = m.dot(p - a);
-            // Written so a NaN distance fails it too.
-            if !(d >= 0.0) {
+            if d.is_nan() || d < 0.0 {
                 return None;
             }
             nearest = nearest.min(d);
@@ -507,7 +506,7 @@ impl SurfaceMap {
 /// sum of squares answers all but the steps within a millionth of the limit.
 fn longer_than(ds: f64, dt: f64, limit: f64) -> bool {
     let (squares, limit2) = (ds * ds + dt * dt, limit * limit);
-    if !(limit > 0.0) {
+    if limit.is_nan() || limit <= 0.0 {
         ds.hypot(dt) > limit
     } else if squares < limit2 * (1.0 - 1e-6) {
         false
