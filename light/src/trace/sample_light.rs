@@ -299,10 +299,8 @@ impl SampleLight {
         }
         // Style 0's floor is zero where nothing raised it: light never sums below none.
         if !self.floors.styles.iter().any(|(style, _)| *style == 0) {
-            for s in self.sums.get(0) {
-                for c in 0..3 {
-                    s[c] = s[c].max(0.0);
-                }
+            for s in self.sums.get(0).as_flattened_mut() {
+                *s = s.max(0.0);
             }
         }
         for (style, floor) in &self.floors.styles {
