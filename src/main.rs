@@ -54,7 +54,24 @@ enum Command {
     Decompile(decompile::DecompileArgs),
 }
 
+unsafe extern "C" {
+    /// mimalloc's `mi_option_set` (mimalloc.h), in the library the allocator links.
+    fn mi_option_set(option: std::ffi::c_int, value: std::ffi::c_long);
+}
+
+/// `mi_option_purge_delay` in mimalloc.h's `mi_option_t` (the same in its versions 2 and 3).
+const MI_OPTION_PURGE_DELAY: std::ffi::c_int = 15;
+
+/// Freed memory stays with the process until it ends: every stage frees and takes back buffers
+/// of the same sizes face after face, and memory given back to the system comes back zeroed by
+/// the kernel, page by page (huge pages included), each time it is taken again.
+fn keep_freed_memory() {
+    // SAFETY: setting an option is allowed at any time; -1 is its documented "never purge".
+    unsafe { mi_option_set(MI_OPTION_PURGE_DELAY, -1) };
+}
+
 fn main() -> ExitCode {
+    keep_freed_memory();
     let cli = Cli::parse_from(batch::command_words(std::env::args()));
     match run(cli.command) {
         Ok(code) => code,
