@@ -759,9 +759,59 @@ fn solid_points_from_in_tiles(
     for tile in points.chunks(tile.max(1)) {
         let (lo, hi) = box_of(tile);
         let node = shared_walk(bsp, node, lo, hi);
-        solid.extend(tile.iter().map(|&p| solid_below(bsp, node, p, 0)));
+        let mut budget = OPEN_BOX_NODES;
+        if box_is_open(bsp, node, lo, hi, &mut budget) == Some(true) {
+            solid.extend(std::iter::repeat_n(false, tile.len()));
+        } else {
+            solid.extend(tile.iter().map(|&p| solid_below(bsp, node, p, 0)));
+        }
     }
     solid
+}
+
+/// The most nodes [`box_is_open`] looks at before leaving a tile to its points' own walks.
+const OPEN_BOX_NODES: usize = 48;
+
+/// Whether every leaf the box `lo..hi` may reach from `node` is open (neither solid nor sky),
+/// a node's plane passing within [`SHARED_WALK_MARGIN`] of the box sending it down both sides:
+/// then no point of the box is in solid, whatever [`solid_below`] would have walked, since that
+/// walk only goes where this one does. `None` when that takes more than `budget` nodes.
+fn box_is_open(
+    bsp: &Bsp,
+    mut node: i32,
+    lo: [f32; 3],
+    hi: [f32; 3],
+    budget: &mut usize,
+) -> Option<bool> {
+    while node >= 0 {
+        *budget = budget.checked_sub(1)?;
+        let n = bsp.nodes.get(node as usize)?;
+        let plane = bsp.planes.get(n.plane as usize)?;
+        let (near, far) = box_distances(plane, lo, hi);
+        node = if near >= SHARED_WALK_MARGIN {
+            n.children[0]
+        } else if far < -SHARED_WALK_MARGIN {
+            n.children[1]
+        } else {
+            if !box_is_open(bsp, n.children[0], lo, hi, budget)? {
+                return Some(false);
+            }
+            n.children[1]
+        };
+    }
+    let leaf = bsp.leafs.get((-(node + 1)) as usize)?;
+    Some(leaf.contents != contents::SOLID && leaf.contents != contents::SKY)
+}
+
+/// The least and the greatest distance of the box `lo..hi` from `plane`.
+fn box_distances(plane: &quake_formats::bsp::BspPlane, lo: [f32; 3], hi: [f32; 3]) -> (f32, f32) {
+    let (mut near, mut far) = (-plane.dist, -plane.dist);
+    for a in 0..3 {
+        let (x, y) = (plane.normal[a] * lo[a], plane.normal[a] * hi[a]);
+        near += x.min(y);
+        far += x.max(y);
+    }
+    (near, far)
 }
 
 /// The box of `points` (not empty).
@@ -792,12 +842,7 @@ fn shared_walk(bsp: &Bsp, mut node: i32, lo: [f32; 3], hi: [f32; 3]) -> i32 {
         let Some(plane) = bsp.planes.get(n.plane as usize) else {
             break;
         };
-        let (mut near, mut far) = (-plane.dist, -plane.dist);
-        for a in 0..3 {
-            let (x, y) = (plane.normal[a] * lo[a], plane.normal[a] * hi[a]);
-            near += x.min(y);
-            far += x.max(y);
-        }
+        let (near, far) = box_distances(plane, lo, hi);
         node = if near >= SHARED_WALK_MARGIN {
             n.children[0]
         } else if far < -SHARED_WALK_MARGIN {
