@@ -188,14 +188,16 @@ pub fn engine_contents(c: i32) -> i32 {
     }
 }
 
-/// Ranking of contents: a region holding several brushes takes the strongest. A liquid holding
-/// an illusionary brush ranks just above the liquid alone, so that it owns the faces between them.
+/// Ranking of contents: a region holding several brushes takes the strongest, and owns the faces
+/// between them. Sky is opaque as solid is: it owns its faces against a detail wall or a fence,
+/// so a sky face behind either is drawn whole. A liquid holding an illusionary brush ranks just
+/// above the liquid alone, so that it owns the faces between them.
 pub fn contents_priority(c: i32) -> u8 {
     match c {
         contents::SOLID => 18,
+        contents::SKY => 17,
         DETAIL_WALL => 16,
         FENCE => 14,
-        contents::SKY => 12,
         ILLUSIONARY_IN_LAVA => 11,
         contents::LAVA => 10,
         ILLUSIONARY_IN_SLIME => 9,
