@@ -182,7 +182,11 @@ fn the_crack_check_counts_no_vertex_left_out_on_purpose() {
     let pillar = box_brush([-128.0, -16.0, -128.0], [-96.0, 16.0, 0.0], "{fence");
     for class in ["func_detail_fence", "func_detail_illusionary"] {
         let out = compile_text(&room_map_with(false, "", &brush_entity(class, &pillar)));
-        assert!(!world_faces_with_vertex(&out.bsp, [-128.0, 16.0, -128.0], "{fence"));
+        assert!(!world_faces_with_vertex(
+            &out.bsp,
+            [-128.0, 16.0, -128.0],
+            "{fence"
+        ));
         let cracks = bsp_compiler::cracks::find_cracks(&out.bsp);
         assert!(cracks.is_empty(), "{class}: {}", cracks.summary());
     }
