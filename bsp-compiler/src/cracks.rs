@@ -116,9 +116,10 @@ pub fn find_cracks(bsp: &Bsp) -> CrackReport {
 /// (1/16 unit), more than `f32` rounding of coordinates in the map's range.
 const BEHIND: f32 = 1.0 / 64.0;
 
-/// What face `f` of model `model` is made of, as far as a BSP tells: a liquid by its texture, a
-/// fence by its texture, an illusionary brush's by the open leaf behind it; otherwise solid or
-/// sky (a `func_detail_wall`'s faces cannot be told from those of solid brushes).
+/// What face `f` of model `model` is made of, as far as a BSP tells, as the compiler classes it
+/// ([`WeldClass::of`]): a liquid or a fence by its texture, an illusionary brush's by the open
+/// leaf behind it; otherwise solid or sky (a `func_detail_wall`'s faces cannot be told from
+/// those of solid brushes).
 pub fn face_class(bsp: &Bsp, model: usize, f: usize) -> WeldClass {
     let Some(face) = bsp.faces.get(f) else {
         return WeldClass::Opaque;

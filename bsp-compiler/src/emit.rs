@@ -186,7 +186,10 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
         .collect();
     let classes: Vec<WeldClass> = pending
         .iter()
-        .map(|f| WeldClass::of(f.face.painted_from))
+        .map(|f| {
+            let texture = input.texinfos[f.face.texinfo as usize].texture;
+            WeldClass::of(f.face.painted_from, &input.texture_names[texture as usize])
+        })
         .collect();
     // Model by model, as ericw-tools does: a door's corner does not cut the wall it closes.
     let mut tjunction_vertices = 0;

@@ -68,8 +68,17 @@ pub enum WeldClass {
 }
 
 impl WeldClass {
-    /// The class of a face painted from a leaf of compiler contents `c`.
-    pub fn of(c: i32) -> WeldClass {
+    /// The class of a face painted from a leaf of compiler contents `c` with the texture
+    /// `texture`. A liquid's texture makes a liquid's face whatever leaf it is painted from (a
+    /// water surface inside an illusionary brush), and a fence's (`{`) a see-through one, as a
+    /// BSP shows them to the crack check ([`crate::cracks::face_class`]).
+    pub fn of(c: i32, texture: &str) -> WeldClass {
+        if texture.starts_with('*') {
+            return WeldClass::Liquid;
+        }
+        if texture.starts_with('{') {
+            return WeldClass::SeeThrough;
+        }
         match c {
             contents::SOLID | contents::SKY => WeldClass::Opaque,
             DETAIL_WALL => WeldClass::DetailWall,
@@ -102,7 +111,7 @@ impl WeldClass {
 
 /// Insert into each polygon (vertex indices into `positions`) every vertex lying inside one of
 /// its edges that it takes by its [`WeldClass`] (`classes`, one per polygon: a vertex belongs to
-/// the classes of the polygons it starts in), then drop the degenerate parts that makes
+/// the classes of the polygons it starts in and of those it is inserted into), then drop the degenerate parts that makes
 /// ([`remove_degenerate_vertices`]), and repeat until nothing changes: an insertion makes new,
 /// shorter edges that a third vertex of a knot of near-coincident ones (where several planes
 /// meet) may lie on. Only the polygons' own vertices are inserted: call it once per model.
@@ -128,9 +137,9 @@ pub fn fix_tjunctions(
             grid.merge(v, into);
         }
         let mut changed = !collapsed.is_empty();
-        for (poly, class) in polygons.iter_mut().zip(classes) {
+        for (poly, &class) in polygons.iter_mut().zip(classes) {
             let before = poly.clone();
-            let added = grid.insert_edge_vertices(poly, class.takes());
+            let added = grid.insert_edge_vertices(poly, class);
             if added == 0 {
                 continue;
             }
@@ -228,9 +237,11 @@ impl<'a> TJunctionGrid<'a> {
         *self.owners.entry(into).or_default() |= bits;
     }
 
-    /// Insert into `poly` every vertex lying inside one of its edges that belongs to a class of
-    /// `takes` (bits); how many were inserted.
-    fn insert_edge_vertices(&self, poly: &mut Vec<u32>, takes: u8) -> usize {
+    /// Insert into `poly`, a polygon of `class`, every vertex lying inside one of its edges that
+    /// belongs to a class it takes; how many were inserted. An inserted vertex belongs to
+    /// `class` from then on: a face that welds with this polygon meets it there too.
+    fn insert_edge_vertices(&mut self, poly: &mut Vec<u32>, class: WeldClass) -> usize {
+        let takes = class.takes();
         let mut inserted = 0;
         let mut out = Vec::with_capacity(poly.len());
         let mut on_edge: Vec<(f64, u32)> = Vec::new();
@@ -239,6 +250,9 @@ impl<'a> TJunctionGrid<'a> {
             out.push(a);
             self.vertices_inside(a, b, &mut on_edge);
             on_edge.retain(|(_, v)| self.owners.get(v).is_some_and(|&bits| bits & takes != 0));
+            for (_, v) in &on_edge {
+                *self.owners.entry(*v).or_default() |= class.bit();
+            }
             inserted += on_edge.len();
             out.extend(on_edge.iter().map(|&(_, v)| v));
         }
@@ -418,6 +432,31 @@ mod tests {
         // Only the polygons given are looked at: another model's vertex goes into no edge.
         let (positions, mut polys) = square_and_neighbour();
         assert_eq!(fix_tjunctions(&positions, &mut polys[..1], &[Opaque]), 0);
+    }
+
+    /// A see-through face's corner on the shared edge of a liquid face and a solid one: the
+    /// liquid takes it, and then the solid face, which meets the liquid there, takes it too, or
+    /// the two would crack along that edge.
+    #[test]
+    fn a_vertex_goes_on_to_the_faces_that_weld_with_a_face_it_went_into() {
+        use WeldClass::*;
+        let positions = [
+            [0.0, 0.0],
+            [64.0, 0.0],
+            [64.0, 32.0],
+            [0.0, 32.0],
+            [0.0, -64.0],
+            [64.0, -64.0],
+            [32.0, 0.0],
+            [32.0, -16.0],
+            [48.0, -16.0],
+        ]
+        .map(|[x, y]| DVec3::new(x, y, 0.0))
+        .to_vec();
+        let mut polys = vec![vec![1, 0, 4, 5], vec![0, 1, 2, 3], vec![6, 7, 8]];
+        let inserted = fix_tjunctions(&positions, &mut polys, &[Opaque, Liquid, SeeThrough]);
+        assert_eq!(inserted, 2);
+        assert!(polys[0].contains(&6) && polys[1].contains(&6), "{polys:?}");
     }
 
     #[test]
