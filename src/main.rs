@@ -33,7 +33,7 @@ enum Command {
     /// Build a map start to finish: bsp, vis, light, and a PNG preview
     Build(build::BuildArgs),
     /// Compile a .map to BSP29 (or BSP2), writing the .prt portal file and a .pts pointfile on a leak
-    Bsp(bsp_compiler::cli::Args),
+    Bsp(Box<bsp_compiler::cli::Args>),
     /// Compute the potentially visible set of every leaf from the .prt portals (--fast: base vis only)
     Vis(vis::cli::Args),
     /// Compute lightmaps with Embree-traced shadow rays (writes the BSP, and .lit for coloured light)

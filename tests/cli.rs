@@ -291,6 +291,31 @@ fn a_leak_writes_a_pointfile_and_no_portal_file_and_vis_refuses_the_void() {
     assert!(prt.exists() && !pts.exists());
 }
 
+/// A map with no point entity in its open space does not leak: the compiler fills nothing and
+/// writes the `.prt` of the whole tree, and vis says that the outside is included and runs.
+#[test]
+fn a_map_without_entities_still_vis() {
+    let dir = scratch("no-entities");
+    std::fs::create_dir_all(&dir).expect("dir");
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let sealed = std::fs::read_to_string(repo.join("maps/leak/sealed.map")).expect("read");
+    // Worldspawn alone: everything up to the line that closes it.
+    let end = sealed.find("\n}\n// entity 1").expect("worldspawn's end");
+    let map = dir.join("blockout.map");
+    std::fs::write(&map, format!("{}\n}}\n", &sealed[..end])).expect("write");
+
+    let out = slipgate(&["bsp", map.to_str().expect("utf8")]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("outside filling skipped"), "{stderr}");
+    assert!(map.with_extension("prt").exists() && !map.with_extension("pts").exists());
+
+    let out = slipgate(&["vis", map.with_extension("bsp").to_str().expect("utf8")]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("the outside is included"), "{stderr}");
+}
+
 /// `slipgate decompile` writes a `.map` that compiles again, sealed, with brushes and textures.
 #[test]
 fn a_decompiled_bsp_compiles_again() {

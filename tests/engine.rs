@@ -1,8 +1,8 @@
 //! End-to-end: maps compiled by Slipgate, played in real engines with real game code.
 //!
 //! Every project map (`maps/*.map`, `maps/test/`, `maps/leak/sealed.map`, the compiler's test maps, `demo.map` again as
-//! BSP2, and the `maps/hard/` maps that compile) and, with `--include-ignored`, every corpus
-//! map, goes through `slipgate bsp`, `vis` and `light` (`support/maps.rs`), then into
+//! BSP2, and the `maps/hard/` maps that compile), LibreQuake's compiled start map decompiled
+//! (`slipgate decompile`), and, with `--include-ignored`, every corpus map, goes through `slipgate bsp`, `vis` and `light` (`support/maps.rs`), then into
 //! QuakeSpasm and DarkPlaces with LibreQuake's game code from `../shared/engine`
 //! (`support/engines.rs`): each engine's dedicated server spawns the map and runs five seconds of
 //! game time, then its client plays it from the player start (god mode, every weapon, walking,
@@ -144,6 +144,27 @@ fn corpus_maps() -> Option<&'static MapSet> {
             }
         });
         Some(MapSet::new(cases.collect(), scratch().join("corpus")))
+    })
+    .as_ref()
+}
+
+/// LibreQuake's start map as ericw-tools compiled it (`public/bsp/librequake/start.bsp`),
+/// decompiled: compiled back, it must play like any map. `None` after saying so when the corpus
+/// is absent.
+fn decompiled_maps() -> Option<&'static MapSet> {
+    static SET: OnceLock<Option<MapSet>> = OnceLock::new();
+    SET.get_or_init(|| {
+        let bsp_path = corpus("public/bsp/librequake/start.bsp")?;
+        let wads = corpus("wads/librequake")?;
+        let bytes = std::fs::read(&bsp_path).expect("read start.bsp");
+        let bsp = quake_formats::Bsp::read(&bytes).expect("start.bsp parses");
+        let decompiled =
+            decompile::decompile(&bsp, &decompile::Options::default()).expect("decompile");
+        let dir = scratch().join("decompiled");
+        std::fs::create_dir_all(&dir).expect("scratch dir");
+        let map = dir.join("start_decompiled.map");
+        std::fs::write(&map, decompiled.text).expect("write the decompiled map");
+        Some(MapSet::new(vec![Case::new(map, vec![wads])], dir))
     })
     .as_ref()
 }
@@ -317,6 +338,24 @@ fn quakespasm_plays_the_corpus_maps() {
 #[ignore = "slow: compiles and plays every corpus map; run with --release -- --ignored"]
 fn darkplaces_plays_the_corpus_maps() {
     if let (Some(engine), Some(set)) = (Engine::find(Kind::DarkPlaces, scratch()), corpus_maps()) {
+        play_all(&engine, set);
+    }
+}
+
+#[test]
+fn quakespasm_plays_a_decompiled_corpus_bsp() {
+    if let (Some(engine), Some(set)) =
+        (Engine::find(Kind::QuakeSpasm, scratch()), decompiled_maps())
+    {
+        play_all(&engine, set);
+    }
+}
+
+#[test]
+fn darkplaces_plays_a_decompiled_corpus_bsp() {
+    if let (Some(engine), Some(set)) =
+        (Engine::find(Kind::DarkPlaces, scratch()), decompiled_maps())
+    {
         play_all(&engine, set);
     }
 }

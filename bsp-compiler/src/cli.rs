@@ -24,8 +24,8 @@ quake_formats::ericw_accepted! {
         nochop: bool => "brushes are never chopped; CSG happens in the BSP tree",
         chopfragment: bool => "brushes are never chopped; CSG happens in the BSP tree",
         forcegoodtree: bool => "the tree is always chosen by the fewest-splits heuristic",
-        notjunc: bool => "T-junctions are always welded, so that no crack is left",
-        tjunc: Option<String> => "T-junctions are always welded, so that no crack is left",
+        notjunc: bool => "T-junctions are always welded wherever a crack could show",
+        tjunc: Option<String> => "T-junctions are always welded wherever a crack could show",
         splitsky: bool => "sky faces merge like any others",
         splitspecial: bool => "sky and liquid faces merge like any others",
         transsky: bool => "sky is always opaque to vis",
@@ -49,7 +49,8 @@ quake_formats::ericw_accepted! {
         notriggermodels: bool => "trigger models are written as for every game",
         includeskip: bool => "skip faces are always left out",
         lmscale: Option<String> => "light reads `_lmscale` from the entities; `slipgate light --lmshift N` sets every model's spacing",
-        missing_textures_as_zero_size: bool => "missing textures become 64x64 placeholders",
+        noextendedcontentflags: bool => "Slipgate writes no extended content flags (ericw-tools' .texinfo.json)",
+        noextendedsurfflags: bool => "Slipgate writes no extended surface flags (ericw-tools' .texinfo.json)",
         nodefaultpaths: bool => "WADs are found as docs/mapping.md says",
         defaultpaths: bool => "WADs are found as docs/mapping.md says",
     }
@@ -159,6 +160,17 @@ pub struct Args {
     /// elsewhere (FTE, QuakeSpasm-Spiked); the WADs are still read for the sizes
     #[arg(long)]
     pub notex: bool,
+    /// A folder searched for loose textures (repeatable): with --notex, a texture no WAD holds
+    /// takes its size from textures/NAME.png or .tga there
+    #[arg(long = "path", value_name = "DIR")]
+    pub texture_paths: Vec<PathBuf>,
+    /// Write textures found nowhere as 0x0 miptex with their names, for engines that load them
+    /// from elsewhere (others crash on them); by default they are 64x64 placeholders
+    #[arg(
+        long = "missing-textures-as-zero-size",
+        visible_alias = "missing_textures_as_zero_size"
+    )]
+    pub missing_textures_as_zero_size: bool,
     /// Merge another .map into this one (repeatable): its worldspawn brushes join the world and
     /// its other entities follow; its worldspawn keys are ignored. A relative path not found from
     /// the working directory is looked for beside the input map
@@ -248,6 +260,8 @@ impl Args {
             add: self.add.clone(),
             omit,
             texture_data: !self.notex,
+            texture_paths: self.texture_paths.clone(),
+            missing_textures_as_zero_size: self.missing_textures_as_zero_size,
             brush_list: self.wrbrushes || self.wrbrushesonly,
             keep_editor_keys: self.keep_editor_keys,
             progress: quake_formats::progress::terminal(),

@@ -21,7 +21,7 @@ use crate::planes::PlaneSet;
 use crate::prefab::{PrefabError, expand_prefabs};
 use crate::texinfo::Projection;
 use crate::tree::SplitHeuristic;
-use crate::wad_lookup::{WadSearch, WadSet};
+use crate::wad_lookup::{MissingTextures, WadSearch, WadSet};
 use crate::warnings::Warning;
 use quake_formats::bsp::limits::MAX_SURFACE_EXTENT;
 use quake_formats::bsp::texinfo_flags;
@@ -255,7 +255,15 @@ pub fn compile(
         &map.entities[0].entity,
         &wad_search(source, options),
         &mut warnings,
-    );
+    )
+    .with_missing(MissingTextures {
+        loose_dirs: if options.texture_data {
+            Vec::new()
+        } else {
+            options.texture_paths.clone()
+        },
+        zero_size: options.missing_textures_as_zero_size,
+    });
     let emitted = emit(EmitInput {
         models: &outputs,
         planes: &planes,

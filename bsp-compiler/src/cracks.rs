@@ -5,11 +5,16 @@
 //! edge), directed edges used by more than two faces and not as often as their reverse, and
 //! distinct vertex indices at the same position. Faces of every kind count (sky, liquids,
 //! fences): engines draw them all, so a T-junction between water and a wall shows as a crack like
-//! any other. Indices the validator would reject are skipped, never trusted.
+//! any other. A vertex counts on an edge only when the edge's face welds with a face the vertex
+//! belongs to ([`WeldClass`]): the compiler leaves the vertices of fences and illusionary brushes
+//! out of solid faces' edges on purpose, as ericw-tools does, since no crack shows there. A face's
+//! class is read from the BSP ([`face_class`]). Indices the validator would reject are skipped,
+//! never trusted.
 
-use crate::weld::{TJUNCTION_EPSILON, cell_and_neighbours};
+use crate::weld::{TJUNCTION_EPSILON, WeldClass, cell_and_neighbours};
 use glam::{DVec3, Vec3};
 use quake_formats::Bsp;
+use quake_formats::bsp::contents;
 use quake_formats::geom::DVec3Ext;
 use quake_formats::geom::POINT_EPSILON;
 use std::collections::{BTreeMap, BTreeSet, HashMap};
@@ -107,12 +112,67 @@ pub fn find_cracks(bsp: &Bsp) -> CrackReport {
     report
 }
 
+/// How far behind a face its back leaf is looked up: less than the thinnest brush mappers make
+/// (1/16 unit), more than `f32` rounding of coordinates in the map's range.
+const BEHIND: f32 = 1.0 / 64.0;
+
+/// What face `f` of model `model` is made of, as far as a BSP tells, as the compiler classes it
+/// ([`WeldClass::of`]): a liquid or a fence by its texture, an illusionary brush's by the open
+/// leaf behind it; otherwise solid or sky (a `func_detail_wall`'s faces cannot be told from
+/// those of solid brushes).
+pub fn face_class(bsp: &Bsp, model: usize, f: usize) -> WeldClass {
+    let Some(face) = bsp.faces.get(f) else {
+        return WeldClass::Opaque;
+    };
+    let name = bsp.face_texture(face).map(|t| t.name()).unwrap_or_default();
+    if name.starts_with('*') {
+        return WeldClass::Liquid;
+    }
+    if name.starts_with('{') {
+        return WeldClass::SeeThrough;
+    }
+    let (Some(vertices), Some(plane)) =
+        (bsp.face_vertices(face), bsp.planes.get(face.plane as usize))
+    else {
+        return WeldClass::Opaque;
+    };
+    let sign = if face.side != 0 { -1.0 } else { 1.0 };
+    let centre = vertices
+        .iter()
+        .fold(Vec3::ZERO, |sum, &v| sum + Vec3::from(v))
+        / vertices.len().max(1) as f32;
+    let behind = centre - Vec3::from(plane.normal) * sign * BEHIND;
+    let leaf = bsp
+        .models
+        .get(model)
+        .and_then(|m| bsp.leaf_from(m.head_nodes[0], behind.to_array()))
+        .and_then(|l| bsp.leafs.get(l));
+    match leaf.map(|l| l.contents) {
+        Some(contents::SOLID | contents::SKY) | None => WeldClass::Opaque,
+        Some(_) => WeldClass::SeeThrough,
+    }
+}
+
 fn check_model(bsp: &Bsp, model: usize, faces: &[(usize, Vec<u32>)], report: &mut CrackReport) {
     let pos = |v: u32| Vec3::from(bsp.vertices[v as usize]).as_dvec3();
     let used: BTreeSet<u32> = faces
         .iter()
         .flat_map(|(_, vs)| vs.iter().copied())
         .collect();
+    // The classes of the faces each vertex belongs to.
+    let mut owners: HashMap<u32, Vec<WeldClass>> = HashMap::new();
+    let classes: Vec<WeldClass> = faces
+        .iter()
+        .map(|&(f, _)| face_class(bsp, model, f))
+        .collect();
+    for ((_, vs), &class) in faces.iter().zip(&classes) {
+        for &v in vs {
+            let list = owners.entry(v).or_default();
+            if !list.contains(&class) {
+                list.push(class);
+            }
+        }
+    }
     let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
     for &v in &used {
         grid.entry(cell(pos(v))).or_default().push(v);
@@ -130,7 +190,12 @@ fn check_model(bsp: &Bsp, model: usize, faces: &[(usize, Vec<u32>)], report: &mu
 
     let mut directed: BTreeMap<[u32; 2], usize> = BTreeMap::new();
     let mut cells = BTreeSet::new();
-    for (f, vs) in faces {
+    for ((f, vs), &class) in faces.iter().zip(&classes) {
+        let welds = |v: &u32| {
+            owners
+                .get(v)
+                .is_some_and(|list| list.iter().any(|&o| class.welds_with(o)))
+        };
         for k in 0..vs.len() {
             let (a, b) = (vs[k], vs[(k + 1) % vs.len()]);
             *directed.entry([a, b]).or_default() += 1;
@@ -146,6 +211,7 @@ fn check_model(bsp: &Bsp, model: usize, faces: &[(usize, Vec<u32>)], report: &mu
                 let along = (pv - pa).dot(d) / len;
                 if v == a
                     || v == b
+                    || !welds(&v)
                     || along <= POINT_EPSILON
                     || along >= len - POINT_EPSILON
                     || (pa + d * (along / len) - pv).length() >= TJUNCTION_EPSILON

@@ -11,7 +11,7 @@ use crate::texinfo::TextureRole;
 use crate::tree::{Tree, engine_contents, is_see_through, vis_class};
 use crate::wad_lookup::WadSet;
 use crate::warnings::Warning;
-use crate::weld::{VertexWelder, cut_to_max_vertices, fix_tjunctions};
+use crate::weld::{VertexWelder, WeldClass, cut_to_max_vertices, fix_tjunctions};
 use glam::DVec3;
 use quake_formats::bsp::limits::QUAKESPASM_MAX_WARP_FACE_VERTS;
 use quake_formats::bsp::{BspPlane, Face, Leaf, Model, Node, TexInfo, contents, texinfo_flags};
@@ -184,7 +184,26 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
         .iter_mut()
         .map(|f| std::mem::take(&mut f.vertices))
         .collect();
-    let tjunction_vertices = fix_tjunctions(&welder.positions, &mut polygons);
+    let classes: Vec<WeldClass> = pending
+        .iter()
+        .map(|f| {
+            let texture = input.texinfos[f.face.texinfo as usize].texture;
+            WeldClass::of(f.face.painted_from, &input.texture_names[texture as usize])
+        })
+        .collect();
+    // Model by model, as ericw-tools does: a door's corner does not cut the wall it closes.
+    let mut tjunction_vertices = 0;
+    let mut start = 0;
+    while start < pending.len() {
+        let model = pending[start].model;
+        let end = start + pending[start..].partition_point(|f| f.model == model);
+        tjunction_vertices += fix_tjunctions(
+            &welder.positions,
+            &mut polygons[start..end],
+            &classes[start..end],
+        );
+        start = end;
+    }
     bsp.vertices = welder
         .positions
         .iter()

@@ -39,6 +39,9 @@ pub(crate) struct ModelFace {
     /// different contents (a water surface from above and from below) neither merge nor share
     /// edges: software renderers (WinQuake's edge list) draw such faces wrongly.
     pub seen_from: i32,
+    /// The compiler contents of the leaf the face is painted from (what its brush is made of:
+    /// see [`crate::weld::WeldClass`]).
+    pub painted_from: i32,
 }
 
 impl ModelFace {
@@ -517,6 +520,7 @@ impl FaceMaker<'_> {
                     leaves: leaves.to_vec(),
                     stored,
                     seen_from,
+                    painted_from: tree.nodes[owner as usize].contents,
                 });
             }
         }

@@ -22,7 +22,7 @@ use glam::DVec3;
 use quake_formats::bsp::contents;
 use quake_formats::bsp::face_flags::FaceFlags;
 use quake_formats::bsp::phong::{self, FacePhong};
-use quake_formats::geom::{Bounds, POINT_EPSILON};
+use quake_formats::geom::Bounds;
 use std::collections::HashMap;
 
 /// Each model's brushes, with what the rest of the compile needs to name them.
@@ -477,21 +477,14 @@ fn key_origin(entities: &[MapEntity], ent: &MapEntity) -> Option<DVec3> {
     Some(DVec3::new(x, y, z))
 }
 
-/// The point entity `ent` (number `index`) as an occupant of open space for the flood: not
-/// when it has no origin, stands at the map's origin (where ericw-tools skips it, taking it for
-/// a brush entity), or is marked `_nofill` (or `_lightgrid_hint`) to stand in the void.
+/// The point entity `ent` (number `index`) as an occupant of open space for the flood, where
+/// [`quake_formats::entities::Entity::fill_origin`] says it marks one.
 pub(crate) fn occupant(ent: &MapEntity, index: usize) -> Option<Occupant> {
-    let [x, y, z] = ent.entity.get_floats::<3>("origin")?;
-    let origin = DVec3::new(x, y, z);
-    let marked = |key| ent.entity.get_float(key).is_some_and(|v| v != 0.0);
-    if origin.abs().max_element() < POINT_EPSILON || marked("_nofill") || marked("_lightgrid_hint")
-    {
-        return None;
-    }
+    let [x, y, z] = ent.entity.fill_origin()?;
     Some(Occupant {
         entity: index,
         classname: ent.entity.classname().to_string(),
-        origin,
+        origin: DVec3::new(x, y, z),
         line: ent.line,
     })
 }

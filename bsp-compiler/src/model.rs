@@ -4,8 +4,11 @@
 //! CSG marks the brush sides other brushes bury; the drawing tree (hull 0) and the two clip hull
 //! trees are built at once; hull 0 is portalised (and, when detail split its structural leaves,
 //! portalised again by clusters); the world's outside is flooded from its point entities and
-//! filled, with the space no entity reaches, and then so are its clip hulls; faces are made
-//! where leaf contents change, merged, and cut where their lightmaps would grow too large.
+//! filled, with the space no entity reaches. A sealed world's tree is then built again, split by
+//! the sides that face open space first (as ericw-tools does), so that planes facing the void
+//! only cut solid space and collapse away; it is portalised and filled again, and so are its clip
+//! hulls. Faces are made where leaf contents change, merged, and cut where their lightmaps would
+//! grow too large.
 
 use crate::csg::mark_hidden_sides;
 use crate::faces::{
@@ -14,11 +17,13 @@ use crate::faces::{
 };
 use crate::gather::ModelInput;
 use crate::options::CompileOptions;
-use crate::outside::{FillOutcome, Occupant, OnPlane, Reach, fill_outside, fill_unreached};
+use crate::outside::{
+    FillOutcome, Occupant, OnPlane, Reach, fill_outside, fill_unreached, visible_sides,
+};
 use crate::planes::PlaneSet;
 use crate::portals::{Portals, make_cluster_portals, make_portals};
 use crate::surface_tree::rebuild_from_surfaces;
-use crate::tree::{Splitting, Tree, build_clip_hull_tree, build_tree};
+use crate::tree::{Splitting, Tree, build_clip_hull_tree, build_tree, rebuild_tree_visible_first};
 use crate::warnings::Warning;
 use glam::DVec3;
 use quake_formats::geom::Bounds;
@@ -75,6 +80,9 @@ pub(crate) fn build_model(
             .fold(Bounds::EMPTY, |acc, b| acc.union(&b.bounds))
     });
     timings[5] = t.elapsed().as_secs_f64();
+    let is_world = m.entity == 0;
+    // Kept for the world's second tree, built once its outside is filled.
+    let world_brushes = (is_world && options.fill).then(|| brushes.clone());
     let ((mut tree, tree_time), (mut hulls, hull_time)) = rayon::join(
         || {
             let t = Instant::now();
@@ -96,38 +104,54 @@ pub(crate) fn build_model(
     timings[4] = hull_time;
 
     let t = Instant::now();
-    let portals = make_portals(&tree, planes, &bounds);
-    let cluster_portals = tree
-        .nodes
-        .iter()
-        .any(|n| n.cluster.is_some() && !n.is_leaf())
-        .then(|| make_cluster_portals(&tree, planes, &bounds));
+    let (mut portals, mut cluster_portals) = portalise(&tree, planes, &bounds);
     timings[1] = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
-    let is_world = m.entity == 0;
-    let fill = (is_world && options.fill).then(|| {
+    let mut fill = (is_world && options.fill).then(|| {
         let flood = cluster_portals.as_ref().unwrap_or(&portals);
-        let mut outcome = fill_outside(
+        fill_world(
             &mut tree,
             planes,
+            &portals,
             flood,
             occupants,
-            OnPlane::Sealing,
+            options,
             &mut warnings,
-        );
-        if let (FillOutcome::Sealed { filled }, Some(reach)) =
-            (&mut outcome, options.unreached_fill())
-        {
-            let units = match reach {
-                Reach::Leaves => &portals,
-                Reach::Clusters => flood,
-            };
-            *filled += fill_unreached(&mut tree, planes, units, occupants, reach);
-        }
-        outcome
+        )
     });
     timings[2] = t.elapsed().as_secs_f64();
+
+    if let (Some(FillOutcome::Sealed { .. }), Some(brushes)) = (&fill, world_brushes) {
+        let t = Instant::now();
+        let visible = visible_sides(&tree, &portals);
+        let mut second = rebuild_tree_visible_first(brushes, planes, splitting, &visible);
+        timings[0] += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let (second_portals, second_clusters) = portalise(&second, planes, &bounds);
+        timings[1] += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let flood = second_clusters.as_ref().unwrap_or(&second_portals);
+        // The same entities flood the same space: its warnings were given the first time.
+        let mut repeated = Vec::new();
+        let outcome = fill_world(
+            &mut second,
+            planes,
+            &second_portals,
+            flood,
+            occupants,
+            options,
+            &mut repeated,
+        );
+        // Sealed again unless a sliver the new planes leave opens a crack: then keep the first.
+        if matches!(outcome, FillOutcome::Sealed { .. }) {
+            tree = second;
+            portals = second_portals;
+            cluster_portals = second_clusters;
+            fill = Some(outcome);
+        }
+        timings[2] += t.elapsed().as_secs_f64();
+    }
 
     // A sealed world's clip hulls are sealed too (grown brushes only close gaps further): fill
     // their outsides as well, so it collapses into one solid leaf instead of many clip nodes.
@@ -161,6 +185,40 @@ pub(crate) fn build_model(
         },
         warnings,
     )
+}
+
+/// The portals of `tree`'s leaves, and of its structural leaves when detail split some of them.
+fn portalise(tree: &Tree, planes: &PlaneSet, bounds: &Bounds) -> (Portals, Option<Portals>) {
+    let portals = make_portals(tree, planes, bounds);
+    let cluster_portals = tree
+        .nodes
+        .iter()
+        .any(|n| n.cluster.is_some() && !n.is_leaf())
+        .then(|| make_cluster_portals(tree, planes, bounds));
+    (portals, cluster_portals)
+}
+
+/// Fill the world's outside, flooding over `flood` (its cluster portals, or its leaf portals
+/// when detail split nothing), then, once sealed and as `options` ask, what no entity reaches.
+fn fill_world(
+    tree: &mut Tree,
+    planes: &PlaneSet,
+    portals: &Portals,
+    flood: &Portals,
+    occupants: &[Occupant],
+    options: &CompileOptions,
+    warnings: &mut Vec<Warning>,
+) -> FillOutcome {
+    let mut outcome = fill_outside(tree, planes, flood, occupants, OnPlane::Sealing, warnings);
+    if let (FillOutcome::Sealed { filled }, Some(reach)) = (&mut outcome, options.unreached_fill())
+    {
+        let units = match reach {
+            Reach::Leaves => portals,
+            Reach::Clusters => flood,
+        };
+        *filled += fill_unreached(tree, planes, units, occupants, reach);
+    }
+    outcome
 }
 
 /// The bounds engines size a model by (a door's travel, its trigger field): its map brushes,

@@ -60,6 +60,12 @@ pub struct CompileOptions {
     pub omit: Vec<String>,
     /// Write texture pixels (off: names and sizes only, for engines that have the textures).
     pub texture_data: bool,
+    /// Folders searched for loose textures (ericw-tools' `-path`): with `texture_data` off, a
+    /// texture no WAD holds takes its size from `textures/NAME.png` (or `.tga`) in one.
+    pub texture_paths: Vec<PathBuf>,
+    /// A texture found nowhere is written as a 0x0 miptex with its name (ericw-tools'
+    /// `-missing_textures_as_zero_size`) instead of a placeholder.
+    pub missing_textures_as_zero_size: bool,
     /// Write the BSPX `BRUSHLIST` lump (see `crate::brushlist`).
     pub brush_list: bool,
     /// Keep editor-only keys (TrenchBroom's `_tb_*`) in the entity lump ([`crate::editor`]).
@@ -99,6 +105,8 @@ impl Default for CompileOptions {
             add: Vec::new(),
             omit: Vec::new(),
             texture_data: true,
+            texture_paths: Vec::new(),
+            missing_textures_as_zero_size: false,
             brush_list: false,
             keep_editor_keys: false,
             progress: Progress::default(),

@@ -11,7 +11,7 @@
 use crate::leak::{LeakReport, MapBrushRef};
 use crate::planes::PlaneSet;
 use crate::portals::Portals;
-use crate::tree::{DETAIL_WALL, Tree, TreeNode, engine_contents, is_opaque};
+use crate::tree::{DETAIL_WALL, Tree, TreeNode, VisibleSides, engine_contents, is_opaque};
 use crate::warnings::Warning;
 use glam::DVec3;
 use quake_formats::bsp::contents;
@@ -234,6 +234,36 @@ pub(crate) fn fill_outside(
         }
     }
     FillOutcome::Sealed { filled }
+}
+
+/// The brush sides of a filled `tree` that face open space: on a portal of `portals` whose
+/// other leaf is not opaque, facing out of their leaf into it.
+pub(crate) fn visible_sides(tree: &Tree, portals: &Portals) -> VisibleSides {
+    let mut visible = VisibleSides::new();
+    for p in &portals.portals {
+        let (Some(plane), [front, back]) = (p.plane_id, p.nodes) else {
+            continue;
+        };
+        if front == portals.outside || back == portals.outside {
+            continue;
+        }
+        for (owner, viewer, owner_is_front) in [(front, back, true), (back, front, false)] {
+            if is_opaque(tree.nodes[viewer as usize].contents) {
+                continue;
+            }
+            // A side looks out of its brush backwards along the plane when the brush lies in
+            // front of it.
+            for b in &tree.nodes[owner as usize].brushes {
+                if b.sides
+                    .iter()
+                    .any(|s| s.plane == plane && s.flipped == owner_is_front)
+                {
+                    visible.insert((b.source, plane));
+                }
+            }
+        }
+    }
+    visible
 }
 
 /// How the space inside a sealed map that no point entity reaches is filled (ericw-tools'

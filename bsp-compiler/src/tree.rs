@@ -10,6 +10,7 @@ use glam::DVec3;
 use quake_formats::bsp::contents;
 use quake_formats::geom::{Bounds, ON_EPSILON, Plane};
 use rayon::prelude::*;
+use std::collections::HashSet;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// How the splitting plane of a node is chosen among the node's unused brush side planes.
@@ -187,14 +188,16 @@ pub fn engine_contents(c: i32) -> i32 {
     }
 }
 
-/// Ranking of contents: a region holding several brushes takes the strongest. A liquid holding
-/// an illusionary brush ranks just above the liquid alone, so that it owns the faces between them.
+/// Ranking of contents: a region holding several brushes takes the strongest, and owns the faces
+/// between them. Sky is opaque as solid is: it owns its faces against a detail wall or a fence,
+/// so a sky face behind either is drawn whole. A liquid holding an illusionary brush ranks just
+/// above the liquid alone, so that it owns the faces between them.
 pub fn contents_priority(c: i32) -> u8 {
     match c {
         contents::SOLID => 18,
+        contents::SKY => 17,
         DETAIL_WALL => 16,
         FENCE => 14,
-        contents::SKY => 12,
         ILLUSIONARY_IN_LAVA => 11,
         contents::LAVA => 10,
         ILLUSIONARY_IN_SLIME => 9,
@@ -386,12 +389,18 @@ const REGION_MARGIN: f64 = 8.0;
 /// Subtrees with at least this many brushes are built in parallel.
 const PARALLEL_BRUSHES: usize = 64;
 
+/// Brush sides that bound open space once the world's outside is filled, by map brush
+/// ([`Brush::source`]) and plane: the sides faces are made on.
+pub type VisibleSides = HashSet<(u32, PlaneId)>;
+
 struct Builder<'a> {
     planes: &'a PlaneSet,
     splitting: Splitting,
     keep_brushes: bool,
     /// Every node plane must cut its region cleanly (see [`Region::split_cleanly`]).
     clean_splits: bool,
+    /// Split by these sides before any other (hints aside), when known.
+    visible: Option<&'a VisibleSides>,
     splits: AtomicUsize,
 }
 
@@ -411,6 +420,28 @@ pub fn build_tree(
         splitting: splitting.into(),
         keep_brushes,
         clean_splits: true,
+        visible: None,
+        splits: AtomicUsize::new(0),
+    };
+    builder.tree(brushes)
+}
+
+/// Build the world's tree again once its outside is filled, as [`build_tree`] (keeping each
+/// leaf's fragments) but splitting by the `visible` sides first, as ericw-tools does: the planes
+/// of sides that face the filled void then only cut space that is solid on both sides, which
+/// collapses into one solid leaf, instead of sitting above the rooms as nodes of their own.
+pub fn rebuild_tree_visible_first(
+    brushes: Vec<Brush>,
+    planes: &PlaneSet,
+    splitting: impl Into<Splitting>,
+    visible: &VisibleSides,
+) -> Tree {
+    let builder = Builder {
+        planes,
+        splitting: splitting.into(),
+        keep_brushes: true,
+        clean_splits: true,
+        visible: Some(visible),
         splits: AtomicUsize::new(0),
     };
     builder.tree(brushes)
@@ -430,6 +461,7 @@ pub fn build_clip_hull_tree(
         splitting: splitting.into(),
         keep_brushes: false,
         clean_splits: false,
+        visible: None,
         splits: AtomicUsize::new(0),
     };
     builder.tree(brushes)
@@ -652,16 +684,21 @@ impl Builder<'_> {
     }
 
     /// The best unused side plane, or `None` when every side has been used (a leaf). Big nodes
-    /// are cut near their middle first, then hint sides win, then the heuristic decides.
+    /// are cut near their middle first, then hint sides win, then visible sides (when known),
+    /// then the heuristic decides.
     fn choose_splitter(&self, brushes: &[Brush], phase: Phase) -> Option<PlaneId> {
-        let unused = |kind: Option<BrushKind>| {
+        let unused = |kind: Option<BrushKind>, visible: Option<&VisibleSides>| {
             let mut list: Vec<PlaneId> = brushes
                 .iter()
                 .filter(|b| phase.splits_with(b) && kind.is_none_or(|k| b.kind == k))
                 .flat_map(|b| {
                     b.sides
                         .iter()
-                        .filter(|s| !s.used && !s.buried)
+                        .filter(move |s| {
+                            !s.used
+                                && !s.buried
+                                && visible.is_none_or(|v| v.contains(&(b.source, s.plane)))
+                        })
                         .map(|s| s.plane)
                 })
                 .collect();
@@ -669,7 +706,7 @@ impl Builder<'_> {
             list.dedup();
             list
         };
-        let candidates = unused(None);
+        let candidates = unused(None, None);
         if candidates.is_empty() {
             return None;
         }
@@ -684,8 +721,15 @@ impl Builder<'_> {
         ) {
             return Some(mid);
         }
-        let hints = unused(Some(BrushKind::Hint));
-        let candidates = if hints.is_empty() { candidates } else { hints };
+        let hints = unused(Some(BrushKind::Hint), None);
+        let visible = self
+            .visible
+            .map(|v| unused(None, Some(v)))
+            .unwrap_or_default();
+        let candidates = [hints, visible]
+            .into_iter()
+            .find(|list| !list.is_empty())
+            .unwrap_or(candidates);
         // Each brush's unused side planes, once per brush, sorted: how many brushes a plane
         // would serve as a node (a plane many sides lie on saves nodes and leaves).
         let mut facing_planes: Vec<PlaneId> = Vec::new();

@@ -10,10 +10,44 @@ use quake_formats::wad::Wad;
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
-/// The WADs a map's worldspawn names, as far as they were found.
+/// The WADs a map's worldspawn names, as far as they were found, and what a texture none of
+/// them holds becomes.
 #[derive(Debug, Default)]
 pub struct WadSet {
     wads: Vec<FoundWad>,
+    missing: MissingTextures,
+}
+
+/// What a texture no WAD holds becomes: by default a placeholder with its name, 64x64 (sky
+/// 256x128), and a warning.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct MissingTextures {
+    /// Folders whose loose pictures (`textures/NAME.png` or `.tga`, ericw-tools' `-path`) give
+    /// such a texture its size; it is then written by name and size, without pixels. Only
+    /// searched when no texture's pixels are written (`-notex`), as in ericw-tools.
+    pub loose_dirs: Vec<PathBuf>,
+    /// Write it as a 0x0 miptex with its name instead of a placeholder (ericw-tools'
+    /// `-missing_textures_as_zero_size`), for engines that load it from elsewhere; others crash
+    /// on it.
+    pub zero_size: bool,
+}
+
+/// The picture formats loose textures are read from.
+const LOOSE_EXTENSIONS: [&str; 2] = ["png", "tga"];
+
+impl MissingTextures {
+    /// The size of the loose picture of texture `name` (as the map writes it, or lowercase), if
+    /// one of the folders holds one.
+    fn loose_size(&self, name: &str) -> Option<(u32, u32)> {
+        let names = [name.to_string(), name.to_ascii_lowercase()];
+        self.loose_dirs.iter().find_map(|dir| {
+            names.iter().find_map(|n| {
+                LOOSE_EXTENSIONS.iter().find_map(|ext| {
+                    image::image_dimensions(dir.join("textures").join(format!("{n}.{ext}"))).ok()
+                })
+            })
+        })
+    }
 }
 
 #[derive(Debug)]
@@ -108,7 +142,15 @@ impl WadSet {
                 Err(reason) => warnings.push(Warning::UnreadableWad { path, reason }),
             }
         }
-        WadSet { wads }
+        WadSet {
+            wads,
+            missing: MissingTextures::default(),
+        }
+    }
+
+    /// This set, with textures no WAD holds becoming what `missing` says.
+    pub fn with_missing(self, missing: MissingTextures) -> WadSet {
+        WadSet { missing, ..self }
     }
 
     /// The files the WADs were read from.
@@ -135,7 +177,15 @@ impl WadSet {
         let mut entries = Vec::with_capacity(used.len());
         for &name in used {
             let lump = lump_name(name);
-            let found = self.find(&lump);
+            let found = self.find(&lump).or_else(|| {
+                let (width, height) = self.missing.loose_size(name)?;
+                Some(MipTex {
+                    raw_name: string_to_name16(&lump),
+                    width,
+                    height,
+                    mips: None,
+                })
+            });
             if found.is_none() {
                 warnings.push(Warning::MissingTexture {
                     name: name.to_string(),
@@ -173,6 +223,12 @@ impl WadSet {
                     raw_name: string_to_name16(&name),
                     width,
                     height,
+                    mips: None,
+                },
+                None if self.missing.zero_size => MipTex {
+                    raw_name: string_to_name16(&name),
+                    width: 0,
+                    height: 0,
                     mips: None,
                 },
                 None => {
@@ -356,6 +412,7 @@ mod tests {
                 wad: Wad::new(lumps),
                 embed: true,
             }],
+            missing: MissingTextures::default(),
         }
     }
 

@@ -246,7 +246,11 @@ impl std::fmt::Display for Warning {
                 "LEAK: {report}; the outside is not filled, see the .pts pointfile"
             ),
             Warning::NoEntitiesToFlood => {
-                write!(f, "no point entity in open space: outside filling skipped")
+                write!(
+                    f,
+                    "no point entity in open space: outside filling skipped (the void stays in \
+                     the map and its portal file, and vis includes it)"
+                )
             }
             Warning::EmptyBrushEntity { entity, classname } => {
                 write!(f, "entity {entity} ({classname}) has no usable brushes")

@@ -1,7 +1,9 @@
 //! Shared vertices: welding equal points and inserting the vertices that lie on another face's
 //! edge (T-junctions), which would otherwise show as cracks.
 
+use crate::tree::{DETAIL_WALL, engine_contents};
 use glam::DVec3;
+use quake_formats::bsp::contents;
 use quake_formats::geom::DVec3Ext;
 use quake_formats::geom::{ON_EPSILON, POINT_EPSILON};
 use std::collections::HashMap;
@@ -51,24 +53,93 @@ impl VertexWelder {
 /// Passes of T-junction fixing before giving up on a polygon set that keeps changing.
 const MAX_TJUNCTION_PASSES: usize = 16;
 
+/// What a face is made of, for T-junctions: which other faces' vertices go into its edges. As in
+/// ericw-tools, solid, sky and liquid faces give their vertices to every face; a solid or sky face
+/// takes no others, a detail wall's face takes those of detail walls too, and a see-through face
+/// (fence, illusionary) or a liquid's takes every vertex. Detail walls, fences and illusionary
+/// brushes are there to leave the world's faces alone, and a crack along their edge on a wall
+/// behind them does not show through them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WeldClass {
+    Opaque,
+    DetailWall,
+    SeeThrough,
+    Liquid,
+}
+
+impl WeldClass {
+    /// The class of a face painted from a leaf of compiler contents `c` with the texture
+    /// `texture`. A liquid's texture makes a liquid's face whatever leaf it is painted from (a
+    /// water surface inside an illusionary brush), and a fence's (`{`) a see-through one, as a
+    /// BSP shows them to the crack check ([`crate::cracks::face_class`]).
+    pub fn of(c: i32, texture: &str) -> WeldClass {
+        if texture.starts_with('*') {
+            return WeldClass::Liquid;
+        }
+        if texture.starts_with('{') {
+            return WeldClass::SeeThrough;
+        }
+        match c {
+            contents::SOLID | contents::SKY => WeldClass::Opaque,
+            DETAIL_WALL => WeldClass::DetailWall,
+            c if contents::is_liquid(engine_contents(c)) && c == engine_contents(c) => {
+                WeldClass::Liquid
+            }
+            _ => WeldClass::SeeThrough,
+        }
+    }
+
+    fn bit(self) -> u8 {
+        1 << self as u8
+    }
+
+    /// Whether a face of this class takes the vertices of faces of class `other`.
+    pub fn welds_with(self, other: WeldClass) -> bool {
+        self.takes() & other.bit() != 0
+    }
+
+    /// The classes (bits) whose faces' vertices a face of this class takes.
+    fn takes(self) -> u8 {
+        let always = WeldClass::Opaque.bit() | WeldClass::Liquid.bit();
+        match self {
+            WeldClass::Opaque => always,
+            WeldClass::DetailWall => always | WeldClass::DetailWall.bit(),
+            WeldClass::SeeThrough | WeldClass::Liquid => u8::MAX,
+        }
+    }
+}
+
 /// Insert into each polygon (vertex indices into `positions`) every vertex lying inside one of
-/// its edges, then drop the degenerate parts that makes ([`remove_degenerate_vertices`]), and
-/// repeat until nothing changes: an insertion makes new, shorter edges that a third vertex of a
-/// knot of near-coincident ones (where several planes meet) may lie on. Polygons may be left with
-/// fewer than three vertices. Returns how many vertices were inserted.
-pub fn fix_tjunctions(positions: &[DVec3], polygons: &mut [Vec<u32>]) -> usize {
-    let mut grid = TJunctionGrid::new(positions);
+/// its edges that it takes by its [`WeldClass`] (`classes`, one per polygon: a vertex belongs to
+/// the classes of the polygons it starts in and of those it is inserted into), then drop the degenerate parts that makes
+/// ([`remove_degenerate_vertices`]), and repeat until nothing changes: an insertion makes new,
+/// shorter edges that a third vertex of a knot of near-coincident ones (where several planes
+/// meet) may lie on. Only the polygons' own vertices are inserted: call it once per model.
+/// Polygons may be left with fewer than three vertices. Returns how many vertices were inserted.
+pub fn fix_tjunctions(
+    positions: &[DVec3],
+    polygons: &mut [Vec<u32>],
+    classes: &[WeldClass],
+) -> usize {
+    let mut owners: HashMap<u32, u8> = HashMap::new();
+    for (poly, class) in polygons.iter().zip(classes) {
+        for &v in poly {
+            *owners.entry(v).or_default() |= class.bit();
+        }
+    }
+    let mut grid = TJunctionGrid::new(positions, owners);
     let mut inserted = 0;
     for _ in 0..MAX_TJUNCTION_PASSES {
         let collapsed = collapse_short_edges(positions, polygons);
-        // A vertex made one with another is no longer anywhere to insert.
-        for &v in &collapsed {
-            grid.remove(v);
+        // A vertex made one with another is no longer anywhere to insert; the one it became
+        // belongs to its faces too.
+        for &(v, into) in &collapsed {
+            grid.merge(v, into);
         }
         let mut changed = !collapsed.is_empty();
-        for poly in polygons.iter_mut() {
+        for (poly, &class) in polygons.iter_mut().zip(classes) {
             let before = poly.clone();
-            let added = grid.insert_edge_vertices(poly);
+            let added = grid.insert_edge_vertices(poly, class);
             if added == 0 {
                 continue;
             }
@@ -91,8 +162,8 @@ pub fn fix_tjunctions(positions: &[DVec3], polygons: &mut [Vec<u32>]) -> usize {
 /// of near-coincident vertices where several planes meet: each lies within the T-junction
 /// distance of the others' edges, so no insertion can fix them (a sliver triangle of three of
 /// them has each vertex on its opposite edge).
-/// Returns the vertices collapsed into others.
-fn collapse_short_edges(positions: &[DVec3], polygons: &mut [Vec<u32>]) -> Vec<u32> {
+/// Returns the vertices collapsed into others, each with the one it became.
+fn collapse_short_edges(positions: &[DVec3], polygons: &mut [Vec<u32>]) -> Vec<(u32, u32)> {
     let mut same: HashMap<u32, u32> = HashMap::new();
     let root = |same: &HashMap<u32, u32>, mut v: u32| {
         while let Some(&r) = same.get(&v) {
@@ -120,13 +191,15 @@ fn collapse_short_edges(positions: &[DVec3], polygons: &mut [Vec<u32>]) -> Vec<u
         }
         remove_degenerate_vertices(poly, positions);
     }
-    same.into_keys().collect()
+    same.keys().map(|&v| (v, root(&same, v))).collect()
 }
 
-/// Vertices bucketed by position, for finding those near an edge.
+/// The vertices of a set of polygons bucketed by position, for finding those near an edge, each
+/// with the [`WeldClass`] bits of the polygons it belongs to.
 struct TJunctionGrid<'a> {
     positions: &'a [DVec3],
     cells: HashMap<[i64; 3], Vec<u32>>,
+    owners: HashMap<u32, u8>,
 }
 
 impl<'a> TJunctionGrid<'a> {
@@ -135,23 +208,40 @@ impl<'a> TJunctionGrid<'a> {
         [c(p.x), c(p.y), c(p.z)]
     }
 
-    fn new(positions: &'a [DVec3]) -> Self {
+    fn new(positions: &'a [DVec3], owners: HashMap<u32, u8>) -> Self {
         let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
-        for (i, &p) in positions.iter().enumerate() {
-            cells.entry(Self::cell(p)).or_default().push(i as u32);
+        for &v in owners.keys() {
+            cells
+                .entry(Self::cell(positions[v as usize]))
+                .or_default()
+                .push(v);
         }
-        Self { positions, cells }
+        // Hash order must not decide the order vertices are found in.
+        for ids in cells.values_mut() {
+            ids.sort_unstable();
+        }
+        Self {
+            positions,
+            cells,
+            owners,
+        }
     }
 
-    fn remove(&mut self, v: u32) {
+    /// Vertex `v` became `into`: it is gone, and `into` belongs to its polygons too.
+    fn merge(&mut self, v: u32, into: u32) {
         let cell = Self::cell(self.positions[v as usize]);
         if let Some(ids) = self.cells.get_mut(&cell) {
             ids.retain(|&id| id != v);
         }
+        let bits = self.owners.remove(&v).unwrap_or(0);
+        *self.owners.entry(into).or_default() |= bits;
     }
 
-    /// Insert into `poly` every vertex lying inside one of its edges; how many were inserted.
-    fn insert_edge_vertices(&self, poly: &mut Vec<u32>) -> usize {
+    /// Insert into `poly`, a polygon of `class`, every vertex lying inside one of its edges that
+    /// belongs to a class it takes; how many were inserted. An inserted vertex belongs to
+    /// `class` from then on: a face that welds with this polygon meets it there too.
+    fn insert_edge_vertices(&mut self, poly: &mut Vec<u32>, class: WeldClass) -> usize {
+        let takes = class.takes();
         let mut inserted = 0;
         let mut out = Vec::with_capacity(poly.len());
         let mut on_edge: Vec<(f64, u32)> = Vec::new();
@@ -159,6 +249,10 @@ impl<'a> TJunctionGrid<'a> {
             let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
             out.push(a);
             self.vertices_inside(a, b, &mut on_edge);
+            on_edge.retain(|(_, v)| self.owners.get(v).is_some_and(|&bits| bits & takes != 0));
+            for (_, v) in &on_edge {
+                *self.owners.entry(*v).or_default() |= class.bit();
+            }
             inserted += on_edge.len();
             out.extend(on_edge.iter().map(|&(_, v)| v));
         }
@@ -292,19 +386,77 @@ mod tests {
         assert_ne!(a, c);
     }
 
+    /// A big square and a small one beside it, whose corner 4 lies on the big one's edge.
+    fn square_and_neighbour() -> (Vec<DVec3>, Vec<Vec<u32>>) {
+        let positions = [
+            [0.0, 0.0],
+            [0.0, 64.0],
+            [64.0, 64.0],
+            [64.0, 0.0],
+            [64.0, 32.0],
+            [96.0, 0.0],
+            [96.0, 32.0],
+        ]
+        .map(|[x, y]| DVec3::new(x, y, 0.0))
+        .to_vec();
+        (positions, vec![vec![0, 1, 2, 3], vec![4, 3, 5, 6]])
+    }
+
     #[test]
     fn vertex_on_an_edge_is_inserted() {
-        // A big square next to two small ones: the small ones' shared corner lies on its edge.
-        let positions = vec![
-            DVec3::new(0.0, 0.0, 0.0),
-            DVec3::new(0.0, 64.0, 0.0),
-            DVec3::new(64.0, 64.0, 0.0),
-            DVec3::new(64.0, 0.0, 0.0),
-            DVec3::new(64.0, 32.0, 0.0),
-        ];
-        let mut polys = vec![vec![0, 1, 2, 3]];
-        assert_eq!(fix_tjunctions(&positions, &mut polys), 1);
+        let (positions, mut polys) = square_and_neighbour();
+        let classes = [WeldClass::Opaque; 2];
+        assert_eq!(fix_tjunctions(&positions, &mut polys, &classes), 1);
         assert_eq!(polys[0], vec![0, 1, 2, 4, 3]);
+    }
+
+    /// Which faces take which faces' vertices, as ericw-tools decides (its `tjuncMatrix` test):
+    /// rows are the big face's class, columns the small one's.
+    #[test]
+    fn faces_take_the_vertices_of_the_classes_they_weld_with() {
+        use WeldClass::*;
+        let all = [Opaque, DetailWall, SeeThrough, Liquid];
+        let takes = [
+            (Opaque, [true, false, false, true]),
+            (DetailWall, [true, true, false, true]),
+            (SeeThrough, [true, true, true, true]),
+            (Liquid, [true, true, true, true]),
+        ];
+        for (big, row) in takes {
+            for (small, expected) in all.into_iter().zip(row) {
+                let (positions, mut polys) = square_and_neighbour();
+                let inserted = fix_tjunctions(&positions, &mut polys, &[big, small]);
+                assert_eq!(inserted == 1, expected, "{big:?} taking from {small:?}");
+            }
+        }
+        // Only the polygons given are looked at: another model's vertex goes into no edge.
+        let (positions, mut polys) = square_and_neighbour();
+        assert_eq!(fix_tjunctions(&positions, &mut polys[..1], &[Opaque]), 0);
+    }
+
+    /// A see-through face's corner on the shared edge of a liquid face and a solid one: the
+    /// liquid takes it, and then the solid face, which meets the liquid there, takes it too, or
+    /// the two would crack along that edge.
+    #[test]
+    fn a_vertex_goes_on_to_the_faces_that_weld_with_a_face_it_went_into() {
+        use WeldClass::*;
+        let positions = [
+            [0.0, 0.0],
+            [64.0, 0.0],
+            [64.0, 32.0],
+            [0.0, 32.0],
+            [0.0, -64.0],
+            [64.0, -64.0],
+            [32.0, 0.0],
+            [32.0, -16.0],
+            [48.0, -16.0],
+        ]
+        .map(|[x, y]| DVec3::new(x, y, 0.0))
+        .to_vec();
+        let mut polys = vec![vec![1, 0, 4, 5], vec![0, 1, 2, 3], vec![6, 7, 8]];
+        let inserted = fix_tjunctions(&positions, &mut polys, &[Opaque, Liquid, SeeThrough]);
+        assert_eq!(inserted, 2);
+        assert!(polys[0].contains(&6) && polys[1].contains(&6), "{polys:?}");
     }
 
     #[test]

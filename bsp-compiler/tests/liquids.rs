@@ -86,6 +86,10 @@ fn transparent_water_is_detail_for_vis() {
     let water = quake_formats::bsp::contents::WATER;
     let contents_at = |p| out.bsp.leafs[out.bsp.leaf_at(p).expect("leaf")].contents;
     assert_eq!((contents_at(BELOW), contents_at(LOWER)), (water, water));
+    // As ericw-tools counts it: the shared solid leaf, air and water in the room, a leaf for
+    // each corridor; three clusters joined by two portals.
+    assert_eq!(out.bsp.leafs.len(), 5);
+    assert_eq!((out.stats.clusters, portals), (3, 2));
 }
 
 #[test]
@@ -98,6 +102,9 @@ fn opaque_water_is_structural_and_closed_to_vis() {
     assert_eq!(errors(&out.bsp), Vec::<String>::new());
     let (c, portals) = clusters_of(&out, [ABOVE, BELOW, LOWER, UPPER]);
     assert_ne!(c[0], c[1], "{c:?}");
+    // The same leaves as with transparent water, each its own cluster, and the same two portals.
+    assert_eq!(out.bsp.leafs.len(), 5);
+    assert_eq!((out.stats.clusters, portals), (4, 2));
     // The lower corridor sees only the water, the upper one only the air above it.
     let prt = PortalFile::parse(&out.portals.write()).expect("prt");
     let joined = |a: usize, b: usize| {

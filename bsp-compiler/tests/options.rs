@@ -702,3 +702,92 @@ fn two_psb_gives_way_to_bsp2_past_16_bit_bounds() {
         .any(|w| w.to_string().contains("2PSB limit exceeded"));
     assert!(warned, "{:?}", out.warnings);
 }
+
+/// The texture of `bsp` named `name`.
+fn texture_named(bsp: &Bsp, name: &str) -> quake_formats::miptex::MipTex {
+    bsp.textures
+        .textures
+        .iter()
+        .flatten()
+        .find(|t| t.name() == name)
+        .cloned()
+        .unwrap_or_else(|| panic!("no texture {name}"))
+}
+
+/// `-path DIR` with `-notex`: a texture no WAD holds takes its name and size from a loose
+/// picture, `DIR/textures/NAME.png` or `.tga`, without a warning (ericw-tools' `looseTextures`);
+/// without `-notex` textures come from WADs only (`looseTexturesIgnored`), and one found
+/// nowhere is a placeholder.
+#[test]
+fn path_gives_loose_textures_their_sizes_with_notex() {
+    let dir = temp_dir("loose");
+    std::fs::create_dir_all(dir.join("textures")).expect("textures dir");
+    image::RgbImage::new(32, 16)
+        .save(dir.join("textures/floor_purple.png"))
+        .expect("png");
+    image::RgbImage::new(128, 64)
+        .save(dir.join("textures/wall_tan.tga"))
+        .expect("tga");
+    let text = room_map(false, "")
+        .replace("floor 0 0 0 1 1", "floor_purple 0 0 0 1 1")
+        .replace("wall 0 0 0 1 1", "WALL_TAN 0 0 0 1 1");
+    let path = dir.to_str().expect("utf8");
+    let out = try_compile_with(&text, &parsed_options(&["-path", path, "-notex", "x.map"]))
+        .expect("compile");
+    assert_eq!(errors(&out.bsp), Vec::<String>::new());
+    for (name, size) in [("floor_purple", (32, 16)), ("wall_tan", (128, 64))] {
+        let t = texture_named(&out.bsp, name);
+        assert_eq!((t.width, t.height), size, "{name}");
+        assert!(t.mips.is_none(), "{name}");
+    }
+    let missing: Vec<String> = out
+        .warnings
+        .iter()
+        .map(|w| w.to_string())
+        .filter(|w| w.contains("not found in any WAD"))
+        .collect();
+    // Only the ceiling's texture is missing.
+    assert_eq!(missing.len(), 1, "{missing:?}");
+
+    let embedded =
+        try_compile_with(&text, &parsed_options(&["-path", path, "x.map"])).expect("compile");
+    let t = texture_named(&embedded.bsp, "floor_purple");
+    assert_eq!((t.width, t.height), (64, 64));
+    assert!(t.mips.is_some());
+}
+
+/// `-missing_textures_as_zero_size`: a texture found nowhere keeps its name with a 0x0 size and
+/// no pixels (ericw-tools' `missingTextureAndMissingTexturesAsZeroSize`); one a WAD holds is
+/// written whole.
+#[test]
+fn missing_textures_as_zero_size_writes_them_0x0() {
+    let wad = Path::new(env!("CARGO_MANIFEST_DIR")).join("../maps");
+    let text = room_map(false, "")
+        .replace("none.wad", "slipgate.wad")
+        .replace("wall 0 0 0 1 1", "brick1 0 0 0 1 1");
+    let wad_dir = wad.to_str().expect("utf8");
+    let options = parsed_options(&[
+        "-wadpath",
+        wad_dir,
+        "-missing_textures_as_zero_size",
+        "x.map",
+    ]);
+    let bsp = compile_options(&text, options);
+    let floor = texture_named(&bsp, "floor");
+    assert_eq!((floor.width, floor.height), (0, 0));
+    assert!(floor.mips.is_none());
+    let brick = texture_named(&bsp, "brick1");
+    assert!(brick.width > 0 && brick.mips.is_some());
+    let back = Bsp::read(&bsp.write().expect("write")).expect("read back");
+    assert_eq!(texture_named(&back, "floor").width, 0);
+}
+
+/// ericw-tools' switches for its `.texinfo.json`, which Slipgate does not write, are accepted
+/// with a note.
+#[test]
+fn extended_flag_switches_are_accepted_with_a_note() {
+    let args = parsed_args(&["-noextendedcontentflags", "-noextendedsurfflags", "x.map"]);
+    let notes = args.ericw_only.notes();
+    assert_eq!(notes.len(), 2, "{notes:?}");
+    assert!(notes[0].starts_with("-noextendedcontentflags has no effect"));
+}

@@ -1,6 +1,7 @@
 //! The entity lump: `{ "key" "value" ... }` blocks, kept as ordered key/value pairs.
 
 use crate::error::{FormatError, Result};
+use crate::geom::POINT_EPSILON;
 
 /// One entity: its key/value pairs in file order (keys may repeat; the first one wins on lookup,
 /// as in Quake's `ValueForKey`).
@@ -64,6 +65,17 @@ impl Entity {
     /// A key parsed as one number (`"light" "300"`); `None` when it is missing or not a number.
     pub fn get_float(&self, key: &str) -> Option<f64> {
         self.get(key)?.trim().parse().ok()
+    }
+
+    /// Where this point entity marks open space for a compiler's outside fill: its `origin`,
+    /// unless it stands at the map's origin (where ericw-tools takes it for a brush entity and
+    /// skips it) or is marked `_nofill` (or `_lightgrid_hint`) to stand in the void. The caller
+    /// leaves out worldspawn and brush entities.
+    pub fn fill_origin(&self) -> Option<[f64; 3]> {
+        let origin = self.get_floats::<3>("origin")?;
+        let marked = |key| self.get_float(key).is_some_and(|v| v != 0.0);
+        let at_map_origin = origin.iter().all(|c| c.abs() < POINT_EPSILON);
+        (!at_map_origin && !marked("_nofill") && !marked("_lightgrid_hint")).then_some(origin)
     }
 }
 

@@ -58,7 +58,10 @@ impl MipTex {
         let width = r.u32()?;
         let height = r.u32()?;
         let offsets = [r.u32()?, r.u32()?, r.u32()?, r.u32()?];
-        if width == 0 || height == 0 || width > 4096 || height > 4096 {
+        let no_pixels = offsets.iter().all(|&o| o == 0);
+        // A name without size or pixels: ericw-tools' `-missing_textures_as_zero_size`.
+        let name_only = no_pixels && width == 0 && height == 0;
+        if !name_only && (width == 0 || height == 0 || width > 4096 || height > 4096) {
             return Err(FormatError::BadLump {
                 lump: "miptex",
                 detail: format!(
@@ -67,7 +70,7 @@ impl MipTex {
                 ),
             });
         }
-        let mips = if offsets.iter().all(|&o| o == 0) {
+        let mips = if no_pixels {
             None
         } else {
             let mut levels: [Vec<u8>; 4] = Default::default();
@@ -210,5 +213,29 @@ mod tests {
         assert!(!MipTex::new("light2", 4, 4, mips(lit)).is_all_fullbright());
         let external = MipTex { mips: None, ..lamp };
         assert!(!external.is_all_fullbright());
+    }
+
+    /// A texture may be a name alone, 0x0 without pixels (ericw-tools'
+    /// `-missing_textures_as_zero_size`); a 0x0 one with pixels, or one of a single side 0, is
+    /// refused.
+    #[test]
+    fn a_name_alone_is_a_texture_but_a_zero_side_with_pixels_is_not() {
+        let encoded = |width: u32, height: u32, offset: u32| {
+            let mut data = Vec::new();
+            data.extend_from_slice(&string_to_name16("missing"));
+            data.extend_from_slice(&width.to_le_bytes());
+            data.extend_from_slice(&height.to_le_bytes());
+            for _ in 0..4 {
+                data.extend_from_slice(&offset.to_le_bytes());
+            }
+            data
+        };
+        let t = MipTex::decode(&encoded(0, 0, 0), "test").expect("name only");
+        assert_eq!(
+            (t.name(), t.width, t.height, t.mips),
+            ("missing".into(), 0, 0, None)
+        );
+        assert!(MipTex::decode(&encoded(0, 0, 40), "test").is_err());
+        assert!(MipTex::decode(&encoded(0, 16, 0), "test").is_err());
     }
 }

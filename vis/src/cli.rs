@@ -165,7 +165,14 @@ impl Inputs {
         let bsp_name = args.bsp.display();
         let bsp = Bsp::read(&read_file(&args.bsp)?).with_context(|| format!("{bsp_name}"))?;
         // Before the portal file: a leaking map has none, and this says why.
-        crate::check_sealed(&bsp).with_context(|| format!("{bsp_name}"))?;
+        let outside = crate::check_sealed(&bsp).with_context(|| format!("{bsp_name}"))?;
+        if let crate::Outside::Included { leaf } = outside {
+            eprintln!(
+                "note: {bsp_name}: no point entity stands in the map's open space, so the \
+                 compiler could not tell inside from outside: the outside is included (leaf \
+                 {leaf} lies in it)"
+            );
+        }
         let prt_path = args
             .prt
             .clone()

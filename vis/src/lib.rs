@@ -28,7 +28,7 @@ pub mod tree_portals;
 pub use ambient::Channels;
 pub use bitset::BitSet;
 pub use clusters::Clusters;
-pub use lump::{LumpStats, check_portals_match, check_sealed, read_pvs, write_vis};
+pub use lump::{LumpStats, Outside, check_portals_match, check_sealed, read_pvs, write_vis};
 pub use portals::PortalGraph;
 pub use pvs::Pvs;
 pub use schedule::{FlowPlan, Grouping, Shard};
@@ -56,8 +56,8 @@ pub enum VisError {
         /// Vis leaves of the BSP's world model.
         vis_leafs: usize,
     },
-    /// The world keeps the void outside the map (open leaves past its bounds on every side):
-    /// the map leaks.
+    /// The world keeps the void outside the map (open leaves past its bounds on every side)
+    /// and a point entity stands in its open space: the map leaks.
     #[error(
         "the map leaks: leaf {leaf} reaches past the world's brushes into the void outside the \
          map, which vis would have to work through; fix the leak (the compiler's .pts pointfile \

@@ -6,6 +6,7 @@ use crate::pvs::Pvs;
 use quake_formats::Bsp;
 use quake_formats::PvsRow;
 use quake_formats::bsp::contents;
+use quake_formats::entities::parse_entities;
 use quake_formats::visrle::compress_row;
 use std::collections::HashMap;
 
@@ -53,16 +54,52 @@ pub fn check_portals_match(bsp: &Bsp, prt_leafs: usize) -> Result<(), VisError> 
             vis_leafs,
         });
     }
-    check_sealed(bsp)
+    check_sealed(bsp).map(|_| ())
+}
+
+/// Whether a BSP's world keeps the void outside the map, which vis then works through too.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Outside {
+    /// The outside was filled: open leaves lie inside the map's brushes.
+    Filled,
+    /// No point entity stands in the map's open space, so the compiler could not tell inside
+    /// from outside and filled nothing (ericw-tools: "no filling performed"): the void's leaves
+    /// are vis leaves like any other. Not a leak.
+    Included {
+        /// One open leaf of the void (BSP leaf number).
+        leaf: usize,
+    },
 }
 
 /// Refuse a BSP whose world keeps the void of a leaking map: the portals of such a map reach
-/// the whole void, and flowing through them is wasted work.
-pub fn check_sealed(bsp: &Bsp) -> Result<(), VisError> {
+/// the whole void, and flowing through them is wasted work. A void with no point entity in any
+/// open leaf is a map with nothing to flood from (a test room, a prefab), which compilers leave
+/// unfilled: vis includes it.
+pub fn check_sealed(bsp: &Bsp) -> Result<Outside, VisError> {
     match void_leaf(bsp, world_vis_leafs(bsp)?) {
-        Some(leaf) => Err(VisError::Void { leaf }),
-        None => Ok(()),
+        None => Ok(Outside::Filled),
+        Some(leaf) if entity_in_open_space(bsp) => Err(VisError::Void { leaf }),
+        Some(leaf) => Ok(Outside::Included { leaf }),
     }
+}
+
+/// Whether a point entity of the entity lump marks open space in the world, as the compiler's
+/// outside fill takes them ([`quake_formats::entities::Entity::fill_origin`]). An entity lump
+/// that cannot be read says yes: vis cannot tell a map with nothing to flood from.
+fn entity_in_open_space(bsp: &Bsp) -> bool {
+    let Ok(entities) = parse_entities(&bsp.entity_text()) else {
+        return true;
+    };
+    entities
+        .iter()
+        .skip(1)
+        .filter(|e| !e.get("model").is_some_and(|m| m.starts_with('*')))
+        .filter_map(|e| e.fill_origin())
+        .any(|origin| {
+            bsp.leaf_at(origin.map(|c| c as f32))
+                .and_then(|leaf| bsp.leafs.get(leaf))
+                .is_some_and(|leaf| leaf.contents != contents::SOLID)
+        })
 }
 
 /// How far past the world model's bounds a leaf must reach to be the void: more than the
