@@ -7,15 +7,14 @@ use std::path::{Path, PathBuf};
 const CRATES: [&str; 4] = ["bsp-compiler", "vis", "light", "runtime-viewer"];
 
 /// How the crates read entity keys: `Entity` accessors (`get`, `get_float`, `get_floats`),
-/// light's `Keys` helpers, and the prefab module's key constants. The literal follows each
-/// opening. Keys starting with `_` are taken wherever they appear (light lists some in tables),
-/// as are the first of a `float_any`/`color_any` list and classname-like literals.
-const KEY_OPENINGS: [&str; 6] = [
+/// the spellings of light's declared entity keys (`NAME: ["key", ...]`), and the prefab module's
+/// key constants. The literal follows each opening. Keys starting with `_` are taken wherever
+/// they appear (light lists some in tables), as are classname-like literals.
+const KEY_OPENINGS: [&str; 5] = [
     ".get(\"",
     ".get_float(\"",
     ">(\"",
-    ".float(\"",
-    ".vec3(\"",
+    ": [\"",
     ": &str = \"",
 ];
 
@@ -55,8 +54,12 @@ fn literals(code: &str) -> Vec<(&str, &str)> {
             break;
         };
         let at = consumed + start;
+        let mut before = at.saturating_sub(16);
+        while !code.is_char_boundary(before) {
+            before -= 1;
+        }
         out.push((
-            &code[at.saturating_sub(16)..at + 1],
+            &code[before..at + 1],
             &rest[start + 1..start + 1 + len],
         ));
         consumed += start + len + 2;
