@@ -210,21 +210,21 @@ fn reach2(points: &[DVec3], inward: &[DVec3], centre: DVec3) -> f64 {
     if n < 3 || inward.contains(&DVec3::ZERO) {
         return f64::INFINITY;
     }
-    let mut sharpest = f64::INFINITY;
+    // The sharpest corner, by the square of half its angle's sine: at points[i], between edge
+    // i - 1 and edge i.
+    let mut sharpest2 = f64::INFINITY;
     for i in 0..n {
-        // The corner at points[i], between edge i - 1 and edge i: half its angle's sine.
         let (before, after) = (inward[(i + n - 1) % n], inward[i]);
-        let half_sine = ((1.0 + before.dot(after)) / 2.0).max(0.0).sqrt();
-        sharpest = sharpest.min(half_sine);
+        sharpest2 = sharpest2.min((1.0 + before.dot(after)) / 2.0);
     }
-    if sharpest.is_nan() || sharpest <= 1e-3 {
+    if sharpest2.is_nan() || sharpest2 <= 1e-6 {
         return f64::INFINITY;
     }
-    let farthest = points
+    let farthest2 = points
         .iter()
-        .map(|p| p.distance(centre))
+        .map(|p| p.distance_squared(centre))
         .fold(0.0, f64::max);
-    let reach = farthest + 2.0 * CONTAINS_SLACK / sharpest + 1e-3;
+    let reach = farthest2.sqrt() + 2.0 * CONTAINS_SLACK / sharpest2.sqrt() + 1e-3;
     reach * reach
 }
 
