@@ -83,13 +83,14 @@ SKY_RAYS = 16  # cosine-weighted sky rays per sample point (256 per luxel)
 BOUNCE_RAYS = 16  # cosine-weighted gather rays per sample point for interreflection
 ROULETTE_LEVEL = 0.25  # unshadowed contributions below this many levels are traced by chance
 RAY_OFFSET = 0.1  # shadow rays start this far off the surface
+EXTENT_TOLERANCE = 0.01  # texture units: a face extreme this close to a luxel boundary is uncertain
 MIN_FOOTPRINT = 1e-3  # texture units^2: a luxel square touching the polygon less is not drawn
 DEFAULT_MAX_LUXELS = 40000  # judged luxels the automatic subset aims at
 RAY_CHUNK = 1 << 21
 SKY_DISTANCE = 65536.0
 BOUNCE_ITERATION_LIMIT = 32
 BOUNCE_CONVERGED = 0.05  # levels: interreflection stops when no luxel changes more
-CACHE_VERSION = 2
+CACHE_VERSION = 3
 
 
 class BspError(Exception):
@@ -536,8 +537,17 @@ class FaceLuxels:
         verts = bsp.face_vertices(face)
         vecs = bsp.tex_vecs[f["texinfo"]]
         st = verts @ vecs[:, :3].T + vecs[:, 3]
-        mins = np.floor(st.min(axis=0) / LUXEL)
-        maxs = np.ceil(st.max(axis=0) / LUXEL)
+        # the lightmap's extents as engines and both tools compute them: in single precision
+        v32, t32 = verts.astype(np.float32), vecs.astype(np.float32)
+        st32 = np.stack([v32[:, 0] * t32[j, 0] + v32[:, 1] * t32[j, 1] + v32[:, 2] * t32[j, 2] + t32[j, 3]
+                         for j in range(2)], axis=1)
+        mins = np.floor(st32.min(axis=0).astype(np.float64) / LUXEL)
+        maxs = np.ceil(st32.max(axis=0).astype(np.float64) / LUXEL)
+        # an extreme a hair off a luxel boundary may fall either side of it in a tool's or an
+        # engine's arithmetic: such a face's lightmap layout is not certain
+        extremes = np.concatenate([st.min(axis=0), st.max(axis=0)]) / LUXEL
+        off = np.abs(extremes - np.rint(extremes)) * LUXEL
+        self.layout_uncertain = bool(np.any((off > 0) & (off < EXTENT_TOLERANCE)))
         self.mins = mins
         self.width, self.height = int(maxs[0] - mins[0]) + 1, int(maxs[1] - mins[1]) + 1
         normal = bsp.plane_normal[f["plane"]]
@@ -914,6 +924,30 @@ def saturate(rgb):
     return np.where(m > LIGHTMAP_MAX, rgb * (LIGHTMAP_MAX / np.maximum(m, 1e-9)), rgb)
 
 
+def error_breakdown(weights, diff, reference, whole):
+    """The error split by kind of luxel: where on the face, how much light."""
+    classes = [
+        ("whole luxels (footprint inside the face)", whole),
+        ("edge luxels (footprint cut by the face's edge)", ~whole),
+        ("dark (reference under 1 level)", reference.max(axis=1) < 1.0),
+        ("dim (reference 1 to 32 levels)", (reference.max(axis=1) >= 1.0) & (reference.max(axis=1) < 32.0)),
+        ("saturated (reference at 255)", reference.max(axis=1) >= LIGHTMAP_MAX - 0.5),
+    ]
+    sq = (weights[:, None] * diff**2).sum(axis=1)
+    total_sq, total_w = sq.sum(), weights.sum()
+    rows = []
+    for name, m in classes:
+        w = weights[m].sum()
+        rows.append({
+            "class": name,
+            "area_share": float(w / total_w) if total_w else 0.0,
+            "error_share": float(sq[m].sum() / total_sq) if total_sq else 0.0,
+            "rmse": math.sqrt(float(sq[m].sum() / (w * diff.shape[1]))) if w else 0.0,
+            "bias": float((weights[m, None] * diff[m]).sum() / (w * diff.shape[1])) if w else 0.0,
+        })
+    return rows
+
+
 def main(argv):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("bsp")
@@ -968,6 +1002,9 @@ def main(argv):
     if not len(judged):
         print("error: the BSP has no lightmapped face to judge", file=sys.stderr)
         return 1
+    # faces whose lightmap layout is uncertain are not judged
+    judged = np.array([f for f in judged if not FaceLuxels(bsp, f, scene.face_offset[f]).layout_uncertain],
+                      dtype=np.int64)
     # a fixed subset: every Nth judged face in face order
     every = args.every
     if every <= 0:
@@ -988,7 +1025,7 @@ def main(argv):
         f"{len(lights)} style-0 lights, sun {'yes' if sun else 'no'}, "
         f"domes {'yes' if dome_up is not None or dome_down is not None else 'no'}, "
         f"colour from {'.lit' if bsp.lit is not None else 'the grey lightmap'}")
-    log(f"subset: every {every}th of {len(judged)} lightmapped faces -> {len(subset)} faces"
+    log(f"subset: 1 in {every} of {len(judged)} lightmapped faces -> {len(subset)} faces"
         + (f" ({len(bad)} left out: lightmap size disagrees)" if bad else ""))
 
     light_digest = json.dumps([[l.origin.tolist(), l.intensity.tolist(), None if l.spot_dir is None else
@@ -1062,6 +1099,11 @@ def main(argv):
     noise = math.sqrt(float((weights[:, None] * var_cmp).sum() / (wsum * diff.shape[1])))
     bias = float((weights[:, None] * diff).sum() / (wsum * diff.shape[1]))
     mean_ref = float((weights[:, None] * reference_cmp).sum() / (wsum * diff.shape[1]))
+    breakdown = error_breakdown(weights, diff, reference_cmp, drawn.whole)
+    for row in breakdown:
+        log(f"  {row['class']:<44} {row['area_share'] * 100:5.1f}% of the area, "
+            f"{row['error_share'] * 100:5.1f}% of the squared error, rmse {row['rmse']:6.2f}, "
+            f"mean lightmap - reference {row['bias']:+6.2f}")
     seconds = time.time() - t0
     log(f"mean reference {mean_ref:.2f} levels, mean lightmap - reference {bias:+.3f} levels, "
         f"{(reference_cmp >= LIGHTMAP_MAX - 0.5).mean() * 100:.1f}% of values saturated; "
@@ -1089,8 +1131,9 @@ def main(argv):
             json.dump({"bsp": args.bsp, "rmse": rmse, "drawn_luxels": len(drawn), "noise": noise,
                        "bias": bias, "mean_reference": mean_ref, "every": every, "faces": int(len(subset)),
                        "bounce": args.bounce, "colour": bsp.lit is not None, "seconds": seconds,
+                       "breakdown": breakdown,
                        "reference_seconds": ref_seconds}, f, indent=1)
-    print(f"subset: every {every}th lightmapped face ({len(subset)} of {len(judged)} faces); "
+    print(f"subset: 1 in {every} lightmapped faces ({len(subset)} of {len(judged)} faces); "
           f"reference time {ref_seconds:.1f} s")
     print(f"rmse {rmse:.3f} over {len(drawn)} drawn luxels; noise {noise:.3f}")
     return 0
