@@ -93,7 +93,7 @@ for map in "$@"; do
     read -r _ sg_rmse _ luxels _ _ _ noise <<<"$(tail -n 1 <<<"$sg_out")"
     read -r _ ew_rmse _ _ _ _ _ _ <<<"$(tail -n 1 <<<"$ew_out")"
     ref_time=$(head -n 1 <<<"$sg_out" | sed 's/.*reference time \([0-9.]*\) s.*/\1/')
-    XX
+    subset=$(head -n 1 <<<"$sg_out" | sed 's/subset: 1 in \([0-9]*\).*/\1/')
     printf '| %s | %s | %.2f s | %.2f | %.2f s | %.2f | %.2f | %s (1 face in %s) | %.0f s |\n' \
       "$name" "$setting" "$sg_time" "$sg_rmse" "$ew_time" "$ew_rmse" "${noise%;}" "$luxels" "$subset" "$ref_time"
   done

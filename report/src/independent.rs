@@ -165,6 +165,7 @@ pub fn run(options: &IndependentOptions) -> Result<IndependentReport, ReportErro
     if options.maps.is_empty() {
         return Err(ReportError::NoMaps);
     }
+    let anchor_as_given = options.anchor.clone();
     let absolute = |p: &PathBuf| std::path::absolute(p).map_err(ReportError::io(p));
     let options = &IndependentOptions {
         maps: options
@@ -286,7 +287,7 @@ pub fn run(options: &IndependentOptions) -> Result<IndependentReport, ReportErro
         machine,
         runs,
         release: options.release,
-        anchor: options.anchor.clone(),
+        anchor: anchor_as_given,
         maps: options.maps.clone(),
         settings,
         rows,
