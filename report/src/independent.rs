@@ -370,15 +370,16 @@ fn worldspawn_wad(map_text: &str) -> Option<&str> {
 /// The map with its `"wad"` key naming `wad` alone (added to worldspawn when it has none).
 fn set_wad_key(map_text: &str, wad: &Path) -> String {
     let key = format!("\"wad\" \"{}\"", wad.display());
+    let has_key = worldspawn_wad(map_text).is_some();
     let mut out = String::with_capacity(map_text.len() + key.len() + 1);
     let mut done = false;
     for line in map_text.lines() {
-        if !done && line.trim().starts_with("\"wad\"") {
+        if !done && has_key && line.trim().starts_with("\"wad\"") {
             out += &key;
             done = true;
         } else {
             out += line;
-            if !done && line.trim() == "{" {
+            if !done && !has_key && line.trim() == "{" {
                 out += "\n";
                 out += &key;
                 done = true;
@@ -662,6 +663,7 @@ mod tests {
         assert_eq!(worldspawn_wad(MAP), Some("../wads/base.wad;gfx.wad"));
         let set = set_wad_key(MAP, Path::new("/tmp/p.wad"));
         assert_eq!(worldspawn_wad(&set), Some("/tmp/p.wad"));
+        assert_eq!(set.matches("\"wad\"").count(), 1, "the key is replaced, not added");
         let without = MAP.replace("\"wad\" \"../wads/base.wad;gfx.wad\"\n", "");
         let added = set_wad_key(&without, Path::new("/tmp/p.wad"));
         assert_eq!(worldspawn_wad(&added), Some("/tmp/p.wad"));
