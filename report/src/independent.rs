@@ -663,7 +663,11 @@ mod tests {
         assert_eq!(worldspawn_wad(MAP), Some("../wads/base.wad;gfx.wad"));
         let set = set_wad_key(MAP, Path::new("/tmp/p.wad"));
         assert_eq!(worldspawn_wad(&set), Some("/tmp/p.wad"));
-        assert_eq!(set.matches("\"wad\"").count(), 1, "the key is replaced, not added");
+        assert_eq!(
+            set.matches("\"wad\"").count(),
+            1,
+            "the key is replaced, not added"
+        );
         let without = MAP.replace("\"wad\" \"../wads/base.wad;gfx.wad\"\n", "");
         let added = set_wad_key(&without, Path::new("/tmp/p.wad"));
         assert_eq!(worldspawn_wad(&added), Some("/tmp/p.wad"));
