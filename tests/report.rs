@@ -196,7 +196,10 @@ fn report_independent_judges_both_tools_against_the_reference() {
         return;
     }
     let has_mitsuba = std::process::Command::new("python3")
-        .args(["-c", "import numpy, mitsuba; mitsuba.set_variant('llvm_ad_rgb')"])
+        .args([
+            "-c",
+            "import numpy, mitsuba; mitsuba.set_variant('llvm_ad_rgb')",
+        ])
         .output()
         .is_ok_and(|o| o.status.success());
     if !has_mitsuba {
@@ -232,6 +235,9 @@ fn report_independent_judges_both_tools_against_the_reference() {
     assert!(md.contains("| open_wall | -extra4 -soft |"), "{md}");
     check_png(&out.join("light-independent.png"));
     let html = std::fs::read_to_string(out.join("independent.html")).expect("independent.html");
-    assert!(tags_balance(&html), "independent.html's tags do not balance");
+    assert!(
+        tags_balance(&html),
+        "independent.html's tags do not balance"
+    );
     std::fs::remove_dir_all(out.parent().expect("scratch dir")).ok();
 }
