@@ -35,12 +35,31 @@ pub struct ReportArgs {
     /// Print report.json to stdout when done
     #[arg(long)]
     stats: bool,
+    /// Light only, both tools against an independent reference (Python 3 with Mitsuba 3 and
+    /// numpy): benchmark forms of the maps, compiled by the anchor (default
+    /// ../shared/anchors/ericw-tools/bin), lit by both tools at default and -extra4 -soft
+    #[arg(long)]
+    independent: bool,
+    /// With --independent: the folder holding benchmark_map.py and reference.py
+    #[arg(long, value_name = "DIR", default_value = "bench/independent")]
+    scripts: PathBuf,
+    /// With --independent: the Python 3 interpreter that runs them
+    #[arg(long, value_name = "PYTHON", default_value = "python3")]
+    python: PathBuf,
 }
 
 const PROJECT_MAPS: [&str; 2] = ["maps/demo.map", "maps/test/corridors.map"];
 const CORPUS: &str = "../shared/corpus";
 const CORPUS_MAPS: [&str; 2] = ["public/maps/id/e1m1.map", "public/maps/librequake/e3m4.map"];
 const CORPUS_WADS: &str = "wads/librequake";
+/// The corpus maps `--independent` measures by default.
+const INDEPENDENT_MAPS: [&str; 3] = [
+    "public/maps/id/e1m1.map",
+    "public/maps/librequake/start.map",
+    "public/maps/librequake/e1m3.map",
+];
+/// ericw-tools beside the project, where `--independent` looks when no --anchor is given.
+const SHARED_ANCHOR: &str = "../shared/anchors/ericw-tools/bin";
 
 /// The project's maps, and the corpus maps when the corpus is beside the project.
 fn default_maps() -> Vec<PathBuf> {
@@ -54,6 +73,9 @@ fn default_maps() -> Vec<PathBuf> {
 }
 
 pub fn report(args: &ReportArgs) -> Result<()> {
+    if args.independent {
+        return independent(args);
+    }
     let maps = if args.maps.is_empty() {
         default_maps()
     } else {
@@ -64,11 +86,7 @@ pub fn report(args: &ReportArgs) -> Result<()> {
         "no maps given, and none of {} found here (run from the project's root)",
         PROJECT_MAPS.join(", ")
     );
-    let mut wad_dirs = args.wad_dirs.clone();
-    let corpus_wads = Path::new(CORPUS).join(CORPUS_WADS);
-    if corpus_wads.is_dir() && !wad_dirs.contains(&corpus_wads) {
-        wad_dirs.push(corpus_wads);
-    }
+    let wad_dirs = wad_dirs(args);
     let options = report::Options {
         maps,
         out_dir: args.out_dir.clone(),
@@ -90,6 +108,66 @@ pub fn report(args: &ReportArgs) -> Result<()> {
         "report: {} rows ({failed} failed) in {}",
         result.rows.len(),
         args.out_dir.join("report.md").display()
+    );
+    if args.stats {
+        println!("{}", serde_json::to_string_pretty(&result)?);
+    }
+    Ok(())
+}
+
+/// The WAD folders given, and the corpus' when it is beside the project.
+fn wad_dirs(args: &ReportArgs) -> Vec<PathBuf> {
+    let mut wad_dirs = args.wad_dirs.clone();
+    let corpus_wads = Path::new(CORPUS).join(CORPUS_WADS);
+    if corpus_wads.is_dir() && !wad_dirs.contains(&corpus_wads) {
+        wad_dirs.push(corpus_wads);
+    }
+    wad_dirs
+}
+
+/// `report --independent`: both tools' light against the independent reference.
+fn independent(args: &ReportArgs) -> Result<()> {
+    let maps = if args.maps.is_empty() {
+        let corpus = Path::new(CORPUS);
+        INDEPENDENT_MAPS
+            .iter()
+            .map(|m| corpus.join(m))
+            .filter(|p| p.is_file())
+            .collect()
+    } else {
+        args.maps.clone()
+    };
+    anyhow::ensure!(
+        !maps.is_empty(),
+        "no maps given, and none of the corpus maps ({}) found under {CORPUS}",
+        INDEPENDENT_MAPS.join(", ")
+    );
+    let anchor = match &args.anchor {
+        Some(a) => a.clone(),
+        None if Path::new(SHARED_ANCHOR).join("light").is_file() => PathBuf::from(SHARED_ANCHOR),
+        None => anyhow::bail!(
+            "--independent measures ericw-tools' light beside ours: give its bin folder with \
+             --anchor DIR (none at {SHARED_ANCHOR})"
+        ),
+    };
+    let options = report::independent::IndependentOptions {
+        maps,
+        out_dir: args.out_dir.clone(),
+        runs: args.runs as usize,
+        anchor,
+        slipgate: std::env::current_exe().context("finding the slipgate binary to time")?,
+        wad_dirs: wad_dirs(args),
+        scripts: args.scripts.clone(),
+        python: args.python.clone(),
+        release: !cfg!(debug_assertions),
+        progress: true,
+    };
+    let result = report::independent::run(&options)?;
+    let failed = result.rows.iter().filter(|r| r.failure.is_some()).count();
+    eprintln!(
+        "report: {} rows ({failed} failed) in {}",
+        result.rows.len(),
+        args.out_dir.join("independent.md").display()
     );
     if args.stats {
         println!("{}", serde_json::to_string_pretty(&result)?);

@@ -167,3 +167,77 @@ fn tag_balance_catches_unclosed_tags() {
     assert!(!tags_balance("<svg><g></svg>"));
     assert!(!tags_balance("<svg>"));
 }
+
+#[test]
+fn report_independent_without_python_says_what_to_install() {
+    let out = command::scratch("report-independent-python", "out");
+    let run = command::slipgate(&[
+        "report",
+        "--independent",
+        "--anchor",
+        "/nonexistent/ericw-tools",
+        "--python",
+        "/nonexistent/python3",
+        "--out-dir",
+        out.to_str().expect("utf8"),
+        "bench/independent/testmaps/open_wall.map",
+    ]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success(), "{stderr}");
+    assert!(stderr.contains("pip install mitsuba numpy"), "{stderr}");
+    std::fs::remove_dir_all(out.parent().expect("scratch dir")).ok();
+}
+
+#[test]
+fn report_independent_judges_both_tools_against_the_reference() {
+    let anchor = Path::new("../shared/anchors/ericw-tools/bin");
+    if !anchor.join("light").is_file() {
+        eprintln!("SKIPPED: ericw-tools not found at {}", anchor.display());
+        return;
+    }
+    let has_mitsuba = std::process::Command::new("python3")
+        .args([
+            "-c",
+            "import numpy, mitsuba; mitsuba.set_variant('llvm_ad_rgb')",
+        ])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !has_mitsuba {
+        eprintln!("SKIPPED: python3 with mitsuba and numpy not found");
+        return;
+    }
+    let out = command::scratch("report-independent", "out");
+    let run = command::slipgate(&[
+        "report",
+        "--independent",
+        "--runs",
+        "1",
+        "--out-dir",
+        out.to_str().expect("utf8"),
+        "bench/independent/testmaps/open_wall.map",
+    ]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{stderr}");
+    let json: serde_json::Value = serde_json::from_slice(
+        &std::fs::read(out.join("independent.json")).expect("independent.json"),
+    )
+    .expect("independent.json parses");
+    let rows = json["rows"].as_array().expect("rows");
+    // two tools at two settings
+    assert_eq!(rows.len(), 4, "{json}");
+    for row in rows {
+        // one light in front of a wall: both tools within a level of physics
+        let rmse = row["figures"]["rmse"].as_f64().expect("an error");
+        assert!(rmse < 1.0, "{row}");
+        assert!(row["figures"]["noise"].as_f64() < Some(0.2), "{row}");
+    }
+    let md = std::fs::read_to_string(out.join("independent.md")).expect("independent.md");
+    assert!(md.contains("| open_wall | -extra4 -soft |"), "{md}");
+    check_png(&out.join("light-independent.png"));
+    let html = std::fs::read_to_string(out.join("independent.html")).expect("independent.html");
+    assert!(
+        tags_balance(&html),
+        "independent.html's tags do not balance"
+    );
+    std::fs::remove_dir_all(out.parent().expect("scratch dir")).ok();
+}

@@ -32,18 +32,29 @@ fn table_html(lines: &[&str]) -> String {
 }
 
 pub fn render(report: &Report, plots: &[PlotFile]) -> String {
-    let markdown = markdown::render(report, plots);
-    let mut s = String::from(
+    page(
+        "Slipgate: speed against error",
+        &markdown::header(report),
+        &markdown::render(report, plots),
+        plots,
+    )
+}
+
+/// A self-contained page: the title, the header paragraph, then the Markdown from its first
+/// `## ` heading on, with each plot's image link replaced by its inline SVG.
+pub fn page(title: &str, header: &str, markdown: &str, plots: &[PlotFile]) -> String {
+    let mut s = format!(
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\"/>\n\
-         <title>Slipgate: speed against error</title>\n<style>\n\
-         body { font-family: sans-serif; margin: 2em; max-width: 80em; }\n\
-         table { border-collapse: collapse; margin: 1em 0; }\n\
-         th, td { border: 1px solid #bbb; padding: 0.2em 0.6em; text-align: right; }\n\
-         th { background: #eee; }\n\
-         td:nth-child(-n+3) { text-align: left; }\n\
-         </style>\n</head>\n<body>\n<h1>Slipgate: speed against error</h1>\n",
+         <title>{title}</title>\n<style>\n\
+         body {{ font-family: sans-serif; margin: 2em; max-width: 80em; }}\n\
+         table {{ border-collapse: collapse; margin: 1em 0; }}\n\
+         th, td {{ border: 1px solid #bbb; padding: 0.2em 0.6em; text-align: right; }}\n\
+         th {{ background: #eee; }}\n\
+         td:nth-child(-n+3) {{ text-align: left; }}\n\
+         </style>\n</head>\n<body>\n<h1>{title}</h1>\n",
+        title = escape(title)
     );
-    let _ = writeln!(s, "<p>{}</p>", escape(&markdown::header(report)));
+    let _ = writeln!(s, "<p>{}</p>", escape(header));
     // Walk the Markdown: headings, paragraphs and tables become HTML; each stage's image link
     // becomes its inline SVG.
     let lines: Vec<&str> = markdown.lines().collect();

@@ -6,10 +6,13 @@
 //!
 //! Output: `report.md` (one table per stage), `report.json` (every figure), a time-against-error
 //! plot per stage as SVG and PNG, and a self-contained `report.html`.
+//!
+//! [`independent`] measures both tools' light against a reference computed outside Slipgate.
 
 #![warn(missing_docs)]
 
 mod html;
+pub mod independent;
 mod machine;
 mod markdown;
 mod measure;

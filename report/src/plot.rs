@@ -8,6 +8,7 @@ use std::sync::OnceLock;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use crate::independent::IndependentReport;
 use crate::settings::{Stage, Tool};
 use crate::{Report, ReportError};
 
@@ -31,6 +32,23 @@ struct Point {
 struct Series {
     name: String,
     points: Vec<Point>,
+}
+
+/// A plot's title and what its axes show.
+struct Axes {
+    title: String,
+    time: &'static str,
+    error: &'static str,
+}
+
+impl Axes {
+    fn of(stage: Stage) -> Axes {
+        Axes {
+            title: format!("{}: time against error", stage.name()),
+            time: stage.time_name(),
+            error: stage.error_name(),
+        }
+    }
 }
 
 const SIZE: (u32, u32) = (900, 560);
@@ -61,57 +79,108 @@ fn fonts_available() -> bool {
 
 /// Draws every stage that has points and returns what was written.
 pub fn draw_all(report: &Report, out_dir: &Path) -> Result<Vec<PlotFile>, ReportError> {
-    let labels = fonts_available();
     let mut files = Vec::new();
     for stage in Stage::ALL {
         let series = series_of(report, stage);
         if series.is_empty() {
             continue;
         }
-        let name = stage.name();
-        let png = out_dir.join(format!("{name}.png"));
-        let failed = |what: String| ReportError::Plot {
-            path: png.clone(),
-            what,
-        };
-        let mut pixels = vec![0u8; SIZE.0 as usize * SIZE.1 as usize * 3];
-        draw(
-            BitMapBackend::with_buffer(&mut pixels, SIZE).into_drawing_area(),
+        files.push(write_plot(
+            out_dir,
+            stage.name(),
             stage,
+            &Axes::of(stage),
             &series,
-            labels,
-        )
-        .map_err(failed)?;
-        let png_bytes = encode_png(pixels).map_err(failed)?;
-        quake_formats::fsutil::write_atomic(&png, &png_bytes).map_err(|source| {
-            ReportError::Format {
-                path: png.clone(),
-                source,
-            }
-        })?;
-        let mut svg_text = String::new();
-        draw(
-            SVGBackend::with_string(&mut svg_text, SIZE).into_drawing_area(),
-            stage,
-            &series,
-            labels,
-        )
-        .map_err(failed)?;
-        let svg = out_dir.join(format!("{name}.svg"));
-        quake_formats::fsutil::write_atomic(&svg, svg_text.as_bytes()).map_err(|source| {
-            ReportError::Format {
-                path: svg.clone(),
-                source,
-            }
-        })?;
-        files.push(PlotFile {
-            stage,
-            svg: format!("{name}.svg"),
-            png: format!("{name}.png"),
-            svg_text,
-        });
+        )?);
     }
     Ok(files)
+}
+
+/// The `--independent` report's one plot: both tools' light, error against the independent
+/// reference over time, one series per map and tool; `None` when nothing was measured.
+pub fn draw_independent(
+    report: &IndependentReport,
+    out_dir: &Path,
+) -> Result<Option<PlotFile>, ReportError> {
+    let mut by_key: BTreeMap<(String, Tool), Vec<Point>> = BTreeMap::new();
+    for row in &report.rows {
+        let (Some(timing), Some(figures)) = (row.timing, row.figures.as_ref()) else {
+            continue;
+        };
+        let (time, error) = (timing.wall_seconds, figures.rmse);
+        if time.is_finite() && time > 0.0 && error.is_finite() {
+            by_key
+                .entry((row.map.clone(), row.tool))
+                .or_default()
+                .push(Point {
+                    time,
+                    error,
+                    setting: row.setting.clone(),
+                });
+        }
+    }
+    let series = into_series(by_key);
+    if series.is_empty() {
+        return Ok(None);
+    }
+    let axes = Axes {
+        title: "light: time against error, independent reference".into(),
+        time: Stage::Light.time_name(),
+        error: "RMSE against the independent reference (8-bit levels)",
+    };
+    write_plot(out_dir, "light-independent", Stage::Light, &axes, &series).map(Some)
+}
+
+/// Draws one plot as `NAME.png` and `NAME.svg` in `out_dir`.
+fn write_plot(
+    out_dir: &Path,
+    name: &str,
+    stage: Stage,
+    axes: &Axes,
+    series: &[Series],
+) -> Result<PlotFile, ReportError> {
+    let labels = fonts_available();
+    let png = out_dir.join(format!("{name}.png"));
+    let failed = |what: String| ReportError::Plot {
+        path: png.clone(),
+        what,
+    };
+    let mut pixels = vec![0u8; SIZE.0 as usize * SIZE.1 as usize * 3];
+    draw(
+        BitMapBackend::with_buffer(&mut pixels, SIZE).into_drawing_area(),
+        axes,
+        series,
+        labels,
+    )
+    .map_err(failed)?;
+    let png_bytes = encode_png(pixels).map_err(failed)?;
+    quake_formats::fsutil::write_atomic(&png, &png_bytes).map_err(|source| {
+        ReportError::Format {
+            path: png.clone(),
+            source,
+        }
+    })?;
+    let mut svg_text = String::new();
+    draw(
+        SVGBackend::with_string(&mut svg_text, SIZE).into_drawing_area(),
+        axes,
+        series,
+        labels,
+    )
+    .map_err(failed)?;
+    let svg = out_dir.join(format!("{name}.svg"));
+    quake_formats::fsutil::write_atomic(&svg, svg_text.as_bytes()).map_err(|source| {
+        ReportError::Format {
+            path: svg.clone(),
+            source,
+        }
+    })?;
+    Ok(PlotFile {
+        stage,
+        svg: format!("{name}.svg"),
+        png: format!("{name}.png"),
+        svg_text,
+    })
 }
 
 /// A drawn plot as PNG bytes, through `image` like every other picture Slipgate writes.
@@ -143,6 +212,11 @@ fn series_of(report: &Report, stage: Stage) -> Vec<Series> {
                 });
         }
     }
+    into_series(by_key)
+}
+
+/// One series per map and tool, its points in order of time.
+fn into_series(by_key: BTreeMap<(String, Tool), Vec<Point>>) -> Vec<Series> {
     by_key
         .into_iter()
         .map(|((map, tool), mut points)| {
@@ -167,7 +241,7 @@ fn seconds_label(x: f64) -> String {
 
 fn draw<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
-    stage: Stage,
+    axes: &Axes,
     series: &[Series],
     labels: bool,
 ) -> Result<(), String> {
@@ -192,10 +266,7 @@ fn draw<DB: DrawingBackend>(
     builder.margin(20);
     if labels {
         builder
-            .caption(
-                format!("{}: time against error", stage.name()),
-                ("sans-serif", 22),
-            )
+            .caption(axes.title.clone(), ("sans-serif", 22))
             .x_label_area_size(45)
             .y_label_area_size(70);
     }
@@ -204,8 +275,8 @@ fn draw<DB: DrawingBackend>(
         .map_err(|e| text(&e))?;
     let mut mesh = chart.configure_mesh();
     if labels {
-        mesh.x_desc(stage.time_name())
-            .y_desc(stage.error_name())
+        mesh.x_desc(axes.time)
+            .y_desc(axes.error)
             .x_labels(8)
             .x_label_formatter(&|x| seconds_label(*x))
             .y_label_formatter(&|y| format!("{y:.2}"));
@@ -282,7 +353,7 @@ mod tests {
             let mut svg = String::new();
             draw(
                 SVGBackend::with_string(&mut svg, SIZE).into_drawing_area(),
-                Stage::Light,
+                &Axes::of(Stage::Light),
                 &two_series(),
                 labels,
             )

@@ -15,14 +15,14 @@ use crate::{
 };
 
 /// One map and the folder its intermediate files go to.
-struct MapWork {
-    source: PathBuf,
-    name: String,
-    dir: PathBuf,
+pub(crate) struct MapWork {
+    pub(crate) source: PathBuf,
+    pub(crate) name: String,
+    pub(crate) dir: PathBuf,
 }
 
 /// The best timing of a step so far, or why it failed.
-type Timings = BTreeMap<(usize, usize, Tool), Result<Timing, String>>;
+pub(crate) type Timings = BTreeMap<(usize, usize, Tool), Result<Timing, String>>;
 
 /// Runs the whole report and writes its files into `options.out_dir`.
 pub fn run(options: &Options) -> Result<Report, ReportError> {
@@ -178,7 +178,7 @@ pub fn run(options: &Options) -> Result<Report, ReportError> {
     Ok(report)
 }
 
-fn progress_bar(wanted: bool, len: u64) -> ProgressBar {
+pub(crate) fn progress_bar(wanted: bool, len: u64) -> ProgressBar {
     let bar = ProgressBar::new(len);
     if !wanted || !std::io::IsTerminal::is_terminal(&std::io::stderr()) {
         bar.set_draw_target(ProgressDrawTarget::hidden());
@@ -192,7 +192,11 @@ fn progress_bar(wanted: bool, len: u64) -> ProgressBar {
 }
 
 /// Keeps the faster of two successes; a failure counts only while nothing succeeded.
-fn record(timings: &mut Timings, key: (usize, usize, Tool), result: Result<Timing, ReportError>) {
+pub(crate) fn record(
+    timings: &mut Timings,
+    key: (usize, usize, Tool),
+    result: Result<Timing, ReportError>,
+) {
     let entry = timings.entry(key).or_insert(Err("not run".into()));
     match (result, &*entry) {
         (Ok(t), Ok(best)) => *entry = Ok(Timing::best(Some(*best), t)),
@@ -203,7 +207,7 @@ fn record(timings: &mut Timings, key: (usize, usize, Tool), result: Result<Timin
 }
 
 /// Each map's work folder, named after the map (numbered when two maps share a name).
-fn map_work(maps: &[PathBuf], work_root: &Path) -> Result<Vec<MapWork>, ReportError> {
+pub(crate) fn map_work(maps: &[PathBuf], work_root: &Path) -> Result<Vec<MapWork>, ReportError> {
     let mut out: Vec<MapWork> = Vec::new();
     for source in maps {
         let stem = source
@@ -229,7 +233,7 @@ fn map_work(maps: &[PathBuf], work_root: &Path) -> Result<Vec<MapWork>, ReportEr
 /// ericw-tools' `qbsp -wadpath DIR` appends a map's whole relative `wad` path to DIR, and
 /// LibreQuake's maps name `../../../../texture-wads/NAME.wad`: so each WAD folder gets a link
 /// `wpN/texture-wads` and qbsp is given `wpN/a/b/c/d`.
-fn link_wad_dirs(wad_dirs: &[PathBuf], work_root: &Path) -> Result<(), ReportError> {
+pub(crate) fn link_wad_dirs(wad_dirs: &[PathBuf], work_root: &Path) -> Result<(), ReportError> {
     for (i, dir) in wad_dirs.iter().enumerate() {
         let base = work_root.join(format!("wp{i}"));
         let deep = base.join("a/b/c/d");
