@@ -10,13 +10,7 @@ const CRATES: [&str; 4] = ["bsp-compiler", "vis", "light", "runtime-viewer"];
 /// the spellings of light's declared entity keys (`NAME: ["key", ...]`), and the prefab module's
 /// key constants. The literal follows each opening. Keys starting with `_` are taken wherever
 /// they appear (light lists some in tables), as are classname-like literals.
-const KEY_OPENINGS: [&str; 5] = [
-    ".get(\"",
-    ".get_float(\"",
-    ">(\"",
-    ": [\"",
-    ": &str = \"",
-];
+const KEY_OPENINGS: [&str; 5] = [".get(\"", ".get_float(\"", ">(\"", ": [\"", ": &str = \""];
 
 fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
@@ -58,10 +52,7 @@ fn literals(code: &str) -> Vec<(&str, &str)> {
         while !code.is_char_boundary(before) {
             before -= 1;
         }
-        out.push((
-            &code[before..at + 1],
-            &rest[start + 1..start + 1 + len],
-        ));
+        out.push((&code[before..at + 1], &rest[start + 1..start + 1 + len]));
         consumed += start + len + 2;
         rest = &code[consumed..];
     }

@@ -477,7 +477,12 @@ impl SurfaceMap {
         let per_luxel = self.per_axis * self.per_axis;
         let width = self.grid.size[0];
         let (luxel, sub) = (i / per_luxel, i % per_luxel);
-        let [s0, t0] = self.grid.luxel_st(luxel % width, luxel / width);
+        self.sub_sample_st(self.grid.luxel_st(luxel % width, luxel / width), sub)
+    }
+
+    /// Texture coordinates of sub-sample `sub` (row by row) of the luxel whose middle is at
+    /// `[s0, t0]`.
+    fn sub_sample_st(&self, [s0, t0]: [f64; 2], sub: usize) -> [f64; 2] {
         if self.per_axis == 1 {
             return [s0, t0];
         }
@@ -539,16 +544,27 @@ pub fn vanilla_on_own_grid(face: &FaceGeom) -> Vec<[f64; 2]> {
 pub fn face_samples(face: &FaceGeom, per_axis: usize, bsp: &Bsp) -> (FaceSamples, PlacementCounts) {
     let [width, height] = face.grid.size;
     let map = SurfaceMap::new(face, per_axis);
-    let count = width * height * per_axis * per_axis;
-    let placed: Vec<Placed> = (0..count)
-        .map(|i| {
-            let [s, t] = map.sample_st(i);
-            map.place(s, t)
-        })
-        .collect();
-    let mut points: Vec<[f32; 3]> = placed.iter().map(|p| p.at.as_vec3().to_array()).collect();
-    let mut moved: Vec<bool> = placed.iter().map(|p| p.moved).collect();
-    let mut apart: Vec<bool> = placed.iter().map(|p| p.on_edge).collect();
+    let per_luxel = per_axis * per_axis;
+    let count = width * height * per_luxel;
+    let mut points: Vec<[f32; 3]> = Vec::with_capacity(count);
+    let mut moved: Vec<bool> = Vec::with_capacity(count);
+    let mut apart: Vec<bool> = Vec::with_capacity(count);
+    let mut beyond: Vec<bool> = Vec::with_capacity(count);
+    // Luxel by luxel (row-major), each luxel's samples row by row: the order of
+    // [`SurfaceMap::sample_st`].
+    for y in 0..height {
+        for x in 0..width {
+            let middle = face.grid.luxel_st(x, y);
+            for sub in 0..per_luxel {
+                let [s, t] = map.sub_sample_st(middle, sub);
+                let placed = map.place(s, t);
+                points.push(placed.at.as_vec3().to_array());
+                moved.push(placed.moved);
+                apart.push(placed.on_edge);
+                beyond.push(placed.beyond);
+            }
+        }
+    }
     let mut counts = PlacementCounts {
         clamped: moved.iter().filter(|&&m| m).count() as u64,
         ..PlacementCounts::default()
@@ -563,7 +579,7 @@ pub fn face_samples(face: &FaceGeom, per_axis: usize, bsp: &Bsp) -> (FaceSamples
         WalkStart::for_box(bsp, lo.map(|c| c - 1.0), hi.map(|c| c + 1.0))
     });
     for i in 0..count {
-        if placed[i].beyond {
+        if beyond[i] {
             occluded[i] = true;
         } else if solid[i] {
             match nudge_start
