@@ -97,11 +97,8 @@ impl Spot {
 /// facing the light or grazed by it (`cos >= 0`, as in ericw-tools: a light level with the
 /// samples still lights them), else 0.
 pub fn angle_factor(cos_incidence: f64, anglescale: f64) -> f64 {
-    if cos_incidence < 0.0 {
-        0.0
-    } else {
-        anglescale * cos_incidence + (1.0 - anglescale)
-    }
+    let facing = anglescale * cos_incidence + (1.0 - anglescale);
+    if cos_incidence < 0.0 { 0.0 } else { facing }
 }
 
 /// A light at a point (an entity, or one copy of a `_surface` template).
@@ -173,13 +170,10 @@ impl PointLight {
         } else {
             angle_factor(cos_incidence, self.anglescale)
         };
-        if angle == 0.0 {
-            return 0.0;
-        }
         let spot = self.spot.map_or(1.0, |s| s.factor(to_point));
-        if spot == 0.0 {
-            return 0.0;
-        }
+        // No early way out for a zero factor: whether a sample faces the light changes from
+        // sample to sample, and the product is zero anyway (of either sign, which light units
+        // never tell apart: sums start at +0).
         self.value_at(dist) * angle * spot
     }
 }
