@@ -569,8 +569,8 @@ pub fn face_samples(face: &FaceGeom, per_axis: usize, bsp: &Bsp) -> (FaceSamples
         clamped: moved.iter().filter(|&&m| m).count() as u64,
         ..PlacementCounts::default()
     };
-    // A luxel's samples, or a few luxels of a row, lie close together.
-    let solid = solid_points_in_tiles(bsp, &points, (per_axis * per_axis).max(4));
+    // A luxel's samples, or a run of a row's luxels with one sample each, lie close together.
+    let solid = solid_points_in_tiles(bsp, &points, (per_axis * per_axis).max(16));
     let mut occluded = vec![false; count];
     // The nudges of points in solid walk the tree from where a box round all the points, and
     // half a unit more, parts.
