@@ -9,8 +9,8 @@
 //! [`LIGHT_SPACE`] under their ceiling, where the lights hang.
 
 use crate::brush::{Brush, Map, MapEntity, MapFormat, aabb, box_corners};
+use crate::entities::WAD_NAME;
 use crate::level::{Level, Surfaces};
-use crate::maps::WAD_NAME;
 use glam::DVec3;
 use quake_formats::geom::Bounds;
 use quake_formats::rng::SplitMix64;
