@@ -82,15 +82,23 @@ fn buried(
     planes: &PlaneSet,
 ) -> bool {
     let own = owner.outward(side, planes);
-    let mut pieces = vec![side.winding.clone()];
+    // The pieces of the side still uncovered, each with its bounds: a cover only clips the
+    // pieces it reaches, so pieces do not multiply by every cover of the whole side.
+    let mut pieces = vec![(side.winding.clone(), side.winding.bounds())];
+    let mut clipped = Vec::new();
     for &j in covers {
         let other = &brushes[j];
-        if !other.bounds.intersects(&side.winding.bounds()) {
-            continue;
-        }
         let mut outside = Vec::new();
-        for w in pieces {
-            clip_outside(w, other, planes, own.normal, &mut outside);
+        for (w, bounds) in pieces {
+            if !other.bounds.intersects(&bounds) {
+                outside.push((w, bounds));
+                continue;
+            }
+            clip_outside(w, other, planes, own.normal, &mut clipped);
+            outside.extend(clipped.drain(..).map(|w| {
+                let b = w.bounds();
+                (w, b)
+            }));
         }
         pieces = outside;
         if pieces.is_empty() {
