@@ -13,6 +13,7 @@
 
 #![warn(missing_docs)]
 
+mod bounds_tree;
 mod brush;
 mod brushlist;
 #[cfg(feature = "cli")]
