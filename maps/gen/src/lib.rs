@@ -5,10 +5,12 @@
 //! [`entities`] holds what every map shares (worldspawn, lights, the player start);
 //! [`level`] turns boxes of open space into sealed shells of brushes; [`maps`] defines the demo
 //! map, the hard cases, the leak pair and the corridor test map; [`brush`] writes `.map` text;
-//! [`random`] makes seeded random maps for property tests; [`open`] the open field for sharded vis.
+//! [`random`] makes seeded random maps for property tests; [`open`] the open field for sharded vis;
+//! [`clutter`] the crowded maps CSG and clip hulls are timed on.
 
 pub mod brush;
 pub mod cli;
+pub mod clutter;
 pub mod entities;
 pub mod level;
 pub mod maps;
