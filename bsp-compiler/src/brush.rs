@@ -23,17 +23,6 @@ pub struct Side {
     pub buried: bool,
 }
 
-/// The part of `w` in front of `plane` (none when it lies on it), like
-/// [`Winding::clip_front`] without `keep_on`, but `w` moves through untouched when it lies wholly
-/// in front: clipping a winding by many planes that mostly miss it then allocates nothing.
-pub fn keep_front(w: Winding, plane: &Plane) -> Option<Winding> {
-    match w.side_of(plane) {
-        PlaneSide::Front => Some(w),
-        PlaneSide::Back | PlaneSide::On => None,
-        PlaneSide::Cross => w.clip_front(plane, false),
-    }
-}
-
 /// The part of `w` (a winding on `plane`) behind `other`. A winding lying on `other` (within
 /// [`ON_EPSILON`]) and facing the same way marks two sides that are one within the epsilon (a
 /// face and a bevel a millionth of a radian apart): the first of them keeps it. Dropping both
@@ -42,7 +31,7 @@ fn clip_behind(w: Winding, plane: &Plane, other: &Plane, other_first: bool) -> O
     let behind = other.flipped();
     match w.side_of(&behind) {
         PlaneSide::On => (!other_first && plane.normal.dot(other.normal) > 0.0).then_some(w),
-        _ => keep_front(w, &behind),
+        _ => w.into_front(&behind),
     }
 }
 
@@ -251,7 +240,7 @@ impl Brush {
         let mut cut = Some(Winding::base_for_plane(&plane));
         for s in &self.sides {
             let out = self.outward(s, planes);
-            cut = cut.and_then(|w| keep_front(w, &out.flipped()));
+            cut = cut.and_then(|w| w.into_front(&out.flipped()));
         }
         let Some(cut) = cut.filter(|w| !w.is_tiny()) else {
             // The plane grazes an edge or a corner: the cut is too thin to build on.
@@ -394,28 +383,6 @@ pub(crate) mod tests {
             DVec3::new(64.0, 64.0, 64.0),
             quake_formats::bsp::contents::SOLID,
         )
-    }
-
-    #[test]
-    fn keep_front_matches_clip_front() {
-        let square = Winding::new(vec![
-            DVec3::new(0.0, 0.0, 0.0),
-            DVec3::new(0.0, 64.0, 0.0),
-            DVec3::new(64.0, 64.0, 0.0),
-            DVec3::new(64.0, 0.0, 0.0),
-        ]);
-        for plane in [
-            Plane::new(DVec3::new(1.0, 0.0, 0.0), -8.0), // wholly in front
-            Plane::new(DVec3::new(1.0, 0.0, 0.0), 80.0), // wholly behind
-            Plane::new(DVec3::new(0.0, 0.0, 1.0), 0.0),  // on it
-            Plane::new(DVec3::new(-1.0, 0.0, 0.0), -32.0), // across
-        ] {
-            assert_eq!(
-                keep_front(square.clone(), &plane),
-                square.clip_front(&plane, false),
-                "{plane:?}"
-            );
-        }
     }
 
     #[test]

@@ -2,7 +2,6 @@
 //! polygon by the portals already bounding the node and then splitting those by the node plane.
 //! A box of six portals around the whole tree joins it to an "outside" leaf.
 
-use crate::brush::keep_front;
 use crate::planes::{PlaneId, PlaneSet};
 use crate::tree::{Tree, TreeNode};
 use glam::DVec3;
@@ -153,7 +152,7 @@ impl Builder {
             let mut w = Some(Winding::base_for_plane(plane));
             for (j, other) in box_planes.iter().enumerate() {
                 if i != j {
-                    w = w.and_then(|w| keep_front(w, other));
+                    w = w.and_then(|w| w.into_front(other));
                 }
             }
             if let Some(w) = w {
@@ -179,7 +178,7 @@ impl Builder {
     ) {
         let mut w = Some(Winding::base_for_plane(plane));
         for keep in above {
-            w = w.and_then(|w| keep_front(w, keep));
+            w = w.and_then(|w| w.into_front(keep));
         }
         for &pid in &self.node_portals[node as usize] {
             let p = &self.portals[pid as usize];
@@ -188,7 +187,7 @@ impl Builder {
             } else {
                 p.plane.flipped()
             };
-            w = w.and_then(|w| keep_front(w, &keep));
+            w = w.and_then(|w| w.into_front(&keep));
         }
         if let Some(w) = w.filter(|w| !w.is_tiny()) {
             self.add(Portal {

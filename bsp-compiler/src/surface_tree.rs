@@ -3,7 +3,6 @@
 //! between solid and open space matter. A second tree built from just those (as id's qbsp did
 //! after filling) needs far fewer clip nodes.
 
-use crate::brush::keep_front;
 use crate::planes::{PlaneId, PlaneSet};
 use crate::portals::Portals;
 use crate::tree::{BuildNode, Splitting, Tree, best_splitter, flatten, mid_split};
@@ -300,7 +299,7 @@ fn inside_point(planes: &[Plane]) -> Option<DVec3> {
         let mut w = Some(Winding::base_for_plane(&plane.flipped()));
         for (j, other) in planes.iter().enumerate() {
             if i != j {
-                w = w.and_then(|w| keep_front(w, other));
+                w = w.and_then(|w| w.into_front(other));
             }
         }
         for p in w.iter().flat_map(|w| &w.points) {
