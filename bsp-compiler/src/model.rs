@@ -96,12 +96,14 @@ pub(crate) fn build_model(
     timings[4] = hull_time;
 
     let t = Instant::now();
-    let portals = make_portals(&tree, planes, &bounds);
-    let cluster_portals = tree
+    let has_clusters = tree
         .nodes
         .iter()
-        .any(|n| n.cluster.is_some() && !n.is_leaf())
-        .then(|| make_cluster_portals(&tree, planes, &bounds));
+        .any(|n| n.cluster.is_some() && !n.is_leaf());
+    let (portals, cluster_portals) = rayon::join(
+        || make_portals(&tree, planes, &bounds),
+        || has_clusters.then(|| make_cluster_portals(&tree, planes, &bounds)),
+    );
     timings[1] = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
@@ -131,21 +133,30 @@ pub(crate) fn build_model(
 
     // A sealed world's clip hulls are sealed too (grown brushes only close gaps further): fill
     // their outsides as well, so it collapses into one solid leaf instead of many clip nodes.
-    let t = Instant::now();
-    if matches!(fill, Some(FillOutcome::Sealed { .. })) {
-        let [h1, h2] = &mut hulls;
-        rayon::join(
-            || fill_hull(h1, planes, &hull_bounds[0], occupants, splitting, options),
-            || fill_hull(h2, planes, &hull_bounds[1], occupants, splitting, options),
-        );
-    }
-    progress.advance(counts[1] + counts[2]);
-    timings[4] += t.elapsed().as_secs_f64();
-
-    let t = Instant::now();
-    let (faces, face_stats) = model_faces(&tree, &portals, planes, texinfos, options.subdivide);
-    timings[3] = t.elapsed().as_secs_f64();
-    progress.advance(counts[0]);
+    // Hull 0's faces are made meanwhile.
+    let sealed = matches!(fill, Some(FillOutcome::Sealed { .. }));
+    let ((faces, face_stats, faces_time), fill_time) = rayon::join(
+        || {
+            let t = Instant::now();
+            let (faces, stats) = model_faces(&tree, &portals, planes, texinfos, options.subdivide);
+            progress.advance(counts[0]);
+            (faces, stats, t.elapsed().as_secs_f64())
+        },
+        || {
+            let t = Instant::now();
+            if sealed {
+                let [h1, h2] = &mut hulls;
+                rayon::join(
+                    || fill_hull(h1, planes, &hull_bounds[0], occupants, splitting, options),
+                    || fill_hull(h2, planes, &hull_bounds[1], occupants, splitting, options),
+                );
+            }
+            progress.advance(counts[1] + counts[2]);
+            t.elapsed().as_secs_f64()
+        },
+    );
+    timings[3] = faces_time;
+    timings[4] += fill_time;
 
     (
         ModelOutput {
