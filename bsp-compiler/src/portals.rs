@@ -80,12 +80,13 @@ fn portalize(
     let mut stack = vec![0u32];
     while let Some(node) = stack.pop() {
         let n = &tree.nodes[node as usize];
+        // Taken before anything else: a leaf's list is dropped here, not kept for every leaf.
+        let above = std::mem::take(&mut bounding[node as usize]);
         if stop(n) {
             continue;
         }
         let Some(plane_id) = n.plane else { continue };
         let plane = *planes.get(plane_id);
-        let above = std::mem::take(&mut bounding[node as usize]);
         b.make_node_portal(node, plane_id, &plane, n.children, &above);
         let mut front = above.clone();
         front.push(plane);
@@ -97,15 +98,18 @@ fn portalize(
         stack.push(n.children[1]);
         stack.push(n.children[0]);
     }
-    // Compact: drop dead portals and renumber.
+    // Compact in place (a second list would hold every portal twice): drop dead portals and
+    // renumber.
     let mut new_index = vec![u32::MAX; b.portals.len()];
-    let mut portals = Vec::new();
-    for (i, p) in b.portals.into_iter().enumerate() {
+    let mut live = 0;
+    for (i, p) in b.portals.iter().enumerate() {
         if !p.winding.is_empty() {
-            new_index[i] = portals.len() as u32;
-            portals.push(p);
+            new_index[i] = live;
+            live += 1;
         }
     }
+    let mut portals = b.portals;
+    portals.retain(|p| !p.winding.is_empty());
     let leaf_portals = b
         .node_portals
         .into_iter()
