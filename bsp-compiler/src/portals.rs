@@ -207,11 +207,17 @@ impl Builder {
     fn split_node_portals(&mut self, node: u32, plane: &Plane, children: [u32; 2]) {
         let list = std::mem::take(&mut self.node_portals[node as usize]);
         for pid in list {
-            let p = &self.portals[pid as usize];
+            let p = &mut self.portals[pid as usize];
             let side = usize::from(p.nodes[0] != node);
             let other = p.nodes[1 - side];
+            // The winding is replaced by its parts (or left empty), so it moves into the split.
+            let split = std::mem::take(&mut p.winding).into_split(plane);
+            let old = Portal {
+                winding: Winding::default(),
+                ..*p
+            };
             self.node_portals[other as usize].retain(|&x| x != pid);
-            let (front, back) = match p.winding.split(plane) {
+            let (front, back) = match split {
                 Split::Front(w) => (Some(w), None),
                 Split::Back(w) => (None, Some(w)),
                 Split::Both { front, back } => (
@@ -220,9 +226,8 @@ impl Builder {
                 ),
                 Split::On { .. } => (None, None),
             };
-            let place = |this: &mut Builder, w: Winding, child: u32, reuse: bool| {
-                let mut portal = this.portals[pid as usize].clone();
-                portal.winding = w;
+            let place = |this: &mut Builder, winding: Winding, child: u32, reuse: bool| {
+                let mut portal = Portal { winding, ..old };
                 portal.nodes[side] = child;
                 if reuse {
                     this.portals[pid as usize] = portal;
@@ -233,7 +238,7 @@ impl Builder {
                 }
             };
             match (front, back) {
-                (None, None) => self.portals[pid as usize].winding = Winding::default(),
+                (None, None) => {}
                 (Some(f), None) => place(self, f, children[0], true),
                 (None, Some(b)) => place(self, b, children[1], true),
                 (Some(f), Some(b)) => {

@@ -8,7 +8,7 @@ use crate::portals::Portals;
 use crate::tree::{BuildNode, Splitting, Tree, best_splitter, flatten, mid_split};
 use glam::DVec3;
 use quake_formats::bsp::contents;
-use quake_formats::geom::{Bounds, Plane, Split, Winding};
+use quake_formats::geom::{Bounds, Plane, PlaneSide, Split, Winding};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Space left between the surfaces and the box bounding the root's region.
@@ -152,10 +152,14 @@ fn split_all<T>(
     let (mut front, mut back) = (Vec::new(), Vec::new());
     let mut splits = 0;
     for item in items {
-        match winding(&item).split(plane) {
-            Split::Front(_) => front.push(item),
-            Split::Back(_) => back.push(item),
-            Split::Both { front: f, back: b } => {
+        // Classified first: an item wholly on one side moves there without a copy.
+        match winding(&item).side_of(plane) {
+            PlaneSide::Front => front.push(item),
+            PlaneSide::Back => back.push(item),
+            PlaneSide::Cross => {
+                let Split::Both { front: f, back: b } = winding(&item).split(plane) else {
+                    continue;
+                };
                 splits += 1;
                 for (w, list) in [(f, &mut front), (b, &mut back)] {
                     if !w.is_tiny() {
@@ -163,7 +167,7 @@ fn split_all<T>(
                     }
                 }
             }
-            Split::On { .. } => {}
+            PlaneSide::On => {}
         }
     }
     (front, back, splits)
