@@ -16,7 +16,7 @@ use crate::gather::ModelInput;
 use crate::options::CompileOptions;
 use crate::outside::{FillOutcome, Occupant, OnPlane, Reach, fill_outside, fill_unreached};
 use crate::planes::PlaneSet;
-use crate::portals::{Portals, make_cluster_portals, make_portals};
+use crate::portals::{Portals, make_clip_hull_portals, make_cluster_portals, make_portals};
 use crate::surface_tree::rebuild_from_surfaces;
 use crate::tree::{Splitting, Tree, build_clip_hull_tree, build_tree};
 use crate::warnings::Warning;
@@ -204,7 +204,7 @@ fn fill_hull(
     if bounds.is_empty() {
         return;
     }
-    let portals = make_portals(tree, planes, bounds);
+    let portals = make_clip_hull_portals(tree, planes, bounds);
     // Entities near walls are inside the grown brushes; that is expected, not worth a warning.
     let mut ignored = Vec::new();
     if let FillOutcome::Sealed { .. } = fill_outside(

@@ -53,20 +53,40 @@ impl Portals {
 
 /// Portalize `tree`, whose contents lie within `bounds`: portals between its leaves.
 pub fn make_portals(tree: &Tree, planes: &PlaneSet, bounds: &Bounds) -> Portals {
-    portalize(tree, planes, bounds, TreeNode::is_leaf)
+    portalize(tree, planes, bounds, TreeNode::is_leaf, |_| true)
 }
 
 /// Portals between the structural leaves (vis clusters) of `tree`, ignoring the detail below.
 pub fn make_cluster_portals(tree: &Tree, planes: &PlaneSet, bounds: &Bounds) -> Portals {
-    portalize(tree, planes, bounds, |n| n.cluster.is_some() || n.is_leaf())
+    portalize(
+        tree,
+        planes,
+        bounds,
+        |n| n.cluster.is_some() || n.is_leaf(),
+        |_| true,
+    )
 }
 
-/// Portals between the nodes where `stop` holds, as if they were leaves.
+/// The portals of a clip hull's `tree` that touch open space: those the outside fill floods
+/// through and the hull's rebuilt tree is made from (`surface_tree`). A node with only solid
+/// below it makes no portal of its own, whose parts could only part solid from solid; the
+/// portals around it are still cut by its plane, so every portal with open space on a side
+/// comes out as [`make_portals`] makes it, in the same order.
+pub fn make_clip_hull_portals(tree: &Tree, planes: &PlaneSet, bounds: &Bounds) -> Portals {
+    let solid = tree.all_solid();
+    portalize(tree, planes, bounds, TreeNode::is_leaf, |node| {
+        !solid[node as usize]
+    })
+}
+
+/// Portals between the nodes where `stop` holds, as if they were leaves; only nodes where
+/// `own_portal` holds make a portal on their plane.
 fn portalize(
     tree: &Tree,
     planes: &PlaneSet,
     bounds: &Bounds,
     stop: impl Fn(&TreeNode) -> bool,
+    own_portal: impl Fn(u32) -> bool,
 ) -> Portals {
     let outside = tree.nodes.len() as u32;
     let mut b = Builder {
@@ -87,13 +107,16 @@ fn portalize(
         }
         let Some(plane_id) = n.plane else { continue };
         let plane = *planes.get(plane_id);
-        b.make_node_portal(node, plane_id, &plane, n.children, &above);
-        let mut front = above.clone();
-        front.push(plane);
-        let mut back = above;
-        back.push(plane.flipped());
-        bounding[n.children[0] as usize] = front;
-        bounding[n.children[1] as usize] = back;
+        // The nodes below one that makes no portal make none either: they need no planes.
+        if own_portal(node) {
+            b.make_node_portal(node, plane_id, &plane, n.children, &above);
+            let mut front = above.clone();
+            front.push(plane);
+            let mut back = above;
+            back.push(plane.flipped());
+            bounding[n.children[0] as usize] = front;
+            bounding[n.children[1] as usize] = back;
+        }
         b.split_node_portals(node, &plane, n.children);
         stack.push(n.children[1]);
         stack.push(n.children[0]);
@@ -336,5 +359,47 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Overlapping solid boxes (no CSG: their sides inside each other split the tree, as a clip
+    /// hull's grown brushes do) make solid subtrees with portals of their own; a clip hull's
+    /// portals leave those out and keep every portal touching open space as it is, in order.
+    #[test]
+    fn clip_hull_portals_are_the_portals_that_touch_open_space() {
+        let mut planes = PlaneSet::new();
+        let boxes = [
+            (DVec3::new(0.0, 0.0, 0.0), DVec3::new(100.0, 100.0, 100.0)),
+            (DVec3::new(50.0, 0.0, 0.0), DVec3::new(150.0, 100.0, 100.0)),
+            (DVec3::new(0.0, 0.0, 120.0), DVec3::new(40.0, 30.0, 160.0)),
+        ];
+        let brushes: Vec<Brush> = boxes
+            .iter()
+            .enumerate()
+            .map(|(i, &(lo, hi))| {
+                Brush::from_planes(&box_planes(lo, hi), &mut planes, contents::SOLID, i as u32)
+                    .expect("brush")
+            })
+            .collect();
+        let bounds = brushes
+            .iter()
+            .fold(Bounds::EMPTY, |acc, b| acc.union(&b.bounds));
+        let tree = build_tree(brushes, &planes, SplitHeuristic::FewestSplits, false);
+        let all = make_portals(&tree, &planes, &bounds);
+        let hull = make_clip_hull_portals(&tree, &planes, &bounds);
+        let solid = |n: u32| n != all.outside && tree.nodes[n as usize].contents == contents::SOLID;
+        let open = |portals: &Portals| -> Vec<Portal> {
+            let touches_open = |p: &&Portal| !p.nodes.iter().all(|&n| solid(n));
+            portals
+                .portals
+                .iter()
+                .filter(touches_open)
+                .cloned()
+                .collect()
+        };
+        assert!(
+            hull.portals.len() < all.portals.len(),
+            "no solid subtree left out"
+        );
+        assert_eq!(open(&hull), open(&all));
     }
 }
