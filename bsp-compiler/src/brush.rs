@@ -47,6 +47,78 @@ pub enum BrushKind {
     Hint,
 }
 
+/// A brush's sides before their planes are numbered: what [`Brush::from_planes`] computes
+/// without the [`PlaneSet`], so that many brushes can be shaped at once and numbered after, in
+/// their order.
+pub struct BrushShape {
+    /// The faces with a winding on the brush, in their order.
+    sides: Vec<(BrushPlane, Winding)>,
+}
+
+impl BrushShape {
+    /// The windings `faces` (outward planes) have on the brush they bound.
+    pub fn of(faces: &[BrushPlane]) -> Result<BrushShape, BrushError> {
+        if faces.len() < 4 {
+            return Err(BrushError::TooFewPlanes(faces.len()));
+        }
+        for (i, a) in faces.iter().enumerate() {
+            for (j, b) in faces.iter().enumerate().skip(i + 1) {
+                if a.plane.same_as(&b.plane) {
+                    return Err(BrushError::DuplicatePlane(i, j));
+                }
+                if a.plane.same_as(&b.plane.flipped()) {
+                    return Err(BrushError::OppositePlanes(i, j));
+                }
+            }
+        }
+        let mut sides = Vec::with_capacity(faces.len());
+        for (i, face) in faces.iter().enumerate() {
+            let mut w = Some(Winding::base_for_plane(&face.plane));
+            for (j, other) in faces.iter().enumerate() {
+                if i == j {
+                    continue;
+                }
+                w = w.and_then(|w| clip_behind(w, &face.plane, &other.plane, j < i));
+            }
+            if let Some(w) = w.filter(|w| !w.is_tiny()) {
+                sides.push((*face, w));
+            }
+        }
+        Ok(BrushShape { sides })
+    }
+
+    /// The brush, its planes numbered in `planes` (even when it turns out too small to keep).
+    pub fn into_brush(
+        self,
+        planes: &mut PlaneSet,
+        contents: i32,
+        source: u32,
+    ) -> Result<Brush, BrushError> {
+        let sides = self
+            .sides
+            .into_iter()
+            .map(|(face, winding)| {
+                let (plane, flipped) = planes.insert(&face.plane);
+                Side {
+                    plane,
+                    flipped,
+                    winding,
+                    texinfo: face.texinfo,
+                    used: false,
+                    buried: false,
+                }
+            })
+            .collect();
+        let brush = Brush::with_sides(sides, contents, source, BrushKind::Structural)
+            .ok_or(BrushError::NoVolume)?;
+        let limit = MAX_WORLD_COORD * 0.5;
+        if (0..3).any(|i| brush.bounds.mins[i] < -limit || brush.bounds.maxs[i] > limit) {
+            return Err(BrushError::TooLarge);
+        }
+        Ok(brush)
+    }
+}
+
 /// A convex volume of one contents type.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Brush {
@@ -100,51 +172,10 @@ impl Brush {
         contents: i32,
         source: u32,
     ) -> Result<Brush, BrushError> {
-        if faces.len() < 4 {
-            return Err(BrushError::TooFewPlanes(faces.len()));
-        }
-        for (i, a) in faces.iter().enumerate() {
-            for (j, b) in faces.iter().enumerate().skip(i + 1) {
-                if a.plane.same_as(&b.plane) {
-                    return Err(BrushError::DuplicatePlane(i, j));
-                }
-                if a.plane.same_as(&b.plane.flipped()) {
-                    return Err(BrushError::OppositePlanes(i, j));
-                }
-            }
-        }
-        let mut sides = Vec::with_capacity(faces.len());
-        for (i, face) in faces.iter().enumerate() {
-            let mut w = Some(Winding::base_for_plane(&face.plane));
-            for (j, other) in faces.iter().enumerate() {
-                if i == j {
-                    continue;
-                }
-                w = w.and_then(|w| clip_behind(w, &face.plane, &other.plane, j < i));
-            }
-            let Some(w) = w.filter(|w| !w.is_tiny()) else {
-                continue;
-            };
-            let (plane, flipped) = planes.insert(&face.plane);
-            sides.push(Side {
-                plane,
-                flipped,
-                winding: w,
-                texinfo: face.texinfo,
-                used: false,
-                buried: false,
-            });
-        }
-        let brush = Brush::with_sides(sides, contents, source, BrushKind::Structural)
-            .ok_or(BrushError::NoVolume)?;
-        let limit = MAX_WORLD_COORD * 0.5;
-        if (0..3).any(|i| brush.bounds.mins[i] < -limit || brush.bounds.maxs[i] > limit) {
-            return Err(BrushError::TooLarge);
-        }
-        Ok(brush)
+        BrushShape::of(faces)?.into_brush(planes, contents, source)
     }
 
-    /// A brush from finished sides, or `None` when it is too small to keep.
+    /// A brush from finished sides, or `None` when it is too small to keep.    /// A brush from finished sides, or `None` when it is too small to keep.
     fn with_sides(sides: Vec<Side>, contents: i32, source: u32, kind: BrushKind) -> Option<Brush> {
         if sides.len() < 4 {
             return None;
