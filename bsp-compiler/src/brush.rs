@@ -23,17 +23,6 @@ pub struct Side {
     pub buried: bool,
 }
 
-/// The part of `w` in front of `plane` (none when it lies on it), like
-/// [`Winding::clip_front`] without `keep_on`, but `w` moves through untouched when it lies wholly
-/// in front: clipping a winding by many planes that mostly miss it then allocates nothing.
-pub fn keep_front(w: Winding, plane: &Plane) -> Option<Winding> {
-    match w.side_of(plane) {
-        PlaneSide::Front => Some(w),
-        PlaneSide::Back | PlaneSide::On => None,
-        PlaneSide::Cross => w.clip_front(plane, false),
-    }
-}
-
 /// The part of `w` (a winding on `plane`) behind `other`. A winding lying on `other` (within
 /// [`ON_EPSILON`]) and facing the same way marks two sides that are one within the epsilon (a
 /// face and a bevel a millionth of a radian apart): the first of them keeps it. Dropping both
@@ -42,7 +31,7 @@ fn clip_behind(w: Winding, plane: &Plane, other: &Plane, other_first: bool) -> O
     let behind = other.flipped();
     match w.side_of(&behind) {
         PlaneSide::On => (!other_first && plane.normal.dot(other.normal) > 0.0).then_some(w),
-        _ => keep_front(w, &behind),
+        _ => w.into_front(&behind),
     }
 }
 
@@ -56,6 +45,78 @@ pub enum BrushKind {
     Detail,
     /// Empty; its hint sides split the structural tree before any other plane.
     Hint,
+}
+
+/// A brush's sides before their planes are numbered: what [`Brush::from_planes`] computes
+/// without the [`PlaneSet`], so that many brushes can be shaped at once and numbered after, in
+/// their order.
+pub struct BrushShape {
+    /// The faces with a winding on the brush, in their order.
+    sides: Vec<(BrushPlane, Winding)>,
+}
+
+impl BrushShape {
+    /// The windings `faces` (outward planes) have on the brush they bound.
+    pub fn of(faces: &[BrushPlane]) -> Result<BrushShape, BrushError> {
+        if faces.len() < 4 {
+            return Err(BrushError::TooFewPlanes(faces.len()));
+        }
+        for (i, a) in faces.iter().enumerate() {
+            for (j, b) in faces.iter().enumerate().skip(i + 1) {
+                if a.plane.same_as(&b.plane) {
+                    return Err(BrushError::DuplicatePlane(i, j));
+                }
+                if a.plane.same_as(&b.plane.flipped()) {
+                    return Err(BrushError::OppositePlanes(i, j));
+                }
+            }
+        }
+        let mut sides = Vec::with_capacity(faces.len());
+        for (i, face) in faces.iter().enumerate() {
+            let mut w = Some(Winding::base_for_plane(&face.plane));
+            for (j, other) in faces.iter().enumerate() {
+                if i == j {
+                    continue;
+                }
+                w = w.and_then(|w| clip_behind(w, &face.plane, &other.plane, j < i));
+            }
+            if let Some(w) = w.filter(|w| !w.is_tiny()) {
+                sides.push((*face, w));
+            }
+        }
+        Ok(BrushShape { sides })
+    }
+
+    /// The brush, its planes numbered in `planes` (even when it turns out too small to keep).
+    pub fn into_brush(
+        self,
+        planes: &mut PlaneSet,
+        contents: i32,
+        source: u32,
+    ) -> Result<Brush, BrushError> {
+        let sides = self
+            .sides
+            .into_iter()
+            .map(|(face, winding)| {
+                let (plane, flipped) = planes.insert(&face.plane);
+                Side {
+                    plane,
+                    flipped,
+                    winding,
+                    texinfo: face.texinfo,
+                    used: false,
+                    buried: false,
+                }
+            })
+            .collect();
+        let brush = Brush::with_sides(sides, contents, source, BrushKind::Structural)
+            .ok_or(BrushError::NoVolume)?;
+        let limit = MAX_WORLD_COORD * 0.5;
+        if (0..3).any(|i| brush.bounds.mins[i] < -limit || brush.bounds.maxs[i] > limit) {
+            return Err(BrushError::TooLarge);
+        }
+        Ok(brush)
+    }
 }
 
 /// A convex volume of one contents type.
@@ -111,51 +172,10 @@ impl Brush {
         contents: i32,
         source: u32,
     ) -> Result<Brush, BrushError> {
-        if faces.len() < 4 {
-            return Err(BrushError::TooFewPlanes(faces.len()));
-        }
-        for (i, a) in faces.iter().enumerate() {
-            for (j, b) in faces.iter().enumerate().skip(i + 1) {
-                if a.plane.same_as(&b.plane) {
-                    return Err(BrushError::DuplicatePlane(i, j));
-                }
-                if a.plane.same_as(&b.plane.flipped()) {
-                    return Err(BrushError::OppositePlanes(i, j));
-                }
-            }
-        }
-        let mut sides = Vec::with_capacity(faces.len());
-        for (i, face) in faces.iter().enumerate() {
-            let mut w = Some(Winding::base_for_plane(&face.plane));
-            for (j, other) in faces.iter().enumerate() {
-                if i == j {
-                    continue;
-                }
-                w = w.and_then(|w| clip_behind(w, &face.plane, &other.plane, j < i));
-            }
-            let Some(w) = w.filter(|w| !w.is_tiny()) else {
-                continue;
-            };
-            let (plane, flipped) = planes.insert(&face.plane);
-            sides.push(Side {
-                plane,
-                flipped,
-                winding: w,
-                texinfo: face.texinfo,
-                used: false,
-                buried: false,
-            });
-        }
-        let brush = Brush::with_sides(sides, contents, source, BrushKind::Structural)
-            .ok_or(BrushError::NoVolume)?;
-        let limit = MAX_WORLD_COORD * 0.5;
-        if (0..3).any(|i| brush.bounds.mins[i] < -limit || brush.bounds.maxs[i] > limit) {
-            return Err(BrushError::TooLarge);
-        }
-        Ok(brush)
+        BrushShape::of(faces)?.into_brush(planes, contents, source)
     }
 
-    /// A brush from finished sides, or `None` when it is too small to keep.
+    /// A brush from finished sides, or `None` when it is too small to keep.    /// A brush from finished sides, or `None` when it is too small to keep.
     fn with_sides(sides: Vec<Side>, contents: i32, source: u32, kind: BrushKind) -> Option<Brush> {
         if sides.len() < 4 {
             return None;
@@ -251,7 +271,7 @@ impl Brush {
         let mut cut = Some(Winding::base_for_plane(&plane));
         for s in &self.sides {
             let out = self.outward(s, planes);
-            cut = cut.and_then(|w| keep_front(w, &out.flipped()));
+            cut = cut.and_then(|w| w.into_front(&out.flipped()));
         }
         let Some(cut) = cut.filter(|w| !w.is_tiny()) else {
             // The plane grazes an edge or a corner: the cut is too thin to build on.
@@ -394,28 +414,6 @@ pub(crate) mod tests {
             DVec3::new(64.0, 64.0, 64.0),
             quake_formats::bsp::contents::SOLID,
         )
-    }
-
-    #[test]
-    fn keep_front_matches_clip_front() {
-        let square = Winding::new(vec![
-            DVec3::new(0.0, 0.0, 0.0),
-            DVec3::new(0.0, 64.0, 0.0),
-            DVec3::new(64.0, 64.0, 0.0),
-            DVec3::new(64.0, 0.0, 0.0),
-        ]);
-        for plane in [
-            Plane::new(DVec3::new(1.0, 0.0, 0.0), -8.0), // wholly in front
-            Plane::new(DVec3::new(1.0, 0.0, 0.0), 80.0), // wholly behind
-            Plane::new(DVec3::new(0.0, 0.0, 1.0), 0.0),  // on it
-            Plane::new(DVec3::new(-1.0, 0.0, 0.0), -32.0), // across
-        ] {
-            assert_eq!(
-                keep_front(square.clone(), &plane),
-                square.clip_front(&plane, false),
-                "{plane:?}"
-            );
-        }
     }
 
     #[test]

@@ -9,6 +9,7 @@
 //! This is sound for leaf contents: inside a leaf, the boundary of the stronger brushes' union
 //! is made of visible sides, which have all been used as node planes above the leaf.
 
+use crate::bounds_tree::BoundsTree;
 use crate::brush::{Brush, Side};
 use crate::planes::PlaneSet;
 use crate::tree::{contents_priority, keeps_sides_inside};
@@ -20,42 +21,32 @@ use rayon::prelude::*;
 /// many.
 pub fn mark_hidden_sides(brushes: &mut [Brush], planes: &PlaneSet) -> usize {
     let pad = DVec3::new(ON_EPSILON, ON_EPSILON, ON_EPSILON);
-    let padded: Vec<Bounds> = brushes
-        .iter()
-        .map(|b| Bounds {
-            mins: b.bounds.mins - pad,
-            maxs: b.bounds.maxs + pad,
-        })
-        .collect();
-    // Candidates per brush via a sort on mins.x, so big maps do not compare every pair.
-    let mut by_x: Vec<usize> = (0..brushes.len()).collect();
-    by_x.sort_by(|&a, &b| {
-        padded[a]
-            .mins
-            .x
-            .total_cmp(&padded[b].mins.x)
-            .then(a.cmp(&b))
-    });
+    let index = BoundsTree::new(
+        brushes
+            .iter()
+            .map(|b| Bounds {
+                mins: b.bounds.mins - pad,
+                maxs: b.bounds.maxs + pad,
+            })
+            .collect(),
+    );
+    let padded = index.boxes();
     let hidden: Vec<Vec<bool>> = (0..brushes.len())
         .into_par_iter()
         .map(|i| {
             let me = &brushes[i];
             let prio = contents_priority(me.contents);
-            let end = by_x.partition_point(|&j| padded[j].mins.x <= padded[i].maxs.x);
-            let mut covers: Vec<usize> = by_x[..end]
-                .iter()
-                .copied()
-                .filter(|&j| {
-                    // Structure must not depend on detail: only detail is hidden by detail.
-                    // Illusionary brushes stay seen inside liquids, `_noclipfaces` ones inside
-                    // brushes of their contents.
-                    j != i
-                        && padded[j].intersects(&padded[i])
-                        && contents_priority(brushes[j].contents) >= prio
-                        && (me.is_detail() || !brushes[j].is_detail())
-                        && !keeps_sides_inside(&brushes[j], me)
-                })
-                .collect();
+            let mut covers = Vec::new();
+            index.overlapping(&padded[i], &mut covers);
+            covers.retain(|&j| {
+                // Structure must not depend on detail: only detail is hidden by detail.
+                // Illusionary brushes stay seen inside liquids, `_noclipfaces` ones inside
+                // brushes of their contents.
+                j != i
+                    && contents_priority(brushes[j].contents) >= prio
+                    && (me.is_detail() || !brushes[j].is_detail())
+                    && !keeps_sides_inside(&brushes[j], me)
+            });
             covers.sort_unstable();
             me.sides
                 .iter()
@@ -82,15 +73,23 @@ fn buried(
     planes: &PlaneSet,
 ) -> bool {
     let own = owner.outward(side, planes);
-    let mut pieces = vec![side.winding.clone()];
+    // The pieces of the side still uncovered, each with its bounds: a cover only clips the
+    // pieces it reaches, so pieces do not multiply by every cover of the whole side.
+    let mut pieces = vec![(side.winding.clone(), side.winding.bounds())];
+    let mut clipped = Vec::new();
     for &j in covers {
         let other = &brushes[j];
-        if !other.bounds.intersects(&side.winding.bounds()) {
-            continue;
-        }
         let mut outside = Vec::new();
-        for w in pieces {
-            clip_outside(w, other, planes, own.normal, &mut outside);
+        for (w, bounds) in pieces {
+            if !other.bounds.intersects(&bounds) {
+                outside.push((w, bounds));
+                continue;
+            }
+            clip_outside(w, other, planes, own.normal, &mut clipped);
+            outside.extend(clipped.drain(..).map(|w| {
+                let b = w.bounds();
+                (w, b)
+            }));
         }
         pieces = outside;
         if pieces.is_empty() {

@@ -6,10 +6,10 @@
 //! its entity give it ([`EntityContext`]), and, when it collides, a grown copy for each clip hull.
 //! Point entities become the occupants the outside fill floods from.
 
-use crate::brush::{Brush, BrushKind, BrushPlane};
+use crate::brush::{Brush, BrushKind, BrushPlane, BrushShape};
 use crate::brushlist::{self, ListedBrush};
 use crate::faces::{MIN_SQUARENESS, projection_squareness};
-use crate::hulls::{HULL_BOXES, expand_brush};
+use crate::hulls::{HULL_BOXES, bevelled_planes, grown_planes};
 use crate::leak::MapBrushRef;
 use crate::map::{MapBrush, MapEntity, MapFile};
 use crate::options::CompileOptions;
@@ -22,7 +22,8 @@ use glam::DVec3;
 use quake_formats::bsp::contents;
 use quake_formats::bsp::face_flags::FaceFlags;
 use quake_formats::bsp::phong::{self, FacePhong};
-use quake_formats::geom::Bounds;
+use quake_formats::geom::{Bounds, POINT_EPSILON};
+use rayon::prelude::*;
 use std::collections::HashMap;
 
 /// Each model's brushes, with what the rest of the compile needs to name them.
@@ -143,18 +144,39 @@ impl Gathered {
                     .filter_map(|(b, clip)| listed_brush(b, *clip, &self.planes)),
             );
         }
-        let m = &mut self.models[model];
-        for (brush, clip) in built {
+        // Each colliding brush's bevels once, grown by every hull's box and shaped on all
+        // cores; the planes are numbered after, in the order one brush after another gives.
+        let grows = |brush: &Brush, clip: bool| {
             let collides = matches!(
                 engine_contents(brush.contents),
                 contents::SOLID | contents::SKY
             );
-            for (hull, (mins, maxs)) in HULL_BOXES.iter().enumerate() {
-                if options.clip_hulls
-                    && hulls.has(hull + 1)
-                    && (collides || clip)
-                    && let Some(g) = expand_brush(&brush, &mut self.planes, *mins, *maxs)
-                {
+            options.clip_hulls && (collides || clip)
+        };
+        let grown: Vec<[Option<BrushShape>; 2]> = built
+            .par_iter()
+            .map(|(brush, clip)| {
+                if !grows(brush, *clip) {
+                    return [None, None];
+                }
+                let bevels = bevelled_planes(brush, &self.planes);
+                let mut shapes = HULL_BOXES
+                    .map(|(mins, maxs)| BrushShape::of(&grown_planes(&bevels, mins, maxs)).ok());
+                for (hull, shape) in shapes.iter_mut().enumerate() {
+                    if !hulls.has(hull + 1) {
+                        *shape = None;
+                    }
+                }
+                shapes
+            })
+            .collect();
+        let m = &mut self.models[model];
+        for ((brush, clip), shapes) in built.into_iter().zip(grown) {
+            for (hull, shape) in shapes.into_iter().enumerate() {
+                if let Some(g) = shape.and_then(|s| {
+                    s.into_brush(&mut self.planes, contents::SOLID, brush.source)
+                        .ok()
+                }) {
                     m.hull_brushes[hull].push(g);
                 }
             }

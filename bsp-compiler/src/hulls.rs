@@ -90,20 +90,15 @@ pub fn bevelled_planes(brush: &Brush, planes: &PlaneSet) -> Vec<Plane> {
     list
 }
 
-/// `brush` grown so that a point outside it is a box (`mins`..`maxs` around the point) clear
-/// of the original brush. Solid, untextured.
-pub fn expand_brush(
-    brush: &Brush,
-    planes: &mut PlaneSet,
-    mins: DVec3,
-    maxs: DVec3,
-) -> Option<Brush> {
-    let list = bevelled_planes(brush, planes);
+/// The planes of a brush whose [`bevelled_planes`] are `bevels`, grown by the box
+/// `mins`..`maxs`: the brush they bound holds every point where that box, around the point,
+/// would touch the brush. Each hull grows the same bevels by its own box.
+pub fn grown_planes(bevels: &[Plane], mins: DVec3, maxs: DVec3) -> Vec<BrushPlane> {
     // Planes that differ before growing may be one plane after it (a face and a bevel a
     // millionth of a radian apart, each pushed out by its own support): keep the first, or
     // building the brush refuses the pair and the hull loses the whole brush.
-    let mut grown_planes: Vec<Plane> = Vec::with_capacity(list.len());
-    for p in &list {
+    let mut grown: Vec<Plane> = Vec::with_capacity(bevels.len());
+    for p in bevels {
         let n = p.normal;
         let push: f64 = (0..3)
             .map(|i| {
@@ -114,16 +109,15 @@ pub fn expand_brush(
                 }
             })
             .sum();
-        push_unique(&mut grown_planes, Plane::new(n, p.dist + push));
+        push_unique(&mut grown, Plane::new(n, p.dist + push));
     }
-    let grown: Vec<BrushPlane> = grown_planes
+    grown
         .into_iter()
         .map(|plane| BrushPlane {
             plane,
             texinfo: None,
         })
-        .collect();
-    Brush::from_planes(&grown, planes, contents::SOLID, brush.source).ok()
+        .collect()
 }
 
 /// Append the clip nodes of `tree` to `out` in pre-order (each node before its children, so
@@ -195,6 +189,17 @@ fn collapsed_contents(tree: &Tree) -> Vec<Option<i32>> {
 mod tests {
     use super::*;
     use crate::brush::tests::{box_planes, solid_cube};
+
+    /// `brush` grown as the compile grows it for a hull with the box `mins`..`maxs`.
+    fn expand_brush(
+        brush: &Brush,
+        planes: &mut PlaneSet,
+        mins: DVec3,
+        maxs: DVec3,
+    ) -> Option<Brush> {
+        let faces = grown_planes(&bevelled_planes(brush, planes), mins, maxs);
+        Brush::from_planes(&faces, planes, contents::SOLID, brush.source).ok()
+    }
 
     #[test]
     fn box_grows_by_the_hull_size() {

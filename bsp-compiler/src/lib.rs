@@ -13,6 +13,7 @@
 
 #![warn(missing_docs)]
 
+mod bounds_tree;
 mod brush;
 mod brushlist;
 #[cfg(feature = "cli")]
@@ -27,6 +28,7 @@ pub mod faces;
 mod gather;
 pub mod hull_check;
 mod hulls;
+mod int_hash;
 pub mod leak;
 pub mod lightmap_grid;
 pub mod map;

@@ -21,7 +21,7 @@ use crate::outside::{
     FillOutcome, Occupant, OnPlane, Reach, fill_outside, fill_unreached, visible_sides,
 };
 use crate::planes::PlaneSet;
-use crate::portals::{Portals, make_cluster_portals, make_portals};
+use crate::portals::{Portals, make_clip_hull_portals, make_cluster_portals, make_portals};
 use crate::surface_tree::rebuild_from_surfaces;
 use crate::tree::{Splitting, Tree, build_clip_hull_tree, build_tree, rebuild_tree_visible_first};
 use crate::warnings::Warning;
@@ -155,21 +155,30 @@ pub(crate) fn build_model(
 
     // A sealed world's clip hulls are sealed too (grown brushes only close gaps further): fill
     // their outsides as well, so it collapses into one solid leaf instead of many clip nodes.
-    let t = Instant::now();
-    if matches!(fill, Some(FillOutcome::Sealed { .. })) {
-        let [h1, h2] = &mut hulls;
-        rayon::join(
-            || fill_hull(h1, planes, &hull_bounds[0], occupants, splitting, options),
-            || fill_hull(h2, planes, &hull_bounds[1], occupants, splitting, options),
-        );
-    }
-    progress.advance(counts[1] + counts[2]);
-    timings[4] += t.elapsed().as_secs_f64();
-
-    let t = Instant::now();
-    let (faces, face_stats) = model_faces(&tree, &portals, planes, texinfos, options.subdivide);
-    timings[3] = t.elapsed().as_secs_f64();
-    progress.advance(counts[0]);
+    // Hull 0's faces are made meanwhile.
+    let sealed = matches!(fill, Some(FillOutcome::Sealed { .. }));
+    let ((faces, face_stats, faces_time), fill_time) = rayon::join(
+        || {
+            let t = Instant::now();
+            let (faces, stats) = model_faces(&tree, &portals, planes, texinfos, options.subdivide);
+            progress.advance(counts[0]);
+            (faces, stats, t.elapsed().as_secs_f64())
+        },
+        || {
+            let t = Instant::now();
+            if sealed {
+                let [h1, h2] = &mut hulls;
+                rayon::join(
+                    || fill_hull(h1, planes, &hull_bounds[0], occupants, splitting, options),
+                    || fill_hull(h2, planes, &hull_bounds[1], occupants, splitting, options),
+                );
+            }
+            progress.advance(counts[1] + counts[2]);
+            t.elapsed().as_secs_f64()
+        },
+    );
+    timings[3] = faces_time;
+    timings[4] += fill_time;
 
     (
         ModelOutput {
@@ -189,13 +198,14 @@ pub(crate) fn build_model(
 
 /// The portals of `tree`'s leaves, and of its structural leaves when detail split some of them.
 fn portalise(tree: &Tree, planes: &PlaneSet, bounds: &Bounds) -> (Portals, Option<Portals>) {
-    let portals = make_portals(tree, planes, bounds);
-    let cluster_portals = tree
+    let has_clusters = tree
         .nodes
         .iter()
-        .any(|n| n.cluster.is_some() && !n.is_leaf())
-        .then(|| make_cluster_portals(tree, planes, bounds));
-    (portals, cluster_portals)
+        .any(|n| n.cluster.is_some() && !n.is_leaf());
+    rayon::join(
+        || make_portals(tree, planes, bounds),
+        || has_clusters.then(|| make_cluster_portals(tree, planes, bounds)),
+    )
 }
 
 /// Fill the world's outside, flooding over `flood` (its cluster portals, or its leaf portals
@@ -251,7 +261,7 @@ fn fill_hull(
     if bounds.is_empty() {
         return;
     }
-    let portals = make_portals(tree, planes, bounds);
+    let portals = make_clip_hull_portals(tree, planes, bounds);
     // Entities near walls are inside the grown brushes; that is expected, not worth a warning.
     let mut ignored = Vec::new();
     if let FillOutcome::Sealed { .. } = fill_outside(

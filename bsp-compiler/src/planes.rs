@@ -3,8 +3,8 @@
 //! Engines take a fast path for axial planes that assumes the normal points along +axis, so every
 //! plane is stored with its largest normal component positive; users keep a `flipped` flag.
 
+use crate::int_hash::IntMap;
 use quake_formats::geom::{DIST_EPSILON, Plane};
-use std::collections::HashMap;
 
 pub type PlaneId = u32;
 
@@ -12,7 +12,7 @@ pub type PlaneId = u32;
 pub struct PlaneSet {
     planes: Vec<Plane>,
     /// Planes by their distance rounded down, for lookups within [`DIST_EPSILON`].
-    by_dist: HashMap<i64, Vec<PlaneId>>,
+    by_dist: IntMap<i64, Vec<PlaneId>>,
 }
 
 /// `plane` with its largest normal component positive, and whether that flipped it.

@@ -2,7 +2,6 @@
 //! polygon by the portals already bounding the node and then splitting those by the node plane.
 //! A box of six portals around the whole tree joins it to an "outside" leaf.
 
-use crate::brush::keep_front;
 use crate::planes::{PlaneId, PlaneSet};
 use crate::tree::{Tree, TreeNode};
 use glam::DVec3;
@@ -54,20 +53,40 @@ impl Portals {
 
 /// Portalize `tree`, whose contents lie within `bounds`: portals between its leaves.
 pub fn make_portals(tree: &Tree, planes: &PlaneSet, bounds: &Bounds) -> Portals {
-    portalize(tree, planes, bounds, TreeNode::is_leaf)
+    portalize(tree, planes, bounds, TreeNode::is_leaf, |_| true)
 }
 
 /// Portals between the structural leaves (vis clusters) of `tree`, ignoring the detail below.
 pub fn make_cluster_portals(tree: &Tree, planes: &PlaneSet, bounds: &Bounds) -> Portals {
-    portalize(tree, planes, bounds, |n| n.cluster.is_some() || n.is_leaf())
+    portalize(
+        tree,
+        planes,
+        bounds,
+        |n| n.cluster.is_some() || n.is_leaf(),
+        |_| true,
+    )
 }
 
-/// Portals between the nodes where `stop` holds, as if they were leaves.
+/// The portals of a clip hull's `tree` that touch open space: those the outside fill floods
+/// through and the hull's rebuilt tree is made from (`surface_tree`). A node with only solid
+/// below it makes no portal of its own, whose parts could only part solid from solid; the
+/// portals around it are still cut by its plane, so every portal with open space on a side
+/// comes out as [`make_portals`] makes it, in the same order.
+pub fn make_clip_hull_portals(tree: &Tree, planes: &PlaneSet, bounds: &Bounds) -> Portals {
+    let solid = tree.all_solid();
+    portalize(tree, planes, bounds, TreeNode::is_leaf, |node| {
+        !solid[node as usize]
+    })
+}
+
+/// Portals between the nodes where `stop` holds, as if they were leaves; only nodes where
+/// `own_portal` holds make a portal on their plane.
 fn portalize(
     tree: &Tree,
     planes: &PlaneSet,
     bounds: &Bounds,
     stop: impl Fn(&TreeNode) -> bool,
+    own_portal: impl Fn(u32) -> bool,
 ) -> Portals {
     let outside = tree.nodes.len() as u32;
     let mut b = Builder {
@@ -81,32 +100,39 @@ fn portalize(
     let mut stack = vec![0u32];
     while let Some(node) = stack.pop() {
         let n = &tree.nodes[node as usize];
+        // Taken before anything else: a leaf's list is dropped here, not kept for every leaf.
+        let above = std::mem::take(&mut bounding[node as usize]);
         if stop(n) {
             continue;
         }
         let Some(plane_id) = n.plane else { continue };
         let plane = *planes.get(plane_id);
-        let above = std::mem::take(&mut bounding[node as usize]);
-        b.make_node_portal(node, plane_id, &plane, n.children, &above);
-        let mut front = above.clone();
-        front.push(plane);
-        let mut back = above;
-        back.push(plane.flipped());
-        bounding[n.children[0] as usize] = front;
-        bounding[n.children[1] as usize] = back;
+        // The nodes below one that makes no portal make none either: they need no planes.
+        if own_portal(node) {
+            b.make_node_portal(node, plane_id, &plane, n.children, &above);
+            let mut front = above.clone();
+            front.push(plane);
+            let mut back = above;
+            back.push(plane.flipped());
+            bounding[n.children[0] as usize] = front;
+            bounding[n.children[1] as usize] = back;
+        }
         b.split_node_portals(node, &plane, n.children);
         stack.push(n.children[1]);
         stack.push(n.children[0]);
     }
-    // Compact: drop dead portals and renumber.
+    // Compact in place (a second list would hold every portal twice): drop dead portals and
+    // renumber.
     let mut new_index = vec![u32::MAX; b.portals.len()];
-    let mut portals = Vec::new();
-    for (i, p) in b.portals.into_iter().enumerate() {
+    let mut live = 0;
+    for (i, p) in b.portals.iter().enumerate() {
         if !p.winding.is_empty() {
-            new_index[i] = portals.len() as u32;
-            portals.push(p);
+            new_index[i] = live;
+            live += 1;
         }
     }
+    let mut portals = b.portals;
+    portals.retain(|p| !p.winding.is_empty());
     let leaf_portals = b
         .node_portals
         .into_iter()
@@ -153,7 +179,7 @@ impl Builder {
             let mut w = Some(Winding::base_for_plane(plane));
             for (j, other) in box_planes.iter().enumerate() {
                 if i != j {
-                    w = w.and_then(|w| keep_front(w, other));
+                    w = w.and_then(|w| w.into_front(other));
                 }
             }
             if let Some(w) = w {
@@ -179,7 +205,7 @@ impl Builder {
     ) {
         let mut w = Some(Winding::base_for_plane(plane));
         for keep in above {
-            w = w.and_then(|w| keep_front(w, keep));
+            w = w.and_then(|w| w.into_front(keep));
         }
         for &pid in &self.node_portals[node as usize] {
             let p = &self.portals[pid as usize];
@@ -188,7 +214,7 @@ impl Builder {
             } else {
                 p.plane.flipped()
             };
-            w = w.and_then(|w| keep_front(w, &keep));
+            w = w.and_then(|w| w.into_front(&keep));
         }
         if let Some(w) = w.filter(|w| !w.is_tiny()) {
             self.add(Portal {
@@ -204,11 +230,17 @@ impl Builder {
     fn split_node_portals(&mut self, node: u32, plane: &Plane, children: [u32; 2]) {
         let list = std::mem::take(&mut self.node_portals[node as usize]);
         for pid in list {
-            let p = &self.portals[pid as usize];
+            let p = &mut self.portals[pid as usize];
             let side = usize::from(p.nodes[0] != node);
             let other = p.nodes[1 - side];
+            // The winding is replaced by its parts (or left empty), so it moves into the split.
+            let split = std::mem::take(&mut p.winding).into_split(plane);
+            let old = Portal {
+                winding: Winding::default(),
+                ..*p
+            };
             self.node_portals[other as usize].retain(|&x| x != pid);
-            let (front, back) = match p.winding.split(plane) {
+            let (front, back) = match split {
                 Split::Front(w) => (Some(w), None),
                 Split::Back(w) => (None, Some(w)),
                 Split::Both { front, back } => (
@@ -217,9 +249,8 @@ impl Builder {
                 ),
                 Split::On { .. } => (None, None),
             };
-            let place = |this: &mut Builder, w: Winding, child: u32, reuse: bool| {
-                let mut portal = this.portals[pid as usize].clone();
-                portal.winding = w;
+            let place = |this: &mut Builder, winding: Winding, child: u32, reuse: bool| {
+                let mut portal = Portal { winding, ..old };
                 portal.nodes[side] = child;
                 if reuse {
                     this.portals[pid as usize] = portal;
@@ -230,7 +261,7 @@ impl Builder {
                 }
             };
             match (front, back) {
-                (None, None) => self.portals[pid as usize].winding = Winding::default(),
+                (None, None) => {}
                 (Some(f), None) => place(self, f, children[0], true),
                 (None, Some(b)) => place(self, b, children[1], true),
                 (Some(f), Some(b)) => {
@@ -328,5 +359,47 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Overlapping solid boxes (no CSG: their sides inside each other split the tree, as a clip
+    /// hull's grown brushes do) make solid subtrees with portals of their own; a clip hull's
+    /// portals leave those out and keep every portal touching open space as it is, in order.
+    #[test]
+    fn clip_hull_portals_are_the_portals_that_touch_open_space() {
+        let mut planes = PlaneSet::new();
+        let boxes = [
+            (DVec3::new(0.0, 0.0, 0.0), DVec3::new(100.0, 100.0, 100.0)),
+            (DVec3::new(50.0, 0.0, 0.0), DVec3::new(150.0, 100.0, 100.0)),
+            (DVec3::new(0.0, 0.0, 120.0), DVec3::new(40.0, 30.0, 160.0)),
+        ];
+        let brushes: Vec<Brush> = boxes
+            .iter()
+            .enumerate()
+            .map(|(i, &(lo, hi))| {
+                Brush::from_planes(&box_planes(lo, hi), &mut planes, contents::SOLID, i as u32)
+                    .expect("brush")
+            })
+            .collect();
+        let bounds = brushes
+            .iter()
+            .fold(Bounds::EMPTY, |acc, b| acc.union(&b.bounds));
+        let tree = build_tree(brushes, &planes, SplitHeuristic::FewestSplits, false);
+        let all = make_portals(&tree, &planes, &bounds);
+        let hull = make_clip_hull_portals(&tree, &planes, &bounds);
+        let solid = |n: u32| n != all.outside && tree.nodes[n as usize].contents == contents::SOLID;
+        let open = |portals: &Portals| -> Vec<Portal> {
+            let touches_open = |p: &&Portal| !p.nodes.iter().all(|&n| solid(n));
+            portals
+                .portals
+                .iter()
+                .filter(touches_open)
+                .cloned()
+                .collect()
+        };
+        assert!(
+            hull.portals.len() < all.portals.len(),
+            "no solid subtree left out"
+        );
+        assert_eq!(open(&hull), open(&all));
     }
 }

@@ -3,7 +3,6 @@
 //! nothing reaches, and engines that rebuild portals from the tree (DarkPlaces) find no portal
 //! between the children ("new portal was clipped away").
 
-use crate::brush::keep_front;
 use glam::DVec3;
 use quake_formats::bsp::DARKPLACES_PORTAL_EPSILON;
 use quake_formats::geom::{Bounds, ON_EPSILON, Plane, Split, Winding};
@@ -107,7 +106,7 @@ impl Region {
             .iter()
             .try_fold(cut.clone(), |w, f| {
                 let inner = Plane::new(f.outward.normal, f.outward.dist - PORTAL_EPSILON);
-                keep_front(w, &inner.flipped())
+                w.into_front(&inner.flipped())
             })
             .filter(|w| !w.is_tiny())?;
         Some(self.parts(plane, cut))
@@ -208,7 +207,7 @@ fn clip_inside(w: Winding, planes: &[Plane], own: &Plane) -> Option<Winding> {
     planes
         .iter()
         .filter(|p| !p.same_as(own) && !p.same_as(&own.flipped()))
-        .try_fold(w, |w, p| keep_front(w, &p.flipped()))
+        .try_fold(w, |w, p| w.into_front(&p.flipped()))
         .filter(|w| !w.is_tiny())
 }
 

@@ -3,13 +3,12 @@
 //! between solid and open space matter. A second tree built from just those (as id's qbsp did
 //! after filling) needs far fewer clip nodes.
 
-use crate::brush::keep_front;
 use crate::planes::{PlaneId, PlaneSet};
 use crate::portals::Portals;
 use crate::tree::{BuildNode, Splitting, Tree, best_splitter, flatten, mid_split};
 use glam::DVec3;
 use quake_formats::bsp::contents;
-use quake_formats::geom::{Bounds, Plane, Split, Winding};
+use quake_formats::geom::{Bounds, Plane, PlaneSide, Split, Winding};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Space left between the surfaces and the box bounding the root's region.
@@ -153,10 +152,14 @@ fn split_all<T>(
     let (mut front, mut back) = (Vec::new(), Vec::new());
     let mut splits = 0;
     for item in items {
-        match winding(&item).split(plane) {
-            Split::Front(_) => front.push(item),
-            Split::Back(_) => back.push(item),
-            Split::Both { front: f, back: b } => {
+        // Classified first: an item wholly on one side moves there without a copy.
+        match winding(&item).side_of(plane) {
+            PlaneSide::Front => front.push(item),
+            PlaneSide::Back => back.push(item),
+            PlaneSide::Cross => {
+                let Split::Both { front: f, back: b } = winding(&item).split(plane) else {
+                    continue;
+                };
                 splits += 1;
                 for (w, list) in [(f, &mut front), (b, &mut back)] {
                     if !w.is_tiny() {
@@ -164,7 +167,7 @@ fn split_all<T>(
                     }
                 }
             }
-            Split::On { .. } => {}
+            PlaneSide::On => {}
         }
     }
     (front, back, splits)
@@ -300,7 +303,7 @@ fn inside_point(planes: &[Plane]) -> Option<DVec3> {
         let mut w = Some(Winding::base_for_plane(&plane.flipped()));
         for (j, other) in planes.iter().enumerate() {
             if i != j {
-                w = w.and_then(|w| keep_front(w, other));
+                w = w.and_then(|w| w.into_front(other));
             }
         }
         for p in w.iter().flat_map(|w| &w.points) {

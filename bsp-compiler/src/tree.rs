@@ -11,7 +11,7 @@ use quake_formats::bsp::contents;
 use quake_formats::geom::{Bounds, ON_EPSILON, Plane};
 use rayon::prelude::*;
 use std::collections::HashSet;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicI64, AtomicUsize, Ordering};
 
 /// How the splitting plane of a node is chosen among the node's unused brush side planes.
 ///
@@ -77,11 +77,24 @@ impl SplitHeuristic {
             SplitHeuristic::Balanced => (5 * (c.split - c.facing) + imbalance, non_axial, 0, 0),
         }
     }
+
+    /// The least first component of [`SplitHeuristic::key`] a candidate that splits at least
+    /// `split` items and lies on `facing` of them can reach.
+    fn least_first_key(self, split: i64, facing: i64) -> i64 {
+        match self {
+            SplitHeuristic::FewestSplits => split,
+            SplitHeuristic::Balanced => 5 * (split - facing),
+        }
+    }
 }
 
 /// The candidate with the lowest [`SplitHeuristic::key`] over a node's `items` (brushes or
 /// surfaces), each telling with `sides_of` which sides of a plane it reaches. `facing` is the
 /// sorted list of planes the items lie on, one entry per item.
+///
+/// A candidate stops being counted once its key can only come out above the lowest first key
+/// component some candidate has finished with: both heuristics rank splits before all else, and
+/// splits only add up, so it cannot win.
 pub fn best_splitter<T: Sync>(
     candidates: &[PlaneId],
     items: &[T],
@@ -90,12 +103,20 @@ pub fn best_splitter<T: Sync>(
     planes: &PlaneSet,
     heuristic: SplitHeuristic,
 ) -> Option<PlaneId> {
+    let bound = AtomicI64::new(i64::MAX);
     let score = |&id: &PlaneId| {
         let plane = planes.get(id);
+        let facing = count_sorted(facing, id);
+        let limit = bound.load(Ordering::Relaxed);
         let (mut front, mut back, mut split) = (0i64, 0i64, 0i64);
         for item in items {
             match sides_of(item, plane) {
-                (true, true) => split += 1,
+                (true, true) => {
+                    split += 1;
+                    if heuristic.least_first_key(split, facing) > limit {
+                        return None;
+                    }
+                }
                 (true, false) => front += 1,
                 (false, true) => back += 1,
                 (false, false) => {}
@@ -103,17 +124,23 @@ pub fn best_splitter<T: Sync>(
         }
         let counts = SplitCounts {
             split,
-            facing: count_sorted(facing, id),
+            facing,
             front,
             back,
         };
-        (heuristic.key(plane, counts), id)
+        let key = heuristic.key(plane, counts);
+        bound.fetch_min(key.0, Ordering::Relaxed);
+        Some((key, id))
     };
     // Scoring is candidates x items; small nodes are not worth a fork.
     if candidates.len() * items.len() > 20_000 {
-        candidates.par_iter().map(score).min().map(|(_, id)| id)
+        candidates
+            .par_iter()
+            .filter_map(score)
+            .min()
+            .map(|(_, id)| id)
     } else {
-        candidates.iter().map(score).min().map(|(_, id)| id)
+        candidates.iter().filter_map(score).min().map(|(_, id)| id)
     }
 }
 
@@ -1064,6 +1091,58 @@ mod tests {
                 });
                 proptest::prop_assert_eq!(touched.iter().all(solid), filled, "{:?}", top);
             }
+        }
+
+        /// Counting stops early only for candidates that cannot win: the choice is the one
+        /// scoring every candidate in full makes, for both heuristics.
+        #[test]
+        fn best_splitter_chooses_as_scoring_every_candidate_does(
+            spans in proptest::collection::vec((-20i32..20, 1i32..12), 1..40),
+            cuts in proptest::collection::vec(-24i32..24, 1..16),
+            balanced in proptest::bool::ANY,
+        ) {
+            let mut planes = PlaneSet::new();
+            let mut candidates: Vec<PlaneId> = cuts
+                .iter()
+                .map(|&c| planes.insert(&Plane::new(DVec3::X, f64::from(c))).0)
+                .collect();
+            candidates.sort_unstable();
+            candidates.dedup();
+            // Spans of x; one lies on a candidate where it starts there.
+            let sides = |&(lo, len): &(i32, i32), p: &Plane| {
+                (f64::from(lo + len) > p.dist, f64::from(lo) < p.dist)
+            };
+            let mut facing: Vec<PlaneId> = spans
+                .iter()
+                .filter_map(|&(lo, _)| {
+                    candidates.iter().copied().find(|&id| planes.get(id).dist == f64::from(lo))
+                })
+                .collect();
+            facing.sort_unstable();
+            let heuristic = if balanced {
+                SplitHeuristic::Balanced
+            } else {
+                SplitHeuristic::FewestSplits
+            };
+            let exhaustive = candidates
+                .iter()
+                .map(|&id| {
+                    let plane = planes.get(id);
+                    let count = |want: (bool, bool)| {
+                        spans.iter().filter(|s| sides(s, plane) == want).count() as i64
+                    };
+                    let counts = SplitCounts {
+                        split: count((true, true)),
+                        facing: count_sorted(&facing, id),
+                        front: count((true, false)),
+                        back: count((false, true)),
+                    };
+                    (heuristic.key(plane, counts), id)
+                })
+                .min()
+                .map(|(_, id)| id);
+            let chosen = best_splitter(&candidates, &spans, sides, &facing, &planes, heuristic);
+            proptest::prop_assert_eq!(chosen, exhaustive);
         }
     }
 }

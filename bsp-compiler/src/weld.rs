@@ -1,12 +1,12 @@
 //! Shared vertices: welding equal points and inserting the vertices that lie on another face's
 //! edge (T-junctions), which would otherwise show as cracks.
 
+use crate::int_hash::IntMap;
 use crate::tree::{DETAIL_WALL, engine_contents};
 use glam::DVec3;
 use quake_formats::bsp::contents;
 use quake_formats::geom::DVec3Ext;
-use quake_formats::geom::{ON_EPSILON, POINT_EPSILON};
-use std::collections::HashMap;
+use quake_formats::geom::{Bounds, ON_EPSILON, POINT_EPSILON};
 
 /// Distance from an edge within which a vertex counts as lying on it.
 pub const TJUNCTION_EPSILON: f64 = 0.02;
@@ -17,7 +17,7 @@ const GRID: f64 = 64.0;
 #[derive(Debug, Default)]
 pub struct VertexWelder {
     pub positions: Vec<DVec3>,
-    cells: HashMap<[i64; 3], Vec<u32>>,
+    cells: IntMap<[i64; 3], Vec<u32>>,
 }
 
 /// A grid cell and the 26 around it: every cell a point within one cell width can fall in.
@@ -121,7 +121,7 @@ pub fn fix_tjunctions(
     polygons: &mut [Vec<u32>],
     classes: &[WeldClass],
 ) -> usize {
-    let mut owners: HashMap<u32, u8> = HashMap::new();
+    let mut owners: IntMap<u32, u8> = IntMap::default();
     for (poly, class) in polygons.iter().zip(classes) {
         for &v in poly {
             *owners.entry(v).or_default() |= class.bit();
@@ -164,8 +164,8 @@ pub fn fix_tjunctions(
 /// them has each vertex on its opposite edge).
 /// Returns the vertices collapsed into others, each with the one it became.
 fn collapse_short_edges(positions: &[DVec3], polygons: &mut [Vec<u32>]) -> Vec<(u32, u32)> {
-    let mut same: HashMap<u32, u32> = HashMap::new();
-    let root = |same: &HashMap<u32, u32>, mut v: u32| {
+    let mut same: IntMap<u32, u32> = IntMap::default();
+    let root = |same: &IntMap<u32, u32>, mut v: u32| {
         while let Some(&r) = same.get(&v) {
             v = r;
         }
@@ -198,8 +198,8 @@ fn collapse_short_edges(positions: &[DVec3], polygons: &mut [Vec<u32>]) -> Vec<(
 /// with the [`WeldClass`] bits of the polygons it belongs to.
 struct TJunctionGrid<'a> {
     positions: &'a [DVec3],
-    cells: HashMap<[i64; 3], Vec<u32>>,
-    owners: HashMap<u32, u8>,
+    cells: IntMap<[i64; 3], Vec<u32>>,
+    owners: IntMap<u32, u8>,
 }
 
 impl<'a> TJunctionGrid<'a> {
@@ -208,8 +208,8 @@ impl<'a> TJunctionGrid<'a> {
         [c(p.x), c(p.y), c(p.z)]
     }
 
-    fn new(positions: &'a [DVec3], owners: HashMap<u32, u8>) -> Self {
-        let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+    fn new(positions: &'a [DVec3], owners: IntMap<u32, u8>) -> Self {
+        let mut cells: IntMap<[i64; 3], Vec<u32>> = IntMap::default();
         for &v in owners.keys() {
             cells
                 .entry(Self::cell(positions[v as usize]))
@@ -273,14 +273,36 @@ impl<'a> TJunctionGrid<'a> {
         let len = len2.sqrt();
         let pad = DVec3::new(TJUNCTION_EPSILON, TJUNCTION_EPSILON, TJUNCTION_EPSILON);
         let (lo, hi) = (Self::cell(pa.min(pb) - pad), Self::cell(pa.max(pb) + pad));
+        // A long slanted edge's box spans many cells the edge passes far from: a cell whose
+        // centre is farther from the edge than its half-diagonal (and a unit of slack for
+        // points rounded into it) and the epsilon holds no vertex on the edge.
+        let reach = GRID * 3f64.sqrt() / 2.0 + 1.0 + TJUNCTION_EPSILON;
+        // Every point within the epsilon of the edge lies in its box grown by the epsilon (and
+        // a millionth for rounding): most vertices of the cells fail this first, cheaper test.
+        let slack = DVec3::splat(TJUNCTION_EPSILON + 1e-6);
+        let near_box = Bounds {
+            mins: pa.min(pb) - slack,
+            maxs: pa.max(pb) + slack,
+        };
+        let far = |c: [i64; 3]| {
+            let centre = (DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64) + 0.5) * GRID;
+            let t = ((centre - pa).dot(d) / len2).clamp(0.0, 1.0);
+            (pa + d * t - centre).length() > reach
+        };
         for x in lo[0]..=hi[0] {
             for y in lo[1]..=hi[1] {
                 for z in lo[2]..=hi[2] {
+                    if far([x, y, z]) {
+                        continue;
+                    }
                     for &v in self.cells.get(&[x, y, z]).into_iter().flatten() {
                         if v == a || v == b {
                             continue;
                         }
                         let pv = self.positions[v as usize];
+                        if !near_box.contains(pv) {
+                            continue;
+                        }
                         let t = (pv - pa).dot(d) / len2;
                         let along = t * len;
                         if along <= POINT_EPSILON || along >= len - POINT_EPSILON {

@@ -15,7 +15,7 @@ use quake_formats::miptex::MipTex;
 use crate::embree::{Device, RayPacket16, Scene, sys};
 use crate::error::LightError;
 use crate::faces::FaceGeom;
-use crate::scene::Mesh;
+use crate::mesh::Mesh;
 
 /// The palette index fence textures leave transparent.
 const OPEN_TEXEL: u8 = 255;

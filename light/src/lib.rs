@@ -53,6 +53,7 @@ mod lightgrid;
 mod lighting;
 mod lights;
 mod luxels;
+mod mesh;
 mod nudge;
 mod options;
 mod output;

@@ -73,7 +73,7 @@ pub enum FormatError {
     )]
     ShortBound {
         /// The version being written (BSP29 or 2PSB).
-        version: crate::bsp::BspVersion,
+        version: crate::bsp_version::BspVersion,
         /// `"node"` or `"leaf"`.
         record: &'static str,
         /// The record's index in its lump.

@@ -10,6 +10,7 @@
 #![warn(missing_docs)]
 
 pub mod bsp;
+mod bsp_version;
 mod bytes;
 #[cfg(feature = "cli")]
 pub mod cli;

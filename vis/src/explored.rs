@@ -10,7 +10,7 @@
 //! where many leaf orders lead to the same portal unclipped, this cuts the walk from a number
 //! of paths exponential in the depth down to a few per portal.
 
-use crate::bitset::WindowBits;
+use crate::bitset::{WindowBits, WindowCopy};
 use glam::DVec3;
 use quake_formats::geom::DVec3Ext;
 use quake_formats::geom::POINT_EPSILON;
@@ -18,28 +18,34 @@ use quake_formats::geom::POINT_EPSILON;
 /// At most this many states are kept per portal; later ones are walked without being kept.
 const STATES_PER_PORTAL: usize = 4;
 
+#[derive(Default)]
 struct State {
     source: Vec<DVec3>,
     pass: Vec<DVec3>,
-    might: WindowBits,
+    might: WindowCopy,
 }
 
 /// The states walked on from, per portal, during one base portal's flow.
 #[derive(Default)]
 pub struct Explored {
-    states: Vec<Vec<State>>,
+    /// By portal: how many states are kept, and their places in `pool`. Fixed slots rather than
+    /// a list per portal: a flow touches most portals, and a list each would stay allocated.
+    kept: Vec<(u8, [u32; STATES_PER_PORTAL])>,
     touched: Vec<u32>,
-    spare: Vec<State>,
+    /// Every state kept in this flow first, reused by later flows.
+    pool: Vec<State>,
+    used: usize,
 }
 
 impl Explored {
     /// Forget every state (the start of another base portal's flow over `portals` portals).
     pub fn reset(&mut self, portals: usize) {
         for &p in &self.touched {
-            self.spare.append(&mut self.states[p as usize]);
+            self.kept[p as usize].0 = 0;
         }
         self.touched.clear();
-        self.states.resize_with(portals, Vec::new);
+        self.used = 0;
+        self.kept.resize(portals, (0, [0; STATES_PER_PORTAL]));
     }
 
     /// Whether a state already walked on from `portal` lets through everything this one does.
@@ -53,7 +59,9 @@ impl Explored {
         source_normal: DVec3,
         pass_normal: DVec3,
     ) -> bool {
-        self.states[portal].iter().any(|s| {
+        let (count, slots) = &self.kept[portal];
+        slots[..usize::from(*count)].iter().any(|&i| {
+            let s = &self.pool[i as usize];
             convex_contains(&s.pass, pass, pass_normal)
                 && convex_contains(&s.source, source, source_normal)
                 && might.is_subset(&s.might)
@@ -62,24 +70,26 @@ impl Explored {
 
     /// Remember a state about to be walked on from `portal`.
     pub fn record(&mut self, portal: usize, source: &[DVec3], pass: &[DVec3], might: &WindowBits) {
-        let kept = &mut self.states[portal];
-        if kept.len() >= STATES_PER_PORTAL {
+        let (count, slots) = &mut self.kept[portal];
+        let n = usize::from(*count);
+        if n >= STATES_PER_PORTAL {
             return;
         }
-        if kept.is_empty() {
+        if n == 0 {
             self.touched.push(portal as u32);
         }
-        let mut state = self.spare.pop().unwrap_or_else(|| State {
-            source: Vec::new(),
-            pass: Vec::new(),
-            might: WindowBits::default(),
-        });
+        if self.used == self.pool.len() {
+            self.pool.push(State::default());
+        }
+        let state = &mut self.pool[self.used];
         state.source.clear();
         state.source.extend_from_slice(source);
         state.pass.clear();
         state.pass.extend_from_slice(pass);
         state.might.assign(might);
-        kept.push(state);
+        slots[n] = self.used as u32;
+        *count += 1;
+        self.used += 1;
     }
 }
 

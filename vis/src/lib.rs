@@ -318,32 +318,35 @@ pub fn compute_vis_resuming(
 ) -> Result<VisResult, VisError> {
     let setup = Setup::new(prt, options.threads)?;
     Ok(setup.pool.install(|| {
-        let (mightsee, base_seconds) = base_vis(&setup.graph);
+        let (mut mightsee, base_seconds) = base_vis(&setup.graph);
+        let average_mightsee = average_count(&mightsee);
         let start = Instant::now();
         let portal_vis = match options.mode {
-            VisMode::Fast => mightsee.clone(),
+            VisMode::Fast => std::mem::take(&mut mightsee),
             VisMode::Full { level } => {
                 let wanted = vec![true; mightsee.len()];
                 let plan = FlowPlan::new(&mightsee, options.grouping);
                 let job = FlowJob {
                     graph: &setup.graph,
-                    mightsee: &mightsee,
                     plan: &plan,
                     level,
                     progress: &options.progress,
                     wanted: &wanted,
                     checkpoint,
                 };
-                let done = full_flow(&job, known);
+                let done = full_flow(&job, known, &mut mightsee);
                 done.into_iter()
-                    .zip(&mightsee)
-                    .map(|(d, m)| d.unwrap_or_else(|| m.clone()))
+                    .zip(std::mem::take(&mut mightsee))
+                    .map(|(d, m)| d.unwrap_or(m))
                     .collect()
             }
         };
         let flow_seconds = start.elapsed().as_secs_f64();
-        let mut result = setup.finish(&portal_vis);
-        result.stats.average_mightsee = average_count(&mightsee);
+        // The portals' sets go before the leaves' rows are made: they are the biggest sets.
+        let seen = setup.seen_through(&portal_vis);
+        drop(portal_vis);
+        let mut result = setup.finish(seen);
+        result.stats.average_mightsee = average_mightsee;
         result.stats.base_seconds = base_seconds;
         result.stats.flow_seconds = flow_seconds;
         result
@@ -381,24 +384,26 @@ pub fn compute_shard(
     let grouping = options.grouping;
     let setup = Setup::new(prt, options.threads)?;
     Ok(setup.pool.install(|| {
-        let (mightsee, base_seconds) = base_vis(&setup.graph);
+        let (mut mightsee, base_seconds) = base_vis(&setup.graph);
         let start = Instant::now();
         let plan = FlowPlan::new(&mightsee, grouping);
         let wanted = plan.runs(shard);
         let job = FlowJob {
             graph: &setup.graph,
-            mightsee: &mightsee,
             plan: &plan,
             level,
             progress: &options.progress,
             wanted: &wanted,
             checkpoint,
         };
-        let mut done = full_flow(&job, known);
+        let mut done = full_flow(&job, known, &mut mightsee);
         let results: Vec<(usize, BitSet)> = plan
             .owned(shard)
             .into_iter()
-            .map(|p| (p, done[p].take().unwrap_or_else(|| mightsee[p].clone())))
+            .map(|p| {
+                let set = done[p].take();
+                (p, set.unwrap_or_else(|| std::mem::take(&mut mightsee[p])))
+            })
             .collect();
         ShardFlows {
             portals: mightsee.len(),
@@ -420,7 +425,15 @@ pub fn vis_from_flows(prt: &PortalFile, flows: &[BitSet]) -> Result<VisResult, V
             portals: setup.graph.portals.len(),
         });
     }
-    Ok(setup.pool.install(|| setup.finish(flows)))
+    Ok(setup
+        .pool
+        .install(|| setup.finish(setup.seen_through(flows))))
+}
+
+/// The clusters seen through each portal, and how many portals each portal saw on average.
+struct SeenThrough {
+    clusters: Vec<BitSet>,
+    average_portal_vis: f64,
 }
 
 /// What every entry point builds first.
@@ -449,14 +462,23 @@ impl Setup {
         })
     }
 
-    /// Leaf rows from the portals seen through each portal (stats without base and flow).
-    fn finish(&self, portal_vis: &[BitSet]) -> VisResult {
+    /// The clusters seen through each portal, from the portals seen through it.
+    fn seen_through(&self, portal_vis: &[BitSet]) -> SeenThrough {
         let graph = &self.graph;
-        let seen_through: Vec<BitSet> = (0..graph.portals.len())
-            .into_par_iter()
-            .map(|p| Pvs::clusters_behind(graph, p, &portal_vis[p]))
-            .collect();
-        let mut rows = Pvs::cluster_rows(graph, &seen_through);
+        SeenThrough {
+            clusters: (0..graph.portals.len())
+                .into_par_iter()
+                .map(|p| Pvs::clusters_behind(graph, p, &portal_vis[p]))
+                .collect(),
+            average_portal_vis: average_count(portal_vis),
+        }
+    }
+
+    /// Leaf rows from the clusters seen through each portal (stats without base and flow).
+    fn finish(&self, seen: SeenThrough) -> VisResult {
+        let graph = &self.graph;
+        let mut rows = Pvs::cluster_rows(graph, &seen.clusters);
+        drop(seen.clusters);
         let asymmetric_pairs = Pvs::intersect_with_transpose(&mut rows);
         let pvs = match &self.clusters {
             Some(clusters) => clusters.expand(&rows),
@@ -472,7 +494,7 @@ impl Setup {
             } else {
                 graph.misoriented_portals()
             },
-            average_portal_vis: average_count(portal_vis),
+            average_portal_vis: seen.average_portal_vis,
             average_visible: pvs.average_visible(),
             max_visible: pvs.max_visible(),
             asymmetric_pairs,
@@ -525,7 +547,6 @@ fn check_set_sizes(prt: &PortalFile) -> Result<(), VisError> {
 /// One run of the full flow.
 struct FlowJob<'a> {
     graph: &'a PortalGraph,
-    mightsee: &'a [BitSet],
     plan: &'a FlowPlan,
     level: u8,
     progress: &'a Progress,
@@ -536,8 +557,11 @@ struct FlowJob<'a> {
 
 /// Run the portal flows `job` wants, wave by wave ([`FlowPlan`]), on every worker thread,
 /// taking results in `known` as they are; returns the portals seen through each (`None` for
-/// portals not wanted, or whose worker panicked).
-fn full_flow(job: &FlowJob, known: KnownFlows) -> Vec<Option<BitSet>> {
+/// portals not wanted, or whose worker panicked). A portal's `mightsee` is emptied once its
+/// flow is done and no later flow may read it instead of that result, so the finished flows
+/// take the place of the mightsee sets rather than adding to them; those of the portals
+/// without a result are kept.
+fn full_flow(job: &FlowJob, known: KnownFlows, mightsee: &mut [BitSet]) -> Vec<Option<BitSet>> {
     let n = job.graph.portals.len();
     let bar = job.progress;
     bar.start("flow", job.wanted.iter().filter(|&&w| w).count());
@@ -557,14 +581,14 @@ fn full_flow(job: &FlowJob, known: KnownFlows) -> Vec<Option<BitSet>> {
         last: Mutex::new(Instant::now()),
         busy: AtomicBool::new(false),
     });
-    let ctx = flow::FlowContext {
-        graph: job.graph,
-        mightsee: job.mightsee,
-        results: &results,
-        plan: job.plan,
-        level: job.level,
-    };
     for wave in job.plan.waves() {
+        let ctx = flow::FlowContext {
+            graph: job.graph,
+            mightsee,
+            results: &results,
+            plan: job.plan,
+            level: job.level,
+        };
         let todo: Vec<usize> = wave
             .iter()
             .copied()
@@ -596,6 +620,11 @@ fn full_flow(job: &FlowJob, known: KnownFlows) -> Vec<Option<BitSet>> {
                 }
             }
         });
+        for &p in wave {
+            if results[p].get().is_some() && job.plan.bounds_every_later_flow(p) {
+                mightsee[p] = BitSet::default();
+            }
+        }
     }
     bar.finish();
     results.into_iter().map(OnceLock::into_inner).collect()

@@ -64,6 +64,30 @@ impl Brush {
         }
         Brush { faces }
     }
+
+    /// A five-sided wedge: [`Brush::hexahedron`]'s box cut along the diagonal from its low-Z
+    /// high-Y edge to its high-Z low-Y edge, keeping the low-Y low-Z half. Textures: -X, +X, -Y,
+    /// -Z, the slope.
+    pub fn wedge(corners: [DVec3; 8], textures: [&str; 5]) -> Brush {
+        let box_faces = Brush::hexahedron(
+            corners,
+            [
+                textures[0],
+                textures[1],
+                textures[2],
+                textures[4],
+                textures[3],
+                textures[4],
+            ],
+        )
+        .faces;
+        let mut faces: Vec<Face> = [0, 1, 2, 4]
+            .into_iter()
+            .map(|i| box_faces[i].clone())
+            .collect();
+        faces.push(Face::new([corners[4], corners[2], corners[3]], textures[4]));
+        Brush { faces }
+    }
 }
 
 /// The eight corners of a box in [`Brush::hexahedron`]'s order.

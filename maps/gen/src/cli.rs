@@ -1,5 +1,5 @@
 //! `mapgen [OUT_DIR]`: regenerate the maps and WAD; `mapgen random --seed N OUT.map`: write one
-//! random map.
+//! random map; `mapgen clutter --brushes N OUT.map`: write a clutter benchmark map.
 
 use anyhow::Context;
 use std::path::{Path, PathBuf};
@@ -30,6 +30,15 @@ pub enum Command {
         objects: usize,
         out: PathBuf,
     },
+    /// Write a clutter benchmark map: rooms of heaped, turned brushes (bench/csg_scaling.sh)
+    Clutter {
+        /// Heaped brushes, besides the rooms' shells
+        #[arg(long, default_value_t = 1000)]
+        brushes: usize,
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        out: PathBuf,
+    },
 }
 
 /// The `maps/` directory this crate lives in.
@@ -54,6 +63,16 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         quake_formats::fsutil::write_atomic(out, text.as_bytes())
             .with_context(|| format!("writing {}", out.display()))?;
         eprintln!("wrote random map {seed} to {}", out.display());
+        return Ok(());
+    }
+    if let Some(Command::Clutter { brushes, seed, out }) = &args.command {
+        let text = crate::clutter::clutter_map(*brushes, *seed).to_text();
+        quake_formats::fsutil::write_atomic(out, text.as_bytes())
+            .with_context(|| format!("writing {}", out.display()))?;
+        eprintln!(
+            "wrote clutter map of {brushes} brushes to {}",
+            out.display()
+        );
         return Ok(());
     }
     let start = Instant::now();

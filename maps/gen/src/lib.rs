@@ -2,12 +2,16 @@
 //!
 //! [`textures`] paints procedural textures as PNG pictures and builds the WAD from them with the
 //! `slipgate-wad` crate;
+//! [`entities`] holds what every map shares (worldspawn, lights, the player start);
 //! [`level`] turns boxes of open space into sealed shells of brushes; [`maps`] defines the demo
 //! map, the hard cases, the leak pair and the corridor test map; [`brush`] writes `.map` text;
-//! [`random`] makes seeded random maps for property tests; [`open`] the open field for sharded vis.
+//! [`random`] makes seeded random maps for property tests; [`open`] the open field for sharded vis;
+//! [`clutter`] the crowded maps CSG and clip hulls are timed on.
 
 pub mod brush;
 pub mod cli;
+pub mod clutter;
+pub mod entities;
 pub mod level;
 pub mod maps;
 pub mod open;
@@ -59,7 +63,7 @@ pub fn generate() -> Result<Vec<GeneratedFile>, MapgenError> {
         })
         .collect();
     files.push(GeneratedFile {
-        path: maps::WAD_NAME.to_string(),
+        path: entities::WAD_NAME.to_string(),
         bytes: wad.write(),
         brushes: 0,
         entities: 0,
@@ -117,7 +121,7 @@ fn readme(maps: &[maps::MapFile]) -> String {
     }
     out.push_str(&format!(
         "\n## Textures: `{}`\n\n| name | size | picture |\n|---|---|---|\n",
-        maps::WAD_NAME
+        entities::WAD_NAME
     ));
     for (name, image) in textures::images() {
         out.push_str(&format!(

@@ -2,6 +2,7 @@
 //! a corridor map for clip-hull traces.
 
 use crate::brush::{Brush, Map, MapEntity, MapFormat, aabb, box_corners};
+use crate::entities::{light, player_start, standard, worldspawn};
 use crate::level::{Level, Surfaces};
 use glam::DVec3;
 use quake_formats::geom::Bounds;
@@ -15,8 +16,6 @@ pub struct MapFile {
     pub map: Map,
     pub all_brushes_valid: bool,
 }
-
-pub const WAD_NAME: &str = "slipgate.wad";
 
 const STONE: Surfaces = Surfaces {
     floor: "floor1",
@@ -37,20 +36,6 @@ fn cuboid(lo: [f64; 3], hi: [f64; 3], texture: &str) -> Brush {
     Brush::cuboid(b(lo, hi), texture)
 }
 
-pub(crate) fn worldspawn(message: &str) -> MapEntity {
-    MapEntity::new("worldspawn")
-        .key("message", message)
-        .key("wad", WAD_NAME)
-}
-
-pub(crate) fn light(origin: [f64; 3], level: u32) -> MapEntity {
-    MapEntity::point("light", origin).key("light", &level.to_string())
-}
-
-pub(crate) fn player_start(origin: [f64; 3], angle: u32) -> MapEntity {
-    MapEntity::point("info_player_start", origin).key("angle", &angle.to_string())
-}
-
 /// A ceiling lamp: 32x32x8 hanging from `ceiling` at (x, y), glowing underneath, and the light
 /// just below it.
 fn lamp(x: f64, y: f64, ceiling: f64) -> (Brush, MapEntity) {
@@ -59,14 +44,6 @@ fn lamp(x: f64, y: f64, ceiling: f64) -> (Brush, MapEntity) {
     let hi = [x + 16.0, y + 16.0, ceiling];
     let brush = Brush::cuboid_faces(b(lo, hi), [trim, trim, trim, trim, "light1", trim]);
     (brush, light([x, y, ceiling - 24.0], 250))
-}
-
-pub(crate) fn standard(comment: &[&str], entities: Vec<MapEntity>) -> Map {
-    Map {
-        comment: comment.iter().map(|s| s.to_string()).collect(),
-        format: MapFormat::Standard,
-        entities,
-    }
 }
 
 pub fn demo() -> Map {

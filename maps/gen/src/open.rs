@@ -3,8 +3,8 @@
 //! slow (every portal sees far), so this is the map vis's sharding is measured on.
 
 use crate::brush::{Brush, Map, aabb};
+use crate::entities::{light, player_start, standard, worldspawn};
 use crate::level::{Level, Surfaces};
-use crate::maps::{light, player_start, standard, worldspawn};
 use quake_formats::rng::SplitMix64;
 
 /// The seed of the committed `open/open.map`.

@@ -9,8 +9,8 @@
 //! [`LIGHT_SPACE`] under their ceiling, where the lights hang.
 
 use crate::brush::{Brush, Map, MapEntity, MapFormat, aabb, box_corners};
+use crate::entities::WAD_NAME;
 use crate::level::{Level, Surfaces};
-use crate::maps::WAD_NAME;
 use glam::DVec3;
 use quake_formats::geom::Bounds;
 use quake_formats::rng::SplitMix64;
@@ -96,7 +96,7 @@ fn grid(rng: &mut SplitMix64, lo: f64, hi: f64, step: f64) -> f64 {
     lo + step * rng.below(n + 1) as f64
 }
 
-fn pick<T: Copy>(rng: &mut SplitMix64, list: &[T]) -> T {
+pub(crate) fn pick<T: Copy>(rng: &mut SplitMix64, list: &[T]) -> T {
     list[rng.below(list.len())]
 }
 
@@ -152,7 +152,7 @@ fn corridor(rng: &mut SplitMix64, a: &Room, b: &Room) -> Bounds {
 /// A random rotation (about Z, sometimes tilted about X as well) of a shear, built from
 /// normalised random vectors (square roots are exact everywhere, unlike sines), so every
 /// platform makes the same map.
-fn random_transform(rng: &mut SplitMix64) -> impl Fn(DVec3) -> DVec3 + use<> {
+pub(crate) fn random_transform(rng: &mut SplitMix64) -> impl Fn(DVec3) -> DVec3 + use<> {
     let mut unit_pair = || loop {
         let (a, b) = (rng.range(-1.0, 1.0), rng.range(-1.0, 1.0));
         let len = (a * a + b * b).sqrt();
@@ -176,7 +176,7 @@ fn random_transform(rng: &mut SplitMix64) -> impl Fn(DVec3) -> DVec3 + use<> {
     }
 }
 
-fn bounds_of(points: &[DVec3]) -> Bounds {
+pub(crate) fn bounds_of(points: &[DVec3]) -> Bounds {
     let mut b = Bounds::EMPTY;
     for &p in points {
         b.add_point(p);

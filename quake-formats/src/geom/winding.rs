@@ -200,6 +200,26 @@ impl Winding {
         })
     }
 
+    /// [`Winding::split`] of a winding given away: one wholly on a side (or on the plane) comes
+    /// back in its part as it is, without a copy.
+    pub fn into_split(self, plane: &Plane) -> Split {
+        let crossing = self.with_distances(plane, |dists, whole| match whole {
+            PlaneSide::Cross => Ok(self.split_crossing(plane, dists)),
+            other => Err(other),
+        });
+        match crossing {
+            Ok(split) => split,
+            Err(PlaneSide::Front) => Split::Front(self),
+            Err(PlaneSide::Back) => Split::Back(self),
+            Err(_) => Split::On {
+                facing_front: self
+                    .plane()
+                    .is_some_and(|own| own.normal.dot(plane.normal) > 0.0),
+                winding: self,
+            },
+        }
+    }
+
     /// [`Winding::split`] of a winding with points on both sides of `plane` at `dists`.
     fn split_crossing(&self, plane: &Plane, dists: &[f64]) -> Split {
         let n = self.points.len();
@@ -240,6 +260,18 @@ impl Winding {
             PlaneSide::Back => None,
             PlaneSide::Cross => Some(self.front_of_crossing(plane, dists)),
         })
+    }
+
+    /// The part in front of `plane`, like [`Winding::clip_front`] without `keep_on`, of a winding
+    /// given away: one wholly in front comes back as it is, without a copy, and each point's
+    /// distance is measured once (classifying first and then clipping measured twice).
+    pub fn into_front(self, plane: &Plane) -> Option<Winding> {
+        let clipped = self.with_distances(plane, |dists, whole| match whole {
+            PlaneSide::Front => None,
+            PlaneSide::Cross => Some(Some(self.front_of_crossing(plane, dists))),
+            PlaneSide::Back | PlaneSide::On => Some(None),
+        });
+        clipped.unwrap_or(Some(self))
     }
 
     /// [`Winding::clip_front`] of a winding with points on both sides of `plane` at `dists`.
@@ -339,6 +371,28 @@ mod tests {
                 Split::Back(_) => None,
             };
             prop_assert_eq!(w.clip_front(&plane, keep_on).map(|w| w.points), front.map(|w| w.points));
+        }
+
+        /// Giving the winding away changes nothing but the copy.
+        #[test]
+        fn into_split_is_split(
+            nx in -1.0f64..1.0, ny in -1.0f64..1.0, nz in -1.0f64..1.0,
+            d in -80.0f64..80.0, z in -4.0f64..4.0,
+        ) {
+            let Some(normal) = DVec3::new(nx, ny, nz).normalized() else { return Ok(()); };
+            let (w, plane) = (square(z), Plane::new(normal, d));
+            prop_assert_eq!(w.clone().into_split(&plane), w.split(&plane));
+        }
+
+        /// Giving the winding away changes nothing but the copy.
+        #[test]
+        fn into_front_is_clip_front_without_keep_on(
+            nx in -1.0f64..1.0, ny in -1.0f64..1.0, nz in -1.0f64..1.0,
+            d in -80.0f64..80.0, z in -4.0f64..4.0,
+        ) {
+            let Some(normal) = DVec3::new(nx, ny, nz).normalized() else { return Ok(()); };
+            let (w, plane) = (square(z), Plane::new(normal, d));
+            prop_assert_eq!(w.clone().into_front(&plane), w.clip_front(&plane, false));
         }
 
         #[test]
