@@ -5,9 +5,21 @@
 use glam::DVec3;
 use quake_formats::Bsp;
 
-use super::{options, room_bsp};
+use super::{map_box, options, room_bsp};
 use crate::faces::{FaceGeom, Spacing, face_geometry};
 use crate::{Lighting, Quality, compute_lighting};
+
+/// `text` compiled by the bsp compiler, sealed.
+fn compiled(text: &str) -> Bsp {
+    let source = bsp_compiler::MapSource {
+        path: std::path::PathBuf::from("ericw_case.map"),
+        text: text.to_string(),
+    };
+    let out =
+        bsp_compiler::compile(&source, &bsp_compiler::CompileOptions::default()).expect("compile");
+    assert!(out.leak.is_none(), "the map leaks");
+    out.bsp
+}
 
 /// `bsp` lit at the default quality.
 fn lit(bsp: &Bsp) -> Lighting {
@@ -131,4 +143,62 @@ fn a_light_with_an_unknown_delay_lights_nothing() {
     // The same light with a formula lights the room.
     let bsp = room_bsp(&light([0.0, 0.0, 0.0], "\"delay\" \"1\""));
     assert!(floor_rgb(&bsp, &lit(&bsp), 0.0, 0.0).is_some_and(|c| c[0] > 0));
+}
+
+/// `lightSunArtifact` (`q1_light_sun_artifact`): a red sun at 45° over a floor boxed in by sky,
+/// whose ceiling is a grid of sky brushes of two textures (so their faces meet at many seams).
+/// Every luxel of the floor takes the same red: no sun ray slips through a seam between two
+/// triangles (ericw-tools builds its Embree scene robust for this; 56 of 5,400 luxels here were
+/// black before ours was).
+#[test]
+fn sun_rays_do_not_slip_through_seams_in_the_sky() {
+    const CELL: f64 = 224.0;
+    let (x1, y1, ceiling) = (4.0 * CELL, 6.0 * CELL, 320.0);
+    let sky = |lo, hi, texture: &str| map_box(lo, hi).replace("wall", texture);
+    let mut world = map_box([0.0, 0.0, -16.0], [x1, y1, 0.0]);
+    for (lo, hi) in [
+        ([-16.0, -16.0, -16.0], [0.0, y1 + 16.0, ceiling]),
+        ([x1, -16.0, -16.0], [x1 + 16.0, y1 + 16.0, ceiling]),
+        ([0.0, -16.0, -16.0], [x1, 0.0, ceiling]),
+        ([0.0, y1, -16.0], [x1, y1 + 16.0, ceiling]),
+    ] {
+        world += &sky(lo, hi, "sky1");
+    }
+    for i in 0..4 {
+        for j in 0..6 {
+            let (x, y) = (f64::from(i) * CELL, f64::from(j) * CELL);
+            let texture = if (i + j) % 2 == 0 { "sky1" } else { "sky2" };
+            world += &sky(
+                [x, y, ceiling],
+                [x + CELL, y + CELL, ceiling + 16.0],
+                texture,
+            );
+        }
+    }
+    let bsp = compiled(&format!(
+        "{{\n\"classname\" \"worldspawn\"\n{world}}}\n\
+         {}{{\n\"classname\" \"info_player_start\"\n\"origin\" \"64 64 40\"\n}}\n",
+        light(
+            [100.0, 100.0, 100.0],
+            "\"_sun\" \"1\"\n\"_color\" \"1 0 0\"\n\"mangle\" \"0 -45 0\""
+        )
+    ));
+    let lighting = lit(&bsp);
+    let faces = face_geometry(&bsp, |_| DVec3::ZERO, |_| Spacing::Quake).expect("faces");
+    let mut luxels = Vec::new();
+    for face in faces.iter().filter(|f| f.plane.normal.z > 0.999) {
+        let m = lighting.lightmaps.iter().find(|m| m.face == face.index);
+        let m = m.expect("a lightmap for every upward face");
+        luxels.extend(m.rgb.first().expect("red light: a .lit").iter().copied());
+    }
+    assert!(luxels.len() > 5000, "{} luxels", luxels.len());
+    let red = luxels[0];
+    assert!(red[0] > 100 && red[1] == 0 && red[2] == 0, "{red:?}");
+    let odd = luxels.iter().filter(|&&c| c != red).count();
+    assert_eq!(
+        odd,
+        0,
+        "{odd} of {} upward luxels are not {red:?}",
+        luxels.len()
+    );
 }
