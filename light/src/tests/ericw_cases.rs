@@ -202,3 +202,37 @@ fn sun_rays_do_not_slip_through_seams_in_the_sky() {
         luxels.len()
     );
 }
+
+/// `detailFence` (`q1_detail_fence`): a `func_detail_fence` (here all `skip`, as there, so it has
+/// no faces) around a light and the floor under it. Its inside is written solid, which stops
+/// players; the compiler marks those leaves and light takes them as open, so the light is not
+/// "in solid" and the floor inside the fence takes the light it takes without the fence.
+/// ericw-tools lights the middle of this floor 118; without the marks it was black.
+#[test]
+fn the_inside_of_a_fence_is_lit_as_open_space() {
+    let room = |fence: bool| {
+        let mut entities = light([0.0, 0.0, -64.0], "");
+        if fence {
+            let brush = map_box([-64.0, -64.0, -128.0], [64.0, 64.0, 0.0]).replace("wall", "skip");
+            entities += &format!("{{\n\"classname\" \"func_detail_fence\"\n{brush}}}\n");
+        }
+        room_bsp(&entities)
+    };
+    let fenced = room(true);
+    let flags = fenced.leaf_flags().expect("leaf flags read");
+    assert!(
+        flags.is_some_and(|f| f.iter().any(|l| l.fence)),
+        "the compiler marks the fence's leaves"
+    );
+    assert!(crate::samples::solid_at(&fenced, [0.0, 0.0, -64.0]), "solid to engines");
+    let lighting = lit(&fenced);
+    assert!(lighting.stats.lights_nudged == 0, "the light is not in solid");
+    let open = room(false);
+    let open_lighting = lit(&open);
+    for (x, y) in [(0.0, 0.0), (32.0, 32.0), (-48.0, 16.0), (100.0, 100.0)] {
+        let inside = floor_rgb(&fenced, &lighting, x, y).expect("the floor is lit");
+        let without = floor_rgb(&open, &open_lighting, x, y).expect("the floor is lit");
+        assert!(inside[0] > 40, "({x}, {y}): {inside:?}");
+        assert!(inside[0].abs_diff(without[0]) <= 1, "({x}, {y}): {inside:?} against {without:?}");
+    }
+}
