@@ -8,11 +8,12 @@ use crate::hulls::emit_clipnodes;
 use crate::model::ModelOutput;
 use crate::planes::{PlaneId, PlaneSet};
 use crate::texinfo::TextureRole;
-use crate::tree::{Tree, engine_contents, is_see_through, vis_class};
+use crate::tree::{FENCE, Tree, engine_contents, is_see_through, vis_class};
 use crate::wad_lookup::WadSet;
 use crate::warnings::Warning;
 use crate::weld::{VertexWelder, WeldClass, cut_to_max_vertices, fix_tjunctions};
 use glam::DVec3;
+use quake_formats::bsp::leaf_flags::LeafFlags;
 use quake_formats::bsp::limits::QUAKESPASM_MAX_WARP_FACE_VERTS;
 use quake_formats::bsp::{BspPlane, Face, Leaf, Model, Node, TexInfo, contents, texinfo_flags};
 use quake_formats::entities::{Entity, write_entities};
@@ -301,6 +302,7 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
     // Nodes, leaves and models.
     bsp.leafs.push(Leaf::SHARED_SOLID);
     let mut world_leaf_index: HashMap<u32, u32> = HashMap::new();
+    let mut fence_leaves = Vec::new();
     for (mi, m) in input.models.iter().enumerate() {
         let (first_face, num_faces) = model_faces[mi];
         let leaves_before = bsp.leafs.len();
@@ -314,6 +316,7 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
             leaf_faces: &leaf_faces,
             leaf_growth: &leaf_growth,
             leaf_index: HashMap::new(),
+            fence_leaves: &mut fence_leaves,
         };
         let (mut head, _) = w.node(0);
         if head < 0 {
@@ -366,6 +369,11 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
     bsp.texinfo = textures.out_infos;
     bsp.set_phong_faces(&phong);
     bsp.set_face_flags(&flags);
+    let mut leaf_flags = vec![LeafFlags::default(); bsp.leafs.len()];
+    for &leaf in &fence_leaves {
+        leaf_flags[leaf as usize].fence = true;
+    }
+    bsp.set_leaf_flags(&leaf_flags);
     bsp.planes = planes.planes;
     bsp.set_entity_text(&write_entities(input.entities));
 
@@ -393,6 +401,8 @@ struct TreeWriter<'a, 'b> {
     leaf_growth: &'b HashMap<(usize, u32), Bounds>,
     /// Tree leaf to BSP leaf.
     leaf_index: HashMap<u32, u32>,
+    /// The BSP leaves inside fences (written solid; light takes them as open).
+    fence_leaves: &'b mut Vec<u32>,
 }
 
 impl TreeWriter<'_, '_> {
@@ -419,6 +429,9 @@ impl TreeWriter<'_, '_> {
             let first = self.bsp.marksurfaces.len() as u32;
             self.bsp.marksurfaces.extend(marks.into_iter().flatten());
             let index = self.bsp.leafs.len() as u32;
+            if node.contents == FENCE {
+                self.fence_leaves.push(index);
+            }
             self.bsp.leafs.push(Leaf {
                 contents: engine_contents(node.contents),
                 vis_offset: -1,

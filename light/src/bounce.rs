@@ -278,7 +278,7 @@ impl Field<'_> {
                 lanes.len(),
                 points[k].0.point.as_vec3().to_array(),
                 dir.as_vec3().to_array(),
-                0.0,
+                crate::trace::RAY_START,
                 RAY_LENGTH,
             );
             lanes.push((dir, k));

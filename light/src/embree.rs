@@ -45,7 +45,6 @@ pub mod sys {
     pub const RTC_ERROR_CANCELLED: RTCError = 6;
 
     pub type RTCSceneFlags = c_uint;
-    pub const RTC_SCENE_FLAG_NONE: RTCSceneFlags = 0;
     pub const RTC_SCENE_FLAG_ROBUST: RTCSceneFlags = 1 << 2;
 
     pub type RTCBuildQuality = c_uint;
@@ -463,7 +462,6 @@ impl Drop for GeometryGuard {
 /// Collects geometry for a [`Scene`]; call [`SceneBuilder::commit`] to build.
 pub struct SceneBuilder {
     handle: SceneHandle,
-    robust: bool,
 }
 
 // SAFETY: Embree objects are not tied to the creating thread; `&mut self`
@@ -490,17 +488,7 @@ impl SceneBuilder {
             raw,
             device: Arc::clone(&device.inner),
         };
-        Ok(Self {
-            handle,
-            robust: false,
-        })
-    }
-
-    /// Enables `RTC_SCENE_FLAG_ROBUST`: slower, but avoids rays leaking
-    /// through shared edges (useful for light leaks at brush seams).
-    #[cfg(test)]
-    pub fn set_robust(&mut self, robust: bool) {
-        self.robust = robust;
+        Ok(Self { handle })
     }
 
     /// Adds a triangle mesh and returns the geometry id Embree reports for its hits. Ids are
@@ -569,21 +557,19 @@ impl SceneBuilder {
     }
 
     /// Builds the BVH (build quality MEDIUM: the HIGH build costs more than its faster
-    /// traversal saves on Quake maps). The result is immutable.
+    /// traversal saves on Quake maps), robust: without `RTC_SCENE_FLAG_ROBUST` Embree's
+    /// kernels let a ray through the crack between two triangles that share an edge (a sun ray
+    /// reached the floor through a sky brush's seam), as ericw-tools found. The result is
+    /// immutable.
     ///
     /// # Errors
     /// Returns the Embree error if the build fails (e.g. out of memory).
     pub fn commit(self) -> Result<Scene, EmbreeError> {
-        let flags = if self.robust {
-            sys::RTC_SCENE_FLAG_ROBUST
-        } else {
-            sys::RTC_SCENE_FLAG_NONE
-        };
         let h = &self.handle;
         // SAFETY: the scene is live and not being queried or modified elsewhere
         // (we own the builder by value).
         unsafe {
-            sys::rtcSetSceneFlags(h.raw, flags);
+            sys::rtcSetSceneFlags(h.raw, sys::RTC_SCENE_FLAG_ROBUST);
             sys::rtcSetSceneBuildQuality(h.raw, sys::RTC_BUILD_QUALITY_MEDIUM);
             sys::rtcCommitScene(h.raw);
         }
@@ -1123,9 +1109,8 @@ mod tests {
     }
 
     /// Unit quad in the z = 0 plane, x and y in [0, 1].
-    fn quad_scene(robust: bool) -> (Scene, u32, u32) {
+    fn quad_scene() -> (Scene, u32, u32) {
         let mut b = SceneBuilder::new(&device()).expect("scene");
-        b.set_robust(robust);
         let quad = b
             .add_triangle_mesh(
                 &[
@@ -1149,16 +1134,33 @@ mod tests {
 
     #[test]
     fn quad_blocks_ray_through_it_only() {
-        for robust in [false, true] {
-            let (scene, _, _) = quad_scene(robust);
-            let down = [0.0, 0.0, -1.0];
-            assert!(scene.occluded([0.5, 0.5, 1.0], down, 0.0, 10.0));
-            assert!(!scene.occluded([1.5, 0.5, 1.0], down, 0.0, 10.0));
-            // Segment ending before the quad.
-            assert!(!scene.occluded([0.5, 0.5, 1.0], down, 0.0, 0.5));
-            // Invalid segments hit nothing instead of reaching Embree.
-            assert!(!scene.occluded([0.5, 0.5, 1.0], down, 2.0, 1.0));
-            assert!(!scene.occluded([f32::NAN, 0.5, 1.0], down, 0.0, 10.0));
+        let (scene, _, _) = quad_scene();
+        let down = [0.0, 0.0, -1.0];
+        assert!(scene.occluded([0.5, 0.5, 1.0], down, 0.0, 10.0));
+        assert!(!scene.occluded([1.5, 0.5, 1.0], down, 0.0, 10.0));
+        // Segment ending before the quad.
+        assert!(!scene.occluded([0.5, 0.5, 1.0], down, 0.0, 0.5));
+        // Invalid segments hit nothing instead of reaching Embree.
+        assert!(!scene.occluded([0.5, 0.5, 1.0], down, 2.0, 1.0));
+        assert!(!scene.occluded([f32::NAN, 0.5, 1.0], down, 0.0, 10.0));
+    }
+
+    /// Rays through the edge the quad's two triangles share, at a slant, meet the quad: none
+    /// slips through the seam.
+    #[test]
+    fn no_ray_slips_through_the_seam_between_triangles() {
+        let (scene, _, _) = quad_scene();
+        let slant = [0.3f32, -0.2, -0.93];
+        let len = slant.iter().map(|c| c * c).sum::<f32>().sqrt();
+        let dir = slant.map(|c| c / len);
+        for i in 1..1000 {
+            let t = i as f32 / 1000.0;
+            // The point on the diagonal, and a start 2 units back along the ray.
+            let org = [t - 2.0 * dir[0], t - 2.0 * dir[1], -2.0 * dir[2]];
+            assert!(
+                scene.occluded(org, dir, 0.0, 10.0),
+                "slipped through at {t}"
+            );
         }
     }
 
@@ -1185,7 +1187,7 @@ mod tests {
 
     #[test]
     fn intersect_reports_t_and_geom_id() {
-        let (scene, quad, far) = quad_scene(false);
+        let (scene, quad, far) = quad_scene();
         assert_ne!(quad, far);
         let hit = scene
             .intersect([0.25, 0.75, -2.0], [0.0, 0.0, 1.0], 0.0, f32::INFINITY)
@@ -1211,7 +1213,7 @@ mod tests {
     /// rays past its largest coordinate must stay on our side, in a packet's inactive lanes too.
     #[test]
     fn rays_past_embrees_largest_coordinate_hit_nothing() {
-        let (scene, _, _) = quad_scene(false);
+        let (scene, _, _) = quad_scene();
         let up = [0.0, 0.0, 1.0];
         let far_away = [0.5, 1.0e19, -1.0];
         assert!(scene.intersect(far_away, up, 0.0, 10.0).is_none());
@@ -1364,7 +1366,7 @@ mod tests {
 
     #[test]
     fn first_hit_geom16_matches_intersect() {
-        let (scene, quad, far) = quad_scene(false);
+        let (scene, quad, far) = quad_scene();
         let mut packet = RayPacket16::new();
         let up = [0.0, 0.0, 1.0];
         packet.set(0, [0.5, 0.5, -1.0], up, 0.0, 100.0);
@@ -1388,7 +1390,7 @@ mod tests {
         fn assert_send_sync<T: Send + Sync>() {}
         assert_send_sync::<Scene>();
         assert_send_sync::<Device>();
-        let (scene, _, _) = quad_scene(false);
+        let (scene, _, _) = quad_scene();
         std::thread::scope(|s| {
             for i in 0..4 {
                 let scene = &scene;

@@ -4,7 +4,13 @@
 //! own. A shadow or sun ray meets them there: at an opaque texel it is blocked; at an open one
 //! it goes on from just past the face, to the next fence face or its end. Dirt and bounced light
 //! look at the opaque scene only, so fences neither darken corners nor reflect light.
+//!
+//! The inside of a `func_detail_fence` is written as solid leaves, which stop players as the
+//! fence should; the compiler marks them (`SLIPGATE_LEAFFLAGS`), and light takes them as open
+//! space, as ericw-tools' light does from its qbsp's extended contents: samples and lights
+//! inside a fence are not in solid.
 
+use std::borrow::Cow;
 use std::collections::HashMap;
 use std::sync::Arc;
 
@@ -25,6 +31,26 @@ const MAX_LAYERS: usize = 16;
 
 /// How far past an open texel a ray goes on from, so it does not meet the same face again.
 const STEP_PAST: f32 = 0.01;
+
+/// `bsp` as light sees it: the leaves the compiler marks as inside a fence are open (empty).
+///
+/// # Errors
+/// [`LightError::BspxLump`] when the leaf flags do not read.
+pub fn with_fence_leaves_open(bsp: &Bsp) -> Result<Cow<'_, Bsp>, LightError> {
+    let Some(flags) = bsp.leaf_flags().map_err(LightError::BspxLump)? else {
+        return Ok(Cow::Borrowed(bsp));
+    };
+    if !flags.iter().any(|f| f.fence) {
+        return Ok(Cow::Borrowed(bsp));
+    }
+    let mut open = bsp.clone();
+    for (leaf, flags) in open.leafs.iter_mut().zip(&flags) {
+        if flags.fence {
+            leaf.contents = quake_formats::bsp::contents::EMPTY;
+        }
+    }
+    Ok(Cow::Owned(open))
+}
 
 /// Which texels of a fence texture's full-size picture are open.
 #[derive(Debug, Clone, PartialEq)]

@@ -47,6 +47,8 @@ pub fn compute_lighting(bsp: &Bsp, options: &Options) -> Result<Lighting, LightE
 /// A BSP light cannot read safely, bad entities or faces, or an Embree failure.
 pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, LightError> {
     let start = Instant::now();
+    let open_fences = crate::fence::with_fence_leaves_open(bsp)?;
+    let bsp = open_fences.as_ref();
     let prep = prepare(bsp, options)?;
     let setup_done = Instant::now();
     let plan = Plan::new(bsp, &prep, options);

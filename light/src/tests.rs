@@ -18,6 +18,8 @@ use crate::{
     update_entities_only,
 };
 
+mod ericw_cases;
+
 /// A polygon with its outward normal and whether it is sky.
 struct Poly {
     points: Vec<[f32; 3]>,

@@ -230,7 +230,13 @@ impl SampleRays {
             packet.clear();
             let lanes = (total - first).min(16);
             for (lane, sample) in lane_sample.iter_mut().enumerate().take(lanes) {
-                packet.set(lane, self.starts[s], self.directions(s)[k], 0.0, depth);
+                packet.set(
+                    lane,
+                    self.starts[s],
+                    self.directions(s)[k],
+                    crate::trace::RAY_START,
+                    depth,
+                );
                 *sample = s;
                 s += 1;
                 if s == n {

@@ -18,8 +18,7 @@ use crate::directions::mangle_to_vec;
 use crate::dirt::DirtResponse;
 use crate::settings::DirtToggle;
 
-/// `light` value of a light entity without one (or with `light 0`, as
-/// ericw-tools treats it).
+/// `light` value of a light entity without one.
 pub const DEFAULT_LIGHT: f64 = 300.0;
 
 /// Lights a `_deviance` light is split into when `_samples` is absent.
@@ -73,6 +72,9 @@ struct Common {
 /// One light entity, as a sun, domes, or point lights and templates.
 fn read_light(k: &Keys, origins: &HashMap<&str, DVec3>, global: &Global, out: &mut MapLights) {
     let c = common(k, origins, global);
+    if c.light == 0.0 {
+        return;
+    }
     let sun = SunLight {
         to_sun: DVec3::ZERO,
         light: c.light,
@@ -104,8 +106,8 @@ fn read_light(k: &Keys, origins: &HashMap<&str, DVec3>, global: &Global, out: &m
 fn common(k: &Keys, origins: &HashMap<&str, DVec3>, global: &Global) -> Common {
     let origin = k.vector(&keys::ORIGIN).unwrap_or(DVec3::ZERO);
     let (light, light_color) = k.brightness();
-    // Absent or 0: the default, as ericw-tools takes it.
-    let light = light.filter(|l| *l != 0.0).unwrap_or(DEFAULT_LIGHT);
+    // A `light` of 0 (in either form) lights nothing, as in ericw-tools 2.0.
+    let light = light.unwrap_or(DEFAULT_LIGHT);
     // An explicit `_color` wins over the colour of Half-Life's `light` form.
     let color = k.color(&keys::COLOR).or(light_color).unwrap_or(DVec3::ONE);
     let style = style(k);

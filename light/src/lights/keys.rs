@@ -130,7 +130,7 @@ macro_rules! entity_keys {
 entity_keys! {
     /// Brightness; or Half-Life's `R G B I`: colour (0–255 or 0–1) and brightness (an explicit
     /// `_color` wins over that colour); three numbers are a colour at the default brightness.
-    /// `0` is the default.
+    /// A brightness of `0` lights nothing.
     LIGHT: ["light"] on Lights, Brightness, default "`300`";
     /// Where the light is.
     ORIGIN: ["origin"] on Lights, Vector, default "`0 0 0`";

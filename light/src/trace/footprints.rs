@@ -256,7 +256,7 @@ impl Footprints {
             packet.clear();
             for (lane, &k) in chunk.iter().enumerate() {
                 if let Some((org, dir, reach)) = self.rays[k] {
-                    packet.set(lane, org, dir, 0.0, reach);
+                    packet.set(lane, org, dir, super::RAY_START, reach);
                 }
             }
             let active = packet.active_mask();

@@ -49,6 +49,11 @@ use shadows::VisibilityScratch;
 /// on a surface is not blocked by it.
 pub(crate) const LIGHT_CLEARANCE: f32 = 0.1;
 
+/// Rays from a sample point start this far along (units): Embree's robust scenes count a hit
+/// at the very origin, and a sample on the edge of its face can lie exactly in the plane of a
+/// face beside it that does not hold it, which would then block every ray it casts.
+pub(crate) const RAY_START: f32 = 0.01;
+
 /// Everything shared by all faces while tracing.
 pub struct TraceSetup<'a> {
     pub bsp: &'a Bsp,

@@ -191,7 +191,7 @@ impl VisibilityScratch {
             packet.clear();
             for (lane, &i) in chunk.iter().enumerate() {
                 let (org, dir, reach) = ray(i);
-                packet.set(lane, org, dir, 0.0, reach);
+                packet.set(lane, org, dir, super::RAY_START, reach);
             }
             let active = packet.active_mask();
             if active == 0 {
