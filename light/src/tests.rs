@@ -413,6 +413,55 @@ fn default_is_close_to_reference_on_the_shadow_scene() {
     assert!(e_extra4.rmse < e_default.rmse);
 }
 
+/// A right triangle 48 units a side on the floor, a light over it.
+fn triangle_scene() -> Bsp {
+    let triangle = Poly {
+        points: vec![[0.0, 0.0, 0.0], [0.0, 48.0, 0.0], [48.0, 0.0, 0.0]],
+        normal: [0.0, 0.0, 1.0],
+        sky: false,
+    };
+    let ents =
+        "{ \"classname\" \"worldspawn\" }\n{ \"classname\" \"light\" \"origin\" \"16 16 64\" }\n";
+    synthetic_bsp(&[triangle], ents)
+}
+
+/// The error over drawn luxels leaves out the luxels no engine draws (the far corner of a
+/// triangle's lightmap) and weighs the others by the area of the face each shows on.
+#[test]
+fn error_over_drawn_luxels_weighs_luxels_by_the_face_they_show_on() {
+    let bsp = triangle_scene();
+    let lit = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
+    let drawn = crate::DrawnAreas::on_quake_grids(&bsp, &[0]);
+    let areas = drawn.of(0).expect("the face is drawn");
+    // 4 x 4 luxels; those at (48, 48), (32, 48) and (48, 32) are a luxel or more from the
+    // hypotenuse along an axis.
+    assert_eq!(areas.len(), 16);
+    assert_eq!(areas.iter().filter(|&&a| a == 0.0).count(), 3, "{areas:?}");
+    let unseen = areas
+        .iter()
+        .position(|&a| a == 0.0)
+        .expect("a corner no one sees");
+    let with_luxel = |i: usize, value: u8| {
+        let mut other = lit.clone();
+        other.lightmaps[0].grey[0][i] = value;
+        other
+    };
+    let off = |i: usize| {
+        let v = lit.lightmaps[0].grey[0][i];
+        if v >= 128 { v - 100 } else { v + 100 }
+    };
+    let e = crate::compare_drawn(&with_luxel(unseen, off(unseen)), &lit, &drawn);
+    assert_eq!((e.luxels, e.max), (13, 0), "{e:?}");
+    assert_eq!(compare(&with_luxel(unseen, off(unseen)), &lit).max, 100);
+    // One luxel 100 levels off: the RMSE is 100 times the root of its share of the areas.
+    let total: f64 = areas.iter().sum();
+    for i in (0..16).filter(|&i| areas[i] > 0.0) {
+        let e = crate::compare_drawn(&with_luxel(i, off(i)), &lit, &drawn);
+        let expected = 100.0 * (areas[i] / total).sqrt();
+        assert!((e.rmse - expected).abs() < 1e-9, "luxel {i}: {e:?}");
+    }
+}
+
 /// Regression: a map with no light source was written with a lighting lump of zeros, which
 /// engines draw black; an empty lump they draw fullbright, as an unlit map.
 #[test]
@@ -508,6 +557,31 @@ fn light_cli(name: &str, bsp: &Bsp, args: &[&str]) -> std::path::PathBuf {
     let cli = Cli::try_parse_from(argv).expect("arguments");
     crate::cli::run(&cli.args).expect("light");
     dir
+}
+
+/// `--compare-reference` reports the error over the luxels engines draw and over every luxel,
+/// in its output and its `--stats` file.
+#[test]
+fn compare_reference_measures_drawn_luxels_and_whole_lightmaps() {
+    let stats = std::env::temp_dir().join(format!(
+        "slipgate-light-{}-compare-stats.json",
+        std::process::id()
+    ));
+    let stats_arg = stats.display().to_string();
+    let dir = light_cli(
+        "compare-reference",
+        &triangle_scene(),
+        &["--compare-reference", "--stats", &stats_arg],
+    );
+    let text = std::fs::read_to_string(&stats).expect("stats file");
+    let json: serde_json::Value = serde_json::from_str(&text).expect("JSON");
+    let luxels = |key: &str| json[key]["luxels"].as_u64().expect(key);
+    let drawn = luxels("error_vs_reference");
+    let whole = luxels("error_whole_lightmaps_vs_reference");
+    // Three luxels of the triangle's lightmap lie past its hypotenuse.
+    assert_eq!((drawn, whole), (13, 16));
+    std::fs::remove_dir_all(dir).ok();
+    std::fs::remove_file(stats).ok();
 }
 
 #[test]
