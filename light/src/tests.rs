@@ -1182,10 +1182,10 @@ fn detail_column_bsp(detail_keys: &str) -> Bsp {
     out.bsp
 }
 
-/// The sealed room of [`detail_column_bsp`] with a `func_door` (x 96..140, y -16..16,
-/// z -128..-64) standing on the floor and reaching 12 units into the +x wall (128..144), and a
-/// light in the room, compiled by the bsp compiler.
-fn door_in_wall_bsp() -> Bsp {
+/// The sealed room of [`detail_column_bsp`] with a `func_door` keyed `door_keys` (x 96..140,
+/// y -16..16, z -128..-64) standing on the floor and reaching 12 units into the +x wall
+/// (128..144), and a light in the room, compiled by the bsp compiler.
+fn door_in_wall_bsp(door_keys: &str) -> Bsp {
     let (lo, hi, t) = (-128.0, 128.0, 16.0);
     let (a, b) = (lo - t, hi + t);
     let mut world = String::new();
@@ -1202,7 +1202,7 @@ fn door_in_wall_bsp() -> Bsp {
     let door = map_box([96.0, -16.0, -128.0], [140.0, 16.0, -64.0]);
     let text = format!(
         "{{\n\"classname\" \"worldspawn\"\n{world}}}\n\
-         {{\n\"classname\" \"func_door\"\n{door}}}\n\
+         {{\n\"classname\" \"func_door\"\n{door_keys}\n{door}}}\n\
          {{\n\"classname\" \"light\"\n\"origin\" \"0 0 -32\"\n}}\n\
          {{\n\"classname\" \"info_player_start\"\n\"origin\" \"-90 -90 -100\"\n}}\n"
     );
@@ -1223,7 +1223,7 @@ fn door_in_wall_bsp() -> Bsp {
 /// all takes its model's mean.
 #[test]
 fn door_faces_inside_a_wall_are_not_black() {
-    let bsp = door_in_wall_bsp();
+    let bsp = door_in_wall_bsp("");
     let prep = crate::prepare::prepare(&bsp, &Options::default()).expect("prepare");
     let door_face = |normal: DVec3| {
         prep.faces
@@ -1251,6 +1251,45 @@ fn door_faces_inside_a_wall_are_not_black() {
     let width = top_grey.len() / 3;
     for row in top_grey.chunks(width) {
         assert_eq!(row[width - 1], row[width - 2], "{top_grey:?}");
+    }
+}
+
+/// Regression: a brush model that casts shadows (`_shadow 1`) had its faces inside the world's
+/// solid filled with its open faces' light, so a plaque set into a wall with a light behind it
+/// read 255 on its buried front. ericw-tools gives such a model's samples in solid no light: a
+/// face wholly in the wall has no lightmap, a luxel half in it (at `-extra4`) the light of its
+/// open half spread over the whole. The same door without `_shadow` is filled
+/// ([`door_faces_inside_a_wall_are_not_black`]).
+#[test]
+fn a_shadow_casting_models_faces_inside_a_wall_stay_dark() {
+    let bsp = door_in_wall_bsp("\"_shadow\" \"1\"");
+    let prep = crate::prepare::prepare(&bsp, &Options::default()).expect("prepare");
+    let door_face = |normal: DVec3| {
+        prep.faces
+            .iter()
+            .find(|f| f.model == 1 && f.plane.normal.dot(normal) > 0.99)
+            .map(|f| f.index)
+            .expect("door face")
+    };
+    let (end, top) = (door_face(DVec3::X), door_face(DVec3::Z));
+    let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
+    assert!(face_grey(&lighting, end).iter().all(|&v| v == 0), "buried end lit");
+    // The top's last column (x 144) stands over the wall: its sample is in solid.
+    let top_grey = face_grey(&lighting, top);
+    let width = top_grey.len() / 3;
+    for row in top_grey.chunks(width) {
+        assert!(row[width - 2] > 10, "{top_grey:?}");
+        assert_eq!(row[width - 1], 0, "{top_grey:?}");
+    }
+    // At -extra4 the column before it (x 128) is half over the wall: half its samples add
+    // nothing.
+    let extra4 = compute_lighting(&bsp, &options(Quality::Extra4)).expect("light");
+    assert!(face_grey(&extra4, end).iter().all(|&v| v == 0));
+    let top4 = face_grey(&extra4, top);
+    for row in top4.chunks(width) {
+        let (open, half) = (f64::from(row[width - 3]), f64::from(row[width - 2]));
+        assert!((half - open / 2.0).abs() < 0.2 * open, "{top4:?}");
+        assert_eq!(row[width - 1], 0, "{top4:?}");
     }
 }
 
@@ -2829,3 +2868,4 @@ fn no_key_value_stops_light() {
         assert!(told.contains(" line "), "{told}");
     }
 }
+
