@@ -11,20 +11,11 @@
 //! lists the WORST faces (default 20) that differ most, with their model, texture and centre,
 //! to look at in the map.
 
-use glam::DVec3;
-use light::{FaceLightmap, lightmaps_in};
+use light::{DrawnAreas, FaceLightmap, lightmaps_in};
 use quake_formats::Bsp;
-use quake_formats::extents::LightmapExtents;
-use quake_formats::geom::{Plane, Winding};
 
 /// Per-face means within this many levels count as agreeing.
 const AGREE_LEVELS: f64 = 5.0;
-
-/// Texels between luxels on Quake's lightmap grid.
-const LUXEL: f64 = 16.0;
-
-/// Least area (square texels) a face shares with a luxel's square for the luxel to be drawn.
-const MIN_SHARED_AREA: f64 = 1e-6;
 
 /// The mean of each style's lightmap of one face, over the luxels `seen` marks (all when it
 /// is `None` or does not fit).
@@ -50,67 +41,19 @@ fn style_means(map: &FaceLightmap, seen: Option<&[bool]>) -> Vec<(u8, f64)> {
 /// luxels engines draw when `drawn_only`.
 fn faces_means(bsp: &Bsp, drawn_only: bool) -> Vec<Option<Vec<(u8, f64)>>> {
     let all: Vec<usize> = (0..bsp.faces.len()).collect();
+    let drawn = drawn_only.then(|| DrawnAreas::on_quake_grids(bsp, &all));
     let mut out = vec![None; bsp.faces.len()];
     for map in lightmaps_in(bsp, &all).lightmaps {
-        let face = &bsp.faces[map.face];
-        if drawn_only
-            && bsp
-                .face_texture(face)
-                .is_some_and(|t| t.is_all_fullbright())
-        {
-            continue;
-        }
-        let seen = drawn_only.then(|| drawn_luxels(bsp, map.face)).flatten();
+        let seen = match drawn.as_ref().map(|d| d.of(map.face)) {
+            None => None,
+            Some(None) => continue,
+            Some(Some(areas)) => Some(areas.iter().map(|&a| a > 0.0).collect::<Vec<bool>>()),
+        };
         let mut means = style_means(&map, seen.as_deref());
         means.sort_by_key(|&(style, _)| style);
         out[map.face] = Some(means);
     }
     out
-}
-
-/// Per luxel of `face`'s 16-texel grid, whether bilinear filtering reads it anywhere on the face:
-/// the square one luxel either side of its centre meets the face in texture space.
-fn drawn_luxels(bsp: &Bsp, face: usize) -> Option<Vec<bool>> {
-    let f = bsp.faces.get(face)?;
-    let vecs = bsp.texinfo.get(f.texinfo as usize)?.vecs;
-    let points = bsp.face_vertices(f)?;
-    let extents = LightmapExtents::from_points(&points, &vecs);
-    let st = |p: &[f32; 3], row: &[f32; 4]| {
-        f64::from(p[0] * row[0] + p[1] * row[1] + p[2] * row[2] + row[3])
-    };
-    let polygon = Winding::new(
-        points
-            .iter()
-            .map(|p| DVec3::new(st(p, &vecs[0]), st(p, &vecs[1]), 0.0))
-            .collect(),
-    );
-    let [width, height] = extents.extents.map(|e| (e / 16 + 1) as usize);
-    let [s0, t0] = extents.tex_mins.map(f64::from);
-    Some(
-        (0..width * height)
-            .map(|i| {
-                let centre = [
-                    s0 + LUXEL * (i % width) as f64,
-                    t0 + LUXEL * (i / width) as f64,
-                ];
-                meets_square(&polygon, centre, LUXEL)
-            })
-            .collect(),
-    )
-}
-
-/// Whether the convex `polygon` (in the plane z = 0) and the square of half-side `half` around
-/// `centre` share some area: the polygon clipped to the square keeps a part.
-fn meets_square(polygon: &Winding, centre: [f64; 2], half: f64) -> bool {
-    let sides = [(DVec3::X, 0), (-DVec3::X, 0), (DVec3::Y, 1), (-DVec3::Y, 1)];
-    sides
-        .iter()
-        .try_fold(polygon.clone(), |w, &(inward, axis)| {
-            // The square's side facing `inward`: its front is inside the square.
-            let edge = centre[axis] - half * inward[axis];
-            w.clip_front(&Plane::new(inward, edge * inward[axis]), false)
-        })
-        .is_some_and(|w| w.area() > MIN_SHARED_AREA)
 }
 
 /// The model each face belongs to.

@@ -1,11 +1,14 @@
 //! The rows of `bench/results/light-speed-error.md` for one map:
 //! `cargo run --release -p slipgate-light --example speed_error -- MAP.bsp STRIDE`.
 //! Time (best of 3) and rays are for the whole map; RMSE and max error
-//! (8-bit levels) are against `--reference` on every STRIDE-th face.
+//! (8-bit levels) are against `--reference` on every STRIDE-th face, over the luxels engines
+//! draw (each weighted by the area of the face it shows on), and the RMSE again over every
+//! luxel of the lightmaps.
 
 use light::settings::SoftRadius;
 use light::{
-    Options, Quality, RawLighting, compare, compute_lighting, finish_lighting, trace_lighting,
+    DrawnAreas, Options, Quality, RawLighting, compare, compare_drawn, compute_lighting,
+    finish_lighting, trace_lighting,
 };
 
 fn main() -> anyhow::Result<()> {
@@ -16,7 +19,9 @@ fn main() -> anyhow::Result<()> {
     let stride: usize = stride.parse()?;
     anyhow::ensure!(stride > 0, "STRIDE must be at least 1");
     let bsp = quake_formats::Bsp::read(&std::fs::read(&path)?)?;
-    let some_faces = Some((0..bsp.faces.len()).step_by(stride).collect::<Vec<_>>());
+    let faces: Vec<usize> = (0..bsp.faces.len()).step_by(stride).collect();
+    let drawn = DrawnAreas::on_quake_grids(&bsp, &faces);
+    let some_faces = Some(faces);
     let reference = trace_lighting(
         &bsp,
         &Options {
@@ -37,8 +42,11 @@ fn main() -> anyhow::Result<()> {
         ("--soft 1", Quality::Default, SoftRadius::Samples(1)),
         ("--extra4 --soft", Quality::Extra4, half),
     ];
-    println!("| mode | trace time | rays | RMSE | max | RMSE / max vs filtered reference |");
-    println!("|---|---|---|---|---|---|");
+    println!(
+        "| mode | trace time | rays | RMSE, drawn luxels | max | RMSE / max vs filtered \
+         reference | RMSE, whole lightmaps |"
+    );
+    println!("|---|---|---|---|---|---|---|");
     for (name, quality, soft) in modes {
         let mut options = Options {
             quality,
@@ -59,7 +67,9 @@ fn main() -> anyhow::Result<()> {
                 ..options.clone()
             },
         )?;
-        let e = compare(&part, &finish_lighting(&reference));
+        let exact = finish_lighting(&reference);
+        let e = compare_drawn(&part, &exact, &drawn);
+        let whole = compare(&part, &exact);
         let per_axis = quality.samples_per_axis();
         let soft_reference = RawLighting {
             soft,
@@ -68,14 +78,15 @@ fn main() -> anyhow::Result<()> {
         let filtered = soft_reference
             .softened(per_axis)
             .map_or(String::new(), |r| {
-                let f = compare(&part, &finish_lighting(&r));
+                let f = compare_drawn(&part, &finish_lighting(&r), &drawn);
                 format!("{:.2} / {}", f.rmse, f.max)
             });
         println!(
-            "| {name} | {best:.2} s | {:.1} M | {:.2} | {} | {filtered} |",
+            "| {name} | {best:.2} s | {:.1} M | {:.2} | {} | {filtered} | {:.2} |",
             rays as f64 / 1e6,
             e.rmse,
-            e.max
+            e.max,
+            whole.rmse
         );
     }
     Ok(())

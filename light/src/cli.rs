@@ -82,7 +82,9 @@ pub struct Args {
     /// Measurement: light only every Nth face (the others get no lightmap).
     #[arg(long, value_name = "N")]
     pub face_stride: Option<usize>,
-    /// Measurement: also light the same faces with --reference and report the error.
+    /// Measurement: also light the same faces with --reference and report the error, over the
+    /// luxels engines draw (each weighted by the area of the face it shows on) and over every
+    /// luxel of the lightmaps.
     #[arg(long)]
     pub compare_reference: bool,
     /// Measurement: time a bare occlusion loop over up to this many shadow rays.
@@ -338,17 +340,34 @@ fn measurements(
                 e.rmse, e.max, e.luxels, e.over_8
             );
         };
-        report("--reference", &c.error);
+        report(
+            "--reference, luxels engines draw (weighted by the face area each shows on)",
+            &c.error,
+        );
         extra.insert("error_vs_reference".into(), serde_json::to_value(c.error)?);
+        report(
+            "--reference, every luxel of the lightmaps (inside solid too)",
+            &c.error_whole_lightmaps,
+        );
+        extra.insert(
+            "error_whole_lightmaps_vs_reference".into(),
+            serde_json::to_value(c.error_whole_lightmaps)?,
+        );
         if let Some(e) = &c.error_own_grids {
-            report("--reference on the faces' own grids", e);
+            report(
+                "--reference on the faces' own grids, luxels engines draw",
+                e,
+            );
             extra.insert(
                 "error_own_grids_vs_reference".into(),
                 serde_json::to_value(e)?,
             );
         }
         if let Some(e) = &c.error_filtered {
-            report("--reference with the same --soft filter", e);
+            report(
+                "--reference with the same --soft filter, luxels engines draw",
+                e,
+            );
             extra.insert(
                 "error_vs_filtered_reference".into(),
                 serde_json::to_value(e)?,

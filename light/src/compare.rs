@@ -1,5 +1,7 @@
 //! Measuring light against light: the per-luxel difference of two lightings of the same
-//! faces, a BSP's own lightmaps as a lighting to compare, and a run against `--reference`.
+//! faces (over every luxel, or over the luxels engines draw, each weighted by the area it
+//! stands for: [`DrawnAreas`]), a BSP's own lightmaps as a lighting to compare, and a run
+//! against `--reference`.
 
 use std::collections::HashMap;
 
@@ -7,6 +9,7 @@ use quake_formats::Bsp;
 use quake_formats::bsp::lightgrid::{GridSample, LightGrid};
 use quake_formats::extents::{LightmapExtents, LuxelGrid};
 
+use crate::drawn::DrawnAreas;
 use crate::error::LightError;
 use crate::lighting::{Lighting, Stats};
 use crate::options::Options;
@@ -18,9 +21,11 @@ use quake_formats::lit::grey_level;
 /// Per-luxel difference between two lightings of the same faces, in 8-bit levels.
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
 pub struct ErrorStats {
-    /// Luxels compared (every style of every face both lightings share).
+    /// Luxels compared (every style of every face both lightings share; of drawn luxels only,
+    /// for [`compare_drawn`]).
     pub luxels: u64,
-    /// Root mean square difference.
+    /// Root mean square difference; for [`compare_drawn`], each luxel weighted by the area of
+    /// the face it stands for.
     pub rmse: f64,
     /// Largest difference.
     pub max: u8,
@@ -39,15 +44,17 @@ pub struct ErrorStats {
 struct Tally {
     e: ErrorStats,
     squares: f64,
+    weights: f64,
 }
 
 impl Tally {
-    /// One luxel: `x` here, `y` in the reference.
-    fn add(&mut self, x: u8, y: u8) {
+    /// One luxel of `weight`: `x` here, `y` in the reference.
+    fn add(&mut self, x: u8, y: u8, weight: f64) {
         let d = x.abs_diff(y);
         let e = &mut self.e;
         e.luxels += 1;
-        self.squares += f64::from(d) * f64::from(d);
+        self.squares += weight * f64::from(d) * f64::from(d);
+        self.weights += weight;
         e.max = e.max.max(d);
         e.over_8 += u64::from(d > 8);
         e.over_2 += u64::from(d > 2);
@@ -57,16 +64,32 @@ impl Tally {
 
     fn finish(self) -> ErrorStats {
         ErrorStats {
-            rmse: (self.squares / self.e.luxels.max(1) as f64).sqrt(),
+            rmse: if self.weights > 0.0 {
+                (self.squares / self.weights).sqrt()
+            } else {
+                0.0
+            },
             ..self.e
         }
     }
 }
 
-/// Compares grey lightmaps face by face and style by style (a style only one
-/// side has counts against zero). Faces whose lightmaps differ in size are not on the same
-/// grid (another tool's own grids) and are left out.
+/// Compares grey lightmaps face by face and style by style over every luxel, those inside
+/// solid and past a triangle's corners included (a style only one side has counts against
+/// zero). Faces whose lightmaps differ in size are not on the same grid (another tool's own
+/// grids) and are left out.
 pub fn compare(a: &Lighting, reference: &Lighting) -> ErrorStats {
+    compare_over(a, reference, None)
+}
+
+/// [`compare`] over the luxels engines draw, each weighted by the area of the face it stands
+/// for ([`DrawnAreas`]): what a player sees. Faces `drawn` leaves out are left out.
+pub fn compare_drawn(a: &Lighting, reference: &Lighting, drawn: &DrawnAreas) -> ErrorStats {
+    compare_over(a, reference, Some(drawn))
+}
+
+/// [`compare`], over the luxels `drawn` weighs when given.
+fn compare_over(a: &Lighting, reference: &Lighting, drawn: Option<&DrawnAreas>) -> ErrorStats {
     let by_face: HashMap<usize, &FaceLightmap> =
         reference.lightmaps.iter().map(|m| (m.face, m)).collect();
     let mut tally = Tally::default();
@@ -77,6 +100,11 @@ pub fn compare(a: &Lighting, reference: &Lighting) -> ErrorStats {
         if (m.width, m.height) != (r.width, r.height) {
             continue;
         }
+        let weights = match drawn.map(|d| d.of(m.face)) {
+            None => None,
+            Some(Some(w)) if w.len() == m.width * m.height => Some(w),
+            Some(_) => continue,
+        };
         let mut styles: Vec<u8> = m.styles.clone();
         styles.extend(r.styles.iter().filter(|s| !m.styles.contains(s)));
         let zeros = vec![0u8; m.width * m.height];
@@ -87,8 +115,11 @@ pub fn compare(a: &Lighting, reference: &Lighting) -> ErrorStats {
                     .position(|&x| x == s)
                     .map_or(zeros.clone(), |i| f.grey[i].clone())
             };
-            for (x, y) in pick(m).iter().zip(pick(r).iter()) {
-                tally.add(*x, *y);
+            for (i, (x, y)) in pick(m).iter().zip(pick(r).iter()).enumerate() {
+                let weight = weights.map_or(1.0, |w| w[i]);
+                if weight > 0.0 {
+                    tally.add(*x, *y, weight);
+                }
             }
         }
     }
@@ -121,7 +152,7 @@ pub fn compare_grids(grid: &LightGrid, reference: &LightGrid) -> Option<ErrorSta
         styles.sort_unstable();
         styles.dedup();
         for style in styles {
-            tally.add(grey(a, style), grey(r, style));
+            tally.add(grey(a, style), grey(r, style), 1.0);
         }
     }
     Some(tally.finish())
@@ -236,11 +267,14 @@ pub fn own_grids(lighting: &Lighting) -> Option<Lighting> {
     })
 }
 
-/// A lighting against the reference of the same faces (`--compare-reference`).
+/// A lighting against the reference of the same faces (`--compare-reference`), over the luxels
+/// engines draw ([`compare_drawn`]) unless said otherwise.
 #[derive(Debug, Clone, Copy, serde::Serialize)]
 pub struct ReferenceComparison {
     /// Against the reference.
     pub error: ErrorStats,
+    /// Against the reference over every luxel of the lightmaps ([`compare`]).
+    pub error_whole_lightmaps: ErrorStats,
     /// Against the reference through the same `--soft` filter (it blurs on purpose), when the
     /// run filters.
     pub error_filtered: Option<ErrorStats>,
@@ -270,14 +304,17 @@ pub fn compare_with_reference(
     let raw = trace_lighting(bsp, &reference)?;
     let exact = finish_lighting(&raw);
     let r = &exact.stats;
+    let faces: Vec<usize> = lighting.lightmaps.iter().map(|m| m.face).collect();
+    let drawn = DrawnAreas::on_quake_grids(bsp, &faces);
     Ok(ReferenceComparison {
-        error: compare(lighting, &exact),
+        error: compare_drawn(lighting, &exact, &drawn),
+        error_whole_lightmaps: compare(lighting, &exact),
         error_filtered: raw
             .softened(options.quality.samples_per_axis())
-            .map(|soft| compare(lighting, &finish_lighting(&soft))),
+            .map(|soft| compare_drawn(lighting, &finish_lighting(&soft), &drawn)),
         error_own_grids: own_grids(lighting)
             .zip(own_grids(&exact))
-            .map(|(a, r)| compare(&a, &r)),
+            .map(|(a, r)| compare_drawn(&a, &r, &DrawnAreas::on_own_grids(bsp, lighting))),
         reference_seconds: r.seconds_total,
         reference_rays: r.shadow_rays + r.sun_rays + r.dirt_rays,
     })

@@ -43,6 +43,7 @@ mod directions;
 mod dirt;
 #[cfg(test)]
 mod docs;
+mod drawn;
 mod embree;
 mod error;
 mod faces;
@@ -73,9 +74,10 @@ mod visibility;
 pub use bench::{BareOcclusion, bare_occlusion};
 pub use bounce::Density as BounceDensity;
 pub use compare::{
-    ErrorStats, ReferenceComparison, compare, compare_grids, compare_with_reference, lightmaps_in,
-    own_grid_lightmaps_in, own_grids,
+    ErrorStats, ReferenceComparison, compare, compare_drawn, compare_grids, compare_with_reference,
+    lightmaps_in, own_grid_lightmaps_in, own_grids,
 };
+pub use drawn::DrawnAreas;
 pub use embree::CONFIG_ENV as EMBREE_CONFIG_ENV;
 pub use error::LightError;
 pub use lighting::{Lighting, RawLighting, Stats};

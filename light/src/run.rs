@@ -73,7 +73,13 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
             soft_radius: settings.soft.samples(q.samples_per_axis()),
         },
     };
-    let (faces, own_grids) = finish_faces(traced, &bounced, &prep.faces, to_luxels);
+    let (faces, own_grids) = finish_faces(
+        traced,
+        &bounced,
+        &prep.faces,
+        &prep.lights.shadow_models,
+        to_luxels,
+    );
     stats.luxels = faces.iter().map(|l| (l.width * l.height) as u64).sum();
     stats.faces_lit = faces.len();
     if plan.bouncing {
@@ -339,11 +345,13 @@ impl<'a> Plan<'a> {
 
 /// Each wanted face's light with its bounced light added, floors applied and samples averaged
 /// to luxels: on its 16-texel grid, and beside it the light on its own grid when it was lit
-/// there (the 16-texel light is then read from that).
+/// there (the 16-texel light is then read from that). The occluded samples of the faces of
+/// `shadow_models` stay dark.
 fn finish_faces(
     traced: Vec<Traced>,
     bounced: &[StyleLuxels],
     geoms: &[FaceGeom],
+    shadow_models: &[usize],
     to_luxels: ToLuxels,
 ) -> (Vec<FaceLight>, Vec<Option<OwnGridLight>>) {
     // Gathered first, into room for all, so no vector here grows in steps (each step takes
@@ -357,16 +365,18 @@ fn finish_faces(
         .map(|(light, hidden)| {
             let bounce = bounced.get(light.face).map_or(&[][..], |b| &b[..]);
             // As in ericw-tools, hidden luxels take their neighbours' light, but a brush
-            // model's face with no open luxel at all takes its model's (filled below).
+            // model's face with no open luxel at all takes its model's (filled below), and a
+            // model that casts shadows gives its samples in solid no light at all.
             let fill = match geoms[light.face].model {
                 0 => HiddenLuxels::FromNeighbours,
+                m if shadow_models.contains(&m) => HiddenLuxels::Dark,
                 _ if !all_hidden(hidden) => HiddenLuxels::FromNeighbours,
                 _ => HiddenLuxels::Later,
             };
             light.finish(bounce, fill, to_luxels)
         })
         .collect();
-    fill_hidden_luxels(&mut finished, &hidden, geoms);
+    fill_hidden_luxels(&mut finished, &hidden, geoms, shadow_models);
     finished
         .into_par_iter()
         .map(|light| {
@@ -390,11 +400,20 @@ fn all_hidden(hidden: &[bool]) -> bool {
 /// The luxels of a brush model's faces with no open luxel at all (a door's edge or face in
 /// the wall it slides into) take, per style, the mean of the model's open luxels, all its
 /// faces' together (zero where a face has no light of that style): their own rays, traced
-/// from inside the wall, say nothing. On a door half in a wall ericw-tools writes the same
-/// bytes (one value for all such luxels of the model, not the light of the luxels beside them).
-fn fill_hidden_luxels(faces: &mut [FaceLight], hidden: &[Vec<bool>], geometry: &[FaceGeom]) {
+/// from inside the wall, say nothing. ericw-tools too gives all such luxels of a model one
+/// value (its own estimate of the model's light), not the light of the luxels beside them. The
+/// faces of `shadow_models` are left dark, as ericw-tools leaves a model that casts shadows.
+fn fill_hidden_luxels(
+    faces: &mut [FaceLight],
+    hidden: &[Vec<bool>],
+    geometry: &[FaceGeom],
+    shadow_models: &[usize],
+) {
     let model_of = |light: &FaceLight| geometry[light.face].model;
-    let in_brush_model = |(light, _): &(&FaceLight, &Vec<bool>)| model_of(light) != 0;
+    let in_brush_model = |(light, _): &(&FaceLight, &Vec<bool>)| {
+        let model = model_of(light);
+        model != 0 && !shadow_models.contains(&model)
+    };
     if !faces
         .iter()
         .zip(hidden)

@@ -118,7 +118,10 @@ fn stage_note(report: &Report, stage: Stage) -> String {
             format!(
                 "Grey lightmap bytes of every style against `--reference` (16x16 samples per \
                  luxel, no culling; with bounce for the bouncing settings), in 8-bit levels, on \
-                 {}. `--world_units_per_luxel 8` is measured on the faces' own grids (its \
+                 {}, over the luxels engines draw (those within a luxel of the face, where \
+                 bilinear filtering reads them), each weighted by the area of the face it shows \
+                 on; RMSE over every luxel of the lightmaps (inside solid, past a triangle's \
+                 corners) beside it. `--world_units_per_luxel 8` is measured on the faces' own grids (its \
                  `DECOUPLED_LM` lightmaps) against the reference lit on the same grids; \
                  `--lightgrid` on its grid's points (grey of each style at each open point of \
                  `LIGHTGRID_OCTREE`) against the reference's grid of the same points, which \
@@ -159,7 +162,14 @@ fn table(stage: Stage, rows: &[&Row]) -> String {
             "seen, not in PVS",
             "PVS / sampled",
         ],
-        Stage::Light => &["RMSE", "max", "> 2 levels", "compared", "light grid"],
+        Stage::Light => &[
+            "RMSE, drawn luxels",
+            "max",
+            "> 2 levels",
+            "compared",
+            "RMSE, whole lightmaps",
+            "light grid",
+        ],
         Stage::View => &["fps", "mean diff", "max diff", "other face"],
     };
     let mut s = String::from("| map | setting | tool | wall | CPU | peak memory |");
@@ -221,6 +231,8 @@ fn figure_cells(f: &Figures) -> Vec<String> {
             l.max.to_string(),
             format!("{:.2} %", 100.0 * l.over_2_share),
             format!("{} {}", l.luxels, l.measured.counted()),
+            l.whole_lightmaps_rmse
+                .map_or("—".into(), |r| format!("{r:.3}")),
             l.grid_cost.map_or("—".into(), |g| {
                 format!(
                     "{:.3} s ({:.1} % of the run; faces {:.3} s), {} of {} points open",

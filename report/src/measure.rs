@@ -4,8 +4,8 @@
 use std::path::Path;
 
 use light::{
-    Lighting, Options, Quality, compare, compare_grids, finish_lighting, lightmaps_in,
-    own_grid_lightmaps_in, own_grids, trace_lighting,
+    DrawnAreas, Lighting, Options, Quality, compare, compare_drawn, compare_grids, finish_lighting,
+    lightmaps_in, own_grid_lightmaps_in, own_grids, trace_lighting,
 };
 use quake_formats::Bsp;
 use quake_formats::bsp::lightgrid::LightGrid;
@@ -232,13 +232,14 @@ fn reference(
     Ok((finish_lighting(&raw), start.elapsed().as_secs_f64()))
 }
 
-/// A lit BSP's light against light's reference, in 8-bit grey levels.
+/// A lit BSP's light against light's reference, in 8-bit grey levels, over the luxels engines
+/// draw of the faces the reference lit, each weighted by the area of the face it shows on (for
+/// the light grid: over each style of each grid point open in both grids, alike).
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct LightFigures {
     /// What was compared.
     pub measured: LightMeasure,
-    /// Luxels compared: those of the faces the reference lit (for the light grid: each style
-    /// of each grid point open in both).
+    /// Luxels (or grid samples) compared.
     pub luxels: u64,
     /// Root mean square difference from the reference, in levels.
     pub rmse: f64,
@@ -246,6 +247,9 @@ pub struct LightFigures {
     pub max: u8,
     /// Share of luxels more than 2 levels off (0 to 1).
     pub over_2_share: f64,
+    /// Root mean square difference over every luxel of the lightmaps, those no engine draws
+    /// (inside solid, past a triangle's corners) included; `None` for the light grid.
+    pub whole_lightmaps_rmse: Option<f64>,
     /// What sampling the light grid cost the run, when it sampled one and said so (Slipgate's
     /// `--stats`).
     pub grid_cost: Option<GridCost>,
@@ -306,8 +310,15 @@ pub fn light_figures(
         what: what.into(),
     };
     let faces: Vec<usize> = reference.lightmaps.iter().map(|m| m.face).collect();
-    let e = match measure {
-        LightMeasure::Lightmaps { .. } => compare(&lightmaps_in(&lit, &faces), reference),
+    let (e, whole) = match measure {
+        LightMeasure::Lightmaps { .. } => {
+            let ours = lightmaps_in(&lit, &faces);
+            let drawn = DrawnAreas::on_quake_grids(&lit, &faces);
+            (
+                compare_drawn(&ours, reference, &drawn),
+                Some(compare(&ours, reference)),
+            )
+        }
         LightMeasure::OwnGrids { .. } => {
             let ours =
                 own_grid_lightmaps_in(&lit, &faces).map_err(|source| ReportError::Light {
@@ -316,7 +327,11 @@ pub fn light_figures(
                 })?;
             let exact = own_grids(reference)
                 .ok_or_else(|| cannot("the reference lit no face on its own grid"))?;
-            compare(&ours, &exact)
+            let drawn = DrawnAreas::on_own_grids(&lit, reference);
+            (
+                compare_drawn(&ours, &exact, &drawn),
+                Some(compare(&ours, &exact)),
+            )
         }
         LightMeasure::LightGrid => {
             let grid = lit.light_grid().map_err(|source| ReportError::Format {
@@ -332,13 +347,14 @@ pub fn light_figures(
                     g.spacing, g.mins, g.size
                 )
             };
-            compare_grids(&grid, exact).ok_or_else(|| {
+            let e = compare_grids(&grid, exact).ok_or_else(|| {
                 cannot(&format!(
                     "its light grid's points ({}) are not the reference's ({})",
                     points(&grid),
                     points(exact)
                 ))
-            })?
+            })?;
+            (e, None)
         }
     };
     if e.luxels == 0 {
@@ -353,6 +369,7 @@ pub fn light_figures(
         rmse: e.rmse,
         max: e.max,
         over_2_share: e.over_2 as f64 / e.luxels as f64,
+        whole_lightmaps_rmse: whole.map(|w| w.rmse),
         grid_cost: None,
     })
 }

@@ -33,7 +33,7 @@ impl Stage {
         match self {
             Stage::Bsp => "cracks + player-hull moves that disagree with the brushes",
             Stage::Vis => "PVS / sampled visible pairs",
-            Stage::Light => "RMSE against --reference (8-bit levels)",
+            Stage::Light => "RMSE against --reference, drawn luxels (8-bit levels)",
             Stage::View => "mean difference against the exact renderer (of 255)",
         }
     }

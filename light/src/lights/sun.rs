@@ -127,26 +127,31 @@ mod tests {
         }
     }
 
-    /// ericw-tools' layout for its default of 100 samples: 5 rings of 20 directions, 15
-    /// degrees apart from 7.5 degrees up, and the pole; each takes an even share.
+    /// ericw-tools' layout for its default of 64 samples: 4 rings of 16 directions, 18 degrees
+    /// apart from 9 degrees up, and the pole; each takes an even share. 100 samples are 5 rings
+    /// of 20, 15 degrees apart from 7.5 degrees up.
     #[test]
     fn a_dome_has_rings_of_equal_elevation_steps_and_its_pole() {
-        let suns = dome(sky(202.0), true, 100);
-        assert_eq!(suns.len(), 101);
-        for s in &suns {
-            assert!((s.light - 2.0).abs() < 1e-12 && s.directions == 101);
-            assert!((s.to_sun.length() - 1.0).abs() < 1e-12);
-        }
-        let elevation = |s: &SunLight| s.to_sun.z.asin().to_degrees();
-        for (ring, chunk) in suns[..100].chunks(20).enumerate() {
-            let want = 7.5 + 15.0 * ring as f64;
-            assert!(chunk.iter().all(|s| (elevation(s) - want).abs() < 1e-9));
-        }
-        assert_eq!(suns[100].to_sun, DVec3::Z);
-        let lower = dome(sky(1.0), false, 100);
-        for (a, b) in suns.iter().zip(&lower) {
-            assert_eq!(a.to_sun.truncate(), b.to_sun.truncate());
-            assert_eq!(a.to_sun.z, -b.to_sun.z);
+        for (samples, rings, first, step) in [(64, 4, 9.0, 18.0), (100, 5, 7.5, 15.0)] {
+            let per_ring = 4 * rings;
+            let count = rings * per_ring + 1;
+            let suns = dome(sky(count as f64), true, samples);
+            assert_eq!(suns.len(), count);
+            for s in &suns {
+                assert!((s.light - 1.0).abs() < 1e-12 && s.directions == count);
+                assert!((s.to_sun.length() - 1.0).abs() < 1e-12);
+            }
+            let elevation = |s: &SunLight| s.to_sun.z.asin().to_degrees();
+            for (ring, chunk) in suns[..count - 1].chunks(per_ring).enumerate() {
+                let want = first + step * ring as f64;
+                assert!(chunk.iter().all(|s| (elevation(s) - want).abs() < 1e-9));
+            }
+            assert_eq!(suns[count - 1].to_sun, DVec3::Z);
+            let lower = dome(sky(1.0), false, samples);
+            for (a, b) in suns.iter().zip(&lower) {
+                assert_eq!(a.to_sun.truncate(), b.to_sun.truncate());
+                assert_eq!(a.to_sun.z, -b.to_sun.z);
+            }
         }
     }
 

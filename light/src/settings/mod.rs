@@ -47,8 +47,9 @@ settings! {
     /// without their own `_anglescale` take this.
     anglescale: f64 = 0.5, keys ["_anglescale", "_anglesense"], range Range::Clamp(0.0, 1.0);
 
-    /// Directions per sun penumbra and per sky dome.
-    sunsamples: usize = 100, flag "sunsamples", keys [], range Range::Clamp(1.0, f64::INFINITY);
+    /// Directions per sun penumbra and per sky dome (a dome of 64 is ericw-tools' four rings of
+    /// 16 and one straight down).
+    sunsamples: usize = 64, flag "sunsamples", keys [], range Range::Clamp(8.0, 2048.0);
 
     /// Minimum light of the world's faces.
     minlight: f64 = 0.0, keys ["_minlight", "light"], range Range::Any;

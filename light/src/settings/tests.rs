@@ -78,17 +78,19 @@ fn worldspawn_values_out_of_range_or_unreadable_warn_and_fall_back() {
             "entity 0 (worldspawn, line 1 of the entity lump): key \"_bouncescale\" is \"-2\": outside ≥ 0 (clamped); 0 is used",
         ]
     );
-    let overrides = Overrides {
-        sunsamples: Some(0),
-        ..Overrides::default()
-    };
-    let (s, told) = Settings::resolve(None, &overrides);
-    let warnings = told.warnings;
-    assert_eq!(s.sunsamples, 1);
-    assert_eq!(
-        warnings[0].to_string(),
-        "--sunsamples 0: outside ≥ 1 (clamped); 1 is used"
-    );
+    // ericw-tools' range for `-sunsamples`: 8 to 2048, clamped with a warning.
+    for (given, used) in [(0, 8), (4000, 2048)] {
+        let overrides = Overrides {
+            sunsamples: Some(given),
+            ..Overrides::default()
+        };
+        let (s, told) = Settings::resolve(None, &overrides);
+        assert_eq!(s.sunsamples, used);
+        assert_eq!(
+            told.warnings[0].to_string(),
+            format!("--sunsamples {given}: outside 8–2048 (clamped); {used} is used")
+        );
+    }
 }
 
 #[test]

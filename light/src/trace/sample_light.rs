@@ -162,6 +162,11 @@ pub enum HiddenLuxels {
     FromNeighbours,
     /// Nothing yet (zero): a brush model's are filled from the whole model afterwards.
     Later,
+    /// Nothing: an occluded sample adds no light to its luxel, which takes the sum of its open
+    /// samples over all of them (with `--reference`, the mean of its open samples). A
+    /// shadow-casting brush model's, as ericw-tools leaves them: its faces in the world's
+    /// solid stay dark.
+    Dark,
 }
 
 /// Luxel means of per-sample values over the samples not `occluded`; a luxel with none is
@@ -199,7 +204,7 @@ fn open_luxel_means(
             })
         })
         .collect();
-    if hidden == HiddenLuxels::Later {
+    if hidden != HiddenLuxels::FromNeighbours {
         return luxels.into_iter().map(Option::unwrap_or_default).collect();
     }
     let height = luxels.len() / width.max(1);
@@ -317,12 +322,22 @@ impl SampleLight {
             .sums
             .styles
             .into_iter()
-            .map(|(style, values)| {
+            .map(|(style, mut values)| {
                 let means = match (to_luxels, hidden) {
                     (ToLuxels::AsEricw { soft_radius }, HiddenLuxels::FromNeighbours)
                         if soft_radius > 0 || occluded.contains(&true) =>
                     {
                         ericw_luxels(&values, occluded, width, per_axis, soft_radius)
+                    }
+                    (ToLuxels::AsEricw { soft_radius }, HiddenLuxels::Dark) => {
+                        for (v, _) in values.iter_mut().zip(occluded).filter(|(_, o)| **o) {
+                            *v = [0.0; 3];
+                        }
+                        if soft_radius > 0 {
+                            ericw_luxels(&values, &[], width, per_axis, soft_radius)
+                        } else {
+                            luxel_means(values, per)
+                        }
                     }
                     _ => open_luxel_means(values, per, occluded, width, hidden),
                 };
