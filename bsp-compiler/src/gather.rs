@@ -22,7 +22,7 @@ use glam::DVec3;
 use quake_formats::bsp::contents;
 use quake_formats::bsp::face_flags::FaceFlags;
 use quake_formats::bsp::phong::{self, FacePhong};
-use quake_formats::geom::{Bounds, POINT_EPSILON};
+use quake_formats::geom::Bounds;
 use rayon::prelude::*;
 use std::collections::HashMap;
 
