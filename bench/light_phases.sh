@@ -24,8 +24,8 @@ for spec in "$@"; do
     "$bin" light --threads 1 ${OPTS:-} "$work/$label.bsp" >"$work/$label.log" 2>&1
   callgrind_annotate --inclusive=yes "$work/$label.out" >"$work/$label.txt" 2>/dev/null
 done
-# Each phase by the function that holds it (older builds named some differently: the first
-# pattern found counts).
+# Each phase by the function that holds it, inclusive of what it calls (older builds named some
+# differently: the first pattern found counts).
 python3 - "$work" "${labels[@]}" <<'PY'
 import re, sys
 work, labels = sys.argv[1], sys.argv[2:]
@@ -35,15 +35,25 @@ phases = [
     ("sample points: placement, solid test, nudges", [r"light::samples::face_samples \["]),
     ("  of which placement on the face", [r"light::samples::SurfaceMap::place \["]),
     ("direct light: lights, suns, shadow rays", [r"light::trace::trace_face \["]),
-    ("  of which Embree's occlusion tests", [r"light::embree::Scene::occluded16 \["]),
+    ("  of which Embree's ray queries", [[r"light::embree::Scene::occluded16 \[",
+                                          r"light::embree::Scene::first_hits16 \["]]),
+    ("  of which dirt (ambient occlusion)", [r"light::dirt::adaptive::face_occlusion \["]),
     ("samples to luxels: fill, --soft blur, means", [r"light::luxels::ericw_luxels \["]),
-    ("bytes and lumps", [r"light::run::finish_lighting \[", r"light::finish_lighting \["]),
+    ("bytes and lumps", [r"light::run::finish_lighting \[", r"light::finish_lighting \[",
+                         [r"light::output::finish_face \[", r"light::output::write_lighting \["]]),
 ]
+def one(text, pattern):
+    for line in text.splitlines():
+        if re.search(pattern, line) and "=>" not in line:
+            return int(line.split()[0].replace(",", ""))
+    return None
+
 def count(text, patterns):
+    """The first pattern found; a list of patterns in one entry counts their sum."""
     for p in patterns:
-        for line in text.splitlines():
-            if re.search(p, line) and "=>" not in line:
-                return int(line.split()[0].replace(",", ""))
+        found = [one(text, q) for q in (p if isinstance(p, list) else [p])]
+        if any(n is not None for n in found):
+            return sum(n or 0 for n in found)
     return None
 texts = {l: open(f"{work}/{l}.txt").read() for l in labels}
 print("| phase | " + " | ".join(labels) + " |")

@@ -31,7 +31,7 @@ fn main() -> anyhow::Result<()> {
         },
     )?;
     println!(
-        "reference on every {stride}th face: {:.1} s",
+        "reference on 1 face in {stride}: {:.1} s",
         reference.stats.seconds_trace
     );
     let (none, half) = (SoftRadius::Samples(0), SoftRadius::HalfLuxel);
