@@ -1275,7 +1275,10 @@ fn a_shadow_casting_models_faces_inside_a_wall_stay_dark() {
     };
     let (end, top) = (door_face(DVec3::X), door_face(DVec3::Z));
     let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
-    assert!(face_grey(&lighting, end).iter().all(|&v| v == 0), "buried end lit");
+    assert!(
+        face_grey(&lighting, end).iter().all(|&v| v == 0),
+        "buried end lit"
+    );
     // The top's last column (x 144) stands over the wall: its sample is in solid.
     let top_grey = face_grey(&lighting, top);
     let width = top_grey.len() / 3;
@@ -2870,4 +2873,3 @@ fn no_key_value_stops_light() {
         assert!(told.contains(" line "), "{told}");
     }
 }
-

@@ -224,15 +224,24 @@ fn the_inside_of_a_fence_is_lit_as_open_space() {
         flags.is_some_and(|f| f.iter().any(|l| l.fence)),
         "the compiler marks the fence's leaves"
     );
-    assert!(crate::samples::solid_at(&fenced, [0.0, 0.0, -64.0]), "solid to engines");
+    assert!(
+        crate::samples::solid_at(&fenced, [0.0, 0.0, -64.0]),
+        "solid to engines"
+    );
     let lighting = lit(&fenced);
-    assert!(lighting.stats.lights_nudged == 0, "the light is not in solid");
+    assert!(
+        lighting.stats.lights_nudged == 0,
+        "the light is not in solid"
+    );
     let open = room(false);
     let open_lighting = lit(&open);
     for (x, y) in [(0.0, 0.0), (32.0, 32.0), (-48.0, 16.0), (100.0, 100.0)] {
         let inside = floor_rgb(&fenced, &lighting, x, y).expect("the floor is lit");
         let without = floor_rgb(&open, &open_lighting, x, y).expect("the floor is lit");
         assert!(inside[0] > 40, "({x}, {y}): {inside:?}");
-        assert!(inside[0].abs_diff(without[0]) <= 1, "({x}, {y}): {inside:?} against {without:?}");
+        assert!(
+            inside[0].abs_diff(without[0]) <= 1,
+            "({x}, {y}): {inside:?} against {without:?}"
+        );
     }
 }
