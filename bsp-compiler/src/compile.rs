@@ -23,7 +23,7 @@ use crate::texinfo::Projection;
 use crate::tree::SplitHeuristic;
 use crate::wad_lookup::{MissingTextures, WadSearch, WadSet};
 use crate::warnings::Warning;
-use quake_formats::bsp::limits::MAX_SURFACE_EXTENT;
+use quake_formats::bsp::limits::{BSP29_MAX_CLIPNODES, MAX_SURFACE_EXTENT};
 use quake_formats::bsp::texinfo_flags;
 use quake_formats::entities::Entity;
 use quake_formats::extents::LightmapExtents;
@@ -287,8 +287,23 @@ pub fn compile(
             t.mips = None;
         }
     }
-    // BSP2 holds any map; BSP29 and 2PSB give way to it.
-    if let Err(e) = bsp.check_version_limits() {
+    // BSP2 holds any map; BSP29 and 2PSB give way to it. BSP29 takes more than 32767 clip nodes
+    // only in engines that read their children unsigned, so past that it gives way too.
+    let limits = bsp
+        .check_version_limits()
+        .map_err(|e| e.to_string())
+        .and_then(|()| {
+            if bsp.version == BspVersion::Bsp29 && bsp.clipnodes.len() > BSP29_MAX_CLIPNODES {
+                Err(format!(
+                    "{} clip nodes are more than DarkPlaces and the original engine read in BSP29 \
+                 ({BSP29_MAX_CLIPNODES})",
+                    bsp.clipnodes.len()
+                ))
+            } else {
+                Ok(())
+            }
+        });
+    if let Err(e) = limits {
         warnings.push(Warning::Unsupported {
             what: format!("{e}; switching to BSP2 automatically"),
         });

@@ -9,8 +9,14 @@
 pub const BSP29_MAX_NODES: usize = 32767;
 /// Leaves are named by a child value `-(leaf + 1)` in a signed 16-bit field.
 pub const BSP29_MAX_LEAFS: usize = 32768;
-/// Clip node children are signed 16-bit; negative values are contents.
+/// Clip node children are 16-bit; read as signed (the original engine, DarkPlaces), negative
+/// values are contents, so clip nodes stop at 32767. Slipgate's compiler keeps to this.
 pub const BSP29_MAX_CLIPNODES: usize = 32767;
+/// FitzQuake's reading, kept by QuakeSpasm, vkQuake, Ironwail and FTE, and written by
+/// ericw-tools' qbsp: a child is unsigned 16-bit, and a value at or past the clip node count is
+/// contents (the value less 65536). Contents -1..-15 are 65521..65535, so clip nodes stop at
+/// 65521. The format limit a BSP29 file is read and written back with.
+pub const BSP29_MAX_CLIPNODES_UNSIGNED: usize = 65521;
 /// Faces name their plane with an unsigned 16-bit index.
 pub const BSP29_MAX_PLANES: usize = 65536;
 /// Edges name their vertices with unsigned 16-bit indices.

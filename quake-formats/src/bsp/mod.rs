@@ -217,6 +217,12 @@ impl Bsp {
         bsp.faces = read_records(lump(7), version)?;
         bsp.lighting = lump(8).to_vec();
         bsp.clipnodes = read_records(lump(9), version)?;
+        if !version.has_wide_indices() {
+            let count = bsp.clipnodes.len();
+            for c in &mut bsp.clipnodes {
+                c.widen_bsp29_children(count);
+            }
+        }
         bsp.leafs = read_records(lump(10), version)?;
         bsp.marksurfaces = read_records(lump(11), version)?;
         bsp.edges = read_records(lump(12), version)?;
@@ -336,7 +342,7 @@ impl Bsp {
             (
                 "the clip node count",
                 self.clipnodes.len(),
-                BSP29_MAX_CLIPNODES,
+                BSP29_MAX_CLIPNODES_UNSIGNED,
             ),
             ("the plane count", self.planes.len(), BSP29_MAX_PLANES),
             ("the vertex count", self.vertices.len(), BSP29_MAX_VERTICES),
@@ -668,6 +674,44 @@ mod tests {
         bsp.edges = vec![[0, 0], [big, 1], [1, 2]];
         bsp.surfedges = vec![1, 2, -1];
         bsp
+    }
+
+    /// Regression: ericw-tools' qbsp writes BSP29 files with more than 32767 clip nodes (a 2025
+    /// jam map has 40,000), their children unsigned as FitzQuake's engines read them; every
+    /// tool refused such a file, reading those children as bad contents values.
+    #[test]
+    fn bsp29_clip_node_children_past_32767_read_unsigned_and_write_back() {
+        let count = 40_000;
+        let mut bsp = Bsp::new(BspVersion::Bsp29);
+        bsp.clipnodes = (0..count)
+            .map(|i| ClipNode {
+                plane: 0,
+                children: [
+                    if i + 1 < count {
+                        i as i32 + 1
+                    } else {
+                        contents::EMPTY
+                    },
+                    contents::SOLID,
+                ],
+            })
+            .collect();
+        let bytes = bsp.write().expect("BSP29 holds 40,000 clip nodes");
+        let clip_lump = {
+            let at = 4 + 8 * 9;
+            i32::from_le_bytes(bytes[at..at + 4].try_into().expect("4 bytes")) as usize
+        };
+        // Node 35000's front child, 35001, is stored as its unsigned 16 bits.
+        let child = clip_lump + 35_000 * 8 + 4;
+        assert_eq!(u16::from_le_bytes([bytes[child], bytes[child + 1]]), 35_001);
+        let read = Bsp::read(&bytes).expect("read");
+        assert_eq!(read.clipnodes, bsp.clipnodes);
+        assert_eq!(read.write().expect("write again"), bytes);
+        let over = Bsp {
+            clipnodes: vec![bsp.clipnodes[0]; limits::BSP29_MAX_CLIPNODES_UNSIGNED + 1],
+            ..bsp
+        };
+        assert!(matches!(over.write(), Err(FormatError::Bsp29Limit { .. })));
     }
 
     #[test]

@@ -371,9 +371,30 @@ impl Record for ClipNode {
     fn write(&self, out: &mut Vec<u8>, v: BspVersion) -> Result<()> {
         out.put_u32(self.plane);
         for c in self.children {
-            write_wide_i(out, v, c, Self::LUMP, "child")?;
+            if v.has_wide_indices() || c < 0 {
+                write_wide_i(out, v, c, Self::LUMP, "child")?;
+            } else {
+                // Past 32767 a node child is written unsigned (see `widen_bsp29_children`).
+                out.put_u16(narrow(c as i64, Self::LUMP, "child")?);
+            }
         }
         Ok(())
+    }
+}
+
+impl ClipNode {
+    /// BSP29 clip node children as engines of FitzQuake's line read them
+    /// ([`super::limits::BSP29_MAX_CLIPNODES_UNSIGNED`]): the 16 bits unsigned, and a value at or
+    /// past `count` contents (less 65536). Children below 32768 read the same either way.
+    pub(super) fn widen_bsp29_children(&mut self, count: usize) {
+        for c in &mut self.children {
+            let unsigned = i32::from(*c as i16 as u16);
+            *c = if unsigned as usize >= count {
+                unsigned - 65536
+            } else {
+                unsigned
+            };
+        }
     }
 }
 
