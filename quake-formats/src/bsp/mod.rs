@@ -688,7 +688,7 @@ mod tests {
                 plane: 0,
                 children: [
                     if i + 1 < count {
-                        i as i32 + 1
+                        i + 1
                     } else {
                         contents::EMPTY
                     },
