@@ -1,8 +1,6 @@
 //! The faces of a BSP as geometry the light tool works with: world-space
 //! polygon, facing plane, texture projection and lightmap extents.
 
-use std::collections::HashMap;
-
 use glam::{DVec3, Vec3};
 use quake_formats::Bsp;
 use quake_formats::bsp::texinfo_flags;
@@ -219,6 +217,9 @@ pub fn face_geometry(
 /// Corners closer than this (units) are the same corner.
 const SAME_CORNER: f64 = 0.01;
 
+/// An edge by its two corners on the [`SAME_CORNER`] grid, the lesser first.
+type EdgeKey = ([i64; 3], [i64; 3]);
+
 /// How many shared edges a sample past a face's edge may cross to the faces continuing it on
 /// its plane (ericw-tools follows a point across at most three).
 pub const CONTINUATION_HOPS: usize = 3;
@@ -227,33 +228,37 @@ pub const CONTINUATION_HOPS: usize = 3;
 /// reached across at most [`CONTINUATION_HOPS`] shared edges.
 fn link_continuations(faces: &mut [FaceGeom]) {
     let key = |p: DVec3| (p / SAME_CORNER).round().as_i64vec3().to_array();
-    let mut by_edge: HashMap<([i64; 3], [i64; 3]), Vec<usize>> = HashMap::new();
-    for f in faces.iter().filter(|f| f.kind == FaceKind::Lit) {
-        for (a, b) in edges(&f.points) {
-            let (ka, kb) = (key(a), key(b));
-            by_edge
-                .entry((ka.min(kb), ka.max(kb)))
-                .or_default()
-                .push(f.index);
-        }
-    }
+    let edge_key = |(a, b): (DVec3, DVec3)| {
+        let (ka, kb) = (key(a), key(b));
+        (ka.min(kb), ka.max(kb))
+    };
+    // Every lit face under each of its edges, sorted by edge: one allocation, not one per edge.
+    let mut by_edge: Vec<(EdgeKey, usize)> = faces
+        .par_iter()
+        .filter(|f| f.kind == FaceKind::Lit)
+        .flat_map_iter(|f| edges(&f.points).map(move |e| (edge_key(e), f.index)))
+        .collect();
+    by_edge.par_sort_unstable();
+    let faces_on = |edge: EdgeKey| {
+        let start = by_edge.partition_point(|(k, _)| *k < edge);
+        by_edge[start..]
+            .iter()
+            .take_while(move |(k, _)| *k == edge)
+            .map(|&(_, g)| g)
+    };
     let same_plane = |a: &FaceGeom, b: &FaceGeom| {
         a.model == b.model
             && a.plane.normal.dot(b.plane.normal) > 1.0 - 1e-6
             && (a.plane.dist - b.plane.dist).abs() < SAME_CORNER
     };
     let beside: Vec<Vec<usize>> = faces
-        .iter()
+        .par_iter()
         .map(|f| {
             if f.kind != FaceKind::Lit {
                 return Vec::new();
             }
             let mut next: Vec<usize> = edges(&f.points)
-                .flat_map(|(a, b)| {
-                    let (ka, kb) = (key(a), key(b));
-                    by_edge.get(&(ka.min(kb), ka.max(kb))).into_iter().flatten()
-                })
-                .copied()
+                .flat_map(|e| faces_on(edge_key(e)))
                 .filter(|&g| g != f.index && same_plane(f, &faces[g]))
                 .collect();
             next.sort_unstable();
@@ -261,22 +266,30 @@ fn link_continuations(faces: &mut [FaceGeom]) {
             next
         })
         .collect();
-    for f in 0..faces.len() {
-        let mut reached = vec![f];
-        let mut ring = vec![f];
-        for _ in 0..CONTINUATION_HOPS {
-            ring = ring.iter().flat_map(|&g| &beside[g]).copied().collect();
-            ring.sort_unstable();
-            ring.dedup();
-            ring.retain(|g| !reached.contains(g));
-            reached.extend(&ring);
-        }
-        reached.sort_unstable();
-        faces[f].continuations = reached
-            .into_iter()
-            .filter(|&g| g != f)
-            .map(|g| faces[g].points.clone())
-            .collect();
+    // Each face's copies of its continuations' corners, on all cores: a large part of light's
+    // setup on a small map.
+    let continuations: Vec<Vec<Vec<DVec3>>> = (0..faces.len())
+        .into_par_iter()
+        .map(|f| {
+            let mut reached = vec![f];
+            let mut ring = vec![f];
+            for _ in 0..CONTINUATION_HOPS {
+                ring = ring.iter().flat_map(|&g| &beside[g]).copied().collect();
+                ring.sort_unstable();
+                ring.dedup();
+                ring.retain(|g| !reached.contains(g));
+                reached.extend(&ring);
+            }
+            reached.sort_unstable();
+            reached
+                .into_iter()
+                .filter(|&g| g != f)
+                .map(|g| faces[g].points.clone())
+                .collect()
+        })
+        .collect();
+    for (face, continuations) in faces.iter_mut().zip(continuations) {
+        face.continuations = continuations;
     }
 }
 
