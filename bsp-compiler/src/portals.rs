@@ -281,6 +281,22 @@ mod tests {
     use crate::tree::{SplitHeuristic, build_tree};
     use quake_formats::bsp::contents;
 
+    /// Solid brushes of the boxes `(mins, maxs)`, and the bounds of them all.
+    fn solid_boxes(boxes: &[(DVec3, DVec3)], planes: &mut PlaneSet) -> (Vec<Brush>, Bounds) {
+        let brushes: Vec<Brush> = boxes
+            .iter()
+            .enumerate()
+            .map(|(i, &(lo, hi))| {
+                Brush::from_planes(&box_planes(lo, hi), planes, contents::SOLID, i as u32)
+                    .expect("brush")
+            })
+            .collect();
+        let bounds = brushes
+            .iter()
+            .fold(Bounds::EMPTY, |acc, b| acc.union(&b.bounds));
+        (brushes, bounds)
+    }
+
     #[test]
     fn portals_of_a_single_box_close_every_leaf() {
         let mut planes = PlaneSet::new();
@@ -326,17 +342,7 @@ mod tests {
             ),
             (DVec3::new(16.0, 16.0, 64.0), DVec3::new(48.0, 48.0, 200.0)),
         ];
-        let brushes: Vec<Brush> = boxes
-            .iter()
-            .enumerate()
-            .map(|(i, &(lo, hi))| {
-                Brush::from_planes(&box_planes(lo, hi), &mut planes, contents::SOLID, i as u32)
-                    .expect("brush")
-            })
-            .collect();
-        let bounds = brushes
-            .iter()
-            .fold(Bounds::EMPTY, |acc, b| acc.union(&b.bounds));
+        let (brushes, bounds) = solid_boxes(&boxes, &mut planes);
         let tree = build_tree(brushes, &planes, SplitHeuristic::FewestSplits, true);
         let portals = make_portals(&tree, &planes, &bounds);
         // The half-spaces above each node.
@@ -372,17 +378,7 @@ mod tests {
             (DVec3::new(50.0, 0.0, 0.0), DVec3::new(150.0, 100.0, 100.0)),
             (DVec3::new(0.0, 0.0, 120.0), DVec3::new(40.0, 30.0, 160.0)),
         ];
-        let brushes: Vec<Brush> = boxes
-            .iter()
-            .enumerate()
-            .map(|(i, &(lo, hi))| {
-                Brush::from_planes(&box_planes(lo, hi), &mut planes, contents::SOLID, i as u32)
-                    .expect("brush")
-            })
-            .collect();
-        let bounds = brushes
-            .iter()
-            .fold(Bounds::EMPTY, |acc, b| acc.union(&b.bounds));
+        let (brushes, bounds) = solid_boxes(&boxes, &mut planes);
         let tree = build_tree(brushes, &planes, SplitHeuristic::FewestSplits, false);
         let all = make_portals(&tree, &planes, &bounds);
         let hull = make_clip_hull_portals(&tree, &planes, &bounds);

@@ -1218,6 +1218,18 @@ fn door_in_wall_bsp(door_keys: &str) -> Bsp {
     out.bsp
 }
 
+/// The index of the face of [`door_in_wall_bsp`]'s door (model 1) that faces along a normal.
+fn door_face_facing(bsp: &Bsp) -> impl Fn(DVec3) -> usize {
+    let prep = crate::prepare::prepare(bsp, &Options::default()).expect("prepare");
+    move |normal| {
+        prep.faces
+            .iter()
+            .find(|f| f.model == 1 && f.plane.normal.dot(normal) > 0.99)
+            .map(|f| f.index)
+            .expect("door face")
+    }
+}
+
 /// Regression: a door's faces inside the wall it slides into were black (their rays start in
 /// the wall's solid), so they showed black once the door moved. As in ericw-tools, samples in
 /// the world's solid are occluded: a luxel with some open samples keeps their mean, one with
@@ -1226,14 +1238,7 @@ fn door_in_wall_bsp(door_keys: &str) -> Bsp {
 #[test]
 fn door_faces_inside_a_wall_are_not_black() {
     let bsp = door_in_wall_bsp("");
-    let prep = crate::prepare::prepare(&bsp, &Options::default()).expect("prepare");
-    let door_face = |normal: DVec3| {
-        prep.faces
-            .iter()
-            .find(|f| f.model == 1 && f.plane.normal.dot(normal) > 0.99)
-            .map(|f| f.index)
-            .expect("door face")
-    };
+    let door_face = door_face_facing(&bsp);
     let (end, top, front) = (
         door_face(DVec3::X),
         door_face(DVec3::Z),
@@ -1265,14 +1270,7 @@ fn door_faces_inside_a_wall_are_not_black() {
 #[test]
 fn a_shadow_casting_models_faces_inside_a_wall_stay_dark() {
     let bsp = door_in_wall_bsp("\"_shadow\" \"1\"");
-    let prep = crate::prepare::prepare(&bsp, &Options::default()).expect("prepare");
-    let door_face = |normal: DVec3| {
-        prep.faces
-            .iter()
-            .find(|f| f.model == 1 && f.plane.normal.dot(normal) > 0.99)
-            .map(|f| f.index)
-            .expect("door face")
-    };
+    let door_face = door_face_facing(&bsp);
     let (end, top) = (door_face(DVec3::X), door_face(DVec3::Z));
     let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
     assert!(

@@ -18,7 +18,9 @@ use quake_formats::wad::{Wad, WadLump};
 
 use crate::plot::PlotFile;
 use crate::process::{Timing, run_timed};
-use crate::run::{MapWork, Timings, link_wad_dirs, map_work, progress_bar, record};
+use crate::run::{
+    MapWork, Timings, absolute, absolute_all, link_wad_dirs, map_work, progress_bar, record,
+};
 use crate::settings::Tool;
 use crate::{Machine, ReportError};
 
@@ -166,18 +168,9 @@ pub fn run(options: &IndependentOptions) -> Result<IndependentReport, ReportErro
         return Err(ReportError::NoMaps);
     }
     let anchor_as_given = options.anchor.clone();
-    let absolute = |p: &PathBuf| std::path::absolute(p).map_err(ReportError::io(p));
     let options = &IndependentOptions {
-        maps: options
-            .maps
-            .iter()
-            .map(absolute)
-            .collect::<Result<_, _>>()?,
-        wad_dirs: options
-            .wad_dirs
-            .iter()
-            .map(absolute)
-            .collect::<Result<_, _>>()?,
+        maps: absolute_all(&options.maps)?,
+        wad_dirs: absolute_all(&options.wad_dirs)?,
         out_dir: absolute(&options.out_dir)?,
         slipgate: absolute(&options.slipgate)?,
         anchor: absolute(&options.anchor)?,

@@ -102,24 +102,16 @@ pub fn draw_independent(
     report: &IndependentReport,
     out_dir: &Path,
 ) -> Result<Option<PlotFile>, ReportError> {
-    let mut by_key: BTreeMap<(String, Tool), Vec<Point>> = BTreeMap::new();
-    for row in &report.rows {
-        let (Some(timing), Some(figures)) = (row.timing, row.figures.as_ref()) else {
-            continue;
-        };
-        let (time, error) = (timing.wall_seconds, figures.rmse);
-        if time.is_finite() && time > 0.0 && error.is_finite() {
-            by_key
-                .entry((row.map.clone(), row.tool))
-                .or_default()
-                .push(Point {
-                    time,
-                    error,
-                    setting: row.setting.clone(),
-                });
-        }
-    }
-    let series = into_series(by_key);
+    let series = series_from(report.rows.iter().filter_map(|row| {
+        let (timing, figures) = (row.timing?, row.figures.as_ref()?);
+        Some((
+            &row.map,
+            row.tool,
+            &row.setting,
+            timing.wall_seconds,
+            figures.rmse,
+        ))
+    }));
     if series.is_empty() {
         return Ok(None);
     }
@@ -194,29 +186,35 @@ fn encode_png(pixels: Vec<u8>) -> Result<Vec<u8>, String> {
     Ok(bytes.into_inner())
 }
 
-/// The stage's points with a finite, positive time and a finite error, by map and tool.
+/// The stage's points, by map and tool ([`series_from`]).
 fn series_of(report: &Report, stage: Stage) -> Vec<Series> {
-    let mut by_key: BTreeMap<(String, Tool), Vec<Point>> = BTreeMap::new();
-    for row in report.rows.iter().filter(|r| r.stage == stage) {
-        let (Some(time), Some(error)) = (row.plot_time(), row.plot_error()) else {
-            continue;
-        };
-        if time.is_finite() && time > 0.0 && error.is_finite() {
-            by_key
-                .entry((row.map.clone(), row.tool))
-                .or_default()
-                .push(Point {
-                    time,
-                    error,
-                    setting: row.setting.clone(),
-                });
-        }
-    }
-    into_series(by_key)
+    series_from(
+        report
+            .rows
+            .iter()
+            .filter(|r| r.stage == stage)
+            .filter_map(|row| {
+                let (time, error) = (row.plot_time()?, row.plot_error()?);
+                Some((&row.map, row.tool, &row.setting, time, error))
+            }),
+    )
 }
 
-/// One series per map and tool, its points in order of time.
-fn into_series(by_key: BTreeMap<(String, Tool), Vec<Point>>) -> Vec<Series> {
+/// One series per map and tool of the `(map, tool, setting, time, error)` points with a
+/// finite, positive time and a finite error, its points in order of time.
+fn series_from<'a>(
+    points: impl Iterator<Item = (&'a String, Tool, &'a String, f64, f64)>,
+) -> Vec<Series> {
+    let mut by_key: BTreeMap<(String, Tool), Vec<Point>> = BTreeMap::new();
+    for (map, tool, setting, time, error) in points {
+        if time.is_finite() && time > 0.0 && error.is_finite() {
+            by_key.entry((map.clone(), tool)).or_default().push(Point {
+                time,
+                error,
+                setting: setting.clone(),
+            });
+        }
+    }
     by_key
         .into_iter()
         .map(|((map, tool), mut points)| {

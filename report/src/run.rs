@@ -24,6 +24,16 @@ pub(crate) struct MapWork {
 /// The best timing of a step so far, or why it failed.
 pub(crate) type Timings = BTreeMap<(usize, usize, Tool), Result<Timing, String>>;
 
+/// `p` as an absolute path (steps run in their map's work folder).
+pub(crate) fn absolute(p: &PathBuf) -> Result<PathBuf, ReportError> {
+    std::path::absolute(p).map_err(ReportError::io(p))
+}
+
+/// Each of `paths` as an absolute path.
+pub(crate) fn absolute_all(paths: &[PathBuf]) -> Result<Vec<PathBuf>, ReportError> {
+    paths.iter().map(absolute).collect()
+}
+
 /// Runs the whole report and writes its files into `options.out_dir`.
 pub fn run(options: &Options) -> Result<Report, ReportError> {
     if options.maps.is_empty() {
@@ -31,18 +41,9 @@ pub fn run(options: &Options) -> Result<Report, ReportError> {
     }
     let anchor_as_given = options.anchor.clone();
     // Steps run in their map's work folder, so every path they are given must be absolute.
-    let absolute = |p: &PathBuf| std::path::absolute(p).map_err(ReportError::io(p));
     let options = &Options {
-        maps: options
-            .maps
-            .iter()
-            .map(absolute)
-            .collect::<Result<_, _>>()?,
-        wad_dirs: options
-            .wad_dirs
-            .iter()
-            .map(absolute)
-            .collect::<Result<_, _>>()?,
+        maps: absolute_all(&options.maps)?,
+        wad_dirs: absolute_all(&options.wad_dirs)?,
         out_dir: absolute(&options.out_dir)?,
         slipgate: absolute(&options.slipgate)?,
         anchor: options.anchor.as_ref().map(absolute).transpose()?,
