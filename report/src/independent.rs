@@ -20,6 +20,7 @@ use crate::plot::PlotFile;
 use crate::process::{Timing, run_timed};
 use crate::run::{
     MapWork, Timings, absolute, absolute_all, link_wad_dirs, map_work, progress_bar, record,
+    write_json, write_report_file,
 };
 use crate::settings::Tool;
 use crate::{Machine, ReportError};
@@ -484,18 +485,8 @@ fn judge(options: &IndependentOptions, lit: &Path) -> Result<ReferenceFigures, R
 
 /// independent.json, independent.md, the plot and independent.html.
 fn write_files(report: &IndependentReport, out_dir: &Path) -> Result<(), ReportError> {
-    let write = |name: &str, bytes: &[u8]| {
-        let path = out_dir.join(name);
-        quake_formats::fsutil::write_atomic(&path, bytes).map_err(|source| ReportError::Format {
-            path: path.clone(),
-            source,
-        })
-    };
-    let json = serde_json::to_string_pretty(report).map_err(|e| ReportError::Measure {
-        path: out_dir.join("independent.json"),
-        what: e.to_string(),
-    })?;
-    write("independent.json", json.as_bytes())?;
+    let write = |name: &str, bytes: &[u8]| write_report_file(out_dir, name, bytes);
+    write_json(report, out_dir, "independent.json")?;
     let plot = crate::plot::draw_independent(report, out_dir)?;
     let markdown = render_markdown(report, plot.as_ref());
     write("independent.md", markdown.as_bytes())?;

@@ -459,20 +459,34 @@ fn view_figures(
     })
 }
 
-/// report.json, report.md, the plots and report.html.
-fn write_files(report: &Report, out_dir: &Path) -> Result<(), ReportError> {
-    let write = |name: &str, bytes: &[u8]| {
-        let path = out_dir.join(name);
-        quake_formats::fsutil::write_atomic(&path, bytes).map_err(|source| ReportError::Format {
-            path: path.clone(),
-            source,
-        })
-    };
-    let json = serde_json::to_string_pretty(report).map_err(|e| ReportError::Measure {
-        path: out_dir.join("report.json"),
+/// Writes `bytes` as `out_dir/name`, whole or not at all.
+pub(crate) fn write_report_file(
+    out_dir: &Path,
+    name: &str,
+    bytes: &[u8],
+) -> Result<(), ReportError> {
+    let path = out_dir.join(name);
+    quake_formats::fsutil::write_atomic(&path, bytes)
+        .map_err(|source| ReportError::Format { path, source })
+}
+
+/// Writes `value` as pretty JSON to `out_dir/name`.
+pub(crate) fn write_json(
+    value: &impl serde::Serialize,
+    out_dir: &Path,
+    name: &str,
+) -> Result<(), ReportError> {
+    let json = serde_json::to_string_pretty(value).map_err(|e| ReportError::Measure {
+        path: out_dir.join(name),
         what: e.to_string(),
     })?;
-    write("report.json", json.as_bytes())?;
+    write_report_file(out_dir, name, json.as_bytes())
+}
+
+/// report.json, report.md, the plots and report.html.
+fn write_files(report: &Report, out_dir: &Path) -> Result<(), ReportError> {
+    let write = |name: &str, bytes: &[u8]| write_report_file(out_dir, name, bytes);
+    write_json(report, out_dir, "report.json")?;
     let plots = crate::plot::draw_all(report, out_dir)?;
     write(
         "report.md",
