@@ -104,6 +104,12 @@ impl Closeness {
         }
     }
 
+    /// A squared distance beyond which a light is surely one cell away (see
+    /// [`Closeness::cells`]), with room for the rounding of a square and its root.
+    pub fn surely_far_squared(&self) -> f64 {
+        self.surely_far * self.surely_far * (1.0 + FOOTPRINT_FAR_MARGIN)
+    }
+
     /// Cells per axis for a light at `to_light` (`dist` away) from a sample point on a
     /// surface with unit `normal` (1: the value at the point will do).
     pub fn cells(&self, to_light: DVec3, dist: f64, normal: DVec3) -> usize {

@@ -167,11 +167,23 @@ impl FaceTrace<'_> {
     fn unshadowed_values(&mut self, li: usize, closeness: Closeness) {
         let samples = self.samples;
         let light = &self.lights[li];
+        // Past both its range and the footprints' reach, a light adds less than the gate at
+        // any angle and the sample needs no ray: its square root and divisions are skipped.
+        // A sample whose ray stands for others at its point is as far as they are.
+        let out_of_reach = if self.setup.cull {
+            let range = self.setup.light_reaches[li].range_squared * (1.0 + RANGE_MARGIN);
+            range.max(closeness.surely_far_squared())
+        } else {
+            f64::INFINITY
+        };
         let scratch = &mut *self.scratch;
         scratch.near.clear();
         for (i, &p) in samples.points.iter().enumerate() {
             scratch.value[i] = 0.0;
             let to_light = light.origin - Vec3::from(p).as_dvec3();
+            if to_light.length_squared() > out_of_reach {
+                continue;
+            }
             // One square root per sample and light.
             let Some((dist, dir)) = to_light.length_and_direction() else {
                 continue;
@@ -195,6 +207,10 @@ impl FaceTrace<'_> {
         }
     }
 }
+
+/// Relative margin on a light's squared range before a sample counts as out of its reach:
+/// covers the rounding of the range and of the sample's squared distance.
+const RANGE_MARGIN: f64 = 1e-9;
 
 /// The distinct styles of `arrive_in`, in first-seen order.
 fn styles_in(arrive_in: &[u8]) -> Vec<u8> {
