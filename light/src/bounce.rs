@@ -190,12 +190,44 @@ pub fn point_key(face: usize, index: usize, pass: usize) -> u64 {
 
 /// Where one point gathers: its position, its face's normal (rays are spread around it) and its
 /// shading normal (`_phong`; the face normal otherwise), and the key of its rays' jitter.
+/// A two-sided point (a liquid's surface) takes light from both sides without a cosine of its
+/// own, as ericw-tools' two-sided receivers do: its rays go over the whole sphere.
 #[derive(Debug, Clone, Copy)]
 pub struct GatherPoint {
     pub point: DVec3,
     pub flat: DVec3,
     pub shading: DVec3,
     pub key: u64,
+    pub two_sided: bool,
+}
+
+impl GatherPoint {
+    /// Ray `r` of `strata²`, in cell (`r / strata`, `r % strata`) of the unit square jittered by
+    /// the point's key: cosine-distributed around the face normal, or uniform over the sphere
+    /// for a two-sided point.
+    fn ray(&self, basis: &[DVec3; 2], r: usize, strata: usize) -> DVec3 {
+        let (j1, j2) = jitter(self.key.wrapping_add(r as u64));
+        let u1 = ((r / strata) as f64 + j1) / strata as f64;
+        let u2 = ((r % strata) as f64 + j2) / strata as f64;
+        let (sin, cos) = sin_cos_turns(u2);
+        let (across, along) = if self.two_sided {
+            let z = 1.0 - 2.0 * u1;
+            ((1.0 - z * z).max(0.0).sqrt(), z)
+        } else {
+            (u1.sqrt(), (1.0 - u1).sqrt())
+        };
+        basis[0] * (across * cos) + basis[1] * (across * sin) + self.flat * along
+    }
+
+    /// The solid angle each ray stands for, over the cosine the estimator divides out: π for
+    /// cosine-distributed rays, 4π for the sphere's uniform ones.
+    fn ray_measure(&self) -> f64 {
+        if self.two_sided {
+            4.0 * std::f64::consts::PI
+        } else {
+            std::f64::consts::PI
+        }
+    }
 }
 
 /// What reflecting surfaces give off: per face, its reflectance and its light per luxel.
@@ -243,7 +275,8 @@ impl Field<'_> {
     /// stratified grid jittered by the point's key. A ray that first meets the front of a
     /// reflecting face at `q` brings `π · kernel · ρ E(q) · min(1, d²/128²)` (times the
     /// shading/flat cosine ratio), over the number of rays: the model's integral with
-    /// `dA = d² dω / cos θq`. Rays go 16 to a packet whichever point they leave (a point's
+    /// `dA = d² dω / cos θq`. A two-sided point's rays are uniform over the sphere and bring
+    /// `4π · kernel · ρ E(q) · min(1, d²/128²)`. Rays go 16 to a packet whichever point they leave (a point's
     /// rays need not fill whole packets); each slot takes its rays in order, so the result
     /// does not depend on how they were packed.
     pub fn gather(
@@ -257,21 +290,13 @@ impl Field<'_> {
     ) -> StyleLuxels {
         let mut out = StyleLuxels::new();
         let rays = strata * strata;
-        let scale = self.kernel * std::f64::consts::PI / rays as f64;
+        let scale = self.kernel / rays as f64;
         let mut packet = RayPacket16::new();
         // Per lane: its direction and the point it leaves.
         let mut lanes: Vec<(DVec3, usize)> = Vec::with_capacity(16);
         let all = points.iter().enumerate().flat_map(|(k, (at, _))| {
-            let [t0, t1] = tangent_basis(at.flat);
-            (0..rays).map(move |r| {
-                let (j1, j2) = jitter(at.key.wrapping_add(r as u64));
-                let u1 = ((r / strata) as f64 + j1) / strata as f64;
-                let u2 = ((r % strata) as f64 + j2) / strata as f64;
-                let radius = u1.sqrt();
-                let (sin, cos) = sin_cos_turns(u2);
-                let dir = t0 * (radius * cos) + t1 * (radius * sin) + at.flat * (1.0 - u1).sqrt();
-                (dir, k)
-            })
+            let basis = tangent_basis(at.flat);
+            (0..rays).map(move |r| (at.ray(&basis, r, strata), k))
         });
         for (dir, k) in all {
             packet.set(
@@ -341,13 +366,20 @@ impl Field<'_> {
                 continue;
             };
             let (at, slot) = &points[k];
-            let cos_flat = at.flat.dot(dir);
-            if face.plane.normal.dot(dir) >= 0.0 || cos_flat <= 0.0 {
-                continue; // the back of a face, or a grazing ray
+            if face.plane.normal.dot(dir) >= 0.0 {
+                continue; // the back of a face
             }
-            let cos_shading = at.shading.dot(dir).max(0.0);
+            let cosines = if at.two_sided {
+                1.0
+            } else {
+                let cos_flat = at.flat.dot(dir);
+                if cos_flat <= 0.0 {
+                    continue; // a grazing ray
+                }
+                at.shading.dot(dir).max(0.0) / cos_flat
+            };
             let near = (f64::from(t) / HOTSPOT_CLAMP).min(1.0);
-            let weight = scale * cos_shading / cos_flat * near * near;
+            let weight = scale * at.ray_measure() * cosines * near * near;
             let q = at.point + dir * f64::from(t);
             for (style, luxels) in light {
                 let e = light_at(face, luxels, q);
@@ -385,6 +417,7 @@ impl Field<'_> {
                     flat: r.normal,
                     shading: Vec3::from(r.normals[l]).as_dvec3(),
                     key: point_key(r.face, l, pass),
+                    two_sided: r.two_sided,
                 };
                 points.push((at, gy * xs.len() + gx));
             }
@@ -457,6 +490,8 @@ pub struct Receivers {
     pub height: usize,
     /// The face's normal.
     pub normal: DVec3,
+    /// It takes light from both sides (see [`GatherPoint`]).
+    pub two_sided: bool,
     pub points: Vec<[f32; 3]>,
     pub normals: Vec<[f32; 3]>,
 }
@@ -474,6 +509,7 @@ impl Receivers {
             width: samples.width,
             height: samples.height,
             normal: samples.normal,
+            two_sided: samples.two_sided,
             points: indices.clone().map(|i| samples.points[i]).collect(),
             normals: indices
                 .map(|i| samples.normal_at(i).as_vec3().to_array())

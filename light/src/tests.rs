@@ -1988,6 +1988,49 @@ fn bounce_is_close_to_the_reference_and_never_black_where_it_is_lit() {
     }
 }
 
+/// Floor 0..256 lit from above, and over its middle at z 64 an upward face textured `texture`
+/// (face 1): a liquid's surface lets the light through to the floor below it.
+fn pool_surface_scene(texture: &str) -> Bsp {
+    let surface = quad(
+        [64.0, 64.0, 64.0],
+        [64.0, 192.0, 64.0],
+        [192.0, 192.0, 64.0],
+        [192.0, 64.0, 64.0],
+        [0.0, 0.0, 1.0],
+    );
+    let ents = "{ \"classname\" \"worldspawn\" }\n\
+                { \"classname\" \"light\" \"origin\" \"128 128 192\" }\n";
+    let mut bsp = synthetic_bsp(&[floor(256.0), surface], ents);
+    bsp.textures.textures.push(Some(mip(texture)));
+    let last = bsp.texinfo.len() - 1;
+    bsp.texinfo[last].miptex = bsp.textures.textures.len() as u32 - 1;
+    bsp
+}
+
+#[test]
+fn a_liquid_surface_takes_bounced_light_from_both_sides() {
+    // ericw-tools gathers onto liquids (two-sided receivers) from either side, with no cosine
+    // of their own: the lit floor under the surface bounces up through it. An ordinary face
+    // in its place faces away from the floor, which it shadows anyway.
+    let mut bounced = options(Quality::Default);
+    bounced.overrides.bounce = Some(1);
+    let surface_bounce = |texture: &str| {
+        let bsp = pool_surface_scene(texture);
+        let with = compute_lighting(&bsp, &bounced).expect("light");
+        let without = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
+        let (a, b) = (face_grey(&with, 1), face_grey(&without, 1));
+        assert_eq!(a.len(), b.len());
+        a.iter()
+            .zip(&b)
+            .map(|(&a, &b)| i32::from(a) - i32::from(b))
+            .collect::<Vec<_>>()
+    };
+    let liquid = surface_bounce("*water1");
+    assert!(liquid.iter().all(|&d| d >= 8), "{liquid:?}");
+    let wall = surface_bounce("wall2");
+    assert!(wall.iter().all(|&d| d == 0), "{wall:?}");
+}
+
 /// Bounced light alone (with bounce minus without), style 0, per luxel of every face.
 fn bounce_part(bsp: &Bsp, options: &Options) -> Vec<f32> {
     let with = trace_lighting(bsp, options).expect("light");

@@ -32,6 +32,7 @@ pub fn gather(
                 flat: samples.normal,
                 shading: samples.normal_at(i),
                 key: point_key(samples.face, i, pass),
+                two_sided: samples.two_sided,
             };
             (at, i)
         })
