@@ -157,11 +157,13 @@ impl Fences {
         }))
     }
 
-    /// Lanes of `packet` (each over its segment) that a fence face blocks at an opaque texel.
-    /// `packet` itself is left as it was.
-    pub fn blocks16(&self, packet: &RayPacket16) -> u16 {
-        let segments: [Option<_>; 16] = std::array::from_fn(|lane| packet.segment(lane));
+    /// Of `lanes` of `packet` (each over its segment), those a fence face blocks at an opaque
+    /// texel. `packet` itself is left as it was.
+    pub fn blocks16(&self, packet: &RayPacket16, lanes: u16) -> u16 {
+        let segments: [Option<_>; 16] =
+            std::array::from_fn(|lane| packet.segment(lane).filter(|_| lanes & (1 << lane) != 0));
         let mut probe = *packet;
+        probe.keep_shortened(lanes, 1.0);
         let mut blocked = 0u16;
         for _ in 0..MAX_LAYERS {
             let hits = self.scene.first_hits16(&mut probe, false);

@@ -183,16 +183,20 @@ impl TraceScene {
     /// Bit `i` set if lane `i` of `packet`, cast from a face of brush model
     /// `model`, is blocked (sky blocks too).
     pub fn occluded16(&self, packet: &mut RayPacket16, model: usize) -> u16 {
-        // Before the opaque test, which rewrites the segments of the lanes it blocks.
-        let fenced = self.fences_block16(packet);
-        let blocked = self.scene.occluded16(packet, true) | fenced;
-        // Embree sets tfar of blocked lanes to -inf, so the second query skips them.
+        let opaque = self.scene.occluded16(packet, true);
+        // Only the lanes the opaque faces let through can be blocked by a fence; Embree has
+        // set the others' tfar to -inf, so the second query skips them too.
+        let blocked = opaque | self.fences_block16(packet, !opaque);
         blocked | self.own_occluded16(packet, model)
     }
 
-    /// Lanes of `packet` a fence face blocks at an opaque texel.
-    fn fences_block16(&self, packet: &RayPacket16) -> u16 {
-        self.fences.as_ref().map_or(0, |f| f.blocks16(packet))
+    /// Of the active `lanes` of `packet`, those a fence face blocks at an opaque texel.
+    fn fences_block16(&self, packet: &RayPacket16, lanes: u16) -> u16 {
+        let lanes = lanes & packet.active_mask();
+        match &self.fences {
+            Some(f) if lanes != 0 => f.blocks16(packet, lanes),
+            _ => 0,
+        }
     }
 
     /// Lanes of `packet` (each up to its current `tfar`) that `model`'s own
@@ -219,8 +223,8 @@ impl TraceScene {
             .fold(0, |m, i| m | (1 << i));
         // Just short of the sky hit, so the sky face itself does not block.
         packet.keep_shortened(sky, SKY_HIT_SHORTEN);
-        let fenced = self.fences_block16(packet);
-        let blocked = self.scene.occluded16(packet, true) | fenced;
+        let opaque = self.scene.occluded16(packet, true);
+        let blocked = opaque | self.fences_block16(packet, !opaque);
         sky & !blocked & !self.own_occluded16(packet, model) & !self.any_switchable_blocks16(packet)
     }
 
