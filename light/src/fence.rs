@@ -123,12 +123,77 @@ impl FenceFace {
     }
 }
 
+/// Boxes around the fence faces, [`BOX_MARGIN`] wider each way: a ray whose segment's box
+/// meets none of them meets no fence, and needs no walk through the fence scene (a packet's
+/// walk costs about as much on a few small signs as on many faces).
+#[derive(Debug)]
+struct FenceBoxes {
+    all: (Vec3, Vec3),
+    /// One per face; empty past [`MAX_FACE_BOXES`] faces, where `all` alone is tested.
+    each: Vec<(Vec3, Vec3)>,
+}
+
+/// Room around the boxes for the rounding of a segment's ends.
+const BOX_MARGIN: f32 = 1.0;
+
+/// Faces beyond which a ray is tested against the box of all fences only.
+const MAX_FACE_BOXES: usize = 64;
+
+impl FenceBoxes {
+    fn new(faces: &[(&FaceGeom, Arc<TexelMask>)]) -> FenceBoxes {
+        let box_of = |points: &[DVec3]| {
+            let (lo, hi) = points.iter().fold(
+                (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+                |(lo, hi), p| (lo.min(p.as_vec3()), hi.max(p.as_vec3())),
+            );
+            (lo - BOX_MARGIN, hi + BOX_MARGIN)
+        };
+        let each: Vec<_> = faces.iter().map(|(f, _)| box_of(&f.points)).collect();
+        let all = each.iter().fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), b| (lo.min(b.0), hi.max(b.1)),
+        );
+        FenceBoxes {
+            all,
+            each: if each.len() <= MAX_FACE_BOXES {
+                each
+            } else {
+                Vec::new()
+            },
+        }
+    }
+
+    /// Of `lanes` of `packet`, those whose segment's box meets a fence face's box.
+    fn lanes_near(&self, packet: &RayPacket16, lanes: u16) -> u16 {
+        let overlaps =
+            |(lo, hi): (Vec3, Vec3), b: &(Vec3, Vec3)| lo.cmple(b.1).all() && hi.cmpge(b.0).all();
+        let mut near = 0;
+        for lane in (0..16).filter(|&l| lanes & (1 << l) != 0) {
+            let Some((org, dir, tnear, tfar)) = packet.segment(lane) else {
+                continue;
+            };
+            let (org, dir) = (Vec3::from(org), Vec3::from(dir));
+            let (a, b) = (org + dir * tnear, org + dir * tfar);
+            let segment = (a.min(b), a.max(b));
+            let finite = a.is_finite() && b.is_finite();
+            if !finite
+                || overlaps(segment, &self.all)
+                    && (self.each.is_empty() || self.each.iter().any(|f| overlaps(segment, f)))
+            {
+                near |= 1 << lane;
+            }
+        }
+        near
+    }
+}
+
 /// The shadow-casting fence faces, in a scene of their own.
 pub struct Fences {
     scene: Scene,
     /// The place in `faces` of each triangle's face (by primitive id).
     triangles: Vec<u32>,
     faces: Vec<FenceFace>,
+    boxes: FenceBoxes,
 }
 
 impl Fences {
@@ -154,12 +219,17 @@ impl Fences {
             scene: mesh.commit(device)?,
             triangles: mesh.faces,
             faces: fence_faces,
+            boxes: FenceBoxes::new(faces),
         }))
     }
 
     /// Of `lanes` of `packet` (each over its segment), those a fence face blocks at an opaque
     /// texel. `packet` itself is left as it was.
     pub fn blocks16(&self, packet: &RayPacket16, lanes: u16) -> u16 {
+        let lanes = self.boxes.lanes_near(packet, lanes);
+        if lanes == 0 {
+            return 0;
+        }
         let segments: [Option<_>; 16] =
             std::array::from_fn(|lane| packet.segment(lane).filter(|_| lanes & (1 << lane) != 0));
         let mut probe = *packet;
