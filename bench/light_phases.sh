@@ -19,10 +19,13 @@ for spec in "$@"; do
   label=${spec%%=*}; bin=${spec#*=}
   labels+=("$label")
   cp "$bsp" "$work/$label.bsp"
+  # Run where no source path resolves: from the workspace, callgrind records relative source
+  # paths and callgrind_annotate then splits inlined functions' inclusive counts differently.
+  bin=$(realpath "$bin")
   # shellcheck disable=SC2086 # the option string is split on purpose
-  valgrind --tool=callgrind --callgrind-out-file="$work/$label.out" \
-    "$bin" light --threads 1 ${OPTS:-} "$work/$label.bsp" >"$work/$label.log" 2>&1
-  callgrind_annotate --inclusive=yes "$work/$label.out" >"$work/$label.txt" 2>/dev/null
+  (cd "$work" && valgrind --tool=callgrind --callgrind-out-file="$label.out" \
+    "$bin" light --threads 1 ${OPTS:-} "$label.bsp" >"$label.log" 2>&1)
+  (cd "$work" && callgrind_annotate --inclusive=yes "$label.out" >"$label.txt" 2>/dev/null)
 done
 # Each phase by the function that holds it, inclusive of what it calls (older builds named some
 # differently: the first pattern found counts).
