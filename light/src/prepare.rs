@@ -224,7 +224,8 @@ pub fn face_rules<'a>(lights: &'a MapLights, geom: &FaceGeom) -> FaceRules<'a> {
                 .as_ref()
                 .is_none_or(|t| !t.eq_ignore_ascii_case(&geom.texture))
         });
-    let dirt = !lights.no_dirt_models.contains(&geom.model);
+    // A liquid's surface takes no dirt, as in ericw-tools.
+    let dirt = !lights.no_dirt_models.contains(&geom.model) && geom.kind != FaceKind::LitLiquid;
     FaceRules {
         minlight,
         dirt,

@@ -772,6 +772,17 @@ fn dirt_darkens_the_corner_but_not_the_open_floor() {
 }
 
 #[test]
+fn a_liquid_surface_takes_no_dirt() {
+    // ericw-tools never darkens a lit liquid by dirt: the corner scene's floor as water stays
+    // as bright by the wall as in the open, where as a wall texture it darkens there.
+    let mut bsp = corner_scene("\"_dirt\" \"1\"", "");
+    bsp.textures.textures.push(Some(mip("*water1")));
+    bsp.texinfo[0].miptex = bsp.textures.textures.len() as u32 - 1;
+    let row = floor_row(&bsp, &options(Quality::Default), 8);
+    assert!(row.iter().all(|&v| v == 100), "{row:?}");
+}
+
+#[test]
 fn dirt_switches_per_light_and_from_the_command_line() {
     // The light opts out of worldspawn's dirt.
     let opted_out = floor_row(
