@@ -173,6 +173,26 @@ pub fn trace_grid(sources: &GridSources, spacing: DVec3) -> Result<RawGrid, Ligh
     })
 }
 
+/// The light at each of `points` (anywhere, apart from each other) as a grid point there would
+/// take it; `None` for a point inside solid or sky.
+pub fn light_at(sources: &GridSources, points: &[DVec3]) -> Vec<RawPoint> {
+    let suns = if sources.every_sun_direction {
+        sources.suns.to_vec()
+    } else {
+        grid_suns(sources.suns)
+    };
+    let sources = &GridSources {
+        suns: &suns,
+        ..*sources
+    };
+    let sky = LeafSky::new(sources.bsp, sources.suns);
+    // One point to a run: the leaf walk takes a run's points as one straight row.
+    points
+        .par_iter()
+        .flat_map_iter(|p| trace_run(sources, &sky, std::slice::from_ref(p)).0)
+        .collect()
+}
+
 /// Deeper than this no walk of a sound world tree goes.
 const MAX_TREE_DEPTH: usize = 4096;
 

@@ -34,6 +34,15 @@ fn nudged(bsp: &Bsp, origin: DVec3) -> Option<DVec3> {
     steps.into_iter().find(|&p| !in_solid(bsp, p))
 }
 
+/// `p` if it lies in the open, else the first of its steps that does (as a light moves).
+pub fn free_point(bsp: &Bsp, p: DVec3) -> Option<DVec3> {
+    if in_solid(bsp, p) {
+        nudged(bsp, p)
+    } else {
+        Some(p)
+    }
+}
+
 /// What [`nudge_out_of_solid`] did.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Nudges {

@@ -2,8 +2,8 @@
 //! bounced light, finish each face (bounce added, floors applied, samples averaged to luxels)
 //! and count what was done; then turn light units into bytes and write them into the BSP.
 
-use glam::Vec3;
-use std::collections::BTreeMap;
+use glam::{DVec3, Vec3};
+use std::collections::{BTreeMap, BTreeSet};
 use std::time::Instant;
 
 use quake_formats::Bsp;
@@ -16,7 +16,7 @@ use rayon::prelude::*;
 use crate::bounce::{self, BounceCounts, Density, Field, Receivers, StyleLuxels};
 use crate::error::LightError;
 use crate::faces::{FaceGeom, OwnGrid};
-use crate::lightgrid::{GridSources, RawGrid, finish_grid, trace_grid};
+use crate::lightgrid::{GridSources, RawGrid, finish_grid, light_at, trace_grid};
 use crate::lighting::{Lighting, RawLighting, Stats};
 use crate::lights::assign_switchable_styles;
 use crate::luxels::ToLuxels;
@@ -73,12 +73,14 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
             soft_radius: settings.soft.samples(q.samples_per_axis()),
         },
     };
+    let model_light = |models: &[usize]| plan.model_centre_light(models);
     let (faces, own_grids) = finish_faces(
         traced,
         &bounced,
         &prep.faces,
         &prep.lights.shadow_models,
         to_luxels,
+        &model_light,
     );
     stats.luxels = faces.iter().map(|l| (l.width * l.height) as u64).sum();
     stats.faces_lit = faces.len();
@@ -284,7 +286,13 @@ impl<'a> Plan<'a> {
         if !settings.lightgrid || self.fullbright {
             return Ok(None);
         }
-        let sources = GridSources {
+        trace_grid(&self.grid_sources(), settings.lightgrid_dist.0).map(Some)
+    }
+
+    /// What lights a point in the open: the grid's sources.
+    fn grid_sources(&self) -> GridSources<'_> {
+        let prep = self.prep;
+        GridSources {
             bsp: self.bsp,
             scene: &prep.scene,
             vis: &prep.vis,
@@ -293,12 +301,44 @@ impl<'a> Plan<'a> {
             reaches: &self.reaches,
             suns: &prep.lights.suns,
             minlight: prep.lights.minlight.get(&0),
-            gate: settings.gate,
+            gate: prep.lights.settings.gate,
             sun_distance: prep.sun_distance,
             cull: self.cull(),
             every_sun_direction: self.reference(),
+        }
+    }
+
+    /// Per brush model of `models`, ericw-tools' estimate of its light ("autominlight"): the
+    /// direct light at the middle of its box (moved out of solid as a light is; a model whose
+    /// middle no step frees has none) as a grid point takes it, without minlight, scaled once
+    /// more by the range scale as ericw-tools' value is.
+    fn model_centre_light(&self, models: &[usize]) -> ModelLight {
+        if self.fullbright {
+            return ModelLight::new();
+        }
+        let placed: Vec<(usize, DVec3)> = models
+            .iter()
+            .filter_map(|&m| {
+                let model = self.bsp.models.get(m)?;
+                let corner = |c: [f32; 3]| DVec3::from(c.map(f64::from));
+                let centre = (corner(model.mins) + corner(model.maxs)) / 2.0;
+                Some((m, crate::nudge::free_point(self.bsp, centre)?))
+            })
+            .collect();
+        let points: Vec<DVec3> = placed.iter().map(|&(_, p)| p).collect();
+        let sources = GridSources {
+            minlight: None,
+            ..self.grid_sources()
         };
-        trace_grid(&sources, settings.lightgrid_dist.0).map(Some)
+        let scale = self.prep.lights.settings.range as f32;
+        placed
+            .iter()
+            .zip(light_at(&sources, &points))
+            .filter_map(|(&(m, _), light)| {
+                let light = light?.into_iter().map(|(s, c)| (s, c.map(|v| v * scale)));
+                Some((m, light.collect()))
+            })
+            .collect()
     }
 
     fn stats(&self, traced: &[Traced], bounce: &BounceCounts) -> Stats {
@@ -343,16 +383,21 @@ impl<'a> Plan<'a> {
     }
 }
 
+/// Light per style (light units) of some brush models, by model.
+type ModelLight = BTreeMap<usize, Vec<(u8, [f32; 3])>>;
+
 /// Each wanted face's light with its bounced light added, floors applied and samples averaged
 /// to luxels: on its 16-texel grid, and beside it the light on its own grid when it was lit
 /// there (the 16-texel light is then read from that). The occluded samples of the faces of
-/// `shadow_models` stay dark.
+/// `shadow_models` stay dark; `model_light` gives the light of the brush models whose faces
+/// lie wholly in solid ([`fill_hidden_luxels`]).
 fn finish_faces(
     traced: Vec<Traced>,
     bounced: &[StyleLuxels],
     geoms: &[FaceGeom],
     shadow_models: &[usize],
     to_luxels: ToLuxels,
+    model_light: &(dyn Fn(&[usize]) -> ModelLight + Sync),
 ) -> (Vec<FaceLight>, Vec<Option<OwnGridLight>>) {
     // Gathered first, into room for all, so no vector here grows in steps (each step takes
     // fresh pages) and the parallel collect knows its length.
@@ -376,7 +421,7 @@ fn finish_faces(
             light.finish(bounce, fill, to_luxels)
         })
         .collect();
-    fill_hidden_luxels(&mut finished, &hidden, geoms, shadow_models);
+    fill_hidden_luxels(&mut finished, &hidden, geoms, shadow_models, model_light);
     finished
         .into_par_iter()
         .map(|light| {
@@ -408,6 +453,7 @@ fn fill_hidden_luxels(
     hidden: &[Vec<bool>],
     geometry: &[FaceGeom],
     shadow_models: &[usize],
+    model_light: &dyn Fn(&[usize]) -> ModelLight,
 ) {
     let model_of = |light: &FaceLight| geometry[light.face].model;
     let in_brush_model = |(light, _): &(&FaceLight, &Vec<bool>)| {
@@ -422,6 +468,16 @@ fn fill_hidden_luxels(
     {
         return;
     }
+    let buried: Vec<usize> = faces
+        .iter()
+        .zip(hidden)
+        .filter(in_brush_model)
+        .filter(|(_, h)| all_hidden(h))
+        .map(|(light, _)| model_of(light))
+        .collect::<BTreeSet<usize>>()
+        .into_iter()
+        .collect();
+    let centre_light = model_light(&buried);
     let mut open_luxels: BTreeMap<usize, usize> = BTreeMap::new();
     let mut sums: BTreeMap<(usize, u8), [f64; 3]> = BTreeMap::new();
     for (light, hidden) in faces.iter().zip(hidden).filter(in_brush_model) {
@@ -440,13 +496,22 @@ fn fill_hidden_luxels(
     }
     for (light, hidden) in faces.iter_mut().zip(hidden) {
         let model = model_of(light);
-        let count = open_luxels.get(&model).copied().unwrap_or(0);
-        if model == 0 || count == 0 || !all_hidden(hidden) {
+        if model == 0 || shadow_models.contains(&model) || !all_hidden(hidden) {
             continue;
         }
+        let count = open_luxels.get(&model).copied().unwrap_or(0);
+        let means = || {
+            sums.range((model, 0)..=(model, u8::MAX))
+                .map(|(&(_, style), sum)| (style, sum.map(|s| (s / count as f64) as f32)))
+                .collect::<Vec<_>>()
+        };
+        let fill = match centre_light.get(&model) {
+            Some(light) => light.clone(),
+            None if count > 0 => means(),
+            None => continue,
+        };
         let n = light.width * light.height;
-        for (&(_, style), sum) in sums.range((model, 0)..=(model, u8::MAX)) {
-            let mean = sum.map(|s| (s / count as f64) as f32);
+        for (style, value) in fill {
             let at = light.styles.iter().position(|(s, _)| *s == style);
             let at = at.unwrap_or_else(|| {
                 light.styles.push((style, vec![[0.0; 3]; n]));
@@ -458,7 +523,7 @@ fn fill_hidden_luxels(
                 .zip(hidden)
                 .filter(|(_, h)| **h)
             {
-                *l = mean;
+                *l = value;
             }
         }
         // Style 0 first, as everywhere.

@@ -1279,6 +1279,22 @@ fn door_faces_inside_a_wall_are_not_black() {
 /// open half spread over the whole. The same door without `_shadow` is filled
 /// ([`door_faces_inside_a_wall_are_not_black`]).
 #[test]
+fn a_buried_door_face_takes_the_light_at_the_doors_middle() {
+    // ericw-tools' autominlight: the luxels of a brush model's faces inside solid take the
+    // direct light at the middle of the model's box, scaled once more by the range scale. The
+    // door's middle (118 0 -96) is 134.2 units from the light (300, linear): 165.8 light units,
+    // halved to 82.9, written at the range scale of 0.5 as 41.
+    let bsp = door_in_wall_bsp("");
+    let end = door_face_facing(&bsp)(DVec3::X);
+    let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
+    let grey = face_grey(&lighting, end);
+    assert!(
+        !grey.is_empty() && grey.iter().all(|&v| v.abs_diff(41) <= 1),
+        "{grey:?}"
+    );
+}
+
+#[test]
 fn a_shadow_casting_models_faces_inside_a_wall_stay_dark() {
     let bsp = door_in_wall_bsp("\"_shadow\" \"1\"");
     let door_face = door_face_facing(&bsp);
