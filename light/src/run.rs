@@ -389,8 +389,9 @@ type ModelLight = BTreeMap<usize, Vec<(u8, [f32; 3])>>;
 /// Each wanted face's light with its bounced light added, floors applied and samples averaged
 /// to luxels: on its 16-texel grid, and beside it the light on its own grid when it was lit
 /// there (the 16-texel light is then read from that). The occluded samples of the faces of
-/// `shadow_models` stay dark; `model_light` gives the light of the brush models whose faces
-/// lie wholly in solid ([`fill_hidden_luxels`]).
+/// `shadow_models` stay dark; those of other brush models take the light `model_light` gives
+/// their model (ericw-tools' autominlight), or if it gives none, as [`fill_hidden_luxels`]
+/// says.
 fn finish_faces(
     traced: Vec<Traced>,
     bounced: &[StyleLuxels],
@@ -403,6 +404,23 @@ fn finish_faces(
     // fresh pages) and the parallel collect knows its length.
     let mut lit: Vec<SampleLight> = Vec::with_capacity(traced.len());
     lit.extend(traced.into_iter().filter_map(|t| t.light));
+    // ericw-tools' autominlight: the occluded samples of a brush model's faces take the light
+    // of the model's middle, where it has one.
+    let model_of = |light: &SampleLight| geoms[light.face].model;
+    let buried: BTreeSet<usize> = lit
+        .iter()
+        .filter(|light| light.has_occluded())
+        .map(model_of)
+        .filter(|&m| m != 0 && !shadow_models.contains(&m))
+        .collect();
+    let centre_light = model_light(&buried.into_iter().collect::<Vec<_>>());
+    let lit: Vec<SampleLight> = lit
+        .into_iter()
+        .map(|light| match centre_light.get(&model_of(&light)) {
+            Some(centre) => light.with_model_light(centre),
+            None => light,
+        })
+        .collect();
     let hidden: Vec<Vec<bool>> = lit.iter().map(SampleLight::hidden_luxels).collect();
     let mut finished: Vec<FaceLight> = lit
         .into_par_iter()
@@ -421,7 +439,7 @@ fn finish_faces(
             light.finish(bounce, fill, to_luxels)
         })
         .collect();
-    fill_hidden_luxels(&mut finished, &hidden, geoms, shadow_models, model_light);
+    fill_hidden_luxels(&mut finished, &hidden, geoms, shadow_models);
     finished
         .into_par_iter()
         .map(|light| {
@@ -443,17 +461,16 @@ fn all_hidden(hidden: &[bool]) -> bool {
 }
 
 /// The luxels of a brush model's faces with no open luxel at all (a door's edge or face in
-/// the wall it slides into) take, per style, the mean of the model's open luxels, all its
-/// faces' together (zero where a face has no light of that style): their own rays, traced
-/// from inside the wall, say nothing. ericw-tools too gives all such luxels of a model one
-/// value (its own estimate of the model's light), not the light of the luxels beside them. The
-/// faces of `shadow_models` are left dark, as ericw-tools leaves a model that casts shadows.
+/// the wall it slides into), when the model has no light of its own ([`finish_faces`]: its
+/// middle is in solid), take per style the mean of the model's open luxels, all its faces'
+/// together (zero where a face has no light of that style): their own rays, traced from
+/// inside the wall, say nothing. The faces of `shadow_models` are left dark, as ericw-tools
+/// leaves a model that casts shadows.
 fn fill_hidden_luxels(
     faces: &mut [FaceLight],
     hidden: &[Vec<bool>],
     geometry: &[FaceGeom],
     shadow_models: &[usize],
-    model_light: &dyn Fn(&[usize]) -> ModelLight,
 ) {
     let model_of = |light: &FaceLight| geometry[light.face].model;
     let in_brush_model = |(light, _): &(&FaceLight, &Vec<bool>)| {
@@ -468,16 +485,6 @@ fn fill_hidden_luxels(
     {
         return;
     }
-    let buried: Vec<usize> = faces
-        .iter()
-        .zip(hidden)
-        .filter(in_brush_model)
-        .filter(|(_, h)| all_hidden(h))
-        .map(|(light, _)| model_of(light))
-        .collect::<BTreeSet<usize>>()
-        .into_iter()
-        .collect();
-    let centre_light = model_light(&buried);
     let mut open_luxels: BTreeMap<usize, usize> = BTreeMap::new();
     let mut sums: BTreeMap<(usize, u8), [f64; 3]> = BTreeMap::new();
     for (light, hidden) in faces.iter().zip(hidden).filter(in_brush_model) {
@@ -500,18 +507,12 @@ fn fill_hidden_luxels(
             continue;
         }
         let count = open_luxels.get(&model).copied().unwrap_or(0);
-        let means = || {
-            sums.range((model, 0)..=(model, u8::MAX))
-                .map(|(&(_, style), sum)| (style, sum.map(|s| (s / count as f64) as f32)))
-                .collect::<Vec<_>>()
-        };
-        let fill = match centre_light.get(&model) {
-            Some(light) => light.clone(),
-            None if count > 0 => means(),
-            None => continue,
-        };
+        if count == 0 {
+            continue;
+        }
         let n = light.width * light.height;
-        for (style, value) in fill {
+        for (&(_, style), sum) in sums.range((model, 0)..=(model, u8::MAX)) {
+            let value = sum.map(|s| (s / count as f64) as f32);
             let at = light.styles.iter().position(|(s, _)| *s == style);
             let at = at.unwrap_or_else(|| {
                 light.styles.push((style, vec![[0.0; 3]; n]));

@@ -233,6 +233,11 @@ fn open_luxel_means(
 }
 
 impl SampleLight {
+    /// Whether any sample is inside solid.
+    pub fn has_occluded(&self) -> bool {
+        self.occluded.contains(&true)
+    }
+
     /// Per luxel, whether its every sample is inside solid (empty when no sample is).
     pub fn hidden_luxels(&self) -> Vec<bool> {
         if !self.occluded.contains(&true) {
@@ -242,6 +247,29 @@ impl SampleLight {
             .chunks(self.per_luxel)
             .map(|o| o.iter().all(|&o| o))
             .collect()
+    }
+
+    /// ericw-tools' "autominlight" for a brush model's face: every occluded sample takes
+    /// `light` (the model's light per style, nothing of the face's other styles) and counts as
+    /// open from here on. Floors still raise it.
+    pub fn with_model_light(mut self, light: &[(u8, [f32; 3])]) -> SampleLight {
+        if !self.has_occluded() {
+            return self;
+        }
+        for &(style, _) in light {
+            self.sums.get(style);
+        }
+        for (style, values) in &mut self.sums.styles {
+            let value = light
+                .iter()
+                .find(|(s, _)| s == style)
+                .map_or([0.0; 3], |&(_, c)| c);
+            for (v, _) in values.iter_mut().zip(&self.occluded).filter(|(_, o)| **o) {
+                *v = value;
+            }
+        }
+        self.occluded.clear();
+        self
     }
 
     /// Per style, the luxel means of the light that reflects: lights and
