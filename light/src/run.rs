@@ -18,7 +18,7 @@ use crate::error::LightError;
 use crate::faces::{FaceGeom, OwnGrid};
 use crate::lightgrid::{GridSources, RawGrid, finish_grid, light_at, trace_grid};
 use crate::lighting::{Lighting, RawLighting, Stats};
-use crate::lights::assign_switchable_styles;
+use crate::lights::{AutoMinlight, assign_switchable_styles};
 use crate::luxels::ToLuxels;
 use crate::options::Options;
 use crate::output::{self, Finish, Outputs, finish_face, finish_face_on_own_grid};
@@ -74,13 +74,29 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
         },
     };
     let model_light = |models: &[usize]| plan.model_centre_light(models);
+    let autominlight = &prep.lights.autominlight;
+    // Models whose samples in solid take no light: those that cast shadows, and `-1`.
+    let dark_models: Vec<usize> = (prep.lights.shadow_models.iter().copied())
+        .chain(
+            (autominlight.iter())
+                .filter(|(_, a)| **a == AutoMinlight::Off)
+                .map(|(&m, _)| m),
+        )
+        .collect();
+    let everywhere: Vec<usize> = (autominlight.iter())
+        .filter(|(_, a)| **a == AutoMinlight::Everywhere)
+        .map(|(&m, _)| m)
+        .collect();
     let (faces, own_grids) = finish_faces(
         traced,
         &bounced,
         &prep.faces,
-        &prep.lights.shadow_models,
+        ModelFill {
+            dark: &dark_models,
+            everywhere: &everywhere,
+            light: &model_light,
+        },
         to_luxels,
-        &model_light,
     );
     stats.luxels = faces.iter().map(|l| (l.width * l.height) as u64).sum();
     stats.faces_lit = faces.len();
@@ -309,9 +325,9 @@ impl<'a> Plan<'a> {
     }
 
     /// Per brush model of `models`, ericw-tools' estimate of its light ("autominlight"): the
-    /// direct light at the middle of its box (moved out of solid as a light is; a model whose
-    /// middle no step frees has none) as a grid point takes it, without minlight, scaled once
-    /// more by the range scale as ericw-tools' value is.
+    /// direct light at the middle of its box or its `_autominlight_target` (moved out of solid
+    /// as a light is; a model whose point no step frees has none) as a grid point takes it,
+    /// without minlight, scaled once more by the range scale as ericw-tools' value is.
     fn model_centre_light(&self, models: &[usize]) -> ModelLight {
         if self.fullbright {
             return ModelLight::new();
@@ -322,7 +338,8 @@ impl<'a> Plan<'a> {
                 let model = self.bsp.models.get(m)?;
                 let corner = |c: [f32; 3]| DVec3::from(c.map(f64::from));
                 let centre = (corner(model.mins) + corner(model.maxs)) / 2.0;
-                Some((m, crate::nudge::free_point(self.bsp, centre)?))
+                let at = self.prep.lights.autominlight_at.get(&m).copied();
+                Some((m, crate::nudge::free_point(self.bsp, at.unwrap_or(centre))?))
             })
             .collect();
         let points: Vec<DVec3> = placed.iter().map(|&(_, p)| p).collect();
@@ -386,20 +403,31 @@ impl<'a> Plan<'a> {
 /// Light per style (light units) of some brush models, by model.
 type ModelLight = BTreeMap<usize, Vec<(u8, [f32; 3])>>;
 
+/// What the samples of brush models take where they are inside solid.
+#[derive(Clone, Copy)]
+struct ModelFill<'a> {
+    /// None: those of models that cast shadows, and of `_autominlight -1`.
+    dark: &'a [usize],
+    /// Models whose every sample takes at least their light (`_autominlight 1`).
+    everywhere: &'a [usize],
+    /// The light of the given models (ericw-tools' autominlight).
+    light: &'a (dyn Fn(&[usize]) -> ModelLight + Sync),
+}
+
 /// Each wanted face's light with its bounced light added, floors applied and samples averaged
 /// to luxels: on its 16-texel grid, and beside it the light on its own grid when it was lit
 /// there (the 16-texel light is then read from that). The occluded samples of the faces of
-/// `shadow_models` stay dark; those of other brush models take the light `model_light` gives
+/// `models.dark` stay dark; those of other brush models take the light `models.light` gives
 /// their model (ericw-tools' autominlight), or if it gives none, as [`fill_hidden_luxels`]
 /// says.
 fn finish_faces(
     traced: Vec<Traced>,
     bounced: &[StyleLuxels],
     geoms: &[FaceGeom],
-    shadow_models: &[usize],
+    models: ModelFill,
     to_luxels: ToLuxels,
-    model_light: &(dyn Fn(&[usize]) -> ModelLight + Sync),
 ) -> (Vec<FaceLight>, Vec<Option<OwnGridLight>>) {
+    let shadow_models = models.dark;
     // Gathered first, into room for all, so no vector here grows in steps (each step takes
     // fresh pages) and the parallel collect knows its length.
     let mut lit: Vec<SampleLight> = Vec::with_capacity(traced.len());
@@ -411,14 +439,18 @@ fn finish_faces(
         .iter()
         .filter(|light| light.has_occluded())
         .map(model_of)
+        .chain(models.everywhere.iter().copied())
         .filter(|&m| m != 0 && !shadow_models.contains(&m))
         .collect();
-    let centre_light = model_light(&buried.into_iter().collect::<Vec<_>>());
+    let centre_light = (models.light)(&buried.into_iter().collect::<Vec<_>>());
     let lit: Vec<SampleLight> = lit
         .into_iter()
-        .map(|light| match centre_light.get(&model_of(&light)) {
-            Some(centre) => light.with_model_light(centre),
-            None => light,
+        .map(|light| {
+            let model = model_of(&light);
+            match centre_light.get(&model) {
+                Some(centre) => light.with_model_light(centre, models.everywhere.contains(&model)),
+                None => light,
+            }
         })
         .collect();
     let hidden: Vec<Vec<bool>> = lit.iter().map(SampleLight::hidden_luxels).collect();

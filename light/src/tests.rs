@@ -1296,6 +1296,38 @@ fn a_buried_door_face_takes_the_light_at_the_doors_middle() {
 }
 
 #[test]
+fn autominlight_keys_turn_it_off_everywhere_or_take_it_elsewhere() {
+    let end_grey = |bsp: &Bsp| {
+        let end = door_face_facing(bsp)(DVec3::X);
+        face_grey(
+            &compute_lighting(bsp, &options(Quality::Default)).expect("light"),
+            end,
+        )
+    };
+    // `-1`: the buried end takes no light.
+    let off = end_grey(&door_in_wall_bsp("\"_autominlight\" \"-1\""));
+    assert!(off.iter().all(|&v| v == 0), "{off:?}");
+    // `1`: every luxel of the door takes at least the door's light, the buried end that light.
+    let bsp = door_in_wall_bsp("\"_autominlight\" \"1\"");
+    let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
+    let door_face = door_face_facing(&bsp);
+    for normal in [DVec3::X, -DVec3::X, DVec3::Z, -DVec3::Y] {
+        let grey = face_grey(&lighting, door_face(normal));
+        assert!(grey.iter().all(|&v| v + 1 >= 41), "{normal}: {grey:?}");
+    }
+    // A target 8 units under the light (300, linear): 292, halved to 146, written as 73.
+    let mut bsp = door_in_wall_bsp("\"_autominlight_target\" \"spot\"");
+    let text = bsp.entity_text()
+        + "{\n\"classname\" \"info_null\"\n\"targetname\" \"spot\"\n\"origin\" \"0 0 -40\"\n}\n";
+    bsp.set_entity_text(&text);
+    let spot = end_grey(&bsp);
+    assert!(
+        !spot.is_empty() && spot.iter().all(|&v| v.abs_diff(73) <= 1),
+        "{spot:?}"
+    );
+}
+
+#[test]
 fn a_shadow_casting_models_faces_inside_a_wall_stay_dark() {
     let bsp = door_in_wall_bsp("\"_shadow\" \"1\"");
     let door_face = door_face_facing(&bsp);

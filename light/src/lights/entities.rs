@@ -28,17 +28,22 @@ pub const DEFAULT_DEVIANCE_SAMPLES: usize = 16;
 /// and only costs time and memory.
 pub const MAX_DEVIANCE_SAMPLES: usize = 4096;
 
-/// Every light entity of `entities`, into `out` (in entity order), with a warning for each key
-/// not taken as written.
-pub fn read_lights(entities: &[Entity], global: &Global, out: &mut MapLights) {
-    // Where spotlights aim with `target`.
-    let origins: HashMap<&str, DVec3> = entities
+/// The `origin` of each entity with a `targetname`, by that name.
+pub fn target_origins(entities: &[Entity]) -> HashMap<&str, DVec3> {
+    entities
         .iter()
         .filter_map(|e| {
             let [x, y, z] = e.get_floats::<3>("origin")?;
             Some((e.get("targetname")?, DVec3::new(x, y, z)))
         })
-        .collect();
+        .collect()
+}
+
+/// Every light entity of `entities`, into `out` (in entity order), with a warning for each key
+/// not taken as written.
+pub fn read_lights(entities: &[Entity], global: &Global, out: &mut MapLights) {
+    // Where spotlights aim with `target`.
+    let origins = target_origins(entities);
     for (index, e) in entities.iter().enumerate() {
         if model_index(e).is_some_and(|m| m > 0) || !e.classname().starts_with("light") {
             continue;

@@ -212,6 +212,13 @@ entity_keys! {
     /// default is the world's shadow), `-1` casts none and `func_detail_illusionary` casts none
     /// unless `1` (the compiler marks their faces in the BSP for light).
     SHADOW: ["_shadow"] on Models, Number, default "`0`";
+    /// ericw-tools' autominlight: the model's samples inside solid take the direct light at the
+    /// middle of its box (or at `_autominlight_target`'s entity), halved as ericw-tools' is.
+    /// `-1`: they take none (they stay dark); `1`: every sample of the model takes at least that
+    /// light.
+    AUTOMINLIGHT: ["_autominlight"] on Models, Number, default "`0`";
+    /// The `targetname` of the entity at whose `origin` the model's autominlight is taken.
+    AUTOMINLIGHT_TARGET: ["_autominlight_target"] on Models, Text, default "—";
     /// `1`: the model's shadow can be switched by the game. Style-0 light it blocks goes on a
     /// style of its own (from 32 up, shared with the lights and models of the same `targetname`;
     /// a model without one gets its own), written into the entity as `switchshadstyle`: QuakeC

@@ -79,6 +79,16 @@ impl BounceSettings {
     }
 }
 
+/// A brush model's `_autominlight` other than the default (its samples in solid take the light
+/// at its middle).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AutoMinlight {
+    /// `-1`: its samples in solid take no light.
+    Off,
+    /// `1`: every sample of the model takes at least that light.
+    Everywhere,
+}
+
 /// Everything the entity lump says about lighting.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MapLights {
@@ -97,6 +107,10 @@ pub struct MapLights {
     pub lightignore_models: Vec<usize>,
     /// Brush models whose faces do not reflect light (`_bounce 0`).
     pub no_bounce_models: Vec<usize>,
+    /// Brush models whose `_autominlight` is not the default (occluded samples only).
+    pub autominlight: HashMap<usize, AutoMinlight>,
+    /// Brush models whose autominlight is taken at a target's origin (`_autominlight_target`).
+    pub autominlight_at: HashMap<usize, DVec3>,
     /// Light entities that stay where they are even in solid (`_nonudge 1`).
     pub no_nudge: Vec<usize>,
     /// Diffuse interreflection (`_bounce` and its keys).
@@ -200,6 +214,8 @@ pub fn parse_lights(
         no_dirt_models: Vec::new(),
         lightignore_models: Vec::new(),
         no_bounce_models: Vec::new(),
+        autominlight: HashMap::new(),
+        autominlight_at: HashMap::new(),
         no_nudge: Vec::new(),
         bounce: worldspawn::bounce(&settings, &global),
         dirt: dirt_sampling(&settings),

@@ -8,9 +8,9 @@ use quake_formats::entities::Entity;
 
 use glam::DVec3;
 
-use super::MapLights;
 use super::keys::{self, Keys};
 use super::worldspawn::Global;
+use super::{AutoMinlight, MapLights};
 
 /// The brush model an entity names with its `model` key (`*N`), if any.
 pub fn model_index(e: &Entity) -> Option<usize> {
@@ -45,6 +45,7 @@ pub fn read_world_and_model_keys(entities: &[Entity], world: Option<usize>, out:
 /// The lighting keys of every brush model (not the world), into `out`, with a warning for each
 /// key not taken as written.
 pub fn read_models(entities: &[Entity], global: &Global, out: &mut MapLights) {
+    let origins = super::entities::target_origins(entities);
     for (index, e) in entities.iter().enumerate() {
         let Some(model) = model_index(e).filter(|&m| m > 0) else {
             continue;
@@ -70,6 +71,21 @@ pub fn read_models(entities: &[Entity], global: &Global, out: &mut MapLights) {
         }
         if k.switch(&keys::LIGHTIGNORE) == Some(true) {
             out.lightignore_models.push(model);
+        }
+        match k.number(&keys::AUTOMINLIGHT) {
+            Some(v) if v < 0.0 => {
+                out.autominlight.insert(model, AutoMinlight::Off);
+            }
+            Some(v) if v > 0.0 => {
+                out.autominlight.insert(model, AutoMinlight::Everywhere);
+            }
+            _ => {}
+        }
+        if let Some(at) = k
+            .text(&keys::AUTOMINLIGHT_TARGET)
+            .and_then(|t| origins.get(t))
+        {
+            out.autominlight_at.insert(model, *at);
         }
         if k.number(&keys::BOUNCE).is_some_and(|b| b <= 0.0) {
             out.no_bounce_models.push(model);

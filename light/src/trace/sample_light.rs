@@ -251,21 +251,27 @@ impl SampleLight {
 
     /// ericw-tools' "autominlight" for a brush model's face: every occluded sample takes
     /// `light` (the model's light per style, nothing of the face's other styles) and counts as
-    /// open from here on. Floors still raise it.
-    pub fn with_model_light(mut self, light: &[(u8, [f32; 3])]) -> SampleLight {
-        if !self.has_occluded() {
+    /// open from here on; with `everywhere`, every other sample is raised to it too. Floors
+    /// still raise them.
+    pub fn with_model_light(mut self, light: &[(u8, [f32; 3])], everywhere: bool) -> SampleLight {
+        if !everywhere && !self.has_occluded() {
             return self;
         }
         for &(style, _) in light {
             self.sums.get(style);
         }
+        let n = self.sums.len;
         for (style, values) in &mut self.sums.styles {
             let value = light
                 .iter()
                 .find(|(s, _)| s == style)
                 .map_or([0.0; 3], |&(_, c)| c);
-            for (v, _) in values.iter_mut().zip(&self.occluded).filter(|(_, o)| **o) {
-                *v = value;
+            for (i, v) in values.iter_mut().enumerate().take(n) {
+                if self.occluded.get(i).copied().unwrap_or(false) {
+                    *v = value;
+                } else if everywhere {
+                    *v = std::array::from_fn(|k| v[k].max(value[k]));
+                }
             }
         }
         self.occluded.clear();
