@@ -16,6 +16,7 @@ use std::sync::Arc;
 
 use glam::{DVec3, Vec3};
 use quake_formats::Bsp;
+use quake_formats::geom::Bounds;
 use quake_formats::miptex::MipTex;
 
 use crate::embree::{Device, RayPacket16, Scene, sys};
@@ -128,13 +129,13 @@ impl FenceFace {
 /// walk costs about as much on a few small signs as on many faces).
 #[derive(Debug)]
 struct FenceBoxes {
-    all: (Vec3, Vec3),
+    all: Bounds,
     /// One per face; empty past [`MAX_FACE_BOXES`] faces, where `all` alone is tested.
-    each: Vec<(Vec3, Vec3)>,
+    each: Vec<Bounds>,
 }
 
-/// Room around the boxes for the rounding of a segment's ends.
-const BOX_MARGIN: f32 = 1.0;
+/// Room around the boxes for the rounding of a segment's ends (rays are single precision).
+const BOX_MARGIN: f64 = 1.0;
 
 /// Faces beyond which a ray is tested against the box of all fences only.
 const MAX_FACE_BOXES: usize = 64;
@@ -142,17 +143,17 @@ const MAX_FACE_BOXES: usize = 64;
 impl FenceBoxes {
     fn new(faces: &[(&FaceGeom, Arc<TexelMask>)]) -> FenceBoxes {
         let box_of = |points: &[DVec3]| {
-            let (lo, hi) = points.iter().fold(
-                (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-                |(lo, hi), p| (lo.min(p.as_vec3()), hi.max(p.as_vec3())),
-            );
-            (lo - BOX_MARGIN, hi + BOX_MARGIN)
+            let mut b = Bounds::EMPTY;
+            for &p in points {
+                b.add_point(p);
+            }
+            Bounds {
+                mins: b.mins - BOX_MARGIN,
+                maxs: b.maxs + BOX_MARGIN,
+            }
         };
-        let each: Vec<_> = faces.iter().map(|(f, _)| box_of(&f.points)).collect();
-        let all = each.iter().fold(
-            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-            |(lo, hi), b| (lo.min(b.0), hi.max(b.1)),
-        );
+        let each: Vec<Bounds> = faces.iter().map(|(f, _)| box_of(&f.points)).collect();
+        let all = each.iter().fold(Bounds::EMPTY, |acc, b| acc.union(b));
         FenceBoxes {
             all,
             each: if each.len() <= MAX_FACE_BOXES {
@@ -165,20 +166,21 @@ impl FenceBoxes {
 
     /// Of `lanes` of `packet`, those whose segment's box meets a fence face's box.
     fn lanes_near(&self, packet: &RayPacket16, lanes: u16) -> u16 {
-        let overlaps =
-            |(lo, hi): (Vec3, Vec3), b: &(Vec3, Vec3)| lo.cmple(b.1).all() && hi.cmpge(b.0).all();
         let mut near = 0;
         for lane in (0..16).filter(|&l| lanes & (1 << l) != 0) {
             let Some((org, dir, tnear, tfar)) = packet.segment(lane) else {
                 continue;
             };
-            let (org, dir) = (Vec3::from(org), Vec3::from(dir));
-            let (a, b) = (org + dir * tnear, org + dir * tfar);
-            let segment = (a.min(b), a.max(b));
+            let (org, dir) = (Vec3::from(org).as_dvec3(), Vec3::from(dir).as_dvec3());
+            let (a, b) = (org + dir * f64::from(tnear), org + dir * f64::from(tfar));
+            let segment = Bounds {
+                mins: a.min(b),
+                maxs: a.max(b),
+            };
             let finite = a.is_finite() && b.is_finite();
             if !finite
-                || overlaps(segment, &self.all)
-                    && (self.each.is_empty() || self.each.iter().any(|f| overlaps(segment, f)))
+                || segment.intersects(&self.all)
+                    && (self.each.is_empty() || self.each.iter().any(|f| segment.intersects(f)))
             {
                 near |= 1 << lane;
             }

@@ -138,31 +138,23 @@ pub fn trace_grid(sources: &GridSources, spacing: DVec3) -> Result<RawGrid, Ligh
             most: MAX_GRID_POINTS,
         });
     }
-    let suns = if sources.every_sun_direction {
-        sources.suns.to_vec()
-    } else {
-        grid_suns(sources.suns)
-    };
-    let sources = &GridSources {
-        suns: &suns,
-        ..*sources
-    };
-    let sky = LeafSky::new(sources.bsp, sources.suns);
     let [w, h, d] = size;
     // A run of a row along x at a time: its points share the lights that may reach them and
     // fill packets of rays.
     let runs_per_row = (w + RUN - 1) / RUN;
-    let runs: Vec<(Vec<RawPoint>, u64)> = (0..h * d * runs_per_row)
-        .into_par_iter()
-        .map(|k| {
-            let (run, row) = (k % runs_per_row, k / runs_per_row);
-            let (y, z) = (row % h, row / h);
-            let points: Vec<DVec3> = (run * RUN..(run * RUN + RUN).min(w))
-                .map(|x| mins + DVec3::new(f64::from(x), f64::from(y), f64::from(z)) * spacing)
-                .collect();
-            trace_run(sources, &sky, &points)
-        })
-        .collect();
+    let runs: Vec<(Vec<RawPoint>, u64)> = with_grid_suns(sources, |sources, sky| {
+        (0..h * d * runs_per_row)
+            .into_par_iter()
+            .map(|k| {
+                let (run, row) = (k % runs_per_row, k / runs_per_row);
+                let (y, z) = (row % h, row / h);
+                let points: Vec<DVec3> = (run * RUN..(run * RUN + RUN).min(w))
+                    .map(|x| mins + DVec3::new(f64::from(x), f64::from(y), f64::from(z)) * spacing)
+                    .collect();
+                trace_run(sources, sky, &points)
+            })
+            .collect()
+    });
     let rays = runs.iter().map(|(_, r)| r).sum();
     Ok(RawGrid {
         spacing,
@@ -176,6 +168,18 @@ pub fn trace_grid(sources: &GridSources, spacing: DVec3) -> Result<RawGrid, Ligh
 /// The light at each of `points` (anywhere, apart from each other) as a grid point there would
 /// take it; `None` for a point inside solid or sky.
 pub fn light_at(sources: &GridSources, points: &[DVec3]) -> Vec<RawPoint> {
+    with_grid_suns(sources, |sources, sky| {
+        // One point to a run: the leaf walk takes a run's points as one straight row.
+        points
+            .par_iter()
+            .flat_map_iter(|p| trace_run(sources, sky, std::slice::from_ref(p)).0)
+            .collect()
+    })
+}
+
+/// `f` with `sources` whose suns are sampled as grid points sample them ([`grid_suns`], or all
+/// of them for the reference), and the sky each leaf sees of those.
+fn with_grid_suns<R>(sources: &GridSources, f: impl FnOnce(&GridSources, &LeafSky) -> R) -> R {
     let suns = if sources.every_sun_direction {
         sources.suns.to_vec()
     } else {
@@ -185,12 +189,7 @@ pub fn light_at(sources: &GridSources, points: &[DVec3]) -> Vec<RawPoint> {
         suns: &suns,
         ..*sources
     };
-    let sky = LeafSky::new(sources.bsp, sources.suns);
-    // One point to a run: the leaf walk takes a run's points as one straight row.
-    points
-        .par_iter()
-        .flat_map_iter(|p| trace_run(sources, &sky, std::slice::from_ref(p)).0)
-        .collect()
+    f(sources, &LeafSky::new(sources.bsp, sources.suns))
 }
 
 /// Deeper than this no walk of a sound world tree goes.

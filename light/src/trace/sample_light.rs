@@ -240,7 +240,7 @@ impl SampleLight {
 
     /// Per luxel, whether its every sample is inside solid (empty when no sample is).
     pub fn hidden_luxels(&self) -> Vec<bool> {
-        if !self.occluded.contains(&true) {
+        if !self.has_occluded() {
             return Vec::new();
         }
         self.occluded
@@ -260,13 +260,12 @@ impl SampleLight {
         for &(style, _) in light {
             self.sums.get(style);
         }
-        let n = self.sums.len;
         for (style, values) in &mut self.sums.styles {
             let value = light
                 .iter()
                 .find(|(s, _)| s == style)
                 .map_or([0.0; 3], |&(_, c)| c);
-            for (i, v) in values.iter_mut().enumerate().take(n) {
+            for (i, v) in values.iter_mut().enumerate() {
                 if self.occluded.get(i).copied().unwrap_or(false) {
                     *v = value;
                 } else if everywhere {
