@@ -141,7 +141,8 @@ const BOX_MARGIN: f64 = 1.0;
 const MAX_FACE_BOXES: usize = 64;
 
 impl FenceBoxes {
-    fn new(faces: &[(&FaceGeom, Arc<TexelMask>)]) -> FenceBoxes {
+    /// The boxes of the fence faces with these corners.
+    fn new<'a>(faces: impl Iterator<Item = &'a [DVec3]>) -> FenceBoxes {
         let box_of = |points: &[DVec3]| {
             let mut b = Bounds::EMPTY;
             for &p in points {
@@ -152,7 +153,7 @@ impl FenceBoxes {
                 maxs: b.maxs + BOX_MARGIN,
             }
         };
-        let each: Vec<Bounds> = faces.iter().map(|(f, _)| box_of(&f.points)).collect();
+        let each: Vec<Bounds> = faces.map(box_of).collect();
         let all = each.iter().fold(Bounds::EMPTY, |acc, b| acc.union(b));
         FenceBoxes {
             all,
@@ -221,7 +222,7 @@ impl Fences {
             scene: mesh.commit(device)?,
             triangles: mesh.faces,
             faces: fence_faces,
-            boxes: FenceBoxes::new(faces),
+            boxes: FenceBoxes::new(faces.iter().map(|(f, _)| &f.points[..])),
         }))
     }
 
@@ -274,6 +275,30 @@ impl Fences {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_ray_near_a_fence_face_is_walked_and_one_far_from_all_is_not() {
+        let face = [
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(0.0, 64.0, 0.0),
+            DVec3::new(0.0, 64.0, 64.0),
+            DVec3::new(0.0, 0.0, 64.0),
+        ];
+        let boxes = FenceBoxes::new(std::iter::once(&face[..]));
+        let mut packet = RayPacket16::new();
+        // Through the face; ending half a unit short of its plane (within the margin); beside
+        // it; and far from it.
+        packet.set(0, [-32.0, 32.0, 32.0], [1.0, 0.0, 0.0], 0.0, 64.0);
+        packet.set(1, [-32.0, 32.0, 32.0], [1.0, 0.0, 0.0], 0.0, 31.5);
+        packet.set(2, [-32.0, 200.0, 32.0], [1.0, 0.0, 0.0], 0.0, 64.0);
+        packet.set(3, [500.0, 500.0, 500.0], [0.0, 0.0, 1.0], 0.0, 100.0);
+        assert_eq!(boxes.lanes_near(&packet, 0b1111), 0b0011);
+        assert_eq!(
+            boxes.lanes_near(&packet, 0b0010),
+            0b0010,
+            "only the lanes asked"
+        );
+    }
 
     #[test]
     fn masks_tile_and_need_an_open_texel() {

@@ -283,6 +283,29 @@ mod tests {
         assert_eq!(l.contribution(10.0, DVec3::new(1.0, 0.0, 0.0), -0.5), 0.0);
     }
 
+    proptest::proptest! {
+        /// What light's per-sample cut relies on (`trace::points`): past its range, by the
+        /// relative margin on the squared distance, a light adds less than the gate.
+        #[test]
+        fn past_its_range_a_light_adds_less_than_the_gate(
+            falloff in proptest::sample::select(vec![
+                Falloff::Linear,
+                Falloff::Inverse,
+                Falloff::InverseSquare,
+                Falloff::InverseSquareSoft,
+            ]),
+            value in 1.0f64..5000.0,
+            wait in 0.05f64..10.0,
+            gate in 0.001f64..2.0,
+            beyond in 0.0f64..3.0,
+        ) {
+            let l = light(falloff, value, wait);
+            let range = l.range(gate);
+            let dist = (range * range * (1.0 + 1e-9)).sqrt() * (1.0 + beyond);
+            proptest::prop_assert!(l.value_at(dist).abs() < gate, "{} at {}", l.value_at(dist), dist);
+        }
+    }
+
     #[test]
     fn angle_factor_blends_cosine() {
         assert_eq!(angle_factor(1.0, 0.5), 1.0);
