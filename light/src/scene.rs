@@ -4,7 +4,9 @@
 //! A `_shadowself` model gets a small scene of its own, which only rays
 //! from that model's faces are tested against. `_switchableshadow` models
 //! get a scene per style, apart from the rest: what they block of style-0
-//! light goes on their style ([`TraceScene::switchable_blocks16`]).
+//! light goes on their style ([`TraceScene::switchable_blocks16`]), but for
+//! rays from their own faces (and those of models sharing their style), which
+//! they shadow as fixed geometry, as ericw-tools does.
 //! Fence faces are kept apart too, so light can pass their open texels
 //! ([`crate::fence`]).
 
@@ -38,6 +40,8 @@ pub struct TraceScene {
     own: HashMap<usize, Scene>,
     /// Per switchable shadow style, the faces of its models.
     switchable: Vec<(u8, Scene)>,
+    /// Per switchable shadow model, the index in `switchable` of its style.
+    own_switchable: HashMap<usize, usize>,
     /// The shadow-casting fence faces, whose open texels let light through.
     fences: Option<Fences>,
     /// Triangles in the scene (opaque + sky) and the `_shadowself` scenes.
@@ -141,6 +145,14 @@ impl TraceScene {
             triangles += mesh.triangles.len();
             switchable.push((style, mesh.commit(device)?));
         }
+        let own_switchable = casters
+            .switchable
+            .iter()
+            .filter_map(|&(model, style)| {
+                let k = switchable.iter().position(|(s, _)| *s == style)?;
+                Some((model, k))
+            })
+            .collect();
         let sky_only = if sky.triangles.is_empty() {
             None
         } else {
@@ -156,6 +168,7 @@ impl TraceScene {
             opaque_faces: opaque.faces,
             own,
             switchable,
+            own_switchable,
             fences,
             triangles,
         })
@@ -171,6 +184,12 @@ impl TraceScene {
     /// number `k` block.
     pub fn switchable_blocks16(&self, packet: &mut RayPacket16, k: usize) -> u16 {
         self.switchable[k].1.occluded16(packet, true)
+    }
+
+    /// The number (as [`TraceScene::switchable_blocks16`] takes it) of the switchable shadow
+    /// `model` is part of, whose models shadow `model`'s faces as fixed geometry.
+    pub fn own_switchable(&self, model: usize) -> Option<usize> {
+        self.own_switchable.get(&model).copied()
     }
 
     /// Lanes of `packet` any switchable shadow blocks: sunlight takes them as fixed shadows.
@@ -200,11 +219,16 @@ impl TraceScene {
     }
 
     /// Lanes of `packet` (each up to its current `tfar`) that `model`'s own
-    /// scene blocks; 0 for a model without one.
+    /// scene or its switchable shadow's models block; 0 for a model with neither.
     fn own_occluded16(&self, packet: &mut RayPacket16, model: usize) -> u16 {
-        self.own
+        let own = self
+            .own
             .get(&model)
-            .map_or(0, |own| own.occluded16(packet, true))
+            .map_or(0, |own| own.occluded16(packet, true));
+        // Embree has set the blocked lanes' tfar to -inf: the second query skips them.
+        own | self
+            .own_switchable(model)
+            .map_or(0, |k| self.switchable_blocks16(packet, k))
     }
 
     /// Bit `i` set if lane `i` of `packet`, cast from a face of `model`,
@@ -230,7 +254,8 @@ impl TraceScene {
 
     /// For each active lane of `packet`, cast from a face of `model`, the
     /// opaque face it meets first and the distance to it (`None`: it meets
-    /// nothing, the sky, or `model`'s own `_shadowself` scene first).
+    /// nothing, the sky, or `model`'s own `_shadowself` scene or switchable
+    /// shadow first).
     pub fn first_faces16(
         &self,
         packet: &mut RayPacket16,
@@ -266,8 +291,9 @@ impl TraceScene {
                 out[lane] = Some(packet.tfar(lane));
             }
         }
-        if let Some(own) = self.own.get(&model) {
-            // tfar ends at the world hit, so any hit here is nearer.
+        let own_switchable = self.own_switchable(model).map(|k| &self.switchable[k].1);
+        for own in self.own.get(&model).into_iter().chain(own_switchable) {
+            // tfar ends at the nearest hit so far, so any hit here is nearer.
             let own_ids = own.first_hit_geom16(packet, true);
             for (lane, id) in own_ids.iter().enumerate() {
                 if *id != sys::RTC_INVALID_GEOMETRY_ID {

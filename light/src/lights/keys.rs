@@ -223,7 +223,8 @@ entity_keys! {
     /// style of its own (from 32 up, shared with the lights and models of the same `targetname`;
     /// a model without one gets its own), written into the entity as `switchshadstyle`: QuakeC
     /// sets that style to `a` to show the shadow and `m` to hide it. The model casts no fixed
-    /// shadow (its `_shadow` is ignored); sunlight takes it as a fixed one.
+    /// shadow (its `_shadow` is ignored) but on itself and the models sharing its style, which it
+    /// always shadows; sunlight takes it as a fixed one.
     SWITCHABLESHADOW: ["_switchableshadow"] on Models, Number, default "`0`";
     /// `1`: the model shadows itself only.
     SHADOWSELF: ["_shadowself", "_selfshadow"] on Models, Number, default "`0`";

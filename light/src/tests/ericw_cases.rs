@@ -50,12 +50,23 @@ fn luxel_rgb(
     p: DVec3,
     normal: DVec3,
 ) -> Option<[u8; 3]> {
+    luxel_rgb_in(bsp, lighting, (model, p, normal), 0)
+}
+
+/// [`luxel_rgb`] in `style`, of the face of `model` facing `normal` at `p` (`at`).
+fn luxel_rgb_in(
+    bsp: &Bsp,
+    lighting: &Lighting,
+    at: (usize, DVec3, DVec3),
+    style: u8,
+) -> Option<[u8; 3]> {
+    let (model, p, normal) = at;
     let faces = face_geometry(bsp, |_| DVec3::ZERO, |_| Spacing::Quake).expect("faces");
     let face = faces
         .iter()
         .find(|f| f.model == model && f.plane.normal.dot(normal) > 0.999 && face_holds(f, p))?;
     let m = lighting.lightmaps.iter().find(|m| m.face == face.index)?;
-    let slot = m.styles.iter().position(|&s| s == 0)?;
+    let slot = m.styles.iter().position(|&s| s == style)?;
     let [sv, tv] = face
         .vecs
         .map(|v| DVec3::new(v[0].into(), v[1].into(), v[2].into()));
@@ -244,4 +255,49 @@ fn the_inside_of_a_fence_is_lit_as_open_space() {
             "({x}, {y}): {inside:?} against {without:?}"
         );
     }
+}
+
+/// `switchableshadowSelfShadows` (`q1_light_switchableshadow_selfshadows`): a `_switchableshadow`
+/// door with `_minlight 25`, a slab on the floor with a fin standing on it, lit from beside the
+/// fin. The door always shadows itself: where the fin hides the light from the slab, style 0
+/// holds the door's minlight alone and the door's switchable style (32) nothing; on the floor
+/// beyond the door the light the fin blocks is in style 32 alone. ericw-tools writes 12 (its
+/// minlight) and 0 on the door, 0 and 89 on the floor.
+#[test]
+fn a_switchable_shadow_always_shadows_its_own_model() {
+    let door = |keys: &str| {
+        let brushes = map_box([-32.0, -48.0, -128.0], [32.0, 48.0, -112.0])
+            + &map_box([0.0, -32.0, -112.0], [16.0, 32.0, -48.0]);
+        room_bsp(&format!(
+            "{{\n\"classname\" \"func_door\"\n{keys}\n{brushes}}}\n{}",
+            light([100.0, 0.0, -60.0], "\"light\" \"500\"")
+        ))
+    };
+    let slab_behind_fin = (1, DVec3::new(-16.0, 0.0, -112.0), DVec3::Z);
+    let floor_behind_door = (0, DVec3::new(-88.0, 0.0, -128.0), DVec3::Z);
+    let switchable = door("\"_switchableshadow\" \"1\"\n\"_minlight\" \"25\"");
+    let lighting = lit(&switchable);
+    let at = |at, style| luxel_rgb_in(&switchable, &lighting, at, style).unwrap_or([0; 3]);
+    // Within one of ericw-tools' value, as its own check allows.
+    let minlight = at(slab_behind_fin, 0);
+    assert!(
+        minlight.iter().all(|c| c.abs_diff(12) <= 1),
+        "the door's minlight: {minlight:?}"
+    );
+    assert_eq!(
+        at(slab_behind_fin, 32),
+        [0; 3],
+        "nothing in the door's style"
+    );
+    assert_eq!(at(floor_behind_door, 0), [0; 3], "the door's shadow");
+    // The light the door blocks: what the floor takes where the door casts no shadow.
+    let open = door("");
+    let open_floor = luxel_rgb_in(&open, &lit(&open), floor_behind_door, 0);
+    let open_floor = open_floor.expect("the floor is lit without the door's shadow");
+    assert!(open_floor[0] > 40, "{open_floor:?}");
+    assert_eq!(
+        at(floor_behind_door, 32),
+        open_floor,
+        "the blocked light, in style 32"
+    );
 }

@@ -123,9 +123,11 @@ impl FaceTrace<'_> {
 
     /// For a style-0 light whose shadow rays the world let through (`visibility.lit`): the
     /// samples a switchable shadow blocks take its style in `arrive_in` instead (the first
-    /// switchable shadow on the ray, in style order).
+    /// switchable shadow on the ray, in style order). The face's own switchable shadow is none
+    /// of those: it shadows its faces as fixed geometry, which the world's test included.
     fn switchable_shadows(&mut self, arrive_in: &mut [u8]) {
         let (setup, samples) = (self.setup, self.samples);
+        let own = setup.scene.own_switchable(self.face.model);
         let styles: Vec<u8> = setup.scene.switchable_styles().collect();
         let scratch = &mut *self.scratch;
         let reached = scratch.visibility.lit.clone();
@@ -137,6 +139,9 @@ impl FaceTrace<'_> {
             (samples.points[i], dir, length)
         };
         for (k, &style) in styles.iter().enumerate() {
+            if Some(k) == own {
+                continue;
+            }
             for (v, o) in values.iter_mut().zip(&open) {
                 if !o {
                     *v = 0.0;
