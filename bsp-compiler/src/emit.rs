@@ -229,6 +229,7 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
     let mut model_faces: Vec<(u32, u32)> = vec![(0, 0); input.models.len()];
     let mut phong = Vec::with_capacity(pending.len());
     let mut flags = Vec::with_capacity(pending.len());
+    let mut surflight_groups = Vec::with_capacity(pending.len());
     let pieces = pending.iter().zip(polygons).flat_map(|(pf, poly)| {
         let max = max_face_edges(
             input.max_edges,
@@ -278,6 +279,7 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
         });
         phong.push(input.texinfos[f.texinfo as usize].phong);
         flags.push(input.texinfos[f.texinfo as usize].flags);
+        surflight_groups.push(input.texinfos[f.texinfo as usize].surflight_group);
         let range = node_faces
             .entry((pf.model, f.node))
             .or_insert((face_index, 0));
@@ -369,6 +371,7 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
     bsp.texinfo = textures.out_infos;
     bsp.set_phong_faces(&phong);
     bsp.set_face_flags(&flags);
+    bsp.set_surflight_groups(&surflight_groups);
     let mut leaf_flags = vec![LeafFlags::default(); bsp.leafs.len()];
     for &leaf in &fence_leaves {
         leaf_flags[leaf as usize].fence = true;

@@ -100,6 +100,7 @@ pub(crate) fn gather(
                 phong: merged_phong(ent, index, brush_class),
                 lit_water: lit_water(&map.entities, ent, options.lit_water),
                 flags: merged_face_flags(ent, index, brush_class),
+                surflight_group: merged_surflight_group(ent, index, brush_class, warnings),
             },
             transwater: options.transwater,
             bmodel_contents: options.bmodel_contents,
@@ -217,6 +218,9 @@ pub struct MapTexInfo {
     pub lit_water: bool,
     /// What the world-merged entity's keys say of its faces' shadows and ambient sound.
     pub flags: FaceFlags,
+    /// The `_surflight_group` of the world-merged entity (worldspawn included) the face came
+    /// from; 0: none.
+    pub surflight_group: i32,
 }
 
 /// What a face's entity says about the face, beyond its brush: one of these per entity.
@@ -226,6 +230,7 @@ pub(crate) struct FaceKeys {
     /// Whether its liquids are lit (only liquids' texinfos carry it).
     pub lit_water: bool,
     pub flags: FaceFlags,
+    pub surflight_group: i32,
 }
 
 impl MapTexInfo {
@@ -240,6 +245,7 @@ impl MapTexInfo {
             phong: self.phong,
             lit_water: self.lit_water,
             flags: self.flags,
+            surflight_group: self.surflight_group,
         }
     }
 }
@@ -349,23 +355,29 @@ impl EntityBrushes {
     }
 }
 
+/// What a texinfo is interned by: its projection's bits, texture, phong group, whether it is lit
+/// water, its face flags and surface light group.
+type TexInfoKey = ([u64; 8], u32, u32, bool, FaceFlags, i32);
+
 /// Texture names and texinfos, interned in first-use order.
 #[derive(Default)]
 pub(crate) struct TexInfoTable {
     pub names: Vec<String>,
     name_index: HashMap<String, u32>,
     pub infos: Vec<MapTexInfo>,
-    info_index: HashMap<([u64; 8], u32, u32, bool, FaceFlags), u32>,
+    info_index: HashMap<TexInfoKey, u32>,
 }
 
 impl TexInfoTable {
     /// The texinfo of `name` projected by `vecs` on a face whose entity gives it `keys` (faces
-    /// of different phong groups, lighting or flags never share one, so they never merge).
+    /// of different phong or surface light groups, lighting or flags never share one, so they
+    /// never merge).
     pub(crate) fn intern(&mut self, name: &str, vecs: [[f64; 4]; 2], keys: FaceKeys) -> u32 {
         let FaceKeys {
             phong,
             lit_water,
             flags,
+            surflight_group,
         } = keys;
         let key = name.to_ascii_lowercase();
         let texture = match self.name_index.get(&key) {
@@ -381,7 +393,14 @@ impl TexInfoTable {
         let role = TextureRole::of(name);
         // Only liquids' texinfos depend on it; others stay shared.
         let lit_water = lit_water && matches!(role, TextureRole::Liquid(_));
-        let key = (bits, texture, phong.group, lit_water, flags);
+        let key = (
+            bits,
+            texture,
+            phong.group,
+            lit_water,
+            flags,
+            surflight_group,
+        );
         if let Some(&i) = self.info_index.get(&key) {
             return i;
         }
@@ -393,6 +412,7 @@ impl TexInfoTable {
             phong,
             lit_water,
             flags,
+            surflight_group,
         });
         self.info_index.insert(key, i);
         i
@@ -458,6 +478,35 @@ fn merged_face_flags(ent: &MapEntity, index: usize, class: EntityBrushes) -> Fac
             || (class == EntityBrushes::Illusionary && shadow != Some(1.0)),
         no_ambient: ent.entity.get_float("_noambient").is_some_and(|v| v != 0.0),
     }
+}
+
+/// The `_surflight_group` of entity `index` if it is worldspawn or merged into the world (light
+/// could not tell their faces apart otherwise; it reads brush models' own keys). A value that is
+/// not a whole number warns and leaves no group.
+fn merged_surflight_group(
+    ent: &MapEntity,
+    index: usize,
+    class: EntityBrushes,
+    warnings: &mut Vec<Warning>,
+) -> i32 {
+    const KEY: &str = "_surflight_group";
+    let Some(text) = ent
+        .entity
+        .get(KEY)
+        .filter(|_| class != EntityBrushes::Submodel)
+    else {
+        return 0;
+    };
+    text.trim().parse().unwrap_or_else(|_| {
+        warnings.push(Warning::BadKey {
+            entity: index,
+            line: ent.line,
+            key: KEY.into(),
+            value: text.into(),
+            used: "no group".into(),
+        });
+        0
+    })
 }
 
 /// The `_phong` group of entity `index` if it is merged into the world (its
@@ -750,6 +799,7 @@ mod tests {
             phong,
             lit_water: true,
             flags,
+            surflight_group: 0,
         };
         let plain = table.intern(
             "wall",
@@ -770,6 +820,13 @@ mod tests {
         assert_ne!(a, b);
         assert_eq!(table.infos[b as usize].flags, shadowless);
         assert_eq!(table.infos[a as usize].phong, grouped);
+        let lit_group = FaceKeys {
+            surflight_group: 5,
+            ..keys(FacePhong::default(), FaceFlags::default())
+        };
+        let c = table.intern("wall", vecs, lit_group);
+        assert!(![plain, a, b].contains(&c));
+        assert_eq!(table.infos[c as usize].surflight_group, 5);
         assert_eq!(table.names.len(), 1, "one texture either way");
     }
 }

@@ -254,3 +254,55 @@ fn merged_entities_keys_for_shadow_and_sound_reach_their_faces() {
         flags(false, false)
     );
 }
+
+/// `_surflight_group` on worldspawn and the entities merged into it reaches their faces through
+/// `SLIPGATE_SURFGROUP`; a brush model's stays in its entity for light; no group, no lump.
+#[test]
+fn merged_entities_surface_light_groups_reach_their_faces() {
+    let groups = |world_keys: &str, classname: &str, keys: &str| {
+        let brush = box_brush([-32.0, -32.0, -128.0], [32.0, 32.0, -64.0], "wall2");
+        let entity = format!("{{\n\"classname\" \"{classname}\"\n{keys}\n{brush}}}\n");
+        let out = compile_text(&room_map_with(false, world_keys, &entity));
+        let bsp = out.bsp;
+        let groups = bsp.surflight_groups().expect("lump")?;
+        let of = |box_face: bool| {
+            let mut g: Vec<i32> = (0..bsp.faces.len())
+                .filter(|&f| (face_texture(&bsp, f) == "wall2") == box_face)
+                .map(|f| groups[f])
+                .collect();
+            g.dedup();
+            g
+        };
+        Some((of(true), of(false)))
+    };
+    assert_eq!(groups("", "func_detail", ""), None);
+    assert_eq!(
+        groups("", "func_detail", "\"_surflight_group\" \"3\""),
+        Some((vec![3], vec![0]))
+    );
+    assert_eq!(
+        groups(
+            "\"_surflight_group\" \"2\"\n",
+            "func_group",
+            "\"_surflight_group\" \"-4\""
+        ),
+        Some((vec![-4], vec![2]))
+    );
+    assert_eq!(groups("", "func_wall", "\"_surflight_group\" \"3\""), None);
+}
+
+#[test]
+fn a_surface_light_group_that_is_not_a_number_warns_and_leaves_none() {
+    let brush = box_brush([-32.0, -32.0, -128.0], [32.0, 32.0, -64.0], "wall2");
+    let entity =
+        format!("{{\n\"classname\" \"func_group\"\n\"_surflight_group\" \"red\"\n{brush}}}\n");
+    let out = compile_text(&room_map_with(false, "", &entity));
+    let warned: Vec<String> = out.warnings.iter().map(|w| w.to_string()).collect();
+    assert!(
+        warned
+            .iter()
+            .any(|w| w.contains("\"_surflight_group\" \"red\"") && w.contains("no group")),
+        "{warned:?}"
+    );
+    assert_eq!(out.bsp.surflight_groups().expect("lump"), None);
+}

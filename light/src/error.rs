@@ -22,8 +22,9 @@ pub enum LightError {
     /// Embree failed (starting the device or building the scene).
     #[error(transparent)]
     Embree(#[from] EmbreeError),
-    /// A damaged BSPX lump light reads: the compiler's `SLIPGATE_PHONG` or `SLIPGATE_FACEFLAGS`,
-    /// or a lit BSP's `DECOUPLED_LM`, `LMSHIFT` or `LMOFFSET` (the message names it).
+    /// A damaged BSPX lump light reads: the compiler's `SLIPGATE_PHONG`, `SLIPGATE_FACEFLAGS` or
+    /// `SLIPGATE_SURFGROUP`, or a lit BSP's `DECOUPLED_LM`, `LMSHIFT` or `LMOFFSET` (the message
+    /// names it).
     #[error("{0}")]
     BspxLump(quake_formats::FormatError),
     /// `--lightgrid_dist` so fine for the map that the grid would hold too many points.

@@ -160,10 +160,15 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
         leaf.and_then(|l| bsp.leafs.get(l))
             .is_some_and(|l| quake_formats::bsp::contents::is_liquid(l.contents))
     };
+    let recorded_groups = bsp.surflight_groups().map_err(LightError::BspxLump)?;
+    let groups = surface::SurfaceGroups {
+        models: &map_lights.surflight_groups,
+        faces: recorded_groups.as_deref(),
+    };
     let surface = surface::expand_templates(
         &map_lights.templates,
         &faces,
-        &map_lights.surflight_groups,
+        groups,
         surface::DEFAULT_SPACING,
         &in_liquid,
     );

@@ -2,8 +2,10 @@
 //! face with the named texture, one copy per piece of the face after cutting
 //! it on the lines of a grid of `spacing` units (as ericw-tools does), placed
 //! `offset` units in front of the piece's middle.
-//! A template with a `_surflight_group` only goes on faces of brush models
-//! with that group (and one without on faces of models without one).
+//! A template goes only on faces of its own `_surflight_group` (0 when it has
+//! none): a brush model's from its entity, and for the world's faces the group
+//! the compiler recorded of the entity each came from (worldspawn,
+//! `func_detail*`, `func_group`), as ericw-tools' qbsp records it for its light.
 
 use std::collections::HashMap;
 
@@ -42,17 +44,41 @@ fn subdivide(w: Winding, spacing: f64, out: &mut Vec<Winding>) {
     out.push(w);
 }
 
-/// The lights every template puts on the faces using its texture, in its group (`groups`:
-/// brush models with a non-zero `_surflight_group`). A liquid's faces seen from inside it (those
-/// `in_liquid` says look into liquid from their middle) get none, as in ericw-tools.
+/// Where the faces' `_surflight_group`s come from.
+#[derive(Debug, Clone, Copy)]
+pub struct SurfaceGroups<'a> {
+    /// Brush models with a non-zero group, and that group.
+    pub models: &'a HashMap<usize, i64>,
+    /// Per face, the group the compiler recorded (`SLIPGATE_SURFGROUP`), if the BSP has them.
+    pub faces: Option<&'a [i32]>,
+}
+
+impl SurfaceGroups<'_> {
+    /// The group of face `f`: its model's, else the compiler's record of it, else none (0).
+    fn of(&self, f: &FaceGeom) -> i64 {
+        let recorded = || {
+            self.faces
+                .and_then(|g| g.get(f.index))
+                .map(|&g| i64::from(g))
+        };
+        self.models
+            .get(&f.model)
+            .copied()
+            .or_else(recorded)
+            .unwrap_or(0)
+    }
+}
+
+/// The lights every template puts on the faces using its texture, in its group. A liquid's
+/// faces seen from inside it (those `in_liquid` says look into liquid from their middle) get
+/// none, as in ericw-tools.
 pub fn expand_templates(
     templates: &[SurfaceTemplate],
     faces: &[FaceGeom],
-    groups: &HashMap<usize, i64>,
+    groups: SurfaceGroups,
     spacing: f64,
     in_liquid: &dyn Fn(DVec3) -> bool,
 ) -> Vec<PointLight> {
-    let group_of = |model: usize| groups.get(&model).copied().unwrap_or(0);
     let underwater_side = |f: &FaceGeom| {
         let middle = || f.points.iter().sum::<DVec3>() / f.points.len().max(1) as f64;
         f.texture.starts_with('*') && in_liquid(middle() + f.plane.normal)
@@ -61,7 +87,7 @@ pub fn expand_templates(
     for t in templates {
         for f in faces.iter().filter(|f| {
             f.texture.eq_ignore_ascii_case(&t.texture)
-                && group_of(f.model) == t.group
+                && groups.of(f) == t.group
                 && !underwater_side(f)
         }) {
             let mut pieces = Vec::new();
@@ -84,7 +110,8 @@ mod tests {
     use super::*;
 
     /// ericw-tools: a template with a `_surflight_group` emits only from brushes with the same
-    /// group, and a template without one not from grouped brushes.
+    /// group, and a template without one not from grouped brushes; a brush model's group is its
+    /// entity's, a world face's the one the compiler recorded.
     #[test]
     fn templates_go_only_on_faces_of_their_group() {
         let extents = quake_formats::extents::LightmapExtents {
@@ -111,7 +138,7 @@ mod tests {
             grid: quake_formats::extents::LuxelGrid::vanilla(&extents, &vecs),
             own_grid: None,
         };
-        let faces = [face(0, 0), face(1, 1), face(2, 2)];
+        let faces = [face(0, 0), face(1, 1), face(2, 2), face(3, 0)];
         let template = |group: i64| SurfaceTemplate {
             texture: "LAVA1".to_string(),
             light: PointLight {
@@ -132,12 +159,20 @@ mod tests {
             spot_angle: 40.0,
             group,
         };
-        let groups = HashMap::from([(1, 7)]);
-        let on =
-            |t: SurfaceTemplate| expand_templates(&[t], &faces, &groups, 128.0, &|_| false).len();
-        assert_eq!(on(template(0)), 2, "the world's face and model 2's");
-        assert_eq!(on(template(7)), 1, "model 1's face only");
-        assert_eq!(on(template(3)), 0);
+        let models = HashMap::from([(1, 7)]);
+        let recorded = [0, 0, 0, 3];
+        let on = |t: SurfaceTemplate, recorded: Option<&[i32]>| {
+            let groups = SurfaceGroups {
+                models: &models,
+                faces: recorded,
+            };
+            expand_templates(&[t], &faces, groups, 128.0, &|_| false).len()
+        };
+        assert_eq!(on(template(0), None), 3, "the world's faces and model 2's");
+        assert_eq!(on(template(7), None), 1, "model 1's face only");
+        assert_eq!(on(template(3), None), 0);
+        assert_eq!(on(template(0), Some(&recorded)), 2, "face 0 and model 2's");
+        assert_eq!(on(template(3), Some(&recorded)), 1, "the world's face 3");
     }
 
     /// As ericw-tools' `-surflight_dump` shows: a 64-unit square across the origin is cut into

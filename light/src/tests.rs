@@ -1146,19 +1146,8 @@ fn map_box(lo: [f64; 3], hi: [f64; 3]) -> String {
 /// (about 48 units in radius, from the floor up to z 0) keyed `detail_keys`,
 /// compiled by the bsp compiler.
 fn detail_column_bsp(detail_keys: &str) -> Bsp {
-    let (lo, hi, t) = (-128.0, 128.0, 16.0);
-    let (a, b) = (lo - t, hi + t);
-    let mut world = String::new();
-    for (l, h) in [
-        ([a, a, a], [b, b, lo]),
-        ([a, a, hi], [b, b, b]),
-        ([a, a, lo], [lo, b, hi]),
-        ([hi, a, lo], [b, b, hi]),
-        ([lo, a, lo], [hi, lo, hi]),
-        ([lo, hi, lo], [hi, b, hi]),
-    ] {
-        world += &map_box(l, h);
-    }
+    let lo = -128.0;
+    let world = sealed_room_brushes();
     // Counter-clockwise seen from above.
     let ring = [
         [48.0, -20.0],
@@ -1199,19 +1188,7 @@ fn detail_column_bsp(detail_keys: &str) -> Bsp {
 /// y -16..16, z -128..-64) standing on the floor and reaching 12 units into the +x wall
 /// (128..144), and a light in the room, compiled by the bsp compiler.
 fn door_in_wall_bsp(door_keys: &str) -> Bsp {
-    let (lo, hi, t) = (-128.0, 128.0, 16.0);
-    let (a, b) = (lo - t, hi + t);
-    let mut world = String::new();
-    for (l, h) in [
-        ([a, a, a], [b, b, lo]),
-        ([a, a, hi], [b, b, b]),
-        ([a, a, lo], [lo, b, hi]),
-        ([hi, a, lo], [b, b, hi]),
-        ([lo, a, lo], [hi, lo, hi]),
-        ([lo, hi, lo], [hi, b, hi]),
-    ] {
-        world += &map_box(l, h);
-    }
+    let world = sealed_room_brushes();
     let door = map_box([96.0, -16.0, -128.0], [140.0, 16.0, -64.0]);
     let text = format!(
         "{{\n\"classname\" \"worldspawn\"\n{world}}}\n\
@@ -1380,9 +1357,8 @@ fn a_point_on_a_solid_surface_is_in_solid() {
     }
 }
 
-/// A sealed room (inside -128..128 on every axis) with `entities` (entity blocks) after its
-/// worldspawn, compiled by the bsp compiler.
-fn room_bsp(entities: &str) -> Bsp {
+/// The worldspawn brushes of a sealed room, inside -128..128 on every axis, 16 units thick.
+fn sealed_room_brushes() -> String {
     let (lo, hi, t) = (-128.0, 128.0, 16.0);
     let (a, b) = (lo - t, hi + t);
     let mut world = String::new();
@@ -1396,6 +1372,13 @@ fn room_bsp(entities: &str) -> Bsp {
     ] {
         world += &map_box(l, h);
     }
+    world
+}
+
+/// A sealed room (inside -128..128 on every axis) with `entities` (entity blocks) after its
+/// worldspawn, compiled by the bsp compiler.
+fn room_bsp(entities: &str) -> Bsp {
+    let world = sealed_room_brushes();
     let text = format!(
         "{{\n\"classname\" \"worldspawn\"\n{world}}}\n{entities}\
          {{\n\"classname\" \"info_player_start\"\n\"origin\" \"-90 -90 -100\"\n}}\n"

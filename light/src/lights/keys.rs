@@ -180,8 +180,10 @@ entity_keys! {
     SURFACE_OFFSET: ["_surface_offset"] on Lights, Number, default "`2`";
     /// `1`: those copies shine out of their face as spotlights (cone `angle`).
     SURFACE_SPOTLIGHT: ["_surface_spotlight"] on Lights, Switch, default "`0`";
-    /// A `_surface` template with a group puts its copies only on faces of brush models with the
-    /// same group; one without, only on faces of the world and of models without one.
+    /// A `_surface` template puts its copies only on faces of its own group: those of brush
+    /// entities with the same group, or of worldspawn, `func_detail*` and `func_group` with it
+    /// (the compiler records their faces' groups in the BSP for light); a template without one,
+    /// only on faces without one.
     SURFLIGHT_GROUP: ["_surflight_group"] on LightsAndModels, Whole, default "`0`";
     /// `1`: the light is a sun (parallel light from sky faces) along `mangle` or towards
     /// `target`.

@@ -5,7 +5,7 @@
 use glam::DVec3;
 use quake_formats::Bsp;
 
-use super::{map_box, options, room_bsp};
+use super::{map_box, options, room_bsp, sealed_room_brushes};
 use crate::faces::{FaceGeom, Spacing, face_geometry};
 use crate::{Lighting, Quality, compute_lighting};
 
@@ -299,5 +299,54 @@ fn a_switchable_shadow_always_shadows_its_own_model() {
         at(floor_behind_door, 32),
         open_floor,
         "the blocked light, in style 32"
+    );
+}
+
+/// `surflightGroup` (`q1_light_surflight_group`): two boxes topped with `bolt16` on either side
+/// of a wall, one of the world's, one a `func_detail` with `_surflight_group 1`, and two
+/// `_surface` templates for `bolt16`: a red one without a group and a blue one of group 1. Each
+/// box's top takes the light of its own group's template alone (ericw-tools: 75 0 0 and 0 0 75);
+/// the compiler records the detail box's group in the BSP, as its entity is merged away.
+#[test]
+fn surface_lights_go_only_on_faces_of_their_group() {
+    // A box whose top (`map_box`'s fifth plane) is `bolt16`.
+    let lamp = |lo, hi| {
+        let mut lines: Vec<String> = map_box(lo, hi).lines().map(String::from).collect();
+        lines[5] = lines[5].replace("wall", "bolt16");
+        lines.join("\n") + "\n"
+    };
+    let bsp = compiled(&format!(
+        "{{\n\"classname\" \"worldspawn\"\n{}{}{}}}\n\
+         {{\n\"classname\" \"func_detail\"\n\"_surflight_group\" \"1\"\n{}}}\n{}{}\
+         {{\n\"classname\" \"info_player_start\"\n\"origin\" \"-90 -90 -100\"\n}}\n",
+        sealed_room_brushes(),
+        lamp([-64.0, -96.0, -128.0], [64.0, -32.0, -112.0]),
+        map_box([-128.0, -8.0, -128.0], [128.0, 8.0, -32.0]),
+        lamp([-64.0, 32.0, -128.0], [64.0, 96.0, -112.0]),
+        light(
+            [0.0, -64.0, 0.0],
+            "\"_surface\" \"bolt16\"\n\"_color\" \"1 0 0\""
+        ),
+        light(
+            [0.0, 64.0, 0.0],
+            "\"_surface\" \"bolt16\"\n\"_surflight_group\" \"1\"\n\"_color\" \"0 0 1\""
+        ),
+    ));
+    let lighting = lit(&bsp);
+    let top = |y| {
+        luxel_rgb(&bsp, &lighting, 0, DVec3::new(0.0, y, -112.0), DVec3::Z)
+            .expect("the box's top is lit")
+    };
+    let [r, g, b] = top(-64.0);
+    assert!(
+        r > 40 && g == 0 && b == 0,
+        "the world's box: {:?}",
+        [r, g, b]
+    );
+    let blue = top(64.0);
+    assert_eq!(
+        blue,
+        [0, 0, r],
+        "the detail box: the blue template's light alone"
     );
 }

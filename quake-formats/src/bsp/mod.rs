@@ -3,9 +3,9 @@
 //! The model stores every index as `u32`/`i32` and every bound as `f32`, wide enough for every
 //! version. Each record type knows its encoding per version (`records::Record`); lumps are
 //! read and written by one generic pair of functions. Trailing BSPX lumps are kept as named byte
-//! blobs; [`phong`], [`face_flags`] and [`leaf_flags`] read and write Slipgate's own ones,
-//! [`light_lumps`] those that carry light (coloured, directional, HDR, at other spacings) and
-//! [`lightgrid`] the light grid.
+//! blobs; [`phong`], [`face_flags`], [`surflight_group`] and [`leaf_flags`] read and write
+//! Slipgate's own ones, [`light_lumps`] those that carry light (coloured, directional, HDR, at
+//! other spacings) and [`lightgrid`] the light grid.
 
 pub mod face_flags;
 pub mod leaf_flags;
@@ -14,6 +14,7 @@ pub mod lightgrid;
 pub mod limits;
 pub mod phong;
 mod records;
+pub mod surflight_group;
 mod validate;
 
 pub use crate::bsp_version::BspVersion;

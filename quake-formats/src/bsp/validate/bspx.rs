@@ -10,7 +10,7 @@ use crate::bsp::light_lumps::{
 };
 use crate::bsp::lightgrid::LIGHTGRID_OCTREE;
 use crate::bsp::limits::LMSHIFT_MAX_LIGHTMAP_SIZE;
-use crate::bsp::{face_flags, phong};
+use crate::bsp::{face_flags, phong, surflight_group};
 use crate::extents::LuxelGrid;
 
 pub(super) fn check(c: &mut Checker) {
@@ -28,6 +28,14 @@ pub(super) fn check(c: &mut Checker) {
         c.report(
             Rule::BspxFaceRecords,
             face_flags::LUMP_NAME,
+            0,
+            e.to_string(),
+        );
+    }
+    if let Err(e) = c.bsp.surflight_groups() {
+        c.report(
+            Rule::BspxFaceRecords,
+            surflight_group::LUMP_NAME,
             0,
             e.to_string(),
         );
