@@ -105,3 +105,125 @@ fn a_sky_ceiling_is_one_leaf_and_the_void_past_it_stays_solid() {
     // Each clip hull: the room's six walls.
     assert_eq!(bsp.clipnodes.len(), 12);
 }
+
+/// The inside of [`edge_room`]: 176 x 96 x 128.
+const EDGE_ROOM_INSIDE: ([f64; 3], [f64; 3]) = ([-112.0, -96.0, 96.0], [64.0, 0.0, 224.0]);
+/// Where [`edge_room`]'s player starts: on the floor, near its -x -y corner.
+const EDGE_ROOM_START: [f32; 3] = [-88.0, -64.0, 120.0];
+
+/// A box room with walls 16 thick that overlap nowhere: the floor and the ceiling cover just the
+/// inside's footprint, the four walls stand beside them from the floor's underside to the
+/// ceiling's top, so walls meet each other only along the room's vertical edges and the
+/// outside corners stay void. The ceiling is `ceiling` (a texture name); `entities` follow the
+/// player start.
+fn edge_room(ceiling: &str, entities: &str) -> String {
+    let ([x0, y0, z0], [x1, y1, z1]) = EDGE_ROOM_INSIDE;
+    let t = 16.0;
+    let brushes = [
+        box_brush([x0, y0, z0 - t], [x1, y1, z0], "wall"),
+        box_brush([x0, y0, z1], [x1, y1, z1 + t], ceiling),
+        box_brush([x0 - t, y0, z0 - t], [x0, y1, z1 + t], "wall"),
+        box_brush([x1, y0, z0 - t], [x1 + t, y1, z1 + t], "wall"),
+        box_brush([x0, y0 - t, z0 - t], [x1, y0, z1 + t], "wall"),
+        box_brush([x0, y1, z0 - t], [x1, y1 + t, z1 + t], "wall"),
+    ]
+    .concat();
+    let [sx, sy, sz] = EDGE_ROOM_START;
+    format!(
+        "{{\n\"classname\" \"worldspawn\"\n{brushes}}}\n\
+         {{\n\"classname\" \"info_player_start\"\n\"origin\" \"{sx} {sy} {sz}\"\n}}\n{entities}"
+    )
+}
+
+/// [`edge_room`] with a 64 x 64 box on its floor, 16 high, `below` units of it sunk under the
+/// floor's top, in a brush entity of `classname`.
+fn edge_room_with_box(classname: &str, below: f64) -> String {
+    let floor = EDGE_ROOM_INSIDE.0[2];
+    let block = box_brush(
+        [-16.0, -80.0, floor - below],
+        [48.0, -16.0, floor + 16.0],
+        "block",
+    );
+    edge_room("wall", &brush_entity(classname, &block))
+}
+
+/// ericw-tools' `simpleWorldspawnDetail`: a `func_detail` box on the floor, a light above it.
+/// Sealed; 5 faces of the box and 9 of the room (its floor cut where the box's edges meet it);
+/// one node per face of the room and per face the box shows; at most 22 clip nodes.
+#[test]
+fn a_detail_box_in_an_edge_room() {
+    let light = "{\n\"classname\" \"light\"\n\"origin\" \"-24 -48 152\"\n}\n";
+    let text = edge_room_with_box("func_detail", 0.0) + light;
+    let out = compile_text(&text);
+    let bsp = &out.bsp;
+    assert!(out.leak.is_none());
+    assert_eq!(bsp.faces.len(), 14);
+    assert_eq!(bsp.nodes.len(), 6 + 5);
+    assert!(bsp.clipnodes.len() <= 22, "{}", bsp.clipnodes.len());
+}
+
+/// ericw-tools' `simpleWorldspawnDetailIllusionary`: the box is a `func_detail_illusionary` that
+/// goes down through the floor and 16 units into the void under it. 11 faces and 11 nodes; the
+/// shared solid leaf and six open ones; where the box sticks into the void it is solid; one vis
+/// leaf, no portals.
+#[test]
+fn an_illusionary_box_through_an_edge_room_floor() {
+    let out = compile_text(&edge_room_with_box("func_detail_illusionary", 32.0));
+    let bsp = &out.bsp;
+    assert!(out.leak.is_none());
+    assert_eq!(bsp.faces.len(), 11);
+    assert_eq!(bsp.nodes.len(), 11);
+    assert_eq!(bsp.leafs.len(), 7);
+    assert_eq!(leaf_contents(bsp, [8.0, -40.0, 72.0]), contents::SOLID);
+    assert!(out.portals.portals.is_empty());
+    assert_eq!(vis_clusters(&out.portals), 1);
+}
+
+/// The clip nodes of `hull` (1 or 2) in the world.
+fn clip_nodes_of_hull(bsp: &Bsp, hull: usize) -> usize {
+    let mut count = 0;
+    let mut stack = vec![bsp.models[0].head_nodes[hull]];
+    while let Some(n) = stack.pop() {
+        if let Ok(i) = usize::try_from(n) {
+            count += 1;
+            stack.extend(bsp.clipnodes[i].children);
+        }
+    }
+    count
+}
+
+/// ericw-tools' `simpleWorldspawnSky`: the room's ceiling is sky. One sky face and five walls;
+/// between 7 nodes (the room cut as one box, then once between sky and room) and 11 (cut at the
+/// sky first, then two open boxes); the shared solid leaf, the room's and the sky's; the void
+/// past every wall and past the sky is solid; no portals. ericw-tools' test asks for 12 clip
+/// nodes, the room's six walls in each clip hull; its own qbsp (2.0.0-alpha11) writes 111 on its
+/// map: the player start lies inside the shambler hull's grown wall (8 units past it, here as
+/// there), so no entity is in that hull's open space and neither tool fills it. The player hull
+/// is filled: six walls.
+#[test]
+fn a_sky_ceiling_on_an_edge_room() {
+    let out = compile_text(&edge_room("sky4", ""));
+    let bsp = &out.bsp;
+    assert!(out.leak.is_none());
+    let textures: Vec<String> = (0..bsp.faces.len()).map(|f| face_texture(bsp, f)).collect();
+    assert_eq!(textures.iter().filter(|t| *t == "sky4").count(), 1);
+    assert_eq!(textures.iter().filter(|t| *t == "wall").count(), 5);
+    assert!((7..=11).contains(&bsp.nodes.len()), "{}", bsp.nodes.len());
+    assert_eq!(bsp.leafs.len(), 3);
+    let player = EDGE_ROOM_START;
+    assert_eq!(leaf_contents(bsp, player), contents::EMPTY);
+    assert_eq!(leaf_contents(bsp, [-88.0, -64.0, 232.0]), contents::SKY);
+    for offset in [
+        [0.0, 0.0, 500.0],
+        [500.0, 0.0, 0.0],
+        [-500.0, 0.0, 0.0],
+        [0.0, 500.0, 0.0],
+        [0.0, -500.0, 0.0],
+        [0.0, 0.0, -500.0],
+    ] {
+        let p = [0, 1, 2].map(|i| player[i] + offset[i]);
+        assert_eq!(leaf_contents(bsp, p), contents::SOLID, "{p:?}");
+    }
+    assert!(out.portals.portals.is_empty());
+    assert_eq!(clip_nodes_of_hull(bsp, 1), 6);
+}
