@@ -1,6 +1,8 @@
 //! The faces of a BSP as geometry the light tool works with: world-space
 //! polygon, facing plane, texture projection and lightmap extents.
 
+use std::sync::Arc;
+
 use glam::{DVec3, Vec3};
 use quake_formats::Bsp;
 use quake_formats::bsp::texinfo_flags;
@@ -9,6 +11,7 @@ use quake_formats::geom::Plane;
 use rayon::prelude::*;
 
 use crate::error::LightError;
+use crate::outline::FaceRegion;
 
 /// What a face is for lighting and shadowing.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -50,9 +53,9 @@ pub struct FaceGeom {
     pub origin: DVec3,
     pub extents: LightmapExtents,
     /// The lit faces of the same model on the same plane reached from this one across at most
-    /// [`CONTINUATION_HOPS`] shared edges, as polygons: where a luxel past this face's edge
-    /// finds the surface it stands over.
-    pub continuations: Vec<Vec<DVec3>>,
+    /// [`CONTINUATION_HOPS`] shared edges, as outlines: where a luxel past this face's edge
+    /// finds the surface it stands over. Each lit face's outline is made once and shared.
+    pub continuations: Vec<Arc<FaceRegion>>,
     /// The grid light samples the face on: Quake's 16-texel one over `extents`, or its own.
     pub grid: LuxelGrid,
     /// What its own grid is, when it has one; the lightmap over `extents` is then taken from
@@ -69,6 +72,11 @@ impl FaceGeom {
             && !["trigger", "skip"]
                 .iter()
                 .any(|t| self.texture.eq_ignore_ascii_case(t))
+    }
+
+    /// The face's outline, for telling where on it a point of its plane lies.
+    pub fn region(&self) -> FaceRegion {
+        FaceRegion::from_points(self.points.clone(), self.plane.normal)
     }
 }
 
@@ -266,9 +274,12 @@ fn link_continuations(faces: &mut [FaceGeom]) {
             next
         })
         .collect();
-    // Each face's copies of its continuations' corners, on all cores: a large part of light's
-    // setup on a small map.
-    let continuations: Vec<Vec<Vec<DVec3>>> = (0..faces.len())
+    // Each lit face's outline, made once: the faces it continues share it.
+    let regions: Vec<Option<Arc<FaceRegion>>> = faces
+        .par_iter()
+        .map(|f| (f.kind == FaceKind::Lit).then(|| Arc::new(f.region())))
+        .collect();
+    let continuations: Vec<Vec<Arc<FaceRegion>>> = (0..faces.len())
         .into_par_iter()
         .map(|f| {
             let mut reached = vec![f];
@@ -281,10 +292,20 @@ fn link_continuations(faces: &mut [FaceGeom]) {
                 reached.extend(&ring);
             }
             reached.sort_unstable();
+            // An outline's inward normals come from the plane it is seen on: a continuation on
+            // a plane whose normal differs in its last bits gets an outline of its own.
+            let normal = faces[f].plane.normal;
             reached
                 .into_iter()
                 .filter(|&g| g != f)
-                .map(|g| faces[g].points.clone())
+                .filter_map(|g| match &regions[g] {
+                    Some(r) if faces[g].plane.normal == normal => Some(r.clone()),
+                    Some(_) => Some(Arc::new(FaceRegion::from_points(
+                        faces[g].points.clone(),
+                        normal,
+                    ))),
+                    None => None,
+                })
                 .collect()
         })
         .collect();

@@ -57,6 +57,7 @@ mod luxels;
 mod mesh;
 mod nudge;
 mod options;
+mod outline;
 mod output;
 mod phong;
 mod prepare;

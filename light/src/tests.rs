@@ -11,7 +11,7 @@ use quake_formats::miptex::{MipTex, TextureLump};
 
 use crate::dirt::DirtMode;
 use crate::faces::{FaceKind, Spacing, face_geometry};
-use crate::samples::{FaceRegion, face_samples};
+use crate::samples::face_samples;
 use crate::settings::SoftRadius;
 use crate::{
     Options, Quality, apply_lighting, compare, compute_lighting, trace_lighting,
@@ -365,7 +365,7 @@ fn sample_points_invert_an_angled_projection() {
     assert_eq!([samples.width, samples.height], ext.luxel_size());
     let v = bsp.texinfo[0].vecs;
     let n = faces[0].plane.normal;
-    let region = FaceRegion::of_face(&faces[0]);
+    let region = faces[0].region();
     let mut exact = 0;
     for y in 0..samples.height {
         for x in 0..samples.width {
