@@ -21,7 +21,7 @@ use crate::planes::PlaneSet;
 use crate::prefab::{PrefabError, expand_prefabs};
 use crate::texinfo::Projection;
 use crate::tree::SplitHeuristic;
-use crate::wad_lookup::{MissingTextures, WadSearch, WadSet};
+use crate::wad_lookup::{MissingTextures, TextureList, WadSearch, WadSet};
 use crate::warnings::Warning;
 use quake_formats::bsp::limits::{BSP29_MAX_CLIPNODES, MAX_SURFACE_EXTENT};
 use quake_formats::bsp::texinfo_flags;
@@ -269,6 +269,13 @@ pub fn compile(
         planes: &planes,
         texinfos: &table.infos,
         texture_names: &table.names,
+        texture_list: TextureList::of_map(
+            map.entities
+                .iter()
+                .flat_map(|e| &e.brushes)
+                .flat_map(|b| &b.faces)
+                .map(|f| f.texture.as_str()),
+        ),
         wads: &wads,
         entities: &lump_entities(&map, &left_out, options),
         version: options.version,

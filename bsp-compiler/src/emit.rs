@@ -9,7 +9,7 @@ use crate::model::ModelOutput;
 use crate::planes::{PlaneId, PlaneSet};
 use crate::texinfo::TextureRole;
 use crate::tree::{FENCE, Tree, engine_contents, is_see_through, vis_class};
-use crate::wad_lookup::WadSet;
+use crate::wad_lookup::{TextureList, WadSet};
 use crate::warnings::Warning;
 use crate::weld::{VertexWelder, WeldClass, cut_to_max_vertices, fix_tjunctions};
 use glam::DVec3;
@@ -27,6 +27,8 @@ pub(crate) struct EmitInput<'a> {
     pub planes: &'a PlaneSet,
     pub texinfos: &'a [MapTexInfo],
     pub texture_names: &'a [String],
+    /// The texture lump's order; the textures of `texture_names` are found in it.
+    pub texture_list: TextureList,
     pub wads: &'a WadSet,
     pub entities: &'a [Entity],
     pub version: BspVersion,
@@ -68,28 +70,27 @@ impl PlaneTable<'_> {
     }
 }
 
-/// Texinfos and textures written on first use.
+/// Texinfos written on first use, each naming its texture's slot in the texture lump.
 struct TextureTable<'a> {
     infos: &'a [MapTexInfo],
     info_index: Vec<u32>,
-    texture_index: Vec<u32>,
+    /// The lump slot of each texture of [`EmitInput::texture_names`].
+    texture_slot: Vec<u32>,
     out_infos: Vec<TexInfo>,
-    used_textures: Vec<u32>,
+    /// Whether a face shows the texture of each slot.
+    shown: Vec<bool>,
 }
 
 impl TextureTable<'_> {
     fn get(&mut self, id: u32) -> u32 {
         if self.info_index[id as usize] == u32::MAX {
             let info = &self.infos[id as usize];
-            let tex = info.texture as usize;
-            if self.texture_index[tex] == u32::MAX {
-                self.texture_index[tex] = self.used_textures.len() as u32;
-                self.used_textures.push(info.texture);
-            }
+            let slot = self.texture_slot[info.texture as usize];
+            self.shown[slot as usize] = true;
             self.info_index[id as usize] = self.out_infos.len() as u32;
             self.out_infos.push(TexInfo {
                 vecs: info.vecs.map(|row| row.map(|c| c as f32)),
-                miptex: self.texture_index[tex],
+                miptex: slot,
                 flags: if info.is_special() {
                     texinfo_flags::SPECIAL
                 } else {
@@ -134,19 +135,24 @@ struct PendingFace<'a> {
     vertices: Vec<u32>,
 }
 
-pub(crate) fn emit(input: EmitInput) -> Emitted {
+pub(crate) fn emit(mut input: EmitInput) -> Emitted {
     let mut bsp = Bsp::new(input.version);
     let mut planes = PlaneTable {
         source: input.planes,
         index: vec![u32::MAX; input.planes.len()],
         planes: Vec::new(),
     };
+    let texture_slot: Vec<u32> = input
+        .texture_names
+        .iter()
+        .map(|name| input.texture_list.slot(name))
+        .collect();
     let mut textures = TextureTable {
         infos: input.texinfos,
         info_index: vec![u32::MAX; input.texinfos.len()],
-        texture_index: vec![u32::MAX; input.texture_names.len()],
+        texture_slot,
         out_infos: Vec::new(),
-        used_textures: Vec::new(),
+        shown: vec![false; input.texture_list.len()],
     };
 
     // Faces in output order: model by model, node by node.
@@ -357,17 +363,10 @@ pub(crate) fn emit(input: EmitInput) -> Emitted {
         }
     }
 
-    let used: Vec<&str> = textures
-        .used_textures
-        .iter()
-        .map(|&t| input.texture_names[t as usize].as_str())
-        .collect();
-    bsp.textures.textures = input
-        .wads
-        .texture_lump(&used, input.warnings)
-        .into_iter()
-        .map(Some)
-        .collect();
+    bsp.textures.textures =
+        input
+            .wads
+            .texture_lump(&input.texture_list, &textures.shown, input.warnings);
     bsp.texinfo = textures.out_infos;
     bsp.set_phong_faces(&phong);
     bsp.set_face_flags(&flags);

@@ -1,5 +1,5 @@
-//! Finding the WADs a map names and the miptex for each texture it uses, plus the other frames
-//! of its animations, with placeholders for whatever is missing so the BSP still loads.
+//! Finding the WADs a map names and the miptex for each texture it names, plus the other frames
+//! of its animations, with placeholders for whatever is missing that the BSP needs to load.
 
 use crate::texinfo::{AnimationFrame, TextureRole};
 use crate::warnings::Warning;
@@ -18,8 +18,8 @@ pub struct WadSet {
     missing: MissingTextures,
 }
 
-/// What a texture no WAD holds becomes: by default a placeholder with its name, 64x64 (sky
-/// 256x128), and a warning.
+/// What a texture no WAD holds becomes: by default, when a face shows it, a placeholder with
+/// its name, 64x64 (sky 256x128), and a warning; otherwise an absent miptex.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct MissingTextures {
     /// Folders whose loose pictures (`textures/NAME.png` or `.tga`, ericw-tools' `-path`) give
@@ -170,12 +170,21 @@ impl WadSet {
         })
     }
 
-    /// The texture lump for the textures faces use (`used`, in the order texinfos refer to
-    /// them): those textures, then the other frames engines need to link their animations.
-    /// Textures no WAD holds become placeholders, with a warning.
-    pub(crate) fn texture_lump(&self, used: &[&str], warnings: &mut Vec<Warning>) -> Vec<MipTex> {
-        let mut entries = Vec::with_capacity(used.len());
-        for &name in used {
+    /// The texture lump for `list`, each texture with whether a face shows it (`shown`), then
+    /// the other frames engines need to link its animations. A texture no WAD holds is left
+    /// out (an absent miptex, offset -1, as ericw-tools writes every missing texture), or 0x0
+    /// with its name under [`MissingTextures::zero_size`]; but one a face shows, or an animation
+    /// frame below one the lump holds, becomes a placeholder with a warning (see
+    /// [`placeholder`]).
+    pub(crate) fn texture_lump(
+        &self,
+        list: &TextureList,
+        shown: &[bool],
+        warnings: &mut Vec<Warning>,
+    ) -> Vec<Option<MipTex>> {
+        let mut entries = Vec::with_capacity(list.names.len());
+        for (i, name) in list.names.iter().enumerate() {
+            let shown = shown.get(i).copied().unwrap_or(false);
             let lump = lump_name(name);
             let found = self.find(&lump).or_else(|| {
                 let (width, height) = self.missing.loose_size(name)?;
@@ -186,25 +195,39 @@ impl WadSet {
                     mips: None,
                 })
             });
-            if found.is_none() {
-                warnings.push(Warning::MissingTexture {
-                    name: name.to_string(),
-                });
+            if found.is_none() && shown {
+                warnings.push(Warning::MissingTexture { name: name.clone() });
             }
-            if lump.starts_with('+') && AnimationFrame::of(&lump).is_none() {
-                warnings.push(Warning::BadAnimationName {
-                    name: name.to_string(),
-                });
+            if lump.starts_with('+')
+                && AnimationFrame::of(&lump).is_none()
+                && (shown || found.is_some())
+            {
+                warnings.push(Warning::BadAnimationName { name: name.clone() });
             }
-            entries.push((lump, found));
+            entries.push(LumpEntry {
+                name: lump,
+                found,
+                shown,
+            });
         }
-        let completing = self.completing_frames(&entries, warnings);
+        let completing = self.completing_frames(&entries);
         entries.extend(completing);
 
-        // A placeholder frame takes the size of a real frame of its animation.
+        // Each animation cycle's highest frame the lump holds, and the size of a real frame,
+        // which a placeholder frame takes.
+        let mut cycle_ends: HashMap<(String, bool), u8> = HashMap::new();
         let mut frame_sizes: HashMap<String, (u32, u32)> = HashMap::new();
-        for (name, found) in &entries {
-            if let (Some(frame), Some(t)) = (AnimationFrame::of(name), found) {
+        for e in &entries {
+            let Some(frame) = AnimationFrame::of(&e.name) else {
+                continue;
+            };
+            if e.shown || e.found.is_some() {
+                let end = cycle_ends
+                    .entry((frame.base.to_string(), frame.alternate))
+                    .or_default();
+                *end = (*end).max(frame.index + 1);
+            }
+            if let Some(t) = &e.found {
                 frame_sizes
                     .entry(frame.base.to_string())
                     .or_insert((t.width, t.height));
@@ -212,80 +235,144 @@ impl WadSet {
         }
         entries
             .into_iter()
-            .map(|(name, found)| match found {
-                Some(MipTex {
-                    width,
-                    height,
-                    mips: Some(mips),
-                    ..
-                }) => MipTex::new(&name, width, height, mips),
-                Some(MipTex { width, height, .. }) => MipTex {
-                    raw_name: string_to_name16(&name),
-                    width,
-                    height,
-                    mips: None,
-                },
-                None if self.missing.zero_size => MipTex {
-                    raw_name: string_to_name16(&name),
-                    width: 0,
-                    height: 0,
-                    mips: None,
-                },
-                None => {
-                    let size = AnimationFrame::of(&name)
-                        .and_then(|f| frame_sizes.get(f.base).copied())
-                        .unwrap_or_else(|| placeholder_size(&name));
-                    placeholder(&name, size)
+            .map(|e| {
+                let completes_cycle = AnimationFrame::of(&e.name).is_some_and(|f| {
+                    cycle_ends
+                        .get(&(f.base.to_string(), f.alternate))
+                        .is_some_and(|&end| f.index < end)
+                });
+                if e.found.is_none() && !e.shown && completes_cycle {
+                    warnings.push(Warning::MissingAnimationFrame {
+                        name: e.name.clone(),
+                    });
+                }
+                match e.found {
+                    Some(MipTex {
+                        width,
+                        height,
+                        mips: Some(mips),
+                        ..
+                    }) => Some(MipTex::new(&e.name, width, height, mips)),
+                    Some(MipTex { width, height, .. }) => Some(MipTex {
+                        raw_name: string_to_name16(&e.name),
+                        width,
+                        height,
+                        mips: None,
+                    }),
+                    None if self.missing.zero_size => Some(MipTex {
+                        raw_name: string_to_name16(&e.name),
+                        width: 0,
+                        height: 0,
+                        mips: None,
+                    }),
+                    None if e.shown || completes_cycle => {
+                        let size = AnimationFrame::of(&e.name)
+                            .and_then(|f| frame_sizes.get(f.base).copied())
+                            .unwrap_or_else(|| placeholder_size(&e.name));
+                        Some(placeholder(&e.name, size))
+                    }
+                    None => None,
                 }
             })
             .collect()
     }
 
-    /// The frames that complete the animations among `entries`, which engines link from all
-    /// `+0name`..`+9name` and `+aname`..`+jname` in the lump and reject when one has a gap: in
-    /// each cycle, every frame below the highest one used (placeholders where no WAD holds
-    /// them, as the map needs those), and the WADs' frames from the first on up to a gap.
-    fn completing_frames(
-        &self,
-        entries: &[(String, Option<MipTex>)],
-        warnings: &mut Vec<Warning>,
-    ) -> Vec<(String, Option<MipTex>)> {
-        let used: HashSet<&str> = entries.iter().map(|(n, _)| n.as_str()).collect();
+    /// The frames the WADs hold that complete the animations among `entries`, which engines
+    /// link from all `+0name`..`+9name` and `+aname`..`+jname` in the lump: in each cycle, the
+    /// WADs' frames from the first on up to a gap (engines reject a cycle with one). The
+    /// frames below a listed one are listed already ([`TextureList::of_map`]).
+    fn completing_frames(&self, entries: &[LumpEntry]) -> Vec<LumpEntry> {
+        let listed: HashSet<&str> = entries.iter().map(|e| e.name.as_str()).collect();
         let mut cycles_done = HashSet::new();
         let mut out = Vec::new();
-        for (name, _) in entries {
-            let Some(frame) = AnimationFrame::of(name) else {
+        for e in entries {
+            let Some(frame) = AnimationFrame::of(&e.name) else {
                 continue;
             };
             for alternate in [false, true] {
                 if !cycles_done.insert((frame.base, alternate)) {
                     continue;
                 }
-                let used_end = (0..10)
-                    .rev()
-                    .find(|&i| used.contains(frame.sibling(alternate, i).as_str()))
-                    .map_or(0, |i| i + 1);
                 for i in 0..10 {
                     let sibling = frame.sibling(alternate, i);
-                    if used.contains(sibling.as_str()) {
+                    if listed.contains(sibling.as_str()) {
                         continue;
                     }
-                    let found = self.find(&sibling);
-                    if found.is_none() {
-                        if i >= used_end {
-                            break;
-                        }
-                        warnings.push(Warning::MissingAnimationFrame {
-                            name: sibling.clone(),
-                        });
-                    }
-                    out.push((sibling, found));
+                    let Some(found) = self.find(&sibling) else {
+                        break;
+                    };
+                    out.push(LumpEntry {
+                        name: sibling,
+                        found: Some(found),
+                        shown: false,
+                    });
                 }
             }
         }
         out
     }
 }
+
+/// A texture of the lump being made: its name in the BSP, the WADs' miptex of it, and whether
+/// a face shows it.
+struct LumpEntry {
+    name: String,
+    found: Option<MipTex>,
+    shown: bool,
+}
+
+/// The textures a BSP lists, in the order ericw-tools' qbsp lists them: `skip` first (qbsp
+/// registers it before it reads the map), then each texture the map names on a brush face, in
+/// the order the map first names it (letter case aside), whether or not any face of it is
+/// drawn; a frame of an animation is followed by the frames below it in its cycle. Textures
+/// are found by name (letter case aside) as texinfos refer to them.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(crate) struct TextureList {
+    /// The names as the map first writes them.
+    names: Vec<String>,
+    slots: HashMap<String, u32>,
+}
+
+impl TextureList {
+    /// The list for a map whose brush faces name `face_textures`, in file order.
+    pub(crate) fn of_map<'a>(face_textures: impl IntoIterator<Item = &'a str>) -> TextureList {
+        let mut list = TextureList::default();
+        list.slot(SKIP_TEXTURE);
+        for name in face_textures {
+            if list.slots.contains_key(&name.to_ascii_lowercase()) {
+                continue;
+            }
+            list.slot(name);
+            // Engines load an animation only with every frame below the highest one there.
+            if let Some(frame) = AnimationFrame::of(name) {
+                for i in 0..frame.index {
+                    list.slot(&frame.sibling(frame.alternate, i));
+                }
+            }
+        }
+        list
+    }
+
+    /// The slot of texture `name`, added at the end when it is not listed yet.
+    pub(crate) fn slot(&mut self, name: &str) -> u32 {
+        let key = name.to_ascii_lowercase();
+        if let Some(&slot) = self.slots.get(&key) {
+            return slot;
+        }
+        let slot = self.names.len() as u32;
+        self.names.push(name.to_string());
+        self.slots.insert(key, slot);
+        slot
+    }
+
+    /// How many textures are listed.
+    pub(crate) fn len(&self) -> usize {
+        self.names.len()
+    }
+}
+
+/// The texture ericw-tools' qbsp always lists first.
+const SKIP_TEXTURE: &str = "skip";
 
 /// The name a texture gets in the BSP: at most 15 characters, lowercase as in id's BSPs.
 /// Engines depend on the case: DarkPlaces (2018) counts sky textures by a case-sensitive `sky`
@@ -416,8 +503,45 @@ mod tests {
         }
     }
 
-    fn names_and_sizes(lump: &[MipTex]) -> Vec<(String, u32)> {
-        lump.iter().map(|t| (t.name(), t.width)).collect()
+    /// The lump for a map whose faces show `shown` and name `unshown` too (after them).
+    fn lump_of(
+        set: &WadSet,
+        shown: &[&str],
+        unshown: &[&str],
+        warnings: &mut Vec<Warning>,
+    ) -> Vec<Option<MipTex>> {
+        let mut list = TextureList::of_map(shown.iter().chain(unshown).copied());
+        let mut is_shown = vec![false; list.len()];
+        for name in shown {
+            is_shown[list.slot(name) as usize] = true;
+        }
+        set.texture_lump(&list, &is_shown, warnings)
+    }
+
+    /// Each slot's name and width, `None` for an absent miptex.
+    fn names_and_sizes(lump: &[Option<MipTex>]) -> Vec<Option<(String, u32)>> {
+        lump.iter()
+            .map(|t| t.as_ref().map(|t| (t.name(), t.width)))
+            .collect()
+    }
+
+    fn entry(name: &str, size: u32) -> Option<(String, u32)> {
+        Some((name.to_string(), size))
+    }
+
+    #[test]
+    fn skip_comes_first_then_the_maps_textures_in_its_order() {
+        let list = TextureList::of_map(["wall", "*water1", "Wall", "clip", "SKIP", "floor"]);
+        assert_eq!(list.names, ["skip", "wall", "*water1", "clip", "floor"]);
+        let mut list = TextureList::of_map(["+3button", "+1BUTTON", "+bdoor", "x"]);
+        assert_eq!(
+            list.names,
+            [
+                "skip", "+3button", "+0button", "+1button", "+2button", "+bdoor", "+adoor", "x"
+            ]
+        );
+        assert_eq!(list.slot("+2BUTTON"), 4);
+        assert_eq!(list.slot("new"), 8);
     }
 
     #[test]
@@ -430,14 +554,41 @@ mod tests {
             beside_map: PathBuf::from("/nonexistent/m.wad"),
         };
         let set = WadSet::load(&world, &search, &mut warnings);
-        let lump = set.texture_lump(&["SKY4"], &mut warnings);
-        let t = &lump[0];
+        let lump = lump_of(&set, &["SKY4"], &["clip"], &mut warnings);
+        // skip and clip, which no face shows, are absent, as ericw-tools leaves every texture
+        // it cannot find.
+        assert!(lump[0].is_none() && lump[2].is_none());
+        let t = lump[1].as_ref().expect("a placeholder");
         assert_eq!((t.width, t.height), (256, 128));
         // Lowercase: DarkPlaces crashes on a sky texture named SKY4.
         assert_eq!(t.name(), "sky4");
         let mips = t.mips.as_ref().expect("pixels");
         assert_eq!(mips[3].len(), 32 * 16);
+        // The missing WAD and the shown texture.
         assert_eq!(warnings.len(), 2);
+    }
+
+    #[test]
+    fn textures_no_face_shows_are_written_when_a_wad_holds_them() {
+        let set = wad_set(&[("skip", 64), ("clip", 32), ("wall", 128)]);
+        let mut warnings = Vec::new();
+        let lump = lump_of(&set, &["wall"], &["clip", "trigger"], &mut warnings);
+        assert_eq!(
+            names_and_sizes(&lump),
+            [
+                entry("skip", 64),
+                entry("wall", 128),
+                entry("clip", 32),
+                None
+            ]
+        );
+        assert_eq!(warnings, vec![]);
+        let zero = set.with_missing(MissingTextures {
+            zero_size: true,
+            ..MissingTextures::default()
+        });
+        let lump = lump_of(&zero, &["wall"], &["trigger"], &mut warnings);
+        assert_eq!(names_and_sizes(&lump)[2], entry("trigger", 0));
     }
 
     #[test]
@@ -450,22 +601,23 @@ mod tests {
             ("+abutton", 32),
             ("+0other", 32),
             ("WALL", 128),
+            ("skip", 64),
         ]);
         let mut warnings = Vec::new();
-        let lump = set.texture_lump(&["wall", "+3BUTTON"], &mut warnings);
+        let lump = lump_of(&set, &["wall", "+3BUTTON"], &[], &mut warnings);
         assert_eq!(warnings, vec![]);
-        // The used textures keep their places; the other frames follow.
+        // The frames below a used one follow it; the WADs' other frames come last.
         assert_eq!(
             names_and_sizes(&lump),
             [
-                ("wall", 128),
-                ("+3button", 32),
-                ("+0button", 32),
-                ("+1button", 32),
-                ("+2button", 32),
-                ("+abutton", 32),
+                entry("skip", 64),
+                entry("wall", 128),
+                entry("+3button", 32),
+                entry("+0button", 32),
+                entry("+1button", 32),
+                entry("+2button", 32),
+                entry("+abutton", 32),
             ]
-            .map(|(n, s)| (n.to_string(), s))
         );
     }
 
@@ -473,12 +625,12 @@ mod tests {
     fn wad_frames_stop_at_a_gap_above_the_used_ones() {
         let set = wad_set(&[("+0x", 32), ("+1x", 32), ("+3x", 32), ("+bx", 32)]);
         let mut warnings = Vec::new();
-        let lump = set.texture_lump(&["+0x"], &mut warnings);
+        let lump = lump_of(&set, &["+0x"], &[], &mut warnings);
         assert_eq!(warnings, vec![]);
         // No +ax, so the alternates +bx alone would be a broken cycle.
         assert_eq!(
             names_and_sizes(&lump),
-            [("+0x", 32), ("+1x", 32)].map(|(n, s)| (n.to_string(), s))
+            [None, entry("+0x", 32), entry("+1x", 32)]
         );
     }
 
@@ -486,10 +638,16 @@ mod tests {
     fn gaps_below_a_used_frame_get_placeholders_of_the_animation_size() {
         let set = wad_set(&[("+0x", 32), ("+2x", 32)]);
         let mut warnings = Vec::new();
-        let lump = set.texture_lump(&["+3x"], &mut warnings);
+        let lump = lump_of(&set, &["+3x"], &[], &mut warnings);
         assert_eq!(
             names_and_sizes(&lump),
-            [("+3x", 32), ("+0x", 32), ("+1x", 32), ("+2x", 32)].map(|(n, s)| (n.to_string(), s))
+            [
+                None,
+                entry("+3x", 32),
+                entry("+0x", 32),
+                entry("+1x", 32),
+                entry("+2x", 32)
+            ]
         );
         assert_eq!(
             warnings,
@@ -505,15 +663,34 @@ mod tests {
     }
 
     #[test]
+    fn a_frame_below_one_a_wad_holds_is_needed_even_where_no_face_shows_it() {
+        // Engines would refuse +1x (held, though only named on a buried face) without +0x.
+        let set = wad_set(&[("+1x", 32)]);
+        let mut warnings = Vec::new();
+        let lump = lump_of(&set, &[], &["+1x", "+1y"], &mut warnings);
+        assert_eq!(
+            names_and_sizes(&lump),
+            [None, entry("+1x", 32), entry("+0x", 32), None, None]
+        );
+        assert_eq!(
+            warnings,
+            vec![Warning::MissingAnimationFrame {
+                name: "+0x".to_string()
+            }]
+        );
+    }
+
+    #[test]
     fn a_missing_animation_gets_complete_placeholder_cycles() {
         // QuakeSpasm stopped with "Missing frame 0 of +3BUTNN" on an id map without its WAD.
         let set = WadSet::default();
         let mut warnings = Vec::new();
-        let lump = set.texture_lump(&["+3BUTNN", "+bButnn", "+0LIFT"], &mut warnings);
+        let lump = lump_of(&set, &["+3BUTNN", "+bButnn", "+0LIFT"], &[], &mut warnings);
+        let lump: Vec<MipTex> = lump.into_iter().flatten().collect();
         assert_eq!(
             lump.iter().map(MipTex::name).collect::<Vec<_>>(),
             [
-                "+3butnn", "+bbutnn", "+0lift", "+0butnn", "+1butnn", "+2butnn", "+abutnn"
+                "+3butnn", "+0butnn", "+1butnn", "+2butnn", "+bbutnn", "+abutnn", "+0lift"
             ]
         );
         assert!(lump.iter().all(|t| (t.width, t.height) == (64, 64)));
@@ -529,8 +706,10 @@ mod tests {
     #[test]
     fn a_plus_without_a_frame_is_reported() {
         let mut warnings = Vec::new();
-        let lump = wad_set(&[("+xbutton", 16)]).texture_lump(&["+xbutton"], &mut warnings);
-        assert_eq!(lump.len(), 1);
+        let set = wad_set(&[("+xbutton", 16)]);
+        let lump = lump_of(&set, &["+xbutton"], &["+ybutton"], &mut warnings);
+        assert_eq!(lump.len(), 3);
+        // +ybutton is in no WAD and no face shows it: absent, so harmless.
         assert_eq!(
             warnings,
             vec![Warning::BadAnimationName {
