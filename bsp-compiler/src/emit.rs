@@ -112,6 +112,33 @@ fn max_face_edges(max_edges: usize, role: TextureRole) -> Option<usize> {
     }
 }
 
+/// How far engines widen a model's box on every side as they load the models lump (id's engine
+/// did, in `Mod_LoadSubmodels`, and QuakeSpasm and DarkPlaces still do).
+const ENGINE_MODEL_SPREAD: f64 = 1.0;
+
+/// The box written for model `bounds` (its brushes'): a unit inside them on every side, as qbsp
+/// writes it, so that the box engines load is the brushes' own again. That box is what QuakeC
+/// sizes a door's travel and a trigger's field by, and what the server links a brush model into
+/// the world with and the renderer culls it by: written exact, it would come out a unit too large
+/// on every side and doors would travel two units further than on qbsp's files. A model thinner
+/// than two units gets a box turned inside out, which the engine's widening turns back.
+fn written_model_bounds(bounds: &Bounds) -> Bounds {
+    let spread = DVec3::splat(ENGINE_MODEL_SPREAD);
+    Bounds {
+        mins: bounds.mins + spread,
+        maxs: bounds.maxs - spread,
+    }
+}
+
+/// `bounds` rounded outward to whole units, as qbsp writes node and leaf bounds in every BSP
+/// version (BSP29 can only store whole units; BSP2 gets the same values).
+fn whole_units(bounds: Bounds) -> Bounds {
+    Bounds {
+        mins: bounds.mins.floor(),
+        maxs: bounds.maxs.ceil(),
+    }
+}
+
 /// The internal nodes of a model's tree in output order (pre-order, all-solid subtrees left out).
 fn node_order(tree: &Tree, solid: &[bool]) -> Vec<u32> {
     let mut order = Vec::new();
@@ -326,15 +353,15 @@ pub(crate) fn emit(mut input: EmitInput) -> Emitted {
             leaf_index: HashMap::new(),
             fence_leaves: &mut fence_leaves,
         };
-        let (mut head, _) = w.node(0);
+        let (mut head, head_bounds) = w.node(0);
         if head < 0 {
             // Engines start at a node: give a one-leaf model a node with the leaf on both sides.
             let plane = w.planes.push(&Plane::new(DVec3::new(0.0, 0.0, 1.0), 0.0));
             w.bsp.nodes.push(Node {
                 plane,
                 children: [head, head],
-                mins: m.bounds.mins.as_vec3().to_array(),
-                maxs: m.bounds.maxs.as_vec3().to_array(),
+                mins: head_bounds.mins.as_vec3().to_array(),
+                maxs: head_bounds.maxs.as_vec3().to_array(),
                 first_face: 0,
                 num_faces: 0,
             });
@@ -347,9 +374,10 @@ pub(crate) fn emit(mut input: EmitInput) -> Emitted {
         for (hull, tree) in m.hulls.iter().enumerate() {
             clip_heads[hull] = emit_clipnodes(tree, &mut |id| planes.get(id), &mut bsp.clipnodes);
         }
+        let written = written_model_bounds(&m.bounds);
         bsp.models.push(Model {
-            mins: m.bounds.mins.as_vec3().to_array(),
-            maxs: m.bounds.maxs.as_vec3().to_array(),
+            mins: written.mins.as_vec3().to_array(),
+            maxs: written.maxs.as_vec3().to_array(),
             origin: [0.0; 3],
             head_nodes: [head, clip_heads[0], clip_heads[1], 0],
             vis_leafs: (bsp.leafs.len() - leaves_before) as i32,
@@ -408,11 +436,22 @@ struct TreeWriter<'a, 'b> {
 }
 
 impl TreeWriter<'_, '_> {
-    /// Write tree node `n`; returns its child value and bounds (empty for the solid leaf).
+    /// Write tree node `n`; returns its child value and bounds.
+    ///
+    /// As qbsp does, a leaf's bounds are those of its region (its portals, the outside box's
+    /// included) and a node's those of its children, the shared solid leaf's regions below it
+    /// included: a node's bounds hold its whole region, and the head node's the model's brushes
+    /// grown by the outside box's margin. All are rounded outward to whole units.
     fn node(&mut self, n: u32) -> (i32, Bounds) {
         let tree = &self.output.tree;
         if self.solid[n as usize] {
-            return (-1, Bounds::EMPTY);
+            let region = tree
+                .leaves_below(n)
+                .into_iter()
+                .fold(Bounds::EMPTY, |acc, l| {
+                    acc.union(&self.output.portals.leaf_bounds(l))
+                });
+            return (-1, whole_units(region));
         }
         let node = &tree.nodes[n as usize];
         let Some(plane) = node.plane else {
@@ -427,6 +466,7 @@ impl TreeWriter<'_, '_> {
                 Some(grown) => bounds.union(grown),
                 None => bounds,
             };
+            let bounds = whole_units(bounds);
             let marks = self.leaf_faces.get(&(self.model, n));
             let first = self.bsp.marksurfaces.len() as u32;
             self.bsp.marksurfaces.extend(marks.into_iter().flatten());

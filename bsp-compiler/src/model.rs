@@ -233,6 +233,8 @@ fn fill_world(
 
 /// The bounds engines size a model by (a door's travel, its trigger field): its map brushes,
 /// clip brushes included, not the grown ones; a unit box around the origin for an empty model.
+/// The file stores them a unit inside on every side (see `emit`), and the portals' outside box
+/// is a margin outside them.
 fn model_bounds(m: &ModelInput) -> Bounds {
     let bounds = m
         .brushes

@@ -7,8 +7,10 @@ use crate::tree::{Tree, TreeNode};
 use glam::DVec3;
 use quake_formats::geom::{Bounds, Plane, Split, Winding};
 
-/// Space left between the map and the outside box.
-const OUTSIDE_MARGIN: f64 = 8.0;
+/// Space left between a model's brushes and the outside box: ericw-tools' qbsp pads its trees
+/// by 24 units, and the bounds written for the leaves and nodes along the box reach it (so a
+/// model's head node spans its brushes grown by this much, as in the BSPs qbsp writes).
+const OUTSIDE_MARGIN: f64 = 24.0;
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct Portal {

@@ -530,9 +530,10 @@ fn brush_entities_become_submodels() {
     assert_eq!(errors(bsp), Vec::<String>::new());
     assert_eq!(bsp.models.len(), 2);
     assert_eq!(bsp.models[1].num_faces, 6);
-    // The model's box is the door's own (engines derive its travel from it), not grown by a hull.
-    assert_eq!(bsp.models[1].mins, [-32.0, -8.0, -128.0]);
-    assert_eq!(bsp.models[1].maxs, [32.0, 8.0, 0.0]);
+    // The model's box is the door's own a unit inside (engines widen it back as they load it and
+    // derive its travel from it), not grown by a hull.
+    assert_eq!(bsp.models[1].mins, [-31.0, -7.0, -127.0]);
+    assert_eq!(bsp.models[1].maxs, [31.0, 7.0, -1.0]);
     assert!(bsp.entity_text().contains("\"model\" \"*1\""));
     check_round_trip(bsp);
 }
@@ -613,8 +614,8 @@ fn origin_brushes_set_the_origin_of_their_model() {
     assert_eq!(errors(bsp), Vec::<String>::new());
     assert!(bsp.entity_text().contains("\"origin\" \"64 0 -64\""));
     // Built around the origin: the engine moves it back into place.
-    assert_eq!(bsp.models[1].mins, [-32.0, -8.0, -64.0]);
-    assert_eq!(bsp.models[1].maxs, [32.0, 8.0, 64.0]);
+    assert_eq!(bsp.models[1].mins, [-31.0, -7.0, -63.0]);
+    assert_eq!(bsp.models[1].maxs, [31.0, 7.0, 63.0]);
     // The origin brush is neither drawn nor solid, and the textures stay where they were.
     assert_eq!(bsp.models[1].num_faces, plain.bsp.models[1].num_faces);
     assert_eq!(
@@ -642,8 +643,8 @@ fn origin_keys_and_rotate_targets_set_the_origin_of_their_model() {
             bsp.entity_text().contains("\"origin\" \"64 0 -64\""),
             "{entity}"
         );
-        assert_eq!(bsp.models[1].mins, [-32.0, -8.0, -64.0], "{entity}");
-        assert_eq!(bsp.models[1].maxs, [32.0, 8.0, 64.0], "{entity}");
+        assert_eq!(bsp.models[1].mins, [-31.0, -7.0, -63.0], "{entity}");
+        assert_eq!(bsp.models[1].maxs, [31.0, 7.0, 63.0], "{entity}");
         assert_eq!(
             model_texels(bsp, 1, [64.0, 0.0, -64.0]),
             model_texels(&plain.bsp, 1, [0.0; 3])

@@ -70,9 +70,10 @@ fn a_nested_prefab_is_placed_turned_and_merged() {
     let bsp = &out.bsp;
     assert_eq!(errors(bsp), Vec::<String>::new());
     assert_eq!(bsp.models.len(), 2, "the prefab is one func_wall");
-    // Scaled by 2 and turned to face +Y: x -16..16, y 0..32, z 0..80, moved by the origin.
-    assert_eq!(bsp.models[1].mins, [-80.0, -64.0, -128.0]);
-    assert_eq!(bsp.models[1].maxs, [-48.0, -32.0, -48.0]);
+    // Scaled by 2 and turned to face +Y: x -16..16, y 0..32, z 0..80, moved by the origin (the
+    // model's box is written a unit inside).
+    assert_eq!(bsp.models[1].mins, [-79.0, -63.0, -127.0]);
+    assert_eq!(bsp.models[1].maxs, [-49.0, -33.0, -49.0]);
     let text = bsp.entity_text();
     assert!(!text.contains("misc_external_map") && !text.contains("_external_map"));
     assert!(text.contains("\"targetname\" \"gate\""), "{text}");
