@@ -32,8 +32,8 @@ const SKY_HIT_SHORTEN: f32 = 1.0 - 1e-5;
 pub struct TraceScene {
     pub scene: Scene,
     sky_geom: u32,
-    /// The world has sky faces (else no ray can reach the sky).
-    has_sky: bool,
+    /// The sky faces alone, to find where a sun ray meets the sky first.
+    sky_only: Option<Scene>,
     /// The face of each opaque triangle (by primitive id).
     opaque_faces: Vec<u32>,
     /// Per `_shadowself` model (not already in `scene`): its own faces.
@@ -145,7 +145,6 @@ impl TraceScene {
             triangles += mesh.triangles.len();
             switchable.push((style, mesh.commit(device)?));
         }
-        let has_sky = !sky.triangles.is_empty();
         let own_switchable = casters
             .switchable
             .iter()
@@ -154,13 +153,18 @@ impl TraceScene {
                 Some((model, k))
             })
             .collect();
+        let sky_only = if sky.triangles.is_empty() {
+            None
+        } else {
+            Some(sky.commit(device)?)
+        };
         let mut builder = SceneBuilder::new(device)?;
         builder.add_triangle_mesh(&opaque.vertices, &opaque.triangles)?;
         let sky_geom = builder.add_triangle_mesh(&sky.vertices, &sky.triangles)?;
         Ok(TraceScene {
             scene: builder.commit()?,
             sky_geom,
-            has_sky,
+            sky_only,
             opaque_faces: opaque.faces,
             own,
             switchable,
@@ -228,20 +232,23 @@ impl TraceScene {
     }
 
     /// Bit `i` set if lane `i` of `packet`, cast from a face of `model`,
-    /// reaches a sky face before anything else: one closest-hit query over the opaque and sky
-    /// faces (a ray blocked near its start stops there), then the fences, the model's own
-    /// scene and the switchable shadows up to the sky hit.
+    /// reaches a sky face before anything else.
+    /// First where each ray meets the sky (sky faces alone, a small scene),
+    /// then whether anything blocks it before that: an occlusion query,
+    /// which stops at any hit, where one closest-hit query over everything
+    /// must rule out every nearer surface.
     pub fn sees_sky16(&self, packet: &mut RayPacket16, model: usize) -> u16 {
-        if !self.has_sky {
+        let Some(sky_only) = &self.sky_only else {
             return 0;
-        }
-        let ids = self.scene.first_hit_geom16(packet, true);
+        };
+        let ids = sky_only.first_hit_geom16(packet, true);
         let sky = (0..16)
-            .filter(|&i| ids[i] == self.sky_geom)
+            .filter(|&i| ids[i] != sys::RTC_INVALID_GEOMETRY_ID)
             .fold(0, |m, i| m | (1 << i));
         // Just short of the sky hit, so the sky face itself does not block.
         packet.keep_shortened(sky, SKY_HIT_SHORTEN);
-        let blocked = self.fences_block16(packet, sky);
+        let opaque = self.scene.occluded16(packet, true);
+        let blocked = opaque | self.fences_block16(packet, !opaque);
         sky & !blocked & !self.own_occluded16(packet, model) & !self.any_switchable_blocks16(packet)
     }
 
