@@ -1,5 +1,6 @@
 //! The command line: `slipgate-bsp [--bsp2 | --2psb] [--wad-dir DIR]... IN.map [OUT.bsp]`.
 
+use crate::content_flags::content_json;
 use crate::convert::{MapFormat, convert_map};
 use crate::map::parse_map;
 use crate::onlyents::replace_entities;
@@ -49,7 +50,6 @@ quake_formats::ericw_accepted! {
         notriggermodels: bool => "trigger models are written as for every game",
         includeskip: bool => "skip faces are always left out",
         lmscale: Option<String> => "light reads `_lmscale` from the entities; `slipgate light --lmshift N` sets every model's spacing",
-        noextendedcontentflags: bool => "Slipgate writes no extended content flags (ericw-tools' .texinfo.json)",
         noextendedsurfflags: bool => "Slipgate writes no extended surface flags (ericw-tools' .texinfo.json)",
         nodefaultpaths: bool => "WADs are found as docs/mapping.md says",
         defaultpaths: bool => "WADs are found as docs/mapping.md says",
@@ -61,7 +61,8 @@ quake_formats::ericw_accepted! {
 pub struct Args {
     /// The .map file to compile
     pub input: PathBuf,
-    /// The BSP to write (default: the input with .bsp); the .prt (and .pts on a leak) go beside it
+    /// The BSP to write (default: the input with .bsp); the .prt, the .content.json (and the .pts
+    /// on a leak) go beside it
     pub output: Option<PathBuf>,
     /// Write BSP2 (BSP29 is used unless a limit is exceeded)
     #[arg(long)]
@@ -152,6 +153,10 @@ pub struct Args {
     /// without it, a leaking map gets no .prt and an old one is removed)
     #[arg(long)]
     pub keepprt: bool,
+    /// Write no MAPNAME.content.json (each leaf's extended content flags, which ericw-tools'
+    /// light reads); an old one is removed
+    #[arg(long)]
+    pub noextendedcontentflags: bool,
     /// Build no clip hulls: players and monsters collide with nothing but point-sized hull 0
     /// (for engines that collide with brushes, with --wrbrushes)
     #[arg(long)]
@@ -328,7 +333,7 @@ fn only_entities(source: &MapSource, args: &Args, bsp_path: &Path) -> Result<()>
 }
 
 /// Remove a file an earlier compile left that no longer belongs to the map (a pointfile once it
-/// seals, a portal file once it leaks).
+/// seals, a portal file once it leaks, content flags not asked for).
 fn remove_stale(path: &Path) -> Result<()> {
     match std::fs::remove_file(path) {
         Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
@@ -370,6 +375,7 @@ fn compile_and_write(args: &Args) -> Result<Option<crate::CompileStats>> {
     let out = compile(&source, &args.compile_options())?;
     let pts_path = bsp_path.with_extension("pts");
     let prt_path = bsp_path.with_extension("prt");
+    let content_path = bsp_path.with_extension("content.json");
     if args.leaktest
         && let Some(leak) = &out.leak
     {
@@ -385,6 +391,11 @@ fn compile_and_write(args: &Args) -> Result<Option<crate::CompileStats>> {
         write_atomic(&prt_path, out.portals.write().as_bytes())?;
     } else {
         remove_stale(&prt_path)?;
+    }
+    if args.noextendedcontentflags {
+        remove_stale(&content_path)?;
+    } else {
+        write_atomic(&content_path, content_json(&out.leaf_contents).as_bytes())?;
     }
     match &out.leak {
         Some(leak) => write_atomic(&pts_path, write_pointfile(&leak.pointfile).as_bytes())?,

@@ -3,6 +3,7 @@
 //! ([`crate::model`], the models in parallel), then emit the BSP and the portal file.
 
 use crate::brushlist::brush_list_lump;
+use crate::content_flags::ContentFlags;
 use crate::editor::{OmittedLayer, omitted_layers, without_editor_keys};
 use crate::emit::{EmitInput, emit};
 use crate::faces::{
@@ -171,6 +172,8 @@ pub struct CompileOutput {
     pub bsp: Bsp,
     /// The `.prt` file for vis.
     pub portals: PortalFile,
+    /// Each BSP leaf's extended content flags, in leaf order (the `.content.json` file).
+    pub leaf_contents: Vec<ContentFlags>,
     /// Where the world leaks, if it does.
     pub leak: Option<LeakReport>,
     /// What the compile worked around.
@@ -329,6 +332,7 @@ pub fn compile(
     Ok(CompileOutput {
         bsp,
         portals: emitted.portals,
+        leaf_contents: emitted.leaf_contents,
         leak,
         warnings,
         stats,

@@ -2,13 +2,14 @@
 //! faces, nodes, leaves (leaf 0 is the shared solid leaf), clip nodes and models; and the
 //! world's portals into a PRT1 file (PRT2 when it has detail).
 
+use crate::content_flags::ContentFlags;
 use crate::faces::ModelFace;
 use crate::gather::MapTexInfo;
 use crate::hulls::emit_clipnodes;
 use crate::model::ModelOutput;
 use crate::planes::{PlaneId, PlaneSet};
 use crate::texinfo::TextureRole;
-use crate::tree::{FENCE, Tree, engine_contents, is_see_through, vis_class};
+use crate::tree::{Tree, engine_contents, is_see_through, vis_class};
 use crate::wad_lookup::{TextureList, WadSet};
 use crate::warnings::Warning;
 use crate::weld::{VertexWelder, WeldClass, cut_to_max_vertices, fix_tjunctions};
@@ -42,6 +43,8 @@ pub(crate) struct EmitInput<'a> {
 pub(crate) struct Emitted {
     pub bsp: Bsp,
     pub portals: PortalFile,
+    /// Each BSP leaf's extended content flags, in leaf order.
+    pub leaf_contents: Vec<ContentFlags>,
     pub tjunction_vertices: usize,
 }
 
@@ -336,8 +339,8 @@ pub(crate) fn emit(mut input: EmitInput) -> Emitted {
 
     // Nodes, leaves and models.
     bsp.leafs.push(Leaf::SHARED_SOLID);
+    let mut leaf_contents = vec![ContentFlags::SOLID];
     let mut world_leaf_index: HashMap<u32, u32> = HashMap::new();
-    let mut fence_leaves = Vec::new();
     for (mi, m) in input.models.iter().enumerate() {
         let (first_face, num_faces) = model_faces[mi];
         let leaves_before = bsp.leafs.len();
@@ -351,7 +354,8 @@ pub(crate) fn emit(mut input: EmitInput) -> Emitted {
             leaf_faces: &leaf_faces,
             leaf_growth: &leaf_growth,
             leaf_index: HashMap::new(),
-            fence_leaves: &mut fence_leaves,
+            leaf_contents: &mut leaf_contents,
+            transwater: input.transwater,
         };
         let (mut head, head_bounds) = w.node(0);
         if head < 0 {
@@ -399,10 +403,12 @@ pub(crate) fn emit(mut input: EmitInput) -> Emitted {
     bsp.set_phong_faces(&phong);
     bsp.set_face_flags(&flags);
     bsp.set_surflight_groups(&surflight_groups);
-    let mut leaf_flags = vec![LeafFlags::default(); bsp.leafs.len()];
-    for &leaf in &fence_leaves {
-        leaf_flags[leaf as usize].fence = true;
-    }
+    let leaf_flags: Vec<LeafFlags> = leaf_contents
+        .iter()
+        .map(|c| LeafFlags {
+            fence: c.contains(ContentFlags::WINDOW),
+        })
+        .collect();
     bsp.set_leaf_flags(&leaf_flags);
     bsp.planes = planes.planes;
     bsp.set_entity_text(&write_entities(input.entities));
@@ -416,6 +422,7 @@ pub(crate) fn emit(mut input: EmitInput) -> Emitted {
     Emitted {
         bsp,
         portals,
+        leaf_contents,
         tjunction_vertices,
     }
 }
@@ -431,8 +438,10 @@ struct TreeWriter<'a, 'b> {
     leaf_growth: &'b HashMap<(usize, u32), Bounds>,
     /// Tree leaf to BSP leaf.
     leaf_index: HashMap<u32, u32>,
-    /// The BSP leaves inside fences (written solid; light takes them as open).
-    fence_leaves: &'b mut Vec<u32>,
+    /// Each written leaf's extended content flags, in leaf order.
+    leaf_contents: &'b mut Vec<ContentFlags>,
+    /// Liquids are detail and translucent ([`EmitInput::transwater`]).
+    transwater: bool,
 }
 
 impl TreeWriter<'_, '_> {
@@ -471,9 +480,11 @@ impl TreeWriter<'_, '_> {
             let first = self.bsp.marksurfaces.len() as u32;
             self.bsp.marksurfaces.extend(marks.into_iter().flatten());
             let index = self.bsp.leafs.len() as u32;
-            if node.contents == FENCE {
-                self.fence_leaves.push(index);
-            }
+            self.leaf_contents.push(ContentFlags::of_leaf(
+                node.contents,
+                &node.brushes,
+                self.transwater,
+            ));
             self.bsp.leafs.push(Leaf {
                 contents: engine_contents(node.contents),
                 vis_offset: -1,

@@ -19,6 +19,7 @@ mod brushlist;
 #[cfg(feature = "cli")]
 pub mod cli;
 mod compile;
+pub mod content_flags;
 pub mod convert;
 pub mod cracks;
 mod csg;

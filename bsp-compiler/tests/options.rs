@@ -782,12 +782,13 @@ fn missing_textures_as_zero_size_writes_them_0x0() {
     assert_eq!(texture_named(&back, "floor").width, 0);
 }
 
-/// ericw-tools' switches for its `.texinfo.json`, which Slipgate does not write, are accepted
-/// with a note.
+/// ericw-tools' switch for its `.texinfo.json`, which Slipgate does not write, is accepted with
+/// a note; the one for the `.content.json` acts (see `content_flags.rs`).
 #[test]
-fn extended_flag_switches_are_accepted_with_a_note() {
+fn extended_flag_switches_are_accepted() {
     let args = parsed_args(&["-noextendedcontentflags", "-noextendedsurfflags", "x.map"]);
     let notes = args.ericw_only.notes();
-    assert_eq!(notes.len(), 2, "{notes:?}");
-    assert!(notes[0].starts_with("-noextendedcontentflags has no effect"));
+    assert_eq!(notes.len(), 1, "{notes:?}");
+    assert!(notes[0].starts_with("-noextendedsurfflags has no effect"));
+    assert!(args.noextendedcontentflags);
 }
