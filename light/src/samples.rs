@@ -33,7 +33,6 @@ use crate::outline::{FaceRegion, ON_EDGE};
 /// Distance of sample points in front of their face, in map units.
 pub const SURFACE_OFFSET: f64 = 1.0;
 
-
 /// The sample points of one face.
 #[derive(Debug, Clone)]
 pub struct FaceSamples {
