@@ -493,7 +493,8 @@ pub(crate) fn read_map(
 
 /// Parse `source`, its prefabs expanded; its first entity must be worldspawn.
 fn parse_with_worldspawn(source: &MapSource) -> Result<MapFile, CompileError> {
-    let map = expand_prefabs(parse_map(&source.path, &source.text)?, &source.path)?;
+    let mut map = expand_prefabs(parse_map(&source.path, &source.text)?, &source.path)?;
+    map.drop_texture_folders();
     let classname = map
         .entities
         .first()

@@ -76,6 +76,34 @@ pub struct MapFile {
     pub entities: Vec<MapEntity>,
 }
 
+impl MapFile {
+    /// Drop the folder from every face's texture name (`base/metal1` becomes `metal1`), as
+    /// ericw-tools' qbsp does for Quake 1 maps: editors that load textures from folders write
+    /// the folder into the name, but WADs, the texture lump and the name rules (`*`, `sky`,
+    /// `clip`...) know the bare name only.
+    pub fn drop_texture_folders(&mut self) {
+        let faces = self
+            .entities
+            .iter_mut()
+            .flat_map(|e| &mut e.brushes)
+            .flat_map(|b| &mut b.faces);
+        for face in faces {
+            if let Some(bare) = texture_without_folder(&face.texture) {
+                face.texture = bare.to_string();
+            }
+        }
+    }
+}
+
+/// The part of `texture` after its last `/` (only `/`: ericw-tools leaves `\` alone), when it
+/// has a folder and the part is not empty.
+fn texture_without_folder(texture: &str) -> Option<&str> {
+    texture
+        .rsplit_once('/')
+        .map(|(_, bare)| bare)
+        .filter(|bare| !bare.is_empty())
+}
+
 /// A `.map` file's text. Quake text is Latin-1: bytes that are not UTF-8 become the chars of
 /// the same value.
 pub fn read_map_text(path: &Path) -> std::io::Result<String> {
@@ -402,6 +430,15 @@ mod tests {
         assert_eq!(face.points[2].x, 0.5);
         assert_eq!(face.texture, "{fence");
         assert!(matches!(face.projection, Projection::Valve { .. }));
+    }
+
+    #[test]
+    fn texture_folders_are_dropped_up_to_the_last_slash() {
+        assert_eq!(texture_without_folder("base/metal1"), Some("metal1"));
+        assert_eq!(texture_without_folder("a/b/*water1"), Some("*water1"));
+        assert_eq!(texture_without_folder("metal1"), None);
+        assert_eq!(texture_without_folder("base\\metal1"), None);
+        assert_eq!(texture_without_folder("base/"), None);
     }
 
     #[test]

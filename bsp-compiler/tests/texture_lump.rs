@@ -11,6 +11,7 @@ mod common;
 use bsp_compiler::{CompileOptions, MapSource, Warning, compile};
 use common::*;
 use quake_formats::Bsp;
+use quake_formats::bsp::contents;
 use quake_formats::miptex::MipTex;
 use quake_formats::wad::{Wad, WadLump};
 use std::path::{Path, PathBuf};
@@ -136,6 +137,36 @@ fn wad_textures_follow_skip_in_map_order_with_pixels() {
     for i in 0..5 {
         assert!(slot(&bsp, i).mips.is_some(), "slot {i}");
     }
+}
+
+/// The folder editors write before a texture's name (`base/floor1`) is dropped up to the last
+/// `/`, as ericw-tools' qbsp drops it: the bare name is looked up in the WAD and written to the
+/// lump. It also decides contents, where ericw-tools keeps the folder: `liquids/*water1` is water.
+#[test]
+fn texture_folders_are_dropped_from_names() {
+    let dir = project("folders");
+    let water = box_brush(
+        [-128.0, -128.0, -128.0],
+        [128.0, 128.0, -64.0],
+        "liquids/*water1",
+    );
+    let text = textured_room(&water, "")
+        .replace("floor1 0 0 0", "base/floor1 0 0 0")
+        .replace("metal1 0 0 0", "a/b/metal1 0 0 0");
+    let (bsp, warnings) = compiled_at(&dir, &text, &with_wads());
+    assert_eq!(
+        names(&bsp),
+        named(&["skip", "floor1", "metal1", "brick1", "*water1"])
+    );
+    for i in 0..5 {
+        assert!(slot(&bsp, i).mips.is_some(), "slot {i}");
+    }
+    assert!(
+        warnings.iter().all(|w| !w.to_string().contains('/')),
+        "{warnings:?}"
+    );
+    let leaf = bsp.leaf_at([0.0, 0.0, -100.0]).expect("a leaf");
+    assert_eq!(bsp.leafs[leaf].contents, contents::WATER);
 }
 
 /// ericw-tools' `wadExternal`: the same textures from an `-xwadpath` WAD, names and sizes
