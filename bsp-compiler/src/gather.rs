@@ -457,9 +457,14 @@ fn origin_brush_centre(ent: &MapEntity, planes: &mut PlaneSet) -> Option<DVec3> 
     (!bounds.is_empty()).then(|| bounds.center())
 }
 
-/// Whether `ent`'s liquids are lit: its `_litwater` key, else the worldspawn's, else `default`.
+/// Whether `ent`'s liquids are lit: its `_litwater` key (or ericw-tools' other name for it,
+/// `_splitturb`), else the worldspawn's, else `default`.
 fn lit_water(entities: &[MapEntity], ent: &MapEntity, default: bool) -> bool {
-    let key = |e: &MapEntity| e.entity.get_float("_litwater").map(|v| v != 0.0);
+    let key = |e: &MapEntity| {
+        (e.entity.get_float("_litwater"))
+            .or_else(|| e.entity.get_float("_splitturb"))
+            .map(|v| v != 0.0)
+    };
     key(ent)
         .or_else(|| entities.first().and_then(key))
         .unwrap_or(default)

@@ -554,6 +554,14 @@ fn liquids_are_lit_unless_litwater_is_off() {
     );
     let bsp = compile_options(&on_in_entity, parsed_options(&["x.map"]));
     assert!(flags_of(&bsp, "*water0").iter().all(|f| f & SPECIAL == 0));
+    // ericw-tools' `litWater` test: `_splitturb 0` on a func_group leaves its liquids unlit.
+    let off_by_other_name = room_map_with(
+        false,
+        "",
+        &format!("{{\n\"classname\" \"func_group\"\n\"_splitturb\" \"0\"\n{pool}}}\n"),
+    );
+    let bsp = compile_options(&off_by_other_name, parsed_options(&["x.map"]));
+    assert!(flags_of(&bsp, "*water0").iter().all(|f| f & SPECIAL != 0));
 }
 
 /// `-bmodelcontents`: a brush model's water brush is water inside (FTE swims in it), its solid
