@@ -206,7 +206,7 @@ const DIMMEST_KEPT: f64 = 1.0;
 /// Finishes one face. Returns the lightmap and how many styles were dropped
 /// for exceeding four.
 pub fn finish_face(light: &FaceLight, finish: &Finish) -> (FaceLightmap, usize) {
-    let (maps, dropped) = keep_styles(style_maps(light, finish));
+    let (maps, dropped) = keep_styles(style_maps(light, finish), finish);
     (lightmap_of(light, maps, finish), dropped)
 }
 
@@ -220,7 +220,7 @@ pub fn finish_face_on_own_grid(
     grid: OwnGrid,
     finish: &Finish,
 ) -> (FaceLightmap, usize) {
-    let (own_maps, dropped) = keep_styles(style_maps(own, finish));
+    let (own_maps, dropped) = keep_styles(style_maps(own, finish), finish);
     let mut all = style_maps(vanilla, finish);
     let maps = own_maps
         .iter()
@@ -278,14 +278,13 @@ fn style_maps(light: &FaceLight, finish: &Finish) -> Vec<StyleMap> {
 }
 
 /// The styles a face keeps of `maps`: those lit anywhere (a luxel [`DIMMEST_KEPT`] or
-/// brighter), brightest first, four at most, as ericw-tools keeps them (a style dark all over
-/// is not written, style 0 included: a face with none gets no lightmap, style 255 and no light
+/// brighter, or with HDR output any light at all, which its words keep where the bytes are 0),
+/// brightest first, four at most, as ericw-tools keeps them (a style dark all over is not
+/// written, style 0 included: a face with none gets no lightmap, style 255 and no light
 /// offset). Also says how many lit styles were dropped.
-fn keep_styles(maps: Vec<StyleMap>) -> (Vec<StyleMap>, usize) {
-    let mut maps: Vec<StyleMap> = maps
-        .into_iter()
-        .filter(|m| m.brightest >= DIMMEST_KEPT)
-        .collect();
+fn keep_styles(maps: Vec<StyleMap>, finish: &Finish) -> (Vec<StyleMap>, usize) {
+    let lit = |m: &StyleMap| m.brightest >= DIMMEST_KEPT || (finish.hdr && m.brightest > 0.0);
+    let mut maps: Vec<StyleMap> = maps.into_iter().filter(|m| lit(m)).collect();
     maps.sort_by_key(|m| std::cmp::Reverse(m.energy));
     let dropped = maps.len().saturating_sub(MAX_LIGHTMAPS);
     maps.truncate(MAX_LIGHTMAPS);
@@ -559,6 +558,30 @@ mod tests {
         assert!(dim.styles.is_empty(), "{:?}", dim.grey);
         let (lit, _) = finish_face(&face(2.0), &PLAIN);
         assert_eq!((lit.styles, lit.grey), (vec![0], vec![vec![1, 0]]));
+    }
+
+    /// ericw-tools' `hdr` test: with HDR output, a face whose light rounds to bytes of 0 keeps
+    /// its lightmap (grey 0), so the HDR words carry the light the bytes cannot.
+    #[test]
+    fn with_hdr_output_a_face_dimmer_than_one_level_keeps_its_lightmap() {
+        let face = FaceLight {
+            face: 0,
+            width: 2,
+            height: 1,
+            styles: vec![(0, vec![[0.6; 3], [0.0; 3]])],
+            directions: Vec::new(),
+        };
+        let (bytes_only, _) = finish_face(&face, &PLAIN);
+        assert!(bytes_only.styles.is_empty());
+        let hdr = Finish { hdr: true, ..PLAIN };
+        let (m, _) = finish_face(&face, &hdr);
+        assert_eq!((m.styles, m.grey), (vec![0], vec![vec![0, 0]]));
+        assert_ne!(m.hdr[0][0], 0, "the HDR word keeps the light");
+        let dark = FaceLight {
+            styles: vec![(0, vec![[0.0; 3]; 2])],
+            ..face
+        };
+        assert!(finish_face(&dark, &hdr).0.styles.is_empty());
     }
 
     /// Regression: a face no light reaches was written as style 0 with a lightmap of zeros;
