@@ -172,24 +172,33 @@ mod tests {
             .unwrap_or(p)
     }
 
+    /// A convex region on the plane z = 64: corners on a circle of `radius` at `angles`
+    /// (radians), sorted and thinned to no two closer than `min_gap`; `None` when fewer than
+    /// three remain.
+    fn circle_region(mut angles: Vec<f64>, radius: f64, min_gap: f64) -> Option<FaceRegion> {
+        angles.sort_by(f64::total_cmp);
+        angles.dedup_by(|a, b| (*a - *b).abs() < min_gap);
+        (angles.len() >= 3).then(|| {
+            let points = angles
+                .iter()
+                .map(|a| DVec3::new(radius * a.cos(), radius * a.sin(), 64.0))
+                .collect();
+            FaceRegion::from_points(points, DVec3::Z)
+        })
+    }
+
     proptest! {
         /// Looking only at the edges a point is outside of finds the same nearest point.
         #[test]
         fn nearest_looks_only_at_edges_the_point_is_outside_of(
-            mut angles in proptest::collection::vec(0.0f64..std::f64::consts::TAU, 3..9),
+            angles in proptest::collection::vec(0.0f64..std::f64::consts::TAU, 3..9),
             radius in 1.0f64..500.0,
             x in -800.0f64..800.0,
             y in -800.0f64..800.0,
         ) {
-            angles.sort_by(f64::total_cmp);
-            angles.dedup_by(|a, b| (*a - *b).abs() < 0.05);
-            prop_assume!(angles.len() >= 3);
-            // A convex polygon on the plane z = 64: points on a circle, in order.
-            let points: Vec<DVec3> = angles
-                .iter()
-                .map(|a| DVec3::new(radius * a.cos(), radius * a.sin(), 64.0))
-                .collect();
-            let region = FaceRegion::from_points(points, DVec3::Z);
+            let region = circle_region(angles, radius, 0.05);
+            prop_assume!(region.is_some());
+            let region = region.expect("assumed");
             let p = DVec3::new(x, y, 64.0);
             let inside = (region.points.iter().zip(&region.inward)).all(|(&a, m)| m.dot(p - a) >= 0.0);
             let got = region.nearest(p);
@@ -204,21 +213,16 @@ mod tests {
         /// The distance bound never turns away a point the edges take, near the outline too.
         #[test]
         fn contains_takes_what_every_edge_takes(
-            mut angles in proptest::collection::vec(0.0f64..std::f64::consts::TAU, 3..9),
+            angles in proptest::collection::vec(0.0f64..std::f64::consts::TAU, 3..9),
             radius in 1.0f64..500.0,
             x in -800.0f64..800.0,
             y in -800.0f64..800.0,
             toward in 0usize..9,
             nudge in -1e-5f64..1e-5,
         ) {
-            angles.sort_by(f64::total_cmp);
-            angles.dedup_by(|a, b| (*a - *b).abs() < 0.01);
-            prop_assume!(angles.len() >= 3);
-            let points: Vec<DVec3> = angles
-                .iter()
-                .map(|a| DVec3::new(radius * a.cos(), radius * a.sin(), 64.0))
-                .collect();
-            let region = FaceRegion::from_points(points, DVec3::Z);
+            let region = circle_region(angles, radius, 0.01);
+            prop_assume!(region.is_some());
+            let region = region.expect("assumed");
             // A point anywhere, and one just off a corner.
             let corner = region.points[toward % region.points.len()];
             for p in [DVec3::new(x, y, 64.0), corner + DVec3::new(nudge, -nudge, 0.0)] {
@@ -227,6 +231,5 @@ mod tests {
                 prop_assert_eq!(region.contains(p), by_edges);
             }
         }
-
     }
 }
