@@ -5,6 +5,11 @@
 /// `<!-- {start} -->` and `<!-- end of {end} -->`; with `SLIPGATE_WRITE_DOCS` set, writes it
 /// there instead.
 pub fn check_generated_table(start: &str, end: &str, table: &str) {
+    // Tests run in parallel: two tables written at once would each put back the other's old one.
+    static FILE: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _only_writer = FILE
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/mapping.md");
     let docs = std::fs::read_to_string(&path).expect("docs/mapping.md");
     let start_marker = format!("<!-- {start} -->\n");

@@ -456,7 +456,7 @@ fn trace_run(src: &GridSources, sky: &LeafSky, points: &[DVec3]) -> (Vec<RawPoin
             rays += cast(
                 points,
                 &lanes,
-                |p| src.scene.sees_sky16(p, 0),
+                |p| src.scene.sees_sky16(p, 0, sun.sky_texture.as_deref()),
                 |i| sums[i].sums.add(sun.style, sun.light, sun.color),
             );
         }
@@ -529,6 +529,7 @@ mod tests {
             anglescale: 0.5,
             dirt: None,
             directions,
+            sky_texture: None,
         };
         let mut suns = vec![sun(300.0, 1)];
         suns.extend((0..100).map(|_| sun(0.5, 100)));

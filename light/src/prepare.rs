@@ -3,7 +3,7 @@
 
 use glam::DVec3;
 use quake_formats::Bsp;
-use quake_formats::entities::{parse_entities, write_entities};
+use quake_formats::entities::{Entity, parse_entities, write_entities};
 use quake_formats::geom::Bounds;
 
 use crate::embree::Device;
@@ -108,6 +108,43 @@ fn faceless_solids(
     out
 }
 
+/// A `_suntexture` the BSP has no texture of filters nothing (as in ericw-tools): each sun
+/// naming one shines through every sky face, with a warning naming its entity.
+fn drop_unknown_sun_textures(bsp: &Bsp, entities: &[Entity], lights: &mut MapLights) {
+    let known = |name: &str| {
+        bsp.textures
+            .textures
+            .iter()
+            .flatten()
+            .any(|t| t.name().eq_ignore_ascii_case(name))
+    };
+    let key = "_suntexture";
+    let named_by_a_sun = |name: &str| {
+        lights
+            .suns
+            .iter()
+            .any(|s| s.sky_texture.as_deref() == Some(name))
+    };
+    for (index, e) in entities.iter().enumerate() {
+        match e.get(key) {
+            Some(name) if named_by_a_sun(name) && !known(name) => {
+                lights.warnings.push(SettingWarning {
+                    given: Given::key(index, e, key),
+                    value: name.to_string(),
+                    problem: "the map has no such texture; the sun shines through every sky face"
+                        .to_string(),
+                });
+            }
+            _ => {}
+        }
+    }
+    for sun in &mut lights.suns {
+        if sun.sky_texture.as_deref().is_some_and(|name| !known(name)) {
+            sun.sky_texture = None;
+        }
+    }
+}
+
 /// Per face, whether it casts no shadow (the compiler's `SLIPGATE_FACEFLAGS`); empty when the
 /// file has no such lump.
 fn shadowless_faces(bsp: &Bsp) -> Result<Vec<bool>, LightError> {
@@ -131,6 +168,7 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
     let mut entities = parse_entities(&bsp.entity_text())?;
     let mut map_lights = parse_lights(&mut entities, &options.overrides)?;
     let entity_text = (map_lights.switchable.count > 0).then(|| write_entities(&entities));
+    drop_unknown_sun_textures(bsp, &entities, &mut map_lights);
     let origin_of = |m: usize| {
         map_lights
             .model_origins

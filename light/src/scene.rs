@@ -34,6 +34,10 @@ pub struct TraceScene {
     sky_geom: u32,
     /// The sky faces alone, to find where a sun ray meets the sky first.
     sky_only: Option<Scene>,
+    /// Per triangle of `sky_only`, its texture's index in `sky_textures`.
+    sky_texture_of: Vec<u16>,
+    /// The names of the sky faces' textures.
+    sky_textures: Vec<String>,
     /// The face of each opaque triangle (by primitive id).
     opaque_faces: Vec<u32>,
     /// Per `_shadowself` model (not already in `scene`): its own faces.
@@ -153,6 +157,22 @@ impl TraceScene {
                 Some((model, k))
             })
             .collect();
+        let mut sky_textures: Vec<String> = Vec::new();
+        let sky_texture_of = sky
+            .faces
+            .iter()
+            .map(|&f| {
+                let name = faces.get(f as usize).map_or("", |f| f.texture.as_str());
+                let at = sky_textures
+                    .iter()
+                    .position(|t| t.eq_ignore_ascii_case(name))
+                    .unwrap_or_else(|| {
+                        sky_textures.push(name.to_string());
+                        sky_textures.len() - 1
+                    });
+                u16::try_from(at).unwrap_or(u16::MAX)
+            })
+            .collect();
         let sky_only = if sky.triangles.is_empty() {
             None
         } else {
@@ -165,6 +185,8 @@ impl TraceScene {
             scene: builder.commit()?,
             sky_geom,
             sky_only,
+            sky_texture_of,
+            sky_textures,
             opaque_faces: opaque.faces,
             own,
             switchable,
@@ -232,18 +254,38 @@ impl TraceScene {
     }
 
     /// Bit `i` set if lane `i` of `packet`, cast from a face of `model`,
-    /// reaches a sky face before anything else.
+    /// reaches a sky face before anything else, one textured `only` if given (`_suntexture`).
     /// First where each ray meets the sky (sky faces alone, a small scene),
     /// then whether anything blocks it before that: an occlusion query,
     /// which stops at any hit, where one closest-hit query over everything
     /// must rule out every nearer surface.
-    pub fn sees_sky16(&self, packet: &mut RayPacket16, model: usize) -> u16 {
+    pub fn sees_sky16(&self, packet: &mut RayPacket16, model: usize, only: Option<&str>) -> u16 {
         let Some(sky_only) = &self.sky_only else {
             return 0;
         };
-        let ids = sky_only.first_hit_geom16(packet, true);
+        let only = match only {
+            None => None,
+            Some(name) => match self
+                .sky_textures
+                .iter()
+                .position(|t| t.eq_ignore_ascii_case(name))
+            {
+                Some(at) => Some(at),
+                None => return 0,
+            },
+        };
+        let hits = sky_only.first_hits16(packet, true);
+        let through = |(geom, prim): (u32, u32)| {
+            geom != sys::RTC_INVALID_GEOMETRY_ID
+                && only.is_none_or(|at| {
+                    self.sky_texture_of
+                        .get(prim as usize)
+                        .map(|&t| usize::from(t))
+                        == Some(at)
+                })
+        };
         let sky = (0..16)
-            .filter(|&i| ids[i] != sys::RTC_INVALID_GEOMETRY_ID)
+            .filter(|&i| through(hits[i]))
             .fold(0, |m, i| m | (1 << i));
         // Just short of the sky hit, so the sky face itself does not block.
         packet.keep_shortened(sky, SKY_HIT_SHORTEN);

@@ -3,6 +3,7 @@
 //! `_sun 1`, `_sunlight2 1` and `_sunlight3 1`.
 
 use std::collections::HashMap;
+use std::sync::Arc;
 
 use glam::DVec3;
 use quake_formats::entities::Entity;
@@ -88,6 +89,10 @@ fn read_light(k: &Keys, origins: &HashMap<&str, DVec3>, global: &Global, out: &m
         anglescale: c.anglescale,
         dirt: c.dirt,
         directions: 1,
+        sky_texture: k
+            .text(&keys::SUNTEXTURE)
+            .filter(|t| !t.is_empty())
+            .map(Arc::from),
     };
     if k.switch(&keys::SUN) == Some(true) {
         let to_sun = -c.aim.unwrap_or(DVec3::new(0.0, 0.0, -1.0));

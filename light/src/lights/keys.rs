@@ -192,6 +192,10 @@ entity_keys! {
     SUNLIGHT2: ["_sunlight2"] on Lights, Switch, default "`0`";
     /// `1`: the light is a sky dome from below with its brightness and colour.
     SUNLIGHT3: ["_sunlight3"] on Lights, Switch, default "`0`";
+    /// A `_sun`, `_sunlight2` or `_sunlight3` light shines only through sky faces with this
+    /// texture (as in ericw-tools; a texture the BSP does not hold is a warning and the sun
+    /// shines through every sky face).
+    SUNTEXTURE: ["_suntexture"] on Lights, Text, default "every sky texture";
     /// `1`: the light is ignored by the light tool (left for the game).
     NOSTATICLIGHT: ["_nostaticlight"] on Lights, Switch, default "`0`";
     /// `1`: the light stays where it is. Otherwise a light inside solid, or lying exactly on a

@@ -4,6 +4,8 @@
 //! `_sunlight2 1` or `_sunlight3 1`. A sun or dome spread over many directions is one
 //! [`SunLight`] per direction, sharing its light.
 
+use std::sync::Arc;
+
 use glam::DVec3;
 
 use super::worldspawn::Global;
@@ -24,6 +26,8 @@ pub struct SunLight {
     pub dirt: Option<DirtResponse>,
     /// How many directions its sun or dome is spread over (1: a sun without a penumbra).
     pub directions: usize,
+    /// `_suntexture`: the only sky texture it shines through (`None`: every sky face).
+    pub sky_texture: Option<Arc<str>>,
 }
 
 /// `sun` spread over `degrees` around its direction (a cone's half-angle): `sunsamples`
@@ -87,6 +91,7 @@ pub fn world_suns(settings: &Settings, global: &Global) -> Vec<SunLight> {
             anglescale: global.anglescale,
             dirt: global.dirt_if(settings.sunlight_dirt),
             directions: 1,
+            sky_texture: None,
         };
         out.extend(spread(sun, settings.sun_penumbra, global.sunsamples));
     }
@@ -104,6 +109,7 @@ pub fn world_suns(settings: &Settings, global: &Global) -> Vec<SunLight> {
                 anglescale: global.anglescale,
                 dirt: dome_dirt,
                 directions: 1,
+                sky_texture: None,
             };
             out.extend(dome(sky, upper, global.sunsamples));
         }
@@ -124,6 +130,7 @@ mod tests {
             anglescale: 0.5,
             dirt: None,
             directions: 1,
+            sky_texture: None,
         }
     }
 

@@ -214,6 +214,76 @@ fn sun_rays_do_not_slip_through_seams_in_the_sky() {
     );
 }
 
+/// `suntexture` (`q1_light_suntexture`): two `_sun` lights, each with `_suntexture` naming one
+/// of two sky textures, shine only through the sky faces of their own texture: the floor under
+/// one sky is red, under the other blue (ericw-tools: 35 0 0 and 0 0 142 there). A
+/// `_suntexture` the map has no texture of is a warning and filters nothing.
+#[test]
+fn a_sun_with_a_sky_texture_shines_only_through_that_sky() {
+    let (x1, y1, ceiling) = (512.0, 256.0, 256.0);
+    let mut world = map_box([-16.0, -16.0, -16.0], [x1 + 16.0, y1 + 16.0, 0.0]);
+    for (lo, hi) in [
+        ([-16.0, -16.0, 0.0], [0.0, y1 + 16.0, ceiling]),
+        ([x1, -16.0, 0.0], [x1 + 16.0, y1 + 16.0, ceiling]),
+        ([0.0, -16.0, 0.0], [x1, 0.0, ceiling]),
+        ([0.0, y1, 0.0], [x1, y1 + 16.0, ceiling]),
+    ] {
+        world += &map_box(lo, hi);
+    }
+    let half = x1 / 2.0;
+    world += &map_box([-16.0, -16.0, ceiling], [half, y1 + 16.0, ceiling + 16.0])
+        .replace("wall", "sky_red");
+    world += &map_box(
+        [half, -16.0, ceiling],
+        [x1 + 16.0, y1 + 16.0, ceiling + 16.0],
+    )
+    .replace("wall", "sky_blue");
+    let sun = |color: &str, texture: &str| {
+        light(
+            [64.0, 64.0, 64.0],
+            &format!(
+                "\"_sun\" \"1\"\n\"mangle\" \"0 -90 0\"\n\"_color\" \"{color}\"\n\"_suntexture\" \"{texture}\""
+            ),
+        )
+    };
+    let map = |suns: &str| {
+        compiled(&format!(
+            "{{\n\"classname\" \"worldspawn\"\n{world}}}\n{suns}\
+             {{\n\"classname\" \"info_player_start\"\n\"origin\" \"64 64 40\"\n}}\n"
+        ))
+    };
+    let floor = |bsp: &Bsp, lighting: &Lighting, x: f64| {
+        luxel_rgb(bsp, lighting, 0, DVec3::new(x, y1 / 2.0, 0.0), DVec3::Z).expect("a lit floor")
+    };
+    let bsp = map(&(sun("1 0 0", "sky_red") + &sun("0 0 1", "SKY_BLUE")));
+    let lighting = lit(&bsp);
+    let [r, g, b] = floor(&bsp, &lighting, half / 2.0);
+    assert!(
+        r > 100 && g == 0 && b == 0,
+        "under the red sky: {:?}",
+        [r, g, b]
+    );
+    let [r, g, b] = floor(&bsp, &lighting, half * 1.5);
+    assert!(
+        r == 0 && g == 0 && b > 100,
+        "under the blue sky: {:?}",
+        [r, g, b]
+    );
+
+    let bsp = map(&sun("0 1 0", "no_such_sky"));
+    let lighting = lit(&bsp);
+    for x in [half / 2.0, half * 1.5] {
+        let [r, g, b] = floor(&bsp, &lighting, x);
+        assert!(r == 0 && g > 100 && b == 0, "at x {x}: {:?}", [r, g, b]);
+    }
+    let told: Vec<String> = lighting.warnings.iter().map(ToString::to_string).collect();
+    assert!(
+        told.iter()
+            .any(|w| w.contains("\"_suntexture\" is \"no_such_sky\"")),
+        "{told:?}"
+    );
+}
+
 /// `detailFence` (`q1_detail_fence`): a `func_detail_fence` (here all `skip`, as there, so it has
 /// no faces) around a light and the floor under it. Its inside is written solid, which stops
 /// players; the compiler marks those leaves and light takes them as open, so the light is not

@@ -115,7 +115,8 @@ impl FaceTrace<'_> {
             }
         }
         let ray = |i: usize| (samples.points[i], dir, setup.sun_distance);
-        let reaches = |p: &mut RayPacket16| setup.scene.sees_sky16(p, face.model);
+        let only = sun.sky_texture.as_deref();
+        let reaches = |p: &mut RayPacket16| setup.scene.sees_sky16(p, face.model, only);
         let packet = &mut self.packet;
         let visibility = &mut scratch.visibility;
         self.counts.sun_rays += match probes {
