@@ -266,6 +266,7 @@ pub(crate) fn emit(mut input: EmitInput) -> Emitted {
     let mut phong = Vec::with_capacity(pending.len());
     let mut flags = Vec::with_capacity(pending.len());
     let mut surflight_groups = Vec::with_capacity(pending.len());
+    let mut minlights = Vec::with_capacity(pending.len());
     let pieces = pending.iter().zip(polygons).flat_map(|(pf, poly)| {
         let max = max_face_edges(
             input.max_edges,
@@ -313,9 +314,11 @@ pub(crate) fn emit(mut input: EmitInput) -> Emitted {
             },
             light_offset: -1,
         });
-        phong.push(input.texinfos[f.texinfo as usize].phong);
-        flags.push(input.texinfos[f.texinfo as usize].flags);
-        surflight_groups.push(input.texinfos[f.texinfo as usize].surflight_group);
+        let info = &input.texinfos[f.texinfo as usize];
+        phong.push(info.phong);
+        flags.push(info.flags);
+        surflight_groups.push(info.surflight_group);
+        minlights.push(info.minlight);
         let range = node_faces
             .entry((pf.model, f.node))
             .or_insert((face_index, 0));
@@ -403,6 +406,7 @@ pub(crate) fn emit(mut input: EmitInput) -> Emitted {
     bsp.set_phong_faces(&phong);
     bsp.set_face_flags(&flags);
     bsp.set_surflight_groups(&surflight_groups);
+    bsp.set_face_minlights(&minlights);
     let leaf_flags: Vec<LeafFlags> = leaf_contents
         .iter()
         .map(|c| LeafFlags {

@@ -21,6 +21,7 @@ use crate::warnings::{DroppedFace, Warning};
 use glam::DVec3;
 use quake_formats::bsp::contents;
 use quake_formats::bsp::face_flags::FaceFlags;
+use quake_formats::bsp::face_minlight::FaceMinlight;
 use quake_formats::bsp::phong::{self, FacePhong};
 use quake_formats::geom::Bounds;
 use rayon::prelude::*;
@@ -101,7 +102,9 @@ pub(crate) fn gather(
                 lit_water: lit_water(&map.entities, ent, options.lit_water),
                 flags: merged_face_flags(ent, index, brush_class),
                 surflight_group: merged_surflight_group(ent, index, brush_class, warnings),
+                minlight: merged_minlight(ent, index, brush_class),
             },
+            minlight_exclude: merged_minlight_exclude(ent, index, brush_class),
             transwater: options.transwater,
             bmodel_contents: options.bmodel_contents,
             table: &mut g.table,
@@ -221,6 +224,8 @@ pub struct MapTexInfo {
     /// The `_surflight_group` of the world-merged entity (worldspawn included) the face came
     /// from; 0: none.
     pub surflight_group: i32,
+    /// The `_minlight` of the world-merged entity the face came from (level 0: none).
+    pub minlight: FaceMinlight,
 }
 
 /// What a face's entity says about the face, beyond its brush: one of these per entity.
@@ -231,6 +236,7 @@ pub(crate) struct FaceKeys {
     pub lit_water: bool,
     pub flags: FaceFlags,
     pub surflight_group: i32,
+    pub minlight: FaceMinlight,
 }
 
 impl MapTexInfo {
@@ -246,6 +252,7 @@ impl MapTexInfo {
             lit_water: self.lit_water,
             flags: self.flags,
             surflight_group: self.surflight_group,
+            minlight: self.minlight,
         }
     }
 }
@@ -356,8 +363,8 @@ impl EntityBrushes {
 }
 
 /// What a texinfo is interned by: its projection's bits, texture, phong group, whether it is lit
-/// water, its face flags and surface light group.
-type TexInfoKey = ([u64; 8], u32, u32, bool, FaceFlags, i32);
+/// water, its face flags, surface light group and minlight's bits.
+type TexInfoKey = ([u64; 8], u32, u32, bool, FaceFlags, i32, [u32; 4]);
 
 /// Texture names and texinfos, interned in first-use order.
 #[derive(Default)]
@@ -378,6 +385,7 @@ impl TexInfoTable {
             lit_water,
             flags,
             surflight_group,
+            minlight,
         } = keys;
         let key = name.to_ascii_lowercase();
         let texture = match self.name_index.get(&key) {
@@ -400,6 +408,13 @@ impl TexInfoTable {
             lit_water,
             flags,
             surflight_group,
+            [
+                minlight.level,
+                minlight.color[0],
+                minlight.color[1],
+                minlight.color[2],
+            ]
+            .map(f32::to_bits),
         );
         if let Some(&i) = self.info_index.get(&key) {
             return i;
@@ -413,6 +428,7 @@ impl TexInfoTable {
             lit_water,
             flags,
             surflight_group,
+            minlight,
         });
         self.info_index.insert(key, i);
         i
@@ -477,12 +493,54 @@ fn merged_face_flags(ent: &MapEntity, index: usize, class: EntityBrushes) -> Fac
     if index == 0 || class == EntityBrushes::Submodel {
         return FaceFlags::default();
     }
-    let shadow = ent.entity.get_float("_shadow");
+    let number = |key| ent.entity.get_float(key);
+    let shadow = number("_shadow");
     FaceFlags {
         no_shadow: shadow == Some(-1.0)
             || (class == EntityBrushes::Illusionary && shadow != Some(1.0)),
-        no_ambient: ent.entity.get_float("_noambient").is_some_and(|v| v != 0.0),
+        no_ambient: number("_noambient").is_some_and(|v| v != 0.0),
+        no_dirt: number("_dirt") == Some(-1.0),
+        no_bounce: number("_bounce").is_some_and(|v| v <= 0.0),
+        light_ignore: number("_lightignore") == Some(1.0),
+        no_minlight: false,
     }
+}
+
+/// The `_minlight` (and `_minlight_color` or `_mincolor`, 0–1 or 0–255) of an entity merged
+/// into the world, which light reads from the BSP for its faces as it reads a brush model's
+/// from its entity.
+fn merged_minlight(ent: &MapEntity, index: usize, class: EntityBrushes) -> FaceMinlight {
+    let level = ent.entity.get_float("_minlight").unwrap_or(0.0);
+    if index == 0 || class == EntityBrushes::Submodel || level == 0.0 {
+        return FaceMinlight::default();
+    }
+    let color = ["_minlight_color", "_mincolor"]
+        .iter()
+        .find_map(|key| ent.entity.get_floats::<3>(key))
+        .map_or([1.0; 3], |c| {
+            let scale = if c.iter().all(|&v| v <= 1.0) {
+                1.0
+            } else {
+                255.0
+            };
+            c.map(|v| (v / scale) as f32)
+        });
+    FaceMinlight {
+        level: level as f32,
+        color,
+    }
+}
+
+/// The `_minlight_exclude` texture of an entity merged into the world: its faces of that
+/// texture take no minlight.
+fn merged_minlight_exclude(ent: &MapEntity, index: usize, class: EntityBrushes) -> Option<String> {
+    if index == 0 || class == EntityBrushes::Submodel {
+        return None;
+    }
+    ent.entity
+        .get("_minlight_exclude")
+        .filter(|t| !t.is_empty())
+        .map(str::to_string)
 }
 
 /// The `_surflight_group` of entity `index` if it is worldspawn or merged into the world (light
@@ -583,6 +641,8 @@ struct EntityContext<'a> {
     class: EntityBrushes,
     origin: DVec3,
     keys: FaceKeys,
+    /// Faces of this texture take no minlight (`_minlight_exclude`).
+    minlight_exclude: Option<String>,
     /// Liquids are seen through (ericw-tools' `-transwater`): they are detail, which vis does
     /// not cut into clusters; otherwise structural in any entity, as vis's boundaries.
     transwater: bool,
@@ -593,6 +653,25 @@ struct EntityContext<'a> {
 }
 
 impl EntityContext<'_> {
+    /// The entity's keys as they apply to a face of `texture`.
+    fn face_keys(&self, texture: &str) -> FaceKeys {
+        let excluded = self
+            .minlight_exclude
+            .as_deref()
+            .is_some_and(|t| t.eq_ignore_ascii_case(texture));
+        if !excluded {
+            return self.keys;
+        }
+        FaceKeys {
+            flags: FaceFlags {
+                no_minlight: true,
+                ..self.keys.flags
+            },
+            minlight: FaceMinlight::default(),
+            ..self.keys
+        }
+    }
+
     /// The faces of map brush number `bi`. As in id's and ericw-tools' compilers, a face whose
     /// three points are collinear (no plane) and a face on a plane an earlier face of the brush
     /// already lies on (either way round; id's dm2 has one) are dropped with a warning naming
@@ -638,7 +717,9 @@ impl EntityContext<'_> {
                     texture: f.texture.clone(),
                 });
             }
-            let texinfo = self.table.intern(&f.texture, vecs, self.keys);
+            let texinfo = self
+                .table
+                .intern(&f.texture, vecs, self.face_keys(&f.texture));
             out.roles.push(role);
             out.lines.push(f.line);
             out.planes.push(BrushPlane {
@@ -805,6 +886,7 @@ mod tests {
             lit_water: true,
             flags,
             surflight_group: 0,
+            minlight: FaceMinlight::default(),
         };
         let plain = table.intern(
             "wall",
@@ -819,7 +901,7 @@ mod tests {
         );
         let shadowless = FaceFlags {
             no_shadow: true,
-            no_ambient: false,
+            ..FaceFlags::default()
         };
         let b = table.intern("wall", vecs, keys(grouped, shadowless));
         assert_ne!(a, b);

@@ -233,6 +233,7 @@ fn merged_entities_keys_for_shadow_and_sound_reach_their_faces() {
     let flags = |no_shadow, no_ambient| FaceFlags {
         no_shadow,
         no_ambient,
+        ..FaceFlags::default()
     };
     assert_eq!(flagged("func_detail", ""), flags(false, false));
     assert_eq!(

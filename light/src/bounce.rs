@@ -77,7 +77,12 @@ pub fn face_reflectance(
         .iter()
         .map(|f| {
             let in_scene = f.model == 0 || lights.shadow_models.contains(&f.model);
-            if f.kind != FaceKind::Lit || !in_scene || lights.no_bounce_models.contains(&f.model) {
+            let merged_no_bounce = lights.face_flags.get(f.index).is_some_and(|m| m.no_bounce);
+            if f.kind != FaceKind::Lit
+                || !in_scene
+                || merged_no_bounce
+                || lights.no_bounce_models.contains(&f.model)
+            {
                 return None;
             }
             let mean = bsp

@@ -145,13 +145,6 @@ fn drop_unknown_sun_textures(bsp: &Bsp, entities: &[Entity], lights: &mut MapLig
     }
 }
 
-/// Per face, whether it casts no shadow (the compiler's `SLIPGATE_FACEFLAGS`); empty when the
-/// file has no such lump.
-fn shadowless_faces(bsp: &Bsp) -> Result<Vec<bool>, LightError> {
-    let flags = bsp.face_flags().map_err(LightError::BspxLump)?;
-    Ok(flags.map_or_else(Vec::new, |f| f.iter().map(|f| f.no_shadow).collect()))
-}
-
 /// Reads faces, entities and visibility and builds the Embree scene.
 ///
 /// # Errors
@@ -167,6 +160,9 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
     let device = device?;
     let mut entities = parse_entities(&bsp.entity_text())?;
     let mut map_lights = parse_lights(&mut entities, &options.overrides)?;
+    map_lights
+        .read_merged_faces(bsp)
+        .map_err(LightError::BspxLump)?;
     let entity_text = (map_lights.switchable.count > 0).then(|| write_entities(&entities));
     drop_unknown_sun_textures(bsp, &entities, &mut map_lights);
     let origin_of = |m: usize| {
@@ -178,7 +174,7 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
     };
     let faces = face_geometry(bsp, origin_of, |m| map_lights.spacing(m))?;
     let solids = faceless_solids(bsp, &faces, &map_lights.shadow_models, origin_of);
-    let shadowless = shadowless_faces(bsp)?;
+    let shadowless: Vec<bool> = map_lights.face_flags.iter().map(|f| f.no_shadow).collect();
     let fences = fence_masks(bsp, &faces);
     let casters = Casters {
         shadowless: &shadowless,
@@ -257,22 +253,32 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
 
 /// The rules of the faces of brush model `model` (0 = world).
 pub fn face_rules<'a>(lights: &'a MapLights, geom: &FaceGeom) -> FaceRules<'a> {
-    // A brush model's own `_minlight` wins; otherwise worldspawn's applies.
+    let merged = lights
+        .face_flags
+        .get(geom.index)
+        .copied()
+        .unwrap_or_default();
+    // The face's own merged entity's `_minlight` wins, then its brush model's, then
+    // worldspawn's.
     let minlight = lights
-        .minlight
-        .get(&geom.model)
+        .face_minlight
+        .get(&geom.index)
+        .or_else(|| lights.minlight.get(&geom.model))
         .or_else(|| lights.minlight.get(&0))
         .filter(|m| {
-            m.exclude_texture
-                .as_ref()
-                .is_none_or(|t| !t.eq_ignore_ascii_case(&geom.texture))
+            !merged.no_minlight
+                && m.exclude_texture
+                    .as_ref()
+                    .is_none_or(|t| !t.eq_ignore_ascii_case(&geom.texture))
         });
     // A liquid's surface takes no dirt, as in ericw-tools.
-    let dirt = !lights.no_dirt_models.contains(&geom.model) && geom.kind != FaceKind::LitLiquid;
+    let dirt = !merged.no_dirt
+        && !lights.no_dirt_models.contains(&geom.model)
+        && geom.kind != FaceKind::LitLiquid;
     FaceRules {
         minlight,
         dirt,
-        minlight_only: lights.lightignore_models.contains(&geom.model),
+        minlight_only: merged.light_ignore || lights.lightignore_models.contains(&geom.model),
         bounce_dirt: lights.bounce.dirt.filter(|_| dirt && lights.bounce.is_on()),
     }
 }

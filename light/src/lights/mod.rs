@@ -17,6 +17,7 @@ mod worldspawn;
 use glam::DVec3;
 use std::collections::HashMap;
 
+use quake_formats::bsp::face_flags::FaceFlags;
 use quake_formats::entities::Entity;
 
 use crate::dirt::{DirtResponse, DirtSampling};
@@ -107,6 +108,12 @@ pub struct MapLights {
     pub lightignore_models: Vec<usize>,
     /// Brush models whose faces do not reflect light (`_bounce 0`).
     pub no_bounce_models: Vec<usize>,
+    /// Per face, what the keys of the entity merged into the world it came from say of it
+    /// (the compiler's `SLIPGATE_FACEFLAGS`; empty without that lump).
+    pub face_flags: Vec<FaceFlags>,
+    /// Faces with a minlight of their own entity's, merged into the world (the compiler's
+    /// `SLIPGATE_FACEMINLIGHT`).
+    pub face_minlight: HashMap<usize, Minlight>,
     /// Brush models whose `_autominlight` is not the default (occluded samples only).
     pub autominlight: HashMap<usize, AutoMinlight>,
     /// Brush models whose autominlight is taken at a target's origin (`_autominlight_target`).
@@ -214,6 +221,8 @@ pub fn parse_lights(
         no_dirt_models: Vec::new(),
         lightignore_models: Vec::new(),
         no_bounce_models: Vec::new(),
+        face_flags: Vec::new(),
+        face_minlight: HashMap::new(),
         autominlight: HashMap::new(),
         autominlight_at: HashMap::new(),
         no_nudge: Vec::new(),
@@ -240,6 +249,21 @@ pub fn parse_lights(
         .retain(|m| !switchable.iter().any(|(s, _)| s == m));
     entities::read_lights(entities, &global, &mut out);
     Ok(out)
+}
+
+impl MapLights {
+    /// Reads what the compiler recorded in `bsp` of the keys of entities merged into the world,
+    /// per face ([`MapLights::face_flags`], [`MapLights::face_minlight`]).
+    ///
+    /// # Errors
+    /// A damaged `SLIPGATE_FACEFLAGS` or `SLIPGATE_FACEMINLIGHT` lump.
+    pub fn read_merged_faces(
+        &mut self,
+        bsp: &quake_formats::Bsp,
+    ) -> Result<(), quake_formats::FormatError> {
+        let global = worldspawn::Global::new(&self.settings);
+        models::read_merged_faces(bsp, &global, self)
+    }
 }
 
 /// `-lmshift`'s default: Quake's 16 texels, leaving each model its `_lmscale`.

@@ -1,8 +1,10 @@
 //! Brush models' lighting keys: which cast shadows (`_shadow`, `_shadowself`), which take no
 //! dirt (`_dirt -1`), light (`_lightignore`) or reflect (`_bounce 0`), their own minlight and
 //! lightmap spacing (`_world_units_per_luxel`), their `origin` offset, and `_phong` smoothing
-//! and `_lmscale` (worldspawn's too, as model 0).
+//! and `_lmscale` (worldspawn's too, as model 0). The same keys of entities merged into the world
+//! (`func_detail*`, `func_group`) come per face, from what the compiler recorded in the BSP.
 
+use quake_formats::Bsp;
 use quake_formats::bsp::phong;
 use quake_formats::entities::Entity;
 
@@ -98,4 +100,26 @@ pub fn read_models(entities: &[Entity], global: &Global, out: &mut MapLights) {
         }
         out.warnings.extend(k.into_warnings());
     }
+}
+
+/// What the compiler recorded in `bsp` of the keys of entities merged into the world, per face:
+/// their flags (`_dirt -1`, `_bounce 0`, `_lightignore 1`, `_minlight_exclude`, `_shadow`) and
+/// their own minlight, into `out`.
+///
+/// # Errors
+/// A damaged `SLIPGATE_FACEFLAGS` or `SLIPGATE_FACEMINLIGHT` lump.
+pub fn read_merged_faces(
+    bsp: &Bsp,
+    global: &Global,
+    out: &mut MapLights,
+) -> Result<(), quake_formats::FormatError> {
+    out.face_flags = bsp.face_flags()?.unwrap_or_default();
+    for (face, m) in bsp.face_minlights()?.unwrap_or_default().iter().enumerate() {
+        if m.level != 0.0 {
+            let color = DVec3::from(m.color.map(f64::from));
+            let minlight = global.minlight(f64::from(m.level), color, None);
+            out.face_minlight.insert(face, minlight);
+        }
+    }
+    Ok(())
 }

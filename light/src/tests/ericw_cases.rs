@@ -5,7 +5,7 @@
 use glam::DVec3;
 use quake_formats::Bsp;
 
-use super::{map_box, options, room_bsp, sealed_room_brushes};
+use super::{map_box, options, room_bsp, sealed_room_brushes, slab_bsp};
 use crate::faces::{FaceGeom, Spacing, face_geometry};
 use crate::{Lighting, Quality, compute_lighting};
 
@@ -282,6 +282,43 @@ fn a_sun_with_a_sky_texture_shines_only_through_that_sky() {
             .any(|w| w.contains("\"_suntexture\" is \"no_such_sky\"")),
         "{told:?}"
     );
+}
+
+/// `litWater`'s third cube (`q1_litwater`): a `func_group` keyed `_lightignore 1` and
+/// `_minlight 100` is merged into the world, yet its faces take its minlight and no light, as a
+/// brush model's would (ericw-tools: 50 50 50 on its top under a light). The compiler records
+/// the keys of merged entities per face; `_minlight_exclude` leaves a texture's faces without
+/// any minlight, and `_dirt -1` and `_bounce 0` are kept per face too.
+#[test]
+fn keys_of_merged_entities_reach_light_per_face() {
+    let top = |classname: &str, keys: &str| {
+        let bsp = slab_bsp(classname, keys, "wall");
+        let lighting = lit(&bsp);
+        luxel_rgb(&bsp, &lighting, 0, DVec3::new(0.0, 0.0, -48.0), DVec3::Z)
+    };
+    let ignored = "\"_lightignore\" \"1\"\n\"_minlight\" \"100\"";
+    assert_eq!(top("func_group", ignored), Some([50, 50, 50]));
+    assert_eq!(top("func_detail", ignored), Some([50, 50, 50]));
+    let lit_top = top("func_group", "").expect("a lit top");
+    assert!(lit_top[0] > 60, "{lit_top:?}");
+    let dark = top("func_group", "\"_lightignore\" \"1\"");
+    assert!(dark.is_none_or(|c| c == [0, 0, 0]), "{dark:?}");
+    let excluded = format!("{ignored}\n\"_minlight_exclude\" \"WALL\"");
+    let none = top("func_group", &excluded);
+    assert!(none.is_none_or(|c| c == [0, 0, 0]), "{none:?}");
+
+    let bsp = slab_bsp(
+        "func_group",
+        "\"_dirt\" \"-1\"\n\"_bounce\" \"0\"\n\"_minlight\" \"20\"\n\"_mincolor\" \"255 0 0\"",
+        "wall",
+    );
+    let flags = bsp.face_flags().expect("lump").expect("flags");
+    let marked = flags.iter().filter(|f| f.no_dirt && f.no_bounce).count();
+    assert_eq!(marked, 6, "the slab's six faces");
+    let minlights = bsp.face_minlights().expect("lump").expect("minlights");
+    let red: Vec<_> = minlights.iter().filter(|m| m.level == 20.0).collect();
+    assert_eq!(red.len(), 6);
+    assert!(red.iter().all(|m| m.color == [1.0, 0.0, 0.0]), "{red:?}");
 }
 
 /// `detailFence` (`q1_detail_fence`): a `func_detail_fence` (here all `skip`, as there, so it has

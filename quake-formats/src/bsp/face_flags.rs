@@ -1,11 +1,14 @@
 //! `SLIPGATE_FACEFLAGS`: Slipgate's own BSPX lump that carries what the keys of entities merged
 //! into the world (`func_detail*`, `func_group`, worldspawn) say about their faces, which the
-//! BSP's core lumps cannot hold: whether a face casts shadows (`_shadow`) and whether it gives
-//! ambient sound (`_noambient`). The compiler writes it; light and vis read it.
+//! BSP's core lumps cannot hold: whether a face casts shadows (`_shadow`), gives ambient sound
+//! (`_noambient`), takes dirt (`_dirt -1`), reflects bounced light (`_bounce 0`), takes light
+//! at all (`_lightignore 1`) or takes minlight (`_minlight_exclude`). The compiler writes it;
+//! light and vis read it.
 //!
-//! One byte per face, in face order: bit 0 set, the face casts no shadow; bit 1 set, it gives
-//! no ambient sound. Other bits are reserved and read as zero. The lump is left out when no face
-//! has a flag, and engines ignore BSPX lumps they do not know.
+//! One byte per face, in face order: bit 0 set, the face casts no shadow; bit 1, it gives no
+//! ambient sound; bit 2, it takes no dirt; bit 3, it reflects no bounced light; bit 4, it takes
+//! minlight only; bit 5, it takes no minlight. Other bits are reserved and read as zero. The
+//! lump is left out when no face has a flag, and engines ignore BSPX lumps they do not know.
 
 use super::Bsp;
 use crate::error::Result;
@@ -14,6 +17,10 @@ use crate::error::Result;
 pub const LUMP_NAME: &str = "SLIPGATE_FACEFLAGS";
 const NO_SHADOW: u8 = 1;
 const NO_AMBIENT: u8 = 2;
+const NO_DIRT: u8 = 4;
+const NO_BOUNCE: u8 = 8;
+const LIGHT_IGNORE: u8 = 16;
+const NO_MINLIGHT: u8 = 32;
 
 /// What a face's entity says about it beyond the core lumps.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -23,17 +30,38 @@ pub struct FaceFlags {
     pub no_shadow: bool,
     /// The face gives no ambient sound to the leaves it is in (`_noambient 1`).
     pub no_ambient: bool,
+    /// Dirt does not darken the face (`_dirt -1`).
+    pub no_dirt: bool,
+    /// The face reflects no bounced light (`_bounce 0` or below).
+    pub no_bounce: bool,
+    /// The face takes minlight only, no lights or suns (`_lightignore 1`).
+    pub light_ignore: bool,
+    /// The face takes no minlight, not even the world's (`_minlight_exclude` names its texture).
+    pub no_minlight: bool,
 }
 
 impl FaceFlags {
     fn byte(self) -> u8 {
-        (u8::from(self.no_shadow) * NO_SHADOW) | (u8::from(self.no_ambient) * NO_AMBIENT)
+        [
+            (self.no_shadow, NO_SHADOW),
+            (self.no_ambient, NO_AMBIENT),
+            (self.no_dirt, NO_DIRT),
+            (self.no_bounce, NO_BOUNCE),
+            (self.light_ignore, LIGHT_IGNORE),
+            (self.no_minlight, NO_MINLIGHT),
+        ]
+        .iter()
+        .fold(0, |b, &(set, bit)| if set { b | bit } else { b })
     }
 
     fn from_byte(b: u8) -> FaceFlags {
         FaceFlags {
             no_shadow: b & NO_SHADOW != 0,
             no_ambient: b & NO_AMBIENT != 0,
+            no_dirt: b & NO_DIRT != 0,
+            no_bounce: b & NO_BOUNCE != 0,
+            light_ignore: b & LIGHT_IGNORE != 0,
+            no_minlight: b & NO_MINLIGHT != 0,
         }
     }
 }
@@ -77,11 +105,16 @@ mod tests {
             FaceFlags::default(),
             FaceFlags {
                 no_shadow: true,
-                no_ambient: false,
+                no_dirt: true,
+                ..FaceFlags::default()
             },
             FaceFlags {
                 no_shadow: true,
                 no_ambient: true,
+                no_bounce: true,
+                light_ignore: true,
+                no_minlight: true,
+                ..FaceFlags::default()
             },
         ];
         bsp.set_face_flags(&flags);
@@ -98,15 +131,9 @@ mod tests {
         let mut bsp = crate::bsp::bsp_with_faces(2);
         bsp.set_bspx_lump(LUMP_NAME, vec![1, 2, 3]);
         assert!(bsp.face_flags().is_err(), "3 records for 2 faces");
-        bsp.set_bspx_lump(LUMP_NAME, vec![0xfc, 0xff]);
+        bsp.set_bspx_lump(LUMP_NAME, vec![0xc0, 0xff]);
         let read = bsp.face_flags().expect("lump").expect("present");
         assert_eq!(read[0], FaceFlags::default());
-        assert_eq!(
-            read[1],
-            FaceFlags {
-                no_shadow: true,
-                no_ambient: true
-            }
-        );
+        assert_eq!(read[1].byte(), 0x3f);
     }
 }
