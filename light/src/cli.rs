@@ -292,6 +292,7 @@ fn run_with_current_threads(args: &Args) -> anyhow::Result<Option<crate::Stats>>
     if args.onlyents {
         return update_entities_only(args, bsp).map(|()| None);
     }
+    let ericw_lumps = ericw_face_keys(&mut bsp, path);
     let mut options = args.lighting_options()?;
     options.progress = quake_formats::progress::terminal();
     if let Some(stride) = args.face_stride {
@@ -304,6 +305,9 @@ fn run_with_current_threads(args: &Args) -> anyhow::Result<Option<crate::Stats>>
 
     let extra = measurements(args, &bsp, &options, &lighting)?;
 
+    for name in ericw_lumps {
+        bsp.remove_bspx_lump(name);
+    }
     let files = crate::apply_lighting(&mut bsp, &lighting);
     let companions = args.companion_files(&bsp, files);
     let out = args.output.as_ref().unwrap_or(path);
@@ -317,6 +321,36 @@ fn run_with_current_threads(args: &Args) -> anyhow::Result<Option<crate::Stats>>
         write_atomic(stats_path, serde_json::to_string_pretty(&json)?.as_bytes())?;
     }
     Ok(Some(lighting.stats))
+}
+
+/// For a BSP from ericw-tools' qbsp (none of Slipgate's per-face key lumps), the keys of its
+/// merged and brush entities from the `MAPNAME.texinfo.json` ericw-tools wrote beside it, added
+/// to `bsp` as those lumps: their names, to be taken out before the BSP is written. A file that
+/// does not read is a warning; the map is lit without it.
+fn ericw_face_keys(bsp: &mut Bsp, path: &Path) -> crate::ericw_texinfo::AddedLumps {
+    let json_path = path.with_extension("texinfo.json");
+    if crate::ericw_texinfo::has_face_key_lumps(bsp) || !json_path.is_file() {
+        return Vec::new();
+    }
+    let read = std::fs::read_to_string(&json_path).map_err(|e| e.to_string());
+    match read.and_then(|text| crate::ericw_texinfo::add_face_keys(bsp, &text)) {
+        Ok(added) => {
+            if !added.is_empty() {
+                eprintln!(
+                    "light: per-face keys of func_detail, func_group and brush entities read from {}",
+                    json_path.display()
+                );
+            }
+            added
+        }
+        Err(e) => {
+            eprintln!(
+                "warning: {}: {e}; lit without its per-face keys",
+                json_path.display()
+            );
+            Vec::new()
+        }
+    }
 }
 
 /// The measurements `--compare-reference` and `--bench-occlusion` ask for, printed and as

@@ -45,6 +45,8 @@ mod dirt;
 mod docs;
 mod drawn;
 mod embree;
+#[cfg(feature = "cli")]
+pub mod ericw_texinfo;
 mod error;
 mod faces;
 mod fence;

@@ -1,6 +1,7 @@
 //! ericw-tools' `bspinfo` and `bsputil --check` (the tools mappers check BSPs with) accept the
 //! demo map lit with every BSPX light lump, and its `light` gives the faces the same
-//! `DECOUPLED_LM` grids ours does, when they are present in `../shared/anchors`. Skipped,
+//! `DECOUPLED_LM` grids ours does, and our light reads the `texinfo.json` its `qbsp` writes,
+//! when they are present in `../shared/anchors`. Skipped,
 //! saying so, when absent.
 
 use std::path::{Path, PathBuf};
@@ -139,4 +140,97 @@ fn ericw_tools_light_makes_the_same_decoupled_grids() {
         );
     }
     std::fs::remove_dir_all(dir).ok();
+}
+
+/// A box room from ericw-tools' `qbsp` with a `func_group` slab keyed `_lightignore 1` and
+/// `_minlight 100` under a light: `slipgate-light` reads the `texinfo.json` ericw-tools wrote
+/// beside the BSP, so the slab's top takes its minlight (50) and no light, as with ericw-tools'
+/// light, and the BSP it writes carries no lump of those keys.
+#[test]
+fn light_reads_the_per_face_keys_ericw_tools_qbsp_writes_beside_the_bsp() {
+    let qbsp = anchor("qbsp");
+    if !qbsp.exists() {
+        println!("SKIPPED: no ericw-tools qbsp in {}", anchor("").display());
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("slipgate-light-texinfo-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let map = dir.join("slab.map");
+    std::fs::write(&map, slab_map()).expect("write the map");
+    let bin = anchor("");
+    let out = Command::new(&qbsp)
+        .arg(&map)
+        .current_dir(&dir)
+        .env("LD_LIBRARY_PATH", &bin)
+        .output()
+        .expect("run qbsp");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let bsp_path = dir.join("slab.bsp");
+    assert!(dir.join("slab.texinfo.json").is_file());
+    let log = run(
+        Path::new(env!("CARGO_BIN_EXE_slipgate-light")),
+        &[],
+        &bsp_path,
+    );
+    assert!(log.contains("per-face keys"), "{log}");
+    let bsp = quake_formats::Bsp::read(&std::fs::read(&bsp_path).expect("read")).expect("BSP");
+    assert!(bsp.face_flags().expect("no lump").is_none());
+    let top = (0..bsp.faces.len())
+        .find(|&f| {
+            let verts = bsp.face_vertices(&bsp.faces[f]).unwrap_or_default();
+            let plane = &bsp.planes[bsp.faces[f].plane as usize];
+            let up = plane.normal[2] * if bsp.faces[f].side == 0 { 1.0 } else { -1.0 };
+            up > 0.999 && !verts.is_empty() && verts.iter().all(|v| v[2] == -48.0)
+        })
+        .expect("the slab's top");
+    let at = usize::try_from(bsp.faces[top].light_offset).expect("a lightmap");
+    assert_eq!(&bsp.lighting[at..at + 4], &[50; 4], "minlight only");
+    std::fs::remove_dir_all(dir).ok();
+}
+
+/// A sealed box room (inside -128..128), a light, and the `func_group` slab of
+/// [`light_reads_the_per_face_keys_ericw_tools_qbsp_writes_beside_the_bsp`].
+fn slab_map() -> String {
+    let cube = |lo: [f64; 3], hi: [f64; 3]| {
+        let ([x0, y0, z0], [x1, y1, z1]) = (lo, hi);
+        let planes = [
+            [[x1, y0, z0], [x1, y0, z1], [x1, y1, z0]],
+            [[x0, y0, z0], [x0, y1, z0], [x0, y0, z1]],
+            [[x0, y1, z0], [x1, y1, z0], [x0, y1, z1]],
+            [[x0, y0, z0], [x0, y0, z1], [x1, y0, z0]],
+            [[x0, y0, z1], [x0, y1, z1], [x1, y0, z1]],
+            [[x0, y0, z0], [x1, y0, z0], [x0, y1, z0]],
+        ];
+        let mut s = String::from("{\n");
+        for p in planes {
+            for [x, y, z] in p {
+                s += &format!("( {x} {y} {z} ) ");
+            }
+            s += "wall 0 0 0 1 1\n";
+        }
+        s + "}\n"
+    };
+    let (a, b, lo, hi) = (-144.0, 144.0, -128.0, 128.0);
+    let mut world = String::new();
+    for (l, h) in [
+        ([a, a, a], [b, b, lo]),
+        ([a, a, hi], [b, b, b]),
+        ([a, a, lo], [lo, b, hi]),
+        ([hi, a, lo], [b, b, hi]),
+        ([lo, a, lo], [hi, lo, hi]),
+        ([lo, hi, lo], [hi, b, hi]),
+    ] {
+        world += &cube(l, h);
+    }
+    let slab = cube([-32.0, -32.0, -64.0], [32.0, 32.0, -48.0]);
+    format!(
+        "{{\n\"classname\" \"worldspawn\"\n{world}}}\n\
+         {{\n\"classname\" \"func_group\"\n\"_lightignore\" \"1\"\n\"_minlight\" \"100\"\n{slab}}}\n\
+         {{\n\"classname\" \"light\"\n\"origin\" \"0 0 64\"\n}}\n\
+         {{\n\"classname\" \"info_player_start\"\n\"origin\" \"-90 -90 -100\"\n}}\n"
+    )
 }
