@@ -1,8 +1,7 @@
 //! ericw-tools' `bspinfo` and `bsputil --check` (the tools mappers check BSPs with) accept the
 //! demo map lit with every BSPX light lump, and its `light` gives the faces the same
 //! `DECOUPLED_LM` grids ours does, and our light reads the `texinfo.json` its `qbsp` writes,
-//! when they are present in `../shared/anchors`. Skipped,
-//! saying so, when absent.
+//! when they are present in `../shared/anchors`. Skipped, saying so, when absent.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
