@@ -236,44 +236,39 @@ pub const CONTINUATION_HOPS: usize = 3;
 /// reached across at most [`CONTINUATION_HOPS`] shared edges.
 fn link_continuations(faces: &mut [FaceGeom]) {
     let key = |p: DVec3| (p / SAME_CORNER).round().as_i64vec3().to_array();
-    let edge_key = |(a, b): (DVec3, DVec3)| {
-        let (ka, kb) = (key(a), key(b));
-        (ka.min(kb), ka.max(kb))
-    };
     // Every lit face under each of its edges, sorted by edge: one allocation, not one per edge.
     let mut by_edge: Vec<(EdgeKey, usize)> = faces
         .par_iter()
         .filter(|f| f.kind == FaceKind::Lit)
-        .flat_map_iter(|f| edges(&f.points).map(move |e| (edge_key(e), f.index)))
+        .flat_map_iter(|f| {
+            let corners: Vec<[i64; 3]> = f.points.iter().map(|&p| key(p)).collect();
+            (0..corners.len()).map(move |i| {
+                let (a, b) = (corners[i], corners[(i + 1) % corners.len()]);
+                ((a.min(b), a.max(b)), f.index)
+            })
+        })
         .collect();
     by_edge.par_sort_unstable();
-    let faces_on = |edge: EdgeKey| {
-        let start = by_edge.partition_point(|(k, _)| *k < edge);
-        by_edge[start..]
-            .iter()
-            .take_while(move |(k, _)| *k == edge)
-            .map(|&(_, g)| g)
-    };
     let same_plane = |a: &FaceGeom, b: &FaceGeom| {
         a.model == b.model
             && a.plane.normal.dot(b.plane.normal) > 1.0 - 1e-6
             && (a.plane.dist - b.plane.dist).abs() < SAME_CORNER
     };
-    let beside: Vec<Vec<usize>> = faces
-        .par_iter()
-        .map(|f| {
-            if f.kind != FaceKind::Lit {
-                return Vec::new();
+    // The faces under one edge are a run of `by_edge`: each is beside the others on its plane.
+    let mut beside: Vec<Vec<usize>> = vec![Vec::new(); faces.len()];
+    for run in by_edge.chunk_by(|a, b| a.0 == b.0) {
+        for &(_, f) in run {
+            for &(_, g) in run {
+                if g != f && same_plane(&faces[f], &faces[g]) {
+                    beside[f].push(g);
+                }
             }
-            let mut next: Vec<usize> = edges(&f.points)
-                .flat_map(|e| faces_on(edge_key(e)))
-                .filter(|&g| g != f.index && same_plane(f, &faces[g]))
-                .collect();
-            next.sort_unstable();
-            next.dedup();
-            next
-        })
-        .collect();
+        }
+    }
+    for next in &mut beside {
+        next.sort_unstable();
+        next.dedup();
+    }
     // Each lit face's outline, made once: the faces it continues share it.
     let regions: Vec<Option<Arc<FaceRegion>>> = faces
         .par_iter()
@@ -312,9 +307,4 @@ fn link_continuations(faces: &mut [FaceGeom]) {
     for (face, continuations) in faces.iter_mut().zip(continuations) {
         face.continuations = continuations;
     }
-}
-
-/// The edges of a polygon, corner to next corner.
-fn edges(points: &[DVec3]) -> impl Iterator<Item = (DVec3, DVec3)> + '_ {
-    (0..points.len()).map(|i| (points[i], points[(i + 1) % points.len()]))
 }
