@@ -134,12 +134,30 @@ impl FaceGeom {
     }
 }
 
-/// Every face of `bsp` with its model; `origin_of` gives per-model offsets, `spacing_of` the
-/// spacing a model's faces are lit at.
+/// [`unlinked_face_geometry`] with each face's continuations attached.
 ///
 /// # Errors
 /// [`LightError::BadFace`] for a face whose indices run outside the file.
+#[cfg(test)]
 pub fn face_geometry(
+    bsp: &Bsp,
+    origin_of: impl Fn(usize) -> DVec3 + Sync,
+    spacing_of: impl Fn(usize) -> Spacing + Sync,
+) -> Result<Vec<FaceGeom>, LightError> {
+    let mut faces = unlinked_face_geometry(bsp, origin_of, spacing_of)?;
+    let links = continuations(&faces);
+    attach_continuations(&mut faces, links);
+    Ok(faces)
+}
+
+/// Every face of `bsp` with its model; `origin_of` gives per-model offsets, `spacing_of` the
+/// spacing a model's faces are lit at. Their [`FaceGeom::continuations`] are left empty:
+/// [`continuations`] finds them and [`attach_continuations`] fills them in, while the faces
+/// serve what needs none (the shadow scene is built meanwhile).
+///
+/// # Errors
+/// [`LightError::BadFace`] for a face whose indices run outside the file.
+pub fn unlinked_face_geometry(
     bsp: &Bsp,
     origin_of: impl Fn(usize) -> DVec3 + Sync,
     spacing_of: impl Fn(usize) -> Spacing + Sync,
@@ -217,9 +235,7 @@ pub fn face_geometry(
         })
         .collect();
     // The first bad face in file order, whichever thread found it.
-    let mut faces = faces.into_iter().collect::<Result<Vec<_>, _>>()?;
-    link_continuations(&mut faces);
-    Ok(faces)
+    faces.into_iter().collect::<Result<Vec<_>, _>>()
 }
 
 /// Corners closer than this (units) are the same corner.
@@ -232,9 +248,9 @@ type EdgeKey = ([i64; 3], [i64; 3]);
 /// its plane (ericw-tools follows a point across at most three).
 pub const CONTINUATION_HOPS: usize = 3;
 
-/// Fills each lit face's [`FaceGeom::continuations`]: the lit faces of its model on its plane
-/// reached across at most [`CONTINUATION_HOPS`] shared edges.
-fn link_continuations(faces: &mut [FaceGeom]) {
+/// Each lit face's [`FaceGeom::continuations`]: the lit faces of its model on its plane reached
+/// across at most [`CONTINUATION_HOPS`] shared edges.
+pub fn continuations(faces: &[FaceGeom]) -> Vec<Vec<Arc<FaceRegion>>> {
     let key = |p: DVec3| (p / SAME_CORNER).round().as_i64vec3().to_array();
     // Every lit face under each of its edges, sorted by edge: one allocation, not one per edge.
     let mut by_edge: Vec<(EdgeKey, usize)> = faces
@@ -274,7 +290,7 @@ fn link_continuations(faces: &mut [FaceGeom]) {
         .par_iter()
         .map(|f| (f.kind == FaceKind::Lit).then(|| Arc::new(f.region())))
         .collect();
-    let continuations: Vec<Vec<Arc<FaceRegion>>> = (0..faces.len())
+    (0..faces.len())
         .into_par_iter()
         .map(|f| {
             let mut reached = vec![f];
@@ -303,8 +319,12 @@ fn link_continuations(faces: &mut [FaceGeom]) {
                 })
                 .collect()
         })
-        .collect();
-    for (face, continuations) in faces.iter_mut().zip(continuations) {
+        .collect()
+}
+
+/// Fills each face's [`FaceGeom::continuations`] with what [`continuations`] found for it.
+pub fn attach_continuations(faces: &mut [FaceGeom], links: Vec<Vec<Arc<FaceRegion>>>) {
+    for (face, continuations) in faces.iter_mut().zip(links) {
         face.continuations = continuations;
     }
 }

@@ -8,7 +8,9 @@ use quake_formats::geom::Bounds;
 
 use crate::embree::Device;
 use crate::error::LightError;
-use crate::faces::{FaceGeom, FaceKind, face_geometry};
+use crate::faces::{
+    FaceGeom, FaceKind, attach_continuations, continuations, unlinked_face_geometry,
+};
 use crate::fence::fence_masks;
 use crate::hull;
 use crate::lights::{MapLights, PointLight, parse_lights};
@@ -172,7 +174,7 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
             .copied()
             .unwrap_or(DVec3::ZERO)
     };
-    let faces = face_geometry(bsp, origin_of, |m| map_lights.spacing(m))?;
+    let mut faces = unlinked_face_geometry(bsp, origin_of, |m| map_lights.spacing(m))?;
     let solids = faceless_solids(bsp, &faces, &map_lights.shadow_models, origin_of);
     let shadowless: Vec<bool> = map_lights.face_flags.iter().map(|f| f.no_shadow).collect();
     let fences = fence_masks(bsp, &faces);
@@ -184,7 +186,13 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
         switchable: &map_lights.switchable.shadows,
         fences: &fences,
     };
-    let scene = TraceScene::build(&device, &faces, &casters)?;
+    // Embree builds its tree on its own threads while ours link the faces.
+    let (scene, links) = rayon::join(
+        || TraceScene::build(&device, &faces, &casters),
+        || continuations(&faces),
+    );
+    let scene = scene?;
+    attach_continuations(&mut faces, links);
     let vis = Visibility::new(bsp, &faces);
     let lump = bsp.phong_faces().map_err(LightError::BspxLump)?;
     let groups = phong::groups(&faces, &map_lights.phong, lump.as_deref());
