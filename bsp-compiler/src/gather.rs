@@ -501,7 +501,8 @@ fn merged_face_flags(ent: &MapEntity, index: usize, class: EntityBrushes) -> Fac
         no_ambient: number("_noambient").is_some_and(|v| v != 0.0),
         no_dirt: number("_dirt") == Some(-1.0),
         no_bounce: number("_bounce").is_some_and(|v| v <= 0.0),
-        light_ignore: number("_lightignore") == Some(1.0),
+        // A switch, as light reads one: off for 0 and -1, on for any other number.
+        light_ignore: number("_lightignore").is_some_and(|v| v != 0.0 && v != -1.0),
         no_minlight: false,
     }
 }
