@@ -67,16 +67,16 @@ settings! {
     addmin: bool = false, flag "addmin", keys [], range Range::Any;
 
     /// Sun brightness (light from sky faces).
-    sunlight: f64 = 0.0, keys ["_sunlight"], range Range::Any;
+    sunlight: f64 = 0.0, keys ["_sunlight", "_sun_light"], range Range::Any;
 
     /// Direction the sunlight travels, `yaw pitch roll` in degrees.
-    sun_mangle: DVec3 = DVec3::new(0.0, -90.0, 0.0), keys ["_sun_mangle", "_sunlight_mangle"], range Range::Any;
+    sun_mangle: DVec3 = DVec3::new(0.0, -90.0, 0.0), keys ["_sun_mangle", "_sunlight_mangle", "_sun_angle"], range Range::Any;
 
     /// Soft sun: its directions spread over a cone this many degrees wide.
     sun_penumbra: f64 = 0.0, keys ["_sunlight_penumbra"], range Range::Any;
 
     /// Sun colour.
-    sunlight_color: Color = Color::WHITE, keys ["_sunlight_color"], range Range::Any;
+    sunlight_color: Color = Color::WHITE, keys ["_sunlight_color", "_sun_color"], range Range::Any;
 
     /// `1`/`-1`: dirt on sunlight on/off.
     sunlight_dirt: DirtToggle = DirtToggle::AsDirt, keys ["_sunlight_dirt"], range Range::Any;
@@ -98,7 +98,7 @@ settings! {
 
     /// Dirt (ambient occlusion) on every light, sun and minlight (lights with `_dirt -1` still
     /// opt out).
-    dirt: bool = false, flag "dirt" alias "dirty", keys ["_dirt"], range Range::Any;
+    dirt: bool = false, flag "dirt" alias "dirty", keys ["_dirt", "_dirty"], range Range::Any;
 
     /// Dirt ray pattern: `0` an ordered cone, `1` random directions per sample.
     dirt_mode: DirtMode = DirtMode::Ordered, flag "dirtmode", keys ["_dirtmode"], range Range::Any;

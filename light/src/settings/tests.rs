@@ -130,3 +130,16 @@ fn the_docs_list_every_setting_as_declared() {
         &markdown_table(),
     );
 }
+
+/// ericw-tools' other spellings of worldspawn's sun and dirt keys (its light.rst lists them):
+/// `_sun_light`, `_sun_angle`, `_sun_color` and `_dirty`.
+#[test]
+fn ericw_tools_other_spellings_of_sun_and_dirt_keys_are_read() {
+    let world = r#"{ "classname" "worldspawn" "_sun_light" "150" "_sun_angle" "30 -60 0" "_sun_color" "255 128 0" "_dirty" "1" }"#;
+    let (s, warnings) = resolve_text(world, &Overrides::default());
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert_eq!(s.sunlight, 150.0);
+    assert_eq!(s.sun_mangle, DVec3::new(30.0, -60.0, 0.0));
+    assert!((s.sunlight_color.0 - DVec3::new(1.0, 128.0 / 255.0, 0.0)).length() < 1e-9);
+    assert!(s.dirt);
+}
