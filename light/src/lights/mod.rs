@@ -247,7 +247,9 @@ pub fn parse_lights(
     let switchable = &out.switchable.shadows;
     out.shadow_models
         .retain(|m| !switchable.iter().any(|(s, _)| s == m));
-    entities::read_lights(entities, &global, &mut out);
+    if !out.settings.nolights {
+        entities::read_lights(entities, &global, &mut out);
+    }
     Ok(out)
 }
 

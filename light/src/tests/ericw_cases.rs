@@ -321,6 +321,25 @@ fn keys_of_merged_entities_reach_light_per_face() {
     assert!(red.iter().all(|m| m.color == [1.0, 0.0, 0.0]), "{red:?}");
 }
 
+/// ericw-tools' `-nolights`: light entities are ignored (a `_sun` light's too), worldspawn's
+/// minlight still lights the map.
+#[test]
+fn nolights_leaves_only_the_worlds_own_light() {
+    let bsp = room_bsp(&(light([0.0, 0.0, -48.0], "") + &light([0.0, 0.0, 0.0], "\"_sun\" \"1\"")));
+    let mut opts = options(Quality::Default);
+    opts.overrides.minlight = Some(20.0);
+    let with_lights = compute_lighting(&bsp, &opts).expect("light");
+    let lit = floor_rgb(&bsp, &with_lights, 0.0, 0.0).expect("a lit floor");
+    assert!(lit[0] > 20, "{lit:?}");
+    opts.overrides.nolights = Some(true);
+    let lighting = compute_lighting(&bsp, &opts).expect("light");
+    assert_eq!(floor_rgb(&bsp, &lighting, 0.0, 0.0), Some([10, 10, 10]));
+    assert_eq!(
+        floor_rgb(&bsp, &lighting, 100.0, -100.0),
+        Some([10, 10, 10])
+    );
+}
+
 /// `detailFence` (`q1_detail_fence`): a `func_detail_fence` (here all `skip`, as there, so it has
 /// no faces) around a light and the floor under it. Its inside is written solid, which stops
 /// players; the compiler marks those leaves and light takes them as open, so the light is not
