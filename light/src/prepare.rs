@@ -287,6 +287,12 @@ pub fn face_rules<'a>(lights: &'a MapLights, geom: &FaceGeom) -> FaceRules<'a> {
         minlight,
         dirt,
         minlight_only: merged.light_ignore || lights.lightignore_models.contains(&geom.model),
+        maxlight: lights
+            .model_maxlight
+            .get(&geom.model)
+            .copied()
+            .or(Some(lights.settings.maxlight))
+            .filter(|&m| m > 0.0),
         bounce_dirt: lights.bounce.dirt.filter(|_| dirt && lights.bounce.is_on()),
     }
 }

@@ -212,6 +212,8 @@ entity_keys! {
     MINLIGHT_COLOR: ["_minlight_color", "_mincolor"] on Models, Color, default "white";
     /// A texture of the model that does not get its minimum light.
     MINLIGHT_EXCLUDE: ["_minlight_exclude"] on Models, Text, default "—";
+    /// The most light the model's faces take, in levels (instead of the world's `_maxlight`).
+    MAXLIGHT: ["_maxlight"] on Models, Number, default "worldspawn's";
     /// `1`: the model casts shadows (the world always does); a model of `skip` brushes, which
     /// has no faces, casts the shadow of its brushes (read from the BSP's tree). `0` or `-1`: a
     /// model casts none. On brushes merged into the world (`func_detail*`, `func_group`, whose

@@ -98,6 +98,8 @@ pub struct MapLights {
     pub templates: Vec<SurfaceTemplate>,
     /// Minlight per model index (0 = world, from worldspawn).
     pub minlight: HashMap<usize, Minlight>,
+    /// Brush models with their own `_maxlight`, in levels.
+    pub model_maxlight: HashMap<usize, f64>,
     /// Brush models that cast shadows (`_shadow 1`).
     pub shadow_models: Vec<usize>,
     /// Brush models that shadow only their own faces (`_shadowself 1`).
@@ -216,6 +218,7 @@ pub fn parse_lights(
         suns: sun::world_suns(&settings, &global),
         templates: Vec::new(),
         minlight: HashMap::new(),
+        model_maxlight: HashMap::new(),
         shadow_models: Vec::new(),
         self_shadow_models: Vec::new(),
         no_dirt_models: Vec::new(),

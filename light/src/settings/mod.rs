@@ -66,6 +66,10 @@ settings! {
     /// Add minlight to every luxel's light instead of raising dark luxels to it.
     addmin: bool = false, flag "addmin", keys [], range Range::Any;
 
+    /// The most light a luxel takes, in levels (0: no cap): a brighter sample is dimmed to it,
+    /// its colour kept, as ericw-tools dims it.
+    maxlight: f64 = 0.0, keys ["_maxlight"], range Range::Any;
+
     /// Ignore light entities (their suns, domes and surface lights too): only worldspawn's
     /// sunlight, sky domes and minlight light the map.
     nolights: bool = false, flag "nolights", keys [], range Range::Any;

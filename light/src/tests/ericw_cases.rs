@@ -340,6 +340,38 @@ fn nolights_leaves_only_the_worlds_own_light() {
     );
 }
 
+/// ericw-tools' `_maxlight` (worldspawn, and a brush model's own): no luxel is brighter than
+/// that many levels; a brighter sample is dimmed with its colour kept.
+#[test]
+fn maxlight_caps_the_light_and_keeps_its_colour() {
+    let bsp = room_bsp(&light([0.0, 0.0, -96.0], "\"light\" \"600\"\n\"_color\" \"255 128 0\""));
+    let mut opts = options(Quality::Default);
+    let free = compute_lighting(&bsp, &opts).expect("light");
+    let [r, g, _] = floor_rgb(&bsp, &free, 0.0, 0.0).expect("lit");
+    assert!(r > 200, "{r}");
+    opts.overrides.maxlight = Some(60.0);
+    let capped = compute_lighting(&bsp, &opts).expect("light");
+    let brightest = capped
+        .lightmaps
+        .iter()
+        .flat_map(|m| m.rgb.iter().flatten())
+        .map(|c| c[0].max(c[1]).max(c[2]))
+        .max();
+    assert_eq!(brightest, Some(60));
+    let [cr, cg, cb] = floor_rgb(&bsp, &capped, 0.0, 0.0).expect("lit");
+    assert_eq!(cr, 60);
+    let (ratio, capped_ratio) = (f64::from(g) / f64::from(r), f64::from(cg) / f64::from(cr));
+    assert!((ratio - capped_ratio).abs() < 0.03 && cb == 0, "{ratio} {capped_ratio}");
+
+    // A brush model's own cap wins over the world's (none here).
+    let bsp = slab_bsp("func_wall", "\"_maxlight\" \"20\"", "wall");
+    let lighting = lit(&bsp);
+    let top = luxel_rgb(&bsp, &lighting, 1, DVec3::new(0.0, 0.0, -48.0), DVec3::Z);
+    assert_eq!(top, Some([20, 20, 20]));
+    let floor = floor_rgb(&bsp, &lighting, 100.0, 100.0).expect("lit");
+    assert!(floor[0] > 20, "{floor:?}");
+}
+
 /// `detailFence` (`q1_detail_fence`): a `func_detail_fence` (here all `skip`, as there, so it has
 /// no faces) around a light and the floor under it. Its inside is written solid, which stops
 /// players; the compiler marks those leaves and light takes them as open, so the light is not

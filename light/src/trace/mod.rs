@@ -91,6 +91,8 @@ pub struct FaceRules<'a> {
     pub dirt: bool,
     /// `_lightignore`: minlight only, no lights or suns.
     pub minlight_only: bool,
+    /// `_maxlight`: the most light a sample takes, in levels (`None`: no cap).
+    pub maxlight: Option<f64>,
     /// Bounced light will be added and darkened by dirt this way: dirt is
     /// then measured at every sample (bounce reaches where lights do not).
     pub bounce_dirt: Option<DirtResponse>,
@@ -218,6 +220,8 @@ impl<'a> FaceTrace<'a> {
                 Directions::new(&samples.points, &face.vecs, face.plane.normal)
             }),
             occluded: samples.occluded.clone(),
+            // ericw-tools caps its samples at twice the level, before the range scale.
+            max_sample: rules.maxlight.map(|level| (2.0 * level) as f32),
         };
         let mut bounds = Bounds::EMPTY;
         for &p in &samples.points {

@@ -64,6 +64,8 @@ pub struct SampleLight {
     pub(super) directions: Option<Directions>,
     /// Per sample, inside solid: left out of its luxel's mean (empty: none is).
     pub(super) occluded: Vec<bool>,
+    /// The brightest channel a sample may reach (`_maxlight`); a brighter one is scaled down.
+    pub(super) max_sample: Option<f32>,
 }
 
 /// Per sample and style, the directions towards the lights and suns that reached it, each
@@ -346,6 +348,16 @@ impl SampleLight {
             for (s, f) in sum.iter_mut().zip(floor) {
                 for c in 0..3 {
                     s[c] = s[c].max(f[c]);
+                }
+            }
+        }
+        if let Some(cap) = self.max_sample {
+            for (_, values) in &mut self.sums.styles {
+                for v in values.iter_mut() {
+                    let brightest = v[0].max(v[1]).max(v[2]);
+                    if brightest > cap {
+                        *v = v.map(|c| c * cap / brightest);
+                    }
                 }
             }
         }
