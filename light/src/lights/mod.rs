@@ -12,6 +12,7 @@ mod models;
 mod point;
 mod styles;
 mod sun;
+mod unsupported;
 mod worldspawn;
 
 use glam::DVec3;
@@ -253,6 +254,7 @@ pub fn parse_lights(
     if !out.settings.nolights {
         entities::read_lights(entities, &global, &mut out);
     }
+    out.warnings.extend(unsupported::warnings(entities));
     Ok(out)
 }
 

@@ -344,7 +344,10 @@ fn nolights_leaves_only_the_worlds_own_light() {
 /// that many levels; a brighter sample is dimmed with its colour kept.
 #[test]
 fn maxlight_caps_the_light_and_keeps_its_colour() {
-    let bsp = room_bsp(&light([0.0, 0.0, -96.0], "\"light\" \"600\"\n\"_color\" \"255 128 0\""));
+    let bsp = room_bsp(&light(
+        [0.0, 0.0, -96.0],
+        "\"light\" \"600\"\n\"_color\" \"255 128 0\"",
+    ));
     let mut opts = options(Quality::Default);
     let free = compute_lighting(&bsp, &opts).expect("light");
     let [r, g, _] = floor_rgb(&bsp, &free, 0.0, 0.0).expect("lit");
@@ -361,7 +364,10 @@ fn maxlight_caps_the_light_and_keeps_its_colour() {
     let [cr, cg, cb] = floor_rgb(&bsp, &capped, 0.0, 0.0).expect("lit");
     assert_eq!(cr, 60);
     let (ratio, capped_ratio) = (f64::from(g) / f64::from(r), f64::from(cg) / f64::from(cr));
-    assert!((ratio - capped_ratio).abs() < 0.03 && cb == 0, "{ratio} {capped_ratio}");
+    assert!(
+        (ratio - capped_ratio).abs() < 0.03 && cb == 0,
+        "{ratio} {capped_ratio}"
+    );
 
     // A brush model's own cap wins over the world's (none here).
     let bsp = slab_bsp("func_wall", "\"_maxlight\" \"20\"", "wall");

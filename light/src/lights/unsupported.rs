@@ -1,0 +1,166 @@
+//! ericw-tools' light keys that Slipgate's light does not implement. A map that sets one is lit
+//! without it, with a warning naming the entity, its line and the key, so the difference is not
+//! silent.
+
+use quake_formats::entities::Entity;
+
+use crate::settings::{Given, SettingWarning};
+
+/// Which entities a key is read on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Where {
+    Worldspawn,
+    Lights,
+    /// Brush entities, merged into the world or not.
+    Brushes,
+}
+
+/// Each key, where ericw-tools reads it, and what it does there.
+const UNSUPPORTED: &[(&str, Where, &str)] = &[
+    ("_sun2", Where::Worldspawn, "second sun"),
+    ("_sun2_color", Where::Worldspawn, "second sun's colour"),
+    ("_sun2_mangle", Where::Worldspawn, "second sun's direction"),
+    (
+        "_lightmap_scale",
+        Where::Worldspawn,
+        "one lightmap scale for every face (Slipgate reads `_lmscale`)",
+    ),
+    (
+        "_spotlightautofalloff",
+        Where::Worldspawn,
+        "spotlight falloff set by the distance to its target",
+    ),
+    (
+        "_compilerstyle_start",
+        Where::Worldspawn,
+        "first style of switchable lights (Slipgate starts at 32)",
+    ),
+    (
+        "_compilerstyle_max",
+        Where::Worldspawn,
+        "last style of switchable lights",
+    ),
+    (
+        "_surflightsubdivision",
+        Where::Worldspawn,
+        "spacing of surface lights",
+    ),
+    ("_choplight", Where::Worldspawn, "spacing of surface lights"),
+    (
+        "_bouncelightsubdivision",
+        Where::Worldspawn,
+        "spacing of bounce emitters",
+    ),
+    ("_project_texture", Where::Lights, "projected texture"),
+    (
+        "_project_mangle",
+        Where::Lights,
+        "projected texture's direction",
+    ),
+    (
+        "_project_fov",
+        Where::Lights,
+        "projected texture's field of view",
+    ),
+    (
+        "_bouncescale",
+        Where::Lights,
+        "scale of this light's bounced light (Slipgate reads `_bounce 0` to turn it off)",
+    ),
+    ("_light_channel_mask", Where::Lights, "light channels"),
+    ("_shadow_channel_mask", Where::Lights, "shadow channels"),
+    (
+        "_phong_angle_concave",
+        Where::Brushes,
+        "separate smoothing angle for concave joins",
+    ),
+    (
+        "_shadowworldonly",
+        Where::Brushes,
+        "shadow cast on the world only",
+    ),
+    ("_minlight_mottle", Where::Brushes, "mottled minlight"),
+    ("_object_channel_mask", Where::Brushes, "light channels"),
+];
+
+/// A warning for each key of [`UNSUPPORTED`] an entity of `entities` sets where ericw-tools
+/// reads it.
+pub fn warnings(entities: &[Entity]) -> Vec<SettingWarning> {
+    let mut out = Vec::new();
+    for (index, e) in entities.iter().enumerate() {
+        let classname = e.classname();
+        let here = if classname == "worldspawn" {
+            Where::Worldspawn
+        } else if classname.starts_with("light") {
+            Where::Lights
+        } else {
+            Where::Brushes
+        };
+        for &(key, place, what) in UNSUPPORTED {
+            let Some(value) = e.get(key).filter(|v| !v.trim().is_empty()) else {
+                continue;
+            };
+            if place == here {
+                out.push(SettingWarning {
+                    given: Given::key(index, e, key),
+                    value: value.to_string(),
+                    problem: format!(
+                        "ericw-tools' {what}, which Slipgate's light does not implement: ignored"
+                    ),
+                });
+            }
+        }
+    }
+    out
+}
+
+/// The keys of [`UNSUPPORTED`] as a Markdown list for docs/mapping.md.
+#[cfg(test)]
+pub fn markdown_list() -> String {
+    let mut out = String::new();
+    for (key, place, what) in UNSUPPORTED {
+        let on = match place {
+            Where::Worldspawn => "worldspawn",
+            Where::Lights => "lights",
+            Where::Brushes => "brush entities",
+        };
+        out += &format!("- `{key}` ({on}): {what}\n");
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use quake_formats::entities::parse_entities;
+
+    #[test]
+    fn each_unsupported_key_warns_where_ericw_tools_reads_it() {
+        let text = r#"
+{ "classname" "worldspawn" "_sun2" "100" "_project_texture" "x" }
+{ "classname" "light" "origin" "0 0 0" "_project_texture" "window1" "_bouncescale" "" }
+{ "classname" "func_wall" "model" "*1" "_shadowworldonly" "1" }
+"#;
+        let entities = parse_entities(text).expect("entities");
+        let told: Vec<String> = warnings(&entities)
+            .iter()
+            .map(ToString::to_string)
+            .collect();
+        assert_eq!(told.len(), 3, "{told:?}");
+        assert!(told[0].contains("\"_sun2\"") && told[0].contains("second sun"));
+        assert!(
+            told[1].contains("\"_project_texture\" is \"window1\""),
+            "{told:?}"
+        );
+        assert!(told[2].contains("_shadowworldonly"));
+    }
+
+    #[test]
+    fn the_docs_list_every_unsupported_key() {
+        crate::docs::check_generated_table(
+            "unsupported light keys: generated from light/src/lights/unsupported.rs",
+            "unsupported light keys",
+            &markdown_list(),
+        );
+    }
+}
