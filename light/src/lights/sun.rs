@@ -78,15 +78,24 @@ pub fn dome(sun: SunLight, upper: bool, sunsamples: usize) -> Vec<SunLight> {
     shared_out(&sun, dirs)
 }
 
-/// The sun and domes worldspawn's settings ask for, in that order.
+/// The suns (`_sunlight`, `_sun2`) and domes worldspawn's settings ask for, in that order.
 pub fn world_suns(settings: &Settings, global: &Global) -> Vec<SunLight> {
     let mut out = Vec::new();
-    if settings.sunlight != 0.0 {
-        let mangle = settings.sun_mangle;
+    for (light, mangle, color) in [
+        (
+            settings.sunlight,
+            settings.sun_mangle,
+            settings.sunlight_color,
+        ),
+        (settings.sun2, settings.sun2_mangle, settings.sun2_color),
+    ] {
+        if light == 0.0 {
+            continue;
+        }
         let sun = SunLight {
             to_sun: -mangle_to_vec(mangle.x, mangle.y),
-            light: settings.sunlight,
-            color: settings.sunlight_color.0,
+            light,
+            color: color.0,
             style: 0,
             anglescale: global.anglescale,
             dirt: global.dirt_if(settings.sunlight_dirt),
@@ -178,5 +187,28 @@ mod tests {
             let total: f64 = suns.iter().map(|s| s.light).sum();
             assert!((total - 1.0).abs() < 1e-12);
         }
+    }
+
+    /// worldspawn's `_sun2`: a second sun beside `_sunlight`, with its own direction and colour.
+    #[test]
+    fn a_second_sun_shines_beside_the_first() {
+        let settings = Settings {
+            sunlight: 200.0,
+            sun2: 100.0,
+            sun2_mangle: DVec3::new(0.0, -45.0, 0.0),
+            sun2_color: crate::settings::Color(DVec3::new(1.0, 0.0, 0.0)),
+            ..Settings::default()
+        };
+        let suns = world_suns(&settings, &Global::new(&settings));
+        assert_eq!(suns.len(), 2);
+        assert_eq!((suns[0].light, suns[0].color), (200.0, DVec3::ONE));
+        assert!((suns[0].to_sun - DVec3::Z).length() < 1e-9);
+        assert_eq!((suns[1].light, suns[1].color), (100.0, DVec3::X));
+        let half = std::f64::consts::FRAC_1_SQRT_2;
+        assert!(
+            (suns[1].to_sun - DVec3::new(-half, 0.0, half)).length() < 1e-9,
+            "{:?}",
+            suns[1].to_sun
+        );
     }
 }

@@ -17,9 +17,6 @@ enum Where {
 
 /// Each key, where ericw-tools reads it, and what it does there.
 const UNSUPPORTED: &[(&str, Where, &str)] = &[
-    ("_sun2", Where::Worldspawn, "second sun"),
-    ("_sun2_color", Where::Worldspawn, "second sun's colour"),
-    ("_sun2_mangle", Where::Worldspawn, "second sun's direction"),
     (
         "_lightmap_scale",
         Where::Worldspawn,
@@ -137,7 +134,7 @@ mod tests {
     #[test]
     fn each_unsupported_key_warns_where_ericw_tools_reads_it() {
         let text = r#"
-{ "classname" "worldspawn" "_sun2" "100" "_project_texture" "x" }
+{ "classname" "worldspawn" "_spotlightautofalloff" "1" "_project_texture" "x" }
 { "classname" "light" "origin" "0 0 0" "_project_texture" "window1" "_bouncescale" "" }
 { "classname" "func_wall" "model" "*1" "_shadowworldonly" "1" }
 "#;
@@ -147,7 +144,7 @@ mod tests {
             .map(ToString::to_string)
             .collect();
         assert_eq!(told.len(), 3, "{told:?}");
-        assert!(told[0].contains("\"_sun2\"") && told[0].contains("second sun"));
+        assert!(told[0].contains("\"_spotlightautofalloff\"") && told[0].contains("spotlight"));
         assert!(
             told[1].contains("\"_project_texture\" is \"window1\""),
             "{told:?}"

@@ -89,6 +89,15 @@ settings! {
     /// `1`/`-1`: dirt on sunlight on/off.
     sunlight_dirt: DirtToggle = DirtToggle::AsDirt, keys ["_sunlight_dirt"], range Range::Any;
 
+    /// Brightness of a second sun, spread and dirtied as the first.
+    sun2: f64 = 0.0, keys ["_sun2"], range Range::Any;
+
+    /// Direction the second sun's light travels, `yaw pitch roll` in degrees.
+    sun2_mangle: DVec3 = DVec3::new(0.0, -90.0, 0.0), keys ["_sun2_mangle"], range Range::Any;
+
+    /// Colour of the second sun.
+    sun2_color: Color = Color::WHITE, keys ["_sun2_color"], range Range::Any;
+
     /// Brightness of a sky dome lighting from above: `--sunsamples` directions on rings of equal elevation steps and one straight down, laid out as ericw-tools lays them, so its sky is brighter overhead than at the horizon.
     sunlight2: f64 = 0.0, keys ["_sunlight2"], range Range::Any;
 
