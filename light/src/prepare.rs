@@ -182,6 +182,7 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
         shadowless: &shadowless,
         models: &map_lights.shadow_models,
         self_shadow_models: &map_lights.self_shadow_models,
+        world_shadow_models: &map_lights.world_shadow_models,
         solids: &solids,
         switchable: &map_lights.switchable.shadows,
         fences: &fences,

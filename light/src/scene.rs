@@ -2,7 +2,8 @@
 //! and of shadow-casting brush models, plus the sky faces as a separate
 //! geometry so a ray can tell "reached the sky" from "hit a wall".
 //! A `_shadowself` model gets a small scene of its own, which only rays
-//! from that model's faces are tested against. `_switchableshadow` models
+//! from that model's faces are tested against; the `_shadowworldonly` models
+//! share one that only rays from the world's faces are. `_switchableshadow` models
 //! get a scene per style, apart from the rest: what they block of style-0
 //! light goes on their style ([`TraceScene::switchable_blocks16`]), but for
 //! rays from their own faces (and those of models sharing their style), which
@@ -42,6 +43,8 @@ pub struct TraceScene {
     opaque_faces: Vec<u32>,
     /// Per `_shadowself` model (not already in `scene`): its own faces.
     own: HashMap<usize, Scene>,
+    /// The faces of the `_shadowworldonly` models, which shadow the world's faces only.
+    world_only: Option<Scene>,
     /// Per switchable shadow style, the faces of its models.
     switchable: Vec<(u8, Scene)>,
     /// Per switchable shadow model, the index in `switchable` of its style.
@@ -61,6 +64,8 @@ pub struct Casters<'a> {
     pub models: &'a [usize],
     /// Brush models whose faces shadow only their own model (`_shadowself 1`).
     pub self_shadow_models: &'a [usize],
+    /// Brush models whose faces shadow only the world's (`_shadowworldonly 1`).
+    pub world_shadow_models: &'a [usize],
     /// Polygons in world space: the solid of shadow-casting models without faces.
     pub solids: &'a [Vec<DVec3>],
     /// Brush models whose shadow is switchable, and its style.
@@ -87,6 +92,7 @@ impl TraceScene {
             shadowless,
             models: shadow_models,
             self_shadow_models,
+            world_shadow_models,
             solids,
             switchable,
             fences,
@@ -109,6 +115,7 @@ impl TraceScene {
         let mut fence_faces = Vec::new();
         let mut sky = Mesh::default();
         let mut own_meshes: HashMap<usize, Mesh> = HashMap::new();
+        let mut world_only = Mesh::default();
         let mut switchable_meshes: Vec<(u8, Mesh)> = Vec::new();
         for f in faces {
             if let (FaceKind::Lit, Some(style)) = (f.kind, switchable_style(f)) {
@@ -127,6 +134,7 @@ impl TraceScene {
                     Some(mask) => fence_faces.push((f, mask)),
                     None => opaque.add(f),
                 },
+                FaceKind::Lit if world_shadow_models.contains(&f.model) => world_only.add(f),
                 FaceKind::Lit if self_shadow_models.contains(&f.model) => {
                     own_meshes.entry(f.model).or_default().add(f);
                 }
@@ -144,6 +152,12 @@ impl TraceScene {
             triangles += mesh.triangles.len();
             own.insert(model, mesh.commit(device)?);
         }
+        triangles += world_only.triangles.len();
+        let world_only = if world_only.triangles.is_empty() {
+            None
+        } else {
+            Some(world_only.commit(device)?)
+        };
         let mut switchable = Vec::with_capacity(switchable_meshes.len());
         for (style, mesh) in switchable_meshes {
             triangles += mesh.triangles.len();
@@ -189,6 +203,7 @@ impl TraceScene {
             sky_textures,
             opaque_faces: opaque.faces,
             own,
+            world_only,
             switchable,
             own_switchable,
             fences,
@@ -241,12 +256,16 @@ impl TraceScene {
     }
 
     /// Lanes of `packet` (each up to its current `tfar`) that `model`'s own
-    /// scene or its switchable shadow's models block; 0 for a model with neither.
+    /// scene or its switchable shadow's models block, or for the world the
+    /// world-only shadows; 0 for a model with none of these.
     fn own_occluded16(&self, packet: &mut RayPacket16, model: usize) -> u16 {
-        let own = self
-            .own
-            .get(&model)
-            .map_or(0, |own| own.occluded16(packet, true));
+        let own = match (&self.world_only, model) {
+            (Some(world_only), 0) => world_only.occluded16(packet, true),
+            _ => self
+                .own
+                .get(&model)
+                .map_or(0, |own| own.occluded16(packet, true)),
+        };
         // Embree has set the blocked lanes' tfar to -inf: the second query skips them.
         own | self
             .own_switchable(model)

@@ -236,6 +236,9 @@ entity_keys! {
     SWITCHABLESHADOW: ["_switchableshadow"] on Models, Number, default "`0`";
     /// `1`: the model shadows itself only.
     SHADOWSELF: ["_shadowself", "_selfshadow"] on Models, Number, default "`0`";
+    /// `1`: the model shadows the world's faces only (not its own, nor other models'); it wins
+    /// over `_shadow`.
+    SHADOWWORLDONLY: ["_shadowworldonly"] on Models, Number, default "`0`";
     /// `1`: the model's faces receive no light but minlight.
     LIGHTIGNORE: ["_lightignore"] on Models, Switch, default "`0`";
     /// The model's faces are lit on a world-aligned grid of one luxel every this many units

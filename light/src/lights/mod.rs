@@ -105,6 +105,8 @@ pub struct MapLights {
     pub shadow_models: Vec<usize>,
     /// Brush models that shadow only their own faces (`_shadowself 1`).
     pub self_shadow_models: Vec<usize>,
+    /// Brush models that shadow only the world's faces (`_shadowworldonly 1`).
+    pub world_shadow_models: Vec<usize>,
     /// Brush models whose faces never take dirt (`_dirt -1`).
     pub no_dirt_models: Vec<usize>,
     /// Brush models whose faces get minlight only (`_lightignore 1`).
@@ -222,6 +224,7 @@ pub fn parse_lights(
         model_maxlight: HashMap::new(),
         shadow_models: Vec::new(),
         self_shadow_models: Vec::new(),
+        world_shadow_models: Vec::new(),
         no_dirt_models: Vec::new(),
         lightignore_models: Vec::new(),
         no_bounce_models: Vec::new(),
@@ -247,10 +250,12 @@ pub fn parse_lights(
     }
     models::read_world_and_model_keys(entities, world, &mut out);
     models::read_models(entities, &global, &mut out);
-    // A switchable shadow is one the game turns on and off, never a fixed one.
+    // A switchable shadow is one the game turns on and off, never a fixed one; a world-only
+    // shadow falls on the world alone.
     let switchable = &out.switchable.shadows;
+    let world_only = &out.world_shadow_models;
     out.shadow_models
-        .retain(|m| !switchable.iter().any(|(s, _)| s == m));
+        .retain(|m| !switchable.iter().any(|(s, _)| s == m) && !world_only.contains(m));
     if !out.settings.nolights {
         entities::read_lights(entities, &global, &mut out);
     }

@@ -59,6 +59,9 @@ pub fn read_models(entities: &[Entity], global: &Global, out: &mut MapLights) {
         if k.number(&keys::SHADOWSELF) == Some(1.0) {
             out.self_shadow_models.push(model);
         }
+        if k.number(&keys::SHADOWWORLDONLY) == Some(1.0) {
+            out.world_shadow_models.push(model);
+        }
         if let Some(o) = k.vector(&keys::MODEL_ORIGIN) {
             out.model_origins.insert(model, o);
         }

@@ -71,11 +71,6 @@ const UNSUPPORTED: &[(&str, Where, &str)] = &[
         Where::Brushes,
         "separate smoothing angle for concave joins",
     ),
-    (
-        "_shadowworldonly",
-        Where::Brushes,
-        "shadow cast on the world only",
-    ),
     ("_minlight_mottle", Where::Brushes, "mottled minlight"),
     ("_object_channel_mask", Where::Brushes, "light channels"),
 ];
@@ -136,7 +131,7 @@ mod tests {
         let text = r#"
 { "classname" "worldspawn" "_spotlightautofalloff" "1" "_project_texture" "x" }
 { "classname" "light" "origin" "0 0 0" "_project_texture" "window1" "_bouncescale" "" }
-{ "classname" "func_wall" "model" "*1" "_shadowworldonly" "1" }
+{ "classname" "func_wall" "model" "*1" "_minlight_mottle" "1" }
 "#;
         let entities = parse_entities(text).expect("entities");
         let told: Vec<String> = warnings(&entities)
@@ -149,7 +144,7 @@ mod tests {
             told[1].contains("\"_project_texture\" is \"window1\""),
             "{told:?}"
         );
-        assert!(told[2].contains("_shadowworldonly"));
+        assert!(told[2].contains("_minlight_mottle"));
     }
 
     #[test]

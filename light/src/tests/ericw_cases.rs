@@ -378,6 +378,39 @@ fn maxlight_caps_the_light_and_keeps_its_colour() {
     assert!(floor[0] > 20, "{floor:?}");
 }
 
+/// ericw-tools' `_shadowworldonly`: the model shadows the world's faces, not another model's.
+/// A slab with it over the floor, a plate (another brush model) on the floor under it: the
+/// floor beside the plate is in the slab's shadow, the plate's top is lit as without the slab.
+#[test]
+fn a_world_only_shadow_falls_on_the_world_alone() {
+    let slab = map_box([-32.0, -32.0, -64.0], [32.0, 32.0, -48.0]);
+    let plate = map_box([-16.0, -16.0, -128.0], [16.0, 16.0, -120.0]);
+    let room = |slab_keys: &str| {
+        room_bsp(&format!(
+            "{{\n\"classname\" \"func_wall\"\n{slab_keys}\n{slab}}}\n\
+             {{\n\"classname\" \"func_wall\"\n{plate}}}\n{}",
+            light([0.0, 0.0, 64.0], "")
+        ))
+    };
+    let look = |bsp: &Bsp| {
+        let lighting = lit(bsp);
+        let plate_top = luxel_rgb(bsp, &lighting, 2, DVec3::new(0.0, 0.0, -120.0), DVec3::Z);
+        let floor = floor_rgb(bsp, &lighting, 24.0, 0.0);
+        (
+            plate_top.expect("a lit plate")[0],
+            floor.map_or(0, |c| c[0]),
+        )
+    };
+    let (plate_open, floor_open) = look(&room(""));
+    assert!(
+        plate_open > 20 && floor_open > 20,
+        "{plate_open} {floor_open}"
+    );
+    let (plate, floor) = look(&room("\"_shadowworldonly\" \"1\"\n\"_shadow\" \"1\""));
+    assert_eq!(floor, 0, "the world is in the slab's shadow");
+    assert_eq!(plate, plate_open, "the plate is not");
+}
+
 /// `detailFence` (`q1_detail_fence`): a `func_detail_fence` (here all `skip`, as there, so it has
 /// no faces) around a light and the floor under it. Its inside is written solid, which stops
 /// players; the compiler marks those leaves and light takes them as open, so the light is not
