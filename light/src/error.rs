@@ -17,8 +17,17 @@ pub enum LightError {
         detail: String,
     },
     /// More distinct switchable light names than styles to give them.
-    #[error("more switchable lights (distinct targetnames) than light styles 32..254")]
-    TooManySwitchableLights,
+    #[error(
+        "more switchable lights and shadows (distinct targetnames) than light styles {first} to \
+         {last} (worldspawn's _compilerstyle_start and _compilerstyle_max; engines other than \
+         DarkPlaces and FTE keep styles below 64)"
+    )]
+    TooManySwitchableLights {
+        /// The first style given out.
+        first: usize,
+        /// The last style that could be given out.
+        last: usize,
+    },
     /// Embree failed (starting the device or building the scene).
     #[error(transparent)]
     Embree(#[from] EmbreeError),

@@ -18,7 +18,7 @@ use crate::error::LightError;
 use crate::faces::{FaceGeom, OwnGrid};
 use crate::lightgrid::{GridSources, RawGrid, finish_grid, light_at, trace_grid};
 use crate::lighting::{Lighting, RawLighting, Stats};
-use crate::lights::{AutoMinlight, assign_switchable_styles};
+use crate::lights::{AutoMinlight, StyleRange, assign_switchable_styles};
 use crate::luxels::ToLuxels;
 use crate::options::Options;
 use crate::output::{self, Finish, Outputs, finish_face, finish_face_on_own_grid};
@@ -28,6 +28,7 @@ use crate::quality::Quality;
 use crate::reach::{LightReaches, light_reaches};
 use crate::resample;
 use crate::samples::{FaceSamples, PlacementCounts, face_samples};
+use crate::settings::{Overrides, Settings, World};
 use crate::trace::{
     FaceLight, HiddenLuxels, SampleLight, TraceCounts, TraceScratch, TraceSetup, trace_face,
 };
@@ -826,7 +827,13 @@ pub fn apply_lighting(bsp: &mut Bsp, lighting: &Lighting) -> LightFiles {
 pub fn update_entities_only(bsp: &mut Bsp) -> Result<usize, LightError> {
     let mut entities = parse_entities(&bsp.entity_text())?;
     // Keys that do not read are told when the map is lit; here only styles are given out.
-    let assigned = assign_switchable_styles(&mut entities, &mut Vec::new())?;
+    let world = entities.iter().position(|e| e.classname() == "worldspawn");
+    let world = world.map(|index| World {
+        index,
+        entity: &entities[index],
+    });
+    let range = StyleRange::of(&Settings::resolve(world, &Overrides::default()).0);
+    let assigned = assign_switchable_styles(&mut entities, range, &mut Vec::new())?;
     if assigned.count > 0 {
         bsp.set_entity_text(&write_entities(&entities));
     }

@@ -138,8 +138,9 @@ entity_keys! {
     COLOR: ["_color"] on Lights, Color, default "white";
     /// Light style (0 steady, 1–12 Quake's animations, up to 254; clamped into that range).
     STYLE: ["style"] on Lights, Whole, default "`0`";
-    /// A switchable light: lights sharing a name get their own style, from 32 up, written into
-    /// the entity for the game to switch. Also the name spotlights aim at with `target`.
+    /// A switchable light: lights sharing a name get their own style, from worldspawn's
+    /// `_compilerstyle_start` (32) up, written into the entity for the game to switch. Also the
+    /// name spotlights aim at with `target`.
     TARGETNAME: ["targetname"] on Lights, Text, default "—";
     /// Spotlight: shines towards the entity with this `targetname`.
     TARGET: ["target"] on Lights, Text, default "—";
@@ -228,11 +229,11 @@ entity_keys! {
     /// The `targetname` of the entity at whose `origin` the model's autominlight is taken.
     AUTOMINLIGHT_TARGET: ["_autominlight_target"] on Models, Text, default "—";
     /// `1`: the model's shadow can be switched by the game. Style-0 light it blocks goes on a
-    /// style of its own (from 32 up, shared with the lights and models of the same `targetname`;
-    /// a model without one gets its own), written into the entity as `switchshadstyle`: QuakeC
-    /// sets that style to `a` to show the shadow and `m` to hide it. The model casts no fixed
-    /// shadow (its `_shadow` is ignored) but on itself and the models sharing its style, which it
-    /// always shadows; sunlight takes it as a fixed one.
+    /// style of its own (from `_compilerstyle_start` up, shared with the lights and models of the
+    /// same `targetname`; a model without one gets its own), written into the entity as
+    /// `switchshadstyle`: QuakeC sets that style to `a` to show the shadow and `m` to hide it. The
+    /// model casts no fixed shadow (its `_shadow` is ignored) but on itself and the models sharing
+    /// its style, which it always shadows; sunlight takes it as a fixed one.
     SWITCHABLESHADOW: ["_switchableshadow"] on Models, Number, default "`0`";
     /// `1`: the model shadows itself only.
     SHADOWSELF: ["_shadowself", "_selfshadow"] on Models, Number, default "`0`";

@@ -26,7 +26,7 @@ use crate::error::LightError;
 use crate::faces::Spacing;
 use crate::settings::{ChosenSetting, Overrides, SettingWarning, Settings, World};
 pub use point::{Falloff, PointLight, Spot, angle_factor};
-pub use styles::{SwitchableStyles, assign_switchable_styles};
+pub use styles::{StyleRange, SwitchableStyles, assign_switchable_styles};
 pub use sun::SunLight;
 pub use worldspawn::dirt_sampling;
 
@@ -203,8 +203,6 @@ pub fn parse_lights(
     entities: &mut [Entity],
     overrides: &Overrides,
 ) -> Result<MapLights, LightError> {
-    let mut style_warnings = Vec::new();
-    let switchable = assign_switchable_styles(entities, &mut style_warnings)?;
     let world = entities.iter().position(|e| e.classname() == "worldspawn");
     let (settings, told) = Settings::resolve(
         world.map(|index| World {
@@ -213,6 +211,9 @@ pub fn parse_lights(
         }),
         overrides,
     );
+    let mut style_warnings = Vec::new();
+    let switchable =
+        assign_switchable_styles(entities, StyleRange::of(&settings), &mut style_warnings)?;
     let mut warnings = told.warnings;
     warnings.extend(style_warnings);
     let global = worldspawn::Global::new(&settings);

@@ -1,5 +1,6 @@
-//! Switchable styles, given out from [`FIRST_SWITCHABLE_STYLE`] up and written into the
-//! entities so the game's switching code finds them:
+//! Switchable styles, given out from worldspawn's `_compilerstyle_start` (32) up to below its
+//! `_compilerstyle_max` (64, the light styles most engines keep) and written into the entities
+//! so the game's switching code finds them:
 //!
 //! - a light with a `targetname` and no `style` of its own gets a style (lights sharing a name
 //!   share it), written as its `style`;
@@ -18,9 +19,24 @@ use super::models::model_index;
 use crate::error::LightError;
 use crate::settings::SettingWarning;
 
-/// First style given to switchable lights (styles below are the engine's
-/// animated presets).
-pub const FIRST_SWITCHABLE_STYLE: u8 = 32;
+/// The styles switchable lights and shadows are given: `first` up to below `end`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StyleRange {
+    pub first: usize,
+    pub end: usize,
+}
+
+impl StyleRange {
+    /// The range worldspawn's `_compilerstyle_start` and `_compilerstyle_max` give, never past
+    /// the last style a BSP can name.
+    pub fn of(settings: &crate::settings::Settings) -> StyleRange {
+        let last = usize::from(quake_formats::bsp::limits::MAX_LIGHTSTYLE);
+        StyleRange {
+            first: settings.compilerstyle_start.min(last),
+            end: settings.compilerstyle_max.min(last + 1),
+        }
+    }
+}
 
 /// The styles [`assign_switchable_styles`] gave out.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -34,15 +50,19 @@ pub struct SwitchableStyles {
 }
 
 impl SwitchableStyles {
-    /// The style of `name` (a new one for a name not seen yet; a new one every time for none).
-    fn style_for(&mut self, name: Option<&str>) -> Result<u8, LightError> {
+    /// The style of `name` (a new one of `range` for a name not seen yet; a new one every time
+    /// for none).
+    fn style_for(&mut self, name: Option<&str>, range: StyleRange) -> Result<u8, LightError> {
         if let Some(&(_, s)) = name.and_then(|n| self.names.iter().find(|(m, _)| m == n)) {
             return Ok(s);
         }
-        let s = u8::try_from(FIRST_SWITCHABLE_STYLE as usize + self.count)
-            .ok()
-            .filter(|s| *s <= quake_formats::bsp::limits::MAX_LIGHTSTYLE)
-            .ok_or(LightError::TooManySwitchableLights)?;
+        let s = (range.first + self.count < range.end)
+            .then(|| u8::try_from(range.first + self.count).ok())
+            .flatten()
+            .ok_or(LightError::TooManySwitchableLights {
+                first: range.first,
+                last: range.end.saturating_sub(1),
+            })?;
         self.count += 1;
         if let Some(n) = name {
             self.names.push((n.to_string(), s));
@@ -51,14 +71,15 @@ impl SwitchableStyles {
     }
 }
 
-/// Gives out the switchable styles of lights and switchable shadows (see the module comment)
-/// and writes them into the entities; the keys not taken as written are warned about into
+/// Gives out the switchable styles of lights and switchable shadows from `range` (see the
+/// module comment) and writes them into the entities; the keys not taken as written are warned about into
 /// `warnings`.
 ///
 /// # Errors
 /// More switchable names than styles.
 pub fn assign_switchable_styles(
     entities: &mut [Entity],
+    range: StyleRange,
     warnings: &mut Vec<SettingWarning>,
 ) -> Result<SwitchableStyles, LightError> {
     let mut out = SwitchableStyles::default();
@@ -70,7 +91,7 @@ pub fn assign_switchable_styles(
         };
         // Warnings about `style` come when the lights are read.
         if style(&Keys::new(e, index)) == 0 {
-            let style = out.style_for(Some(&name))?;
+            let style = out.style_for(Some(&name), range)?;
             e.set("style", style.to_string());
         }
     }
@@ -82,7 +103,7 @@ pub fn assign_switchable_styles(
         let switchable = k.number(&keys::SWITCHABLESHADOW) == Some(1.0);
         warnings.extend(k.into_warnings());
         if switchable {
-            let style = out.style_for(name_of(e).as_deref())?;
+            let style = out.style_for(name_of(e).as_deref(), range)?;
             e.set("switchshadstyle", style.to_string());
             out.shadows.push((model, style));
         }
@@ -98,7 +119,7 @@ pub fn assign_switchable_styles(
         let target = target.to_string();
         let style = match style(&Keys::new(e, index)) {
             0 => {
-                let style = out.style_for(None)?;
+                let style = out.style_for(None, range)?;
                 entities[index].set("style", style.to_string());
                 style
             }
@@ -134,7 +155,8 @@ mod tests {
 { "classname" "light" "origin" "0 0 0" "_switchableshadow_target" "gate" }
 "#;
         let mut ents = parse_entities(text).expect("parse");
-        let styles = assign_switchable_styles(&mut ents, &mut Vec::new()).expect("styles");
+        let range = StyleRange::of(&crate::settings::Settings::default());
+        let styles = assign_switchable_styles(&mut ents, range, &mut Vec::new()).expect("styles");
         assert_eq!(ents[1].get("style"), Some("32"));
         assert_eq!(ents[2].get("switchshadstyle"), Some("32"), "shares door's");
         assert_eq!(
@@ -151,5 +173,33 @@ mod tests {
         // The gate takes the first target light's style; the second finds it taken.
         assert_eq!(styles.shadows, vec![(1, 32), (2, 34), (3, 33)]);
         assert_eq!(styles.count, 4);
+    }
+
+    /// Styles go from worldspawn's `_compilerstyle_start` to below its `_compilerstyle_max`
+    /// (32 and 64: most engines keep 64 styles); one more switchable name than fits is an
+    /// error naming the range, as ericw-tools refuses it.
+    #[test]
+    fn styles_stay_in_the_compiler_style_range() {
+        let lights = |n: usize| {
+            (0..n)
+                .map(|i| format!("{{ \"classname\" \"light\" \"targetname\" \"t{i}\" }}\n"))
+                .collect::<String>()
+        };
+        let default = StyleRange::of(&crate::settings::Settings::default());
+        assert_eq!(default, StyleRange { first: 32, end: 64 });
+        let mut ents = parse_entities(&lights(32)).expect("parse");
+        let styles = assign_switchable_styles(&mut ents, default, &mut Vec::new()).expect("fit");
+        assert_eq!(styles.count, 32);
+        assert_eq!(ents[31].get("style"), Some("63"));
+        let mut ents = parse_entities(&lights(33)).expect("parse");
+        let err = assign_switchable_styles(&mut ents, default, &mut Vec::new()).expect_err("full");
+        assert!(err.to_string().contains("32 to 63"), "{err}");
+        let wide = StyleRange {
+            first: 40,
+            end: 255,
+        };
+        let mut ents = parse_entities(&lights(33)).expect("parse");
+        let styles = assign_switchable_styles(&mut ents, wide, &mut Vec::new()).expect("fit");
+        assert_eq!((styles.count, ents[0].get("style")), (33, Some("40")));
     }
 }

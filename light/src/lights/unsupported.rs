@@ -28,16 +28,6 @@ const UNSUPPORTED: &[(&str, Where, &str)] = &[
         "spotlight falloff set by the distance to its target",
     ),
     (
-        "_compilerstyle_start",
-        Where::Worldspawn,
-        "first style of switchable lights (Slipgate starts at 32)",
-    ),
-    (
-        "_compilerstyle_max",
-        Where::Worldspawn,
-        "last style of switchable lights",
-    ),
-    (
         "_surflightsubdivision",
         Where::Worldspawn,
         "spacing of surface lights",

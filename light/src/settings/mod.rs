@@ -70,6 +70,15 @@ settings! {
     /// its colour kept, as ericw-tools dims it.
     maxlight: f64 = 0.0, keys ["_maxlight"], range Range::Any;
 
+    /// First light style given to switchable lights and shadows (styles below are Quake's
+    /// animated presets).
+    compilerstyle_start: usize = 32, keys ["_compilerstyle_start"], range Range::Clamp(1.0, 254.0);
+
+    /// Switchable styles stay below this one: QuakeSpasm, Ironwail, vkQuake and id's engine
+    /// keep 64 light styles (a map with more switchable names than fit is refused, as
+    /// ericw-tools refuses it); DarkPlaces and FTE take up to 255.
+    compilerstyle_max: usize = 64, keys ["_compilerstyle_max"], range Range::Clamp(1.0, 255.0);
+
     /// Ignore light entities (their suns, domes and surface lights too): only worldspawn's
     /// sunlight, sky domes and minlight light the map.
     nolights: bool = false, flag "nolights", keys [], range Range::Any;
