@@ -71,6 +71,8 @@ struct Common {
     anglescale: f64,
     /// The direction a spotlight (or a `_sun` entity) shines in.
     aim: Option<DVec3>,
+    /// How far the `target` it aims at is (`None`: aimed by `mangle`, or not at all).
+    target_distance: Option<f64>,
     dirt: Option<DirtResponse>,
     deviance: f64,
 }
@@ -134,10 +136,11 @@ fn common(k: &Keys, origins: &HashMap<&str, DVec3>, global: &Global) -> Common {
         }
         None => global.anglescale,
     };
-    let aim = match (k.vector(&keys::MANGLE), k.text(&keys::TARGET)) {
-        (Some(m), _) => Some(mangle_to_vec(m.x, m.y)),
-        (None, Some(t)) => origins.get(t).and_then(|&to| (to - origin).normalized()),
-        (None, None) => None,
+    let target = k.text(&keys::TARGET).and_then(|t| origins.get(t));
+    let (aim, target_distance) = match (k.vector(&keys::MANGLE), target) {
+        (Some(m), _) => (Some(mangle_to_vec(m.x, m.y)), None),
+        (None, Some(&to)) => ((to - origin).normalized(), Some((to - origin).length())),
+        (None, None) => (None, None),
     };
     let toggle = k
         .number(&keys::DIRT)
@@ -160,6 +163,7 @@ fn common(k: &Keys, origins: &HashMap<&str, DVec3>, global: &Global) -> Common {
         style,
         anglescale,
         aim,
+        target_distance,
         dirt: global.dirt_with(toggle, response),
         deviance: k.number(&keys::DEVIANCE).unwrap_or(0.0).max(0.0),
     }
@@ -193,12 +197,25 @@ fn point_light(k: &Keys, c: Common, global: &Global, out: &mut MapLights) {
         return;
     };
     let wait = k.number(&keys::WAIT).filter(|w| *w > 0.0).unwrap_or(1.0);
+    let angle = k.number(&keys::ANGLE).unwrap_or(DEFAULT_SPOT_ANGLE);
+    // `_spotlightautofalloff`: a targeted spotlight reaches just past its cone at the target.
+    let auto_reach = c
+        .target_distance
+        .filter(|d| global.spotlight_autofalloff && *d > 0.0)
+        .map(|d| {
+            let cone = if angle > 0.0 {
+                angle
+            } else {
+                DEFAULT_SPOT_ANGLE
+            };
+            d + d * (cone / 2.0).to_radians().tan()
+        });
     // `_falloff` (linear only): reaches zero exactly that many units out.
-    let atten = match k.number(&keys::FALLOFF).filter(|f| *f > 0.0) {
+    let reach = k.number(&keys::FALLOFF).filter(|f| *f > 0.0).or(auto_reach);
+    let atten = match reach {
         Some(reach) if falloff == Falloff::Linear => c.light.abs() / reach,
         _ => wait * global.scaledist,
     };
-    let angle = k.number(&keys::ANGLE).unwrap_or(DEFAULT_SPOT_ANGLE);
     let softangle = k.number(&keys::SOFTANGLE).unwrap_or(0.0);
     let point = PointLight {
         origin: c.origin,

@@ -23,11 +23,6 @@ const UNSUPPORTED: &[(&str, Where, &str)] = &[
         "one lightmap scale for every face (Slipgate reads `_lmscale`)",
     ),
     (
-        "_spotlightautofalloff",
-        Where::Worldspawn,
-        "spotlight falloff set by the distance to its target",
-    ),
-    (
         "_surflightsubdivision",
         Where::Worldspawn,
         "spacing of surface lights",
@@ -119,7 +114,7 @@ mod tests {
     #[test]
     fn each_unsupported_key_warns_where_ericw_tools_reads_it() {
         let text = r#"
-{ "classname" "worldspawn" "_spotlightautofalloff" "1" "_project_texture" "x" }
+{ "classname" "worldspawn" "_lightmap_scale" "2" "_project_texture" "x" }
 { "classname" "light" "origin" "0 0 0" "_project_texture" "window1" "_bouncescale" "" }
 { "classname" "func_wall" "model" "*1" "_minlight_mottle" "1" }
 "#;
@@ -129,7 +124,7 @@ mod tests {
             .map(ToString::to_string)
             .collect();
         assert_eq!(told.len(), 3, "{told:?}");
-        assert!(told[0].contains("\"_spotlightautofalloff\"") && told[0].contains("spotlight"));
+        assert!(told[0].contains("\"_lightmap_scale\"") && told[0].contains("lightmap scale"));
         assert!(
             told[1].contains("\"_project_texture\" is \"window1\""),
             "{told:?}"

@@ -23,6 +23,8 @@ pub struct Global {
     pub minlight_dirt: Option<DirtResponse>,
     /// `--addmin`: minlight is added to style 0 instead of raising it.
     pub addmin: bool,
+    /// `_spotlightautofalloff`: a targeted spotlight without `_falloff` fades out at its target.
+    pub spotlight_autofalloff: bool,
 }
 
 impl Global {
@@ -39,6 +41,7 @@ impl Global {
             },
             minlight_dirt: None,
             addmin: settings.addmin,
+            spotlight_autofalloff: settings.spotlight_autofalloff,
         };
         global.minlight_dirt = global.dirt_if(settings.minlight_dirt);
         global

@@ -70,6 +70,11 @@ settings! {
     /// its colour kept, as ericw-tools dims it.
     maxlight: f64 = 0.0, keys ["_maxlight"], range Range::Any;
 
+    /// `1`: a spotlight aimed at its `target` (and without `_falloff`) falls off linearly to
+    /// zero just past its cone's reach at the target: the distance to it plus the cone's radius
+    /// there, as in ericw-tools (linear lights only).
+    spotlight_autofalloff: bool = false, keys ["_spotlightautofalloff"], range Range::Any;
+
     /// First light style given to switchable lights and shadows (styles below are Quake's
     /// animated presets).
     compilerstyle_start: usize = 32, keys ["_compilerstyle_start"], range Range::Clamp(1.0, 254.0);

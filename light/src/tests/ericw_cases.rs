@@ -411,6 +411,41 @@ fn a_world_only_shadow_falls_on_the_world_alone() {
     assert_eq!(plate, plate_open, "the plate is not");
 }
 
+/// ericw-tools' `_spotlightautofalloff`: a linear spotlight aimed at a `target` fades to zero
+/// just past its cone at the target (the distance plus the cone's radius there), instead of
+/// at its brightness in units. 224 units above the floor, light 600, angle 40: zero at 305.5
+/// units, so the floor under it takes 600 − 224 × 600 / 305.5 ≈ 160 where it took 376.
+#[test]
+fn spotlight_autofalloff_fades_out_at_the_target() {
+    let bsp = room_bsp(&format!(
+        "{}{{\n\"classname\" \"info_null\"\n\"targetname\" \"spot\"\n\"origin\" \"0 0 -128\"\n}}\n",
+        light([0.0, 0.0, 96.0], "\"light\" \"600\"\n\"target\" \"spot\"")
+    ));
+    let mut opts = options(Quality::Default);
+    let plain = floor_rgb(
+        &bsp,
+        &compute_lighting(&bsp, &opts).expect("light"),
+        0.0,
+        0.0,
+    );
+    opts.overrides.spotlight_autofalloff = Some(true);
+    let auto = floor_rgb(
+        &bsp,
+        &compute_lighting(&bsp, &opts).expect("light"),
+        0.0,
+        0.0,
+    );
+    let (plain, auto) = (
+        f64::from(plain.expect("lit")[0]),
+        f64::from(auto.expect("lit")[0]),
+    );
+    let want = (600.0 - 224.0 * 600.0 / (224.0 + 224.0 * 20f64.to_radians().tan())) / 376.0;
+    assert!(
+        (auto / plain - want).abs() < 0.02,
+        "{auto} / {plain}, want {want}"
+    );
+}
+
 /// `detailFence` (`q1_detail_fence`): a `func_detail_fence` (here all `skip`, as there, so it has
 /// no faces) around a light and the floor under it. Its inside is written solid, which stops
 /// players; the compiler marks those leaves and light takes them as open, so the light is not
