@@ -28,6 +28,23 @@ quake_formats::ericw_accepted! {
         litonly: bool => "the BSP is always written with its .lit",
         nolighting: bool => "light is always computed",
         wrnormals: bool => "no normals lump is written",
+        gamedir: Option<String> => "light reads textures from the BSP and the palette as --palette says",
+        basedir: Option<String> => "light reads textures from the BSP and the palette as --palette says",
+        filepriority: Option<String> => "light reads textures from the BSP",
+        path: Vec<String> => "light reads textures from the BSP",
+        emissivequality: Option<String> => "bounced light comes from each face's whole surface",
+        visapprox: Option<String> => "lights are culled by the PVS, which never cuts light off early",
+        facestyles: Option<String> => "a face keeps the 4 styles BSP29 and BSP2 hold",
+        exportobj: bool => "no .obj is written",
+        lmscale: Option<String> => "the lightmap spacing comes from _lmscale keys or --lmshift",
+        radlights: Option<String> => ".rad files are not read; `_surface` light entities make surface lights",
+        lightgrid_format: Option<String> => "the light grid is written as LIGHTGRID_OCTREE",
+        bouncelightsdebug: bool => "no debug lightmaps; `slipgate view --lightmap-only` shows the light",
+        phongdebug_obj: bool => "no debug output; `slipgate view --lightmap-only` shows the light",
+        debugoccluded: bool => "no debug lightmaps; `slipgate view --lightmap-only` shows the light",
+        debugneighbours: bool => "no debug lightmaps; `slipgate view --lightmap-only` shows the light",
+        debugmottle: bool => "no debug lightmaps; `slipgate view --lightmap-only` shows the light",
+        highlightseams: bool => "no debug lightmaps; `slipgate view --lightmap-only` shows the light",
     }
 }
 
@@ -63,6 +80,9 @@ pub struct Args {
     /// from an earlier run is removed.
     #[arg(long)]
     pub nolit: bool,
+    /// Both `--bspxlit` and `--bspxlux`: colour and directions in the BSP (ericw-tools' `-bspx`).
+    #[arg(long)]
+    pub bspx: bool,
     /// Only update the entity lump: give switchable lights (`targetname`) their styles without
     /// relighting, after `slipgate bsp --onlyents` replaced the entities.
     #[arg(long, conflicts_with_all = ["compare_reference", "bench_occlusion"])]
@@ -214,9 +234,14 @@ impl Args {
     /// The library options these arguments ask for, with the palette `run` would find (and no
     /// progress reported).
     pub fn lighting_options(&self) -> anyhow::Result<Options> {
+        let mut overrides = Overrides::clone(&self.overrides);
+        if self.bspx {
+            overrides.bspxlit = overrides.bspxlit.or(Some(true));
+            overrides.bspxlux = overrides.bspxlux.or(Some(true));
+        }
         Ok(Options {
             quality: self.quality(),
-            overrides: Overrides::clone(&self.overrides),
+            overrides,
             no_cull: self.no_cull,
             palette: find_palette(self)?,
             ..Options::default()
@@ -604,13 +629,27 @@ mod tests {
             "-dirtdebug",
             "-surflight_subdivide",
             "64",
+            "-emissivequality",
+            "high",
+            "-path",
+            "a",
+            "-path",
+            "b",
+            "-visapprox",
+            "vis",
+            "-bspx",
             "x.bsp",
         ]);
         let words =
             join_optional_values(quake_formats::cli::normalise_single_dash(words.into_iter()));
         let cli = LightCli::try_parse_from(words).expect("parses");
         let notes = cli.args.ericw_only.notes();
-        assert_eq!(notes.len(), 3, "{notes:?}");
+        assert_eq!(notes.len(), 6, "{notes:?}");
+        let overrides = cli.args.lighting_options().expect("options").overrides;
+        assert_eq!(
+            (overrides.bspxlit, overrides.bspxlux),
+            (Some(true), Some(true))
+        );
         assert!(
             notes[0].starts_with("-nopercent has no effect"),
             "{notes:?}"

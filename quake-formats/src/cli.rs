@@ -20,6 +20,12 @@ impl<T> Given for Option<T> {
     }
 }
 
+impl<T> Given for Vec<T> {
+    fn given(&self) -> bool {
+        !self.is_empty()
+    }
+}
+
 /// Declares a stage's ericw-tools options that it accepts without acting on them, so that a
 /// compile profile written for ericw-tools runs unchanged: each is a hidden clap option (a
 /// `bool` flag or an `Option<String>` value) with the note printed when it is given, saying
