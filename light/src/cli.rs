@@ -90,9 +90,9 @@ pub struct Args {
     /// Worker threads for tracing (default: one per core).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
     pub threads: Option<u16>,
-    /// ericw-tools' options accepted with a note (hidden from the help).
+    /// ericw-tools' options accepted with a note (hidden from the help); boxed, being many.
     #[command(flatten)]
-    pub ericw_only: EricwOnly,
+    pub ericw_only: Box<EricwOnly>,
     /// Consider every light for every face (no range, plane-side or PVS culling).
     #[arg(long)]
     pub no_cull: bool,
