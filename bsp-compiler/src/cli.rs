@@ -53,6 +53,16 @@ quake_formats::ericw_accepted! {
         noextendedsurfflags: bool => "Slipgate writes no extended surface flags (ericw-tools' .texinfo.json)",
         nodefaultpaths: bool => "WADs are found as docs/mapping.md says",
         defaultpaths: bool => "WADs are found as docs/mapping.md says",
+        gamedir: Option<String> => "WADs are found as docs/mapping.md says",
+        basedir: Option<String> => "WADs are found as docs/mapping.md says",
+        filepriority: Option<String> => "WADs are found as docs/mapping.md says",
+        oldrottex: bool => "rotate_ brushes are textured as docs/mapping.md says",
+        midsplitsurffraction: Option<String> => "the tree is always chosen by the fewest-splits heuristic",
+        midsplitbrushfraction: Option<String> => "the tree is always chosen by the fewest-splits heuristic",
+        aliasdef: Vec<String> => "entity aliases are not read; the map's classnames are kept",
+        texturedefs: Option<String> => "texture remaps are not read; the map's texture names are kept",
+        debugbspbrushes: bool => "no debug maps are written",
+        debugleafvolumes: bool => "no debug maps are written",
     }
 }
 

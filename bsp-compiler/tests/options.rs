@@ -614,10 +614,16 @@ fn ericw_tools_only_options_are_accepted_with_a_note() {
         "-threads",
         "2",
         "-lowpriority",
+        "-gamedir",
+        "id1",
+        "-aliasdef",
+        "a.def",
+        "-aliasdef",
+        "b.def",
         "x.map",
     ]);
     let notes = args.ericw_only.notes();
-    assert_eq!(notes.len(), 7, "{notes:?}");
+    assert_eq!(notes.len(), 9, "{notes:?}");
     for name in [
         "-nopercent",
         "-verbose",
@@ -625,6 +631,8 @@ fn ericw_tools_only_options_are_accepted_with_a_note() {
         "-tjunc",
         "-splitsky",
         "-chop",
+        "-gamedir",
+        "-aliasdef",
     ] {
         assert!(
             notes

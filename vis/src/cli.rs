@@ -19,6 +19,12 @@ quake_formats::ericw_accepted! {
         noautoclean: bool => "state files are removed once vis finishes",
         phsonly: bool => "Quake maps have no PHS",
         visdist: Option<String> => "the PVS is never cut by distance; it stays exact",
+        gamedir: Option<String> => "vis reads only the BSP and its portal file",
+        basedir: Option<String> => "vis reads only the BSP and its portal file",
+        filepriority: Option<String> => "vis reads only the BSP and its portal file",
+        path: Vec<String> => "vis reads only the BSP and its portal file",
+        defaultpaths: bool => "vis reads only the BSP and its portal file",
+        nodefaultpaths: bool => "vis reads only the BSP and its portal file",
     }
 }
 

@@ -52,12 +52,17 @@ fn ericw_tools_only_options_are_accepted_with_a_note() {
         "2000",
         "-level",
         "2",
+        "-path",
+        "a",
+        "-path",
+        "b",
+        "-nodefaultpaths",
         "x.bsp",
     ];
     let words = quake_formats::cli::normalise_single_dash(words.iter().map(|s| s.to_string()));
     let cli = VisCli::try_parse_from(words).expect("parses");
     let notes = cli.args.ericw_only.notes();
-    assert_eq!(notes.len(), 2, "{notes:?}");
+    assert_eq!(notes.len(), 4, "{notes:?}");
     assert!(notes[1].starts_with("-visdist has no effect"), "{notes:?}");
     assert_eq!(cli.args.level, 2);
 }
