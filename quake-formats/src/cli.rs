@@ -83,11 +83,14 @@ macro_rules! ericw_accepted {
 }
 
 /// ericw-tools writes long options with one dash (`-extra4`, `-2psb`); clap wants two. Negative
-/// numbers (`-100`, `-1e5`) and short flags (`-h`) are left alone. The first word (the program
-/// name) is kept as it is.
+/// numbers (`-100`, `-1e5`) and short flags (`-h`) are left alone, but for ericw-tools' `-v`,
+/// its tools' short form of `-verbose`. The first word (the program name) is kept as it is.
 pub fn normalise_single_dash(args: impl Iterator<Item = String>) -> Vec<String> {
     args.enumerate()
         .map(|(i, a)| {
+            if i > 0 && a == "-v" {
+                return "--verbose".to_string();
+            }
             let name = a.strip_prefix('-').unwrap_or_default();
             let is_ericw_long = i > 0
                 && name.len() > 1
@@ -162,14 +165,23 @@ mod tests {
     #[test]
     fn single_dash_long_options_become_double_dash() {
         let args = [
-            "slipgate", "light", "-extra4", "-soft", "-h", "--pos", "-100", "-1e5", "-2psb",
+            "slipgate", "light", "-extra4", "-soft", "-h", "--pos", "-100", "-1e5", "-2psb", "-v",
             "x.bsp",
         ];
         let out = normalise_single_dash(args.iter().map(|s| s.to_string()));
         assert_eq!(
             out,
             [
-                "slipgate", "light", "--extra4", "--soft", "-h", "--pos", "-100", "-1e5", "--2psb",
+                "slipgate",
+                "light",
+                "--extra4",
+                "--soft",
+                "-h",
+                "--pos",
+                "-100",
+                "-1e5",
+                "--2psb",
+                "--verbose",
                 "x.bsp"
             ]
         );
