@@ -587,6 +587,7 @@ fn merged_phong(ent: &MapEntity, index: usize, class: EntityBrushes) -> FacePhon
         Some(angle) => FacePhong {
             group: index as u32,
             angle: angle as f32,
+            concave: phong::concave_from_key(ent.entity.get_float("_phong_angle_concave")),
         },
         None => FacePhong::default(),
     }
@@ -868,7 +869,11 @@ mod tests {
             .enumerate()
             .map(|(i, e)| merged_phong(e, i, EntityBrushes::of(i, e.entity.classname())))
             .collect();
-        let group = |group, angle| FacePhong { group, angle };
+        let group = |group, angle| FacePhong {
+            group,
+            angle,
+            concave: 0.0,
+        };
         let none = FacePhong::default();
         // Worldspawn and brush models keep their keys for light to read.
         assert_eq!(got, vec![none, group(1, 89.0), group(2, 30.0), none, none]);
@@ -881,6 +886,7 @@ mod tests {
         let grouped = FacePhong {
             group: 3,
             angle: 89.0,
+            concave: 0.0,
         };
         let keys = |phong, flags| FaceKeys {
             phong,

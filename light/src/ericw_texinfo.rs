@@ -23,6 +23,7 @@ struct TexinfoKeys {
     flags: FaceFlags,
     minlight: FaceMinlight,
     phong_angle: f32,
+    phong_angle_concave: f32,
     phong_group: i64,
     surflight_group: i32,
 }
@@ -61,6 +62,9 @@ impl TexinfoKeys {
             },
             minlight,
             phong_angle: number("phong_angle").unwrap_or(0.0) as f32,
+            phong_angle_concave: quake_formats::bsp::phong::concave_from_key(number(
+                "phong_angle_concave",
+            )),
             phong_group: whole("phong_group"),
             surflight_group: i32::try_from(whole("surflight_group")).unwrap_or(0),
         }
@@ -96,8 +100,8 @@ pub fn add_face_keys(bsp: &mut Bsp, json: &str) -> Result<AddedLumps, String> {
                 .unwrap_or_default()
         })
         .collect();
-    // Faces with the same phong group number and angle smooth together.
-    let mut phong_ids: HashMap<(i64, u32), u32> = HashMap::new();
+    // Faces with the same phong group number and angles smooth together.
+    let mut phong_ids: HashMap<(i64, u32, u32), u32> = HashMap::new();
     let phong: Vec<FacePhong> = keys
         .iter()
         .map(|k| {
@@ -105,12 +109,16 @@ pub fn add_face_keys(bsp: &mut Bsp, json: &str) -> Result<AddedLumps, String> {
                 return FacePhong::default();
             }
             let next = phong_ids.len() as u32 + 1;
-            let group = *phong_ids
-                .entry((k.phong_group, k.phong_angle.to_bits()))
-                .or_insert(next);
+            let key = (
+                k.phong_group,
+                k.phong_angle.to_bits(),
+                k.phong_angle_concave.to_bits(),
+            );
+            let group = *phong_ids.entry(key).or_insert(next);
             FacePhong {
                 group,
                 angle: k.phong_angle.min(180.0),
+                concave: k.phong_angle_concave,
             }
         })
         .collect();
@@ -129,10 +137,11 @@ pub fn add_face_keys(bsp: &mut Bsp, json: &str) -> Result<AddedLumps, String> {
 }
 
 /// The per-face key lumps Slipgate's compiler writes.
-const FACE_KEY_LUMPS: [&str; 4] = [
+const FACE_KEY_LUMPS: [&str; 5] = [
     quake_formats::bsp::face_flags::LUMP_NAME,
     quake_formats::bsp::face_minlight::LUMP_NAME,
     quake_formats::bsp::phong::LUMP_NAME,
+    quake_formats::bsp::phong::CONCAVE_LUMP_NAME,
     quake_formats::bsp::surflight_group::LUMP_NAME,
 ];
 

@@ -58,13 +58,42 @@ fn angle_at(points: &[DVec3], normal: DVec3, plane_dist: f64, p: DVec3) -> Optio
     inside.then_some(std::f64::consts::TAU)
 }
 
+/// A group's smoothing angles, in degrees.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PhongAngles {
+    /// Faces whose normals are at most this far apart smooth together (`_phong_angle`).
+    pub angle: f64,
+    /// The same where they meet in a concave joint (`_phong_angle_concave`; 0: `angle`).
+    pub concave: f64,
+}
+
+impl PhongAngles {
+    /// One angle for every joint.
+    #[cfg(test)]
+    pub fn of(angle: f64) -> PhongAngles {
+        PhongAngles {
+            angle,
+            concave: 0.0,
+        }
+    }
+
+    /// The angle for a joint, concave or not.
+    fn for_joint(self, concave: bool) -> f64 {
+        if concave && self.concave > 0.0 {
+            self.concave
+        } else {
+            self.angle
+        }
+    }
+}
+
 /// Which faces smooth together.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct PhongGroups {
     /// Per face: its group (an index into `angles`), or `None`.
     pub of_face: Vec<Option<usize>>,
-    /// Per group: its phong angle in degrees.
-    pub angles: Vec<f64>,
+    /// Per group: its smoothing angles.
+    pub angles: Vec<PhongAngles>,
 }
 
 /// Where a group comes from: a brush model's (or worldspawn's) own keys, or
@@ -81,7 +110,7 @@ enum GroupKey {
 /// angle in degrees; 0 = worldspawn) smooths with its model's faces.
 pub fn groups(
     faces: &[FaceGeom],
-    model_angles: &HashMap<usize, f64>,
+    model_angles: &HashMap<usize, PhongAngles>,
     lump: Option<&[FacePhong]>,
 ) -> PhongGroups {
     let mut ids: HashMap<GroupKey, usize> = HashMap::new();
@@ -96,7 +125,13 @@ pub fn groups(
         let recorded = lump
             .and_then(|l| l.get(f.index))
             .filter(|r| r.group != 0)
-            .map(|r| (GroupKey::Lump(r.group), f64::from(r.angle)));
+            .map(|r| {
+                let angles = PhongAngles {
+                    angle: f64::from(r.angle),
+                    concave: f64::from(r.concave),
+                };
+                (GroupKey::Lump(r.group), angles)
+            });
         let own = || {
             model_angles
                 .get(&f.model)
@@ -123,7 +158,7 @@ pub fn corner_normals(faces: &[FaceGeom], groups: &PhongGroups) -> Vec<Option<Ve
             members[*g].push(f);
         }
     }
-    for (members, &angle) in members.iter().zip(&groups.angles) {
+    for (members, &angles) in members.iter().zip(&groups.angles) {
         let mut grid: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
         for (m, f) in members.iter().enumerate() {
             let mut bounds = Bounds::EMPTY;
@@ -140,7 +175,7 @@ pub fn corner_normals(faces: &[FaceGeom], groups: &PhongGroups) -> Vec<Option<Ve
                 }
             }
         }
-        let cos_limit = angle.to_radians().cos();
+        let cos_limit = |concave: bool| angles.for_joint(concave).to_radians().cos();
         for f in members {
             let normal = f.plane.normal;
             let corners = f
@@ -150,7 +185,9 @@ pub fn corner_normals(faces: &[FaceGeom], groups: &PhongGroups) -> Vec<Option<Ve
                     let mut sum = DVec3::ZERO;
                     for &m in grid.get(&cell_of(p)).into_iter().flatten() {
                         let g = members[m];
-                        if g.plane.normal.dot(normal) < cos_limit - 1e-9 {
+                        // Concave: the other face rises in front of this one.
+                        let concave = f.plane.distance(centroid(&g.points)) > TOUCH_EPSILON;
+                        if g.plane.normal.dot(normal) < cos_limit(concave) - 1e-9 {
                             continue;
                         }
                         if let Some(w) = angle_at(&g.points, g.plane.normal, g.plane.dist, p) {
@@ -164,6 +201,11 @@ pub fn corner_normals(faces: &[FaceGeom], groups: &PhongGroups) -> Vec<Option<Ve
         }
     }
     out
+}
+
+/// The mean of `points`.
+fn centroid(points: &[DVec3]) -> DVec3 {
+    points.iter().fold(DVec3::ZERO, |a, &p| a + p) / points.len().max(1) as f64
 }
 
 /// The smooth normal at `p` (on or just off the face) from the face's
@@ -263,14 +305,18 @@ mod tests {
                 ..square()
             })
             .collect();
-        let group = |g: u32, angle: f32| FacePhong { group: g, angle };
+        let group = |g: u32, angle: f32| FacePhong {
+            group: g,
+            angle,
+            concave: 0.0,
+        };
         // Face 1 is in a compiler group; faces 0 and 2 follow worldspawn's
         // `_phong`; face 3 belongs to model 1, which has no key.
         let lump = [group(0, 0.0), group(7, 45.0), group(0, 0.0), group(0, 0.0)];
-        let world = HashMap::from([(0, 60.0)]);
+        let world = HashMap::from([(0, PhongAngles::of(60.0))]);
         let g = groups(&faces, &world, Some(&lump));
         assert_eq!(g.of_face, vec![Some(0), Some(1), Some(0), None]);
-        assert_eq!(g.angles, vec![60.0, 45.0]);
+        assert_eq!(g.angles, vec![PhongAngles::of(60.0), PhongAngles::of(45.0)]);
         let g = groups(&faces, &HashMap::new(), Some(&lump));
         assert_eq!(g.of_face, vec![None, Some(0), None, None]);
         assert_eq!(
@@ -285,10 +331,51 @@ mod tests {
     #[test]
     fn corners_of_a_lone_face_keep_its_normal() {
         let f = square();
-        let angles = HashMap::from([(0, 89.0)]);
+        let angles = HashMap::from([(0, PhongAngles::of(89.0))]);
         let groups = groups(std::slice::from_ref(&f), &angles, None);
         let normals = corner_normals(std::slice::from_ref(&f), &groups);
         let c = normals[0].as_ref().expect("phong face");
         assert!(c.iter().all(|n| n.near(f.plane.normal, 1e-12)));
+    }
+
+    /// `_phong_angle_concave`: the square and a face leaning 45° off its x = 0 edge smooth
+    /// within `_phong_angle 89` whichever way the other leans; with a concave angle of 1 the
+    /// trough (the other face rising in front of the square) stays sharp, the ridge does not.
+    #[test]
+    fn a_concave_angle_keeps_troughs_sharp_and_smooths_ridges() {
+        let lean = |rise: f64| {
+            let points = vec![
+                DVec3::new(0.0, 0.0, 0.0),
+                DVec3::new(-10.0, 0.0, rise),
+                DVec3::new(-10.0, 10.0, rise),
+                DVec3::new(0.0, 10.0, 0.0),
+            ];
+            let normal = DVec3::new(rise.signum(), 0.0, 1.0)
+                .normalized()
+                .expect("unit");
+            FaceGeom {
+                index: 1,
+                points,
+                plane: Plane::new(normal, 0.0),
+                ..square()
+            }
+        };
+        let corner = |other: FaceGeom, angles: PhongAngles| {
+            let faces = [square(), other];
+            let groups = groups(&faces, &HashMap::from([(0, angles)]), None);
+            corner_normals(&faces, &groups)[0]
+                .as_ref()
+                .expect("smoothed")[0]
+        };
+        let up = DVec3::Z;
+        let (trough, ridge) = (lean(10.0), lean(-10.0));
+        assert!(!corner(trough.clone(), PhongAngles::of(89.0)).near(up, 1e-6));
+        assert!(!corner(ridge.clone(), PhongAngles::of(89.0)).near(up, 1e-6));
+        let concave_sharp = PhongAngles {
+            angle: 89.0,
+            concave: 1.0,
+        };
+        assert!(corner(trough, concave_sharp).near(up, 1e-12));
+        assert!(!corner(ridge, concave_sharp).near(up, 1e-6));
     }
 }

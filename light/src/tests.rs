@@ -1628,6 +1628,15 @@ fn phong_on_func_detail_reaches_light_through_the_bsp() {
         assert_eq!(lump[f.index].group, want, "face {}", f.index);
     }
     compute_lighting(&smooth, &options(Quality::Default)).expect("light");
+    assert!(lump.iter().all(|r| r.concave == 0.0));
+
+    // `_phong_angle_concave` on the func_detail reaches light too (its own lump).
+    let concave = detail_column_bsp("\"_phong\" \"1\"\n\"_phong_angle_concave\" \"10\"");
+    let lump = concave.phong_faces().expect("lump").expect("written");
+    let prep = crate::prepare::prepare(&concave, &Options::default()).expect("prepare");
+    for f in column_sides(&prep) {
+        assert_eq!((lump[f].angle, lump[f].concave), (89.0, 10.0));
+    }
 }
 
 /// The largest difference in red between the luxels of two lightings of the same faces.
@@ -2887,6 +2896,7 @@ fn no_key_value_stops_light() {
         "_samples" => "\"_deviance\" \"8\"\n",
         "_surface_offset" | "_surface_spotlight" | "_surflight_group" => "\"_surface\" \"wall\"\n",
         "_minlight_color" | "_mincolor" => "\"_minlight\" \"8\"\n",
+        "_phong_angle_concave" => "\"_phong\" \"1\"\n",
         _ => "",
     };
     let light_with = |key: &str, value: &str| {

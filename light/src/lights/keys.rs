@@ -252,6 +252,8 @@ entity_keys! {
     PHONG: ["_phong"] on WorldAndModels, Number, default "off";
     /// The greatest angle between faces `_phong` smooths across, in degrees.
     PHONG_ANGLE: ["_phong_angle"] on WorldAndModels, Number, default "`89`";
+    /// The same where two faces meet in a concave joint (`1`: concave joints stay sharp).
+    PHONG_ANGLE_CONCAVE: ["_phong_angle_concave"] on WorldAndModels, Number, default "`_phong_angle`";
     /// Where the model is placed, so light finds its faces.
     MODEL_ORIGIN: ["origin"] on Models, Vector, default "`0 0 0`";
 }

@@ -129,8 +129,8 @@ pub struct MapLights {
     pub bounce: BounceSettings,
     /// How dirt occlusion is measured (used only when something takes dirt).
     pub dirt: DirtSampling,
-    /// Brush models (0 = world) with `_phong` smoothing, and their angle in degrees.
-    pub phong: HashMap<usize, f64>,
+    /// Brush models (0 = world) with `_phong` smoothing, and their angles.
+    pub phong: HashMap<usize, crate::phong::PhongAngles>,
     /// Offset of each brush model with an `origin` key (rotating entities).
     pub model_origins: HashMap<usize, DVec3>,
     /// Brush models with a non-zero `_surflight_group`, and that group.

@@ -19,7 +19,7 @@ pub fn model_index(e: &Entity) -> Option<usize> {
     e.get("model")?.strip_prefix('*')?.parse().ok()
 }
 
-/// `_phong` and `_phong_angle` (into `out.phong`) and `_lmscale` (into `out.model_lmscale`) of
+/// `_phong`, `_phong_angle` and `_phong_angle_concave` (into `out.phong`) and `_lmscale` (into `out.model_lmscale`) of
 /// worldspawn (`world`, as model 0) and every brush model, with a warning for each key not
 /// taken as written.
 pub fn read_world_and_model_keys(entities: &[Entity], world: Option<usize>, out: &mut MapLights) {
@@ -38,7 +38,12 @@ pub fn read_world_and_model_keys(entities: &[Entity], world: Option<usize>, out:
         }
         let phong = (k.number(&keys::PHONG), k.number(&keys::PHONG_ANGLE));
         if let Some(angle) = phong::angle_from_keys(phong.0, phong.1) {
-            out.phong.insert(model, angle);
+            let concave = phong::concave_from_key(k.number(&keys::PHONG_ANGLE_CONCAVE));
+            let angles = crate::phong::PhongAngles {
+                angle,
+                concave: f64::from(concave),
+            };
+            out.phong.insert(model, angles);
         }
         out.warnings.extend(k.into_warnings());
     }

@@ -51,11 +51,6 @@ const UNSUPPORTED: &[(&str, Where, &str)] = &[
     ),
     ("_light_channel_mask", Where::Lights, "light channels"),
     ("_shadow_channel_mask", Where::Lights, "shadow channels"),
-    (
-        "_phong_angle_concave",
-        Where::Brushes,
-        "separate smoothing angle for concave joins",
-    ),
     ("_minlight_mottle", Where::Brushes, "mottled minlight"),
     ("_object_channel_mask", Where::Brushes, "light channels"),
 ];
