@@ -151,7 +151,7 @@ mod tests {
                 spot: None,
                 anglescale: 0.5,
                 dirt: None,
-                bounce: true,
+                bounce: 1.0,
                 entity: 1,
             },
             offset: 2.0,

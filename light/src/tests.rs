@@ -2001,6 +2001,21 @@ fn bounce_lights_the_underside_of_the_box_only_when_asked() {
     assert_eq!(face_grey(&from_key, BOX_UNDERSIDE), under);
     let opted_out = compute_lighting(&shadow_scene("\"_bounce\" \"0\""), &bounced).expect("light");
     assert!(face_grey(&opted_out, BOX_UNDERSIDE).iter().all(|&b| b == 0));
+    // `_bouncescale` scales the light's share: none at 0, half at 0.5, more above 1.
+    let scaled = |scale: &str| {
+        let keys = format!("\"_bouncescale\" \"{scale}\"");
+        let lit = compute_lighting(&shadow_scene(&keys), &bounced).expect("light");
+        face_grey(&lit, BOX_UNDERSIDE)
+    };
+    assert!(scaled("0").iter().all(|&b| b == 0));
+    assert_eq!(scaled("1"), under);
+    let (half, double) = (scaled("0.5"), scaled("2"));
+    for ((&h, &d), &u) in half.iter().zip(&double).zip(&under) {
+        assert!(
+            h.abs_diff(u / 2) <= 1 && d.abs_diff(u * 2) <= 1,
+            "{h} {d} {u}"
+        );
+    }
 }
 
 #[test]

@@ -227,7 +227,12 @@ fn point_light(k: &Keys, c: Common, global: &Global, out: &mut MapLights) {
         spot: c.aim.map(|dir| Spot::new(dir, angle, softangle)),
         anglescale: c.anglescale,
         dirt: c.dirt,
-        bounce: k.number(&keys::BOUNCE).is_none_or(|b| b > 0.0),
+        bounce: if k.number(&keys::BOUNCE).is_none_or(|b| b > 0.0) {
+            k.number(&keys::BOUNCESCALE)
+                .map_or(1.0, |s| s.max(0.0) as f32)
+        } else {
+            0.0
+        },
         entity: k.index,
     };
     match k.text(&keys::SURFACE) {

@@ -170,6 +170,8 @@ entity_keys! {
     DIRTGAIN: ["_dirtgain"] on Lights, Number, default "worldspawn's";
     /// `0`: this light's light does not reflect / this model's faces do not reflect.
     BOUNCE: ["_bounce"] on LightsAndModels, Number, default "`1`";
+    /// How much of this light bounces (`0`: none, as `_bounce 0`); ericw-tools documents it.
+    BOUNCESCALE: ["_bouncescale"] on Lights, Number, default "`1`";
     /// Soft shadows: the light is spread as `_samples` lights in a ball of this radius (for
     /// `_sun` lights: a cone of this many degrees).
     DEVIANCE: ["_deviance"] on Lights, Number, default "`0`";

@@ -117,8 +117,8 @@ pub struct PointLight {
     pub anglescale: f64,
     /// How dirt darkens this light (`None`: it ignores dirt).
     pub dirt: Option<DirtResponse>,
-    /// Its light bounces (false for `_bounce 0`).
-    pub bounce: bool,
+    /// How much of its light bounces: `_bouncescale` (0 for `_bounce 0`).
+    pub bounce: f32,
     /// Entity index it came from (for messages).
     pub entity: usize,
 }
@@ -220,7 +220,7 @@ mod tests {
             spot: None,
             anglescale: 0.5,
             dirt: None,
-            bounce: true,
+            bounce: 1.0,
             entity: 0,
         }
     }

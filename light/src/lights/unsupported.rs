@@ -44,11 +44,6 @@ const UNSUPPORTED: &[(&str, Where, &str)] = &[
         Where::Lights,
         "projected texture's field of view",
     ),
-    (
-        "_bouncescale",
-        Where::Lights,
-        "scale of this light's bounced light (Slipgate reads `_bounce 0` to turn it off)",
-    ),
     ("_light_channel_mask", Where::Lights, "light channels"),
     ("_shadow_channel_mask", Where::Lights, "shadow channels"),
     ("_minlight_mottle", Where::Brushes, "mottled minlight"),
@@ -110,7 +105,7 @@ mod tests {
     fn each_unsupported_key_warns_where_ericw_tools_reads_it() {
         let text = r#"
 { "classname" "worldspawn" "_lightmap_scale" "2" "_project_texture" "x" }
-{ "classname" "light" "origin" "0 0 0" "_project_texture" "window1" "_bouncescale" "" }
+{ "classname" "light" "origin" "0 0 0" "_project_texture" "window1" "_project_fov" "" }
 { "classname" "func_wall" "model" "*1" "_minlight_mottle" "1" }
 "#;
         let entities = parse_entities(text).expect("entities");

@@ -148,8 +148,9 @@ fn settle(
 
 /// Adds `value` of `light` (its colour) in `style` to sample `i` for each `(i, value)`
 /// of `arrived`, or for a local minlight raises the sample's floor to it.
-/// Light of a `_bounce 0` light is also kept in `no_bounce`, so it can be
-/// taken out of what reflects.
+/// The part of a light's light that does not bounce (all of a `_bounce 0` light's, the rest of
+/// its `_bouncescale`) is also kept in `no_bounce`, so it can be taken out of what reflects (a
+/// scale above 1 keeps a negative part, which adds).
 fn deposit(
     light: &PointLight,
     style: u8,
@@ -176,13 +177,14 @@ fn deposit(
             d.add_from_point(style, i, light.origin, value * weight);
         }
     }
-    if !local_min && !light.bounce {
+    let kept_share = 1.0 - f64::from(light.bounce);
+    if !local_min && kept_share != 0.0 {
         let len = out.sums.len;
         let kept = out.no_bounce.get_or_insert_with(|| StyleBuffers::new(len));
         let buffer = kept.get(style);
         for (i, value) in arrived {
             for (o, c) in buffer[i].iter_mut().zip(color) {
-                *o += (value * c) as f32;
+                *o += (value * c * kept_share) as f32;
             }
         }
     }

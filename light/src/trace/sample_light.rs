@@ -56,7 +56,8 @@ pub struct SampleLight {
     pub(super) floors: StyleBuffers,
     /// `--addmin` minlight of style 0, added when finishing (it does not bounce).
     pub(super) added_minlight: Option<Vec<[f32; 3]>>,
-    /// The part of `sums` from `_bounce 0` lights.
+    /// The part of `sums` that does not bounce (`_bounce 0` lights, the rest of a
+    /// `_bouncescale`).
     pub(super) no_bounce: Option<StyleBuffers>,
     /// Per sample, the dirt factor of bounced light (empty: none).
     pub(super) bounce_dirt: Vec<f32>,
@@ -280,8 +281,8 @@ impl SampleLight {
     }
 
     /// Per style, the luxel means of the light that reflects: lights and
-    /// suns without minlight or `_bounce 0` lights; style 0 only unless
-    /// `styled`. Styles with no light are left out.
+    /// suns without minlight, each light's times its `_bouncescale` (0 for
+    /// `_bounce 0`); style 0 only unless `styled`. Styles with no light are left out.
     pub fn reflected(&self, styled: bool) -> Vec<(u8, Vec<[f32; 3]>)> {
         let mut out = Vec::new();
         for (style, values) in &self.sums.styles {
