@@ -36,7 +36,6 @@ quake_formats::ericw_accepted! {
         visapprox: Option<String> => "lights are culled by the PVS, which never cuts light off early",
         facestyles: Option<String> => "a face keeps the 4 styles BSP29 and BSP2 hold",
         exportobj: bool => "no .obj is written",
-        lmscale: Option<String> => "the lightmap spacing comes from _lmscale keys or --lmshift",
         radlights: Option<String> => ".rad files are not read; `_surface` light entities make surface lights",
         lightgrid_format: Option<String> => "the light grid is written as LIGHTGRID_OCTREE",
         bouncelightsdebug: bool => "no debug lightmaps; `slipgate view --lightmap-only` shows the light",

@@ -2792,6 +2792,28 @@ fn brush_entities_set_their_own_spacing() {
     assert_eq!(sizes(&options(Quality::Default)), vec![None, None]);
 }
 
+/// worldspawn's `_lightmap_scale` (ericw-tools' `-lmscale`) lights every model at that fraction
+/// of 16 texels, over a brush entity's own `_lmscale`.
+#[test]
+fn the_maps_lightmap_scale_wins_over_each_models() {
+    let world = [floor(64.0)];
+    let model = [quad(
+        [0.0, 0.0, 32.0],
+        [0.0, 64.0, 32.0],
+        [64.0, 64.0, 32.0],
+        [64.0, 0.0, 32.0],
+        [0.0, 0.0, 1.0],
+    )];
+    let ents = "{ \"classname\" \"worldspawn\" \"_lightmap_scale\" \"0.5\" }\n{ \"classname\" \"func_wall\" \"model\" \"*1\" \"_lmscale\" \"0.25\" }\n{ \"classname\" \"light\" \"origin\" \"32 32 100\" }\n";
+    let mut bsp = synthetic_bsp_models(&[&world, &model], ents);
+    let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
+    apply_lighting(&mut bsp, &lighting);
+    assert_eq!(
+        bsp.lightmap_shifts().expect("LMSHIFT reads"),
+        Some(vec![3, 3])
+    );
+}
+
 /// `_lmscale` on a brush entity lights its faces at a fraction of 16 texels, written as
 /// `LMSHIFT` and `LMOFFSET`; the world keeps Quake's grid (shift 4, its 16-texel lightmap).
 #[test]

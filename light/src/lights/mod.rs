@@ -155,15 +155,17 @@ impl MapLights {
     /// The spacing model `model`'s faces are lit at, as in ericw-tools: with the map's
     /// `_world_units_per_luxel` set, world-aligned grids at the model's own
     /// `_world_units_per_luxel`, else the map's; else `-lmshift` for every model when it is
-    /// not 4; else the model's `_lmscale` (a fraction of 16 texels, as ericw-tools' qbsp reads
-    /// it); else Quake's.
+    /// not 4; else the map's `_lightmap_scale` (`-lmscale`) for every model; else the model's
+    /// `_lmscale` (fractions of 16 texels, as ericw-tools' qbsp reads them); else Quake's.
     pub fn spacing(&self, model: usize) -> Spacing {
         let map = self.settings.world_units_per_luxel;
         if map > 0.0 {
             let own = self.model_units_per_luxel.get(&model).copied();
             return Spacing::WorldUnits(own.filter(|&u| u > 0.0).unwrap_or(map));
         }
+        let map_scale = self.settings.lightmap_scale;
         let shift = match self.settings.lmshift {
+            QUAKE_SHIFT if map_scale > 0.0 => shift_of_texels(16.0 * map_scale),
             QUAKE_SHIFT => {
                 let scale = self.model_lmscale.get(&model).copied().unwrap_or(0.0);
                 shift_of_texels(16.0 * scale)

@@ -197,6 +197,10 @@ settings! {
     /// fraction of 16 texels each). 4 (Quake's 16 texels): each model's `_lmscale`.
     lmshift: usize = 4, flag "lmshift", keys [], range Range::Clamp(0.0, 30.0);
 
+    /// Light every face at this fraction of Quake's 16 texels (`0.5`: a luxel every 8 texels),
+    /// as `--lmshift` does, overriding each model's `_lmscale` (0: unset).
+    lightmap_scale: f64 = 0.0, flag "lmscale", keys ["_lightmap_scale"], range Range::AtLeast(0.0);
+
     /// Map units between light grid points (one number, or one per axis; at least 1).
     lightgrid_dist: Spacing = Spacing::EVEN_32, flag "lightgrid_dist", keys ["_lightgrid_dist"], range Range::Any;
 }
