@@ -23,7 +23,6 @@ quake_formats::ericw_accepted! {
         phongdebug: bool => "no debug lightmaps; `slipgate view --lightmap-only` shows the light",
         bouncedebug: bool => "no debug lightmaps; `slipgate view --lightmap-only` shows the light",
         surflight_dump: bool => "surface lights are not written out",
-        surflight_subdivide: Option<String> => "surface lights are sampled over each face's own luxels",
         lit2: bool => "the .lit2 format is not written",
         litonly: bool => "the BSP is always written with its .lit",
         nolighting: bool => "light is always computed",
@@ -643,12 +642,13 @@ mod tests {
             join_optional_values(quake_formats::cli::normalise_single_dash(words.into_iter()));
         let cli = LightCli::try_parse_from(words).expect("parses");
         let notes = cli.args.ericw_only.notes();
-        assert_eq!(notes.len(), 6, "{notes:?}");
+        assert_eq!(notes.len(), 5, "{notes:?}");
         let overrides = cli.args.lighting_options().expect("options").overrides;
         assert_eq!(
             (overrides.bspxlit, overrides.bspxlux),
             (Some(true), Some(true))
         );
+        assert_eq!(overrides.surflight_subdivide, Some(64.0), "an option now");
         assert!(
             notes[0].starts_with("-nopercent has no effect"),
             "{notes:?}"

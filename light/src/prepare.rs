@@ -212,7 +212,7 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
         &map_lights.templates,
         &faces,
         groups,
-        surface::DEFAULT_SPACING,
+        map_lights.settings.surflight_subdivide,
         &in_liquid,
     );
     let surface_lights = surface.len();

@@ -15,9 +15,6 @@ use quake_formats::geom::{Plane, Split, Winding};
 use crate::faces::FaceGeom;
 use crate::lights::{PointLight, Spot, SurfaceTemplate};
 
-/// Default grid spacing of surface light copies (ericw-tools' 128).
-pub const DEFAULT_SPACING: f64 = 128.0;
-
 /// Pieces thinner than this along an axis are not cut off.
 const MIN_PIECE: f64 = 8.0;
 

@@ -18,12 +18,6 @@ enum Where {
 /// Each key, where ericw-tools reads it, and what it does there.
 const UNSUPPORTED: &[(&str, Where, &str)] = &[
     (
-        "_surflightsubdivision",
-        Where::Worldspawn,
-        "spacing of surface lights",
-    ),
-    ("_choplight", Where::Worldspawn, "spacing of surface lights"),
-    (
         "_bouncelightsubdivision",
         Where::Worldspawn,
         "spacing of bounce emitters",
@@ -99,7 +93,7 @@ mod tests {
     #[test]
     fn each_unsupported_key_warns_where_ericw_tools_reads_it() {
         let text = r#"
-{ "classname" "worldspawn" "_choplight" "2" "_project_texture" "x" }
+{ "classname" "worldspawn" "_bouncelightsubdivision" "2" "_project_texture" "x" }
 { "classname" "light" "origin" "0 0 0" "_project_texture" "window1" "_project_fov" "" }
 { "classname" "func_wall" "model" "*1" "_minlight_mottle" "1" }
 "#;
@@ -109,7 +103,7 @@ mod tests {
             .map(ToString::to_string)
             .collect();
         assert_eq!(told.len(), 3, "{told:?}");
-        assert!(told[0].contains("\"_choplight\"") && told[0].contains("surface lights"));
+        assert!(told[0].contains("\"_bouncelightsubdivision\"") && told[0].contains("bounce"));
         assert!(
             told[1].contains("\"_project_texture\" is \"window1\""),
             "{told:?}"

@@ -197,6 +197,10 @@ settings! {
     /// fraction of 16 texels each). 4 (Quake's 16 texels): each model's `_lmscale`.
     lmshift: usize = 4, flag "lmshift", keys [], range Range::Clamp(0.0, 30.0);
 
+    /// Grid spacing of a `_surface` light's copies over its faces, in units (ericw-tools'
+    /// `-surflight_subdivide`).
+    surflight_subdivide: f64 = 128.0, flag "surflight_subdivide", keys ["_surflightsubdivision", "_choplight"], range Range::Clamp(1.0, 8192.0);
+
     /// Light every face at this fraction of Quake's 16 texels (`0.5`: a luxel every 8 texels),
     /// as `--lmshift` does, overriding each model's `_lmscale` (0: unset).
     lightmap_scale: f64 = 0.0, flag "lmscale", keys ["_lightmap_scale"], range Range::AtLeast(0.0);

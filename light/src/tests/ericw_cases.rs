@@ -446,6 +446,27 @@ fn spotlight_autofalloff_fades_out_at_the_target() {
     );
 }
 
+/// ericw-tools' `-surflight_subdivide` (worldspawn `_surflightsubdivision`, `_choplight`): the
+/// grid a `_surface` light's copies are spread on; halving it puts more copies on the faces.
+#[test]
+fn surface_light_spacing_is_a_setting() {
+    let bsp = room_bsp(&light(
+        [0.0, 0.0, 0.0],
+        "\"_surface\" \"wall\"\n\"light\" \"20\"",
+    ));
+    let copies = |spacing: Option<f64>| {
+        let mut opts = options(Quality::Default);
+        opts.overrides.surflight_subdivide = spacing;
+        compute_lighting(&bsp, &opts)
+            .expect("light")
+            .stats
+            .surface_lights
+    };
+    let (default, finer) = (copies(None), copies(Some(64.0)));
+    assert!(default > 0 && finer > 2 * default, "{default} {finer}");
+    assert_eq!(copies(Some(128.0)), default, "128 units by default");
+}
+
 /// `detailFence` (`q1_detail_fence`): a `func_detail_fence` (here all `skip`, as there, so it has
 /// no faces) around a light and the floor under it. Its inside is written solid, which stops
 /// players; the compiler marks those leaves and light takes them as open, so the light is not
