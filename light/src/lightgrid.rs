@@ -445,6 +445,9 @@ fn trace_run(src: &GridSources, sky: &LeafSky, points: &[DVec3]) -> (Vec<RawPoin
             })
             .collect();
         for (si, sun) in src.suns.iter().enumerate() {
+            let Some(filter) = src.scene.sky_filter(sun.sky_texture.as_deref()) else {
+                continue;
+            };
             lanes.clear();
             lanes.extend(
                 directions
@@ -456,7 +459,7 @@ fn trace_run(src: &GridSources, sky: &LeafSky, points: &[DVec3]) -> (Vec<RawPoin
             rays += cast(
                 points,
                 &lanes,
-                |p| src.scene.sees_sky16(p, 0, sun.sky_texture.as_deref()),
+                |p| src.scene.sees_sky16(p, 0, filter),
                 |i| sums[i].sums.add(sun.style, sun.light, sun.color),
             );
         }

@@ -29,6 +29,15 @@ const NO_FACE: u32 = u32::MAX;
 /// Sun rays are tested for blockers up to this fraction of their distance to the sky.
 const SKY_HIT_SHORTEN: f32 = 1.0 - 1e-5;
 
+/// The sky faces a sun shines through ([`TraceScene::sky_filter`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SkyFilter {
+    /// Every sky face.
+    Any,
+    /// Those of one texture (`_suntexture`), by its index among the sky's textures.
+    Texture(u16),
+}
+
 /// A committed scene and the geometry id of its sky faces.
 pub struct TraceScene {
     pub scene: Scene,
@@ -255,53 +264,58 @@ impl TraceScene {
         }
     }
 
-    /// Lanes of `packet` (each up to its current `tfar`) that `model`'s own
-    /// scene or its switchable shadow's models block, or for the world the
-    /// world-only shadows; 0 for a model with none of these.
+    /// The scenes that shadow `model`'s faces beside the shared one: its own `_shadowself`
+    /// scene, its switchable shadow's models, and for the world the world-only shadows.
+    fn own_scenes(&self, model: usize) -> impl Iterator<Item = &Scene> {
+        let world_only = self.world_only.as_ref().filter(|_| model == 0);
+        let switchable = self.own_switchable(model).map(|k| &self.switchable[k].1);
+        self.own
+            .get(&model)
+            .into_iter()
+            .chain(switchable)
+            .chain(world_only)
+    }
+
+    /// Lanes of `packet` (each up to its current `tfar`) that `model`'s own scenes block
+    /// ([`TraceScene::own_scenes`]); 0 for a model without any.
     fn own_occluded16(&self, packet: &mut RayPacket16, model: usize) -> u16 {
-        let own = match (&self.world_only, model) {
-            (Some(world_only), 0) => world_only.occluded16(packet, true),
-            _ => self
-                .own
-                .get(&model)
-                .map_or(0, |own| own.occluded16(packet, true)),
-        };
-        // Embree has set the blocked lanes' tfar to -inf: the second query skips them.
-        own | self
-            .own_switchable(model)
-            .map_or(0, |k| self.switchable_blocks16(packet, k))
+        // Embree sets a blocked lane's tfar to -inf: each later query skips it.
+        self.own_scenes(model)
+            .fold(0, |m, scene| m | scene.occluded16(packet, true))
+    }
+
+    /// Which sky faces a sun shines through: all, or those of its `_suntexture` (`None`: the
+    /// sky has no face of that texture, so the sun reaches nothing). Resolved once per sun,
+    /// outside the loop over its rays.
+    pub fn sky_filter(&self, texture: Option<&str>) -> Option<SkyFilter> {
+        match texture {
+            None => Some(SkyFilter::Any),
+            Some(name) => self
+                .sky_textures
+                .iter()
+                .position(|t| t.eq_ignore_ascii_case(name))
+                .and_then(|at| u16::try_from(at).ok())
+                .map(SkyFilter::Texture),
+        }
     }
 
     /// Bit `i` set if lane `i` of `packet`, cast from a face of `model`,
-    /// reaches a sky face before anything else, one textured `only` if given (`_suntexture`).
+    /// reaches a sky face `filter` lets through before anything else.
     /// First where each ray meets the sky (sky faces alone, a small scene),
     /// then whether anything blocks it before that: an occlusion query,
     /// which stops at any hit, where one closest-hit query over everything
     /// must rule out every nearer surface.
-    pub fn sees_sky16(&self, packet: &mut RayPacket16, model: usize, only: Option<&str>) -> u16 {
+    pub fn sees_sky16(&self, packet: &mut RayPacket16, model: usize, filter: SkyFilter) -> u16 {
         let Some(sky_only) = &self.sky_only else {
             return 0;
-        };
-        let only = match only {
-            None => None,
-            Some(name) => match self
-                .sky_textures
-                .iter()
-                .position(|t| t.eq_ignore_ascii_case(name))
-            {
-                Some(at) => Some(at),
-                None => return 0,
-            },
         };
         let hits = sky_only.first_hits16(packet, true);
         let through = |(geom, prim): (u32, u32)| {
             geom != sys::RTC_INVALID_GEOMETRY_ID
-                && only.is_none_or(|at| {
-                    self.sky_texture_of
-                        .get(prim as usize)
-                        .map(|&t| usize::from(t))
-                        == Some(at)
-                })
+                && match filter {
+                    SkyFilter::Any => true,
+                    SkyFilter::Texture(t) => self.sky_texture_of.get(prim as usize) == Some(&t),
+                }
         };
         let sky = (0..16)
             .filter(|&i| through(hits[i]))
@@ -352,8 +366,7 @@ impl TraceScene {
                 out[lane] = Some(packet.tfar(lane));
             }
         }
-        let own_switchable = self.own_switchable(model).map(|k| &self.switchable[k].1);
-        for own in self.own.get(&model).into_iter().chain(own_switchable) {
+        for own in self.own_scenes(model) {
             // tfar ends at the nearest hit so far, so any hit here is nearer.
             let own_ids = own.first_hit_geom16(packet, true);
             for (lane, id) in own_ids.iter().enumerate() {

@@ -94,6 +94,10 @@ impl FaceTrace<'_> {
         let (setup, samples, face) = (self.setup, self.samples, self.face);
         let (lights, suns) = (self.lights, self.suns);
         let sun = &suns[si];
+        // A sun of a texture the sky does not have reaches nothing.
+        let Some(filter) = setup.scene.sky_filter(sun.sky_texture.as_deref()) else {
+            return;
+        };
         let dirty = self.takes_dirt(sun.dirt);
         let scratch = &mut *self.scratch;
         let value = &mut scratch.value;
@@ -115,8 +119,7 @@ impl FaceTrace<'_> {
             }
         }
         let ray = |i: usize| (samples.points[i], dir, setup.sun_distance);
-        let only = sun.sky_texture.as_deref();
-        let reaches = |p: &mut RayPacket16| setup.scene.sees_sky16(p, face.model, only);
+        let reaches = |p: &mut RayPacket16| setup.scene.sees_sky16(p, face.model, filter);
         let packet = &mut self.packet;
         let visibility = &mut scratch.visibility;
         self.counts.sun_rays += match probes {
