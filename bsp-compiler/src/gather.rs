@@ -486,11 +486,19 @@ fn lit_water(entities: &[MapEntity], ent: &MapEntity, default: bool) -> bool {
         .unwrap_or(default)
 }
 
-/// What the keys of an entity merged into the world say of its faces' shadows and sound:
-/// `_shadow -1` casts none, and `func_detail_illusionary` casts none unless `_shadow 1` (as in
-/// ericw-tools); `_noambient 1` gives no ambient sound. Brush models' keys are light's to read.
+/// Whether entity `index` of `class` is merged into the world (`func_detail*`, `func_group`):
+/// light reads the keys of worldspawn and brush models from their entities, but those of merged
+/// entities only from what the compiler records per face.
+fn merged_into_world(index: usize, class: EntityBrushes) -> bool {
+    index != 0 && class != EntityBrushes::Submodel
+}
+
+/// What the keys of an entity merged into the world say of its faces: `_shadow -1` casts none,
+/// and `func_detail_illusionary` casts none unless `_shadow 1` (as in ericw-tools);
+/// `_noambient 1` gives no ambient sound; `_dirt -1`, `_bounce 0` and `_lightignore` as on a
+/// brush model. Brush models' keys are light's to read.
 fn merged_face_flags(ent: &MapEntity, index: usize, class: EntityBrushes) -> FaceFlags {
-    if index == 0 || class == EntityBrushes::Submodel {
+    if !merged_into_world(index, class) {
         return FaceFlags::default();
     }
     let number = |key| ent.entity.get_float(key);
@@ -512,30 +520,25 @@ fn merged_face_flags(ent: &MapEntity, index: usize, class: EntityBrushes) -> Fac
 /// from its entity.
 fn merged_minlight(ent: &MapEntity, index: usize, class: EntityBrushes) -> FaceMinlight {
     let level = ent.entity.get_float("_minlight").unwrap_or(0.0);
-    if index == 0 || class == EntityBrushes::Submodel || level == 0.0 {
+    if !merged_into_world(index, class) || level == 0.0 {
         return FaceMinlight::default();
     }
     let color = ["_minlight_color", "_mincolor"]
         .iter()
         .find_map(|key| ent.entity.get_floats::<3>(key))
-        .map_or([1.0; 3], |c| {
-            let scale = if c.iter().all(|&v| v <= 1.0) {
-                1.0
-            } else {
-                255.0
-            };
-            c.map(|v| (v / scale) as f32)
+        .map_or(DVec3::ONE, |c| {
+            quake_formats::entities::normalize_color(DVec3::from(c))
         });
     FaceMinlight {
         level: level as f32,
-        color,
+        color: color.as_vec3().to_array(),
     }
 }
 
 /// The `_minlight_exclude` texture of an entity merged into the world: its faces of that
 /// texture take no minlight.
 fn merged_minlight_exclude(ent: &MapEntity, index: usize, class: EntityBrushes) -> Option<String> {
-    if index == 0 || class == EntityBrushes::Submodel {
+    if !merged_into_world(index, class) {
         return None;
     }
     ent.entity
@@ -578,7 +581,7 @@ fn merged_surflight_group(
 /// index as group id. Worldspawn and brush models get none here; light reads
 /// their own keys.
 fn merged_phong(ent: &MapEntity, index: usize, class: EntityBrushes) -> FacePhong {
-    let merged = index != 0 && class != EntityBrushes::Submodel;
+    let merged = merged_into_world(index, class);
     let angle = phong::angle_from_keys(
         ent.entity.get_float("_phong"),
         ent.entity.get_float("_phong_angle"),

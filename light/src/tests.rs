@@ -2763,10 +2763,9 @@ fn own_grids_give_the_same_bytes_on_one_and_two_threads() {
     }
 }
 
-/// A brush entity's own `_world_units_per_luxel` wins over the map's, and counts only while
-/// the map's is set (as in ericw-tools).
-#[test]
-fn brush_entities_set_their_own_spacing() {
+/// A 64-unit floor (the world, keyed `world_keys`) under a 64-unit plate 32 units up (a
+/// `func_wall`, model 1, keyed `plate_keys`), lit from above.
+fn floor_and_plate(world_keys: &str, plate_keys: &str) -> Bsp {
     let world = [floor(64.0)];
     let model = [quad(
         [0.0, 0.0, 32.0],
@@ -2775,8 +2774,19 @@ fn brush_entities_set_their_own_spacing() {
         [64.0, 0.0, 32.0],
         [0.0, 0.0, 1.0],
     )];
-    let ents = "{ \"classname\" \"worldspawn\" }\n{ \"classname\" \"func_wall\" \"model\" \"*1\" \"_world_units_per_luxel\" \"4\" }\n{ \"classname\" \"light\" \"origin\" \"32 32 100\" }\n";
-    let bsp = synthetic_bsp_models(&[&world, &model], ents);
+    let ents = format!(
+        "{{ \"classname\" \"worldspawn\" {world_keys} }}\n\
+         {{ \"classname\" \"func_wall\" \"model\" \"*1\" {plate_keys} }}\n\
+         {{ \"classname\" \"light\" \"origin\" \"32 32 100\" }}\n"
+    );
+    synthetic_bsp_models(&[&world, &model], &ents)
+}
+
+/// A brush entity's own `_world_units_per_luxel` wins over the map's, and counts only while
+/// the map's is set (as in ericw-tools).
+#[test]
+fn brush_entities_set_their_own_spacing() {
+    let bsp = floor_and_plate("", "\"_world_units_per_luxel\" \"4\"");
     let sizes = |o: &Options| {
         let lighting = compute_lighting(&bsp, o).expect("light");
         lighting
@@ -2796,16 +2806,7 @@ fn brush_entities_set_their_own_spacing() {
 /// of 16 texels, over a brush entity's own `_lmscale`.
 #[test]
 fn the_maps_lightmap_scale_wins_over_each_models() {
-    let world = [floor(64.0)];
-    let model = [quad(
-        [0.0, 0.0, 32.0],
-        [0.0, 64.0, 32.0],
-        [64.0, 64.0, 32.0],
-        [64.0, 0.0, 32.0],
-        [0.0, 0.0, 1.0],
-    )];
-    let ents = "{ \"classname\" \"worldspawn\" \"_lightmap_scale\" \"0.5\" }\n{ \"classname\" \"func_wall\" \"model\" \"*1\" \"_lmscale\" \"0.25\" }\n{ \"classname\" \"light\" \"origin\" \"32 32 100\" }\n";
-    let mut bsp = synthetic_bsp_models(&[&world, &model], ents);
+    let mut bsp = floor_and_plate("\"_lightmap_scale\" \"0.5\"", "\"_lmscale\" \"0.25\"");
     let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
     apply_lighting(&mut bsp, &lighting);
     assert_eq!(
@@ -2818,16 +2819,7 @@ fn the_maps_lightmap_scale_wins_over_each_models() {
 /// `LMSHIFT` and `LMOFFSET`; the world keeps Quake's grid (shift 4, its 16-texel lightmap).
 #[test]
 fn lmscale_writes_lmshift_and_lmoffset() {
-    let world = [floor(64.0)];
-    let model = [quad(
-        [0.0, 0.0, 32.0],
-        [0.0, 64.0, 32.0],
-        [64.0, 64.0, 32.0],
-        [64.0, 0.0, 32.0],
-        [0.0, 0.0, 1.0],
-    )];
-    let ents = "{ \"classname\" \"worldspawn\" }\n{ \"classname\" \"func_wall\" \"model\" \"*1\" \"_lmscale\" \"0.25\" }\n{ \"classname\" \"light\" \"origin\" \"32 32 100\" }\n";
-    let mut bsp = synthetic_bsp_models(&[&world, &model], ents);
+    let mut bsp = floor_and_plate("", "\"_lmscale\" \"0.25\"");
     let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
     apply_lighting(&mut bsp, &lighting);
     assert_eq!(

@@ -194,42 +194,24 @@ fn light_reads_the_per_face_keys_ericw_tools_qbsp_writes_beside_the_bsp() {
 /// A sealed box room (inside -128..128), a light, and the `func_group` slab of
 /// [`light_reads_the_per_face_keys_ericw_tools_qbsp_writes_beside_the_bsp`].
 fn slab_map() -> String {
-    let cube = |lo: [f64; 3], hi: [f64; 3]| {
-        let ([x0, y0, z0], [x1, y1, z1]) = (lo, hi);
-        let planes = [
-            [[x1, y0, z0], [x1, y0, z1], [x1, y1, z0]],
-            [[x0, y0, z0], [x0, y1, z0], [x0, y0, z1]],
-            [[x0, y1, z0], [x1, y1, z0], [x0, y1, z1]],
-            [[x0, y0, z0], [x0, y0, z1], [x1, y0, z0]],
-            [[x0, y0, z1], [x0, y1, z1], [x1, y0, z1]],
-            [[x0, y0, z0], [x1, y0, z0], [x0, y1, z0]],
-        ];
-        let mut s = String::from("{\n");
-        for p in planes {
-            for [x, y, z] in p {
-                s += &format!("( {x} {y} {z} ) ");
-            }
-            s += "wall 0 0 0 1 1\n";
-        }
-        s + "}\n"
+    use mapgen::brush::{Brush, Map, MapEntity, MapFormat, aabb};
+    use mapgen::level::{Level, Surfaces};
+    let room = Level::default()
+        .room(aabb([-128.0; 3], [128.0; 3]), Surfaces::all("wall"))
+        .brushes();
+    let slab = Brush::cuboid(aabb([-32.0, -32.0, -64.0], [32.0, 32.0, -48.0]), "wall");
+    let map = Map {
+        comment: Vec::new(),
+        format: MapFormat::Standard,
+        entities: vec![
+            MapEntity::new("worldspawn").brushes(room),
+            MapEntity::new("func_group")
+                .key("_lightignore", "1")
+                .key("_minlight", "100")
+                .brushes([slab]),
+            MapEntity::point("light", [0.0, 0.0, 64.0]),
+            MapEntity::point("info_player_start", [-90.0, -90.0, -100.0]),
+        ],
     };
-    let (a, b, lo, hi) = (-144.0, 144.0, -128.0, 128.0);
-    let mut world = String::new();
-    for (l, h) in [
-        ([a, a, a], [b, b, lo]),
-        ([a, a, hi], [b, b, b]),
-        ([a, a, lo], [lo, b, hi]),
-        ([hi, a, lo], [b, b, hi]),
-        ([lo, a, lo], [hi, lo, hi]),
-        ([lo, hi, lo], [hi, b, hi]),
-    ] {
-        world += &cube(l, h);
-    }
-    let slab = cube([-32.0, -32.0, -64.0], [32.0, 32.0, -48.0]);
-    format!(
-        "{{\n\"classname\" \"worldspawn\"\n{world}}}\n\
-         {{\n\"classname\" \"func_group\"\n\"_lightignore\" \"1\"\n\"_minlight\" \"100\"\n{slab}}}\n\
-         {{\n\"classname\" \"light\"\n\"origin\" \"0 0 64\"\n}}\n\
-         {{\n\"classname\" \"info_player_start\"\n\"origin\" \"-90 -90 -100\"\n}}\n"
-    )
+    map.to_text()
 }

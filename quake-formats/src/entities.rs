@@ -3,6 +3,16 @@
 use crate::error::{FormatError, Result};
 use crate::geom::POINT_EPSILON;
 
+/// ericw-tools' colour rule for `r g b` keys (`_color`, `_minlight_color`...): components all
+/// within 0..1 are fractions, otherwise they are 0..255. Returned as fractions.
+pub fn normalize_color(c: glam::DVec3) -> glam::DVec3 {
+    if c.x <= 1.0 && c.y <= 1.0 && c.z <= 1.0 {
+        c
+    } else {
+        c / 255.0
+    }
+}
+
 /// One entity: its key/value pairs in file order (keys may repeat; the first one wins on lookup,
 /// as in Quake's `ValueForKey`).
 ///

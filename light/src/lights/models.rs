@@ -19,9 +19,9 @@ pub fn model_index(e: &Entity) -> Option<usize> {
     e.get("model")?.strip_prefix('*')?.parse().ok()
 }
 
-/// `_phong`, `_phong_angle` and `_phong_angle_concave` (into `out.phong`) and `_lmscale` (into `out.model_lmscale`) of
-/// worldspawn (`world`, as model 0) and every brush model, with a warning for each key not
-/// taken as written.
+/// `_phong`, `_phong_angle` and `_phong_angle_concave` (into `out.phong`) and `_lmscale` (into
+/// `out.model_lmscale`) of worldspawn (`world`, as model 0) and every brush model, with a warning
+/// for each key not taken as written.
 pub fn read_world_and_model_keys(entities: &[Entity], world: Option<usize>, out: &mut MapLights) {
     for (index, e) in entities.iter().enumerate() {
         let model = if Some(index) == world {

@@ -72,8 +72,8 @@ impl SwitchableStyles {
 }
 
 /// Gives out the switchable styles of lights and switchable shadows from `range` (see the
-/// module comment) and writes them into the entities; the keys not taken as written are warned about into
-/// `warnings`.
+/// module comment) and writes them into the entities; the keys not taken as written are warned
+/// about into `warnings`.
 ///
 /// # Errors
 /// More switchable names than styles.

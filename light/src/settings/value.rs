@@ -222,15 +222,7 @@ impl Color {
     pub const WHITE: Color = Color(DVec3::ONE);
 }
 
-/// ericw-tools' colour rule: components all within 0..1 are fractions, otherwise they are
-/// 0..255.
-pub fn normalize_color(c: DVec3) -> DVec3 {
-    if c.x <= 1.0 && c.y <= 1.0 && c.z <= 1.0 {
-        c
-    } else {
-        c / 255.0
-    }
-}
+pub use quake_formats::entities::normalize_color;
 
 /// `r g b`, in 0..255 or all three in 0..1.
 impl SettingValue for Color {
