@@ -30,6 +30,9 @@ fn repo() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
+/// How the layer marked Omit From Export, last in the saved map, begins.
+const OMITTED_LAYER_START: &str = "{\n\"classname\" \"func_group\"\n\"_tb_type\" \"_tb_layer\"";
+
 /// A game folder (`game/`, with the mod `mymod`) and a map folder (`src/`) beside it.
 struct Project {
     game: PathBuf,
@@ -111,11 +114,14 @@ fn words(parameters: &str) -> Vec<String> {
 fn run_task(task: &Value, workdir: &Path, vars: &HashMap<&'static str, String>) {
     let field = |name: &str| fill(task[name].as_str().expect(name), vars);
     match task["type"].as_str().expect("type") {
-        // TrenchBroom writes the map as it exports it; the compiler itself leaves out what
-        // Export would (the omitted layer, checked below), so a copy stands in for it.
+        // TrenchBroom writes the map as it exports it: without the layer marked Omit From
+        // Export (the compiler would compile it, as ericw-tools does), which `Project::new`
+        // put last.
         "export" => {
             let target = PathBuf::from(field("target"));
-            std::fs::copy(workdir.join("demo.map"), &target).expect("export");
+            let saved = std::fs::read_to_string(workdir.join("demo.map")).expect("saved map");
+            let layer = saved.find(OMITTED_LAYER_START).expect("the omitted layer");
+            std::fs::write(&target, &saved[..layer]).expect("export");
         }
         "tool" => {
             let stage = match task["tool"].as_str().expect("tool") {

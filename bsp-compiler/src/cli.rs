@@ -208,6 +208,11 @@ pub struct Args {
     /// vanilla clients
     #[arg(long)]
     pub keep_editor_keys: bool,
+    /// Leave out TrenchBroom layers marked Omit From Export, with everything in them, as
+    /// TrenchBroom's Export step does; by default they are compiled, as ericw-tools compiles
+    /// them (a note names each)
+    #[arg(long)]
+    pub omit_layers: bool,
     /// Write the BSPX BRUSHLIST lump: every model's brushes, for engines and importers that
     /// collide with brushes (FTE, bevy_trenchbroom)
     #[arg(long, alias = "bspx")]
@@ -279,6 +284,7 @@ impl Args {
             missing_textures_as_zero_size: self.missing_textures_as_zero_size,
             brush_list: self.wrbrushes || self.wrbrushesonly,
             keep_editor_keys: self.keep_editor_keys,
+            omit_layers: self.omit_layers,
             progress: quake_formats::progress::terminal(),
         }
     }

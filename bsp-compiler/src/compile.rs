@@ -463,13 +463,13 @@ pub fn wad_search(source: &MapSource, options: &CompileOptions) -> WadSearch {
 }
 
 /// The entities of `map` the compile leaves out (worldspawn never): those of the classes
-/// `options.omit` names and those in editor layers marked to be omitted from export, with those
-/// layers.
+/// `options.omit` names and, with `options.omit_layers`, those in editor layers marked to be
+/// omitted from export; and those layers, left out or not.
 pub(crate) fn entities_left_out(
     map: &MapFile,
     options: &CompileOptions,
 ) -> (Vec<bool>, Vec<OmittedLayer>) {
-    let (mut left_out, layers) = omitted_layers(map);
+    let (mut left_out, layers) = omitted_layers(map, options.omit_layers);
     for (index, ent) in map.entities.iter().enumerate().skip(1) {
         let class = ent.entity.classname();
         left_out[index] |= options.omit.iter().any(|c| c == class);

@@ -4,8 +4,10 @@
 //! TrenchBroom keeps layers and groups as `func_group` entities with `_tb_type` `_tb_layer` or
 //! `_tb_group` and an `_tb_id`; an entity in a layer or group names it by `_tb_layer` or
 //! `_tb_group`, and a group names its own layer or parent group the same way. Its Export step
-//! leaves out the layers whose `_tb_layer_omit_from_export` is `1`, with everything in them;
-//! compiling the saved map does the same here. Editor keys are left out of the entity lump (as
+//! leaves out the layers whose `_tb_layer_omit_from_export` is `1`, with everything in them.
+//! Compiling the saved map keeps them, as ericw-tools' qbsp does (a map sealed only by such a
+//! layer seals the same with both tools), unless `--omit-layers` asks for what Export does; a
+//! note names each such layer either way. Editor keys are left out of the entity lump (as
 //! ericw-tools does: `_tb_textures` alone can be long enough to crash vanilla clients) unless
 //! asked to keep them.
 
@@ -31,19 +33,22 @@ pub(crate) fn without_editor_keys(entity: &Entity) -> Entity {
     }
 }
 
-/// A layer left out of the compile.
+/// A layer marked "Omit From Export".
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct OmittedLayer {
     /// Its name in the editor (`_tb_name`).
     pub name: String,
     /// The entity that is the layer.
     pub entity: usize,
-    /// Entities left out with it (the layer's own entity not counted).
+    /// Entities in it (the layer's own entity not counted).
     pub entities: usize,
+    /// It was left out of the compile with everything in it (`--omit-layers`).
+    pub left_out: bool,
 }
 
-/// The entities of `map` in layers marked "Omit From Export" (by entity index), and those layers.
-pub(crate) fn omitted_layers(map: &MapFile) -> (Vec<bool>, Vec<OmittedLayer>) {
+/// The entities of `map` in layers marked "Omit From Export" (by entity index), and those layers,
+/// which are left out of the compile when `omit` says so.
+pub(crate) fn omitted_layers(map: &MapFile, omit: bool) -> (Vec<bool>, Vec<OmittedLayer>) {
     let entities = &map.entities;
     let id_of = |kind: &str| -> HashMap<&str, usize> {
         entities
@@ -89,10 +94,14 @@ pub(crate) fn omitted_layers(map: &MapFile) -> (Vec<bool>, Vec<OmittedLayer>) {
                     .to_string(),
                 entity: layer,
                 entities: usize::from(i != layer),
+                left_out: omit,
             }),
         }
     }
     omitted.sort_by_key(|o| o.entity);
+    if !omit {
+        left_out.fill(false);
+    }
     (left_out, omitted)
 }
 
@@ -116,7 +125,7 @@ mod tests {
             {\n\"classname\" \"light\"\n\"_tb_layer\" \"3\"\n}\n\
             {\n\"classname\" \"info_player_start\"\n}\n";
         let map = parse_map(Path::new("layers.map"), text).expect("parse");
-        let (left_out, layers) = omitted_layers(&map);
+        let (left_out, layers) = omitted_layers(&map, true);
         assert_eq!(
             left_out,
             [false, true, true, true, true, false, false, false]
@@ -126,7 +135,8 @@ mod tests {
             [OmittedLayer {
                 name: "Notes".to_string(),
                 entity: 1,
-                entities: 3
+                entities: 3,
+                left_out: true,
             }]
         );
         let world = without_editor_keys(&map.entities[0].entity);

@@ -70,6 +70,9 @@ pub struct CompileOptions {
     pub brush_list: bool,
     /// Keep editor-only keys (TrenchBroom's `_tb_*`) in the entity lump ([`crate::editor`]).
     pub keep_editor_keys: bool,
+    /// Leave out the editor layers marked "Omit From Export", as TrenchBroom's Export does
+    /// ([`crate::editor`]); ericw-tools compiles them.
+    pub omit_layers: bool,
     /// Where the long phases report their progress.
     pub progress: Progress,
 }
@@ -109,6 +112,7 @@ impl Default for CompileOptions {
             missing_textures_as_zero_size: false,
             brush_list: false,
             keep_editor_keys: false,
+            omit_layers: false,
             progress: Progress::default(),
         }
     }

@@ -48,7 +48,7 @@ pub enum Warning {
         /// The contents the brush gets.
         used: FaceContents,
     },
-    /// An editor layer marked "Omit From Export": left out with everything in it.
+    /// An editor layer marked "Omit From Export": compiled, or left out with everything in it.
     OmittedLayer(OmittedLayer),
     /// A WAD worldspawn names that is nowhere it was looked for (`looked`, in order).
     MissingWad {
@@ -190,9 +190,14 @@ impl std::fmt::Display for Warning {
                 f,
                 "line {line}: entity {entity}, brush {brush}: this face's texture gives other contents than the brush's first face; the brush is {used}"
             ),
+            Warning::OmittedLayer(layer) if layer.left_out => write!(
+                f,
+                "note: layer {:?} (entity {}) is marked Omit From Export: left out with the {} entities in it (--omit-layers)",
+                layer.name, layer.entity, layer.entities
+            ),
             Warning::OmittedLayer(layer) => write!(
                 f,
-                "note: layer {:?} (entity {}) is marked Omit From Export: left out with the {} entities in it",
+                "note: layer {:?} (entity {}) is marked Omit From Export: compiled, with the {} entities in it, as ericw-tools compiles it (TrenchBroom's Export, or --omit-layers, leaves it out)",
                 layer.name, layer.entity, layer.entities
             ),
             Warning::MissingWad { name, looked } => {

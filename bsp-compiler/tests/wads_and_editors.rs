@@ -132,10 +132,11 @@ fn a_missing_wad_says_where_it_was_looked_for() {
     );
 }
 
-/// TrenchBroom's keys stay out of the entity lump (unless kept), and a layer marked Omit From
-/// Export is left out with its entities, saying so.
+/// TrenchBroom's keys stay out of the entity lump (unless kept). A layer marked Omit From Export
+/// is compiled, as ericw-tools compiles it, or with `--omit-layers` left out with its entities
+/// as TrenchBroom's Export leaves it; a note says which.
 #[test]
-fn editor_keys_and_omitted_layers_stay_out_of_the_bsp() {
+fn editor_keys_stay_out_of_the_bsp_and_omitted_layers_compile_as_in_ericw_tools() {
     let layer =
         "{\n\"classname\" \"func_group\"\n\"_tb_type\" \"_tb_layer\"\n\"_tb_name\" \"Notes\"\n\
                  \"_tb_id\" \"4\"\n\"_tb_layer_omit_from_export\" \"1\"\n}\n\
@@ -148,7 +149,30 @@ fn editor_keys_and_omitted_layers_stay_out_of_the_bsp() {
         "\"wad\" \"none.wad\"\n",
         "\"wad\" \"none.wad\"\n\"_tb_textures\" \"textures/base\"\n\"_tb_mod\" \"lq\"\n",
     );
-    let out = try_compile(&text).expect("compile");
+    let note = |warnings: &[Warning]| {
+        warnings
+            .iter()
+            .find(|w| matches!(w, Warning::OmittedLayer(_)))
+            .map(|w| w.to_string())
+    };
+    let compiled = try_compile(&text).expect("compile");
+    let entities = parse_entities(&compiled.bsp.entity_text()).expect("entities");
+    let classes: Vec<&str> = entities.iter().map(|e| e.classname()).collect();
+    assert_eq!(classes, ["worldspawn", "light", "func_wall", "info_player_start"]);
+    assert_eq!(compiled.bsp.models.len(), 2, "the layer's func_wall is a model");
+    assert_eq!(
+        note(&compiled.warnings).as_deref(),
+        Some(
+            "note: layer \"Notes\" (entity 1) is marked Omit From Export: compiled, with the 2 \
+             entities in it, as ericw-tools compiles it (TrenchBroom's Export, or --omit-layers, \
+             leaves it out)"
+        )
+    );
+    let omit = CompileOptions {
+        omit_layers: true,
+        ..CompileOptions::default()
+    };
+    let out = try_compile_with(&text, &omit).expect("compile");
     let entities = parse_entities(&out.bsp.entity_text()).expect("entities");
     let classes: Vec<&str> = entities.iter().map(|e| e.classname()).collect();
     assert_eq!(classes, ["worldspawn", "info_player_start"]);
@@ -162,16 +186,11 @@ fn editor_keys_and_omitted_layers_stay_out_of_the_bsp() {
         1,
         "the omitted func_wall has no model"
     );
-    let note = out
-        .warnings
-        .iter()
-        .find(|w| matches!(w, Warning::OmittedLayer(_)))
-        .map(|w| w.to_string());
     assert_eq!(
-        note.as_deref(),
+        note(&out.warnings).as_deref(),
         Some(
             "note: layer \"Notes\" (entity 1) is marked Omit From Export: left out with the 2 \
-             entities in it"
+             entities in it (--omit-layers)"
         )
     );
     let kept = try_compile_with(
@@ -184,4 +203,28 @@ fn editor_keys_and_omitted_layers_stay_out_of_the_bsp() {
     .expect("compile");
     let world = &parse_entities(&kept.bsp.entity_text()).expect("entities")[0];
     assert_eq!(world.get("_tb_textures"), Some("textures/base"));
+}
+
+/// A map whose hole is closed only by a brush in a layer marked Omit From Export seals, as it
+/// does with ericw-tools' qbsp (which compiles such layers); left out as TrenchBroom's Export
+/// leaves it, the map leaks.
+#[test]
+fn a_layer_marked_omit_from_export_still_seals_the_map() {
+    let patch = "{\n\"classname\" \"func_group\"\n\"_tb_type\" \"_tb_layer\"\n\"_tb_name\" \"seal\"\n\
+                 \"_tb_id\" \"5\"\n\"_tb_layer_omit_from_export\" \"1\"\n"
+        .to_string()
+        + &box_brush([128.0, 0.0, -128.0], [144.0, 32.0, 128.0], "brick1")
+        + "}\n";
+    let text = room_map_with(true, "", "").replace("wall 0 0 0 1 1", "brick1 0 0 0 1 1");
+    let leaky = try_compile(&text).expect("compile");
+    assert!(leaky.stats.leaked, "the room has a hole");
+    let text = room_map_with(true, "", &patch).replace("wall 0 0 0 1 1", "brick1 0 0 0 1 1");
+    let sealed = try_compile(&text).expect("compile");
+    assert!(!sealed.stats.leaked, "the layer's brush closes the hole");
+    let omit = CompileOptions {
+        omit_layers: true,
+        ..CompileOptions::default()
+    };
+    let left_out = try_compile_with(&text, &omit).expect("compile");
+    assert!(left_out.stats.leaked, "--omit-layers leaves the seal out");
 }
