@@ -198,7 +198,7 @@ impl WindowBits {
     }
 
     /// Whether every member is a member of `other`.
-    pub(crate) fn is_subset(&self, other: &WindowCopy) -> bool {
+    pub(crate) fn is_subset(&self, other: WindowView) -> bool {
         let other_hi = other.lo + other.words.len();
         (self.lo..self.hi).all(|wi| {
             let theirs = if (other.lo..other_hi).contains(&wi) {
@@ -211,21 +211,23 @@ impl WindowBits {
     }
 }
 
-/// The window of a [`WindowBits`] alone: what is kept of many of them takes the window's
-/// words, not the whole set's.
-#[derive(Debug, Clone, Default)]
-pub struct WindowCopy {
+/// The window of a [`WindowBits`] alone, kept elsewhere: what is kept of many of them takes
+/// the window's words, not the whole set's.
+#[derive(Debug, Clone, Copy)]
+pub struct WindowView<'a> {
     /// The index of the first word.
-    lo: usize,
-    words: Vec<u64>,
+    pub lo: usize,
+    /// The window's words.
+    pub words: &'a [u64],
 }
 
-impl WindowCopy {
-    /// Make `self` a copy of `bits`.
-    pub fn assign(&mut self, bits: &WindowBits) {
-        self.lo = bits.lo;
-        self.words.clear();
-        self.words.extend_from_slice(bits.window());
+impl WindowBits {
+    /// The window as a view.
+    pub(crate) fn view(&self) -> WindowView<'_> {
+        WindowView {
+            lo: self.lo,
+            words: self.window(),
+        }
     }
 }
 
@@ -281,11 +283,8 @@ mod tests {
             let both: Vec<usize> = expected.iter().copied().filter(|&i| b.contains(i)).collect();
             prop_assert_eq!(members(&and), both.clone());
             prop_assert_eq!(new, both.iter().any(|&i| !known.contains(i)));
-            let (mut copy_a, mut copy_and) = (WindowCopy::default(), WindowCopy::default());
-            copy_a.assign(&wa);
-            copy_and.assign(&and);
-            prop_assert!(and.is_subset(&copy_a));
-            prop_assert_eq!(wa.is_subset(&copy_and), both.len() == expected.len());
+            prop_assert!(and.is_subset(wa.view()));
+            prop_assert_eq!(wa.is_subset(and.view()), both.len() == expected.len());
             for i in 0..300 {
                 prop_assert_eq!(and.contains(i), both.contains(&i));
             }

@@ -10,7 +10,7 @@
 //! where many leaf orders lead to the same portal unclipped, this cuts the walk from a number
 //! of paths exponential in the depth down to a few per portal.
 
-use crate::bitset::{WindowBits, WindowCopy};
+use crate::bitset::{WindowBits, WindowView};
 use glam::DVec3;
 use quake_formats::geom::DVec3Ext;
 use quake_formats::geom::POINT_EPSILON;
@@ -18,23 +18,42 @@ use quake_formats::geom::POINT_EPSILON;
 /// At most this many states are kept per portal; later ones are walked without being kept.
 const STATES_PER_PORTAL: usize = 4;
 
-#[derive(Default)]
+/// A state walked on from: its windings' places in [`Explored::points`] and its bound's window
+/// (first word, and the words' place in [`Explored::words`]).
 struct State {
-    source: Vec<DVec3>,
-    pass: Vec<DVec3>,
-    might: WindowCopy,
+    source: (usize, usize),
+    pass: (usize, usize),
+    might_lo: usize,
+    might: (usize, usize),
 }
 
 /// The states walked on from, per portal, during one base portal's flow.
+///
+/// Their windings and bounds lie end to end in two buffers emptied at each flow's start, so
+/// memory follows the largest single flow; a buffer per state, kept for reuse, would grow each
+/// to the largest it ever held.
 #[derive(Default)]
 pub struct Explored {
-    /// By portal: how many states are kept, and their places in `pool`. Fixed slots rather than
-    /// a list per portal: a flow touches most portals, and a list each would stay allocated.
+    /// By portal: how many states are kept, and their places in `states`. Fixed slots rather
+    /// than a list per portal: a flow touches most portals, and a list each would stay
+    /// allocated.
     kept: Vec<(u8, [u32; STATES_PER_PORTAL])>,
     touched: Vec<u32>,
-    /// Every state kept in this flow first, reused by later flows.
-    pool: Vec<State>,
-    used: usize,
+    states: Vec<State>,
+    points: Vec<DVec3>,
+    words: Vec<u64>,
+}
+
+/// The part `(start, end)` of `items`.
+fn part<T>(items: &[T], (start, end): (usize, usize)) -> &[T] {
+    &items[start..end]
+}
+
+/// Appends `new` to `items`; returns its part.
+fn append<T: Copy>(items: &mut Vec<T>, new: &[T]) -> (usize, usize) {
+    let start = items.len();
+    items.extend_from_slice(new);
+    (start, items.len())
 }
 
 impl Explored {
@@ -44,7 +63,9 @@ impl Explored {
             self.kept[p as usize].0 = 0;
         }
         self.touched.clear();
-        self.used = 0;
+        self.states.clear();
+        self.points.clear();
+        self.words.clear();
         self.kept.resize(portals, (0, [0; STATES_PER_PORTAL]));
     }
 
@@ -61,10 +82,14 @@ impl Explored {
     ) -> bool {
         let (count, slots) = &self.kept[portal];
         slots[..usize::from(*count)].iter().any(|&i| {
-            let s = &self.pool[i as usize];
-            convex_contains(&s.pass, pass, pass_normal)
-                && convex_contains(&s.source, source, source_normal)
-                && might.is_subset(&s.might)
+            let s = &self.states[i as usize];
+            let bound = WindowView {
+                lo: s.might_lo,
+                words: part(&self.words, s.might),
+            };
+            convex_contains(part(&self.points, s.pass), pass, pass_normal)
+                && convex_contains(part(&self.points, s.source), source, source_normal)
+                && might.is_subset(bound)
         })
     }
 
@@ -78,18 +103,14 @@ impl Explored {
         if n == 0 {
             self.touched.push(portal as u32);
         }
-        if self.used == self.pool.len() {
-            self.pool.push(State::default());
-        }
-        let state = &mut self.pool[self.used];
-        state.source.clear();
-        state.source.extend_from_slice(source);
-        state.pass.clear();
-        state.pass.extend_from_slice(pass);
-        state.might.assign(might);
-        slots[n] = self.used as u32;
+        slots[n] = self.states.len() as u32;
         *count += 1;
-        self.used += 1;
+        self.states.push(State {
+            source: append(&mut self.points, source),
+            pass: append(&mut self.points, pass),
+            might_lo: might.view().lo,
+            might: append(&mut self.words, might.view().words),
+        });
     }
 }
 
