@@ -137,9 +137,11 @@ fn run_stages(args: &BuildArgs, bsp: &Path) -> Result<Vec<StageRun>> {
             argv.push("--fast".into());
         }
         argv.extend(extra_args(args.vis_opts.as_deref()));
+        crate::keep_freed_memory(false);
         let (stage, _) = run_stage("vis", argv, vis::cli::run, |r| {
             r.as_ref().map_or(String::new(), vis_figures)
         })?;
+        crate::keep_freed_memory(true);
         stages.push(stage);
     }
 

@@ -62,17 +62,20 @@ unsafe extern "C" {
 /// `mi_option_purge_delay` in mimalloc.h's `mi_option_t` (the same in its versions 2 and 3).
 const MI_OPTION_PURGE_DELAY: std::ffi::c_int = 15;
 
-/// Freed memory stays with the process until it ends: every stage frees and takes back buffers
-/// of the same sizes face after face, and memory given back to the system comes back zeroed by
-/// the kernel, page by page (huge pages included), each time it is taken again.
-fn keep_freed_memory() {
-    // SAFETY: setting an option is allowed at any time; -1 is its documented "never purge".
-    unsafe { mi_option_set(MI_OPTION_PURGE_DELAY, -1) };
+/// Whether freed memory stays with the process until it ends, or goes back to the system at once.
+/// The compiler and light free and take back buffers of the same sizes face after face, and
+/// memory given back to the system comes back zeroed by the kernel, page by page (huge pages
+/// included), each time it is taken again: they keep it. Vis frees the states of one portal's
+/// flow, of sizes later flows seldom ask for again: kept, they would stay on top of its peak.
+pub(crate) fn keep_freed_memory(keep: bool) {
+    // SAFETY: setting an option is allowed at any time; -1 is its documented "never purge",
+    // 0 "purge at once".
+    unsafe { mi_option_set(MI_OPTION_PURGE_DELAY, if keep { -1 } else { 0 }) };
 }
 
 fn main() -> ExitCode {
-    keep_freed_memory();
     let cli = Cli::parse_from(batch::command_words(std::env::args()));
+    keep_freed_memory(!matches!(cli.command, Command::Vis(_)));
     match run(cli.command) {
         Ok(code) => code,
         Err(e) => {
