@@ -68,12 +68,7 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
         stats.seconds_lightgrid = (grid_done - bounce_done).as_secs_f64();
     }
     let settings = &prep.lights.settings;
-    let to_luxels = match options.quality {
-        Quality::Reference => ToLuxels::OpenMeans,
-        q => ToLuxels::AsEricw {
-            soft_radius: settings.soft.samples(q.samples_per_axis()),
-        },
-    };
+    let to_luxels = plan.to_luxels();
     let model_light = |models: &[usize]| plan.model_centre_light(models);
     let autominlight = &prep.lights.autominlight;
     // Models whose samples in solid take no light: those that cast shadows, and `-1`.
@@ -216,6 +211,16 @@ impl<'a> Plan<'a> {
             .trace_setup(self.bsp, &self.reaches, gate, true, true)
     }
 
+    /// How the run's samples become luxels.
+    fn to_luxels(&self) -> ToLuxels {
+        match self.options.quality {
+            Quality::Reference => ToLuxels::OpenMeans,
+            q => ToLuxels::AsEricw {
+                soft_radius: self.prep.lights.settings.soft.samples(q.samples_per_axis()),
+            },
+        }
+    }
+
     /// Each traced face's direct light. The reference's bounce gathers at the samples of the
     /// faces it measures, so only those are traced here when it bounces.
     fn direct_light(&self) -> Vec<Traced> {
@@ -225,6 +230,7 @@ impl<'a> Plan<'a> {
             reflectance: &self.reflectance,
             bouncing: self.bouncing && !reference,
             samples: self.bouncing && reference,
+            finish: (!self.bouncing).then(|| self.to_luxels()),
         };
         let faces: Vec<usize> = if self.bouncing && reference {
             let wanted = self.to_trace.iter().copied();
@@ -273,6 +279,7 @@ impl<'a> Plan<'a> {
             reflectance: &self.reflectance,
             bouncing: true,
             samples: false,
+            finish: None,
         };
         let field = trace_faces(
             self.bsp,
@@ -431,34 +438,47 @@ fn finish_faces(
     let shadow_models = models.dark;
     // Gathered first, into room for all, so no vector here grows in steps (each step takes
     // fresh pages) and the parallel collect knows its length.
-    let mut lit: Vec<SampleLight> = Vec::with_capacity(traced.len());
+    let mut lit: Vec<TracedLight> = Vec::with_capacity(traced.len());
     lit.extend(traced.into_iter().filter_map(|t| t.light));
     // ericw-tools' autominlight: the occluded samples of a brush model's faces take the light
     // of the model's middle, where it has one.
     let model_of = |light: &SampleLight| geoms[light.face].model;
     let buried: BTreeSet<usize> = lit
         .iter()
+        .filter_map(TracedLight::samples)
         .filter(|light| light.has_occluded())
         .map(model_of)
         .chain(models.everywhere.iter().copied())
         .filter(|&m| m != 0 && !shadow_models.contains(&m))
         .collect();
     let centre_light = (models.light)(&buried.into_iter().collect::<Vec<_>>());
-    let lit: Vec<SampleLight> = lit
+    let lit: Vec<TracedLight> = lit
         .into_iter()
-        .map(|light| {
-            let model = model_of(&light);
-            match centre_light.get(&model) {
-                Some(centre) => light.with_model_light(centre, models.everywhere.contains(&model)),
-                None => light,
+        .map(|traced| match traced {
+            TracedLight::Samples(light) => {
+                let model = model_of(&light);
+                TracedLight::Samples(match centre_light.get(&model) {
+                    Some(centre) => {
+                        light.with_model_light(centre, models.everywhere.contains(&model))
+                    }
+                    None => light,
+                })
             }
+            finished => finished,
         })
         .collect();
-    let hidden: Vec<Vec<bool>> = lit.iter().map(SampleLight::hidden_luxels).collect();
+    let hidden: Vec<Vec<bool>> = lit
+        .iter()
+        .map(|t| t.samples().map_or_else(Vec::new, SampleLight::hidden_luxels))
+        .collect();
     let mut finished: Vec<FaceLight> = lit
         .into_par_iter()
         .zip(hidden.par_iter())
-        .map(|(light, hidden)| {
+        .map(|(traced, hidden)| {
+            let light = match traced {
+                TracedLight::Samples(light) => light,
+                TracedLight::Luxels(light) => return light,
+            };
             let bounce = bounced.get(light.face).map_or(&[][..], |b| &b[..]);
             // As in ericw-tools, hidden luxels take their neighbours' light, but a brush
             // model's face with no open luxel at all takes its model's (filled below), and a
@@ -565,11 +585,27 @@ fn fill_hidden_luxels(
     }
 }
 
+/// A face's direct light: per sample, or (a world face when nothing bounces, whose light
+/// nothing else changes) already per luxel.
+enum TracedLight {
+    Samples(SampleLight),
+    Luxels(FaceLight),
+}
+
+impl TracedLight {
+    fn samples(&self) -> Option<&SampleLight> {
+        match self {
+            TracedLight::Samples(light) => Some(light),
+            TracedLight::Luxels(_) => None,
+        }
+    }
+}
+
 /// One face after direct light: what later steps need of it.
 struct Traced {
     face: usize,
-    /// Its light per sample (faces whose lightmap is wanted).
-    light: Option<SampleLight>,
+    /// Its light (faces whose lightmap is wanted).
+    light: Option<TracedLight>,
     /// Its sample points (kept for the reference's bounce gathering). Boxed, as `receivers`:
     /// most runs keep neither, and every face's record is in one large vector.
     samples: Option<Box<FaceSamples>>,
@@ -589,6 +625,9 @@ struct Keep<'a> {
     reflectance: &'a [Option<[f32; 3]>],
     bouncing: bool,
     samples: bool,
+    /// When nothing bounces: world faces go to luxels as soon as traced, so their samples'
+    /// buffers are freed face by face instead of all held to the end.
+    finish: Option<ToLuxels>,
 }
 
 /// A face's light on its own grid, and that grid.
@@ -619,9 +658,17 @@ fn trace_faces(
             progress.advance(1);
             let reflected =
                 (keep.bouncing && keep.reflectance[f].is_some()).then(|| light.reflected(styled));
+            let light = keep.wanted[f].then(|| match keep.finish {
+                Some(to_luxels) if geom.model == 0 => TracedLight::Luxels(light.finish(
+                    &[],
+                    HiddenLuxels::FromNeighbours,
+                    to_luxels,
+                )),
+                _ => TracedLight::Samples(light),
+            });
             Traced {
                 face: f,
-                light: keep.wanted[f].then_some(light),
+                light,
                 receivers: keep
                     .bouncing
                     .then(|| Box::new(Receivers::new(&samples, geom))),
