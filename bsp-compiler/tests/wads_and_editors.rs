@@ -158,8 +158,15 @@ fn editor_keys_stay_out_of_the_bsp_and_omitted_layers_compile_as_in_ericw_tools(
     let compiled = try_compile(&text).expect("compile");
     let entities = parse_entities(&compiled.bsp.entity_text()).expect("entities");
     let classes: Vec<&str> = entities.iter().map(|e| e.classname()).collect();
-    assert_eq!(classes, ["worldspawn", "light", "func_wall", "info_player_start"]);
-    assert_eq!(compiled.bsp.models.len(), 2, "the layer's func_wall is a model");
+    assert_eq!(
+        classes,
+        ["worldspawn", "light", "func_wall", "info_player_start"]
+    );
+    assert_eq!(
+        compiled.bsp.models.len(),
+        2,
+        "the layer's func_wall is a model"
+    );
     assert_eq!(
         note(&compiled.warnings).as_deref(),
         Some(
@@ -210,11 +217,12 @@ fn editor_keys_stay_out_of_the_bsp_and_omitted_layers_compile_as_in_ericw_tools(
 /// leaves it, the map leaks.
 #[test]
 fn a_layer_marked_omit_from_export_still_seals_the_map() {
-    let patch = "{\n\"classname\" \"func_group\"\n\"_tb_type\" \"_tb_layer\"\n\"_tb_name\" \"seal\"\n\
+    let patch =
+        "{\n\"classname\" \"func_group\"\n\"_tb_type\" \"_tb_layer\"\n\"_tb_name\" \"seal\"\n\
                  \"_tb_id\" \"5\"\n\"_tb_layer_omit_from_export\" \"1\"\n"
-        .to_string()
-        + &box_brush([128.0, 0.0, -128.0], [144.0, 32.0, 128.0], "brick1")
-        + "}\n";
+            .to_string()
+            + &box_brush([128.0, 0.0, -128.0], [144.0, 32.0, 128.0], "brick1")
+            + "}\n";
     let text = room_map_with(true, "", "").replace("wall 0 0 0 1 1", "brick1 0 0 0 1 1");
     let leaky = try_compile(&text).expect("compile");
     assert!(leaky.stats.leaked, "the room has a hole");

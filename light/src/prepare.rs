@@ -186,6 +186,7 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
         solids: &solids,
         switchable: &map_lights.switchable.shadows,
         fences: &fences,
+        channels: &map_lights.channel_models,
     };
     // Embree builds its tree on its own threads while ours link the faces.
     let (scene, links) = rayon::join(
@@ -288,6 +289,7 @@ pub fn face_rules<'a>(lights: &'a MapLights, geom: &FaceGeom) -> FaceRules<'a> {
         minlight,
         dirt,
         minlight_only: merged.light_ignore || lights.lightignore_models.contains(&geom.model),
+        channels: lights.channels_of(geom.model),
         maxlight: lights
             .model_maxlight
             .get(&geom.model)

@@ -459,7 +459,7 @@ fn finish_faces(
                 let model = model_of(&light);
                 TracedLight::Samples(match centre_light.get(&model) {
                     Some(centre) => {
-                        light.with_model_light(centre, models.everywhere.contains(&model))
+                        Box::new(light.with_model_light(centre, models.everywhere.contains(&model)))
                     }
                     None => light,
                 })
@@ -469,14 +469,17 @@ fn finish_faces(
         .collect();
     let hidden: Vec<Vec<bool>> = lit
         .iter()
-        .map(|t| t.samples().map_or_else(Vec::new, SampleLight::hidden_luxels))
+        .map(|t| {
+            t.samples()
+                .map_or_else(Vec::new, SampleLight::hidden_luxels)
+        })
         .collect();
     let mut finished: Vec<FaceLight> = lit
         .into_par_iter()
         .zip(hidden.par_iter())
         .map(|(traced, hidden)| {
             let light = match traced {
-                TracedLight::Samples(light) => light,
+                TracedLight::Samples(light) => *light,
                 TracedLight::Luxels(light) => return light,
             };
             let bounce = bounced.get(light.face).map_or(&[][..], |b| &b[..]);
@@ -588,7 +591,7 @@ fn fill_hidden_luxels(
 /// A face's direct light: per sample, or (a world face when nothing bounces, whose light
 /// nothing else changes) already per luxel.
 enum TracedLight {
-    Samples(SampleLight),
+    Samples(Box<SampleLight>),
     Luxels(FaceLight),
 }
 
@@ -659,12 +662,10 @@ fn trace_faces(
             let reflected =
                 (keep.bouncing && keep.reflectance[f].is_some()).then(|| light.reflected(styled));
             let light = keep.wanted[f].then(|| match keep.finish {
-                Some(to_luxels) if geom.model == 0 => TracedLight::Luxels(light.finish(
-                    &[],
-                    HiddenLuxels::FromNeighbours,
-                    to_luxels,
-                )),
-                _ => TracedLight::Samples(light),
+                Some(to_luxels) if geom.model == 0 => {
+                    TracedLight::Luxels(light.finish(&[], HiddenLuxels::FromNeighbours, to_luxels))
+                }
+                _ => TracedLight::Samples(Box::new(light)),
             });
             Traced {
                 face: f,
@@ -728,10 +729,12 @@ fn bounce_light(
             }
         }
         // Wanted faces receive every pass (unless the reference measures them); reflecting ones
-        // every pass but the last, for the next.
+        // every pass but the last, for the next. Bounced light is on channel 1.
+        let on_channel_1 = |t: &Traced| prep.lights.channels_of(prep.faces[t.face].model) & 1 != 0;
         let receiving: Vec<&Traced> = field
             .iter()
             .filter(|t| (!reference && t.light.is_some()) || (!last && t.reflected.is_some()))
+            .filter(|t| on_channel_1(t))
             .collect();
         let mut next: Vec<Option<StyleLuxels>> = vec![None; n];
         let at_receivers = gather_faces(receiving.par_iter().copied(), |t, c| {

@@ -9,7 +9,10 @@
 //! rays from their own faces (and those of models sharing their style), which
 //! they shadow as fixed geometry, as ericw-tools does.
 //! Fence faces are kept apart too, so light can pass their open texels
-//! ([`crate::fence`]).
+//! ([`crate::fence`]). Models on light channels other than 1 (`_object_channel_mask`) get a
+//! scene per mask: they block the rays of the lights whose shadow channels share a bit with it
+//! ([`TraceScene::occluded16_by`]), and the shared scene (the world, on channel 1) only those
+//! of lights with channel 1 among them.
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -60,6 +63,10 @@ pub struct TraceScene {
     own_switchable: HashMap<usize, usize>,
     /// The shadow-casting fence faces, whose open texels let light through.
     fences: Option<Fences>,
+    /// Per light-channel mask other than 1, the faces of the models on it.
+    channels: Vec<(u32, Scene)>,
+    /// The brush models on light channels other than 1, and their mask.
+    model_channels: HashMap<usize, u32>,
     /// Triangles in the scene (opaque + sky) and the `_shadowself` scenes.
     pub triangles: usize,
 }
@@ -81,6 +88,9 @@ pub struct Casters<'a> {
     pub switchable: &'a [(usize, u8)],
     /// Faces with a fence texture and the mask of its open texels: light passes those.
     pub fences: &'a [(usize, Arc<TexelMask>)],
+    /// Brush models on light channels other than 1, and their mask: they cast shadows on the
+    /// lights whose shadow channels share a bit with it.
+    pub channels: &'a [(usize, u32)],
 }
 
 impl TraceScene {
@@ -105,7 +115,14 @@ impl TraceScene {
             solids,
             switchable,
             fences,
+            channels,
         } = *casters;
+        let channel_of = |f: &FaceGeom| {
+            channels
+                .iter()
+                .find(|(m, _)| *m == f.model)
+                .map(|&(_, mask)| mask)
+        };
         let fence_masks: HashMap<usize, &Arc<TexelMask>> =
             fences.iter().map(|(face, mask)| (*face, mask)).collect();
         let fence_mask = |f: &FaceGeom| fence_masks.get(&f.index).map(|&mask| mask.clone());
@@ -126,7 +143,19 @@ impl TraceScene {
         let mut own_meshes: HashMap<usize, Mesh> = HashMap::new();
         let mut world_only = Mesh::default();
         let mut switchable_meshes: Vec<(u8, Mesh)> = Vec::new();
+        let mut channel_meshes: Vec<(u32, Mesh)> = Vec::new();
         for f in faces {
+            if let (FaceKind::Lit, Some(mask)) = (f.kind, channel_of(f)) {
+                match channel_meshes.iter_mut().find(|(m, _)| *m == mask) {
+                    Some((_, mesh)) => mesh.add(f),
+                    None => {
+                        let mut mesh = Mesh::default();
+                        mesh.add(f);
+                        channel_meshes.push((mask, mesh));
+                    }
+                }
+                continue;
+            }
             if let (FaceKind::Lit, Some(style)) = (f.kind, switchable_style(f)) {
                 let at = match switchable_meshes.iter().position(|(s, _)| *s == style) {
                     Some(at) => at,
@@ -172,6 +201,11 @@ impl TraceScene {
             triangles += mesh.triangles.len();
             switchable.push((style, mesh.commit(device)?));
         }
+        let mut channel_scenes = Vec::with_capacity(channel_meshes.len());
+        for (mask, mesh) in channel_meshes {
+            triangles += mesh.triangles.len();
+            channel_scenes.push((mask, mesh.commit(device)?));
+        }
         let own_switchable = casters
             .switchable
             .iter()
@@ -216,6 +250,8 @@ impl TraceScene {
             switchable,
             own_switchable,
             fences,
+            channels: channel_scenes,
+            model_channels: channels.iter().copied().collect(),
             triangles,
         })
     }
@@ -248,11 +284,36 @@ impl TraceScene {
     /// Bit `i` set if lane `i` of `packet`, cast from a face of brush model
     /// `model`, is blocked (sky blocks too).
     pub fn occluded16(&self, packet: &mut RayPacket16, model: usize) -> u16 {
-        let opaque = self.scene.occluded16(packet, true);
-        // Only the lanes the opaque faces let through can be blocked by a fence; Embree has
-        // set the others' tfar to -inf, so the second query skips them too.
-        let blocked = opaque | self.fences_block16(packet, !opaque);
-        blocked | self.own_occluded16(packet, model)
+        self.occluded16_by(packet, model, 1)
+    }
+
+    /// [`TraceScene::occluded16`] for the rays of a light whose shadow channels are
+    /// `shadow_channels`: the world and the models on channel 1 block them when it has channel
+    /// 1, the models on other channels when it shares one of theirs.
+    pub fn occluded16_by(
+        &self,
+        packet: &mut RayPacket16,
+        model: usize,
+        shadow_channels: u32,
+    ) -> u16 {
+        let mut blocked = 0;
+        if shadow_channels & 1 != 0 {
+            let opaque = self.scene.occluded16(packet, true);
+            // Only the lanes the opaque faces let through can be blocked by a fence; Embree
+            // has set the others' tfar to -inf, so the second query skips them too.
+            blocked = opaque | self.fences_block16(packet, !opaque);
+            blocked |= self.own_occluded16(packet, model);
+        }
+        self.channels_block16(packet, shadow_channels) | blocked
+    }
+
+    /// Lanes of `packet` that the models on light channels other than 1 sharing a bit with
+    /// `shadow_channels` block.
+    fn channels_block16(&self, packet: &mut RayPacket16, shadow_channels: u32) -> u16 {
+        self.channels
+            .iter()
+            .filter(|(mask, _)| mask & shadow_channels != 0)
+            .fold(0, |m, (_, scene)| m | scene.occluded16(packet, true))
     }
 
     /// Of the active `lanes` of `packet`, those a fence face blocks at an opaque texel.
@@ -324,7 +385,10 @@ impl TraceScene {
         packet.keep_shortened(sky, SKY_HIT_SHORTEN);
         let opaque = self.scene.occluded16(packet, true);
         let blocked = opaque | self.fences_block16(packet, !opaque);
-        sky & !blocked & !self.own_occluded16(packet, model) & !self.any_switchable_blocks16(packet)
+        sky & !blocked
+            & !self.own_occluded16(packet, model)
+            & !self.any_switchable_blocks16(packet)
+            & !self.channels_block16(packet, 1)
     }
 
     /// For each active lane of `packet`, cast from a face of `model`, the
@@ -357,10 +421,35 @@ impl TraceScene {
     }
 
     /// For each active lane of `packet`, cast from a face of `model`, the
-    /// distance to the first surface if that is an opaque one (not sky).
+    /// distance to the first surface if that is an opaque one (not sky), among what shares a
+    /// light channel with `model` (dirt: a model on other channels neither takes it from the
+    /// world nor gives it).
     pub fn opaque_hits16(&self, packet: &mut RayPacket16, model: usize) -> [Option<f32>; 16] {
-        let ids = self.scene.first_hit_geom16(packet, true);
+        let channels = self.model_channels.get(&model).copied().unwrap_or(1);
         let mut out = [None; 16];
+        if channels & 1 != 0 {
+            self.world_opaque_hits16(packet, model, &mut out);
+        }
+        // tfar ends at the nearest hit so far, so any hit here is nearer.
+        for (_, scene) in self.channels.iter().filter(|(m, _)| m & channels != 0) {
+            let ids = scene.first_hit_geom16(packet, true);
+            for (lane, id) in ids.iter().enumerate() {
+                if *id != sys::RTC_INVALID_GEOMETRY_ID {
+                    out[lane] = Some(packet.tfar(lane));
+                }
+            }
+        }
+        out
+    }
+
+    /// [`TraceScene::opaque_hits16`] on channel 1: the shared scene and `model`'s own scenes.
+    fn world_opaque_hits16(
+        &self,
+        packet: &mut RayPacket16,
+        model: usize,
+        out: &mut [Option<f32>; 16],
+    ) {
+        let ids = self.scene.first_hit_geom16(packet, true);
         for (lane, id) in ids.iter().enumerate() {
             if *id != self.sky_geom && *id != sys::RTC_INVALID_GEOMETRY_ID {
                 out[lane] = Some(packet.tfar(lane));
@@ -375,6 +464,5 @@ impl TraceScene {
                 }
             }
         }
-        out
     }
 }

@@ -149,6 +149,8 @@ mod tests {
                 anglescale: 0.5,
                 dirt: None,
                 bounce: 1.0,
+                light_channels: 1,
+                shadow_channels: 1,
                 entity: 1,
             },
             offset: 2.0,

@@ -169,6 +169,16 @@ fn common(k: &Keys, origins: &HashMap<&str, DVec3>, global: &Global) -> Common {
     }
 }
 
+/// A light-channel mask key (`_light_channel_mask` and the like): its bits, `None` when unset;
+/// a value outside 32 bits is a warning and `None`.
+pub(super) fn channel_mask(k: &Keys, key: &keys::EntityKey) -> Option<u32> {
+    let value = k.whole(key)?;
+    u32::try_from(value).ok().or_else(|| {
+        k.warn(key.names[0], "not a mask of 32 bits; the default is used");
+        None
+    })
+}
+
 /// `style`, held to the styles a lightmap can name (with a warning outside them).
 pub(super) fn style(k: &Keys) -> u8 {
     let most = quake_formats::bsp::limits::MAX_LIGHTSTYLE;
@@ -217,6 +227,7 @@ fn point_light(k: &Keys, c: Common, global: &Global, out: &mut MapLights) {
         _ => wait * global.scaledist,
     };
     let softangle = k.number(&keys::SOFTANGLE).unwrap_or(0.0);
+    let light_channels = channel_mask(k, &keys::LIGHT_CHANNEL_MASK).unwrap_or(1);
     let point = PointLight {
         origin: c.origin,
         light: c.light,
@@ -233,13 +244,18 @@ fn point_light(k: &Keys, c: Common, global: &Global, out: &mut MapLights) {
         } else {
             0.0
         },
+        light_channels,
+        shadow_channels: channel_mask(k, &keys::SHADOW_CHANNEL_MASK).unwrap_or(light_channels),
         entity: k.index,
     };
     match k.text(&keys::SURFACE) {
+        // Surface lights are on channel 1, as in ericw-tools.
         Some(texture) => out.templates.push(SurfaceTemplate {
             texture: texture.to_string(),
             light: PointLight {
                 spot: None,
+                light_channels: 1,
+                shadow_channels: 1,
                 ..point
             },
             offset: k.number(&keys::SURFACE_OFFSET).unwrap_or(2.0),

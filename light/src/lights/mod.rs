@@ -107,6 +107,8 @@ pub struct MapLights {
     pub self_shadow_models: Vec<usize>,
     /// Brush models that shadow only the world's faces (`_shadowworldonly 1`).
     pub world_shadow_models: Vec<usize>,
+    /// Brush models on light channels other than 1 (`_object_channel_mask`), and their mask.
+    pub channel_models: Vec<(usize, u32)>,
     /// Brush models whose faces never take dirt (`_dirt -1`).
     pub no_dirt_models: Vec<usize>,
     /// Brush models whose faces get minlight only (`_lightignore 1`).
@@ -152,6 +154,15 @@ pub struct MapLights {
 }
 
 impl MapLights {
+    /// The light channels of model `model` (`_object_channel_mask`; 1 for the world and by
+    /// default).
+    pub fn channels_of(&self, model: usize) -> u32 {
+        self.channel_models
+            .iter()
+            .find(|(m, _)| *m == model)
+            .map_or(1, |&(_, mask)| mask)
+    }
+
     /// The spacing model `model`'s faces are lit at, as in ericw-tools: with the map's
     /// `_world_units_per_luxel` set, world-aligned grids at the model's own
     /// `_world_units_per_luxel`, else the map's; else `-lmshift` for every model when it is
@@ -228,6 +239,7 @@ pub fn parse_lights(
         shadow_models: Vec::new(),
         self_shadow_models: Vec::new(),
         world_shadow_models: Vec::new(),
+        channel_models: Vec::new(),
         no_dirt_models: Vec::new(),
         lightignore_models: Vec::new(),
         no_bounce_models: Vec::new(),

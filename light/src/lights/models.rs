@@ -1,4 +1,5 @@
-//! Brush models' lighting keys: which cast shadows (`_shadow`, `_shadowself`), which take no
+//! Brush models' lighting keys: which cast shadows (`_shadow`, `_shadowself`), their light
+//! channels (`_object_channel_mask`), which take no
 //! dirt (`_dirt -1`), light (`_lightignore`) or reflect (`_bounce 0`), their own minlight and
 //! lightmap spacing (`_world_units_per_luxel`), their `origin` offset, and `_phong` smoothing
 //! and `_lmscale` (worldspawn's too, as model 0). The same keys of entities merged into the world
@@ -66,6 +67,10 @@ pub fn read_models(entities: &[Entity], global: &Global, out: &mut MapLights) {
         }
         if k.number(&keys::SHADOWWORLDONLY) == Some(1.0) {
             out.world_shadow_models.push(model);
+        }
+        match super::entities::channel_mask(&k, &keys::OBJECT_CHANNEL_MASK) {
+            Some(mask) if mask != 1 => out.channel_models.push((model, mask)),
+            _ => {}
         }
         if let Some(o) = k.vector(&keys::MODEL_ORIGIN) {
             out.model_origins.insert(model, o);

@@ -119,6 +119,11 @@ pub struct PointLight {
     pub dirt: Option<DirtResponse>,
     /// How much of its light bounces: `_bouncescale` (0 for `_bounce 0`).
     pub bounce: f32,
+    /// The light channels it lights (`_light_channel_mask`): the faces of models whose
+    /// channels share a bit with these.
+    pub light_channels: u32,
+    /// The light channels whose models block its rays (`_shadow_channel_mask`).
+    pub shadow_channels: u32,
     /// Entity index it came from (for messages).
     pub entity: usize,
 }
@@ -221,6 +226,8 @@ mod tests {
             anglescale: 0.5,
             dirt: None,
             bounce: 1.0,
+            light_channels: 1,
+            shadow_channels: 1,
             entity: 0,
         }
     }

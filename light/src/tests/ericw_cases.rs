@@ -411,6 +411,78 @@ fn a_world_only_shadow_falls_on_the_world_alone() {
     assert_eq!(plate, plate_open, "the plate is not");
 }
 
+/// ericw-tools' light channels (its test "light channel mask"): a light lights the models whose
+/// `_object_channel_mask` shares a bit with its `_light_channel_mask` (the world is on channel
+/// 1), and a model on another channel than 1 casts shadows on the lights of its channel
+/// (their `_shadow_channel_mask`, by default their light channels) and on no other. A slab
+/// over a plate on the floor, both brush models; the light above them.
+#[test]
+fn light_channels_choose_what_a_light_lights_and_what_shadows_it() {
+    let slab = map_box([-32.0, -32.0, -64.0], [32.0, 32.0, -48.0]);
+    let plate = map_box([-16.0, -16.0, -128.0], [16.0, 16.0, -120.0]);
+    let look = |slab_keys: &str, plate_keys: &str, light_keys: &str| {
+        let bsp = room_bsp(&format!(
+            "{{\n\"classname\" \"func_wall\"\n{slab_keys}\n{slab}}}\n\
+             {{\n\"classname\" \"func_wall\"\n{plate_keys}\n{plate}}}\n{}",
+            light([0.0, 0.0, 64.0], light_keys)
+        ));
+        let lighting = lit(&bsp);
+        let red = |rgb: Option<[u8; 3]>| rgb.map_or(0, |c| c[0]);
+        let slab_top = luxel_rgb(&bsp, &lighting, 1, DVec3::new(0.0, 0.0, -48.0), DVec3::Z);
+        let plate_top = luxel_rgb(&bsp, &lighting, 2, DVec3::new(0.0, 0.0, -120.0), DVec3::Z);
+        let floor = floor_rgb(&bsp, &lighting, 100.0, 100.0);
+        (red(slab_top), red(plate_top), red(floor))
+    };
+    let (slab, plate, floor) = look("", "", "");
+    assert!(
+        slab > 20 && plate > 20 && floor > 20,
+        "{slab} {plate} {floor}"
+    );
+    let on_2 = "\"_object_channel_mask\" \"2\"";
+    // A channel-2 light lights the channel-2 plate, not the world nor the channel-1 slab,
+    // which casts no shadow (no `_shadow`).
+    let (slab2, plate2, floor2) = look("", on_2, "\"_light_channel_mask\" \"2\"");
+    assert_eq!(
+        (slab2, floor2),
+        (0, 0),
+        "the world and the slab are on channel 1"
+    );
+    assert_eq!(plate2, plate, "the plate takes the light as before");
+    // The channel-2 slab shadows the channel-2 plate from the channel-2 light, and is lit.
+    let (slab3, plate3, _) = look(on_2, on_2, "\"_light_channel_mask\" \"2\"");
+    assert_eq!(plate3, 0, "a model on channel 2 casts shadows on channel 2");
+    assert!(slab3 > 20, "{slab3}");
+    // A channel-1 light: the channel-2 slab neither takes its light nor blocks it; with
+    // `_shadow_channel_mask 3`, it blocks it.
+    let (slab4, plate4, floor4) = look(on_2, "", "");
+    assert_eq!((slab4, plate4, floor4), (0, plate, floor));
+    let (_, plate5, _) = look(on_2, "", "\"_shadow_channel_mask\" \"3\"");
+    assert_eq!(plate5, 0, "shadow channels 1 and 2: the slab blocks");
+}
+
+/// ericw-tools' "light channel mask / dirt interaction": dirt comes from what shares a light
+/// channel. A box on the floor beside a lit spot: as a shadow caster on channel 1 it darkens
+/// the floor at its foot with dirt; on channel 2 it does not (the light lights both channels).
+#[test]
+fn dirt_comes_only_from_models_on_the_same_channel() {
+    let block = map_box([32.0, -32.0, -128.0], [64.0, 32.0, -64.0]);
+    let floor_at_foot = |block_keys: &str| {
+        let bsp = room_bsp(&format!(
+            "{{\n\"classname\" \"func_wall\"\n{block_keys}\n{block}}}\n{}",
+            light([0.0, 0.0, 64.0], "\"_light_channel_mask\" \"3\"")
+        ));
+        let mut opts = options(Quality::Default);
+        opts.overrides.dirt = Some(true);
+        let lighting = compute_lighting(&bsp, &opts).expect("light");
+        floor_rgb(&bsp, &lighting, 26.0, 0.0).expect("lit")[0]
+    };
+    let open = floor_at_foot("");
+    let dirty = floor_at_foot("\"_shadow\" \"1\"");
+    let other_channel = floor_at_foot("\"_object_channel_mask\" \"2\"");
+    assert!(dirty < open, "{dirty} {open}");
+    assert_eq!(other_channel, open);
+}
+
 /// ericw-tools' `_spotlightautofalloff`: a linear spotlight aimed at a `target` fades to zero
 /// just past its cone at the target (the distance plus the cone's radius there), instead of
 /// at its brightness in units. 224 units above the floor, light 600, angle 40: zero at 305.5

@@ -83,7 +83,7 @@ pub struct TraceSetup<'a> {
 }
 
 /// What one face takes from the lights (set per brush model).
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy)]
 pub struct FaceRules<'a> {
     /// The floor for style 0 (none for a face its model's `_minlight_exclude` names).
     pub minlight: Option<&'a Minlight>,
@@ -91,11 +91,28 @@ pub struct FaceRules<'a> {
     pub dirt: bool,
     /// `_lightignore`: minlight only, no lights or suns.
     pub minlight_only: bool,
+    /// The light channels the face's model receives light on (`_object_channel_mask`; suns,
+    /// surface lights and bounced light are on channel 1).
+    pub channels: u32,
     /// `_maxlight`: the most light a sample takes, in levels (`None`: no cap).
     pub maxlight: Option<f64>,
     /// Bounced light will be added and darkened by dirt this way: dirt is
     /// then measured at every sample (bounce reaches where lights do not).
     pub bounce_dirt: Option<DirtResponse>,
+}
+
+impl Default for FaceRules<'_> {
+    /// Every light and sun, on channel 1; no minlight, dirt, cap or bounce dirt.
+    fn default() -> Self {
+        FaceRules {
+            minlight: None,
+            dirt: false,
+            minlight_only: false,
+            channels: 1,
+            maxlight: None,
+            bounce_dirt: None,
+        }
+    }
 }
 
 /// Per-luxel colour of each style a face receives, in light units.
@@ -232,6 +249,9 @@ impl<'a> FaceTrace<'a> {
         let dirt = setup.dirt.filter(|_| rules.dirt);
         let (lights, suns) = if rules.minlight_only {
             (&[][..], &[][..])
+        } else if rules.channels & 1 == 0 {
+            // Suns are on channel 1.
+            (setup.lights, &[][..])
         } else {
             (setup.lights, setup.suns)
         };

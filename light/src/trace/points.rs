@@ -34,6 +34,10 @@ impl FaceTrace<'_> {
         self.counts.pairs_culled += (self.lights.len() - near_lights.len()) as u64;
         let closeness = Closeness::of(self.samples);
         for li in near_lights.iter().map(|&li| li as usize) {
+            // A light lights only the models on one of its channels.
+            if self.lights[li].light_channels & self.rules.channels == 0 {
+                continue;
+            }
             if self.setup.cull && self.culled(li) {
                 self.counts.pairs_culled += 1;
                 continue;
@@ -79,7 +83,11 @@ impl FaceTrace<'_> {
             &scratch.value,
             ray,
             &mut self.packet,
-            |p| !setup.scene.occluded16(p, face.model),
+            |p| {
+                !setup
+                    .scene
+                    .occluded16_by(p, face.model, light.shadow_channels)
+            },
         );
         let switchable = light.style == 0
             && light.falloff != Falloff::LocalMin
