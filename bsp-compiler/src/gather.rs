@@ -82,6 +82,7 @@ pub(crate) fn gather(
             continue;
         }
         let brush_class = EntityBrushes::of(index, class);
+        warn_partial_numbers(ent, index, brush_class, warnings);
         let origin = match brush_class {
             EntityBrushes::Submodel => submodel_origin(&map.entities, ent, &mut g.planes),
             _ => None,
@@ -473,12 +474,61 @@ fn origin_brush_centre(ent: &MapEntity, planes: &mut PlaneSet) -> Option<DVec3> 
     (!bounds.is_empty()).then(|| bounds.center())
 }
 
+/// The number keys the compiler reads on every brush entity (worldspawn's `_litwater` too).
+const NUMBER_KEYS: &[&str] = &["_litwater", "_splitturb", "_mirrorinside", "_noclipfaces"];
+
+/// The number keys it reads on entities merged into the world only (light reads brush models'
+/// own).
+const MERGED_NUMBER_KEYS: &[&str] = &[
+    "_shadow",
+    "_noambient",
+    "_dirt",
+    "_bounce",
+    "_lightignore",
+    "_minlight",
+    "_phong",
+    "_phong_angle",
+    "_phong_angle_concave",
+];
+
+/// A warning for each number key the compiler reads on `ent` whose value is not wholly a
+/// number: it takes the number the value starts with, as ericw-tools' `atof` does (`"150x"` is
+/// 150), and a value with none is not set.
+fn warn_partial_numbers(
+    ent: &MapEntity,
+    index: usize,
+    class: EntityBrushes,
+    warnings: &mut Vec<Warning>,
+) {
+    let merged = merged_into_world(index, class);
+    let keys = NUMBER_KEYS
+        .iter()
+        .chain(MERGED_NUMBER_KEYS.iter().filter(|_| merged));
+    for &key in keys {
+        let Some(value) = ent.entity.get(key).filter(|v| !v.trim().is_empty()) else {
+            continue;
+        };
+        let used = match ent.entity.get_leading_float(key) {
+            Some((_, true)) => continue,
+            Some((v, false)) => format!("{v}, the number it starts with, as ericw-tools reads it"),
+            None => "nothing: the key is not set".to_string(),
+        };
+        warnings.push(Warning::BadKey {
+            entity: index,
+            line: ent.line,
+            key: key.to_string(),
+            value: value.to_string(),
+            used,
+        });
+    }
+}
+
 /// Whether `ent`'s liquids are lit: its `_litwater` key (or ericw-tools' other name for it,
 /// `_splitturb`), else the worldspawn's, else `default`.
 fn lit_water(entities: &[MapEntity], ent: &MapEntity, default: bool) -> bool {
     let key = |e: &MapEntity| {
-        (e.entity.get_float("_litwater"))
-            .or_else(|| e.entity.get_float("_splitturb"))
+        (e.entity.get_leading_float("_litwater").map(|(v, _)| v))
+            .or_else(|| e.entity.get_leading_float("_splitturb").map(|(v, _)| v))
             .map(|v| v != 0.0)
     };
     key(ent)
@@ -501,7 +551,7 @@ fn merged_face_flags(ent: &MapEntity, index: usize, class: EntityBrushes) -> Fac
     if !merged_into_world(index, class) {
         return FaceFlags::default();
     }
-    let number = |key| ent.entity.get_float(key);
+    let number = |key| ent.entity.get_leading_float(key).map(|(v, _)| v);
     let shadow = number("_shadow");
     FaceFlags {
         no_shadow: shadow == Some(-1.0)
@@ -519,7 +569,11 @@ fn merged_face_flags(ent: &MapEntity, index: usize, class: EntityBrushes) -> Fac
 /// into the world, which light reads from the BSP for its faces as it reads a brush model's
 /// from its entity.
 fn merged_minlight(ent: &MapEntity, index: usize, class: EntityBrushes) -> FaceMinlight {
-    let level = ent.entity.get_float("_minlight").unwrap_or(0.0);
+    let level = ent
+        .entity
+        .get_leading_float("_minlight")
+        .map(|(v, _)| v)
+        .unwrap_or(0.0);
     if !merged_into_world(index, class) || level == 0.0 {
         return FaceMinlight::default();
     }
@@ -583,14 +637,18 @@ fn merged_surflight_group(
 fn merged_phong(ent: &MapEntity, index: usize, class: EntityBrushes) -> FacePhong {
     let merged = merged_into_world(index, class);
     let angle = phong::angle_from_keys(
-        ent.entity.get_float("_phong"),
-        ent.entity.get_float("_phong_angle"),
+        ent.entity.get_leading_float("_phong").map(|(v, _)| v),
+        ent.entity.get_leading_float("_phong_angle").map(|(v, _)| v),
     );
     match angle.filter(|_| merged) {
         Some(angle) => FacePhong {
             group: index as u32,
             angle: angle as f32,
-            concave: phong::concave_from_key(ent.entity.get_float("_phong_angle_concave")),
+            concave: phong::concave_from_key(
+                ent.entity
+                    .get_leading_float("_phong_angle_concave")
+                    .map(|(v, _)| v),
+            ),
         },
         None => FacePhong::default(),
     }
@@ -775,10 +833,15 @@ impl EntityContext<'_> {
     ) -> (Vec<(Brush, bool)>, usize, usize) {
         let mut out = Vec::new();
         let (mut bad, mut hints) = (0, 0);
-        let mirror_inside = ent.entity.get_float("_mirrorinside").map(|v| v != 0.0);
+        let mirror_inside = ent
+            .entity
+            .get_leading_float("_mirrorinside")
+            .map(|(v, _)| v)
+            .map(|v| v != 0.0);
         let no_clip_faces = ent
             .entity
-            .get_float("_noclipfaces")
+            .get_leading_float("_noclipfaces")
+            .map(|(v, _)| v)
             .is_some_and(|v| v != 0.0);
         for (bi, mb) in ent.brushes.iter().enumerate() {
             if is_origin_brush(mb) {

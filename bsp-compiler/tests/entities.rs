@@ -256,6 +256,33 @@ fn merged_entities_keys_for_shadow_and_sound_reach_their_faces() {
     );
 }
 
+/// A number key of an entity merged into the world reads as ericw-tools' `atof` reads it: the
+/// number its value starts with (`"-1x"` is -1), with a warning naming the entity, its line,
+/// the key and the value taken; a value that starts with no number is not set, and warns too.
+#[test]
+fn merged_entities_number_keys_read_as_far_as_the_number_goes() {
+    let brush = box_brush([-32.0, -32.0, -128.0], [32.0, 32.0, -64.0], "*water1");
+    let entity = format!(
+        "{{\n\"classname\" \"func_detail\"\n\"_noambient\" \"1x\"\n\"_shadow\" \"off\"\n{brush}}}\n"
+    );
+    let out = compile_text(&room_map_with(false, "", &entity));
+    let flags = out.bsp.face_flags().expect("lump").unwrap_or_default();
+    let water = (0..out.bsp.faces.len())
+        .find(|&f| face_texture(&out.bsp, f) == "*water1")
+        .expect("a water face");
+    let flag = flags.get(water).copied().unwrap_or_default();
+    assert!(flag.no_ambient && !flag.no_shadow, "{flag:?}");
+    let warned: Vec<String> = out.warnings.iter().map(|w| w.to_string()).collect();
+    let about = |key: &str| warned.iter().find(|w| w.contains(key)).cloned();
+    let noambient = about("\"_noambient\" \"1x\"").expect("a warning for _noambient");
+    assert!(
+        noambient.contains("entity 1") && noambient.contains("1, the number it starts with"),
+        "{noambient}"
+    );
+    let shadow = about("\"_shadow\" \"off\"").expect("a warning for _shadow");
+    assert!(shadow.contains("not set"), "{shadow}");
+}
+
 /// `_surflight_group` on worldspawn and the entities merged into it reaches their faces through
 /// `SLIPGATE_SURFGROUP`; a brush model's stays in its entity for light; no group, no lump.
 #[test]

@@ -77,6 +77,17 @@ impl Entity {
         self.get(key)?.trim().parse().ok()
     }
 
+    /// A key read as ericw-tools reads a number (C's `atof`): the number its first word starts
+    /// with (`"150x"` is 150), and whether that number was the whole value; `None` when the key
+    /// is missing or starts with no number.
+    pub fn get_leading_float(&self, key: &str) -> Option<(f64, bool)> {
+        let text = self.get(key)?;
+        let mut words = text.split_whitespace();
+        let first = words.next()?;
+        let (value, used) = leading_number(first)?;
+        Some((value, used == first.len() && words.next().is_none()))
+    }
+
     /// Where this point entity marks open space for a compiler's outside fill: its `origin`,
     /// unless it stands at the map's origin (where ericw-tools takes it for a brush entity and
     /// skips it) or is marked `_nofill` (or `_lightgrid_hint`) to stand in the void. The caller
@@ -87,6 +98,39 @@ impl Entity {
         let at_map_origin = origin.iter().all(|c| c.abs() < POINT_EPSILON);
         (!at_map_origin && !marked("_nofill") && !marked("_lightgrid_hint")).then_some(origin)
     }
+}
+
+/// The number `word` starts with (sign, digits, a point, an exponent: C's `strtod` without its
+/// hexadecimal and infinite forms), and how many bytes of it that takes.
+pub fn leading_number(word: &str) -> Option<(f64, usize)> {
+    let bytes = word.as_bytes();
+    let digits_from = |mut i: usize| {
+        while bytes.get(i).is_some_and(u8::is_ascii_digit) {
+            i += 1;
+        }
+        i
+    };
+    let mut end = usize::from(matches!(bytes.first(), Some(b'+' | b'-')));
+    let int_end = digits_from(end);
+    let mut mantissa_digits = int_end - end;
+    end = int_end;
+    if bytes.get(end) == Some(&b'.') {
+        let frac_end = digits_from(end + 1);
+        mantissa_digits += frac_end - end - 1;
+        end = frac_end;
+    }
+    if mantissa_digits == 0 {
+        return None;
+    }
+    if matches!(bytes.get(end), Some(b'e' | b'E')) {
+        let sign = usize::from(matches!(bytes.get(end + 1), Some(b'+' | b'-')));
+        let exp_end = digits_from(end + 1 + sign);
+        if exp_end > end + 1 + sign {
+            end = exp_end;
+        }
+    }
+    let value: f64 = word[..end].parse().ok()?;
+    value.is_finite().then_some((value, end))
 }
 
 /// Parse entity text. Quake's format has no escapes: a value runs to the next `"`.
@@ -180,6 +224,19 @@ pub fn write_entities(entities: &[Entity]) -> String {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn numbers_read_as_far_as_they_go() {
+        use super::leading_number;
+        assert_eq!(leading_number("150"), Some((150.0, 3)));
+        assert_eq!(leading_number("150x"), Some((150.0, 3)));
+        assert_eq!(leading_number("-1.5e2z"), Some((-150.0, 6)));
+        assert_eq!(leading_number("1e"), Some((1.0, 1)));
+        assert_eq!(leading_number(".5"), Some((0.5, 2)));
+        assert_eq!(leading_number("-"), None);
+        assert_eq!(leading_number("x5"), None);
+        assert_eq!(leading_number("."), None);
+    }
+
     use super::*;
     use proptest::prelude::*;
 

@@ -14,7 +14,7 @@
 use std::cell::RefCell;
 
 use glam::DVec3;
-use quake_formats::entities::Entity;
+use quake_formats::entities::{Entity, leading_number};
 
 use crate::settings::{Given, SettingWarning, normalize_color};
 
@@ -462,39 +462,6 @@ impl std::fmt::Display for ShownVec {
     }
 }
 
-/// The number `word` starts with (sign, digits, a point, an exponent: C's `strtod` without its
-/// hexadecimal and infinite forms), and how many bytes of it that takes.
-fn leading_number(word: &str) -> Option<(f64, usize)> {
-    let bytes = word.as_bytes();
-    let digits_from = |mut i: usize| {
-        while bytes.get(i).is_some_and(u8::is_ascii_digit) {
-            i += 1;
-        }
-        i
-    };
-    let mut end = usize::from(matches!(bytes.first(), Some(b'+' | b'-')));
-    let int_end = digits_from(end);
-    let mut mantissa_digits = int_end - end;
-    end = int_end;
-    if bytes.get(end) == Some(&b'.') {
-        let frac_end = digits_from(end + 1);
-        mantissa_digits += frac_end - end - 1;
-        end = frac_end;
-    }
-    if mantissa_digits == 0 {
-        return None;
-    }
-    if matches!(bytes.get(end), Some(b'e' | b'E')) {
-        let sign = usize::from(matches!(bytes.get(end + 1), Some(b'+' | b'-')));
-        let exp_end = digits_from(end + 1 + sign);
-        if exp_end > end + 1 + sign {
-            end = exp_end;
-        }
-    }
-    let value: f64 = word[..end].parse().ok()?;
-    value.is_finite().then_some((value, end))
-}
-
 /// The whole number `word` starts with (a sign and digits), and how many bytes that takes.
 fn leading_whole(word: &str) -> Option<(i64, usize)> {
     let bytes = word.as_bytes();
@@ -565,14 +532,6 @@ mod tests {
 
     #[test]
     fn numbers_read_as_far_as_they_go() {
-        assert_eq!(leading_number("150"), Some((150.0, 3)));
-        assert_eq!(leading_number("150x"), Some((150.0, 3)));
-        assert_eq!(leading_number("-1.5e2z"), Some((-150.0, 6)));
-        assert_eq!(leading_number("1e"), Some((1.0, 1)));
-        assert_eq!(leading_number(".5"), Some((0.5, 2)));
-        assert_eq!(leading_number("-"), None);
-        assert_eq!(leading_number("x5"), None);
-        assert_eq!(leading_number("."), None);
         assert_eq!(leading_whole("2.7"), Some((2, 1)));
         assert_eq!(leading_whole("-3"), Some((-3, 2)));
         assert_eq!(leading_whole("abc"), None);
