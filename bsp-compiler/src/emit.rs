@@ -267,6 +267,7 @@ pub(crate) fn emit(mut input: EmitInput) -> Emitted {
     let mut flags = Vec::with_capacity(pending.len());
     let mut surflight_groups = Vec::with_capacity(pending.len());
     let mut minlights = Vec::with_capacity(pending.len());
+    let mut channels = Vec::with_capacity(pending.len());
     let pieces = pending.iter().zip(polygons).flat_map(|(pf, poly)| {
         let max = max_face_edges(
             input.max_edges,
@@ -319,6 +320,7 @@ pub(crate) fn emit(mut input: EmitInput) -> Emitted {
         flags.push(info.flags);
         surflight_groups.push(info.surflight_group);
         minlights.push(info.minlight);
+        channels.push(info.channels);
         let range = node_faces
             .entry((pf.model, f.node))
             .or_insert((face_index, 0));
@@ -407,6 +409,7 @@ pub(crate) fn emit(mut input: EmitInput) -> Emitted {
     bsp.set_face_flags(&flags);
     bsp.set_surflight_groups(&surflight_groups);
     bsp.set_face_minlights(&minlights);
+    bsp.set_face_channels(&channels);
     let leaf_flags: Vec<LeafFlags> = leaf_contents
         .iter()
         .map(|c| LeafFlags {

@@ -20,6 +20,7 @@ use crate::tree::{DETAIL_WALL, FENCE, ILLUSIONARY, VISBLOCKER, engine_contents};
 use crate::warnings::{DroppedFace, Warning};
 use glam::DVec3;
 use quake_formats::bsp::contents;
+use quake_formats::bsp::face_channels::DEFAULT_CHANNELS;
 use quake_formats::bsp::face_flags::FaceFlags;
 use quake_formats::bsp::face_minlight::FaceMinlight;
 use quake_formats::bsp::phong::{self, FacePhong};
@@ -104,6 +105,7 @@ pub(crate) fn gather(
                 flags: merged_face_flags(ent, index, brush_class),
                 surflight_group: merged_surflight_group(ent, index, brush_class, warnings),
                 minlight: merged_minlight(ent, index, brush_class),
+                channels: merged_channels(ent, index, brush_class, warnings),
             },
             minlight_exclude: merged_minlight_exclude(ent, index, brush_class),
             transwater: options.transwater,
@@ -227,6 +229,9 @@ pub struct MapTexInfo {
     pub surflight_group: i32,
     /// The `_minlight` of the world-merged entity the face came from (level 0: none).
     pub minlight: FaceMinlight,
+    /// The `_object_channel_mask` of the world-merged entity the face came from (1: the
+    /// world's).
+    pub channels: u32,
 }
 
 /// What a face's entity says about the face, beyond its brush: one of these per entity.
@@ -238,6 +243,7 @@ pub(crate) struct FaceKeys {
     pub flags: FaceFlags,
     pub surflight_group: i32,
     pub minlight: FaceMinlight,
+    pub channels: u32,
 }
 
 impl MapTexInfo {
@@ -254,6 +260,7 @@ impl MapTexInfo {
             flags: self.flags,
             surflight_group: self.surflight_group,
             minlight: self.minlight,
+            channels: self.channels,
         }
     }
 }
@@ -365,7 +372,7 @@ impl EntityBrushes {
 
 /// What a texinfo is interned by: its projection's bits, texture, phong group, whether it is lit
 /// water, its face flags, surface light group and minlight's bits.
-type TexInfoKey = ([u64; 8], u32, u32, bool, FaceFlags, i32, [u32; 4]);
+type TexInfoKey = ([u64; 8], u32, u32, bool, FaceFlags, i32, [u32; 4], u32);
 
 /// Texture names and texinfos, interned in first-use order.
 #[derive(Default)]
@@ -387,6 +394,7 @@ impl TexInfoTable {
             flags,
             surflight_group,
             minlight,
+            channels,
         } = keys;
         let key = name.to_ascii_lowercase();
         let texture = match self.name_index.get(&key) {
@@ -416,6 +424,7 @@ impl TexInfoTable {
                 minlight.color[2],
             ]
             .map(f32::to_bits),
+            channels,
         );
         if let Some(&i) = self.info_index.get(&key) {
             return i;
@@ -430,6 +439,7 @@ impl TexInfoTable {
             flags,
             surflight_group,
             minlight,
+            channels,
         });
         self.info_index.insert(key, i);
         i
@@ -627,6 +637,35 @@ fn merged_surflight_group(
             used: "no group".into(),
         });
         0
+    })
+}
+
+/// The `_object_channel_mask` of entity `index` if it is merged into the world (light reads
+/// brush models' own): the light channels its faces take light on and block light on. A value
+/// that is not a whole number from 0 to 2^32 - 1 warns and leaves the world's.
+fn merged_channels(
+    ent: &MapEntity,
+    index: usize,
+    class: EntityBrushes,
+    warnings: &mut Vec<Warning>,
+) -> u32 {
+    const KEY: &str = "_object_channel_mask";
+    let Some(text) = ent
+        .entity
+        .get(KEY)
+        .filter(|t| merged_into_world(index, class) && !t.trim().is_empty())
+    else {
+        return DEFAULT_CHANNELS;
+    };
+    text.trim().parse().unwrap_or_else(|_| {
+        warnings.push(Warning::BadKey {
+            entity: index,
+            line: ent.line,
+            key: KEY.into(),
+            value: text.into(),
+            used: "the world's channel, 1".into(),
+        });
+        DEFAULT_CHANNELS
     })
 }
 
@@ -960,6 +999,7 @@ mod tests {
             flags,
             surflight_group: 0,
             minlight: FaceMinlight::default(),
+            channels: DEFAULT_CHANNELS,
         };
         let plain = table.intern(
             "wall",

@@ -283,6 +283,51 @@ fn merged_entities_number_keys_read_as_far_as_the_number_goes() {
     assert!(shadow.contains("not set"), "{shadow}");
 }
 
+/// `_object_channel_mask` of an entity merged into the world reaches its faces through
+/// `SLIPGATE_FACECHANNELS`; a brush model's stays in its entity for light; every face on
+/// channel 1, no lump; a value that is not a whole number warns and leaves channel 1.
+#[test]
+fn merged_entities_light_channels_reach_their_faces() {
+    let channels = |classname: &str, keys: &str| {
+        let brush = box_brush([-32.0, -32.0, -128.0], [32.0, 32.0, -64.0], "wall2");
+        let entity = format!("{{\n\"classname\" \"{classname}\"\n{keys}\n{brush}}}\n");
+        let out = compile_text(&room_map_with(false, "", &entity));
+        let masks = out.bsp.face_channels().expect("lump");
+        let of_box = masks.map(|m| {
+            let mut of: Vec<u32> = (0..out.bsp.faces.len())
+                .filter(|&f| face_texture(&out.bsp, f) == "wall2")
+                .map(|f| m[f])
+                .collect();
+            of.dedup();
+            of
+        });
+        let warned = out
+            .warnings
+            .iter()
+            .map(|w| w.to_string())
+            .collect::<Vec<_>>();
+        (of_box, warned)
+    };
+    assert_eq!(channels("func_detail", "").0, None);
+    assert_eq!(
+        channels("func_group", "\"_object_channel_mask\" \"8\"").0,
+        Some(vec![8])
+    );
+    assert_eq!(
+        channels("func_wall", "\"_object_channel_mask\" \"8\"").0,
+        None,
+        "light reads a brush model's own key"
+    );
+    let (none, warned) = channels("func_detail", "\"_object_channel_mask\" \"two\"");
+    assert_eq!(none, None);
+    assert!(
+        warned
+            .iter()
+            .any(|w| w.contains("_object_channel_mask") && w.contains("channel, 1")),
+        "{warned:?}"
+    );
+}
+
 /// `_surflight_group` on worldspawn and the entities merged into it reaches their faces through
 /// `SLIPGATE_SURFGROUP`; a brush model's stays in its entity for light; no group, no lump.
 #[test]

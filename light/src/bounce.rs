@@ -78,10 +78,12 @@ pub fn face_reflectance(
         .map(|f| {
             let in_scene = f.model == 0 || lights.shadow_models.contains(&f.model);
             let merged_no_bounce = lights.face_flags.get(f.index).is_some_and(|m| m.no_bounce);
+            // A face off the world's light channel reflects nothing, as in ericw-tools.
             if f.kind != FaceKind::Lit
                 || !in_scene
                 || merged_no_bounce
                 || lights.no_bounce_models.contains(&f.model)
+                || lights.channels_of(f) != 1
             {
                 return None;
             }

@@ -7,11 +7,12 @@
 //!
 //! The file is one JSON object: texinfo number (as a string) to an object of the flags that are
 //! set, such as `"no_shadow": true`, `"minlight": 100.0`, `"minlight_color": [255, 0, 0]`,
-//! `"phong_angle": 89.0`, `"phong_group": 2`, `"surflight_group": 3`.
+//! `"phong_angle": 89.0`, `"phong_group": 2`, `"surflight_group": 3`, `"object_channel_mask": 2`.
 
 use std::collections::HashMap;
 
 use quake_formats::Bsp;
+use quake_formats::bsp::face_channels::DEFAULT_CHANNELS;
 use quake_formats::bsp::face_flags::FaceFlags;
 use quake_formats::bsp::face_minlight::FaceMinlight;
 use quake_formats::bsp::phong::FacePhong;
@@ -26,6 +27,8 @@ struct TexinfoKeys {
     phong_angle_concave: f32,
     phong_group: i64,
     surflight_group: i32,
+    /// Its light channels (`_object_channel_mask`; `None`: the world's).
+    channels: Option<u32>,
 }
 
 impl TexinfoKeys {
@@ -67,6 +70,9 @@ impl TexinfoKeys {
             )),
             phong_group: whole("phong_group"),
             surflight_group: i32::try_from(whole("surflight_group")).unwrap_or(0),
+            channels: u32::try_from(whole("object_channel_mask"))
+                .ok()
+                .filter(|&m| m != 0),
         }
     }
 }
@@ -129,6 +135,11 @@ pub fn add_face_keys(bsp: &mut Bsp, json: &str) -> Result<AddedLumps, String> {
     bsp.set_phong_faces(&phong);
     let groups: Vec<i32> = keys.iter().map(|k| k.surflight_group).collect();
     bsp.set_surflight_groups(&groups);
+    let channels: Vec<u32> = keys
+        .iter()
+        .map(|k| k.channels.unwrap_or(DEFAULT_CHANNELS))
+        .collect();
+    bsp.set_face_channels(&channels);
     // Each is left out when no face has a key of its kind.
     Ok(FACE_KEY_LUMPS
         .into_iter()
@@ -137,12 +148,13 @@ pub fn add_face_keys(bsp: &mut Bsp, json: &str) -> Result<AddedLumps, String> {
 }
 
 /// The per-face key lumps Slipgate's compiler writes.
-const FACE_KEY_LUMPS: [&str; 5] = [
+const FACE_KEY_LUMPS: [&str; 6] = [
     quake_formats::bsp::face_flags::LUMP_NAME,
     quake_formats::bsp::face_minlight::LUMP_NAME,
     quake_formats::bsp::phong::LUMP_NAME,
     quake_formats::bsp::phong::CONCAVE_LUMP_NAME,
     quake_formats::bsp::surflight_group::LUMP_NAME,
+    quake_formats::bsp::face_channels::LUMP_NAME,
 ];
 
 /// Whether `bsp` carries any of the per-face key lumps Slipgate's compiler writes (then it was
@@ -180,12 +192,13 @@ mod tests {
         let mut bsp = bsp_with_faces(3);
         let json = r#"{
             "0": {},
-            "1": {"light_ignore": true, "minlight": 100.0, "no_shadow": true},
+            "1": {"light_ignore": true, "minlight": 100.0, "no_shadow": true,
+                  "object_channel_mask": 8},
             "2": {"minlight": 20.0, "minlight_color": [255, 0, 0], "phong_angle": 89.0,
                   "surflight_group": 4, "is_special": true}
         }"#;
         let added = add_face_keys(&mut bsp, json).expect("read");
-        assert_eq!(added.len(), 4, "{added:?}");
+        assert_eq!(added.len(), 5, "{added:?}");
         let flags = bsp.face_flags().expect("lump").expect("flags");
         assert_eq!(flags[0], FaceFlags::default());
         assert!(flags[1].light_ignore && flags[1].no_shadow && !flags[1].no_dirt);
@@ -197,6 +210,7 @@ mod tests {
         assert_eq!((phong[2].group, phong[2].angle), (1, 89.0));
         assert_eq!(phong[0].group, 0);
         assert_eq!(bsp.surflight_groups().expect("lump"), Some(vec![0, 0, 4]));
+        assert_eq!(bsp.face_channels().expect("lump"), Some(vec![1, 8, 1]));
         assert!(has_face_key_lumps(&bsp));
         for name in added {
             bsp.remove_bspx_lump(name);

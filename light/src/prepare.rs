@@ -178,6 +178,7 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
     let solids = faceless_solids(bsp, &faces, &map_lights.shadow_models, origin_of);
     let shadowless: Vec<bool> = map_lights.face_flags.iter().map(|f| f.no_shadow).collect();
     let fences = fence_masks(bsp, &faces);
+    let face_channels = map_lights.face_channel_masks(&faces);
     let casters = Casters {
         shadowless: &shadowless,
         models: &map_lights.shadow_models,
@@ -186,7 +187,7 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
         solids: &solids,
         switchable: &map_lights.switchable.shadows,
         fences: &fences,
-        channels: &map_lights.channel_models,
+        channels: &face_channels,
     };
     // Embree builds its tree on its own threads while ours link the faces.
     let (scene, links) = rayon::join(
@@ -289,7 +290,7 @@ pub fn face_rules<'a>(lights: &'a MapLights, geom: &FaceGeom) -> FaceRules<'a> {
         minlight,
         dirt,
         minlight_only: merged.light_ignore || lights.lightignore_models.contains(&geom.model),
-        channels: lights.channels_of(geom.model),
+        channels: lights.channels_of(geom),
         maxlight: lights
             .model_maxlight
             .get(&geom.model)

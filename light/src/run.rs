@@ -730,7 +730,7 @@ fn bounce_light(
         }
         // Wanted faces receive every pass (unless the reference measures them); reflecting ones
         // every pass but the last, for the next. Bounced light is on channel 1.
-        let on_channel_1 = |t: &Traced| prep.lights.channels_of(prep.faces[t.face].model) & 1 != 0;
+        let on_channel_1 = |t: &Traced| prep.lights.channels_of(&prep.faces[t.face]) & 1 != 0;
         let receiving: Vec<&Traced> = field
             .iter()
             .filter(|t| (!reference && t.light.is_some()) || (!last && t.reflected.is_some()))

@@ -9,8 +9,8 @@
 //! rays from their own faces (and those of models sharing their style), which
 //! they shadow as fixed geometry, as ericw-tools does.
 //! Fence faces are kept apart too, so light can pass their open texels
-//! ([`crate::fence`]). Models on light channels other than 1 (`_object_channel_mask`) get a
-//! scene per mask: they block the rays of the lights whose shadow channels share a bit with it
+//! ([`crate::fence`]). Faces on light channels other than 1 (`_object_channel_mask` of brush
+//! models and of the entities merged into the world) get a scene per mask: they block the rays of the lights whose shadow channels share a bit with it
 //! ([`TraceScene::occluded16_by`]), and the shared scene (the world, on channel 1) only those
 //! of lights with channel 1 among them.
 
@@ -65,8 +65,8 @@ pub struct TraceScene {
     fences: Option<Fences>,
     /// Per light-channel mask other than 1, the faces of the models on it.
     channels: Vec<(u32, Scene)>,
-    /// The brush models on light channels other than 1, and their mask.
-    model_channels: HashMap<usize, u32>,
+    /// Per face, its light channels (empty: every face on channel 1).
+    face_channels: Vec<u32>,
     /// Triangles in the scene (opaque + sky) and the `_shadowself` scenes.
     pub triangles: usize,
 }
@@ -88,9 +88,9 @@ pub struct Casters<'a> {
     pub switchable: &'a [(usize, u8)],
     /// Faces with a fence texture and the mask of its open texels: light passes those.
     pub fences: &'a [(usize, Arc<TexelMask>)],
-    /// Brush models on light channels other than 1, and their mask: they cast shadows on the
-    /// lights whose shadow channels share a bit with it.
-    pub channels: &'a [(usize, u32)],
+    /// Per face, its light channels (empty: every face on channel 1): faces off channel 1
+    /// cast shadows on the lights whose shadow channels share a bit with theirs.
+    pub channels: &'a [u32],
 }
 
 impl TraceScene {
@@ -117,12 +117,7 @@ impl TraceScene {
             fences,
             channels,
         } = *casters;
-        let channel_of = |f: &FaceGeom| {
-            channels
-                .iter()
-                .find(|(m, _)| *m == f.model)
-                .map(|&(_, mask)| mask)
-        };
+        let channel_of = |f: &FaceGeom| channels.get(f.index).copied().filter(|&c| c != 1);
         let fence_masks: HashMap<usize, &Arc<TexelMask>> =
             fences.iter().map(|(face, mask)| (*face, mask)).collect();
         let fence_mask = |f: &FaceGeom| fence_masks.get(&f.index).map(|&mask| mask.clone());
@@ -251,7 +246,7 @@ impl TraceScene {
             own_switchable,
             fences,
             channels: channel_scenes,
-            model_channels: channels.iter().copied().collect(),
+            face_channels: channels.to_vec(),
             triangles,
         })
     }
@@ -420,12 +415,16 @@ impl TraceScene {
         out
     }
 
-    /// For each active lane of `packet`, cast from a face of `model`, the
+    /// For each active lane of `packet`, cast from `face` of brush model `model`, the
     /// distance to the first surface if that is an opaque one (not sky), among what shares a
-    /// light channel with `model` (dirt: a model on other channels neither takes it from the
-    /// world nor gives it).
-    pub fn opaque_hits16(&self, packet: &mut RayPacket16, model: usize) -> [Option<f32>; 16] {
-        let channels = self.model_channels.get(&model).copied().unwrap_or(1);
+    /// light channel with the face (dirt: faces on other channels neither take it from the
+    /// world nor give it).
+    pub fn opaque_hits16(
+        &self,
+        packet: &mut RayPacket16,
+        (model, face): (usize, usize),
+    ) -> [Option<f32>; 16] {
+        let channels = self.face_channels.get(face).copied().unwrap_or(1);
         let mut out = [None; 16];
         if channels & 1 != 0 {
             self.world_opaque_hits16(packet, model, &mut out);

@@ -131,7 +131,7 @@ pub fn occlusion_at(
     scene: &TraceScene,
 ) -> (Vec<f32>, u64) {
     let sample_rays = SampleRays::new(samples, indices, sampling, rays);
-    sample_rays.occlusion(scene, model, sampling.depth as f32)
+    sample_rays.occlusion(scene, (model, samples.face), sampling.depth as f32)
 }
 
 /// Where the dirt rays of some samples start and which directions they take.
@@ -217,7 +217,8 @@ impl SampleRays {
     /// coincide, which Embree traverses faster than 16 directions from one point), and no
     /// packet is left part empty while rays remain (a face's few samples fill packets with
     /// their next directions). Each sample sums its rays in pattern order.
-    fn occlusion(&self, scene: &TraceScene, model: usize, depth: f32) -> (Vec<f32>, u64) {
+    /// `from`: the face's brush model and the face.
+    fn occlusion(&self, scene: &TraceScene, from: (usize, usize), depth: f32) -> (Vec<f32>, u64) {
         let n = self.starts.len();
         let per_sample = self.flat.len();
         let total = n * per_sample;
@@ -243,7 +244,7 @@ impl SampleRays {
                     (k, s) = (k + 1, 0);
                 }
             }
-            let hits = scene.opaque_hits16(&mut packet, model);
+            let hits = scene.opaque_hits16(&mut packet, from);
             for (hit, &sample) in hits.iter().zip(&lane_sample).take(lanes) {
                 if let Some(t) = hit {
                     gathered[sample] += 1.0 - (t / depth).min(1.0);

@@ -170,11 +170,11 @@ entity_keys! {
     DIRTGAIN: ["_dirtgain"] on Lights, Number, default "worldspawn's";
     /// `0`: this light's light does not reflect / this model's faces do not reflect.
     BOUNCE: ["_bounce"] on LightsAndModels, Number, default "`1`";
-    /// Light channels (a bit mask) this light lights: brush models whose
+    /// Light channels (a bit mask) this light lights: the faces of brush entities whose
     /// `_object_channel_mask` shares a bit with it (the world is on channel 1).
     LIGHT_CHANNEL_MASK: ["_light_channel_mask"] on Lights, Whole, default "`1`";
-    /// Light channels (a bit mask) whose models block this light's rays: those whose
-    /// `_object_channel_mask` shares a bit with it (the world is on channel 1).
+    /// Light channels (a bit mask) whose faces block this light's rays: those of brush entities
+    /// whose `_object_channel_mask` shares a bit with it (the world is on channel 1).
     SHADOW_CHANNEL_MASK: ["_shadow_channel_mask"] on Lights, Whole, default "its `_light_channel_mask`";
     /// How much of this light bounces (`0`: none, as `_bounce 0`); ericw-tools documents it.
     BOUNCESCALE: ["_bouncescale"] on Lights, Number, default "`1`";
@@ -248,11 +248,12 @@ entity_keys! {
     /// `1`: the model shadows the world's faces only (not its own, nor other models'); it wins
     /// over `_shadow`.
     SHADOWWORLDONLY: ["_shadowworldonly"] on Models, Number, default "`0`";
-    /// Light channels (a bit mask) the model receives light on and blocks light on: a light
-    /// lights its faces when the masks share a bit with its `_light_channel_mask`, and the
-    /// model blocks the rays of a light whose `_shadow_channel_mask` shares one. Not `1`: the
-    /// model casts shadows (as `_shadow 1`) and reflects no bounced light; suns, surface lights
-    /// and bounced light are on channel 1, and dirt comes from what shares a channel.
+    /// Light channels (a bit mask) the entity's faces receive light on and block light on: a
+    /// light lights them when the masks share a bit with its `_light_channel_mask`, and they
+    /// block the rays of a light whose `_shadow_channel_mask` shares one. Not `1`: they cast
+    /// shadows (as `_shadow 1`) and reflect no bounced light; suns, surface lights and bounced
+    /// light are on channel 1, and dirt comes from what shares a channel. On `func_detail*` and
+    /// `func_group` too (the compiler records it per face).
     OBJECT_CHANNEL_MASK: ["_object_channel_mask"] on Models, Whole, default "`1`";
     /// `1`: the model's faces receive no light but minlight.
     LIGHTIGNORE: ["_lightignore"] on Models, Switch, default "`0`";

@@ -18,6 +18,7 @@ mod worldspawn;
 use glam::DVec3;
 use std::collections::HashMap;
 
+use quake_formats::bsp::face_channels::DEFAULT_CHANNELS;
 use quake_formats::bsp::face_flags::FaceFlags;
 use quake_formats::entities::Entity;
 
@@ -121,6 +122,9 @@ pub struct MapLights {
     /// Faces with a minlight of their own entity's, merged into the world (the compiler's
     /// `SLIPGATE_FACEMINLIGHT`).
     pub face_minlight: HashMap<usize, Minlight>,
+    /// Per face, the light channels of the entity merged into the world it came from (the
+    /// compiler's `SLIPGATE_FACECHANNELS`; empty without that lump).
+    pub face_channels: Vec<u32>,
     /// Brush models whose `_autominlight` is not the default (occluded samples only).
     pub autominlight: HashMap<usize, AutoMinlight>,
     /// Brush models whose autominlight is taken at a target's origin (`_autominlight_target`).
@@ -154,13 +158,26 @@ pub struct MapLights {
 }
 
 impl MapLights {
-    /// The light channels of model `model` (`_object_channel_mask`; 1 for the world and by
-    /// default).
-    pub fn channels_of(&self, model: usize) -> u32 {
-        self.channel_models
-            .iter()
-            .find(|(m, _)| *m == model)
-            .map_or(1, |&(_, mask)| mask)
+    /// The light channels of `face`: its merged entity's `_object_channel_mask`, else its brush
+    /// model's (1, the world's, by default).
+    pub fn channels_of(&self, face: &crate::faces::FaceGeom) -> u32 {
+        match self.face_channels.get(face.index) {
+            Some(&mask) if mask != DEFAULT_CHANNELS => mask,
+            _ => self
+                .channel_models
+                .iter()
+                .find(|(m, _)| *m == face.model)
+                .map_or(DEFAULT_CHANNELS, |&(_, mask)| mask),
+        }
+    }
+
+    /// Every face's light channels ([`MapLights::channels_of`]); empty when all are on
+    /// channel 1.
+    pub fn face_channel_masks(&self, faces: &[crate::faces::FaceGeom]) -> Vec<u32> {
+        if self.channel_models.is_empty() && self.face_channels.is_empty() {
+            return Vec::new();
+        }
+        faces.iter().map(|f| self.channels_of(f)).collect()
     }
 
     /// The spacing model `model`'s faces are lit at, as in ericw-tools: with the map's
@@ -245,6 +262,7 @@ pub fn parse_lights(
         no_bounce_models: Vec::new(),
         face_flags: Vec::new(),
         face_minlight: HashMap::new(),
+        face_channels: Vec::new(),
         autominlight: HashMap::new(),
         autominlight_at: HashMap::new(),
         no_nudge: Vec::new(),
@@ -280,7 +298,8 @@ pub fn parse_lights(
 
 impl MapLights {
     /// Reads what the compiler recorded in `bsp` of the keys of entities merged into the world,
-    /// per face ([`MapLights::face_flags`], [`MapLights::face_minlight`]).
+    /// per face ([`MapLights::face_flags`], [`MapLights::face_minlight`],
+    /// [`MapLights::face_channels`]).
     ///
     /// # Errors
     /// A damaged `SLIPGATE_FACEFLAGS` or `SLIPGATE_FACEMINLIGHT` lump.

@@ -460,6 +460,40 @@ fn light_channels_choose_what_a_light_lights_and_what_shadows_it() {
     assert_eq!(plate5, 0, "shadow channels 1 and 2: the slab blocks");
 }
 
+/// ericw-tools' "light channel mask" for entities merged into the world: a `func_detail` with
+/// `_object_channel_mask 2` takes the light of channel-2 lights and casts no shadow on channel
+/// 1 (the compiler records its faces' mask in `SLIPGATE_FACECHANNELS`).
+#[test]
+fn a_merged_entity_on_another_channel_takes_its_lights_and_casts_on_them_alone() {
+    let slab = map_box([-32.0, -32.0, -64.0], [32.0, 32.0, -48.0]);
+    let look = |slab_keys: &str, light_keys: &str| {
+        let bsp = room_bsp(&format!(
+            "{{\n\"classname\" \"func_detail\"\n{slab_keys}\n{slab}}}\n{}",
+            light([0.0, 0.0, 64.0], light_keys)
+        ));
+        let lighting = lit(&bsp);
+        let red = |rgb: Option<[u8; 3]>| rgb.map_or(0, |c| c[0]);
+        let slab_top = luxel_rgb(&bsp, &lighting, 0, DVec3::new(0.0, 0.0, -48.0), DVec3::Z);
+        (red(slab_top), red(floor_rgb(&bsp, &lighting, 0.0, 0.0)))
+    };
+    let (slab, floor) = look("", "");
+    assert!(slab > 20, "{slab}");
+    assert_eq!(floor, 0, "in the slab's shadow");
+    let on_2 = "\"_object_channel_mask\" \"2\"";
+    let (slab1, floor1) = look(on_2, "");
+    assert_eq!(slab1, 0, "a channel-1 light does not light the slab");
+    assert!(
+        floor1 > 20,
+        "the slab casts no shadow on channel 1: {floor1}"
+    );
+    let (slab2, floor2) = look(on_2, "\"_light_channel_mask\" \"2\"");
+    assert_eq!(
+        (slab2, floor2),
+        (slab, 0),
+        "a channel-2 light lights the slab alone"
+    );
+}
+
 /// ericw-tools' "light channel mask / dirt interaction": dirt comes from what shares a light
 /// channel. A box on the floor beside a lit spot: as a shadow caster on channel 1 it darkens
 /// the floor at its foot with dirt; on channel 2 it does not (the light lights both channels).
