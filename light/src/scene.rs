@@ -10,9 +10,9 @@
 //! they shadow as fixed geometry, as ericw-tools does.
 //! Fence faces are kept apart too, so light can pass their open texels
 //! ([`crate::fence`]). Faces on light channels other than 1 (`_object_channel_mask` of brush
-//! models and of the entities merged into the world) get a scene per mask: they block the rays of the lights whose shadow channels share a bit with it
-//! ([`TraceScene::occluded16_by`]), and the shared scene (the world, on channel 1) only those
-//! of lights with channel 1 among them.
+//! models and of the entities merged into the world) get a scene per mask: they block the rays
+//! of the lights whose shadow channels share a bit with it ([`TraceScene::occluded16_by`]), and
+//! the shared scene (the world, on channel 1) only those of lights with channel 1 among them.
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -63,7 +63,7 @@ pub struct TraceScene {
     own_switchable: HashMap<usize, usize>,
     /// The shadow-casting fence faces, whose open texels let light through.
     fences: Option<Fences>,
-    /// Per light-channel mask other than 1, the faces of the models on it.
+    /// Per light-channel mask other than 1, the faces on it.
     channels: Vec<(u32, Scene)>,
     /// Per face, its light channels (empty: every face on channel 1).
     face_channels: Vec<u32>,
@@ -283,8 +283,8 @@ impl TraceScene {
     }
 
     /// [`TraceScene::occluded16`] for the rays of a light whose shadow channels are
-    /// `shadow_channels`: the world and the models on channel 1 block them when it has channel
-    /// 1, the models on other channels when it shares one of theirs.
+    /// `shadow_channels`: the world and the faces on channel 1 block them when it has channel
+    /// 1, the faces on other channels when it shares one of theirs.
     pub fn occluded16_by(
         &self,
         packet: &mut RayPacket16,
@@ -302,7 +302,7 @@ impl TraceScene {
         self.channels_block16(packet, shadow_channels) | blocked
     }
 
-    /// Lanes of `packet` that the models on light channels other than 1 sharing a bit with
+    /// Lanes of `packet` that the faces on light channels other than 1 sharing a bit with
     /// `shadow_channels` block.
     fn channels_block16(&self, packet: &mut RayPacket16, shadow_channels: u32) -> u16 {
         self.channels
