@@ -14,7 +14,7 @@ use crate::brush::{Brush, Side};
 use crate::planes::PlaneSet;
 use crate::tree::{contents_priority, keeps_sides_inside};
 use glam::DVec3;
-use quake_formats::geom::{Bounds, ON_EPSILON, PlaneSide, Split, Winding};
+use quake_formats::geom::{Bounds, ON_EPSILON, Plane, PlaneSide, Split, Winding};
 use rayon::prelude::*;
 
 /// Mark every side of `brushes` that lies wholly inside other brushes as buried. Returns how
@@ -85,11 +85,8 @@ fn buried(
                 outside.push((w, bounds));
                 continue;
             }
-            clip_outside(w, other, planes, own.normal, &mut clipped);
-            outside.extend(clipped.drain(..).map(|w| {
-                let b = w.bounds();
-                (w, b)
-            }));
+            clip_outside((w, bounds), other, planes, own.normal, &mut clipped);
+            outside.append(&mut clipped);
         }
         pieces = outside;
         if pieces.is_empty() {
@@ -99,37 +96,47 @@ fn buried(
     false
 }
 
-/// Push the parts of `w` outside `brush`. A part lying on one of its sides counts as inside
-/// when the two face each other (touching brushes) and outside when they face the same way.
+/// Push the parts of `w` (with its bounds) outside `brush`, each with its bounds. A part lying
+/// on one of its sides counts as inside when the two face each other (touching brushes) and
+/// outside when they face the same way.
 fn clip_outside(
-    w: Winding,
+    (w, bounds): (Winding, Bounds),
     brush: &Brush,
     planes: &PlaneSet,
     facing: DVec3,
-    out: &mut Vec<Winding>,
+    out: &mut Vec<(Winding, Bounds)>,
 ) {
     let mut rest = w;
-    // Whether `rest` is tiny, computed again only when a split changes it.
+    // `rest`'s bounds and whether it is tiny, computed again only when a split changes it.
+    let mut rest_bounds = Some(bounds);
     let mut tiny = None;
     for s in &brush.sides {
         let plane = brush.outward(s, planes);
         // Classify first: most windings lie wholly on one side, and splitting would copy them.
-        match rest.side_of(&plane) {
+        let side = match axial_axis(&plane) {
+            Some(k) => axial_side(&plane, k, rest_bounds.get_or_insert_with(|| rest.bounds())),
+            None => rest.side_of(&plane),
+        };
+        match side {
             PlaneSide::Front => {
-                out.push(rest);
+                let b = rest_bounds.unwrap_or_else(|| rest.bounds());
+                out.push((rest, b));
                 return;
             }
             PlaneSide::On if plane.normal.dot(facing) > 0.0 => {
-                out.push(rest);
+                let b = rest_bounds.unwrap_or_else(|| rest.bounds());
+                out.push((rest, b));
                 return;
             }
             PlaneSide::Back | PlaneSide::On => {}
             PlaneSide::Cross => {
                 if let Split::Both { front, back } = rest.split(&plane) {
                     if !front.is_tiny() {
-                        out.push(front);
+                        let b = front.bounds();
+                        out.push((front, b));
                     }
                     rest = back;
+                    rest_bounds = None;
                     tiny = None;
                 }
             }
@@ -138,6 +145,25 @@ fn clip_outside(
             return;
         }
     }
+}
+
+/// The axis a plane's normal lies along (one component ±1, the others 0), if it does.
+fn axial_axis(plane: &Plane) -> Option<usize> {
+    let n = plane.normal.to_array();
+    (0..3).find(|&k| n[k].abs() == 1.0 && (0..3).all(|j| j == k || n[j] == 0.0))
+}
+
+/// Where a winding whose points' box is `bounds` lies against `plane`, whose normal lies along
+/// axis `k`: a point's distance from it is then its coordinate (or its negation) less the
+/// plane's distance, exactly, so the box's extremes give the points' extreme distances, as
+/// [`Winding::side_of`] finds them point by point.
+fn axial_side(plane: &Plane, k: usize, bounds: &Bounds) -> PlaneSide {
+    let (lo, hi) = if plane.normal[k] > 0.0 {
+        (bounds.mins[k] - plane.dist, bounds.maxs[k] - plane.dist)
+    } else {
+        (-bounds.maxs[k] - plane.dist, -bounds.mins[k] - plane.dist)
+    };
+    PlaneSide::of_both(hi > ON_EPSILON, lo < -ON_EPSILON)
 }
 
 #[cfg(test)]
@@ -257,6 +283,39 @@ mod tests {
     }
 
     proptest::proptest! {
+        /// Against an axial plane, the side from the winding's box is the side its points give,
+        /// for points near the plane (within a few epsilons) as well as far from it.
+        #[test]
+        fn an_axial_side_from_the_box_is_the_points_side(
+            points in proptest::collection::vec(
+                (-4i32..4, -4i32..4, -4i32..4, -3i32..4),
+                1..8,
+            ),
+            axis in 0usize..3,
+            flip: bool,
+            dist in -2i32..3,
+        ) {
+            let eps = ON_EPSILON;
+            let points: Vec<DVec3> = points
+                .iter()
+                .map(|&(x, y, z, near)| {
+                    let mut p = DVec3::new(x as f64, y as f64, z as f64) * 16.0;
+                    // Some coordinates within a few epsilons of the plane.
+                    p[axis] = f64::from(dist) * 16.0 + f64::from(near) * eps * 0.75;
+                    if near == 3 {
+                        p[axis] += 40.0;
+                    }
+                    p
+                })
+                .collect();
+            let w = Winding::new(points);
+            let mut normal = DVec3::ZERO;
+            normal[axis] = if flip { -1.0 } else { 1.0 };
+            let plane = Plane::new(normal, normal[axis] * f64::from(dist) * 16.0);
+            proptest::prop_assert_eq!(axial_axis(&plane), Some(axis));
+            proptest::prop_assert_eq!(axial_side(&plane, axis, &w.bounds()), w.side_of(&plane));
+        }
+
         /// A side marked buried lies inside the other boxes: points just outside it, all over
         /// it, are inside some other box.
         #[test]
