@@ -291,6 +291,10 @@ pub fn face_rules<'a>(lights: &'a MapLights, geom: &FaceGeom) -> FaceRules<'a> {
         dirt,
         minlight_only: merged.light_ignore || lights.lightignore_models.contains(&geom.model),
         channels: lights.channels_of(geom),
+        color_scale: lights
+            .model_lightcolorscale
+            .get(&geom.model)
+            .map(|&s| s as f32),
         maxlight: lights
             .model_maxlight
             .get(&geom.model)

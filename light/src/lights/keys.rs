@@ -260,6 +260,9 @@ entity_keys! {
     /// The model's faces are lit on a world-aligned grid of one luxel every this many units
     /// (when the map's `_world_units_per_luxel` is set).
     WORLD_UNITS_PER_LUXEL: ["_world_units_per_luxel"] on Models, Number, default "the map's";
+    /// How much colour the faces' light keeps: `0` greys it (each luxel takes its brightest
+    /// channel in all three), `1` keeps it; between, a mix, as in ericw-tools.
+    LIGHTCOLORSCALE: ["_lightcolorscale"] on WorldAndModels, Number, default "`1`";
     /// The model's lightmap spacing as a fraction of Quake's 16 texels, rounded down to a
     /// power of two texels (BSPX `LMSHIFT`).
     LMSCALE: ["_lmscale"] on WorldAndModels, Number, default "`1`";

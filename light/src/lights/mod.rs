@@ -102,6 +102,8 @@ pub struct MapLights {
     pub minlight: HashMap<usize, Minlight>,
     /// Brush models with their own `_maxlight`, in levels.
     pub model_maxlight: HashMap<usize, f64>,
+    /// Worldspawn (model 0) and brush models whose `_lightcolorscale` is not 1.
+    pub model_lightcolorscale: HashMap<usize, f64>,
     /// Brush models that cast shadows (`_shadow 1`).
     pub shadow_models: Vec<usize>,
     /// Brush models that shadow only their own faces (`_shadowself 1`).
@@ -253,6 +255,7 @@ pub fn parse_lights(
         templates: Vec::new(),
         minlight: HashMap::new(),
         model_maxlight: HashMap::new(),
+        model_lightcolorscale: HashMap::new(),
         shadow_models: Vec::new(),
         self_shadow_models: Vec::new(),
         world_shadow_models: Vec::new(),

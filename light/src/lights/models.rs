@@ -20,8 +20,8 @@ pub fn model_index(e: &Entity) -> Option<usize> {
     e.get("model")?.strip_prefix('*')?.parse().ok()
 }
 
-/// `_phong`, `_phong_angle` and `_phong_angle_concave` (into `out.phong`) and `_lmscale` (into
-/// `out.model_lmscale`) of worldspawn (`world`, as model 0) and every brush model, with a warning
+/// `_phong`, `_phong_angle` and `_phong_angle_concave` (into `out.phong`), `_lmscale` (into
+/// `out.model_lmscale`) and `_lightcolorscale` (into `out.model_lightcolorscale`) of worldspawn (`world`, as model 0) and every brush model, with a warning
 /// for each key not taken as written.
 pub fn read_world_and_model_keys(entities: &[Entity], world: Option<usize>, out: &mut MapLights) {
     for (index, e) in entities.iter().enumerate() {
@@ -36,6 +36,9 @@ pub fn read_world_and_model_keys(entities: &[Entity], world: Option<usize>, out:
         let k = Keys::new(e, index);
         if let Some(scale) = k.number(&keys::LMSCALE) {
             out.model_lmscale.insert(model, scale);
+        }
+        if let Some(scale) = k.number(&keys::LIGHTCOLORSCALE).filter(|s| *s != 1.0) {
+            out.model_lightcolorscale.insert(model, scale);
         }
         let phong = (k.number(&keys::PHONG), k.number(&keys::PHONG_ANGLE));
         if let Some(angle) = phong::angle_from_keys(phong.0, phong.1) {

@@ -13,6 +13,8 @@ enum Where {
     Lights,
     /// Brush entities, merged into the world or not.
     Brushes,
+    /// Brush entities merged into the world (`func_detail*`, `func_group`: no `model` key).
+    MergedBrushes,
 }
 
 /// Each key, where ericw-tools reads it, and what it does there.
@@ -34,6 +36,11 @@ const UNSUPPORTED: &[(&str, Where, &str)] = &[
         "projected texture's field of view",
     ),
     ("_minlight_mottle", Where::Brushes, "mottled minlight"),
+    (
+        "_lightcolorscale",
+        Where::MergedBrushes,
+        "light colour scale of brushes merged into the world",
+    ),
 ];
 
 /// A warning for each key of [`UNSUPPORTED`] an entity of `entities` sets where ericw-tools
@@ -49,11 +56,12 @@ pub fn warnings(entities: &[Entity]) -> Vec<SettingWarning> {
         } else {
             Where::Brushes
         };
+        let merged = here == Where::Brushes && e.get("model").is_none();
         for &(key, place, what) in UNSUPPORTED {
             let Some(value) = e.get(key).filter(|v| !v.trim().is_empty()) else {
                 continue;
             };
-            if place == here {
+            if place == here || (place == Where::MergedBrushes && merged) {
                 out.push(SettingWarning {
                     given: Given::key(index, e, key),
                     value: value.to_string(),
@@ -76,6 +84,7 @@ pub fn markdown_list() -> String {
             Where::Worldspawn => "worldspawn",
             Where::Lights => "lights",
             Where::Brushes => "brush entities",
+            Where::MergedBrushes => "brush entities merged into the world",
         };
         out += &format!("- `{key}` ({on}): {what}\n");
     }
@@ -92,20 +101,25 @@ mod tests {
         let text = r#"
 { "classname" "worldspawn" "_bouncelightsubdivision" "2" "_project_texture" "x" }
 { "classname" "light" "origin" "0 0 0" "_project_texture" "window1" "_project_fov" "" }
-{ "classname" "func_wall" "model" "*1" "_minlight_mottle" "1" "_object_channel_mask" "2" }
+{ "classname" "func_wall" "model" "*1" "_minlight_mottle" "1" "_lightcolorscale" "0" }
+{ "classname" "func_detail" "_lightcolorscale" "0" }
 "#;
         let entities = parse_entities(text).expect("entities");
         let told: Vec<String> = warnings(&entities)
             .iter()
             .map(ToString::to_string)
             .collect();
-        assert_eq!(told.len(), 3, "{told:?}");
+        assert_eq!(told.len(), 4, "{told:?}");
         assert!(told[0].contains("\"_bouncelightsubdivision\"") && told[0].contains("bounce"));
         assert!(
             told[1].contains("\"_project_texture\" is \"window1\""),
             "{told:?}"
         );
         assert!(told[2].contains("_minlight_mottle"));
+        assert!(
+            told[3].contains("entity 3") && told[3].contains("_lightcolorscale"),
+            "a merged entity's colour scale, not a brush model's: {told:?}"
+        );
     }
 
     #[test]

@@ -517,6 +517,42 @@ fn dirt_comes_only_from_models_on_the_same_channel() {
     assert_eq!(other_channel, open);
 }
 
+/// ericw-tools' `_lightcolorscale` (a brush model's key): `0` greys the light of its faces, each
+/// luxel taking its brightest channel in all three; `0.5` keeps half the colour; the world's
+/// light keeps its colour.
+#[test]
+fn light_color_scale_greys_a_models_faces() {
+    let slab = map_box([-32.0, -32.0, -64.0], [32.0, 32.0, -48.0]);
+    let look = |keys: &str| {
+        let bsp = room_bsp(&format!(
+            "{{\n\"classname\" \"func_wall\"\n{keys}\n{slab}}}\n{}",
+            light([0.0, 0.0, 64.0], "\"_color\" \"255 64 0\"")
+        ));
+        let lighting = lit(&bsp);
+        let top = luxel_rgb(&bsp, &lighting, 1, DVec3::new(0.0, 0.0, -48.0), DVec3::Z);
+        (
+            top.expect("a lit slab"),
+            floor_rgb(&bsp, &lighting, 100.0, 100.0).expect("lit"),
+        )
+    };
+    let (coloured, floor) = look("");
+    assert!(
+        coloured[0] > coloured[1] && coloured[2] == 0,
+        "{coloured:?}"
+    );
+    let (grey, grey_floor) = look("\"_lightcolorscale\" \"0\"");
+    assert_eq!(grey, [coloured[0]; 3], "the brightest channel in all three");
+    assert_eq!(grey_floor, floor, "the world keeps its colour");
+    let (half, _) = look("\"_lightcolorscale\" \"0.5\"");
+    let mid = |c: u8| (f32::from(coloured[0]) + f32::from(c)) / 2.0;
+    for k in 0..3 {
+        assert!(
+            (f32::from(half[k]) - mid(coloured[k])).abs() <= 1.0,
+            "{half:?} against {coloured:?}"
+        );
+    }
+}
+
 /// ericw-tools' `_spotlightautofalloff`: a linear spotlight aimed at a `target` fades to zero
 /// just past its cone at the target (the distance plus the cone's radius there), instead of
 /// at its brightness in units. 224 units above the floor, light 600, angle 40: zero at 305.5

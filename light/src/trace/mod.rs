@@ -96,6 +96,8 @@ pub struct FaceRules<'a> {
     pub channels: u32,
     /// `_maxlight`: the most light a sample takes, in levels (`None`: no cap).
     pub maxlight: Option<f64>,
+    /// `_lightcolorscale`: how much colour the light keeps (`None`: all of it).
+    pub color_scale: Option<f32>,
     /// Bounced light will be added and darkened by dirt this way: dirt is
     /// then measured at every sample (bounce reaches where lights do not).
     pub bounce_dirt: Option<DirtResponse>,
@@ -110,6 +112,7 @@ impl Default for FaceRules<'_> {
             minlight_only: false,
             channels: 1,
             maxlight: None,
+            color_scale: None,
             bounce_dirt: None,
         }
     }
@@ -239,6 +242,7 @@ impl<'a> FaceTrace<'a> {
             occluded: samples.occluded.clone(),
             // ericw-tools caps its samples at twice the level, before the range scale.
             max_sample: rules.maxlight.map(|level| (2.0 * level) as f32),
+            color_scale: rules.color_scale,
         };
         let mut bounds = Bounds::EMPTY;
         for &p in &samples.points {

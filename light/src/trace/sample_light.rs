@@ -67,6 +67,8 @@ pub struct SampleLight {
     pub(super) occluded: Vec<bool>,
     /// The brightest channel a sample may reach (`_maxlight`); a brighter one is scaled down.
     pub(super) max_sample: Option<f32>,
+    /// `_lightcolorscale` ([`super::FaceRules::color_scale`]).
+    pub(super) color_scale: Option<f32>,
 }
 
 /// Per sample and style, the directions towards the lights and suns that reached it, each
@@ -359,6 +361,15 @@ impl SampleLight {
                     if brightest > cap {
                         *v = v.map(|c| c * cap / brightest);
                     }
+                }
+            }
+        }
+        // `_lightcolorscale`, after the cap as in ericw-tools: toward the brightest channel.
+        if let Some(scale) = self.color_scale {
+            for (_, values) in &mut self.sums.styles {
+                for v in values.iter_mut() {
+                    let grey = v[0].max(v[1]).max(v[2]);
+                    *v = v.map(|c| grey * (1.0 - scale) + c * scale);
                 }
             }
         }
