@@ -41,6 +41,11 @@ const UNSUPPORTED: &[(&str, Where, &str)] = &[
         Where::MergedBrushes,
         "light colour scale of brushes merged into the world",
     ),
+    (
+        "_maxlight",
+        Where::MergedBrushes,
+        "light cap of brushes merged into the world",
+    ),
 ];
 
 /// A warning for each key of [`UNSUPPORTED`] an entity of `entities` sets where ericw-tools
@@ -102,14 +107,14 @@ mod tests {
 { "classname" "worldspawn" "_bouncelightsubdivision" "2" "_project_texture" "x" }
 { "classname" "light" "origin" "0 0 0" "_project_texture" "window1" "_project_fov" "" }
 { "classname" "func_wall" "model" "*1" "_minlight_mottle" "1" "_lightcolorscale" "0" }
-{ "classname" "func_detail" "_lightcolorscale" "0" }
+{ "classname" "func_detail" "_lightcolorscale" "0" "_maxlight" "40" }
 "#;
         let entities = parse_entities(text).expect("entities");
         let told: Vec<String> = warnings(&entities)
             .iter()
             .map(ToString::to_string)
             .collect();
-        assert_eq!(told.len(), 4, "{told:?}");
+        assert_eq!(told.len(), 5, "{told:?}");
         assert!(told[0].contains("\"_bouncelightsubdivision\"") && told[0].contains("bounce"));
         assert!(
             told[1].contains("\"_project_texture\" is \"window1\""),
