@@ -621,23 +621,14 @@ fn merged_surflight_group(
     warnings: &mut Vec<Warning>,
 ) -> i32 {
     const KEY: &str = "_surflight_group";
-    let Some(text) = ent
+    match ent
         .entity
         .get(KEY)
         .filter(|_| class != EntityBrushes::Submodel)
-    else {
-        return 0;
-    };
-    text.trim().parse().unwrap_or_else(|_| {
-        warnings.push(Warning::BadKey {
-            entity: index,
-            line: ent.line,
-            key: KEY.into(),
-            value: text.into(),
-            used: "no group".into(),
-        });
-        0
-    })
+    {
+        Some(text) => parse_or_warn((ent, index), KEY, text, (0, "no group"), warnings),
+        None => 0,
+    }
 }
 
 /// The `_object_channel_mask` of entity `index` if it is merged into the world (light reads
@@ -650,22 +641,37 @@ fn merged_channels(
     warnings: &mut Vec<Warning>,
 ) -> u32 {
     const KEY: &str = "_object_channel_mask";
-    let Some(text) = ent
+    match ent
         .entity
         .get(KEY)
         .filter(|t| merged_into_world(index, class) && !t.trim().is_empty())
-    else {
-        return DEFAULT_CHANNELS;
-    };
+    {
+        Some(text) => {
+            let default = (DEFAULT_CHANNELS, "the world's channel, 1");
+            parse_or_warn((ent, index), KEY, text, default, warnings)
+        }
+        None => DEFAULT_CHANNELS,
+    }
+}
+
+/// `text`, the value of `key` on entity `index`, parsed whole; a value that does not parse
+/// warns and gives `default` (its first), named for the warning by its second.
+fn parse_or_warn<T: std::str::FromStr>(
+    (ent, index): (&MapEntity, usize),
+    key: &str,
+    text: &str,
+    (default, used): (T, &str),
+    warnings: &mut Vec<Warning>,
+) -> T {
     text.trim().parse().unwrap_or_else(|_| {
         warnings.push(Warning::BadKey {
             entity: index,
             line: ent.line,
-            key: KEY.into(),
+            key: key.into(),
             value: text.into(),
-            used: "the world's channel, 1".into(),
+            used: used.into(),
         });
-        DEFAULT_CHANNELS
+        default
     })
 }
 
