@@ -65,8 +65,6 @@ pub struct TraceScene {
     fences: Option<Fences>,
     /// Per light-channel mask other than 1, the faces on it.
     channels: Vec<(u32, Scene)>,
-    /// Per face, its light channels (empty: every face on channel 1).
-    face_channels: Vec<u32>,
     /// Triangles in the scene (opaque + sky) and the `_shadowself` scenes.
     pub triangles: usize,
 }
@@ -246,7 +244,6 @@ impl TraceScene {
             own_switchable,
             fences,
             channels: channel_scenes,
-            face_channels: channels.to_vec(),
             triangles,
         })
     }
@@ -415,16 +412,15 @@ impl TraceScene {
         out
     }
 
-    /// For each active lane of `packet`, cast from `face` of brush model `model`, the
-    /// distance to the first surface if that is an opaque one (not sky), among what shares a
-    /// light channel with the face (dirt: faces on other channels neither take it from the
-    /// world nor give it).
+    /// For each active lane of `packet`, cast from a face of brush model `model` on light
+    /// channels `channels`, the distance to the first surface if that is an opaque one (not
+    /// sky), among what shares a light channel with the face (dirt: faces on other channels
+    /// neither take it from the world nor give it).
     pub fn opaque_hits16(
         &self,
         packet: &mut RayPacket16,
-        (model, face): (usize, usize),
+        (model, channels): (usize, u32),
     ) -> [Option<f32>; 16] {
-        let channels = self.face_channels.get(face).copied().unwrap_or(1);
         let mut out = [None; 16];
         if channels & 1 != 0 {
             self.world_opaque_hits16(packet, model, &mut out);

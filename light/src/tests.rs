@@ -1069,7 +1069,7 @@ fn dirt_cone_follows_the_phong_normal() {
         crate::dirt::occlusion_at(
             samples,
             &all,
-            0,
+            (0, 1),
             &sampling,
             crate::dirt::DirtRays::All,
             &prep.scene,
@@ -1787,7 +1787,7 @@ fn dirt_occlusion_does_not_depend_on_the_rays_traced_beside_it() {
                     crate::dirt::occlusion_at(
                         &samples,
                         indices,
-                        geom.model,
+                        (geom.model, 1),
                         &prep.lights.dirt,
                         crate::dirt::DirtRays::All,
                         &prep.scene,

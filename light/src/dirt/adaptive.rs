@@ -57,6 +57,8 @@ pub struct FaceDirt<'a> {
     pub samples: &'a FaceSamples,
     /// The face's brush model (for `_shadowself` scenes).
     pub model: usize,
+    /// The face's light channels (dirt comes from what shares one).
+    pub channels: u32,
     /// The ray pattern, its depth and cone.
     pub sampling: &'a DirtSampling,
     /// Per sample, the first sample at the same point ([`FaceSamples::first_at_same_point`]).
@@ -101,12 +103,26 @@ impl Measured<'_> {
     fn occlusion(&self, indices: &[usize], which: DirtRays) -> (Vec<f32>, u64) {
         let d = &self.dirt;
         if d.sampling.mode != DirtMode::Ordered {
-            return occlusion_at(d.samples, indices, d.model, d.sampling, which, d.scene);
+            return occlusion_at(
+                d.samples,
+                indices,
+                (d.model, d.channels),
+                d.sampling,
+                which,
+                d.scene,
+            );
         }
         let mut unique: Vec<usize> = indices.iter().map(|&i| d.first_at[i]).collect();
         unique.sort_unstable();
         unique.dedup();
-        let (values, rays) = occlusion_at(d.samples, &unique, d.model, d.sampling, which, d.scene);
+        let (values, rays) = occlusion_at(
+            d.samples,
+            &unique,
+            (d.model, d.channels),
+            d.sampling,
+            which,
+            d.scene,
+        );
         let value_of = |i: usize| {
             unique
                 .binary_search(&d.first_at[i])

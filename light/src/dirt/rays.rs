@@ -116,8 +116,8 @@ impl DirtRays {
     }
 }
 
-/// Occlusion of the samples `indices` of `samples` (a face of brush model
-/// `model`), in that order: the mean over the dirt rays (`rays` of them),
+/// Occlusion of the samples `indices` of `samples` (a face of brush model and light channels
+/// `from`), in that order: the mean over the dirt rays (`rays` of them),
 /// cast in a cone around the sample's shading normal (the `_phong` one where
 /// the face has them), of `1 - hit distance / depth` (0 for a ray that
 /// reaches no opaque surface within `depth`; sky does not occlude). Returns
@@ -125,13 +125,13 @@ impl DirtRays {
 pub fn occlusion_at(
     samples: &FaceSamples,
     indices: &[usize],
-    model: usize,
+    from: (usize, u32),
     sampling: &DirtSampling,
     rays: DirtRays,
     scene: &TraceScene,
 ) -> (Vec<f32>, u64) {
     let sample_rays = SampleRays::new(samples, indices, sampling, rays);
-    sample_rays.occlusion(scene, (model, samples.face), sampling.depth as f32)
+    sample_rays.occlusion(scene, from, sampling.depth as f32)
 }
 
 /// Where the dirt rays of some samples start and which directions they take.
@@ -217,8 +217,8 @@ impl SampleRays {
     /// coincide, which Embree traverses faster than 16 directions from one point), and no
     /// packet is left part empty while rays remain (a face's few samples fill packets with
     /// their next directions). Each sample sums its rays in pattern order.
-    /// `from`: the face's brush model and the face.
-    fn occlusion(&self, scene: &TraceScene, from: (usize, usize), depth: f32) -> (Vec<f32>, u64) {
+    /// `from`: the face's brush model and light channels.
+    fn occlusion(&self, scene: &TraceScene, from: (usize, u32), depth: f32) -> (Vec<f32>, u64) {
         let n = self.starts.len();
         let per_sample = self.flat.len();
         let total = n * per_sample;

@@ -315,6 +315,7 @@ impl<'a> FaceTrace<'a> {
                 scene: self.setup.scene,
                 samples: self.samples,
                 model: self.face.model,
+                channels: self.rules.channels,
                 sampling: &sampling,
                 first_at: &self.scratch.visibility.first_at,
                 needed: &needed,
