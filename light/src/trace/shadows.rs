@@ -127,6 +127,8 @@ impl VisibilityScratch {
     /// traced. A shadow narrower than the cell can slip between the probes,
     /// but each direction carries at most a small part of its
     /// source's light.
+    // Inlined into the sun loop, so its per-sample grid lookups are folded in, not called.
+    #[inline]
     pub fn trace_probed(
         &mut self,
         samples: &FaceSamples,
