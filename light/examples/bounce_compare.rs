@@ -1,13 +1,15 @@
 //! Bounce against the reference, ours and ericw-tools': `bounce_compare UNLIT.bsp STRIDE
 //! [ERICW_LIT.bsp] [GRIDxSTRATA ...]`. Lights every STRIDE-th face of UNLIT.bsp with `--bounce`
-//! (default and `--extra4`) and with `--reference --bounce`, and reads ericw-tools' lightmaps of
+//! (default and `--extra4`; from a point per face, the default, and gathered over the surfaces,
+//! `-emissivequality high`) and with `--reference --bounce`, and reads ericw-tools' lightmaps of
 //! the same faces from ERICW_LIT.bsp (its `light -bounce` of the same BSP); errors are in grey
 //! levels. Each `GRIDxSTRATA` (for example `4x8`) also runs both modes with the fast bounce's
 //! receivers every GRID luxels casting STRATA² rays each; a trailing `s` (`2x6s`) smooths the
 //! receivers as the default mode does.
 
 use light::{
-    BounceDensity as Density, Lighting, Options, Quality, compare, compute_lighting, lightmaps_in,
+    BounceDensity as Density, EmissiveQuality, Lighting, Options, Quality, compare,
+    compute_lighting, lightmaps_in,
 };
 use quake_formats::Bsp;
 
@@ -54,7 +56,11 @@ fn main() -> anyhow::Result<()> {
     }
     let bsp = Bsp::read(&std::fs::read(path)?)?;
     let faces: Vec<usize> = (0..bsp.faces.len()).step_by(stride).collect();
-    let run = |quality: Quality, bounce: bool, density: Option<Density>| {
+    // `emission: None` is the default (`low`).
+    let run = |quality: Quality,
+               bounce: bool,
+               emission: Option<EmissiveQuality>,
+               density: Option<Density>| {
         let mut o = Options {
             quality,
             only_faces: Some(faces.clone()),
@@ -62,21 +68,31 @@ fn main() -> anyhow::Result<()> {
             ..Options::default()
         };
         o.overrides.bounce = bounce.then_some(1);
+        o.overrides.emissive_quality = emission;
         compute_lighting(&bsp, &o)
     };
-    let reference = run(Quality::Reference, true, None)?;
+    let reference = run(Quality::Reference, true, None, None)?;
     println!(
         "reference with bounce: {:.1} s",
         reference.stats.seconds_total
     );
-    let direct_reference = run(Quality::Reference, false, None)?;
+    let direct_reference = run(Quality::Reference, false, None, None)?;
     for (name, quality) in [("default", Quality::Default), ("--extra4", Quality::Extra4)] {
+        let lit = run(quality, true, None, None)?;
+        report(
+            &format!(
+                "ours {name} --bounce (from a point per face; {} bounce rays, {:.2} s)",
+                lit.stats.bounce_rays, lit.stats.seconds_bounce
+            ),
+            &lit,
+            &reference,
+        );
         for &density in &densities {
-            let lit = run(quality, true, density)?;
+            let lit = run(quality, true, Some(EmissiveQuality::High), density)?;
             let d = density.unwrap_or_else(|| Density::for_quality(quality));
             report(
                 &format!(
-                    "ours {name} --bounce (grid {}, {} rays; {} bounce rays, {:.2} s)",
+                    "ours {name} --bounce -emissivequality high (grid {}, {} rays; {} bounce rays, {:.2} s)",
                     d.stride,
                     d.strata * d.strata,
                     lit.stats.bounce_rays,
@@ -88,7 +104,7 @@ fn main() -> anyhow::Result<()> {
         }
         report(
             &format!("ours {name}, no bounce, vs direct reference"),
-            &run(quality, false, None)?,
+            &run(quality, false, None, None)?,
             &direct_reference,
         );
     }

@@ -32,6 +32,7 @@ use crate::quality::Quality;
 use crate::samples::FaceSamples;
 use crate::scene::TraceScene;
 
+pub mod points;
 pub mod reference;
 
 /// Reflectance of a texture with `_bouncecolorscale 0` (and of a texture without pixels).
@@ -40,6 +41,17 @@ pub const GREY_REFLECTANCE: f32 = 127.0 / 255.0;
 pub const KERNEL_SCALE: f64 = 0.5;
 /// Distances below this count as this (ericw-tools' bounce hotspot clamp).
 pub const HOTSPOT_CLAMP: f64 = 128.0;
+
+/// Where reflecting faces send bounced light from (ericw-tools' `-emissivequality`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EmissiveQuality {
+    /// One point in front of each face's middle ([`points`]).
+    Low,
+    /// That point and each corner ([`points`]).
+    Medium,
+    /// The whole surface: [`Field`]'s gather.
+    High,
+}
 
 /// Light per style and luxel (row-major) of one face.
 pub type StyleLuxels = Vec<(u8, Vec<[f32; 3]>)>;

@@ -31,7 +31,6 @@ quake_formats::ericw_accepted! {
         basedir: Option<String> => "light reads textures from the BSP and the palette as --palette says",
         filepriority: Option<String> => "light reads textures from the BSP",
         path: Vec<String> => "light reads textures from the BSP",
-        emissivequality: Option<String> => "bounced light comes from each face's whole surface",
         visapprox: Option<String> => "lights are culled by the PVS, which never cuts light off early",
         facestyles: Option<String> => "a face keeps the 4 styles BSP29 and BSP2 hold",
         exportobj: bool => "no .obj is written",
@@ -642,13 +641,17 @@ mod tests {
             join_optional_values(quake_formats::cli::normalise_single_dash(words.into_iter()));
         let cli = LightCli::try_parse_from(words).expect("parses");
         let notes = cli.args.ericw_only.notes();
-        assert_eq!(notes.len(), 5, "{notes:?}");
+        assert_eq!(notes.len(), 4, "{notes:?}");
         let overrides = cli.args.lighting_options().expect("options").overrides;
         assert_eq!(
             (overrides.bspxlit, overrides.bspxlux),
             (Some(true), Some(true))
         );
         assert_eq!(overrides.surflight_subdivide, Some(64.0), "an option now");
+        assert_eq!(
+            overrides.emissive_quality,
+            Some(crate::bounce::EmissiveQuality::High)
+        );
         assert!(
             notes[0].starts_with("-nopercent has no effect"),
             "{notes:?}"

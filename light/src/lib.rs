@@ -76,6 +76,7 @@ mod visibility;
 
 pub use bench::{BareOcclusion, bare_occlusion};
 pub use bounce::Density as BounceDensity;
+pub use bounce::EmissiveQuality;
 pub use compare::{
     ErrorStats, ReferenceComparison, compare, compare_drawn, compare_grids, compare_with_reference,
     lightmaps_in, own_grid_lightmaps_in, own_grids,

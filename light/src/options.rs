@@ -23,8 +23,8 @@ pub struct Options {
     pub progress: Progress,
     /// Colours of texture pixels, for `_bouncecolorscale` (default: Slipgate's own palette).
     pub palette: Option<Palette>,
-    /// Where and how densely the fast bounce gathers, instead of the quality mode's; for
-    /// measurements.
+    /// Where and how densely the fast bounce gathers at `-emissivequality high`, instead of the
+    /// quality mode's; for measurements.
     pub bounce_density: Option<Density>,
 }
 

@@ -13,7 +13,8 @@ use quake_formats::palette::Palette;
 use quake_formats::progress::Progress;
 use rayon::prelude::*;
 
-use crate::bounce::{self, BounceCounts, Density, Field, Receivers, StyleLuxels};
+use crate::bounce::points::{Emission, PointField};
+use crate::bounce::{self, BounceCounts, Density, EmissiveQuality, Field, Receivers, StyleLuxels};
 use crate::error::LightError;
 use crate::faces::{FaceGeom, OwnGrid};
 use crate::lightgrid::{GridSources, RawGrid, finish_grid, light_at, trace_grid};
@@ -737,8 +738,19 @@ fn bounce_light(
             .filter(|t| on_channel_1(t))
             .collect();
         let mut next: Vec<Option<StyleLuxels>> = vec![None; n];
+        // The reference's passes stay with the surfaces' physics.
+        let points = match settings.emission {
+            EmissiveQuality::Low => Some(Emission::Middle),
+            EmissiveQuality::Medium => Some(Emission::MiddleAndCorners),
+            EmissiveQuality::High => None,
+        }
+        .filter(|_| !reference)
+        .map(|emission| PointField::new(&emitting, &prep.vis, emission));
         let at_receivers = gather_faces(receiving.par_iter().copied(), |t, c| {
             let receivers = t.receivers.as_deref()?;
+            if let Some(points) = &points {
+                return Some(points.gather_face(&prep.scene, receivers, c));
+            }
             Some(emitting.gather_face(&prep.scene, receivers, pass, density, c))
         });
         for (face, b, c) in at_receivers {

@@ -9,6 +9,7 @@ use quake_formats::geom::DVec3Ext;
 
 use quake_formats::miptex::{MipTex, TextureLump};
 
+use crate::bounce::EmissiveQuality;
 use crate::dirt::DirtMode;
 use crate::faces::{FaceKind, Spacing, face_geometry};
 use crate::samples::face_samples;
@@ -2020,9 +2021,11 @@ fn bounce_lights_the_underside_of_the_box_only_when_asked() {
 
 #[test]
 fn bounce_is_close_to_the_reference_and_never_black_where_it_is_lit() {
+    // The reference integrates over the reflecting surfaces, as `high` gathers.
     let bsp = shadow_scene("");
     let mut fast = options(Quality::Default);
     fast.overrides.bounce = Some(1);
+    fast.overrides.emissive_quality = Some(EmissiveQuality::High);
     let mut exact = options(Quality::Reference);
     exact.overrides.bounce = Some(1);
     let reference = compute_lighting(&bsp, &exact).expect("reference");
@@ -2125,6 +2128,7 @@ fn fast_bounce_converges_to_the_reference_at_every_luxel_with_more_rays() {
     let rms_error = |strata: usize| {
         let mut fast = options(Quality::Extra4);
         fast.overrides.bounce = Some(1);
+        fast.overrides.emissive_quality = Some(EmissiveQuality::High);
         fast.bounce_density = Some(crate::bounce::Density {
             stride: 1,
             strata,

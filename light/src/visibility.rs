@@ -2,7 +2,9 @@
 //! one of the leaves that hold the face is in the PVS of the light's leaf, and
 //! a face can only see the sky if one of its leaves sees a leaf holding a sky
 //! face. Anything without vis data (no vis lump, a leaf without a row, a
-//! light in solid, a brush-model face) is treated as visible.
+//! light in solid, a brush-model face) is treated as visible. Bounced light from
+//! points ([`crate::bounce::points`]) is the exception: it follows ericw-tools'
+//! rule, which is not conservative (see [`Visibility::sees_all`]).
 
 use glam::DVec3;
 use std::collections::BTreeMap;
@@ -126,6 +128,40 @@ impl Visibility {
             || leafs
                 .iter()
                 .any(|&l| l == light_leaf || bit(row, l) || self.is_liquid(l))
+    }
+
+    /// The world leaves holding `face` (empty for brush-model faces: cannot tell).
+    pub fn face_leafs(&self, face: usize) -> &[u32] {
+        self.face_leafs.get(face).map_or(&[], |l| &l[..])
+    }
+
+    /// The union of the PVS rows of `leafs`, with their own bits set: what any of them may see.
+    /// `None` when vis data cannot tell (no leaves, a leaf without a row, a liquid leaf).
+    pub fn pvs_of(&self, leafs: &[u32]) -> Option<Vec<u8>> {
+        if leafs.is_empty() {
+            return None;
+        }
+        let mut union = vec![0u8; self.rows.len().div_ceil(8)];
+        for &l in leafs {
+            let row = self.rows.get(l as usize)?.as_ref()?;
+            if self.is_liquid(l) {
+                return None;
+            }
+            for (u, r) in union.iter_mut().zip(row) {
+                *u |= r;
+            }
+            if l > 0 {
+                union[(l as usize - 1) / 8] |= 1 << ((l - 1) % 8);
+            }
+        }
+        Some(union)
+    }
+
+    /// Whether `pvs` (from [`Visibility::pvs_of`]) may see every one of `leafs` (liquid leaves
+    /// always count as seen; no leaves: cannot tell, seen). Not conservative: bounced light from
+    /// a point culls an emitter whose face is only partly in sight, as ericw-tools culls it.
+    pub fn sees_all(&self, pvs: &[u8], leafs: &[u32]) -> bool {
+        leafs.iter().all(|&l| bit(pvs, l) || self.is_liquid(l))
     }
 
     /// False only if vis data proves `face` cannot see any sky face.

@@ -1,7 +1,7 @@
 //! ericw-tools' `bspinfo` and `bsputil --check` (the tools mappers check BSPs with) accept the
 //! demo map lit with every BSPX light lump, and its `light` gives the faces the same
-//! `DECOUPLED_LM` grids ours does, and our light reads the `texinfo.json` its `qbsp` writes,
-//! when they are present in `../shared/anchors`. Skipped, saying so, when absent.
+//! `DECOUPLED_LM` grids ours does, its bounced light agrees with ours, and our light reads the
+//! `texinfo.json` its `qbsp` writes, when they are present in `../shared/anchors`. Skipped, saying so, when absent.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -138,6 +138,65 @@ fn ericw_tools_light_makes_the_same_decoupled_grids() {
             "bsputil --check:\n{check}"
         );
     }
+    std::fs::remove_dir_all(dir).ok();
+}
+
+/// Each face's mean grey style-0 light (`None`: no lightmap).
+fn face_means(bsp: &quake_formats::Bsp) -> Vec<Option<f64>> {
+    let all: Vec<usize> = (0..bsp.faces.len()).collect();
+    let mut out = vec![None; all.len()];
+    for map in light::lightmaps_in(bsp, &all).lightmaps {
+        if let Some(grey) = map
+            .styles
+            .iter()
+            .position(|&s| s == 0)
+            .map(|k| &map.grey[k])
+        {
+            let sum: u64 = grey.iter().map(|&v| u64::from(v)).sum();
+            out[map.face] = Some(sum as f64 / grey.len().max(1) as f64);
+        }
+    }
+    out
+}
+
+/// The demo map lit by both tools with one bounce, each at its default `-emissivequality`
+/// (`low`: a point per reflecting face): nearly every face within 5 levels of ericw-tools'.
+/// `high` (gathered over the surfaces) differs more, which is why it is not the default.
+#[test]
+fn bounced_light_agrees_with_ericw_tools() {
+    let ericw_light = anchor("light");
+    if !ericw_light.exists() {
+        println!("SKIPPED: no ericw-tools light in {}", anchor("").display());
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("slipgate-light-bounce-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let bsp = demo();
+    let path = dir.join("demo.bsp");
+    std::fs::write(&path, bsp.write().expect("BSP encodes")).expect("write");
+    run(&ericw_light, &["-bounce"], &path);
+    let theirs = face_means(
+        &quake_formats::Bsp::read(&std::fs::read(&path).expect("read")).expect("decodes"),
+    );
+    let agreement = |emission| {
+        let mut options = Options::default();
+        options.overrides.bounce = Some(1);
+        options.overrides.emissive_quality = emission;
+        let mut ours = bsp.clone();
+        apply_lighting(&mut ours, &compute_lighting(&bsp, &options).expect("light"));
+        let pairs: Vec<(f64, f64)> = face_means(&ours)
+            .into_iter()
+            .zip(&theirs)
+            .filter_map(|(a, b)| Some((a?, (*b)?)))
+            .collect();
+        assert!(pairs.len() > 300, "{} faces lit by both", pairs.len());
+        let close = pairs.iter().filter(|(a, b)| (a - b).abs() <= 5.0).count();
+        close as f64 / pairs.len() as f64
+    };
+    let low = agreement(None);
+    let high = agreement(Some(light::EmissiveQuality::High));
+    assert!(low >= 0.97, "low: {:.1}% of faces", 100.0 * low);
+    assert!(low > high, "low {low}, high {high}");
     std::fs::remove_dir_all(dir).ok();
 }
 

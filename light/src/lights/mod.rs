@@ -22,6 +22,7 @@ use quake_formats::bsp::face_channels::DEFAULT_CHANNELS;
 use quake_formats::bsp::face_flags::FaceFlags;
 use quake_formats::entities::Entity;
 
+use crate::bounce::EmissiveQuality;
 use crate::dirt::{DirtResponse, DirtSampling};
 use crate::error::LightError;
 use crate::faces::Spacing;
@@ -73,6 +74,8 @@ pub struct BounceSettings {
     pub styled: bool,
     /// How dirt darkens bounced light (worldspawn's dirt, when it is on).
     pub dirt: Option<DirtResponse>,
+    /// Where reflecting faces send their light from.
+    pub emission: EmissiveQuality,
 }
 
 impl BounceSettings {

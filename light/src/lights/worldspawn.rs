@@ -88,6 +88,7 @@ pub fn bounce(settings: &Settings, global: &Global) -> BounceSettings {
         color_scale: settings.bounce_color_scale,
         styled: settings.bounce_styled,
         dirt: global.dirt.then_some(global.response),
+        emission: settings.emissive_quality,
     }
 }
 

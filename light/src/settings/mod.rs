@@ -18,6 +18,7 @@ mod value;
 
 use glam::DVec3;
 
+pub use crate::bounce::EmissiveQuality;
 pub use crate::dirt::DirtMode;
 pub use declare::Setting;
 use declare::{settings, without_underscore};
@@ -158,6 +159,12 @@ settings! {
 
     /// Light of switchable and animated styles reflects too, in its own style.
     bounce_styled: bool = false, flag "bouncestyled", keys ["_bouncestyled"], range Range::Any;
+
+    /// Where reflecting faces send bounced light from: `low` one point in front of each face's
+    /// middle, `medium` that and each corner (both as ericw-tools), `high` the whole surface
+    /// (closer to the physics, several times faster on maps lit everywhere, and less like
+    /// ericw-tools' look).
+    emissive_quality: EmissiveQuality = EmissiveQuality::Low, flag "emissivequality", keys [], range Range::Any;
 
     /// Write the coloured lightmaps into the BSP as the BSPX `RGBLIGHTING` lump (beside any
     /// `.lit`), for FTE, QuakeSpasm-Spiked and Ironwail.

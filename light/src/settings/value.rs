@@ -3,6 +3,7 @@
 
 use glam::DVec3;
 
+use crate::bounce::EmissiveQuality;
 use crate::dirt::DirtMode;
 
 /// A type a setting can hold.
@@ -322,6 +323,31 @@ impl SettingValue for SoftRadius {
             SoftRadius::Samples(n) => n.to_string(),
             SoftRadius::HalfLuxel => "-1 (half a luxel)".to_string(),
         }
+    }
+}
+
+/// ericw-tools' names, `low`, `medium` and `high` (any case), or `0`, `1`, `2`.
+impl SettingValue for EmissiveQuality {
+    fn read(text: &str) -> Option<Result<EmissiveQuality, &'static str>> {
+        let text = text.trim();
+        if text.is_empty() {
+            return None;
+        }
+        Some(match text.to_ascii_lowercase().as_str() {
+            "low" | "0" => Ok(EmissiveQuality::Low),
+            "medium" | "1" => Ok(EmissiveQuality::Medium),
+            "high" | "2" => Ok(EmissiveQuality::High),
+            _ => Err("low, medium or high"),
+        })
+    }
+
+    fn show(&self) -> String {
+        match self {
+            EmissiveQuality::Low => "low",
+            EmissiveQuality::Medium => "medium",
+            EmissiveQuality::High => "high",
+        }
+        .to_string()
     }
 }
 

@@ -1,0 +1,518 @@
+//! Bounced light from points, as ericw-tools gives it (its `-emissivequality low` and
+//! `medium`, low its default): each reflecting face sends what it reflects from one point a
+//! unit in front of its middle (and, at medium, from each of its corners too, the face's light
+//! shared among them), as a point light with the bounce kernel.
+//!
+//! A face's light is the mean over its luxels of what it reflects, `ρ E` (occluded luxels count
+//! as dark). Its strongest channel `I` times its area is the point's intensity, and its colour
+//! is the light over `I` when `I` exceeds 1 (else the light itself: ericw-tools' rule, which
+//! makes faces dimmer than one light unit dimmer still). A receiving luxel at `p`, `d` from a
+//! point, takes `kernel · intensity · cos θe · cos θr / max(d, 128)²` of that colour, where `θe`
+//! is the angle off the emitting face's normal and `θr` off the receiver's (a liquid's surface
+//! takes it from both sides, without `cos θr`), if nothing blocks the segment between them.
+//!
+//! Next to [`super::Field`]'s gather, which integrates over the reflecting surfaces, this is
+//! coarse: a face's light leaves from one point, so a face next to a large bright wall takes
+//! the wall's light as if it were all at the wall's middle. It is what maps lit by
+//! ericw-tools were tuned with. Its cost grows with receivers times emitters in sight, so it
+//! culls as ericw-tools does: emitters whose faces lie in a leaf outside the receiving face's
+//! PVS, behind it, or too far to bring more than [`GATE`]; and traces segments coarse to fine
+//! over a face's luxels (see [`see`]).
+
+use glam::{DVec3, Vec3};
+
+use super::{BounceCounts, Field, HOTSPOT_CLAMP, Receivers, StyleLuxels, add_light};
+use crate::embree::RayPacket16;
+use crate::faces::FaceGeom;
+use crate::scene::TraceScene;
+use crate::visibility::Visibility;
+
+/// Contributions below this many light units, in every channel, count as none (ericw-tools'
+/// gate for bounced light).
+const GATE: f64 = 0.01;
+
+/// An emitter that brings no luxel of a face more than this many light units is seen or not
+/// by the whole face at once: a segment to the luxel it lights most decides. Where its
+/// shadow crosses the face, luxels are off by at most this much light.
+const WEAK: f64 = 0.5;
+
+/// Faces smaller than this (square units) give off no bounced light.
+const MIN_AREA: f64 = 1.0;
+
+/// Corners closer than this to a straight line through their neighbours (the cosine between
+/// the two edges) are not corners of the face's outline: T-junction points.
+const STRAIGHT: f64 = 0.999;
+
+/// How many points a reflecting face sends its light from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Emission {
+    /// One, in front of its middle.
+    Middle,
+    /// Its middle and each corner.
+    MiddleAndCorners,
+}
+
+/// One point a reflecting face sends light from.
+#[derive(Debug, Clone)]
+pub struct PointEmitter {
+    pub face: usize,
+    pub point: DVec3,
+    pub normal: DVec3,
+    /// Per style: the colour and the intensity.
+    pub styles: Vec<(u8, [f32; 3], f64)>,
+    /// Its share of its face's light (1 over the face's points).
+    pub share: f64,
+}
+
+/// The point emitters of one pass, and where they stand.
+pub struct PointField<'a> {
+    emitters: Vec<PointEmitter>,
+    /// Per world leaf, the emitters whose faces it holds.
+    by_leaf: Vec<Vec<u32>>,
+    /// Emitters on faces no leaf holds (brush models): in sight of everything.
+    unplaced: Vec<u32>,
+    faces: &'a [FaceGeom],
+    vis: &'a Visibility,
+    kernel: f64,
+}
+
+impl<'a> PointField<'a> {
+    /// The points `field`'s reflecting faces send their light from.
+    pub fn new(field: &Field<'a>, vis: &'a Visibility, emission: Emission) -> PointField<'a> {
+        let emitters = point_emitters(field, emission);
+        let mut by_leaf: Vec<Vec<u32>> = Vec::new();
+        let mut unplaced = Vec::new();
+        for (k, e) in emitters.iter().enumerate() {
+            let leafs = vis.face_leafs(e.face);
+            if leafs.is_empty() {
+                unplaced.push(k as u32);
+            }
+            for &l in leafs {
+                let l = l as usize;
+                if by_leaf.len() <= l {
+                    by_leaf.resize(l + 1, Vec::new());
+                }
+                by_leaf[l].push(k as u32);
+            }
+        }
+        PointField {
+            emitters,
+            by_leaf,
+            unplaced,
+            faces: field.faces,
+            vis,
+            kernel: field.kernel,
+        }
+    }
+
+    /// The emitters that may light face `face`: all of them unless vis data tells, else those
+    /// whose faces lie wholly in the face's PVS.
+    fn in_sight_of(&self, face: usize) -> Vec<u32> {
+        let Some(pvs) = self.vis.pvs_of(self.vis.face_leafs(face)) else {
+            return (0..self.emitters.len() as u32).collect();
+        };
+        let mut found = self.unplaced.clone();
+        for (l, list) in self.by_leaf.iter().enumerate().skip(1) {
+            if !list.is_empty() && pvs[(l - 1) / 8] & (1 << ((l - 1) % 8)) != 0 {
+                found.extend_from_slice(list);
+            }
+        }
+        found.sort_unstable();
+        found.dedup();
+        found.retain(|&k| {
+            let e = &self.emitters[k as usize];
+            self.vis.sees_all(&pvs, self.vis.face_leafs(e.face))
+        });
+        found
+    }
+
+    /// The light the emitters send each luxel of `r`, per style.
+    pub fn gather_face(
+        &self,
+        scene: &TraceScene,
+        r: &Receivers,
+        counts: &mut BounceCounts,
+    ) -> StyleLuxels {
+        let n = r.points.len();
+        let plane = self.faces[r.face].plane;
+        let points: Vec<DVec3> = r.points.iter().map(|&p| Vec3::from(p).as_dvec3()).collect();
+        let normals: Vec<DVec3> = r
+            .normals
+            .iter()
+            .map(|&p| Vec3::from(p).as_dvec3())
+            .collect();
+        let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+        for &p in &points {
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+        // The emitters that may light some luxel, and each luxel's weight from each (row-major
+        // by emitter).
+        let mut lighting: Vec<&PointEmitter> = Vec::new();
+        let mut weights: Vec<f64> = Vec::with_capacity(n * 64);
+        for k in self.in_sight_of(r.face) {
+            let e = &self.emitters[k as usize];
+            if e.face == r.face || (!r.two_sided && plane.distance(e.point) <= 0.0) {
+                continue;
+            }
+            // The receiver's box wholly behind the emitter.
+            let far_corner = DVec3::select(e.normal.cmpgt(DVec3::ZERO), hi, lo);
+            if e.normal.dot(far_corner - e.point) < 0.0 {
+                continue;
+            }
+            let max_total = e.styles.iter().map(|s| s.2).fold(0.0, f64::max);
+            let nearest = e.point.clamp(lo, hi).distance_squared(e.point);
+            if self.kernel * max_total / nearest.max(HOTSPOT_CLAMP * HOTSPOT_CLAMP) < GATE {
+                continue;
+            }
+            let start = weights.len();
+            weights.extend(points.iter().zip(&normals).map(|(&p, &normal)| {
+                // cos θe · cos θr / max(d, 128)², without a square root.
+                let to = p - e.point;
+                let d2 = to.length_squared().max(1e-4);
+                let along_e = e.normal.dot(to).max(0.0);
+                let along_r = if r.two_sided {
+                    d2.sqrt()
+                } else {
+                    (-normal.dot(to)).max(0.0)
+                };
+                let w =
+                    self.kernel * along_e * along_r / (d2 * d2.max(HOTSPOT_CLAMP * HOTSPOT_CLAMP));
+                if w * max_total < GATE { 0.0 } else { w }
+            }));
+            if weights[start..].iter().all(|&w| w == 0.0) {
+                weights.truncate(start);
+            } else {
+                lighting.push(e);
+            }
+        }
+        let from: Vec<DVec3> = lighting.iter().map(|e| e.point).collect();
+        // A weak emitter's visibility is one segment's, to the luxel it lights most.
+        let weak: Vec<Option<usize>> = lighting
+            .iter()
+            .enumerate()
+            .map(|(k, e)| {
+                let max_total = e.styles.iter().map(|s| s.2).fold(0.0, f64::max);
+                let row = &weights[k * n..(k + 1) * n];
+                let (best, w) = row
+                    .iter()
+                    .enumerate()
+                    .fold((0, 0.0), |b, (i, &w)| if w > b.1 { (i, w) } else { b });
+                // The points of one face share its shadows: their weakness adds up.
+                (w * max_total < WEAK * e.share).then_some(best)
+            })
+            .collect();
+        let lit = see(scene, r, &from, &weak, &points, &weights, counts);
+        let mut out = StyleLuxels::new();
+        for (k, e) in lighting.iter().enumerate() {
+            for i in 0..n {
+                let j = k * n + i;
+                if weights[j] == 0.0 || !lit[j] {
+                    continue;
+                }
+                for (style, color, total) in &e.styles {
+                    let w = weights[j] * total;
+                    if color.iter().any(|&c| f64::from(c) * w >= GATE) {
+                        add_light(&mut out, n, &[*style], &[*color], i, w);
+                    }
+                }
+            }
+        }
+        out
+    }
+}
+
+/// Every point `field`'s faces with light and a reflectance send their light from.
+fn point_emitters(field: &Field, emission: Emission) -> Vec<PointEmitter> {
+    let mut out = Vec::new();
+    for (f, light) in field.light.iter().enumerate() {
+        let (Some(light), Some(Some(rho)), Some(face)) =
+            (light, field.reflectance.get(f), field.faces.get(f))
+        else {
+            continue;
+        };
+        let area = polygon_area(&face.points);
+        if area < MIN_AREA {
+            continue;
+        }
+        let corners = corners(&face.points);
+        let Some(middle) = mean(&corners) else {
+            continue;
+        };
+        let mut at = vec![middle];
+        if emission == Emission::MiddleAndCorners {
+            at.extend_from_slice(&corners);
+        }
+        let share = 1.0 / at.len() as f64;
+        let mut styles = Vec::new();
+        for (style, luxels) in light {
+            let n = luxels.len().max(1) as f64;
+            let mut mean = [0.0f64; 3];
+            for l in luxels {
+                for k in 0..3 {
+                    mean[k] += f64::from(l[k]) / n;
+                }
+            }
+            let emit: [f64; 3] = std::array::from_fn(|k| mean[k] * f64::from(rho[k]));
+            let strongest = emit[0].max(emit[1]).max(emit[2]);
+            if strongest <= 0.0 {
+                continue;
+            }
+            let color = if strongest > 1.0 {
+                emit.map(|c| c / strongest)
+            } else {
+                emit
+            };
+            styles.push((*style, color.map(|c| c as f32), strongest * area * share));
+        }
+        if styles.is_empty() {
+            continue;
+        }
+        let normal = face.plane.normal;
+        out.extend(at.into_iter().map(|p| PointEmitter {
+            face: f,
+            point: p + normal,
+            normal,
+            styles: styles.clone(),
+            share,
+        }));
+    }
+    out
+}
+
+/// The area of the convex polygon `points`.
+fn polygon_area(points: &[DVec3]) -> f64 {
+    let Some(&first) = points.first() else {
+        return 0.0;
+    };
+    let mut sum = DVec3::ZERO;
+    for w in points.windows(2).skip(1) {
+        sum += (w[0] - first).cross(w[1] - first);
+    }
+    0.5 * sum.length()
+}
+
+/// The points of `points` that are corners of the outline: those on a straight edge between
+/// their neighbours left out.
+fn corners(points: &[DVec3]) -> Vec<DVec3> {
+    let n = points.len();
+    (0..n)
+        .filter(|&i| {
+            let before = (points[i] - points[(i + n - 1) % n]).normalize_or_zero();
+            let after = (points[(i + 1) % n] - points[i]).normalize_or_zero();
+            before.dot(after) < STRAIGHT
+        })
+        .map(|i| points[i])
+        .collect()
+}
+
+fn mean(points: &[DVec3]) -> Option<DVec3> {
+    (!points.is_empty()).then(|| points.iter().sum::<DVec3>() / points.len() as f64)
+}
+
+/// Whether a luxel sees an emitter.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum State {
+    Unknown,
+    Lit,
+    Blocked,
+}
+
+/// The coarsest grid's step, in luxels, at which [`see`] starts.
+const FIRST_STEP: usize = 4;
+
+/// For each of the points `from` (row-major by point) and each luxel of `r` with a weight
+/// there: whether nothing blocks the segment between them. Coarse to fine: segments to the
+/// luxels of a grid every [`FIRST_STEP`] luxels (and the last row and column) first; then on
+/// each grid of half the step, segments only to luxels whose coarser cell's corners disagree,
+/// the others taking the corners' answer. A shadow narrower than the coarse grid that falls
+/// between its luxels is missed; bounced light from a point is rarely that sharp. A point
+/// `weak` names (with its strongest luxel) is decided by that luxel's one segment (see
+/// [`WEAK`]). Each step's segments, from every point, go 16 to a packet.
+fn see(
+    scene: &TraceScene,
+    r: &Receivers,
+    from: &[DVec3],
+    weak: &[Option<usize>],
+    points: &[DVec3],
+    weights: &[f64],
+    counts: &mut BounceCounts,
+) -> Vec<bool> {
+    let (w, h) = (r.width, r.height);
+    let n = w * h;
+    let mut state = vec![State::Unknown; weights.len()];
+    let mut packet = RayPacket16::new();
+    let mut rays: Vec<usize> = Vec::new();
+    let mut step = FIRST_STEP;
+    while step >= 1 {
+        let coarse = step * 2;
+        let cell = |x: usize, size: usize| {
+            let lo = x / coarse * coarse;
+            (lo, (lo + coarse).min(size - 1))
+        };
+        let (xs, ys) = (crate::grid::grid(w, step), crate::grid::grid(h, step));
+        rays.clear();
+        for (k, weak) in weak.iter().enumerate() {
+            let at = k * n;
+            if let Some(best) = weak {
+                if step == FIRST_STEP {
+                    rays.push(at + best);
+                }
+                continue;
+            }
+            for &y in &ys {
+                for &x in &xs {
+                    let j = at + y * w + x;
+                    if weights[j] == 0.0 || state[j] != State::Unknown {
+                        continue;
+                    }
+                    if step == FIRST_STEP {
+                        rays.push(j);
+                        continue;
+                    }
+                    let ((x0, x1), (y0, y1)) = (cell(x, w), cell(y, h));
+                    let mut known = [(x0, y0), (x1, y0), (x0, y1), (x1, y1)]
+                        .into_iter()
+                        .map(|(x, y)| state[at + y * w + x])
+                        .filter(|&s| s != State::Unknown);
+                    match known.next() {
+                        Some(a) if known.all(|s| s == a) => state[j] = a,
+                        _ => rays.push(j),
+                    }
+                }
+            }
+        }
+        for chunk in rays.chunks(16) {
+            packet.clear();
+            for (lane, &j) in chunk.iter().enumerate() {
+                let origin = from[j / n];
+                let to = points[j % n] - origin;
+                let dist = to.length().max(0.01);
+                packet.set(
+                    lane,
+                    origin.as_vec3().to_array(),
+                    (to / dist).as_vec3().to_array(),
+                    crate::trace::RAY_START,
+                    (dist - 0.01) as f32,
+                );
+            }
+            let blocked = scene.occluded16(&mut packet, r.model);
+            counts.rays += chunk.len() as u64;
+            for (lane, &j) in chunk.iter().enumerate() {
+                state[j] = if blocked & (1 << lane) != 0 {
+                    State::Blocked
+                } else {
+                    State::Lit
+                };
+            }
+        }
+        if step == FIRST_STEP {
+            for (k, best) in weak.iter().enumerate() {
+                if let Some(best) = best {
+                    let answer = state[k * n + best];
+                    state[k * n..(k + 1) * n].fill(answer);
+                }
+            }
+        }
+        step /= 2;
+    }
+    state.into_iter().map(|s| s == State::Lit).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::faces::FaceKind;
+    use crate::lights::BounceSettings;
+    use quake_formats::extents::{LightmapExtents, LuxelGrid};
+    use quake_formats::geom::Plane;
+
+    /// An upward 20 × 10 face at height 0 whose outline also passes through (10, 0, 0), a
+    /// T-junction point on its long edge.
+    fn floor() -> FaceGeom {
+        let extents = LightmapExtents::from_points(&[], &[[0.0; 4]; 2]);
+        FaceGeom {
+            index: 0,
+            model: 0,
+            kind: FaceKind::Lit,
+            texture: String::new(),
+            points: vec![
+                DVec3::new(0.0, 0.0, 0.0),
+                DVec3::new(0.0, 10.0, 0.0),
+                DVec3::new(20.0, 10.0, 0.0),
+                DVec3::new(20.0, 0.0, 0.0),
+                DVec3::new(10.0, 0.0, 0.0),
+            ],
+            plane: Plane::new(DVec3::Z, 0.0),
+            vecs: [[0.0; 4]; 2],
+            origin: DVec3::ZERO,
+            extents,
+            continuations: Vec::new(),
+            grid: LuxelGrid::vanilla(&extents, &[[0.0; 4]; 2]),
+            own_grid: None,
+        }
+    }
+
+    fn emitters_of(light: [f32; 3], emission: Emission) -> Vec<PointEmitter> {
+        let faces = [floor()];
+        let reflectance = [Some([0.5; 3])];
+        // Two luxels: the mean is `light`.
+        let lit = [Some(vec![(0u8, vec![[0.0; 3], light.map(|c| 2.0 * c)])])];
+        let settings = BounceSettings {
+            passes: 1,
+            scale: 1.0,
+            color_scale: 0.0,
+            styled: false,
+            dirt: None,
+            emission: crate::bounce::EmissiveQuality::Low,
+        };
+        point_emitters(&Field::new(&faces, &reflectance, &lit, &settings), emission)
+    }
+
+    #[test]
+    fn a_face_sends_its_mean_reflected_light_from_a_unit_in_front_of_its_middle() {
+        let e = emitters_of([100.0, 50.0, 0.0], Emission::Middle);
+        assert_eq!(e.len(), 1);
+        // The T-junction point does not pull the middle towards it.
+        assert!(
+            e[0].point.distance(DVec3::new(10.0, 5.0, 1.0)) < 1e-9,
+            "{:?}",
+            e[0].point
+        );
+        // Reflected 50 25 0: colour over its strongest channel, intensity 50 × 200 units².
+        let (style, color, intensity) = e[0].styles[0];
+        assert_eq!((style, color), (0, [1.0, 0.5, 0.0]));
+        assert!((intensity - 50.0 * 200.0).abs() < 1e-6, "{intensity}");
+    }
+
+    #[test]
+    fn light_under_one_unit_keeps_its_colour_unscaled() {
+        // ericw-tools' rule: only a strongest channel above 1 is divided out.
+        let e = emitters_of([1.0, 0.5, 0.0], Emission::Middle);
+        let (_, color, intensity) = e[0].styles[0];
+        assert_eq!(color, [0.5, 0.25, 0.0]);
+        assert!((intensity - 0.5 * 200.0).abs() < 1e-6, "{intensity}");
+    }
+
+    #[test]
+    fn medium_adds_the_corners_and_shares_the_light_among_the_points() {
+        let e = emitters_of([100.0; 3], Emission::MiddleAndCorners);
+        assert_eq!(e.len(), 5, "the middle and four corners");
+        assert!(e.iter().all(|p| p.point.z == 1.0));
+        let total: f64 = e.iter().map(|p| p.styles[0].2).sum();
+        assert!((total - 50.0 * 200.0).abs() < 1e-6, "{total}");
+    }
+
+    #[test]
+    fn a_dark_or_tiny_face_sends_nothing() {
+        assert!(emitters_of([0.0; 3], Emission::Middle).is_empty());
+        let sliver = [
+            DVec3::ZERO,
+            DVec3::new(0.0, 0.5, 0.0),
+            DVec3::new(1.0, 0.5, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+        ];
+        assert!((polygon_area(&sliver) - 0.5).abs() < 1e-12);
+        assert!(polygon_area(&sliver) < MIN_AREA);
+    }
+}
