@@ -147,9 +147,10 @@ impl<'a> PointField<'a> {
             hi = hi.max(p);
         }
         // The emitters that may light some luxel, and each luxel's weight from each (row-major
-        // by emitter).
+        // by emitter), a batch at a time.
+        let mut out = StyleLuxels::new();
         let mut lighting: Vec<&PointEmitter> = Vec::new();
-        let mut weights: Vec<f64> = Vec::with_capacity(n * 64);
+        let mut weights: Vec<f64> = Vec::with_capacity(BATCH + n);
         for k in self.in_sight_of(r.face) {
             let e = &self.emitters[k as usize];
             if e.face == r.face || (!r.two_sided && plane.distance(e.point) <= 0.0) {
@@ -160,7 +161,7 @@ impl<'a> PointField<'a> {
             if e.normal.dot(far_corner - e.point) < 0.0 {
                 continue;
             }
-            let max_total = e.styles.iter().map(|s| s.2).fold(0.0, f64::max);
+            let max_total = e.max_intensity();
             let nearest = e.point.clamp(lo, hi).distance_squared(e.point);
             if self.kernel * max_total / nearest.max(HOTSPOT_CLAMP * HOTSPOT_CLAMP) < GATE {
                 continue;
@@ -182,43 +183,71 @@ impl<'a> PointField<'a> {
             }));
             if weights[start..].iter().all(|&w| w == 0.0) {
                 weights.truncate(start);
-            } else {
-                lighting.push(e);
+                continue;
+            }
+            lighting.push(e);
+            if weights.len() >= BATCH {
+                light_batch(scene, r, &points, &lighting, &weights, &mut out, counts);
+                lighting.clear();
+                weights.clear();
             }
         }
-        let from: Vec<DVec3> = lighting.iter().map(|e| e.point).collect();
-        // A weak emitter's visibility is one segment's, to the luxel it lights most.
-        let weak: Vec<Option<usize>> = lighting
-            .iter()
-            .enumerate()
-            .map(|(k, e)| {
-                let max_total = e.styles.iter().map(|s| s.2).fold(0.0, f64::max);
-                let row = &weights[k * n..(k + 1) * n];
-                let (best, w) = row
-                    .iter()
-                    .enumerate()
-                    .fold((0, 0.0), |b, (i, &w)| if w > b.1 { (i, w) } else { b });
-                // The points of one face share its shadows: their weakness adds up.
-                (w * max_total < WEAK * e.share).then_some(best)
-            })
-            .collect();
-        let lit = see(scene, r, &from, &weak, &points, &weights, counts);
-        let mut out = StyleLuxels::new();
-        for (k, e) in lighting.iter().enumerate() {
-            for i in 0..n {
-                let j = k * n + i;
-                if weights[j] == 0.0 || !lit[j] {
-                    continue;
-                }
-                for (style, color, total) in &e.styles {
-                    let w = weights[j] * total;
-                    if color.iter().any(|&c| f64::from(c) * w >= GATE) {
-                        add_light(&mut out, n, &[*style], &[*color], i, w);
-                    }
-                }
-            }
-        }
+        light_batch(scene, r, &points, &lighting, &weights, &mut out, counts);
         out
+    }
+}
+
+/// Weights held at once while lighting a face: emitters times luxels.
+const BATCH: usize = 1 << 15;
+
+impl PointEmitter {
+    /// Its intensity in its brightest style.
+    fn max_intensity(&self) -> f64 {
+        self.styles.iter().map(|s| s.2).fold(0.0, f64::max)
+    }
+}
+
+/// Adds to `out` (per style and luxel of `r`, at `points`) the light of `lighting`, whose
+/// weights at each luxel are `weights` (row-major by emitter), where nothing blocks it.
+fn light_batch(
+    scene: &TraceScene,
+    r: &Receivers,
+    points: &[DVec3],
+    lighting: &[&PointEmitter],
+    weights: &[f64],
+    out: &mut StyleLuxels,
+    counts: &mut BounceCounts,
+) {
+    let n = points.len();
+    let from: Vec<DVec3> = lighting.iter().map(|e| e.point).collect();
+    // A weak emitter's visibility is one segment's, to the luxel it lights most.
+    let weak: Vec<Option<usize>> = lighting
+        .iter()
+        .enumerate()
+        .map(|(k, e)| {
+            let row = &weights[k * n..(k + 1) * n];
+            let (best, w) = row
+                .iter()
+                .enumerate()
+                .fold((0, 0.0), |b, (i, &w)| if w > b.1 { (i, w) } else { b });
+            // The points of one face share its shadows: their weakness adds up.
+            (w * e.max_intensity() < WEAK * e.share).then_some(best)
+        })
+        .collect();
+    let lit = see(scene, r, &from, &weak, points, weights, counts);
+    for (k, e) in lighting.iter().enumerate() {
+        for i in 0..n {
+            let j = k * n + i;
+            if weights[j] == 0.0 || !lit[j] {
+                continue;
+            }
+            for (style, color, total) in &e.styles {
+                let w = weights[j] * total;
+                if color.iter().any(|&c| f64::from(c) * w >= GATE) {
+                    add_light(out, n, &[*style], &[*color], i, w);
+                }
+            }
+        }
     }
 }
 
