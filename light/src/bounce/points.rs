@@ -21,7 +21,7 @@
 
 use glam::{DVec3, Vec3};
 
-use super::{BounceCounts, Field, HOTSPOT_CLAMP, Receivers, StyleLuxels, add_light};
+use super::{BounceCounts, Field, HOTSPOT_CLAMP, Receivers, StyleLuxels};
 use crate::embree::RayPacket16;
 use crate::faces::FaceGeom;
 use crate::scene::TraceScene;
@@ -150,7 +150,8 @@ impl<'a> PointField<'a> {
         // by emitter), a batch at a time.
         let mut out = StyleLuxels::new();
         let mut lighting: Vec<&PointEmitter> = Vec::new();
-        let mut weights: Vec<f64> = Vec::with_capacity(BATCH + n);
+        let mut weights: Vec<f32> = Vec::with_capacity(BATCH + n);
+        let at = Luxels::new(&points, &normals);
         for k in self.in_sight_of(r.face) {
             let e = &self.emitters[k as usize];
             if e.face == r.face || (!r.two_sided && plane.distance(e.point) <= 0.0) {
@@ -167,20 +168,16 @@ impl<'a> PointField<'a> {
                 continue;
             }
             let start = weights.len();
-            weights.extend(points.iter().zip(&normals).map(|(&p, &normal)| {
-                // cos θe · cos θr / max(d, 128)², without a square root.
-                let to = p - e.point;
-                let d2 = to.length_squared().max(1e-4);
-                let along_e = e.normal.dot(to).max(0.0);
-                let along_r = if r.two_sided {
-                    d2.sqrt()
-                } else {
-                    (-normal.dot(to)).max(0.0)
-                };
-                let w =
-                    self.kernel * along_e * along_r / (d2 * d2.max(HOTSPOT_CLAMP * HOTSPOT_CLAMP));
-                if w * max_total < GATE { 0.0 } else { w }
-            }));
+            weights.resize(start + n, 0.0);
+            let gate = (GATE / max_total) as f32;
+            weigh(
+                e,
+                &at,
+                self.kernel as f32,
+                gate,
+                r.two_sided,
+                &mut weights[start..],
+            );
             if weights[start..].iter().all(|&w| w == 0.0) {
                 weights.truncate(start);
                 continue;
@@ -194,6 +191,61 @@ impl<'a> PointField<'a> {
         }
         light_batch(scene, r, &points, &lighting, &weights, &mut out, counts);
         out
+    }
+}
+
+/// A face's luxels, coordinate by coordinate (so that weighing them vectorises).
+struct Luxels {
+    at: [Vec<f32>; 3],
+    normal: [Vec<f32>; 3],
+}
+
+impl Luxels {
+    fn new(points: &[DVec3], normals: &[DVec3]) -> Luxels {
+        let axis = |v: &[DVec3], k: usize| v.iter().map(|p| p[k] as f32).collect();
+        Luxels {
+            at: [0, 1, 2].map(|k| axis(points, k)),
+            normal: [0, 1, 2].map(|k| axis(normals, k)),
+        }
+    }
+}
+
+/// Each luxel's weight from emitter `e`: `kernel · cos θe · cos θr / max(d, 128)²` (`cos θr`
+/// taken as 1 for a two-sided face), 0 where that is under `gate`.
+fn weigh(
+    e: &PointEmitter,
+    luxels: &Luxels,
+    kernel: f32,
+    gate: f32,
+    two_sided: bool,
+    out: &mut [f32],
+) {
+    let [ex, ey, ez] = e.point.as_vec3().to_array();
+    let [ux, uy, uz] = e.normal.as_vec3().to_array();
+    let clamp = (HOTSPOT_CLAMP * HOTSPOT_CLAMP) as f32;
+    let [px, py, pz] = &luxels.at;
+    let [nx, ny, nz] = &luxels.normal;
+    let n = out.len();
+    let (px, py, pz, nx, ny, nz) = (&px[..n], &py[..n], &pz[..n], &nx[..n], &ny[..n], &nz[..n]);
+    // cos θe · cos θr / max(d, 128)², without a square root for one-sided faces; one loop per
+    // kind of face, each free of branches.
+    let along = |i: usize| (px[i] - ex, py[i] - ey, pz[i] - ez);
+    let finish = |w: f32| if w < gate { 0.0 } else { w };
+    if two_sided {
+        for (i, slot) in out.iter_mut().enumerate() {
+            let (tx, ty, tz) = along(i);
+            let d2 = (tx * tx + ty * ty + tz * tz).max(1e-4);
+            let along_e = (ux * tx + uy * ty + uz * tz).max(0.0);
+            *slot = finish(kernel * along_e * d2.sqrt() / (d2 * d2.max(clamp)));
+        }
+    } else {
+        for (i, slot) in out.iter_mut().enumerate() {
+            let (tx, ty, tz) = along(i);
+            let d2 = (tx * tx + ty * ty + tz * tz).max(1e-4);
+            let along_e = (ux * tx + uy * ty + uz * tz).max(0.0);
+            let along_r = (-(nx[i] * tx + ny[i] * ty + nz[i] * tz)).max(0.0);
+            *slot = finish(kernel * along_e * along_r / (d2 * d2.max(clamp)));
+        }
     }
 }
 
@@ -214,7 +266,7 @@ fn light_batch(
     r: &Receivers,
     points: &[DVec3],
     lighting: &[&PointEmitter],
-    weights: &[f64],
+    weights: &[f32],
     out: &mut StyleLuxels,
     counts: &mut BounceCounts,
 ) {
@@ -231,24 +283,37 @@ fn light_batch(
                 .enumerate()
                 .fold((0, 0.0), |b, (i, &w)| if w > b.1 { (i, w) } else { b });
             // The points of one face share its shadows: their weakness adds up.
-            (w * e.max_intensity() < WEAK * e.share).then_some(best)
+            (f64::from(w) * e.max_intensity() < WEAK * e.share).then_some(best)
         })
         .collect();
     let lit = see(scene, r, &from, &weak, points, weights, counts);
     for (k, e) in lighting.iter().enumerate() {
-        for i in 0..n {
-            let j = k * n + i;
-            if weights[j] == 0.0 || !lit[j] {
-                continue;
-            }
-            for (style, color, total) in &e.styles {
-                let w = weights[j] * total;
-                if color.iter().any(|&c| f64::from(c) * w >= GATE) {
-                    add_light(out, n, &[*style], &[*color], i, w);
+        let (weights, lit) = (&weights[k * n..(k + 1) * n], &lit[k * n..(k + 1) * n]);
+        for &(style, color, total) in &e.styles {
+            let strongest = f64::from(color[0].max(color[1]).max(color[2]));
+            let luxels = style_luxels(out, style, n);
+            for ((luxel, &w), _) in luxels.iter_mut().zip(weights).zip(lit).filter(|(_, l)| **l) {
+                let w = f64::from(w) * total;
+                if w > 0.0 && strongest * w >= GATE {
+                    for (v, c) in luxel.iter_mut().zip(color) {
+                        *v += (w * f64::from(c)) as f32;
+                    }
                 }
             }
         }
     }
+}
+
+/// `out`'s luxels of `style` (`n` of them), added dark if it has none yet.
+fn style_luxels(out: &mut StyleLuxels, style: u8, n: usize) -> &mut [[f32; 3]] {
+    let k = match out.iter().position(|(s, _)| *s == style) {
+        Some(k) => k,
+        None => {
+            out.push((style, vec![[0.0; 3]; n]));
+            out.len() - 1
+        }
+    };
+    &mut out[k].1
 }
 
 /// Every point `field`'s faces with light and a reflectance send their light from.
@@ -364,7 +429,7 @@ fn see(
     from: &[DVec3],
     weak: &[Option<usize>],
     points: &[DVec3],
-    weights: &[f64],
+    weights: &[f32],
     counts: &mut BounceCounts,
 ) -> Vec<bool> {
     let (w, h) = (r.width, r.height);
