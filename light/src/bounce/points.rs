@@ -597,6 +597,37 @@ mod tests {
         assert!((total - 50.0 * 200.0).abs() < 1e-6, "{total}");
     }
 
+    proptest::proptest! {
+        /// T-junction points on a rectangle's edges change neither its area nor its corners.
+        #[test]
+        fn straight_edge_points_are_not_corners(
+            x in -4096.0f64..4096.0, y in -4096.0f64..4096.0,
+            w in 1.0f64..512.0, h in 1.0f64..512.0,
+            cuts in proptest::collection::vec((0usize..4, 0.05f64..0.95), 0..6),
+        ) {
+            let rect = [
+                DVec3::new(x, y, 0.0),
+                DVec3::new(x, y + h, 0.0),
+                DVec3::new(x + w, y + h, 0.0),
+                DVec3::new(x + w, y, 0.0),
+            ];
+            let mut points = Vec::new();
+            for (k, &corner) in rect.iter().enumerate() {
+                points.push(corner);
+                let next = rect[(k + 1) % 4];
+                let mut along: Vec<f64> =
+                    cuts.iter().filter(|c| c.0 == k).map(|c| c.1).collect();
+                along.sort_by(f64::total_cmp);
+                points.extend(along.iter().map(|&t| corner.lerp(next, t)));
+            }
+            proptest::prop_assert!((polygon_area(&points) - w * h).abs() < 1e-6 * w * h);
+            let found = corners(&points);
+            proptest::prop_assert_eq!(found.len(), 4, "{:?}", found);
+            let middle = mean(&found).expect("corners");
+            proptest::prop_assert!(middle.distance(DVec3::new(x + w / 2.0, y + h / 2.0, 0.0)) < 1e-6);
+        }
+    }
+
     #[test]
     fn a_dark_or_tiny_face_sends_nothing() {
         assert!(emitters_of([0.0; 3], Emission::Middle).is_empty());
