@@ -486,8 +486,17 @@ fn print_summary(lighting: &Lighting) {
         s.dirt_rays,
         s.seconds_trace,
         s.seconds_setup,
-        s.rays_per_second / 1e6
+        rays as f64 / s.seconds_trace.max(1e-9) / 1e6
     );
+    if s.bounce_passes > 0 {
+        eprintln!(
+            "light: bounce: {} pass{}, {} rays in {:.2} s",
+            s.bounce_passes,
+            if s.bounce_passes == 1 { "" } else { "es" },
+            s.bounce_rays,
+            s.seconds_bounce
+        );
+    }
     if s.grid_points > 0 {
         eprintln!(
             "light: light grid: {} points ({} in the open), {} rays in {:.2} s",

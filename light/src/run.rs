@@ -264,13 +264,17 @@ impl<'a> Plan<'a> {
                 .options
                 .bounce_density
                 .unwrap_or_else(|| Density::for_quality(self.options.quality));
+            let gathering = Gathering {
+                reference: false,
+                density,
+                progress: &self.options.progress,
+            };
             return bounce_light(
                 self.prep,
                 &self.reflectance,
                 traced,
                 traced,
-                false,
-                density,
+                gathering,
                 counts,
             );
         }
@@ -291,14 +295,17 @@ impl<'a> Plan<'a> {
             keep,
             &Progress::default(),
         );
-        let density = Density::for_quality(Quality::Reference);
+        let gathering = Gathering {
+            reference: true,
+            density: Density::for_quality(Quality::Reference),
+            progress: &Progress::default(),
+        };
         bounce_light(
             self.prep,
             &self.reflectance,
             traced,
             &field,
-            true,
-            density,
+            gathering,
             counts,
         )
     }
@@ -684,20 +691,34 @@ fn trace_faces(
         .collect()
 }
 
+/// How [`bounce_light`] gathers, and where it counts the faces it has done.
+struct Gathering<'p> {
+    /// The reference's: at every sample of the faces it measures.
+    reference: bool,
+    /// Where and how densely the surface gather's receivers are (`-emissivequality high`, and
+    /// the reference's passes for the next pass).
+    density: Density,
+    progress: &'p Progress,
+}
+
 /// Bounced light per face (by index; per luxel, or per sample for the reference), `passes`
-/// passes of it, gathered at `density`. `traced` is the direct light of every lit face; with
-/// `reference`, `field` is the same at `--extra4` (the reference's emitters) and bounce is
+/// passes of it, gathered as `gathering` says. `traced` is the direct light of every lit face;
+/// for the reference, `field` is the same at `--extra4` (the reference's emitters) and bounce is
 /// gathered at the samples of `traced` by [`bounce::reference::gather`] (the light a pass
-/// brings to the faces of `field`, for the next pass, at `density`).
+/// brings to the faces of `field`, for the next pass, at its density).
 fn bounce_light(
     prep: &Prepared,
     reflectance: &[Option<[f32; 3]>],
     traced: &[Traced],
     field: &[Traced],
-    reference: bool,
-    density: Density,
+    gathering: Gathering,
     counts: &mut BounceCounts,
 ) -> Vec<StyleLuxels> {
+    let Gathering {
+        reference,
+        density,
+        progress,
+    } = gathering;
     let settings = prep.lights.bounce;
     let n = prep.faces.len();
     let mut light: Vec<Option<StyleLuxels>> = vec![None; n];
@@ -746,13 +767,16 @@ fn bounce_light(
         }
         .filter(|_| !reference)
         .map(|emission| PointField::new(&emitting, &prep.vis, emission));
+        progress.start("bounce", receiving.len());
         let at_receivers = gather_faces(receiving.par_iter().copied(), |t, c| {
             let receivers = t.receivers.as_deref()?;
+            progress.advance(1);
             if let Some(points) = &points {
                 return Some(points.gather_face(&prep.scene, receivers, c));
             }
             Some(emitting.gather_face(&prep.scene, receivers, pass, density, c))
         });
+        progress.finish();
         for (face, b, c) in at_receivers {
             counts.add(&c);
             if !reference {
