@@ -268,6 +268,7 @@ pub(crate) fn emit(mut input: EmitInput) -> Emitted {
     let mut surflight_groups = Vec::with_capacity(pending.len());
     let mut minlights = Vec::with_capacity(pending.len());
     let mut channels = Vec::with_capacity(pending.len());
+    let mut tones = Vec::with_capacity(pending.len());
     let pieces = pending.iter().zip(polygons).flat_map(|(pf, poly)| {
         let max = max_face_edges(
             input.max_edges,
@@ -321,6 +322,7 @@ pub(crate) fn emit(mut input: EmitInput) -> Emitted {
         surflight_groups.push(info.surflight_group);
         minlights.push(info.minlight);
         channels.push(info.channels);
+        tones.push(info.tone);
         let range = node_faces
             .entry((pf.model, f.node))
             .or_insert((face_index, 0));
@@ -410,6 +412,7 @@ pub(crate) fn emit(mut input: EmitInput) -> Emitted {
     bsp.set_surflight_groups(&surflight_groups);
     bsp.set_face_minlights(&minlights);
     bsp.set_face_channels(&channels);
+    bsp.set_face_tones(&tones);
     let leaf_flags: Vec<LeafFlags> = leaf_contents
         .iter()
         .map(|c| LeafFlags {

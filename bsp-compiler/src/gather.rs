@@ -23,6 +23,7 @@ use quake_formats::bsp::contents;
 use quake_formats::bsp::face_channels::DEFAULT_CHANNELS;
 use quake_formats::bsp::face_flags::FaceFlags;
 use quake_formats::bsp::face_minlight::FaceMinlight;
+use quake_formats::bsp::face_tone::FaceTone;
 use quake_formats::bsp::phong::{self, FacePhong};
 use quake_formats::geom::Bounds;
 use rayon::prelude::*;
@@ -106,6 +107,7 @@ pub(crate) fn gather(
                 surflight_group: merged_surflight_group(ent, index, brush_class, warnings),
                 minlight: merged_minlight(ent, index, brush_class),
                 channels: merged_channels(ent, index, brush_class, warnings),
+                tone: merged_tone(ent, index, brush_class),
             },
             minlight_exclude: merged_minlight_exclude(ent, index, brush_class),
             transwater: options.transwater,
@@ -232,6 +234,8 @@ pub struct MapTexInfo {
     /// The `_object_channel_mask` of the world-merged entity the face came from (1: the
     /// world's).
     pub channels: u32,
+    /// The `_maxlight` and `_lightcolorscale` of the world-merged entity the face came from.
+    pub tone: FaceTone,
 }
 
 /// What a face's entity says about the face, beyond its brush: one of these per entity.
@@ -244,6 +248,7 @@ pub(crate) struct FaceKeys {
     pub surflight_group: i32,
     pub minlight: FaceMinlight,
     pub channels: u32,
+    pub tone: FaceTone,
 }
 
 impl MapTexInfo {
@@ -261,6 +266,7 @@ impl MapTexInfo {
             surflight_group: self.surflight_group,
             minlight: self.minlight,
             channels: self.channels,
+            tone: self.tone,
         }
     }
 }
@@ -371,8 +377,18 @@ impl EntityBrushes {
 }
 
 /// What a texinfo is interned by: its projection's bits, texture, phong group, whether it is lit
-/// water, its face flags, surface light group and minlight's bits.
-type TexInfoKey = ([u64; 8], u32, u32, bool, FaceFlags, i32, [u32; 4], u32);
+/// water, its face flags, surface light group, minlight's bits, light channels and tone's bits.
+type TexInfoKey = (
+    [u64; 8],
+    u32,
+    u32,
+    bool,
+    FaceFlags,
+    i32,
+    [u32; 4],
+    u32,
+    [u32; 2],
+);
 
 /// Texture names and texinfos, interned in first-use order.
 #[derive(Default)]
@@ -395,6 +411,7 @@ impl TexInfoTable {
             surflight_group,
             minlight,
             channels,
+            tone,
         } = keys;
         let key = name.to_ascii_lowercase();
         let texture = match self.name_index.get(&key) {
@@ -425,6 +442,7 @@ impl TexInfoTable {
             ]
             .map(f32::to_bits),
             channels,
+            [tone.maxlight, tone.color_scale].map(f32::to_bits),
         );
         if let Some(&i) = self.info_index.get(&key) {
             return i;
@@ -440,6 +458,7 @@ impl TexInfoTable {
             surflight_group,
             minlight,
             channels,
+            tone,
         });
         self.info_index.insert(key, i);
         i
@@ -596,6 +615,22 @@ fn merged_minlight(ent: &MapEntity, index: usize, class: EntityBrushes) -> FaceM
     FaceMinlight {
         level: level as f32,
         color: color.as_vec3().to_array(),
+    }
+}
+
+/// The `_maxlight` and `_lightcolorscale` of an entity merged into the world (light reads
+/// worldspawn's and brush models' own keys). Numbers read as ericw-tools reads them, up to the
+/// first character that is not part of one.
+fn merged_tone(ent: &MapEntity, index: usize, class: EntityBrushes) -> FaceTone {
+    if !merged_into_world(index, class) {
+        return FaceTone::default();
+    }
+    let number = |key| ent.entity.get_leading_float(key).map(|(v, _)| v as f32);
+    FaceTone {
+        maxlight: number("_maxlight").filter(|&m| m > 0.0).unwrap_or(0.0),
+        color_scale: number("_lightcolorscale")
+            .filter(|&s| s >= 0.0 && s != 1.0)
+            .unwrap_or(-1.0),
     }
 }
 
@@ -1006,6 +1041,7 @@ mod tests {
             surflight_group: 0,
             minlight: FaceMinlight::default(),
             channels: DEFAULT_CHANNELS,
+            tone: FaceTone::default(),
         };
         let plain = table.intern(
             "wall",

@@ -7,7 +7,8 @@
 //!
 //! The file is one JSON object: texinfo number (as a string) to an object of the flags that are
 //! set, such as `"no_shadow": true`, `"minlight": 100.0`, `"minlight_color": [255, 0, 0]`,
-//! `"phong_angle": 89.0`, `"phong_group": 2`, `"surflight_group": 3`, `"object_channel_mask": 2`.
+//! `"phong_angle": 89.0`, `"phong_group": 2`, `"surflight_group": 3`, `"object_channel_mask": 2`,
+//! `"maxlight": 40.0`, `"lightcolorscale": 0.0`.
 
 use std::collections::HashMap;
 
@@ -15,6 +16,7 @@ use quake_formats::Bsp;
 use quake_formats::bsp::face_channels::DEFAULT_CHANNELS;
 use quake_formats::bsp::face_flags::FaceFlags;
 use quake_formats::bsp::face_minlight::FaceMinlight;
+use quake_formats::bsp::face_tone::FaceTone;
 use quake_formats::bsp::phong::FacePhong;
 use serde_json::Value;
 
@@ -29,6 +31,8 @@ struct TexinfoKeys {
     surflight_group: i32,
     /// Its light channels (`_object_channel_mask`; `None`: the world's).
     channels: Option<u32>,
+    /// Its `_maxlight` and `_lightcolorscale`.
+    tone: FaceTone,
 }
 
 impl TexinfoKeys {
@@ -73,6 +77,12 @@ impl TexinfoKeys {
             channels: u32::try_from(whole("object_channel_mask"))
                 .ok()
                 .filter(|&m| m != 0),
+            tone: FaceTone {
+                maxlight: number("maxlight").filter(|&m| m > 0.0).unwrap_or(0.0) as f32,
+                color_scale: number("lightcolorscale")
+                    .filter(|&s| s >= 0.0 && s != 1.0)
+                    .unwrap_or(-1.0) as f32,
+            },
         }
     }
 }
@@ -140,6 +150,8 @@ pub fn add_face_keys(bsp: &mut Bsp, json: &str) -> Result<AddedLumps, String> {
         .map(|k| k.channels.unwrap_or(DEFAULT_CHANNELS))
         .collect();
     bsp.set_face_channels(&channels);
+    let tones: Vec<FaceTone> = keys.iter().map(|k| k.tone).collect();
+    bsp.set_face_tones(&tones);
     // Each is left out when no face has a key of its kind.
     Ok(FACE_KEY_LUMPS
         .into_iter()
@@ -148,13 +160,14 @@ pub fn add_face_keys(bsp: &mut Bsp, json: &str) -> Result<AddedLumps, String> {
 }
 
 /// The per-face key lumps Slipgate's compiler writes.
-const FACE_KEY_LUMPS: [&str; 6] = [
+const FACE_KEY_LUMPS: [&str; 7] = [
     quake_formats::bsp::face_flags::LUMP_NAME,
     quake_formats::bsp::face_minlight::LUMP_NAME,
     quake_formats::bsp::phong::LUMP_NAME,
     quake_formats::bsp::phong::CONCAVE_LUMP_NAME,
     quake_formats::bsp::surflight_group::LUMP_NAME,
     quake_formats::bsp::face_channels::LUMP_NAME,
+    quake_formats::bsp::face_tone::LUMP_NAME,
 ];
 
 /// Whether `bsp` carries any of the per-face key lumps Slipgate's compiler writes (then it was
@@ -195,10 +208,11 @@ mod tests {
             "1": {"light_ignore": true, "minlight": 100.0, "no_shadow": true,
                   "object_channel_mask": 8},
             "2": {"minlight": 20.0, "minlight_color": [255, 0, 0], "phong_angle": 89.0,
-                  "surflight_group": 4, "is_special": true}
+                  "surflight_group": 4, "is_special": true, "maxlight": 40.0,
+                  "lightcolorscale": 0.0}
         }"#;
         let added = add_face_keys(&mut bsp, json).expect("read");
-        assert_eq!(added.len(), 5, "{added:?}");
+        assert_eq!(added.len(), 6, "{added:?}");
         let flags = bsp.face_flags().expect("lump").expect("flags");
         assert_eq!(flags[0], FaceFlags::default());
         assert!(flags[1].light_ignore && flags[1].no_shadow && !flags[1].no_dirt);
@@ -211,6 +225,12 @@ mod tests {
         assert_eq!(phong[0].group, 0);
         assert_eq!(bsp.surflight_groups().expect("lump"), Some(vec![0, 0, 4]));
         assert_eq!(bsp.face_channels().expect("lump"), Some(vec![1, 8, 1]));
+        let tones = bsp.face_tones().expect("lump").expect("tones");
+        assert_eq!(tones[0], FaceTone::default());
+        assert_eq!(
+            (tones[2].maxlight(), tones[2].color_scale()),
+            (Some(40.0), Some(0.0))
+        );
         assert!(has_face_key_lumps(&bsp));
         for name in added {
             bsp.remove_bspx_lump(name);

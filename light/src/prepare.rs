@@ -269,6 +269,11 @@ pub fn face_rules<'a>(lights: &'a MapLights, geom: &FaceGeom) -> FaceRules<'a> {
         .get(geom.index)
         .copied()
         .unwrap_or_default();
+    let tone = lights
+        .face_tones
+        .get(geom.index)
+        .copied()
+        .unwrap_or_default();
     // The face's own merged entity's `_minlight` wins, then its brush model's, then
     // worldspawn's.
     let minlight = lights
@@ -291,14 +296,17 @@ pub fn face_rules<'a>(lights: &'a MapLights, geom: &FaceGeom) -> FaceRules<'a> {
         dirt,
         minlight_only: merged.light_ignore || lights.lightignore_models.contains(&geom.model),
         channels: lights.channels_of(geom),
-        color_scale: lights
-            .model_lightcolorscale
-            .get(&geom.model)
-            .map(|&s| s as f32),
-        maxlight: lights
-            .model_maxlight
-            .get(&geom.model)
-            .copied()
+        // The face's own merged entity's keys win, then its brush model's, then worldspawn's.
+        color_scale: tone.color_scale().or_else(|| {
+            lights
+                .model_lightcolorscale
+                .get(&geom.model)
+                .map(|&s| s as f32)
+        }),
+        maxlight: tone
+            .maxlight()
+            .map(f64::from)
+            .or_else(|| lights.model_maxlight.get(&geom.model).copied())
             .or(Some(lights.settings.maxlight))
             .filter(|&m| m > 0.0),
         bounce_dirt: lights.bounce.dirt.filter(|_| dirt && lights.bounce.is_on()),

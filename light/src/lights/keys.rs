@@ -221,7 +221,8 @@ entity_keys! {
     MINLIGHT_COLOR: ["_minlight_color", "_mincolor"] on Models, Color, default "white";
     /// A texture of the model that does not get its minimum light.
     MINLIGHT_EXCLUDE: ["_minlight_exclude"] on Models, Text, default "—";
-    /// The most light the model's faces take, in levels (instead of the world's `_maxlight`).
+    /// The most light the model's faces take, in levels (instead of the world's `_maxlight`;
+    /// on a `func_detail` or `func_group`, its own faces').
     MAXLIGHT: ["_maxlight"] on Models, Number, default "worldspawn's";
     /// `1`: the model casts shadows (the world always does); a model of `skip` brushes, which
     /// has no faces, casts the shadow of its brushes (read from the BSP's tree). `0` or `-1`: a
@@ -261,7 +262,8 @@ entity_keys! {
     /// (when the map's `_world_units_per_luxel` is set).
     WORLD_UNITS_PER_LUXEL: ["_world_units_per_luxel"] on Models, Number, default "the map's";
     /// How much colour the faces' light keeps: `0` greys it (each luxel takes its brightest
-    /// channel in all three), `1` keeps it; between, a mix, as in ericw-tools.
+    /// channel in all three), `1` keeps it; between, a mix, as in ericw-tools (on a
+    /// `func_detail` or `func_group`, its own faces').
     LIGHTCOLORSCALE: ["_lightcolorscale"] on WorldAndModels, Number, default "`1`";
     /// The model's lightmap spacing as a fraction of Quake's 16 texels, rounded down to a
     /// power of two texels (BSPX `LMSHIFT`).

@@ -20,6 +20,7 @@ use std::collections::HashMap;
 
 use quake_formats::bsp::face_channels::DEFAULT_CHANNELS;
 use quake_formats::bsp::face_flags::FaceFlags;
+use quake_formats::bsp::face_tone::FaceTone;
 use quake_formats::entities::Entity;
 
 use crate::bounce::EmissiveQuality;
@@ -130,6 +131,9 @@ pub struct MapLights {
     /// Per face, the light channels of the entity merged into the world it came from (the
     /// compiler's `SLIPGATE_FACECHANNELS`; empty without that lump).
     pub face_channels: Vec<u32>,
+    /// Per face, the `_maxlight` and `_lightcolorscale` of the entity merged into the world it
+    /// came from (the compiler's `SLIPGATE_FACETONE`; empty without that lump).
+    pub face_tones: Vec<FaceTone>,
     /// Brush models whose `_autominlight` is not the default (occluded samples only).
     pub autominlight: HashMap<usize, AutoMinlight>,
     /// Brush models whose autominlight is taken at a target's origin (`_autominlight_target`).
@@ -269,6 +273,7 @@ pub fn parse_lights(
         face_flags: Vec::new(),
         face_minlight: HashMap::new(),
         face_channels: Vec::new(),
+        face_tones: Vec::new(),
         autominlight: HashMap::new(),
         autominlight_at: HashMap::new(),
         no_nudge: Vec::new(),
@@ -305,7 +310,7 @@ pub fn parse_lights(
 impl MapLights {
     /// Reads what the compiler recorded in `bsp` of the keys of entities merged into the world,
     /// per face ([`MapLights::face_flags`], [`MapLights::face_minlight`],
-    /// [`MapLights::face_channels`]).
+    /// [`MapLights::face_channels`], [`MapLights::face_tones`]).
     ///
     /// # Errors
     /// A damaged `SLIPGATE_FACEFLAGS` or `SLIPGATE_FACEMINLIGHT` lump.

@@ -123,7 +123,7 @@ pub fn read_models(entities: &[Entity], global: &Global, out: &mut MapLights) {
 
 /// What the compiler recorded in `bsp` of the keys of entities merged into the world, per face:
 /// their flags (`_dirt -1`, `_bounce 0`, `_lightignore 1`, `_minlight_exclude`, `_shadow`),
-/// their own minlight and their light channels, into `out`.
+/// their own minlight, light channels, `_maxlight` and `_lightcolorscale`, into `out`.
 ///
 /// # Errors
 /// A damaged `SLIPGATE_FACEFLAGS` or `SLIPGATE_FACEMINLIGHT` lump.
@@ -134,6 +134,7 @@ pub fn read_merged_faces(
 ) -> Result<(), quake_formats::FormatError> {
     out.face_flags = bsp.face_flags()?.unwrap_or_default();
     out.face_channels = bsp.face_channels()?.unwrap_or_default();
+    out.face_tones = bsp.face_tones()?.unwrap_or_default();
     for (face, m) in bsp.face_minlights()?.unwrap_or_default().iter().enumerate() {
         if m.level != 0.0 {
             let color = DVec3::from(m.color.map(f64::from));

@@ -13,8 +13,6 @@ enum Where {
     Lights,
     /// Brush entities, merged into the world or not.
     Brushes,
-    /// Brush entities merged into the world (`func_detail*`, `func_group`: no `model` key).
-    MergedBrushes,
 }
 
 /// Each key, where ericw-tools reads it, and what it does there.
@@ -36,16 +34,6 @@ const UNSUPPORTED: &[(&str, Where, &str)] = &[
         "projected texture's field of view",
     ),
     ("_minlight_mottle", Where::Brushes, "mottled minlight"),
-    (
-        "_lightcolorscale",
-        Where::MergedBrushes,
-        "light colour scale of brushes merged into the world",
-    ),
-    (
-        "_maxlight",
-        Where::MergedBrushes,
-        "light cap of brushes merged into the world",
-    ),
 ];
 
 /// A warning for each key of [`UNSUPPORTED`] an entity of `entities` sets where ericw-tools
@@ -61,12 +49,11 @@ pub fn warnings(entities: &[Entity]) -> Vec<SettingWarning> {
         } else {
             Where::Brushes
         };
-        let merged = here == Where::Brushes && e.get("model").is_none();
         for &(key, place, what) in UNSUPPORTED {
             let Some(value) = e.get(key).filter(|v| !v.trim().is_empty()) else {
                 continue;
             };
-            if place == here || (place == Where::MergedBrushes && merged) {
+            if place == here {
                 out.push(SettingWarning {
                     given: Given::key(index, e, key),
                     value: value.to_string(),
@@ -89,7 +76,6 @@ pub fn markdown_list() -> String {
             Where::Worldspawn => "worldspawn",
             Where::Lights => "lights",
             Where::Brushes => "brush entities",
-            Where::MergedBrushes => "brush entities merged into the world",
         };
         out += &format!("- `{key}` ({on}): {what}\n");
     }
@@ -109,22 +95,19 @@ mod tests {
 { "classname" "func_wall" "model" "*1" "_minlight_mottle" "1" "_lightcolorscale" "0" }
 { "classname" "func_detail" "_lightcolorscale" "0" "_maxlight" "40" }
 "#;
+        // The merged entity's keys reach light through the compiler's SLIPGATE_FACETONE.
         let entities = parse_entities(text).expect("entities");
         let told: Vec<String> = warnings(&entities)
             .iter()
             .map(ToString::to_string)
             .collect();
-        assert_eq!(told.len(), 5, "{told:?}");
+        assert_eq!(told.len(), 3, "{told:?}");
         assert!(told[0].contains("\"_bouncelightsubdivision\"") && told[0].contains("bounce"));
         assert!(
             told[1].contains("\"_project_texture\" is \"window1\""),
             "{told:?}"
         );
         assert!(told[2].contains("_minlight_mottle"));
-        assert!(
-            told[3].contains("entity 3") && told[3].contains("_lightcolorscale"),
-            "a merged entity's colour scale, not a brush model's: {told:?}"
-        );
     }
 
     #[test]

@@ -553,6 +553,37 @@ fn light_color_scale_greys_a_models_faces() {
     }
 }
 
+/// `_lightcolorscale` and `_maxlight` on a `func_detail`, whose brushes join the world: the
+/// compiler records them per face (`SLIPGATE_FACETONE`), as ericw-tools' qbsp records them in
+/// its texinfo, and they act on the slab's faces alone.
+#[test]
+fn a_merged_entitys_colour_scale_and_cap_act_on_its_faces_only() {
+    let slab = map_box([-32.0, -32.0, -64.0], [32.0, 32.0, -48.0]);
+    let look = |keys: &str| {
+        let bsp = room_bsp(&format!(
+            "{{\n\"classname\" \"func_detail\"\n{keys}\n{slab}}}\n{}",
+            light([0.0, 0.0, 64.0], "\"_color\" \"255 64 0\"")
+        ));
+        let lighting = lit(&bsp);
+        let top = luxel_rgb(&bsp, &lighting, 0, DVec3::new(0.0, 0.0, -48.0), DVec3::Z);
+        (
+            top.expect("a lit slab"),
+            floor_rgb(&bsp, &lighting, 100.0, 100.0).expect("lit"),
+        )
+    };
+    let (coloured, floor) = look("");
+    assert!(
+        coloured[0] > 40 && coloured[1] < coloured[0],
+        "{coloured:?}"
+    );
+    let (grey, grey_floor) = look("\"_lightcolorscale\" \"0\"");
+    assert_eq!(grey, [coloured[0]; 3], "the brightest channel in all three");
+    assert_eq!(grey_floor, floor, "the world keeps its colour");
+    let (capped, capped_floor) = look("\"_maxlight\" \"20\"");
+    assert!(capped[0] <= 21 && capped[0] >= 19, "{capped:?}");
+    assert_eq!(capped_floor, floor, "the world is not capped");
+}
+
 /// ericw-tools' `_spotlightautofalloff`: a linear spotlight aimed at a `target` fades to zero
 /// just past its cone at the target (the distance plus the cone's radius there), instead of
 /// at its brightness in units. 224 units above the floor, light 600, angle 40: zero at 305.5

@@ -3,13 +3,14 @@
 //! The model stores every index as `u32`/`i32` and every bound as `f32`, wide enough for every
 //! version. Each record type knows its encoding per version (`records::Record`); lumps are
 //! read and written by one generic pair of functions. Trailing BSPX lumps are kept as named byte
-//! blobs; [`phong`], [`face_flags`], [`face_minlight`], [`face_channels`], [`surflight_group`]
+//! blobs; [`phong`], [`face_flags`], [`face_minlight`], [`face_channels`], [`face_tone`], [`surflight_group`]
 //! and [`leaf_flags`] read and write Slipgate's own ones, [`light_lumps`] those that carry light (coloured,
 //! directional, HDR, at other spacings) and [`lightgrid`] the light grid.
 
 pub mod face_channels;
 pub mod face_flags;
 pub mod face_minlight;
+pub mod face_tone;
 pub mod leaf_flags;
 pub mod light_lumps;
 pub mod lightgrid;
