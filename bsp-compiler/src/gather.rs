@@ -625,13 +625,8 @@ fn merged_tone(ent: &MapEntity, index: usize, class: EntityBrushes) -> FaceTone 
     if !merged_into_world(index, class) {
         return FaceTone::default();
     }
-    let number = |key| ent.entity.get_leading_float(key).map(|(v, _)| v as f32);
-    FaceTone {
-        maxlight: number("_maxlight").filter(|&m| m > 0.0).unwrap_or(0.0),
-        color_scale: number("_lightcolorscale")
-            .filter(|&s| s >= 0.0 && s != 1.0)
-            .unwrap_or(-1.0),
-    }
+    let number = |key| ent.entity.get_leading_float(key).map(|(v, _)| v);
+    FaceTone::from_keys(number("_maxlight"), number("_lightcolorscale"))
 }
 
 /// The `_minlight_exclude` texture of an entity merged into the world: its faces of that

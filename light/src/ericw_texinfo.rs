@@ -77,12 +77,7 @@ impl TexinfoKeys {
             channels: u32::try_from(whole("object_channel_mask"))
                 .ok()
                 .filter(|&m| m != 0),
-            tone: FaceTone {
-                maxlight: number("maxlight").filter(|&m| m > 0.0).unwrap_or(0.0) as f32,
-                color_scale: number("lightcolorscale")
-                    .filter(|&s| s >= 0.0 && s != 1.0)
-                    .unwrap_or(-1.0) as f32,
-            },
+            tone: FaceTone::from_keys(number("maxlight"), number("lightcolorscale")),
         }
     }
 }

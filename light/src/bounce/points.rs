@@ -20,6 +20,7 @@
 //! over a face's luxels (see [`see`]).
 
 use glam::{DVec3, Vec3};
+use quake_formats::geom::Winding;
 
 use super::{BounceCounts, Field, HOTSPOT_CLAMP, Receivers, StyleLuxels};
 use crate::embree::RayPacket16;
@@ -35,6 +36,9 @@ const GATE: f64 = 0.01;
 /// by the whole face at once: a segment to the luxel it lights most decides. Where its
 /// shadow crosses the face, luxels are off by at most this much light.
 const WEAK: f64 = 0.5;
+
+/// Points nearer than this (units) to an emitter count as this near (ericw-tools' floor).
+const MIN_DISTANCE: f32 = 0.01;
 
 /// Faces smaller than this (square units) give off no bounced light.
 const MIN_AREA: f64 = 1.0;
@@ -113,7 +117,7 @@ impl<'a> PointField<'a> {
         };
         let mut found = self.unplaced.clone();
         for (l, list) in self.by_leaf.iter().enumerate().skip(1) {
-            if !list.is_empty() && pvs[(l - 1) / 8] & (1 << ((l - 1) % 8)) != 0 {
+            if !list.is_empty() && Visibility::holds(&pvs, l as u32) {
                 found.extend_from_slice(list);
             }
         }
@@ -136,11 +140,6 @@ impl<'a> PointField<'a> {
         let n = r.points.len();
         let plane = self.faces[r.face].plane;
         let points: Vec<DVec3> = r.points.iter().map(|&p| Vec3::from(p).as_dvec3()).collect();
-        let normals: Vec<DVec3> = r
-            .normals
-            .iter()
-            .map(|&p| Vec3::from(p).as_dvec3())
-            .collect();
         let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
         for &p in &points {
             lo = lo.min(p);
@@ -151,7 +150,7 @@ impl<'a> PointField<'a> {
         let mut out = StyleLuxels::new();
         let mut lighting: Vec<&PointEmitter> = Vec::new();
         let mut weights: Vec<f32> = Vec::with_capacity(BATCH + n);
-        let at = Luxels::new(&points, &normals);
+        let at = Luxels::new(&r.points, &r.normals);
         for k in self.in_sight_of(r.face) {
             let e = &self.emitters[k as usize];
             if e.face == r.face || (!r.two_sided && plane.distance(e.point) <= 0.0) {
@@ -201,8 +200,8 @@ struct Luxels {
 }
 
 impl Luxels {
-    fn new(points: &[DVec3], normals: &[DVec3]) -> Luxels {
-        let axis = |v: &[DVec3], k: usize| v.iter().map(|p| p[k] as f32).collect();
+    fn new(points: &[[f32; 3]], normals: &[[f32; 3]]) -> Luxels {
+        let axis = |v: &[[f32; 3]], k: usize| v.iter().map(|p| p[k]).collect();
         Luxels {
             at: [0, 1, 2].map(|k| axis(points, k)),
             normal: [0, 1, 2].map(|k| axis(normals, k)),
@@ -234,14 +233,14 @@ fn weigh(
     if two_sided {
         for (i, slot) in out.iter_mut().enumerate() {
             let (tx, ty, tz) = along(i);
-            let d2 = (tx * tx + ty * ty + tz * tz).max(1e-4);
+            let d2 = (tx * tx + ty * ty + tz * tz).max(MIN_DISTANCE * MIN_DISTANCE);
             let along_e = (ux * tx + uy * ty + uz * tz).max(0.0);
             *slot = finish(kernel * along_e * d2.sqrt() / (d2 * d2.max(clamp)));
         }
     } else {
         for (i, slot) in out.iter_mut().enumerate() {
             let (tx, ty, tz) = along(i);
-            let d2 = (tx * tx + ty * ty + tz * tz).max(1e-4);
+            let d2 = (tx * tx + ty * ty + tz * tz).max(MIN_DISTANCE * MIN_DISTANCE);
             let along_e = (ux * tx + uy * ty + uz * tz).max(0.0);
             let along_r = (-(nx[i] * tx + ny[i] * ty + nz[i] * tz)).max(0.0);
             *slot = finish(kernel * along_e * along_r / (d2 * d2.max(clamp)));
@@ -325,17 +324,14 @@ fn point_emitters(field: &Field, emission: Emission) -> Vec<PointEmitter> {
         else {
             continue;
         };
-        let area = polygon_area(&face.points);
-        if area < MIN_AREA {
+        let area = Winding::new(face.points.clone()).area();
+        let corners = corners(&face.points);
+        if area < MIN_AREA || corners.is_empty() {
             continue;
         }
-        let corners = corners(&face.points);
-        let Some(middle) = mean(&corners) else {
-            continue;
-        };
-        let mut at = vec![middle];
+        let mut at = vec![corners.center()];
         if emission == Emission::MiddleAndCorners {
-            at.extend_from_slice(&corners);
+            at.extend_from_slice(&corners.points);
         }
         let share = 1.0 / at.len() as f64;
         let mut styles = Vec::new();
@@ -374,34 +370,18 @@ fn point_emitters(field: &Field, emission: Emission) -> Vec<PointEmitter> {
     out
 }
 
-/// The area of the convex polygon `points`.
-fn polygon_area(points: &[DVec3]) -> f64 {
-    let Some(&first) = points.first() else {
-        return 0.0;
-    };
-    let mut sum = DVec3::ZERO;
-    for w in points.windows(2).skip(1) {
-        sum += (w[0] - first).cross(w[1] - first);
-    }
-    0.5 * sum.length()
-}
-
 /// The points of `points` that are corners of the outline: those on a straight edge between
 /// their neighbours left out.
-fn corners(points: &[DVec3]) -> Vec<DVec3> {
+fn corners(points: &[DVec3]) -> Winding {
     let n = points.len();
-    (0..n)
+    let kept = (0..n)
         .filter(|&i| {
             let before = (points[i] - points[(i + n - 1) % n]).normalize_or_zero();
             let after = (points[(i + 1) % n] - points[i]).normalize_or_zero();
             before.dot(after) < STRAIGHT
         })
-        .map(|i| points[i])
-        .collect()
-}
-
-fn mean(points: &[DVec3]) -> Option<DVec3> {
-    (!points.is_empty()).then(|| points.iter().sum::<DVec3>() / points.len() as f64)
+        .map(|i| points[i]);
+    Winding::new(kept.collect())
 }
 
 /// Whether a luxel sees an emitter.
@@ -481,13 +461,14 @@ fn see(
             for (lane, &j) in chunk.iter().enumerate() {
                 let origin = from[j / n];
                 let to = points[j % n] - origin;
-                let dist = to.length().max(0.01);
+                let dist = to.length().max(f64::from(MIN_DISTANCE));
                 packet.set(
                     lane,
                     origin.as_vec3().to_array(),
                     (to / dist).as_vec3().to_array(),
                     crate::trace::RAY_START,
-                    (dist - 0.01) as f32,
+                    // Stopping where a ray from the luxel would start.
+                    (dist as f32 - crate::trace::RAY_START).max(0.0),
                 );
             }
             let blocked = scene.occluded16(&mut packet, r.model);
@@ -620,10 +601,11 @@ mod tests {
                 along.sort_by(f64::total_cmp);
                 points.extend(along.iter().map(|&t| corner.lerp(next, t)));
             }
-            proptest::prop_assert!((polygon_area(&points) - w * h).abs() < 1e-6 * w * h);
+            let area = Winding::new(points.clone()).area();
+            proptest::prop_assert!((area - w * h).abs() < 1e-6 * w * h);
             let found = corners(&points);
             proptest::prop_assert_eq!(found.len(), 4, "{:?}", found);
-            let middle = mean(&found).expect("corners");
+            let middle = found.center();
             proptest::prop_assert!(middle.distance(DVec3::new(x + w / 2.0, y + h / 2.0, 0.0)) < 1e-6);
         }
     }
@@ -637,7 +619,7 @@ mod tests {
             DVec3::new(1.0, 0.5, 0.0),
             DVec3::new(1.0, 0.0, 0.0),
         ];
-        assert!((polygon_area(&sliver) - 0.5).abs() < 1e-12);
-        assert!(polygon_area(&sliver) < MIN_AREA);
+        let area = Winding::new(sliver.to_vec()).area();
+        assert!((area - 0.5).abs() < 1e-12 && area < MIN_AREA);
     }
 }

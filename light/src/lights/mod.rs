@@ -313,7 +313,7 @@ impl MapLights {
     /// [`MapLights::face_channels`], [`MapLights::face_tones`]).
     ///
     /// # Errors
-    /// A damaged `SLIPGATE_FACEFLAGS` or `SLIPGATE_FACEMINLIGHT` lump.
+    /// A damaged lump of those keys.
     pub fn read_merged_faces(
         &mut self,
         bsp: &quake_formats::Bsp,

@@ -21,8 +21,9 @@ pub fn model_index(e: &Entity) -> Option<usize> {
 }
 
 /// `_phong`, `_phong_angle` and `_phong_angle_concave` (into `out.phong`), `_lmscale` (into
-/// `out.model_lmscale`) and `_lightcolorscale` (into `out.model_lightcolorscale`) of worldspawn (`world`, as model 0) and every brush model, with a warning
-/// for each key not taken as written.
+/// `out.model_lmscale`) and `_lightcolorscale` (into `out.model_lightcolorscale`) of worldspawn
+/// (`world`, as model 0) and every brush model, with a warning for each key not taken as
+/// written.
 pub fn read_world_and_model_keys(entities: &[Entity], world: Option<usize>, out: &mut MapLights) {
     for (index, e) in entities.iter().enumerate() {
         let model = if Some(index) == world {
@@ -126,7 +127,7 @@ pub fn read_models(entities: &[Entity], global: &Global, out: &mut MapLights) {
 /// their own minlight, light channels, `_maxlight` and `_lightcolorscale`, into `out`.
 ///
 /// # Errors
-/// A damaged `SLIPGATE_FACEFLAGS` or `SLIPGATE_FACEMINLIGHT` lump.
+/// A damaged lump of those keys.
 pub fn read_merged_faces(
     bsp: &Bsp,
     global: &Global,

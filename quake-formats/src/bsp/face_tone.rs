@@ -35,6 +35,17 @@ impl Default for FaceTone {
 }
 
 impl FaceTone {
+    /// From the values of `_maxlight` and `_lightcolorscale` (absent: none of its own; a cap
+    /// of 0 or less, a negative scale or a scale of 1 are none either).
+    pub fn from_keys(maxlight: Option<f64>, color_scale: Option<f64>) -> FaceTone {
+        FaceTone {
+            maxlight: maxlight.filter(|&m| m > 0.0).unwrap_or(0.0) as f32,
+            color_scale: color_scale
+                .filter(|&s| s >= 0.0 && s != 1.0)
+                .unwrap_or(-1.0) as f32,
+        }
+    }
+
     /// Its cap, if it has one of its own.
     pub fn maxlight(&self) -> Option<f32> {
         (self.maxlight > 0.0).then_some(self.maxlight)
