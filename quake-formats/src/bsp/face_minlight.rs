@@ -8,7 +8,7 @@
 //! one, and engines ignore BSPX lumps they do not know.
 
 use super::Bsp;
-use crate::bytes::{PutLe, Reader};
+use crate::bytes::PutLe;
 use crate::error::Result;
 
 /// The lump's BSPX name.
@@ -32,20 +32,12 @@ impl Bsp {
     /// [`FormatError::BadLump`](crate::FormatError::BadLump) when its length does not match the
     /// face count.
     pub fn face_minlights(&self) -> Result<Option<Vec<FaceMinlight>>> {
-        let Some(data) = self.bspx_lump(LUMP_NAME) else {
-            return Ok(None);
-        };
-        self.per_face_records(LUMP_NAME, data.len(), RECORD_LEN)?;
-        let mut r = Reader::new(data, LUMP_NAME);
-        (0..self.faces.len())
-            .map(|_| {
-                Ok(FaceMinlight {
-                    level: r.f32()?,
-                    color: r.f32x3()?,
-                })
+        self.read_per_face(LUMP_NAME, RECORD_LEN, |r| {
+            Ok(FaceMinlight {
+                level: r.f32()?,
+                color: r.f32x3()?,
             })
-            .collect::<Result<Vec<_>>>()
-            .map(Some)
+        })
     }
 
     /// Stores `minlights` (one per face) as the `SLIPGATE_FACEMINLIGHT` lump, replacing any

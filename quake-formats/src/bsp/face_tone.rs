@@ -9,7 +9,7 @@
 //! ignore BSPX lumps they do not know.
 
 use super::Bsp;
-use crate::bytes::{PutLe, Reader};
+use crate::bytes::PutLe;
 use crate::error::Result;
 
 /// The lump's BSPX name.
@@ -65,20 +65,12 @@ impl Bsp {
     /// [`FormatError::BadLump`](crate::FormatError::BadLump) when its length does not match the
     /// face count.
     pub fn face_tones(&self) -> Result<Option<Vec<FaceTone>>> {
-        let Some(data) = self.bspx_lump(LUMP_NAME) else {
-            return Ok(None);
-        };
-        self.per_face_records(LUMP_NAME, data.len(), RECORD_LEN)?;
-        let mut r = Reader::new(data, LUMP_NAME);
-        (0..self.faces.len())
-            .map(|_| {
-                Ok(FaceTone {
-                    maxlight: r.f32()?,
-                    color_scale: r.f32()?,
-                })
+        self.read_per_face(LUMP_NAME, RECORD_LEN, |r| {
+            Ok(FaceTone {
+                maxlight: r.f32()?,
+                color_scale: r.f32()?,
             })
-            .collect::<Result<Vec<_>>>()
-            .map(Some)
+        })
     }
 
     /// Stores `tones` (one per face) as the `SLIPGATE_FACETONE` lump, replacing any earlier

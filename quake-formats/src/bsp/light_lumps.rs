@@ -121,15 +121,7 @@ impl Bsp {
     /// [`FormatError::LumpSize`] or [`FormatError::BadLump`] when its records do not match the
     /// face count.
     pub fn lightmap_offsets(&self) -> Result<Option<Vec<i32>>> {
-        let Some(data) = self.bspx_lump(LMOFFSET) else {
-            return Ok(None);
-        };
-        self.per_face_records(LMOFFSET, data.len(), 4)?;
-        let mut r = Reader::new(data, LMOFFSET);
-        (0..self.faces.len())
-            .map(|_| r.i32())
-            .collect::<Result<Vec<_>>>()
-            .map(Some)
+        self.read_per_face(LMOFFSET, 4, |r| r.i32())
     }
 
     /// Stores one `LMSHIFT` byte and one `LMOFFSET` value per face.
@@ -188,6 +180,25 @@ impl Bsp {
             }
         }
         self.set_bspx_lump(DECOUPLED_LM, data);
+    }
+
+    /// The BSPX lump `lump`, if the file has it, read as one `record`-byte record per face, each
+    /// by `read`.
+    pub(crate) fn read_per_face<T>(
+        &self,
+        lump: &'static str,
+        record: usize,
+        mut read: impl FnMut(&mut Reader) -> Result<T>,
+    ) -> Result<Option<Vec<T>>> {
+        let Some(data) = self.bspx_lump(lump) else {
+            return Ok(None);
+        };
+        self.per_face_records(lump, data.len(), record)?;
+        let mut r = Reader::new(data, lump);
+        (0..self.faces.len())
+            .map(|_| read(&mut r))
+            .collect::<Result<Vec<_>>>()
+            .map(Some)
     }
 
     /// Checks that a per-face lump of `len` bytes holds one `record`-byte record per face.

@@ -7,7 +7,7 @@
 //! face has a group, and engines ignore BSPX lumps they do not know.
 
 use super::Bsp;
-use crate::bytes::{PutLe, Reader};
+use crate::bytes::PutLe;
 use crate::error::Result;
 
 /// The lump's BSPX name.
@@ -22,15 +22,7 @@ impl Bsp {
     /// [`FormatError::BadLump`](crate::FormatError::BadLump) when its length does not match the
     /// face count.
     pub fn surflight_groups(&self) -> Result<Option<Vec<i32>>> {
-        let Some(data) = self.bspx_lump(LUMP_NAME) else {
-            return Ok(None);
-        };
-        self.per_face_records(LUMP_NAME, data.len(), RECORD_LEN)?;
-        let mut r = Reader::new(data, LUMP_NAME);
-        (0..self.faces.len())
-            .map(|_| r.i32())
-            .collect::<Result<Vec<_>>>()
-            .map(Some)
+        self.read_per_face(LUMP_NAME, RECORD_LEN, |r| r.i32())
     }
 
     /// Stores `groups` (one per face) as the `SLIPGATE_SURFGROUP` lump, replacing any earlier
