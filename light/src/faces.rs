@@ -126,6 +126,33 @@ impl OwnGrid {
 }
 
 impl FaceGeom {
+    /// A lit face of model `model` with outline `points` on `plane`, without texture axes or
+    /// neighbours, for tests.
+    #[cfg(test)]
+    pub fn for_test(
+        index: usize,
+        model: usize,
+        points: Vec<DVec3>,
+        plane: quake_formats::geom::Plane,
+    ) -> FaceGeom {
+        use quake_formats::extents::{LightmapExtents, LuxelGrid};
+        let extents = LightmapExtents::from_points(&[], &[[0.0; 4]; 2]);
+        FaceGeom {
+            index,
+            model,
+            kind: FaceKind::Lit,
+            texture: String::new(),
+            points,
+            plane,
+            vecs: [[0.0; 4]; 2],
+            origin: DVec3::ZERO,
+            extents,
+            continuations: Vec::new(),
+            grid: LuxelGrid::vanilla(&extents, &[[0.0; 4]; 2]),
+            own_grid: None,
+        }
+    }
+
     /// The mean of the vertices (inside the face: faces are convex).
     #[cfg(test)]
     pub fn centroid(&self) -> DVec3 {

@@ -252,33 +252,17 @@ pub fn interpolate(face: &FaceGeom, corners: &[DVec3], p: DVec3) -> DVec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use quake_formats::extents::{LightmapExtents, LuxelGrid};
     use quake_formats::geom::Plane;
 
     fn square() -> FaceGeom {
-        FaceGeom {
-            index: 0,
-            model: 0,
-            kind: FaceKind::Lit,
-            texture: String::new(),
-            // Clockwise seen from above (+z).
-            points: vec![
-                DVec3::new(0.0, 0.0, 0.0),
-                DVec3::new(0.0, 10.0, 0.0),
-                DVec3::new(10.0, 10.0, 0.0),
-                DVec3::new(10.0, 0.0, 0.0),
-            ],
-            plane: Plane::new(DVec3::new(0.0, 0.0, 1.0), 0.0),
-            vecs: [[0.0; 4]; 2],
-            origin: DVec3::ZERO,
-            extents: LightmapExtents::from_points(&[], &[[0.0; 4]; 2]),
-            continuations: Vec::new(),
-            grid: LuxelGrid::vanilla(
-                &LightmapExtents::from_points(&[], &[[0.0; 4]; 2]),
-                &[[0.0; 4]; 2],
-            ),
-            own_grid: None,
-        }
+        // Clockwise seen from above (+z).
+        let points = vec![
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(0.0, 10.0, 0.0),
+            DVec3::new(10.0, 10.0, 0.0),
+            DVec3::new(10.0, 0.0, 0.0),
+        ];
+        FaceGeom::for_test(0, 0, points, Plane::new(DVec3::new(0.0, 0.0, 1.0), 0.0))
     }
 
     #[test]

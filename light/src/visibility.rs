@@ -225,27 +225,15 @@ mod tests {
     use super::*;
     use crate::faces::FaceGeom;
     use quake_formats::bsp::{Leaf, Model};
-    use quake_formats::extents::{LightmapExtents, LuxelGrid};
     use quake_formats::geom::Plane;
 
     fn face(index: usize, model: usize) -> FaceGeom {
-        FaceGeom {
+        FaceGeom::for_test(
             index,
             model,
-            kind: FaceKind::Lit,
-            texture: String::new(),
-            points: Vec::new(),
-            plane: Plane::new(DVec3::new(0.0, 0.0, 1.0), 0.0),
-            vecs: [[0.0; 4]; 2],
-            origin: DVec3::ZERO,
-            extents: LightmapExtents::from_points(&[], &[[0.0; 4]; 2]),
-            continuations: Vec::new(),
-            grid: LuxelGrid::vanilla(
-                &LightmapExtents::from_points(&[], &[[0.0; 4]; 2]),
-                &[[0.0; 4]; 2],
-            ),
-            own_grid: None,
-        }
+            Vec::new(),
+            Plane::new(DVec3::new(0.0, 0.0, 1.0), 0.0),
+        )
     }
 
     /// Leaves 1 and 2 see only themselves; both faces are marked in leaf 2.

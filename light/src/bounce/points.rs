@@ -497,35 +497,20 @@ fn see(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::faces::FaceKind;
     use crate::lights::BounceSettings;
-    use quake_formats::extents::{LightmapExtents, LuxelGrid};
     use quake_formats::geom::Plane;
 
     /// An upward 20 × 10 face at height 0 whose outline also passes through (10, 0, 0), a
     /// T-junction point on its long edge.
     fn floor() -> FaceGeom {
-        let extents = LightmapExtents::from_points(&[], &[[0.0; 4]; 2]);
-        FaceGeom {
-            index: 0,
-            model: 0,
-            kind: FaceKind::Lit,
-            texture: String::new(),
-            points: vec![
-                DVec3::new(0.0, 0.0, 0.0),
-                DVec3::new(0.0, 10.0, 0.0),
-                DVec3::new(20.0, 10.0, 0.0),
-                DVec3::new(20.0, 0.0, 0.0),
-                DVec3::new(10.0, 0.0, 0.0),
-            ],
-            plane: Plane::new(DVec3::Z, 0.0),
-            vecs: [[0.0; 4]; 2],
-            origin: DVec3::ZERO,
-            extents,
-            continuations: Vec::new(),
-            grid: LuxelGrid::vanilla(&extents, &[[0.0; 4]; 2]),
-            own_grid: None,
-        }
+        let points = vec![
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(0.0, 10.0, 0.0),
+            DVec3::new(20.0, 10.0, 0.0),
+            DVec3::new(20.0, 0.0, 0.0),
+            DVec3::new(10.0, 0.0, 0.0),
+        ];
+        FaceGeom::for_test(0, 0, points, Plane::new(DVec3::Z, 0.0))
     }
 
     fn emitters_of(light: [f32; 3], emission: Emission) -> Vec<PointEmitter> {
