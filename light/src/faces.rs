@@ -56,6 +56,9 @@ pub struct FaceGeom {
     /// [`CONTINUATION_HOPS`] shared edges, as outlines: where a luxel past this face's edge
     /// finds the surface it stands over. Each lit face's outline is made once and shared.
     pub continuations: Vec<Arc<FaceRegion>>,
+    /// Its own outline, as its continuations share it (lit faces, once
+    /// [`attach_continuations`] has filled it in).
+    pub outline: Option<Arc<FaceRegion>>,
     /// The grid light samples the face on: Quake's 16-texel one over `extents`, or its own.
     pub grid: LuxelGrid,
     /// What its own grid is, when it has one; the lightmap over `extents` is then taken from
@@ -77,6 +80,13 @@ impl FaceGeom {
     /// The face's outline, for telling where on it a point of its plane lies.
     pub fn region(&self) -> FaceRegion {
         FaceRegion::from_points(self.points.clone(), self.plane.normal)
+    }
+
+    /// [`FaceGeom::region`], the one [`FaceGeom::outline`] shares when it is there.
+    pub fn shared_region(&self) -> Arc<FaceRegion> {
+        self.outline
+            .clone()
+            .unwrap_or_else(|| Arc::new(self.region()))
     }
 }
 
@@ -148,6 +158,7 @@ impl FaceGeom {
             origin: DVec3::ZERO,
             extents,
             continuations: Vec::new(),
+            outline: None,
             grid: LuxelGrid::vanilla(&extents, &[[0.0; 4]; 2]),
             own_grid: None,
         }
@@ -256,6 +267,7 @@ pub fn unlinked_face_geometry(
                 origin,
                 extents,
                 continuations: Vec::new(),
+                outline: None,
                 grid: own.map_or_else(|| LuxelGrid::vanilla(&extents, &ti.vecs), |(_, g)| g),
                 own_grid: own.map(|(kind, _)| kind),
             })
@@ -275,22 +287,31 @@ type EdgeKey = ([i64; 3], [i64; 3]);
 /// its plane (ericw-tools follows a point across at most three).
 pub const CONTINUATION_HOPS: usize = 3;
 
+/// What [`continuations`] finds: per face, its continuations and its own outline (lit faces
+/// only), made once and shared by the faces it continues.
+pub struct Links {
+    continuations: Vec<Vec<Arc<FaceRegion>>>,
+    outlines: Vec<Option<Arc<FaceRegion>>>,
+}
+
 /// Each lit face's [`FaceGeom::continuations`]: the lit faces of its model on its plane reached
 /// across at most [`CONTINUATION_HOPS`] shared edges.
-pub fn continuations(faces: &[FaceGeom]) -> Vec<Vec<Arc<FaceRegion>>> {
+pub fn continuations(faces: &[FaceGeom]) -> Links {
     let key = |p: DVec3| (p / SAME_CORNER).round().as_i64vec3().to_array();
-    // Every lit face under each of its edges, sorted by edge: one allocation, not one per edge.
-    let mut by_edge: Vec<(EdgeKey, usize)> = faces
-        .par_iter()
-        .filter(|f| f.kind == FaceKind::Lit)
-        .flat_map_iter(|f| {
-            let corners: Vec<[i64; 3]> = f.points.iter().map(|&p| key(p)).collect();
-            (0..corners.len()).map(move |i| {
-                let (a, b) = (corners[i], corners[(i + 1) % corners.len()]);
-                ((a.min(b), a.max(b)), f.index)
-            })
-        })
-        .collect();
+    let lit = |f: &&FaceGeom| f.kind == FaceKind::Lit;
+    // Every lit face under each of its edges, sorted by edge: one allocation of the exact size
+    // (fresh memory costs more than the keys do to compute).
+    let edges = faces.iter().filter(lit).map(|f| f.points.len()).sum();
+    let mut by_edge: Vec<(EdgeKey, usize)> = Vec::with_capacity(edges);
+    let mut corners: Vec<[i64; 3]> = Vec::new();
+    for f in faces.iter().filter(lit) {
+        corners.clear();
+        corners.extend(f.points.iter().map(|&p| key(p)));
+        for (i, &a) in corners.iter().enumerate() {
+            let b = corners[(i + 1) % corners.len()];
+            by_edge.push(((a.min(b), a.max(b)), f.index));
+        }
+    }
     by_edge.par_sort_unstable();
     let same_plane = |a: &FaceGeom, b: &FaceGeom| {
         a.model == b.model
@@ -298,60 +319,87 @@ pub fn continuations(faces: &[FaceGeom]) -> Vec<Vec<Arc<FaceRegion>>> {
             && (a.plane.dist - b.plane.dist).abs() < SAME_CORNER
     };
     // The faces under one edge are a run of `by_edge`: each is beside the others on its plane.
-    let mut beside: Vec<Vec<usize>> = vec![Vec::new(); faces.len()];
+    // As (face, neighbour) pairs, sorted: each face's neighbours are a run of them.
+    let mut beside: Vec<(u32, u32)> = Vec::new();
     for run in by_edge.chunk_by(|a, b| a.0 == b.0) {
         for &(_, f) in run {
             for &(_, g) in run {
                 if g != f && same_plane(&faces[f], &faces[g]) {
-                    beside[f].push(g);
+                    beside.push((f as u32, g as u32));
                 }
             }
         }
     }
-    for next in &mut beside {
-        next.sort_unstable();
-        next.dedup();
+    drop(by_edge);
+    beside.sort_unstable();
+    beside.dedup();
+    // Where each face's run of neighbours starts in `beside` (one past the last face: its end).
+    let mut starts = vec![0usize; faces.len() + 1];
+    for &(f, _) in &beside {
+        starts[f as usize + 1] += 1;
     }
+    for f in 0..faces.len() {
+        starts[f + 1] += starts[f];
+    }
+    let neighbours = |f: usize| {
+        beside[starts[f]..starts[f + 1]]
+            .iter()
+            .map(|&(_, g)| g as usize)
+    };
     // Each lit face's outline, made once: the faces it continues share it.
-    let regions: Vec<Option<Arc<FaceRegion>>> = faces
+    let outlines: Vec<Option<Arc<FaceRegion>>> = faces
         .par_iter()
         .map(|f| (f.kind == FaceKind::Lit).then(|| Arc::new(f.region())))
         .collect();
-    (0..faces.len())
+    let continuations = (0..faces.len())
         .into_par_iter()
-        .map(|f| {
-            let mut reached = vec![f];
-            let mut ring = vec![f];
-            for _ in 0..CONTINUATION_HOPS {
-                ring = ring.iter().flat_map(|&g| &beside[g]).copied().collect();
-                ring.sort_unstable();
-                ring.dedup();
-                ring.retain(|g| !reached.contains(g));
-                reached.extend(&ring);
-            }
-            reached.sort_unstable();
-            // An outline's inward normals come from the plane it is seen on: a continuation on
-            // a plane whose normal differs in its last bits gets an outline of its own.
-            let normal = faces[f].plane.normal;
-            reached
-                .into_iter()
-                .filter(|&g| g != f)
-                .filter_map(|g| match &regions[g] {
-                    Some(r) if faces[g].plane.normal == normal => Some(r.clone()),
-                    Some(_) => Some(Arc::new(FaceRegion::from_points(
-                        faces[g].points.clone(),
-                        normal,
-                    ))),
-                    None => None,
-                })
-                .collect()
-        })
-        .collect()
+        .map_init(
+            || (Vec::new(), Vec::new(), Vec::new()),
+            |(reached, ring, next): &mut (Vec<usize>, Vec<usize>, Vec<usize>), f| {
+                reached.clear();
+                reached.push(f);
+                ring.clear();
+                ring.push(f);
+                for _ in 0..CONTINUATION_HOPS {
+                    next.clear();
+                    next.extend(ring.iter().flat_map(|&g| neighbours(g)));
+                    next.sort_unstable();
+                    next.dedup();
+                    next.retain(|g| !reached.contains(g));
+                    reached.extend_from_slice(next);
+                    std::mem::swap(ring, next);
+                }
+                reached.sort_unstable();
+                // An outline's inward normals come from the plane it is seen on: a continuation
+                // on a plane whose normal differs in its last bits gets an outline of its own.
+                let normal = faces[f].plane.normal;
+                reached
+                    .iter()
+                    .filter(|&&g| g != f)
+                    .filter_map(|&g| match &outlines[g] {
+                        Some(r) if faces[g].plane.normal == normal => Some(r.clone()),
+                        Some(_) => Some(Arc::new(FaceRegion::from_points(
+                            faces[g].points.clone(),
+                            normal,
+                        ))),
+                        None => None,
+                    })
+                    .collect()
+            },
+        )
+        .collect();
+    Links {
+        continuations,
+        outlines,
+    }
 }
 
-/// Fills each face's [`FaceGeom::continuations`] with what [`continuations`] found for it.
-pub fn attach_continuations(faces: &mut [FaceGeom], links: Vec<Vec<Arc<FaceRegion>>>) {
-    for (face, continuations) in faces.iter_mut().zip(links) {
+/// Fills each face's [`FaceGeom::continuations`] and [`FaceGeom::outline`] with what
+/// [`continuations`] found for it.
+pub fn attach_continuations(faces: &mut [FaceGeom], links: Links) {
+    let each = links.continuations.into_iter().zip(links.outlines);
+    for (face, (continuations, outline)) in faces.iter_mut().zip(each) {
         face.continuations = continuations;
+        face.outline = outline;
     }
 }

@@ -27,6 +27,11 @@ pub struct FaceRegion {
 /// How far outside an edge (units) a point still counts as inside ([`FaceRegion::contains`]).
 const CONTAINS_SLACK: f64 = 1e-6;
 
+/// Room (units) [`FaceRegion::holds_disc`] leaves for rounding: the points it vouches for are
+/// computed apart from the disc's centre, each edge distance rounded on its own, at map
+/// coordinates where that rounding is below a billionth of a unit.
+const DISC_MARGIN: f64 = 1e-6;
+
 /// The square of a distance from `centre` beyond which no point is within [`CONTAINS_SLACK`]
 /// (and the rounding of the edge test) of every edge's inner side: the farthest corner, plus
 /// how far pushing each edge out that much moves a corner (more at a sharper corner), plus room
@@ -107,6 +112,15 @@ impl FaceRegion {
             nearest = nearest.min(d);
         }
         Some(nearest < ON_EDGE)
+    }
+
+    /// Whether every point of the plane within `radius` of `p` (a point on the face's plane)
+    /// is inside the region and off its outline: [`FaceRegion::inside_on_edge`] would say
+    /// `Some(false)` of each. Conservative: `p`'s distances from the edges are held a margin
+    /// above `radius`, for the rounding of the points' own tests.
+    pub fn holds_disc(&self, p: DVec3, radius: f64) -> bool {
+        let clear = radius + ON_EDGE + DISC_MARGIN;
+        (self.points.iter().zip(&self.inward)).all(|(&a, m)| m.dot(p - a) > clear)
     }
 
     /// Whether `p` (a point of the region) lies on its outline (within [`ON_EDGE`]).
@@ -229,6 +243,36 @@ mod tests {
                 let by_edges = (region.points.iter().zip(&region.inward))
                     .all(|(&a, m)| m.dot(p - a) >= -CONTAINS_SLACK);
                 prop_assert_eq!(region.contains(p), by_edges);
+            }
+        }
+
+        /// Every point within the radius of a disc the region holds is inside it and off its
+        /// outline, by the test each sample point takes, discs barely held too.
+        #[test]
+        fn a_held_disc_holds_each_of_its_points(
+            angles in proptest::collection::vec(0.0f64..std::f64::consts::TAU, 3..9),
+            radius in 1.0f64..500.0,
+            x in -400.0f64..400.0,
+            y in -400.0f64..400.0,
+            disc in 0.0f64..40.0,
+            at in proptest::collection::vec((0.0f64..std::f64::consts::TAU, 0.0f64..=1.0), 16),
+        ) {
+            let region = circle_region(angles, radius, 0.05);
+            prop_assume!(region.is_some());
+            let region = region.expect("assumed");
+            let centre = DVec3::new(x, y, 64.0);
+            // The largest disc it holds, within a rounding: the nearest edge minus the margins.
+            let nearest = (region.points.iter().zip(&region.inward))
+                .map(|(&a, m)| m.dot(centre - a))
+                .fold(f64::INFINITY, f64::min);
+            for r in [disc, nearest - ON_EDGE - DISC_MARGIN * 1.5] {
+                if r < 0.0 || !region.holds_disc(centre, r) {
+                    continue;
+                }
+                for &(angle, along) in &at {
+                    let p = centre + DVec3::new(angle.cos(), angle.sin(), 0.0) * r * along;
+                    prop_assert_eq!(region.inside_on_edge(p), Some(false));
+                }
             }
         }
     }

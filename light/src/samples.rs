@@ -187,7 +187,7 @@ impl TextureToWorld {
 #[derive(Debug, Clone)]
 pub struct SurfaceMap {
     to_world: Option<TextureToWorld>,
-    outline: FaceRegion,
+    outline: Arc<FaceRegion>,
     /// The faces continuing this one past its edges ([`FaceGeom::continuations`]).
     continuations: Vec<Arc<FaceRegion>>,
     origin: DVec3,
@@ -220,7 +220,7 @@ impl SurfaceMap {
         });
         SurfaceMap {
             to_world,
-            outline: face.region(),
+            outline: face.shared_region(),
             continuations: face.continuations.clone(),
             origin: face.origin,
             lift: face.plane.normal * SURFACE_OFFSET,
@@ -280,6 +280,33 @@ impl SurfaceMap {
             moved: on_face != on_plane,
             on_edge,
             beyond: longer_than(ds, dt, self.grid.scale),
+        }
+    }
+
+    /// Whether every sample of the luxel whose middle is at `[s0, t0]` lies inside the face
+    /// and off its outline, where [`SurfaceMap::place`] leaves it: each is then
+    /// [`SurfaceMap::inside`]'s, without a look at the face's edges.
+    fn luxel_inside(&self, [s0, t0]: [f64; 2]) -> bool {
+        let Some(m) = &self.to_world else {
+            return false;
+        };
+        // The samples lie within the luxel's half-diagonal of its middle.
+        let radius = self.footprint_radius * self.per_axis as f64;
+        self.outline
+            .holds_disc(m.point(s0, t0) + self.origin, radius)
+    }
+
+    /// [`SurfaceMap::place`] of a point known to lie inside the face and off its outline.
+    fn inside(&self, s: f64, t: f64) -> Placed {
+        let Some(m) = &self.to_world else {
+            return self.place(s, t);
+        };
+        let on_plane = m.point(s, t) + self.origin;
+        Placed {
+            at: on_plane + self.lift,
+            moved: false,
+            on_edge: false,
+            beyond: false,
         }
     }
 
@@ -398,9 +425,16 @@ pub fn face_samples(face: &FaceGeom, per_axis: usize, bsp: &Bsp) -> (FaceSamples
     for y in 0..height {
         for x in 0..width {
             let middle = face.grid.luxel_st(x, y);
+            // With several samples a luxel, one test of its middle answers for all of them
+            // when the luxel lies well inside the face.
+            let inside = per_luxel > 1 && map.luxel_inside(middle);
             for sub in 0..per_luxel {
                 let [s, t] = map.sub_sample_st(middle, sub);
-                let placed = map.place(s, t);
+                let placed = if inside {
+                    map.inside(s, t)
+                } else {
+                    map.place(s, t)
+                };
                 points.push(placed.at.as_vec3().to_array());
                 moved.push(placed.moved);
                 apart.push(placed.on_edge);

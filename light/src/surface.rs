@@ -132,6 +132,7 @@ mod tests {
             origin: DVec3::ZERO,
             extents,
             continuations: Vec::new(),
+            outline: None,
             grid: quake_formats::extents::LuxelGrid::vanilla(&extents, &vecs),
             own_grid: None,
         };
