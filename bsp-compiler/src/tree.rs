@@ -740,19 +740,26 @@ impl Builder<'_> {
         let bounds = brushes
             .iter()
             .fold(Bounds::EMPTY, |acc, b| acc.union(&b.bounds));
+        let visible = self
+            .visible
+            .map(|v| unused(None, Some(v)))
+            .unwrap_or_default();
+        // Only sides faces are made on cut a big node, when they are known (as in ericw-tools):
+        // a hidden side's plane would cut open space where no face asks for it.
+        let mid_candidates = if self.visible.is_some() {
+            &visible
+        } else {
+            &candidates
+        };
         if let Some(mid) = mid_split(
             &bounds,
-            &candidates,
+            mid_candidates,
             self.planes,
             self.splitting.max_node_size,
         ) {
             return Some(mid);
         }
         let hints = unused(Some(BrushKind::Hint), None);
-        let visible = self
-            .visible
-            .map(|v| unused(None, Some(v)))
-            .unwrap_or_default();
         let candidates = [hints, visible]
             .into_iter()
             .find(|list| !list.is_empty())

@@ -124,6 +124,75 @@ fn a_visblocker_blocks_vis_but_not_movement_or_sight_of_its_faces() {
     }
 }
 
+/// A brush of `box_brush`'s sides but its top, which slopes from `high` (x, z) down to `low`.
+fn ramp(x: [f64; 2], y: [f64; 2], bottom: f64, high: [f64; 2], low: [f64; 2]) -> String {
+    let whole = box_brush([x[0], y[0], bottom], [x[1], y[1], high[1]], "ramp");
+    let lines: Vec<&str> = whole.lines().collect();
+    // The fifth side is the top (+z); the slope's three points turn the same way seen from
+    // outside whichever way it falls.
+    let (p1, p2, p3) = if high[0] < low[0] {
+        (
+            [high[0], y[0], high[1]],
+            [high[0], y[1], high[1]],
+            [low[0], y[0], low[1]],
+        )
+    } else {
+        (
+            [high[0], y[0], high[1]],
+            [low[0], y[0], low[1]],
+            [high[0], y[1], high[1]],
+        )
+    };
+    let point = |p: [f64; 3]| format!("( {} {} {} )", p[0], p[1], p[2]);
+    let slope = format!("{} {} {} ramp 0 0 0 1 1", point(p1), point(p2), point(p3));
+    let mut out: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
+    out[5] = slope;
+    out.join("\n") + "\n"
+}
+
+#[test]
+fn a_long_hall_is_cut_in_the_middle_only_by_planes_of_faces() {
+    // A hall 2560 units long (over the 1024 above which a node is cut near its middle), closed
+    // across by a visblocker 256 units from its middle, with a ramp on each side leaning on it
+    // whose steep side, nearer the middle than the visblocker, is hidden in the floor. Only sides faces are made on cut the hall, so each half
+    // stays one leaf and no portal is left (ericw-tools' `q1FuncIllusionaryVisblocker`).
+    let (y, floor, top) = ([-128.0, 128.0], 0.0, 256.0);
+    let mut world = String::new();
+    world += &box_brush(
+        [-1040.0, y[0] - 16.0, floor - 16.0],
+        [1552.0, y[1] + 16.0, floor],
+        "floor",
+    );
+    world += &box_brush(
+        [-1040.0, y[0] - 16.0, top],
+        [1552.0, y[1] + 16.0, top + 16.0],
+        "ceiling",
+    );
+    world += &box_brush([-1040.0, y[0] - 16.0, floor], [1552.0, y[0], top], "wall");
+    world += &box_brush([-1040.0, y[1], floor], [1552.0, y[1] + 16.0, top], "wall");
+    world += &box_brush([-1040.0, y[0], floor], [-1024.0, y[1], top], "wall");
+    world += &box_brush([1536.0, y[0], floor], [1552.0, y[1], top], "wall");
+    // The ramps reach through the walls into the void, where the outside fill makes their
+    // buried side's plane no face's.
+    let wide = [y[0] - 32.0, y[1] + 32.0];
+    world += &ramp([8.0, 40.0], wide, floor - 8.0, [8.0, 16.0], [40.0, floor]);
+    world += &ramp([-40.0, -8.0], wide, floor - 8.0, [-8.0, 16.0], [-40.0, floor]);
+    let blocker = brush_entity(
+        "func_illusionary_visblocker",
+        &box_brush([-8.0, y[0], floor], [8.0, y[1], top], "*water1"),
+    );
+    let text = format!(
+        "{{\n\"classname\" \"worldspawn\"\n\"wad\" \"none.wad\"\n{world}}}\n{blocker}\
+         {{\n\"classname\" \"info_player_start\"\n\"origin\" \"-512 0 24\"\n}}\n\
+         {{\n\"classname\" \"weapon_nailgun\"\n\"origin\" \"512 0 24\"\n}}\n"
+    );
+    let out = try_compile(&text).expect("compile");
+    assert!(out.leak.is_none());
+    assert_eq!(errors(&out.bsp), Vec::<String>::new());
+    let prt = PortalFile::parse(&out.portals.write()).expect("prt");
+    assert_eq!((prt.num_leafs, prt.portals.len()), (3, 0));
+}
+
 /// The feature map (`tests/maps/features.map`): prefabs (one nested, turned, scaled), water
 /// that mirrors inside (func_detail by default, func_illusionary by `_mirrorinside`) and a
 /// visblocker compile without a warning and validate without a problem of any severity.
