@@ -1,14 +1,14 @@
 //! One model from its brushes to its trees and faces: the world and every brush entity go
 //! through this on their own (in parallel).
 //!
-//! CSG marks the brush sides other brushes bury; the drawing tree (hull 0) and the two clip hull
-//! trees are built at once; hull 0 is portalised (and, when detail split its structural leaves,
-//! portalised again by clusters); the world's outside is flooded from its point entities and
-//! filled, with the space no entity reaches. A sealed world's tree is then built again, split by
-//! the sides that face open space first (as ericw-tools does), so that planes facing the void
-//! only cut solid space and collapse away; it is portalised and filled again, and so are its clip
-//! hulls. Faces are made where leaf contents change, merged, and cut where their lightmaps would
-//! grow too large.
+//! CSG marks the brush sides other brushes bury. Then two pipelines run side by side. Hull 0,
+//! the drawing tree: built, portalised (and, when detail split its structural leaves, portalised
+//! again by clusters), its outside flooded from the world's point entities and filled, with the
+//! space no entity reaches; a sealed world's tree is then built again, split by the sides that
+//! face open space first (as ericw-tools does), so that planes facing the void only cut solid
+//! space and collapse away, portalised and filled again; faces are made where leaf contents
+//! change, merged, and cut where their lightmaps would grow too large. The two clip hulls: built,
+//! and for the world filled the same way, on copies kept when hull 0 finds the world sealed.
 
 use crate::csg::mark_hidden_sides;
 use crate::faces::{
@@ -83,12 +83,73 @@ pub(crate) fn build_model(
     let is_world = m.entity == 0;
     // Kept for the world's second tree, built once its outside is filled.
     let world_brushes = (is_world && options.fill).then(|| brushes.clone());
-    let ((mut tree, tree_time), (mut hulls, hull_time)) = rayon::join(
+    // Hull 0 and the clip hulls are built side by side, neither waiting for the other. A sealed
+    // world's clip hulls are sealed too (grown brushes only close gaps further), and their
+    // outsides are filled so that each collapses into one solid leaf instead of many clip
+    // nodes: the world's hulls are filled on copies while hull 0 is still finding out whether
+    // the world is sealed, and the copies kept only when it is.
+    let speculate = is_world && options.fill;
+    let (world, (hulls, filled_hulls, hull_time)) = rayon::join(
         || {
+            let mut times = [0.0; 4];
             let t = Instant::now();
-            let tree = build_tree(brushes, planes, splitting, true);
+            let mut tree = build_tree(brushes, planes, splitting, true);
             progress.advance(counts[0]);
-            (tree, t.elapsed().as_secs_f64())
+            times[0] = t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            let (mut portals, mut cluster_portals) = portalise(&tree, planes, &bounds);
+            times[1] = t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            let mut fill = (is_world && options.fill).then(|| {
+                let flood = cluster_portals.as_ref().unwrap_or(&portals);
+                fill_world(
+                    &mut tree,
+                    planes,
+                    &portals,
+                    flood,
+                    occupants,
+                    options,
+                    &mut warnings,
+                )
+            });
+            times[2] = t.elapsed().as_secs_f64();
+            if let (Some(FillOutcome::Sealed { .. }), Some(brushes)) = (&fill, world_brushes) {
+                let t = Instant::now();
+                let visible = visible_sides(&tree, &portals);
+                let mut second = rebuild_tree_visible_first(brushes, planes, splitting, &visible);
+                times[0] += t.elapsed().as_secs_f64();
+                let t = Instant::now();
+                let (second_portals, second_clusters) = portalise(&second, planes, &bounds);
+                times[1] += t.elapsed().as_secs_f64();
+                let t = Instant::now();
+                let flood = second_clusters.as_ref().unwrap_or(&second_portals);
+                // The same entities flood the same space: its warnings were given the first
+                // time.
+                let mut repeated = Vec::new();
+                let outcome = fill_world(
+                    &mut second,
+                    planes,
+                    &second_portals,
+                    flood,
+                    occupants,
+                    options,
+                    &mut repeated,
+                );
+                // Sealed again unless a sliver the new planes leave opens a crack: then keep the
+                // first.
+                if matches!(outcome, FillOutcome::Sealed { .. }) {
+                    tree = second;
+                    portals = second_portals;
+                    cluster_portals = second_clusters;
+                    fill = Some(outcome);
+                }
+                times[2] += t.elapsed().as_secs_f64();
+            }
+            let t = Instant::now();
+            let (faces, stats) = model_faces(&tree, &portals, planes, texinfos, options.subdivide);
+            progress.advance(counts[0]);
+            times[3] = t.elapsed().as_secs_f64();
+            (tree, portals, cluster_portals, fill, faces, stats, times)
         },
         || {
             let t = Instant::now();
@@ -96,89 +157,28 @@ pub(crate) fn build_model(
                 || build_clip_hull_tree(h1, planes, splitting),
                 || build_clip_hull_tree(h2, planes, splitting),
             );
-            progress.advance(counts[1] + counts[2]);
-            ([a, b], t.elapsed().as_secs_f64())
-        },
-    );
-    timings[0] = tree_time;
-    timings[4] = hull_time;
-
-    let t = Instant::now();
-    let (mut portals, mut cluster_portals) = portalise(&tree, planes, &bounds);
-    timings[1] = t.elapsed().as_secs_f64();
-
-    let t = Instant::now();
-    let mut fill = (is_world && options.fill).then(|| {
-        let flood = cluster_portals.as_ref().unwrap_or(&portals);
-        fill_world(
-            &mut tree,
-            planes,
-            &portals,
-            flood,
-            occupants,
-            options,
-            &mut warnings,
-        )
-    });
-    timings[2] = t.elapsed().as_secs_f64();
-
-    if let (Some(FillOutcome::Sealed { .. }), Some(brushes)) = (&fill, world_brushes) {
-        let t = Instant::now();
-        let visible = visible_sides(&tree, &portals);
-        let mut second = rebuild_tree_visible_first(brushes, planes, splitting, &visible);
-        timings[0] += t.elapsed().as_secs_f64();
-        let t = Instant::now();
-        let (second_portals, second_clusters) = portalise(&second, planes, &bounds);
-        timings[1] += t.elapsed().as_secs_f64();
-        let t = Instant::now();
-        let flood = second_clusters.as_ref().unwrap_or(&second_portals);
-        // The same entities flood the same space: its warnings were given the first time.
-        let mut repeated = Vec::new();
-        let outcome = fill_world(
-            &mut second,
-            planes,
-            &second_portals,
-            flood,
-            occupants,
-            options,
-            &mut repeated,
-        );
-        // Sealed again unless a sliver the new planes leave opens a crack: then keep the first.
-        if matches!(outcome, FillOutcome::Sealed { .. }) {
-            tree = second;
-            portals = second_portals;
-            cluster_portals = second_clusters;
-            fill = Some(outcome);
-        }
-        timings[2] += t.elapsed().as_secs_f64();
-    }
-
-    // A sealed world's clip hulls are sealed too (grown brushes only close gaps further): fill
-    // their outsides as well, so it collapses into one solid leaf instead of many clip nodes.
-    // Hull 0's faces are made meanwhile.
-    let sealed = matches!(fill, Some(FillOutcome::Sealed { .. }));
-    let ((faces, face_stats, faces_time), fill_time) = rayon::join(
-        || {
-            let t = Instant::now();
-            let (faces, stats) = model_faces(&tree, &portals, planes, texinfos, options.subdivide);
-            progress.advance(counts[0]);
-            (faces, stats, t.elapsed().as_secs_f64())
-        },
-        || {
-            let t = Instant::now();
-            if sealed {
-                let [h1, h2] = &mut hulls;
+            let hulls = [a, b];
+            let filled = speculate.then(|| {
+                let mut filled = hulls.clone();
+                let [f1, f2] = &mut filled;
                 rayon::join(
-                    || fill_hull(h1, planes, &hull_bounds[0], occupants, splitting, options),
-                    || fill_hull(h2, planes, &hull_bounds[1], occupants, splitting, options),
+                    || fill_hull(f1, planes, &hull_bounds[0], occupants, splitting, options),
+                    || fill_hull(f2, planes, &hull_bounds[1], occupants, splitting, options),
                 );
-            }
+                filled
+            });
             progress.advance(counts[1] + counts[2]);
-            t.elapsed().as_secs_f64()
+            (hulls, filled, t.elapsed().as_secs_f64())
         },
     );
-    timings[3] = faces_time;
-    timings[4] += fill_time;
+    let (tree, portals, cluster_portals, fill, faces, face_stats, times) = world;
+    let sealed = matches!(fill, Some(FillOutcome::Sealed { .. }));
+    let hulls = match filled_hulls {
+        Some(filled) if sealed => filled,
+        _ => hulls,
+    };
+    timings[..4].copy_from_slice(&times);
+    timings[4] = hull_time;
 
     (
         ModelOutput {

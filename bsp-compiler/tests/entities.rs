@@ -176,7 +176,13 @@ fn a_long_hall_is_cut_in_the_middle_only_by_planes_of_faces() {
     // buried side's plane no face's.
     let wide = [y[0] - 32.0, y[1] + 32.0];
     world += &ramp([8.0, 40.0], wide, floor - 8.0, [8.0, 16.0], [40.0, floor]);
-    world += &ramp([-40.0, -8.0], wide, floor - 8.0, [-8.0, 16.0], [-40.0, floor]);
+    world += &ramp(
+        [-40.0, -8.0],
+        wide,
+        floor - 8.0,
+        [-8.0, 16.0],
+        [-40.0, floor],
+    );
     let blocker = brush_entity(
         "func_illusionary_visblocker",
         &box_brush([-8.0, y[0], floor], [8.0, y[1], top], "*water1"),
