@@ -219,7 +219,20 @@ pub fn compile(
     timings.push(("brushes".to_string(), t.elapsed().as_secs_f64()));
 
     let t = Instant::now();
-    let results = build_models(models, &planes, &table, &occupants, options);
+    // The WADs are read while the models are built: reading a map's texture WADs (megabytes
+    // each) waits on the disk and on fresh memory, which the models' threads need not.
+    let (results, (wads, wad_warnings)) = rayon::join(
+        || build_models(models, &planes, &table, &occupants, options),
+        || {
+            let mut wad_warnings = Vec::new();
+            let wads = WadSet::load(
+                &map.entities[0].entity,
+                &wad_search(source, options),
+                &mut wad_warnings,
+            );
+            (wads, wad_warnings)
+        },
+    );
     timings.push(("models (wall)".to_string(), t.elapsed().as_secs_f64()));
     let mut leak = None;
     let mut phase_sums = [0.0; 6];
@@ -254,12 +267,8 @@ pub fn compile(
     stats.leaked = leak.is_some();
 
     let t = Instant::now();
-    let wads = WadSet::load(
-        &map.entities[0].entity,
-        &wad_search(source, options),
-        &mut warnings,
-    )
-    .with_missing(MissingTextures {
+    warnings.extend(wad_warnings);
+    let wads = wads.with_missing(MissingTextures {
         loose_dirs: if options.texture_data {
             Vec::new()
         } else {
