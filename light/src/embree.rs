@@ -2,16 +2,68 @@
 //!
 //! Only triangle meshes, single-level scenes and occlusion / closest-hit
 //! queries are exposed. The raw declarations in [`sys`] mirror
-//! `<embree3/rtcore*.h>`; their layouts are checked in the unit tests.
+//! `<embree3/rtcore*.h>`; their layouts are checked in the unit tests. The library is opened
+//! (`dlopen`) when the first device is made, so that a program that never traces a ray neither
+//! needs it installed nor pays for loading it.
 
 use std::ffi::{CStr, CString, c_char, c_void};
 use std::fmt;
 use std::sync::{Arc, Mutex, PoisonError};
 
+/// Embree's functions `fns` (their C declarations, as in `rtcore*.h`): a table of pointers
+/// ([`sys`]'s `Api`) filled from the library when it is opened, and a function of each name
+/// calling through it.
+macro_rules! embree_api {
+    ($(fn $name:ident($($arg:ident: $ty:ty),* $(,)?) $(-> $ret:ty)?;)*) => {
+        struct Api {
+            $($name: unsafe extern "C" fn($($ty),*) $(-> $ret)?,)*
+        }
+
+        impl Api {
+            /// Each function in the opened library `handle`; the name of the first missing.
+            ///
+            /// # Safety
+            /// `handle` must be Embree 3's library, open for the rest of the program.
+            unsafe fn find(handle: *mut c_void) -> Result<Api, &'static str> {
+                Ok(Api {
+                    $($name: {
+                        let symbol = concat!(stringify!($name), "\0");
+                        // SAFETY: `symbol` is NUL-terminated; `handle` is open.
+                        let found = unsafe { dlsym(handle, symbol.as_ptr().cast()) };
+                        if found.is_null() {
+                            return Err(stringify!($name));
+                        }
+                        // SAFETY: Embree 3 declares the function of this name with this
+                        // signature; a data pointer from `dlsym` is the function's address.
+                        unsafe {
+                            std::mem::transmute::<
+                                *mut c_void,
+                                unsafe extern "C" fn($($ty),*) $(-> $ret)?,
+                            >(found)
+                        }
+                    },)*
+                })
+            }
+        }
+
+        $(
+            /// Embree's function of this name.
+            ///
+            /// # Safety
+            /// As Embree documents it; [`load`] must have succeeded.
+            pub unsafe fn $name($($arg: $ty),*) $(-> $ret)? {
+                // SAFETY: the caller keeps Embree's contract for the call.
+                unsafe { (api().$name)($($arg),*) }
+            }
+        )*
+    };
+}
+
 /// Raw declarations for the subset of the Embree 3 C API we use.
 #[allow(non_camel_case_types, non_snake_case, dead_code)]
 pub mod sys {
     use std::ffi::{c_char, c_int, c_uint, c_void};
+    use std::sync::OnceLock;
 
     #[repr(C)]
     pub struct RTCDeviceTy {
@@ -173,26 +225,29 @@ pub mod sys {
     pub type RTCDeviceProperty = c_uint;
     pub const RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED: RTCDeviceProperty = 34;
 
-    unsafe extern "C" {
-        pub fn rtcNewDevice(config: *const c_char) -> RTCDevice;
-        pub fn rtcReleaseDevice(device: RTCDevice);
-        pub fn rtcGetDeviceError(device: RTCDevice) -> RTCError;
-        pub fn rtcGetDeviceProperty(device: RTCDevice, prop: RTCDeviceProperty) -> isize;
-        pub fn rtcSetDeviceErrorFunction(
+    // Embree is opened when the first device is made, not when the program starts: the
+    // commands that never trace a ray (bsp, vis, info) do not load it and its thread pool, and
+    // start in a couple of milliseconds less.
+    embree_api! {
+        fn rtcNewDevice(config: *const c_char) -> RTCDevice;
+        fn rtcReleaseDevice(device: RTCDevice);
+        fn rtcGetDeviceError(device: RTCDevice) -> RTCError;
+        fn rtcGetDeviceProperty(device: RTCDevice, prop: RTCDeviceProperty) -> isize;
+        fn rtcSetDeviceErrorFunction(
             device: RTCDevice,
             error: RTCErrorFunction,
             user_ptr: *mut c_void,
         );
 
-        pub fn rtcNewScene(device: RTCDevice) -> RTCScene;
-        pub fn rtcReleaseScene(scene: RTCScene);
-        pub fn rtcSetSceneFlags(scene: RTCScene, flags: RTCSceneFlags);
-        pub fn rtcSetSceneBuildQuality(scene: RTCScene, quality: RTCBuildQuality);
-        pub fn rtcAttachGeometry(scene: RTCScene, geometry: RTCGeometry) -> c_uint;
-        pub fn rtcCommitScene(scene: RTCScene);
+        fn rtcNewScene(device: RTCDevice) -> RTCScene;
+        fn rtcReleaseScene(scene: RTCScene);
+        fn rtcSetSceneFlags(scene: RTCScene, flags: RTCSceneFlags);
+        fn rtcSetSceneBuildQuality(scene: RTCScene, quality: RTCBuildQuality);
+        fn rtcAttachGeometry(scene: RTCScene, geometry: RTCGeometry) -> c_uint;
+        fn rtcCommitScene(scene: RTCScene);
 
-        pub fn rtcNewGeometry(device: RTCDevice, ty: RTCGeometryType) -> RTCGeometry;
-        pub fn rtcSetNewGeometryBuffer(
+        fn rtcNewGeometry(device: RTCDevice, ty: RTCGeometryType) -> RTCGeometry;
+        fn rtcSetNewGeometryBuffer(
             geometry: RTCGeometry,
             ty: RTCBufferType,
             slot: c_uint,
@@ -200,39 +255,119 @@ pub mod sys {
             byte_stride: usize,
             item_count: usize,
         ) -> *mut c_void;
-        pub fn rtcCommitGeometry(geometry: RTCGeometry);
-        pub fn rtcReleaseGeometry(geometry: RTCGeometry);
+        fn rtcCommitGeometry(geometry: RTCGeometry);
+        fn rtcReleaseGeometry(geometry: RTCGeometry);
 
-        pub fn rtcIntersect1(
+        fn rtcIntersect1(
             scene: RTCScene,
             context: *mut RTCIntersectContext,
             rayhit: *mut RTCRayHit,
         );
-        pub fn rtcOccluded1(scene: RTCScene, context: *mut RTCIntersectContext, ray: *mut RTCRay);
-        pub fn rtcOccluded16(
+        fn rtcOccluded1(scene: RTCScene, context: *mut RTCIntersectContext, ray: *mut RTCRay);
+        fn rtcOccluded16(
             valid: *const c_int,
             scene: RTCScene,
             context: *mut RTCIntersectContext,
             ray: *mut RTCRay16,
         );
-        pub fn rtcIntersect16(
+        fn rtcIntersect16(
             valid: *const c_int,
             scene: RTCScene,
             context: *mut RTCIntersectContext,
             rayhit: *mut RTCRayHit16,
         );
-        pub fn rtcOccluded8(
+        fn rtcOccluded8(
             valid: *const c_int,
             scene: RTCScene,
             context: *mut RTCIntersectContext,
             ray: *mut RTCRay8,
         );
-        pub fn rtcIntersect8(
+        fn rtcIntersect8(
             valid: *const c_int,
             scene: RTCScene,
             context: *mut RTCIntersectContext,
             rayhit: *mut RTCRayHit8,
         );
+    }
+
+    /// The file Debian's `libembree3-3` installs (`libembree-dev` depends on it).
+    const LIBRARY: &std::ffi::CStr = c"libembree3.so.3";
+
+    #[link(name = "dl")]
+    unsafe extern "C" {
+        fn dlopen(filename: *const c_char, flags: c_int) -> *mut c_void;
+        fn dlsym(handle: *mut c_void, symbol: *const c_char) -> *mut c_void;
+        fn dlerror() -> *mut c_char;
+    }
+
+    /// `dlopen`'s flags (`<dlfcn.h>`): every symbol resolved at once, none made global.
+    const RTLD_NOW: c_int = 2;
+
+    static API: OnceLock<Result<Api, String>> = OnceLock::new();
+
+    /// Opens Embree's library and finds its entry points, once: why it cannot be used, if it
+    /// cannot. Every call below needs this to have succeeded; a device is made only after it.
+    pub fn load() -> Result<(), String> {
+        API.get_or_init(open)
+            .as_ref()
+            .map(|_| ())
+            .map_err(Clone::clone)
+    }
+
+    fn api() -> &'static Api {
+        match API.get() {
+            Some(Ok(api)) => api,
+            // Every Embree object comes from a device, and a device is made after `load`.
+            _ => panic!("Embree called before it was loaded"),
+        }
+    }
+
+    fn open() -> Result<Api, String> {
+        open_library(LIBRARY)
+    }
+
+    /// The library `library` opened as Embree's.
+    fn open_library(library: &std::ffi::CStr) -> Result<Api, String> {
+        let name = library.to_string_lossy();
+        // SAFETY: `library` is NUL-terminated.
+        let handle = unsafe { dlopen(library.as_ptr(), RTLD_NOW) };
+        if handle.is_null() {
+            // SAFETY: `dlerror` returns NULL or the calling thread's message, NUL-terminated.
+            let why = unsafe {
+                let message = dlerror();
+                if message.is_null() {
+                    String::from("unknown reason")
+                } else {
+                    std::ffi::CStr::from_ptr(message)
+                        .to_string_lossy()
+                        .into_owned()
+                }
+            };
+            return Err(format!("{name} could not be loaded ({why})"));
+        }
+        // SAFETY: `handle` is the library just opened, never closed.
+        unsafe { Api::find(handle) }.map_err(|missing| format!("{name} has no {missing}"))
+    }
+
+    #[cfg(test)]
+    mod tests {
+        use super::*;
+
+        #[test]
+        fn a_library_that_is_not_there_or_not_embree_says_so() {
+            let missing = open_library(c"libslipgate-no-such-embree.so.0").err();
+            assert!(missing.is_some_and(|why| {
+                why.starts_with("libslipgate-no-such-embree.so.0 could not be loaded")
+            }),);
+            // The C library is there, and has none of Embree's functions.
+            let libc = open_library(c"libc.so.6").err();
+            assert_eq!(libc.as_deref(), Some("libc.so.6 has no rtcNewDevice"));
+            let shown = crate::embree::EmbreeError::Unavailable("x could not be loaded".into());
+            assert!(
+                shown.to_string().contains("apt install libembree3-3"),
+                "{shown}"
+            );
+        }
     }
 }
 
@@ -250,6 +385,8 @@ pub enum EmbreeError {
     },
     /// Input rejected before reaching Embree (e.g. a vertex index out of range).
     InvalidInput(String),
+    /// Embree's library could not be opened, or lacks a function light calls.
+    Unavailable(String),
 }
 
 fn error_code_name(code: u32) -> &'static str {
@@ -276,6 +413,10 @@ impl fmt::Display for EmbreeError {
                 }
             }
             Self::InvalidInput(why) => write!(f, "invalid input: {why}"),
+            Self::Unavailable(why) => write!(
+                f,
+                "Embree 3 is needed to trace light and {why}; on Debian, `apt install libembree3-3`"
+            ),
         }
     }
 }
@@ -400,6 +541,7 @@ impl Device {
     /// Fails if Embree cannot create a device (e.g. unsupported CPU, or an
     /// `isa` in `extra` that this CPU lacks).
     pub fn with_options(threads: usize, extra: &str) -> Result<Self, EmbreeError> {
+        sys::load().map_err(EmbreeError::Unavailable)?;
         let hw = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
         let threads = if threads == 0 { hw } else { threads.min(hw) };
         let config = CString::new(device_config(threads, extra))
