@@ -33,15 +33,10 @@ impl Bsp {
     /// Stores `channels` (one mask per face) as the `SLIPGATE_FACECHANNELS` lump, replacing any
     /// earlier one; with every face on channel 1 the lump is left out.
     pub fn set_face_channels(&mut self, channels: &[u32]) {
-        if channels.iter().all(|&c| c == DEFAULT_CHANNELS) {
-            self.remove_bspx_lump(LUMP_NAME);
-            return;
-        }
-        let mut data = Vec::with_capacity(channels.len() * RECORD_LEN);
-        for &c in channels {
+        let unused = |&c: &u32| c == DEFAULT_CHANNELS;
+        self.write_per_face(LUMP_NAME, RECORD_LEN, channels, unused, |data, &c| {
             data.put_u32(c);
-        }
-        self.set_bspx_lump(LUMP_NAME, data);
+        });
     }
 }
 

@@ -85,11 +85,8 @@ impl Bsp {
     /// Stores `flags` (one per face) as the `SLIPGATE_FACEFLAGS` lump, replacing any earlier
     /// one; with no flag set on any face the lump is left out.
     pub fn set_face_flags(&mut self, flags: &[FaceFlags]) {
-        if flags.iter().all(|f| *f == FaceFlags::default()) {
-            self.remove_bspx_lump(LUMP_NAME);
-            return;
-        }
-        self.set_bspx_lump(LUMP_NAME, flags.iter().map(|f| f.byte()).collect());
+        let unused = |f: &FaceFlags| *f == FaceFlags::default();
+        self.write_per_face(LUMP_NAME, 1, flags, unused, |data, f| data.push(f.byte()));
     }
 }
 

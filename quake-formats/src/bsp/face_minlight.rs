@@ -43,16 +43,11 @@ impl Bsp {
     /// Stores `minlights` (one per face) as the `SLIPGATE_FACEMINLIGHT` lump, replacing any
     /// earlier one; with no face at a level of its own the lump is left out.
     pub fn set_face_minlights(&mut self, minlights: &[FaceMinlight]) {
-        if minlights.iter().all(|m| m.level == 0.0) {
-            self.remove_bspx_lump(LUMP_NAME);
-            return;
-        }
-        let mut data = Vec::with_capacity(minlights.len() * RECORD_LEN);
-        for m in minlights {
+        let unused = |m: &FaceMinlight| m.level == 0.0;
+        self.write_per_face(LUMP_NAME, RECORD_LEN, minlights, unused, |data, m| {
             data.put_f32(m.level);
             data.put_f32x3(m.color);
-        }
-        self.set_bspx_lump(LUMP_NAME, data);
+        });
     }
 }
 

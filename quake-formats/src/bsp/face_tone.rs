@@ -76,19 +76,11 @@ impl Bsp {
     /// Stores `tones` (one per face) as the `SLIPGATE_FACETONE` lump, replacing any earlier
     /// one; when no face has either key the lump is left out.
     pub fn set_face_tones(&mut self, tones: &[FaceTone]) {
-        if tones
-            .iter()
-            .all(|t| t.maxlight().is_none() && t.color_scale().is_none())
-        {
-            self.remove_bspx_lump(LUMP_NAME);
-            return;
-        }
-        let mut data = Vec::with_capacity(tones.len() * RECORD_LEN);
-        for t in tones {
+        let unused = |t: &FaceTone| t.maxlight().is_none() && t.color_scale().is_none();
+        self.write_per_face(LUMP_NAME, RECORD_LEN, tones, unused, |data, t| {
             data.put_f32(t.maxlight);
             data.put_f32(t.color_scale);
-        }
-        self.set_bspx_lump(LUMP_NAME, data);
+        });
     }
 }
 

@@ -201,6 +201,27 @@ impl Bsp {
             .map(Some)
     }
 
+    /// Stores `items` (one per face) as the BSPX lump `lump`, each `record` bytes by `write`,
+    /// replacing any earlier one; when every item is `unused` the lump is left out.
+    pub(crate) fn write_per_face<T>(
+        &mut self,
+        lump: &'static str,
+        record: usize,
+        items: &[T],
+        unused: impl Fn(&T) -> bool,
+        mut write: impl FnMut(&mut Vec<u8>, &T),
+    ) {
+        if items.iter().all(unused) {
+            self.remove_bspx_lump(lump);
+            return;
+        }
+        let mut data = Vec::with_capacity(items.len() * record);
+        for item in items {
+            write(&mut data, item);
+        }
+        self.set_bspx_lump(lump, data);
+    }
+
     /// Checks that a per-face lump of `len` bytes holds one `record`-byte record per face.
     pub(crate) fn per_face_records(
         &self,

@@ -100,26 +100,25 @@ impl Bsp {
     /// concave angles as `SLIPGATE_PHONGCONCAVE` when a face has one), replacing
     /// any earlier ones; with no grouped face they are left out.
     pub fn set_phong_faces(&mut self, records: &[FacePhong]) {
-        if records.iter().all(|r| r.group == 0) {
-            self.remove_bspx_lump(LUMP_NAME);
-            self.remove_bspx_lump(CONCAVE_LUMP_NAME);
-            return;
-        }
-        let mut data = Vec::with_capacity(records.len() * RECORD_LEN);
-        for r in records {
-            data.put_u32(r.group);
-            data.put_f32(r.angle);
-        }
-        self.set_bspx_lump(LUMP_NAME, data);
-        if records.iter().any(|r| r.concave != 0.0) {
-            let mut concave = Vec::with_capacity(records.len() * 4);
-            for r in records {
-                concave.put_f32(r.concave);
-            }
-            self.set_bspx_lump(CONCAVE_LUMP_NAME, concave);
-        } else {
-            self.remove_bspx_lump(CONCAVE_LUMP_NAME);
-        }
+        self.write_per_face(
+            LUMP_NAME,
+            RECORD_LEN,
+            records,
+            |r| r.group == 0,
+            |data, r| {
+                data.put_u32(r.group);
+                data.put_f32(r.angle);
+            },
+        );
+        // The concave angles only beside the groups, and only when some face has one.
+        let ungrouped = records.iter().all(|r| r.group == 0);
+        self.write_per_face(
+            CONCAVE_LUMP_NAME,
+            4,
+            records,
+            |r| ungrouped || r.concave == 0.0,
+            |data, r| data.put_f32(r.concave),
+        );
     }
 }
 

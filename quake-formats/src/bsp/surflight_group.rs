@@ -28,15 +28,15 @@ impl Bsp {
     /// Stores `groups` (one per face) as the `SLIPGATE_SURFGROUP` lump, replacing any earlier
     /// one; with no face in a group the lump is left out.
     pub fn set_surflight_groups(&mut self, groups: &[i32]) {
-        if groups.iter().all(|&g| g == 0) {
-            self.remove_bspx_lump(LUMP_NAME);
-            return;
-        }
-        let mut data = Vec::with_capacity(groups.len() * RECORD_LEN);
-        for &g in groups {
-            data.put_i32(g);
-        }
-        self.set_bspx_lump(LUMP_NAME, data);
+        self.write_per_face(
+            LUMP_NAME,
+            RECORD_LEN,
+            groups,
+            |&g| g == 0,
+            |data, &g| {
+                data.put_i32(g);
+            },
+        );
     }
 }
 
