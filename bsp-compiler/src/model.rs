@@ -10,6 +10,7 @@
 //! change, merged, and cut where their lightmaps would grow too large. The two clip hulls: built,
 //! and for the world filled the same way, on copies kept when hull 0 finds the world sealed.
 
+use crate::brush::Brush;
 use crate::csg::mark_hidden_sides;
 use crate::faces::{
     FaceStats, FaceTexInfo, MIN_SQUARENESS, ModelFace, cut_for_lightmaps, faces_from_portals,
@@ -61,139 +62,236 @@ pub(crate) fn build_model(
 ) -> (ModelOutput, Vec<Warning>) {
     let mut warnings = Vec::new();
     let mut timings = [0.0; 6];
-    let bounds = model_bounds(&m);
-    let splitting = Splitting {
-        heuristic: options.heuristic,
-        max_node_size: options.max_node_size,
+    let build = ModelBuild {
+        planes,
+        texinfos,
+        options,
+        occupants,
+        splitting: Splitting {
+            heuristic: options.heuristic,
+            max_node_size: options.max_node_size,
+        },
+        bounds: model_bounds(&m),
+        // Only the world is flooded from the point entities.
+        fills: m.entity == 0 && options.fill,
     };
     let progress = &options.progress;
     let t = Instant::now();
     let mut brushes = m.brushes;
     let [mut h1, mut h2] = m.hull_brushes;
-    let counts = [brushes.len(), h1.len(), h2.len()];
     for list in [&mut brushes, &mut h1, &mut h2] {
         mark_hidden_sides(list, planes);
         progress.advance(list.len());
     }
-    let hull_bounds = [&h1, &h2].map(|list| {
-        list.iter()
-            .fold(Bounds::EMPTY, |acc, b| acc.union(&b.bounds))
-    });
     timings[5] = t.elapsed().as_secs_f64();
-    let is_world = m.entity == 0;
-    // Kept for the world's second tree, built once its outside is filled.
-    let world_brushes = (is_world && options.fill).then(|| brushes.clone());
-    // Hull 0 and the clip hulls are built side by side, neither waiting for the other. A sealed
-    // world's clip hulls are sealed too (grown brushes only close gaps further), and their
-    // outsides are filled so that each collapses into one solid leaf instead of many clip
-    // nodes: the world's hulls are filled on copies while hull 0 is still finding out whether
-    // the world is sealed, and the copies kept only when it is.
-    let speculate = is_world && options.fill;
-    let (world, (hulls, filled_hulls, hull_time)) = rayon::join(
-        || {
-            let mut times = [0.0; 4];
-            let t = Instant::now();
-            let mut tree = build_tree(brushes, planes, splitting, true);
-            progress.advance(counts[0]);
-            times[0] = t.elapsed().as_secs_f64();
-            let t = Instant::now();
-            let (mut portals, mut cluster_portals) = portalise(&tree, planes, &bounds);
-            times[1] = t.elapsed().as_secs_f64();
-            let t = Instant::now();
-            let mut fill = (is_world && options.fill).then(|| {
-                let flood = cluster_portals.as_ref().unwrap_or(&portals);
-                fill_world(
-                    &mut tree,
-                    planes,
-                    &portals,
-                    flood,
-                    occupants,
-                    options,
-                    &mut warnings,
-                )
-            });
-            times[2] = t.elapsed().as_secs_f64();
-            if let (Some(FillOutcome::Sealed { .. }), Some(brushes)) = (&fill, world_brushes) {
-                let t = Instant::now();
-                let visible = visible_sides(&tree, &portals);
-                let mut second = rebuild_tree_visible_first(brushes, planes, splitting, &visible);
-                times[0] += t.elapsed().as_secs_f64();
-                let t = Instant::now();
-                let (second_portals, second_clusters) = portalise(&second, planes, &bounds);
-                times[1] += t.elapsed().as_secs_f64();
-                let t = Instant::now();
-                let flood = second_clusters.as_ref().unwrap_or(&second_portals);
-                // The same entities flood the same space: its warnings were given the first
-                // time.
-                let mut repeated = Vec::new();
-                let outcome = fill_world(
-                    &mut second,
-                    planes,
-                    &second_portals,
-                    flood,
-                    occupants,
-                    options,
-                    &mut repeated,
-                );
-                // Sealed again unless a sliver the new planes leave opens a crack: then keep the
-                // first.
-                if matches!(outcome, FillOutcome::Sealed { .. }) {
-                    tree = second;
-                    portals = second_portals;
-                    cluster_portals = second_clusters;
-                    fill = Some(outcome);
-                }
-                times[2] += t.elapsed().as_secs_f64();
-            }
-            let t = Instant::now();
-            let (faces, stats) = model_faces(&tree, &portals, planes, texinfos, options.subdivide);
-            progress.advance(counts[0]);
-            times[3] = t.elapsed().as_secs_f64();
-            (tree, portals, cluster_portals, fill, faces, stats, times)
-        },
+    // Hull 0 and the clip hulls side by side, neither waiting for the other.
+    let (drawing, (hulls, filled_hulls, hull_time)) = rayon::join(
+        || build.drawing_hull(brushes, &mut warnings),
         || {
             let t = Instant::now();
-            let (a, b) = rayon::join(
-                || build_clip_hull_tree(h1, planes, splitting),
-                || build_clip_hull_tree(h2, planes, splitting),
-            );
-            let hulls = [a, b];
-            let filled = speculate.then(|| {
-                let mut filled = hulls.clone();
-                let [f1, f2] = &mut filled;
-                rayon::join(
-                    || fill_hull(f1, planes, &hull_bounds[0], occupants, splitting, options),
-                    || fill_hull(f2, planes, &hull_bounds[1], occupants, splitting, options),
-                );
-                filled
-            });
-            progress.advance(counts[1] + counts[2]);
+            let (hulls, filled) = build.clip_hulls([h1, h2]);
             (hulls, filled, t.elapsed().as_secs_f64())
         },
     );
-    let (tree, portals, cluster_portals, fill, faces, face_stats, times) = world;
-    let sealed = matches!(fill, Some(FillOutcome::Sealed { .. }));
+    let sealed = matches!(drawing.fill, Some(FillOutcome::Sealed { .. }));
     let hulls = match filled_hulls {
         Some(filled) if sealed => filled,
         _ => hulls,
     };
-    timings[..4].copy_from_slice(&times);
+    timings[..4].copy_from_slice(&drawing.times);
     timings[4] = hull_time;
-
     (
         ModelOutput {
-            tree,
-            portals,
-            cluster_portals,
-            faces,
+            tree: drawing.tree,
+            portals: drawing.portals,
+            cluster_portals: drawing.cluster_portals,
+            faces: drawing.faces,
             hulls,
-            bounds,
-            fill,
-            face_stats,
+            bounds: build.bounds,
+            fill: drawing.fill,
+            face_stats: drawing.face_stats,
             timings,
         },
         warnings,
     )
+}
+
+/// What each of a model's pipelines reads.
+struct ModelBuild<'a> {
+    planes: &'a PlaneSet,
+    texinfos: &'a [FaceTexInfo],
+    options: &'a CompileOptions,
+    occupants: &'a [Occupant],
+    splitting: Splitting,
+    /// The model's bounds ([`model_bounds`]).
+    bounds: Bounds,
+    /// Its outside is flooded and filled (the world, unless `-nofill`).
+    fills: bool,
+}
+
+/// Hull 0 of a model, built: [`ModelOutput`]'s parts of it, and the seconds of its first four
+/// [`MODEL_PHASES`].
+struct DrawingHull {
+    tree: Tree,
+    portals: Portals,
+    cluster_portals: Option<Portals>,
+    fill: Option<FillOutcome>,
+    faces: Vec<ModelFace>,
+    face_stats: FaceStats,
+    times: [f64; 4],
+}
+
+impl ModelBuild<'_> {
+    /// Hull 0 from `brushes` to faces: built, portalised, and (when it [`fills`]) flooded and
+    /// filled; a sealed world is then built again, split by the sides that face open space
+    /// first (as ericw-tools does), so that planes facing the void only cut solid space and
+    /// collapse away.
+    ///
+    /// [`fills`]: ModelBuild::fills
+    fn drawing_hull(&self, brushes: Vec<Brush>, warnings: &mut Vec<Warning>) -> DrawingHull {
+        let (planes, options) = (self.planes, self.options);
+        let mut times = [0.0; 4];
+        let count = brushes.len();
+        // Kept for the world's second tree, built once its outside is filled.
+        let world_brushes = self.fills.then(|| brushes.clone());
+        let t = Instant::now();
+        let mut tree = build_tree(brushes, planes, self.splitting, true);
+        options.progress.advance(count);
+        times[0] = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let (mut portals, mut cluster_portals) = portalise(&tree, planes, &self.bounds);
+        times[1] = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let mut fill = self
+            .fills
+            .then(|| self.fill_world(&mut tree, &portals, cluster_portals.as_ref(), warnings));
+        times[2] = t.elapsed().as_secs_f64();
+        if let (Some(FillOutcome::Sealed { .. }), Some(brushes)) = (&fill, world_brushes) {
+            let t = Instant::now();
+            let visible = visible_sides(&tree, &portals);
+            let mut second = rebuild_tree_visible_first(brushes, planes, self.splitting, &visible);
+            times[0] += t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            let (second_portals, second_clusters) = portalise(&second, planes, &self.bounds);
+            times[1] += t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            // The same entities flood the same space: its warnings were given the first time.
+            let mut repeated = Vec::new();
+            let outcome = self.fill_world(
+                &mut second,
+                &second_portals,
+                second_clusters.as_ref(),
+                &mut repeated,
+            );
+            // Sealed again unless a sliver the new planes leave opens a crack: then keep the first.
+            if matches!(outcome, FillOutcome::Sealed { .. }) {
+                tree = second;
+                portals = second_portals;
+                cluster_portals = second_clusters;
+                fill = Some(outcome);
+            }
+            times[2] += t.elapsed().as_secs_f64();
+        }
+        let t = Instant::now();
+        let (faces, face_stats) =
+            model_faces(&tree, &portals, planes, self.texinfos, options.subdivide);
+        options.progress.advance(count);
+        times[3] = t.elapsed().as_secs_f64();
+        DrawingHull {
+            tree,
+            portals,
+            cluster_portals,
+            fill,
+            faces,
+            face_stats,
+            times,
+        }
+    }
+
+    /// Fill hull 0's outside, flooding over its cluster portals (its leaf portals when detail
+    /// split nothing), then, once sealed and as the options ask, what no entity reaches.
+    fn fill_world(
+        &self,
+        tree: &mut Tree,
+        portals: &Portals,
+        clusters: Option<&Portals>,
+        warnings: &mut Vec<Warning>,
+    ) -> FillOutcome {
+        let (planes, occupants) = (self.planes, self.occupants);
+        let flood = clusters.unwrap_or(portals);
+        let mut outcome = fill_outside(tree, planes, flood, occupants, OnPlane::Sealing, warnings);
+        if let (FillOutcome::Sealed { filled }, Some(reach)) =
+            (&mut outcome, self.options.unreached_fill())
+        {
+            let units = match reach {
+                Reach::Leaves => portals,
+                Reach::Clusters => flood,
+            };
+            *filled += fill_unreached(tree, planes, units, occupants, reach);
+        }
+        outcome
+    }
+
+    /// The clip hulls' trees of `grown` (hulls 1 and 2), and when the model [`fills`], the same
+    /// trees with their outsides filled: a sealed world's clip hulls are sealed too (grown
+    /// brushes only close gaps further), and filled each collapses into one solid leaf instead
+    /// of many clip nodes. They are filled on copies while hull 0 is still finding out whether
+    /// the world is sealed; the caller keeps them only when it is.
+    ///
+    /// [`fills`]: ModelBuild::fills
+    fn clip_hulls(&self, grown: [Vec<Brush>; 2]) -> ([Tree; 2], Option<[Tree; 2]>) {
+        let count = grown[0].len() + grown[1].len();
+        let bounds = grown.each_ref().map(|list| {
+            list.iter()
+                .fold(Bounds::EMPTY, |acc, b| acc.union(&b.bounds))
+        });
+        let [h1, h2] = grown;
+        let (planes, splitting) = (self.planes, self.splitting);
+        let (a, b) = rayon::join(
+            || build_clip_hull_tree(h1, planes, splitting),
+            || build_clip_hull_tree(h2, planes, splitting),
+        );
+        let hulls = [a, b];
+        let filled = self.fills.then(|| {
+            let mut filled = hulls.clone();
+            let [f1, f2] = &mut filled;
+            rayon::join(
+                || self.fill_hull(f1, &bounds[0]),
+                || self.fill_hull(f2, &bounds[1]),
+            );
+            filled
+        });
+        self.options.progress.advance(count);
+        (hulls, filled)
+    }
+
+    /// Fill the outside of a clip hull's tree, flooding from the world's point entities, then
+    /// (as the options ask) what no entity reaches in this hull, and rebuild it from what is
+    /// left.
+    fn fill_hull(&self, tree: &mut Tree, bounds: &Bounds) {
+        if bounds.is_empty() {
+            return;
+        }
+        let planes = self.planes;
+        let portals = make_clip_hull_portals(tree, planes, bounds);
+        // Entities near walls are inside the grown brushes; that is expected, not worth a
+        // warning.
+        let mut ignored = Vec::new();
+        if let FillOutcome::Sealed { .. } = fill_outside(
+            tree,
+            planes,
+            &portals,
+            self.occupants,
+            OnPlane::Open,
+            &mut ignored,
+        ) {
+            // A clip hull has no detail: its clusters are its leaves.
+            if self.options.unreached_fill().is_some() {
+                fill_unreached(tree, planes, &portals, self.occupants, Reach::Leaves);
+            }
+            *tree = rebuild_from_surfaces(tree, &portals, planes, self.splitting);
+        }
+    }
 }
 
 /// The portals of `tree`'s leaves, and of its structural leaves when detail split some of them.
@@ -206,29 +304,6 @@ fn portalise(tree: &Tree, planes: &PlaneSet, bounds: &Bounds) -> (Portals, Optio
         || make_portals(tree, planes, bounds),
         || has_clusters.then(|| make_cluster_portals(tree, planes, bounds)),
     )
-}
-
-/// Fill the world's outside, flooding over `flood` (its cluster portals, or its leaf portals
-/// when detail split nothing), then, once sealed and as `options` ask, what no entity reaches.
-fn fill_world(
-    tree: &mut Tree,
-    planes: &PlaneSet,
-    portals: &Portals,
-    flood: &Portals,
-    occupants: &[Occupant],
-    options: &CompileOptions,
-    warnings: &mut Vec<Warning>,
-) -> FillOutcome {
-    let mut outcome = fill_outside(tree, planes, flood, occupants, OnPlane::Sealing, warnings);
-    if let (FillOutcome::Sealed { filled }, Some(reach)) = (&mut outcome, options.unreached_fill())
-    {
-        let units = match reach {
-            Reach::Leaves => portals,
-            Reach::Clusters => flood,
-        };
-        *filled += fill_unreached(tree, planes, units, occupants, reach);
-    }
-    outcome
 }
 
 /// The bounds engines size a model by (a door's travel, its trigger field): its map brushes,
@@ -247,38 +322,6 @@ fn model_bounds(m: &ModelInput) -> Bounds {
         }
     } else {
         bounds
-    }
-}
-
-/// Fill the outside of a clip hull's tree, flooding from the world's point entities, then (as
-/// `options` ask) what no entity reaches in this hull, and rebuild it from what is left.
-fn fill_hull(
-    tree: &mut Tree,
-    planes: &PlaneSet,
-    bounds: &Bounds,
-    occupants: &[Occupant],
-    splitting: Splitting,
-    options: &CompileOptions,
-) {
-    if bounds.is_empty() {
-        return;
-    }
-    let portals = make_clip_hull_portals(tree, planes, bounds);
-    // Entities near walls are inside the grown brushes; that is expected, not worth a warning.
-    let mut ignored = Vec::new();
-    if let FillOutcome::Sealed { .. } = fill_outside(
-        tree,
-        planes,
-        &portals,
-        occupants,
-        OnPlane::Open,
-        &mut ignored,
-    ) {
-        // A clip hull has no detail: its clusters are its leaves.
-        if options.unreached_fill().is_some() {
-            fill_unreached(tree, planes, &portals, occupants, Reach::Leaves);
-        }
-        *tree = rebuild_from_surfaces(tree, &portals, planes, splitting);
     }
 }
 
