@@ -560,18 +560,23 @@ pub fn add_light(
     weight: f64,
 ) {
     for (&style, f) in styles.iter().zip(flux) {
-        let slot = match out.iter().position(|(s, _)| *s == style) {
-            Some(k) => k,
-            None => {
-                out.push((style, vec![[0.0; 3]; n]));
-                out.len() - 1
-            }
-        };
-        let v = &mut out[slot].1[i];
+        let v = &mut style_luxels(out, style, n)[i];
         for k in 0..3 {
             v[k] += (weight * f64::from(f[k])) as f32;
         }
     }
+}
+
+/// `out`'s luxels of `style` (`n` of them), added dark if it has none yet.
+pub fn style_luxels(out: &mut StyleLuxels, style: u8, n: usize) -> &mut [[f32; 3]] {
+    let k = match out.iter().position(|(s, _)| *s == style) {
+        Some(k) => k,
+        None => {
+            out.push((style, vec![[0.0; 3]; n]));
+            out.len() - 1
+        }
+    };
+    &mut out[k].1
 }
 
 /// Adds `b` into `a`, style by style.

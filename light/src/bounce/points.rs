@@ -22,7 +22,7 @@
 use glam::{DVec3, Vec3};
 use quake_formats::geom::Winding;
 
-use super::{BounceCounts, Field, HOTSPOT_CLAMP, Receivers, StyleLuxels};
+use super::{BounceCounts, Field, HOTSPOT_CLAMP, Receivers, StyleLuxels, style_luxels};
 use crate::embree::RayPacket16;
 use crate::faces::FaceGeom;
 use crate::scene::TraceScene;
@@ -301,18 +301,6 @@ fn light_batch(
             }
         }
     }
-}
-
-/// `out`'s luxels of `style` (`n` of them), added dark if it has none yet.
-fn style_luxels(out: &mut StyleLuxels, style: u8, n: usize) -> &mut [[f32; 3]] {
-    let k = match out.iter().position(|(s, _)| *s == style) {
-        Some(k) => k,
-        None => {
-            out.push((style, vec![[0.0; 3]; n]));
-            out.len() - 1
-        }
-    };
-    &mut out[k].1
 }
 
 /// Every point `field`'s faces with light and a reflectance send their light from.
