@@ -336,12 +336,12 @@ struct PointSums {
 }
 
 impl PointSums {
-    /// `light`'s `value` reached the point.
-    fn add_light(&mut self, light: &PointLight, value: f64) {
+    /// `light`'s `value` reached the point, in `color` (the light's there).
+    fn add_light(&mut self, light: &PointLight, value: f64, color: DVec3) {
         if light.falloff == Falloff::LocalMin {
-            self.floors.raise(light.style, value, light.color);
+            self.floors.raise(light.style, value, color);
         } else {
-            self.sums.add(light.style, value, light.color);
+            self.sums.add(light.style, value, color);
         }
     }
 
@@ -429,7 +429,7 @@ fn trace_run(src: &GridSources, sky: &LeafSky, points: &[DVec3]) -> (Vec<RawPoin
                 points,
                 &lanes,
                 |p| !src.scene.occluded16(p, 0),
-                |i| sums[i].add_light(light, values[i]),
+                |i| sums[i].add_light(light, values[i], light.color_at(points[i])),
             );
         }
         let directions: Vec<Option<&[bool]>> = places

@@ -1,10 +1,13 @@
 //! Everything built before tracing: faces, the shadow scene, the PVS, the lights (with
 //! `_surface` copies and their leaves) and `_phong` normals, and the rules each face takes.
 
+use std::sync::Arc;
+
 use glam::DVec3;
 use quake_formats::Bsp;
 use quake_formats::entities::{Entity, parse_entities, write_entities};
 use quake_formats::geom::Bounds;
+use quake_formats::palette::Palette;
 
 use crate::embree::Device;
 use crate::error::LightError;
@@ -13,6 +16,7 @@ use crate::faces::{
 };
 use crate::fence::fence_masks;
 use crate::hull;
+use crate::lights::projection::Projector;
 use crate::lights::{MapLights, PointLight, parse_lights};
 use crate::nudge;
 use crate::options::Options;
@@ -147,6 +151,39 @@ fn drop_unknown_sun_textures(bsp: &Bsp, entities: &[Entity], lights: &mut MapLig
     }
 }
 
+/// Gives each light whose entity projects a picture its [`Projector`]; a picture the BSP has
+/// no pixels of is a warning naming the entity, and the light shines unprojected (as in
+/// ericw-tools).
+fn attach_projections(bsp: &Bsp, entities: &[Entity], palette: &Palette, lights: &mut MapLights) {
+    for keys in std::mem::take(&mut lights.projections) {
+        let texture = bsp
+            .textures
+            .textures
+            .iter()
+            .flatten()
+            .find(|t| t.name().eq_ignore_ascii_case(&keys.texture));
+        match texture.and_then(|t| Projector::new(&keys, t, palette)) {
+            Some(projector) => {
+                let projector = Arc::new(projector);
+                for light in lights.points.iter_mut().filter(|l| l.entity == keys.entity) {
+                    light.projector = Some(Arc::clone(&projector));
+                }
+            }
+            None => {
+                let Some(e) = entities.get(keys.entity) else {
+                    continue;
+                };
+                lights.warnings.push(SettingWarning {
+                    given: Given::key(keys.entity, e, "_project_texture"),
+                    value: keys.texture.clone(),
+                    problem: "the BSP holds no pixels of that texture; the light is not projected"
+                        .to_string(),
+                });
+            }
+        }
+    }
+}
+
 /// Reads faces, entities and visibility and builds the Embree scene.
 ///
 /// # Errors
@@ -167,6 +204,8 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
         .map_err(LightError::BspxLump)?;
     let entity_text = (map_lights.switchable.count > 0).then(|| write_entities(&entities));
     drop_unknown_sun_textures(bsp, &entities, &mut map_lights);
+    let palette = options.palette.clone().unwrap_or_else(Palette::slipgate);
+    attach_projections(bsp, &entities, &palette, &mut map_lights);
     let origin_of = |m: usize| {
         map_lights
             .model_origins

@@ -153,6 +153,7 @@ mod tests {
                 light_channels: 1,
                 shadow_channels: 1,
                 entity: 1,
+                projector: None,
             },
             offset: 2.0,
             spotlight: false,

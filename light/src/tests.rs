@@ -20,6 +20,7 @@ use crate::{
 };
 
 mod ericw_cases;
+mod projection;
 
 /// A polygon with its outward normal and whether it is sky.
 struct Poly {
@@ -2930,6 +2931,7 @@ fn no_key_value_stops_light() {
         "_surface_offset" | "_surface_spotlight" | "_surflight_group" => "\"_surface\" \"wall\"\n",
         "_minlight_color" | "_mincolor" => "\"_minlight\" \"8\"\n",
         "_phong_angle_concave" => "\"_phong\" \"1\"\n",
+        "_project_mangle" | "_project_fov" | "angles" => "\"_project_texture\" \"wall\"\n",
         _ => "",
     };
     let light_with = |key: &str, value: &str| {

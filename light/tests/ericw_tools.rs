@@ -274,3 +274,108 @@ fn slab_map() -> String {
     };
     map.to_text()
 }
+
+/// A room whose light projects the placeholder picture the compiler made for `floor` straight
+/// down, lit by both tools (ours through Quake's palette, which ericw-tools has built in):
+/// the same faces lit, every luxel within 2 levels of ericw-tools'.
+#[test]
+fn a_projected_picture_lands_where_ericw_tools_puts_it() {
+    let ericw_light = anchor("light");
+    let palette =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/corpus/palette/palette.lmp");
+    if !ericw_light.exists() || !palette.exists() {
+        println!(
+            "SKIPPED: no ericw-tools light in {} or no Quake palette at {}",
+            anchor("").display(),
+            palette.display()
+        );
+        return;
+    }
+    let room = |lo: [i32; 3], hi: [i32; 3], texture: &str| {
+        let ([x0, y0, z0], [x1, y1, z1]) = (lo, hi);
+        format!(
+            "{{\n( {x0} {y0} {z0} ) ( {x0} {} {z0} ) ( {x0} {y0} {} ) {texture} 0 0 0 1 1\n\
+             ( {x1} {y0} {z0} ) ( {x1} {y0} {} ) ( {x1} {} {z0} ) {texture} 0 0 0 1 1\n\
+             ( {x0} {y0} {z0} ) ( {x0} {y0} {} ) ( {} {y0} {z0} ) {texture} 0 0 0 1 1\n\
+             ( {x0} {y1} {z0} ) ( {} {y1} {z0} ) ( {x0} {y1} {} ) {texture} 0 0 0 1 1\n\
+             ( {x0} {y0} {z0} ) ( {} {y0} {z0} ) ( {x0} {} {z0} ) {texture} 0 0 0 1 1\n\
+             ( {x0} {y0} {z1} ) ( {x0} {} {z1} ) ( {} {y0} {z1} ) {texture} 0 0 0 1 1\n}}\n",
+            y0 + 1,
+            z0 + 1,
+            z0 + 1,
+            y0 + 1,
+            z0 + 1,
+            x0 + 1,
+            x0 + 1,
+            z0 + 1,
+            x0 + 1,
+            y0 + 1,
+            y0 + 1,
+            x0 + 1,
+        )
+    };
+    let (w, h, t) = (256, 256, 16);
+    let mut world = room([-w - t, -w - t, -t], [w + t, w + t, 0], "floor");
+    world += &room([-w - t, -w - t, h], [w + t, w + t, h + t], "ceil");
+    world += &room([-w - t, -w - t, 0], [-w, w + t, h], "wall");
+    world += &room([w, -w - t, 0], [w + t, w + t, h], "wall");
+    world += &room([-w, -w - t, 0], [w, -w, h], "wall");
+    world += &room([-w, w, 0], [w, w + t, h], "wall");
+    let text = format!(
+        "{{\n\"classname\" \"worldspawn\"\n{world}}}\n\
+         {{\n\"classname\" \"info_player_start\"\n\"origin\" \"0 0 24\"\n}}\n\
+         {{\n\"classname\" \"light\"\n\"origin\" \"0 0 200\"\n\"light\" \"300\"\n\"delay\" \"3\"\n\
+         \"_project_texture\" \"floor\"\n\"_project_mangle\" \"30 -70 20\"\n\"_project_fov\" \"100\"\n}}\n"
+    );
+    let source = bsp_compiler::MapSource {
+        path: PathBuf::from("projection.map"),
+        text,
+    };
+    let bsp = bsp_compiler::compile(&source, &bsp_compiler::CompileOptions::default())
+        .expect("compile")
+        .bsp;
+    let dir = std::env::temp_dir().join(format!("slipgate-light-project-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join("projection.bsp");
+    std::fs::write(&path, bsp.write().expect("BSP encodes")).expect("write");
+    run(&ericw_light, &[], &path);
+    let theirs = quake_formats::Bsp::read(&std::fs::read(&path).expect("read")).expect("decodes");
+    let options = Options {
+        palette: Some(
+            quake_formats::palette::Palette::from_bytes(&std::fs::read(&palette).expect("read"))
+                .expect("a palette"),
+        ),
+        ..Options::default()
+    };
+    let mut ours = bsp.clone();
+    apply_lighting(&mut ours, &compute_lighting(&bsp, &options).expect("light"));
+    let all: Vec<usize> = (0..bsp.faces.len()).collect();
+    let style0 = |lit: &quake_formats::Bsp| {
+        let mut out = vec![None; all.len()];
+        for map in light::lightmaps_in(lit, &all).lightmaps {
+            if let Some(k) = map.styles.iter().position(|&s| s == 0) {
+                out[map.face] = Some(map.grey[k].clone());
+            }
+        }
+        out
+    };
+    let (ours, theirs) = (style0(&ours), style0(&theirs));
+    let mut worst = 0;
+    for (face, (a, b)) in ours.iter().zip(&theirs).enumerate() {
+        match (a, b) {
+            (Some(a), Some(b)) => {
+                for (x, y) in a.iter().zip(b) {
+                    worst = worst.max(x.abs_diff(*y));
+                }
+            }
+            (None, None) => {}
+            _ => panic!("face {face} lit by one tool only"),
+        }
+    }
+    assert!(
+        ours.iter().flatten().count() > 10,
+        "the picture lights faces"
+    );
+    assert!(worst <= 2, "a luxel {worst} levels from ericw-tools'");
+    std::fs::remove_dir_all(dir).ok();
+}

@@ -12,6 +12,7 @@ use quake_formats::geom::DVec3Ext;
 use super::keys::{self, Keys};
 use super::models::model_index;
 use super::point::{DEFAULT_SPOT_ANGLE, Falloff, PointLight, Spot, split_light};
+use super::projection::{self, ProjectionKeys};
 use super::sun::{SunLight, dome, spread};
 use super::worldspawn::Global;
 use super::{MapLights, SurfaceTemplate};
@@ -247,8 +248,13 @@ fn point_light(k: &Keys, c: Common, global: &Global, out: &mut MapLights) {
         light_channels,
         shadow_channels: channel_mask(k, &keys::SHADOW_CHANNEL_MASK).unwrap_or(light_channels),
         entity: k.index,
+        projector: None,
     };
-    match k.text(&keys::SURFACE) {
+    let surface = k.text(&keys::SURFACE);
+    if surface.is_none() {
+        out.projections.extend(projection(k, c.origin));
+    }
+    match surface {
         // Surface lights are on channel 1, as in ericw-tools.
         Some(texture) => out.templates.push(SurfaceTemplate {
             texture: texture.to_string(),
@@ -277,4 +283,31 @@ fn point_light(k: &Keys, c: Common, global: &Global, out: &mut MapLights) {
         }
         None => out.points.push(point),
     }
+}
+
+/// The picture a light projects (`_project_texture`), if it names one: its direction from
+/// `_project_mangle`, else `mangle`, else the Half-Life `angles`; a field of view outside
+/// 1–179 degrees is a warning and 90.
+fn projection(k: &Keys, origin: DVec3) -> Option<ProjectionKeys> {
+    let texture = k.text(&keys::PROJECT_TEXTURE).filter(|t| !t.is_empty())?;
+    let angles = k
+        .vector(&keys::PROJECT_MANGLE)
+        .or_else(|| k.vector(&keys::MANGLE))
+        .or_else(|| k.vector(&keys::ANGLES).map(|a| DVec3::new(a.y, -a.x, a.z)))
+        .unwrap_or(DVec3::ZERO);
+    let fov = match k.number(&keys::PROJECT_FOV) {
+        Some(fov) if projection::FOV_RANGE.contains(&fov) => fov,
+        Some(_) => {
+            k.warn("_project_fov", "expected 1 to 179 degrees; 90 is used");
+            projection::DEFAULT_FOV
+        }
+        None => projection::DEFAULT_FOV,
+    };
+    Some(ProjectionKeys {
+        entity: k.index,
+        origin,
+        texture: texture.to_string(),
+        angles,
+        fov,
+    })
 }

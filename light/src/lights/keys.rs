@@ -148,6 +148,21 @@ entity_keys! {
     MANGLE: ["mangle"] on Lights, Vector, default "—";
     /// Spotlight cone, degrees.
     ANGLE: ["angle"] on Lights, Number, default "`40`";
+    /// The light shines a picture, like a slide projector: this texture of the BSP, held in
+    /// front of it along `_project_mangle`. A point it reaches takes twice the picture's colour
+    /// there times the light's (a mid-grey texel leaves the light as it is); outside the picture
+    /// it gives nothing. Ignored, with a warning, when the BSP holds no pixels of that texture;
+    /// ignored on `_surface` templates.
+    PROJECT_TEXTURE: ["_project_texture"] on Lights, Text, default "—";
+    /// Direction of the picture, `yaw pitch roll` in degrees (roll turns the picture); without
+    /// it, `mangle`, else the Half-Life `angles` (`pitch yaw roll`, pitch down), else along +x.
+    PROJECT_MANGLE: ["_project_mangle"] on Lights, Vector, default "`mangle`";
+    /// Field of view of the picture along its longer side, degrees (1–179; other values warn
+    /// and take 90).
+    PROJECT_FOV: ["_project_fov"] on Lights, Number, default "`90`";
+    /// The Half-Life light direction `pitch yaw roll` (pitch positive down), read only for a
+    /// projected picture without `_project_mangle` or `mangle`.
+    ANGLES: ["angles"] on Lights, Vector, default "—";
     /// Spotlight inner cone with full brightness; the light fades from it to `angle`.
     SOFTANGLE: ["_softangle"] on Lights, Number, default "`0`";
     /// Falloff: `0` linear, `1` 1/x, `2` 1/x², `3` none, `4` local minlight (raises what it sees

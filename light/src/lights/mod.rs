@@ -10,6 +10,7 @@ mod entities;
 pub mod keys;
 mod models;
 mod point;
+pub mod projection;
 mod styles;
 mod sun;
 mod unsupported;
@@ -140,6 +141,9 @@ pub struct MapLights {
     pub autominlight_at: HashMap<usize, DVec3>,
     /// Light entities that stay where they are even in solid (`_nonudge 1`).
     pub no_nudge: Vec<usize>,
+    /// Pictures light entities project (`_project_texture`), before the BSP's textures are
+    /// looked up ([`MapLights::attach_projections`]).
+    pub projections: Vec<projection::ProjectionKeys>,
     /// Diffuse interreflection (`_bounce` and its keys).
     pub bounce: BounceSettings,
     /// How dirt occlusion is measured (used only when something takes dirt).
@@ -225,7 +229,9 @@ impl MapLights {
     /// True if any light, sun or minlight is not white (a `.lit` is needed).
     pub fn is_coloured(&self) -> bool {
         let grey = |c: &DVec3| c.x != c.y || c.y != c.z;
-        self.points.iter().any(|l| grey(&l.color))
+        self.points
+            .iter()
+            .any(|l| grey(&l.color) || l.projector.as_ref().is_some_and(|p| !p.is_grey()))
             || self.suns.iter().any(|s| grey(&s.color))
             || self.templates.iter().any(|t| grey(&t.light.color))
             || self.minlight.values().any(|m| grey(&m.color))
@@ -277,6 +283,7 @@ pub fn parse_lights(
         autominlight: HashMap::new(),
         autominlight_at: HashMap::new(),
         no_nudge: Vec::new(),
+        projections: Vec::new(),
         bounce: worldspawn::bounce(&settings, &global),
         dirt: dirt_sampling(&settings),
         phong: HashMap::new(),

@@ -5,8 +5,11 @@
 //! linear falloff); the range scale (`_range`) maps light units to lightmap bytes at the very
 //! end.
 
+use std::sync::Arc;
+
 use glam::DVec3;
 
+use super::projection::Projector;
 use crate::directions::ball_points;
 use crate::dirt::DirtResponse;
 
@@ -126,9 +129,19 @@ pub struct PointLight {
     pub shadow_channels: u32,
     /// Entity index it came from (for messages).
     pub entity: usize,
+    /// The picture it projects (`_project_texture`), which tints its colour point by point.
+    pub projector: Option<Arc<Projector>>,
 }
 
 impl PointLight {
+    /// The light's colour at `point`: its own, tinted by the picture it projects there.
+    pub fn color_at(&self, point: DVec3) -> DVec3 {
+        match &self.projector {
+            None => self.color,
+            Some(p) => self.color * p.tint(point),
+        }
+    }
+
     /// Brightness at `dist` units from the light before angle and cone terms.
     pub fn value_at(&self, dist: f64) -> f64 {
         // Distances under one unit are clamped so 1/x stays finite.
@@ -229,6 +242,7 @@ mod tests {
             light_channels: 1,
             shadow_channels: 1,
             entity: 0,
+            projector: None,
         }
     }
 

@@ -22,17 +22,6 @@ const UNSUPPORTED: &[(&str, Where, &str)] = &[
         Where::Worldspawn,
         "spacing of bounce emitters",
     ),
-    ("_project_texture", Where::Lights, "projected texture"),
-    (
-        "_project_mangle",
-        Where::Lights,
-        "projected texture's direction",
-    ),
-    (
-        "_project_fov",
-        Where::Lights,
-        "projected texture's field of view",
-    ),
     ("_minlight_mottle", Where::Brushes, "mottled minlight"),
 ];
 
@@ -91,7 +80,7 @@ mod tests {
     fn each_unsupported_key_warns_where_ericw_tools_reads_it() {
         let text = r#"
 { "classname" "worldspawn" "_bouncelightsubdivision" "2" "_project_texture" "x" }
-{ "classname" "light" "origin" "0 0 0" "_project_texture" "window1" "_project_fov" "" }
+{ "classname" "light" "origin" "0 0 0" "_project_texture" "window1" }
 { "classname" "func_wall" "model" "*1" "_minlight_mottle" "1" "_lightcolorscale" "0" }
 { "classname" "func_detail" "_lightcolorscale" "0" "_maxlight" "40" }
 "#;
@@ -101,13 +90,9 @@ mod tests {
             .iter()
             .map(ToString::to_string)
             .collect();
-        assert_eq!(told.len(), 3, "{told:?}");
+        assert_eq!(told.len(), 2, "{told:?}");
         assert!(told[0].contains("\"_bouncelightsubdivision\"") && told[0].contains("bounce"));
-        assert!(
-            told[1].contains("\"_project_texture\" is \"window1\""),
-            "{told:?}"
-        );
-        assert!(told[2].contains("_minlight_mottle"));
+        assert!(told[1].contains("_minlight_mottle"));
     }
 
     #[test]

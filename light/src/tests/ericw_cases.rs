@@ -22,7 +22,7 @@ fn compiled(text: &str) -> Bsp {
 }
 
 /// `bsp` lit at the default quality.
-fn lit(bsp: &Bsp) -> Lighting {
+pub(super) fn lit(bsp: &Bsp) -> Lighting {
     compute_lighting(bsp, &options(Quality::Default)).expect("light")
 }
 
@@ -85,12 +85,12 @@ fn luxel_rgb_in(
 }
 
 /// The floor luxel of [`room_bsp`] under `(x, y)`.
-fn floor_rgb(bsp: &Bsp, lighting: &Lighting, x: f64, y: f64) -> Option<[u8; 3]> {
+pub(super) fn floor_rgb(bsp: &Bsp, lighting: &Lighting, x: f64, y: f64) -> Option<[u8; 3]> {
     luxel_rgb(bsp, lighting, 0, DVec3::new(x, y, -128.0), DVec3::Z)
 }
 
 /// A light entity of [`room_bsp`] at `origin` with `keys`.
-fn light(origin: [f64; 3], keys: &str) -> String {
+pub(super) fn light(origin: [f64; 3], keys: &str) -> String {
     let [x, y, z] = origin;
     format!("{{\n\"classname\" \"light\"\n\"origin\" \"{x} {y} {z}\"\n{keys}\n}}\n")
 }

@@ -62,27 +62,22 @@ impl Arrivals {
         self.wait = wait;
     }
 
-    pub fn add(
-        &mut self,
-        a: Arrival,
-        lights: &[PointLight],
-        suns: &[SunLight],
-        out: &mut SampleLight,
-    ) {
+    pub fn add(&mut self, a: Arrival, (lights, suns, points): Sources, out: &mut SampleLight) {
         if self.wait {
             self.waiting.push(a);
         } else {
-            settle(&a, a.value, lights, suns, out);
+            settle(&a, a.value, (lights, suns, points), out);
         }
     }
 
     /// [`Arrivals::add`] for light `li` arriving in `style` at each `(sample, value)` of
-    /// `arrived`, in one go when nothing waits.
+    /// `arrived` (samples at `points`), in one go when nothing waits.
     pub fn add_light(
         &mut self,
         (li, light, style): (usize, &PointLight, u8),
         arrived: impl Iterator<Item = (usize, f64)> + Clone,
         (dirty, gated): (bool, bool),
+        points: &[[f32; 3]],
         out: &mut SampleLight,
     ) {
         if self.wait {
@@ -90,7 +85,7 @@ impl Arrivals {
             self.waiting
                 .extend(arrived.map(|(i, v)| Arrival::new(source, i, v, dirty, gated)));
         } else {
-            deposit(light, style, arrived, out);
+            deposit(light, style, arrived, points, out);
         }
     }
 
@@ -99,8 +94,7 @@ impl Arrivals {
     /// as it is traced; those that dirt takes below `gate` are dropped.
     pub fn settle_waiting(
         &self,
-        lights: &[PointLight],
-        suns: &[SunLight],
+        (lights, suns, points): Sources,
         dirt: &mut DirtFactors,
         gate: f64,
         out: &mut SampleLight,
@@ -115,23 +109,26 @@ impl Arrivals {
             if a.gated && v.abs() < gate {
                 continue;
             }
-            settle(a, v, lights, suns, out);
+            settle(a, v, (lights, suns, points), out);
         }
     }
 }
 
+/// Where arrivals come from, and the face's sample points they arrive at.
+pub type Sources<'a> = (&'a [PointLight], &'a [SunLight], &'a [[f32; 3]]);
+
 /// Adds arrival `a` to `out` at `value` (its value after dirt).
-fn settle(
-    a: &Arrival,
-    value: f64,
-    lights: &[PointLight],
-    suns: &[SunLight],
-    out: &mut SampleLight,
-) {
+fn settle(a: &Arrival, value: f64, (lights, suns, points): Sources, out: &mut SampleLight) {
     let i = a.sample as usize;
     match a.source {
         Source::Light { light, style } => {
-            deposit(&lights[light], style, std::iter::once((i, value)), out);
+            deposit(
+                &lights[light],
+                style,
+                std::iter::once((i, value)),
+                points,
+                out,
+            );
         }
         Source::Sun(si) => {
             let sun = &suns[si];
@@ -146,8 +143,8 @@ fn settle(
     }
 }
 
-/// Adds `value` of `light` (its colour) in `style` to sample `i` for each `(i, value)`
-/// of `arrived`, or for a local minlight raises the sample's floor to it.
+/// Adds `value` of `light` (its colour at the sample's point) in `style` to sample `i` for each
+/// `(i, value)` of `arrived`, or for a local minlight raises the sample's floor to it.
 /// The part of a light's light that does not bounce (all of a `_bounce 0` light's, the rest of
 /// its `_bouncescale`) is also kept in `no_bounce`, so it can be taken out of what reflects (a
 /// scale above 1 keeps a negative part, which adds).
@@ -155,10 +152,14 @@ fn deposit(
     light: &PointLight,
     style: u8,
     arrived: impl Iterator<Item = (usize, f64)> + Clone,
+    points: &[[f32; 3]],
     out: &mut SampleLight,
 ) {
     let local_min = light.falloff == Falloff::LocalMin;
-    let color = light.color.to_array();
+    let color = |i: usize| match light.projector {
+        None => light.color,
+        Some(_) => light.color_at(glam::Vec3::from(points[i]).as_dvec3()),
+    };
     let target = if local_min {
         &mut out.floors
     } else {
@@ -166,15 +167,14 @@ fn deposit(
     };
     let buffer = target.get(style);
     for (i, value) in arrived.clone() {
-        for (o, c) in buffer[i].iter_mut().zip(color) {
+        for (o, c) in buffer[i].iter_mut().zip(color(i).to_array()) {
             let add = (value * c) as f32;
             *o = if local_min { o.max(add) } else { *o + add };
         }
     }
     if let Some(d) = out.directions.as_mut().filter(|_| !local_min) {
-        let weight = brightness(light.color);
         for (i, value) in arrived.clone() {
-            d.add_from_point(style, i, light.origin, value * weight);
+            d.add_from_point(style, i, light.origin, value * brightness(color(i)));
         }
     }
     let kept_share = 1.0 - f64::from(light.bounce);
@@ -183,7 +183,7 @@ fn deposit(
         let kept = out.no_bounce.get_or_insert_with(|| StyleBuffers::new(len));
         let buffer = kept.get(style);
         for (i, value) in arrived {
-            for (o, c) in buffer[i].iter_mut().zip(color) {
+            for (o, c) in buffer[i].iter_mut().zip(color(i).to_array()) {
                 *o += (value * c * kept_share) as f32;
             }
         }

@@ -184,8 +184,7 @@ pub fn trace_face(
     let occlusion = face.occlusion();
     let mut dirt = DirtFactors::new(&occlusion, samples.points.len());
     face.scratch.arrivals.settle_waiting(
-        face.lights,
-        face.suns,
+        (face.lights, face.suns, &samples.points),
         &mut dirt,
         setup.gate,
         &mut face.out,

@@ -7,12 +7,13 @@
 //! trace their shadow rays ([`super::shadows`]), and the samples so close that it is averaged
 //! over their squares are traced point by point ([`super::footprints`]).
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use quake_formats::geom::DVec3Ext;
 
 use super::footprints::Closeness;
 use super::{FaceTrace, LIGHT_CLEARANCE};
 use crate::lights::Falloff;
+use crate::lights::projection::Projector;
 use crate::reach::box_distance_squared;
 
 impl FaceTrace<'_> {
@@ -108,9 +109,13 @@ impl FaceTrace<'_> {
             let arrived = (0..value.len())
                 .filter(|&i| lit[i] && arrive_in.as_ref().is_none_or(|a| a[i] == style))
                 .map(|i| (i, value[i]));
-            scratch
-                .arrivals
-                .add_light((li, light, style), arrived, (dirty, true), &mut self.out);
+            scratch.arrivals.add_light(
+                (li, light, style),
+                arrived,
+                (dirty, true),
+                &samples.points,
+                &mut self.out,
+            );
         }
         let scratch = &mut *self.scratch;
         if !scratch.near.is_empty() {
@@ -124,6 +129,7 @@ impl FaceTrace<'_> {
                 (li, light, light.style),
                 footprints.means(),
                 (dirty, false),
+                &samples.points,
                 &mut self.out,
             );
         }
@@ -214,7 +220,10 @@ impl FaceTrace<'_> {
                 (dist as f32 - LIGHT_CLEARANCE).max(0.0),
             );
             let v = light.contribution(dist, -dir, samples.incidence(i, dir));
-            if v.abs() >= self.setup.gate {
+            // A projected picture lights only the samples it falls on.
+            let pictured =
+                |picture: &Projector| picture.tint(Vec3::from(p).as_dvec3()) != DVec3::ZERO;
+            if v.abs() >= self.setup.gate && light.projector.as_deref().is_none_or(pictured) {
                 scratch.value[i] = v;
             }
         }

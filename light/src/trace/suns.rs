@@ -131,7 +131,9 @@ impl FaceTrace<'_> {
         for (i, &v) in value.iter().enumerate() {
             if visibility.lit[i] {
                 let a = Arrival::new(Source::Sun(si), i, v, dirty, true);
-                scratch.arrivals.add(a, lights, suns, &mut self.out);
+                scratch
+                    .arrivals
+                    .add(a, (lights, suns, &samples.points), &mut self.out);
             }
         }
     }
