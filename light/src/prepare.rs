@@ -332,6 +332,9 @@ pub fn face_rules<'a>(lights: &'a MapLights, geom: &FaceGeom) -> FaceRules<'a> {
         && geom.kind != FaceKind::LitLiquid;
     FaceRules {
         minlight,
+        minlight_mottle: (lights.model_minlight_mottle.get(&geom.model))
+            .copied()
+            .unwrap_or(lights.settings.minlight_mottle),
         dirt,
         minlight_only: merged.light_ignore || lights.lightignore_models.contains(&geom.model),
         channels: lights.channels_of(geom),

@@ -3002,3 +3002,57 @@ fn no_key_value_stops_light() {
         assert!(told.contains(" line "), "{told}");
     }
 }
+
+/// `_minlight_mottle`: worldspawn's mottles the world's minimum light, a slow noise of 0 to 48
+/// light units added to it (ericw-tools' range; its floor here spans 27 to 48 bytes, median
+/// 37, and ours the same within 2); a brush model's own `_minlight_mottle 0` keeps its faces
+/// flat, and without the key nothing is mottled.
+#[test]
+fn mottled_minlight_rises_from_the_floor_by_up_to_48_levels() {
+    let wall = map_box([-16.0, -16.0, -128.0], [16.0, 16.0, -96.0]);
+    let bsp = room_bsp(&format!("{{\n\"classname\" \"func_wall\"\n{wall}}}\n"));
+    let model_faces = |m: usize| {
+        let model = &bsp.models[m];
+        let first = model.first_face as usize;
+        first..first + model.num_faces as usize
+    };
+    let (world, wall_faces) = (model_faces(0), model_faces(1));
+    let bytes = |bsp: &Bsp, world_keys: &str, wall_keys: &str| {
+        let mut bsp = bsp.clone();
+        bsp.set_entity_text(&format!(
+            "{{\n\"classname\" \"worldspawn\"\n\"_minlight\" \"50\"\n{world_keys}}}\n\
+             {{\n\"classname\" \"func_wall\"\n\"model\" \"*1\"\n{wall_keys}}}\n"
+        ));
+        let lighting = compute_lighting(&bsp, &options(Quality::Default)).expect("light");
+        let of = |faces: &std::ops::Range<usize>| -> Vec<u8> {
+            (lighting.lightmaps.iter())
+                .filter(|m| faces.contains(&m.face) && !m.styles.is_empty())
+                .flat_map(|m| m.grey[0].clone())
+                .collect()
+        };
+        (of(&world), of(&wall_faces))
+    };
+    let (flat_world, flat_wall) = bytes(&bsp, "", "");
+    assert!(flat_world.iter().chain(&flat_wall).all(|&b| b == 25));
+    let (world_bytes, wall_bytes) = bytes(
+        &bsp,
+        "\"_minlight_mottle\" \"1\"\n",
+        "\"_minlight_mottle\" \"0\"\n",
+    );
+    assert!(wall_bytes.iter().all(|&b| b == 25), "{wall_bytes:?}");
+    let mut sorted = world_bytes.clone();
+    sorted.sort_unstable();
+    let (low, median, high) = (
+        sorted[0],
+        sorted[sorted.len() / 2],
+        sorted[sorted.len() - 1],
+    );
+    assert!(low >= 25 && high <= 49, "{low} to {high}");
+    assert!((35..=39).contains(&median), "median {median}");
+    assert!(high - low > 15, "{low} to {high}");
+    // The mottle is fixed in the world: a second run gives the same bytes.
+    assert_eq!(
+        bytes(&bsp, "\"_minlight_mottle\" \"1\"\n", "").0,
+        world_bytes
+    );
+}

@@ -236,6 +236,9 @@ entity_keys! {
     MINLIGHT_COLOR: ["_minlight_color", "_mincolor"] on Models, Color, default "white";
     /// A texture of the model that does not get its minimum light.
     MINLIGHT_EXCLUDE: ["_minlight_exclude"] on Models, Text, default "—";
+    /// `1`: the minimum light of the model's faces (its own or the world's) is mottled, as
+    /// worldspawn's `_minlight_mottle` mottles the world's; `0`: not.
+    MINLIGHT_MOTTLE: ["_minlight_mottle", "_minlightMottle"] on Models, Switch, default "worldspawn's";
     /// The most light the model's faces take, in levels (instead of the world's `_maxlight`;
     /// on a `func_detail` or `func_group`, its own faces').
     MAXLIGHT: ["_maxlight"] on Models, Number, default "worldspawn's";

@@ -9,6 +9,7 @@
 mod entities;
 pub mod keys;
 mod models;
+pub mod mottle;
 mod point;
 pub mod projection;
 mod styles;
@@ -105,6 +106,8 @@ pub struct MapLights {
     pub templates: Vec<SurfaceTemplate>,
     /// Minlight per model index (0 = world, from worldspawn).
     pub minlight: HashMap<usize, Minlight>,
+    /// Brush models with their own `_minlight_mottle` (else the map's setting).
+    pub model_minlight_mottle: HashMap<usize, bool>,
     /// Brush models with their own `_maxlight`, in levels.
     pub model_maxlight: HashMap<usize, f64>,
     /// Worldspawn (model 0) and brush models whose `_lightcolorscale` is not 1.
@@ -267,6 +270,7 @@ pub fn parse_lights(
         suns: sun::world_suns(&settings, &global),
         templates: Vec::new(),
         minlight: HashMap::new(),
+        model_minlight_mottle: HashMap::new(),
         model_maxlight: HashMap::new(),
         model_lightcolorscale: HashMap::new(),
         shadow_models: Vec::new(),

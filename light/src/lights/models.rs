@@ -112,6 +112,9 @@ pub fn read_models(entities: &[Entity], global: &Global, out: &mut MapLights) {
         if let Some(level) = k.number(&keys::MAXLIGHT).filter(|m| *m > 0.0) {
             out.model_maxlight.insert(model, level);
         }
+        if let Some(mottle) = k.switch(&keys::MINLIGHT_MOTTLE) {
+            out.model_minlight_mottle.insert(model, mottle);
+        }
         if let Some(level) = k.number(&keys::MINLIGHT).filter(|m| *m != 0.0) {
             let color = k.color(&keys::MINLIGHT_COLOR).unwrap_or(DVec3::ONE);
             let exclude = k.text(&keys::MINLIGHT_EXCLUDE).map(str::to_string);

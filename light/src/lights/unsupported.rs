@@ -16,14 +16,11 @@ enum Where {
 }
 
 /// Each key, where ericw-tools reads it, and what it does there.
-const UNSUPPORTED: &[(&str, Where, &str)] = &[
-    (
-        "_bouncelightsubdivision",
-        Where::Worldspawn,
-        "spacing of bounce emitters",
-    ),
-    ("_minlight_mottle", Where::Brushes, "mottled minlight"),
-];
+const UNSUPPORTED: &[(&str, Where, &str)] = &[(
+    "_bouncelightsubdivision",
+    Where::Worldspawn,
+    "spacing of bounce emitters",
+)];
 
 /// A warning for each key of [`UNSUPPORTED`] an entity of `entities` sets where ericw-tools
 /// reads it.
@@ -90,9 +87,8 @@ mod tests {
             .iter()
             .map(ToString::to_string)
             .collect();
-        assert_eq!(told.len(), 2, "{told:?}");
+        assert_eq!(told.len(), 1, "{told:?}");
         assert!(told[0].contains("\"_bouncelightsubdivision\"") && told[0].contains("bounce"));
-        assert!(told[1].contains("_minlight_mottle"));
     }
 
     #[test]

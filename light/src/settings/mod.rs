@@ -67,6 +67,11 @@ settings! {
     /// Add minlight to every luxel's light instead of raising dark luxels to it.
     addmin: bool = false, flag "addmin", keys [], range Range::Any;
 
+    /// `1`: the minimum light is mottled: a slow noise of 0 to 48 levels, on a lattice of 16
+    /// units fixed in the world, is added to it, so a surface lit by nothing else does not read
+    /// as one flat wash (Quake II's look; brush models may set their own).
+    minlight_mottle: bool = false, keys ["_minlight_mottle", "_minlightMottle"], range Range::Any;
+
     /// The most light a luxel takes, in levels (0: no cap): a brighter sample is dimmed to it,
     /// its colour kept, as ericw-tools dims it.
     maxlight: f64 = 0.0, keys ["_maxlight"], range Range::Any;

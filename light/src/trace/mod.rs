@@ -33,6 +33,7 @@ use quake_formats::geom::Bounds;
 use crate::dirt::{DirtFactors, DirtNeed, DirtResponse, DirtSampling, FaceDirt, face_occlusion};
 use crate::embree::RayPacket16;
 use crate::faces::FaceGeom;
+use crate::lights::mottle::mottle;
 use crate::lights::{Minlight, PointLight, SunLight};
 use crate::reach::LightReaches;
 use crate::samples::FaceSamples;
@@ -87,6 +88,8 @@ pub struct TraceSetup<'a> {
 pub struct FaceRules<'a> {
     /// The floor for style 0 (none for a face its model's `_minlight_exclude` names).
     pub minlight: Option<&'a Minlight>,
+    /// `_minlight_mottle`: [`crate::lights::mottle::mottle`] is added to the floor.
+    pub minlight_mottle: bool,
     /// Dirt may darken this face (false for models with `_dirt -1`).
     pub dirt: bool,
     /// `_lightignore`: minlight only, no lights or suns.
@@ -108,6 +111,7 @@ impl Default for FaceRules<'_> {
     fn default() -> Self {
         FaceRules {
             minlight: None,
+            minlight_mottle: false,
             dirt: false,
             minlight_only: false,
             channels: 1,
@@ -333,8 +337,14 @@ impl<'a> FaceTrace<'a> {
         };
         let n = self.samples.points.len();
         let dirt = dirt.get(m.dirt);
+        let points = &self.samples.points;
+        // The mottle raises the floor, as in ericw-tools; minlight that adds is never mottled.
+        let mottled = self.rules.minlight_mottle && !m.add;
         let values = (0..n).map(|i| {
-            let level = m.level * dirt.map_or(1.0, |d| f64::from(d[i]));
+            let mut level = m.level * dirt.map_or(1.0, |d| f64::from(d[i]));
+            if mottled {
+                level += mottle(Vec3::from(points[i]).as_dvec3());
+            }
             m.color.to_array().map(|c| (level * c) as f32)
         });
         if m.add {
