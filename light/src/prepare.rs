@@ -66,14 +66,12 @@ impl Prepared {
     /// What tracing reads, with lights cut off at `light_reaches` (built with `gate`).
     pub fn trace_setup<'a>(
         &'a self,
-        bsp: &'a Bsp,
         light_reaches: &'a LightReaches,
         gate: f64,
         cull: bool,
         adaptive: bool,
     ) -> TraceSetup<'a> {
         TraceSetup {
-            bsp,
             faces: &self.faces,
             scene: &self.scene,
             vis: &self.vis,

@@ -196,20 +196,14 @@ impl<'a> Plan<'a> {
     /// sampling for the reference.
     fn setup(&self) -> TraceSetup<'_> {
         let gate = self.prep.lights.settings.gate;
-        self.prep.trace_setup(
-            self.bsp,
-            &self.reaches,
-            gate,
-            self.cull(),
-            !self.reference(),
-        )
+        self.prep
+            .trace_setup(&self.reaches, gate, self.cull(), !self.reference())
     }
 
     /// What tracing the reference's bounce emitters reads: culled and adaptive, as `--extra4`.
     fn emitter_setup(&self) -> TraceSetup<'_> {
         let gate = self.prep.lights.settings.gate;
-        self.prep
-            .trace_setup(self.bsp, &self.reaches, gate, true, true)
+        self.prep.trace_setup(&self.reaches, gate, true, true)
     }
 
     /// How the run's samples become luxels.

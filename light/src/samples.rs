@@ -60,8 +60,6 @@ pub struct FaceSamples {
     /// Per sample: no place to measure light (inside solid, or far past the face's edge), so
     /// its light does not count (empty: no sample is).
     pub occluded: Vec<bool>,
-    /// Where the samples' texture coordinates land on the face.
-    pub map: SurfaceMap,
 }
 
 impl FaceSamples {
@@ -310,44 +308,10 @@ impl SurfaceMap {
         }
     }
 
-    /// The lifted point for grid coordinates (s, t) ([`SurfaceMap::place`]).
-    pub fn point(&self, s: f64, t: f64) -> DVec3 {
-        self.place(s, t).at
-    }
-
-    /// A box holding every point [`SurfaceMap::point`] gives (a little
-    /// wider, for rounding), in single precision.
-    pub fn bounds(&self) -> ([f32; 3], [f32; 3]) {
-        let (mut lo, mut hi) = (self.centre(), self.centre());
-        let continued = self.continuations.iter().flat_map(|c| &c.points);
-        for &p in self.outline.points.iter().chain(continued) {
-            lo = lo.min(p + self.lift);
-            hi = hi.max(p + self.lift);
-        }
-        (
-            (lo - FOOTPRINT_BOX_SLACK).as_vec3().to_array(),
-            (hi + FOOTPRINT_BOX_SLACK).as_vec3().to_array(),
-        )
-    }
-
     /// Grid units (texels, or luxels of a face's own grid) along each axis one sample stands
     /// for.
     pub fn sample_step(&self) -> f64 {
         self.grid.scale / self.per_axis as f64
-    }
-
-    /// Half-diagonal of one sample's square, in world units.
-    pub fn footprint_radius(&self) -> f64 {
-        self.footprint_radius
-    }
-
-    /// Texture coordinates of sample `i` (in [`FaceSamples::points`] order):
-    /// the middle of its square.
-    pub fn sample_st(&self, i: usize) -> [f64; 2] {
-        let per_luxel = self.per_axis * self.per_axis;
-        let width = self.grid.size[0];
-        let (luxel, sub) = (i / per_luxel, i % per_luxel);
-        self.sub_sample_st(self.grid.luxel_st(luxel % width, luxel / width), sub)
     }
 
     /// Texture coordinates of sub-sample `sub` (row by row) of the luxel whose middle is at
@@ -362,18 +326,6 @@ impl SurfaceMap {
             s0 + first + step * (sub % self.per_axis) as f64,
             t0 + first + step * (sub / self.per_axis) as f64,
         ]
-    }
-
-    /// `n x n` points spread evenly over sample `i`'s square, each placed as
-    /// a sample point would be (onto the face, lifted; not nudged).
-    pub fn footprint_points(&self, i: usize, n: usize) -> impl Iterator<Item = DVec3> + '_ {
-        let [s, t] = self.sample_st(i);
-        let sub = self.sample_step() / n as f64;
-        let first = -self.sample_step() / 2.0 + sub / 2.0;
-        (0..n * n).map(move |k| {
-            let (ks, kt) = ((k % n) as f64, (k / n) as f64);
-            self.point(s + first + sub * ks, t + first + sub * kt)
-        })
     }
 }
 
@@ -490,7 +442,6 @@ pub fn face_samples(face: &FaceGeom, per_axis: usize, bsp: &Bsp) -> (FaceSamples
             moved,
             apart,
             occluded,
-            map,
         },
         counts,
     )
@@ -536,18 +487,14 @@ const ON_PLANE: f32 = 0.1;
 /// the per-point test, so the shared walk ends where [`solid_at`]'s would.
 const SHARED_WALK_MARGIN: f32 = 0.25;
 
-/// How much wider than its points a face's box of close-light footprint points is (units): the
-/// points are rounded to f32 after the box is taken.
-const FOOTPRINT_BOX_SLACK: f64 = 0.01;
-
 /// A node of the world BSP where the shared walk of [`solid_points_in_tiles`]
 /// arrives for every point inside a box: walks of points inside that box
-/// (the close-light footprints of one face) start there instead of at the
+/// (the nudges of one face's samples in solid) start there instead of at the
 /// root, and end where they would have. A box inside another one is on one
 /// side of every plane the bigger box is on one side of (the near and far
 /// sums are monotonic in the box corners, rounding included).
 #[derive(Debug, Clone, Copy)]
-pub struct WalkStart {
+struct WalkStart {
     node: i32,
     lo: [f32; 3],
     hi: [f32; 3],
@@ -555,14 +502,14 @@ pub struct WalkStart {
 
 impl WalkStart {
     /// The root, for points anywhere (None: the BSP has no world model).
-    pub fn root(bsp: &Bsp) -> Option<WalkStart> {
+    fn root(bsp: &Bsp) -> Option<WalkStart> {
         let &node = bsp.models.first()?.head_nodes.first()?;
         let (lo, hi) = ([f32::NEG_INFINITY; 3], [f32::INFINITY; 3]);
         Some(WalkStart { node, lo, hi })
     }
 
     /// Where points inside `lo..hi` part ways.
-    pub fn for_box(bsp: &Bsp, lo: [f32; 3], hi: [f32; 3]) -> Option<WalkStart> {
+    fn for_box(bsp: &Bsp, lo: [f32; 3], hi: [f32; 3]) -> Option<WalkStart> {
         let root = WalkStart::root(bsp)?;
         Some(WalkStart {
             node: shared_walk(bsp, root.node, lo, hi),
@@ -616,38 +563,14 @@ fn solid_below(bsp: &Bsp, mut node: i32, p: [f32; 3], mut depth: usize) -> bool 
 /// on down to where its own points part, so a tile inside one leaf costs one walk, not one a
 /// point.
 pub fn solid_points_in_tiles(bsp: &Bsp, points: &[[f32; 3]], tile: usize) -> Vec<bool> {
-    match WalkStart::root(bsp) {
-        Some(root) => solid_points_from_in_tiles(bsp, &root, points, tile),
-        None => vec![false; points.len()],
-    }
-}
-
-/// [`solid_points_in_tiles`] in one tile, with the walk starting at `start` when it holds all
-/// of `points` (else at the root).
-pub fn solid_points_from(bsp: &Bsp, start: &WalkStart, points: &[[f32; 3]]) -> Vec<bool> {
-    solid_points_from_in_tiles(bsp, start, points, points.len())
-}
-
-/// [`solid_points_from`] in tiles of `tile` points ([`solid_points_in_tiles`]).
-fn solid_points_from_in_tiles(
-    bsp: &Bsp,
-    start: &WalkStart,
-    points: &[[f32; 3]],
-    tile: usize,
-) -> Vec<bool> {
+    let Some(root) = WalkStart::root(bsp) else {
+        return vec![false; points.len()];
+    };
     if points.is_empty() {
         return Vec::new();
     }
     let (lo, hi) = box_of(points);
-    let from = if start.contains(lo, hi) {
-        start.node
-    } else {
-        match WalkStart::root(bsp) {
-            Some(root) => root.node,
-            None => return vec![false; points.len()],
-        }
-    };
-    let node = shared_walk(bsp, from, lo, hi);
+    let node = shared_walk(bsp, root.node, lo, hi);
     let mut solid = Vec::with_capacity(points.len());
     for tile in points.chunks(tile.max(1)) {
         let (lo, hi) = box_of(tile);

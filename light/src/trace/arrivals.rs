@@ -29,19 +29,15 @@ pub struct Arrival {
     value: f64,
     /// The source takes dirt on this face.
     pub dirty: bool,
-    /// Dropped when below the gate once dirt is applied (not for
-    /// close-light squares, which are kept whatever their value).
-    gated: bool,
 }
 
 impl Arrival {
-    pub fn new(source: Source, sample: usize, value: f64, dirty: bool, gated: bool) -> Arrival {
+    pub fn new(source: Source, sample: usize, value: f64, dirty: bool) -> Arrival {
         Arrival {
             source,
             sample: sample as u32,
             value,
             dirty,
-            gated,
         }
     }
 }
@@ -49,7 +45,7 @@ impl Arrival {
 /// Where a face's arrivals go. With dirt measured they wait (dirt is measured
 /// after the shadow rays, only where some light that takes it arrives); without,
 /// they go straight into the sums, in the same order and so to the same sums
-/// (a gated arrival is above the gate already: nothing darkens it).
+/// (an arrival is above the gate already: nothing darkens it).
 #[derive(Debug, Default)]
 pub struct Arrivals {
     pub waiting: Vec<Arrival>,
@@ -76,14 +72,14 @@ impl Arrivals {
         &mut self,
         (li, light, style): (usize, &PointLight, u8),
         arrived: impl Iterator<Item = (usize, f64)> + Clone,
-        (dirty, gated): (bool, bool),
+        dirty: bool,
         points: &[[f32; 3]],
         out: &mut SampleLight,
     ) {
         if self.wait {
             let source = Source::Light { light: li, style };
             self.waiting
-                .extend(arrived.map(|(i, v)| Arrival::new(source, i, v, dirty, gated)));
+                .extend(arrived.map(|(i, v)| Arrival::new(source, i, v, dirty)));
         } else {
             deposit(light, style, arrived, points, out);
         }
@@ -106,7 +102,8 @@ impl Arrivals {
                 Source::Sun(si) => suns[si].dirt,
             };
             let v = a.value * dirt.get(response).map_or(1.0, |d| f64::from(d[i]));
-            if a.gated && v.abs() < gate {
+            // Dirt may take it below the gate: then it is dropped.
+            if v.abs() < gate {
                 continue;
             }
             settle(a, v, (lights, suns, points), out);

@@ -6,8 +6,8 @@
 //!    ([`LightReaches`]) are culled by the face's plane, their range and the PVS; each
 //!    remaining light's unshadowed value is worked out per sample, and the samples it reaches
 //!    are found with shadow rays, 16 neighbouring samples to a packet (coherent rays;
-//!    [`shadows`]). A sample so close to a light that its brightness changes a lot across the
-//!    sample's square takes the mean over points spread across it ([`footprints`]).
+//!    [`shadows`]). Each sample takes the light at its point, however close the light is
+//!    (as ericw-tools takes it).
 //! 2. Suns and sky domes ([`suns`]): a face that sees no sky in the PVS skips them, and a
 //!    direction that meets none of the sky boxes it sees is skipped; a sun ray counts only
 //!    when the first thing it meets is sky.
@@ -20,14 +20,12 @@
 //! [`SampleLight::finish`] applies the floors and averages samples to luxels.
 
 mod arrivals;
-mod footprints;
 mod points;
 mod sample_light;
 mod shadows;
 pub(crate) mod suns;
 
 use glam::Vec3;
-use quake_formats::Bsp;
 use quake_formats::geom::Bounds;
 
 use crate::dirt::{DirtFactors, DirtNeed, DirtResponse, DirtSampling, FaceDirt, face_occlusion};
@@ -40,7 +38,6 @@ use crate::samples::FaceSamples;
 use crate::scene::TraceScene;
 use crate::visibility::Visibility;
 use arrivals::Arrivals;
-use footprints::Footprints;
 use sample_light::Directions;
 use sample_light::StyleBuffers;
 pub use sample_light::{HiddenLuxels, SampleLight};
@@ -57,7 +54,6 @@ pub(crate) const RAY_START: f32 = 0.01;
 
 /// Everything shared by all faces while tracing.
 pub struct TraceSetup<'a> {
-    pub bsp: &'a Bsp,
     pub faces: &'a [FaceGeom],
     pub scene: &'a TraceScene,
     pub vis: &'a Visibility,
@@ -165,13 +161,10 @@ impl TraceCounts {
 pub struct TraceScratch {
     arrivals: Arrivals,
     value: Vec<f64>,
-    /// Samples so close to the current light that it is averaged over their squares.
-    near: Vec<(usize, usize)>,
     /// Per sample: the direction and length of its shadow ray to the current light.
     to_light: Vec<([f32; 3], f32)>,
     /// The lights that may reach the face ([`LightReaches::near`]).
     near_lights: Vec<u32>,
-    footprints: Footprints,
     visibility: VisibilityScratch,
 }
 
@@ -266,7 +259,6 @@ impl<'a> FaceTrace<'a> {
         scratch.arrivals.start_face(dirt.is_some());
         scratch.value.clear();
         scratch.value.resize(n, 0.0);
-        scratch.footprints.start_face();
         FaceTrace {
             setup,
             samples,

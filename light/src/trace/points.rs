@@ -3,14 +3,12 @@
 //! Only the lights whose reach may touch the box around the face's samples are looked at
 //! ([`crate::reach::LightReaches`]); each is culled when the face's plane turns from it, when
 //! it is out of range of the box, or when the PVS says it cannot see the face. A light that
-//! remains gets its unshadowed value at every sample, the samples with a value above the gate
-//! trace their shadow rays ([`super::shadows`]), and the samples so close that it is averaged
-//! over their squares are traced point by point ([`super::footprints`]).
+//! remains gets its unshadowed value at every sample, and the samples with a value above the gate
+//! trace their shadow rays ([`super::shadows`]).
 
 use glam::{DVec3, Vec3};
 use quake_formats::geom::DVec3Ext;
 
-use super::footprints::Closeness;
 use super::{FaceTrace, LIGHT_CLEARANCE};
 use crate::lights::Falloff;
 use crate::lights::projection::Projector;
@@ -33,7 +31,6 @@ impl FaceTrace<'_> {
         }
         self.counts.pairs += self.lights.len() as u64;
         self.counts.pairs_culled += (self.lights.len() - near_lights.len()) as u64;
-        let closeness = Closeness::of(self.samples);
         for li in near_lights.iter().map(|&li| li as usize) {
             // A light lights only the models on one of its channels.
             if self.lights[li].light_channels & self.rules.channels == 0 {
@@ -43,7 +40,7 @@ impl FaceTrace<'_> {
                 self.counts.pairs_culled += 1;
                 continue;
             }
-            self.point_light(li, closeness);
+            self.point_light(li);
         }
         self.scratch.near_lights = near_lights;
     }
@@ -67,11 +64,11 @@ impl FaceTrace<'_> {
 
     /// Light `li` on every sample: values and shadow rays, then the arrivals of those it
     /// reaches (in a switchable shadow's style where one blocks it).
-    fn point_light(&mut self, li: usize, closeness: Closeness) {
+    fn point_light(&mut self, li: usize) {
         let (setup, samples, face) = (self.setup, self.samples, self.face);
         let light = &self.lights[li];
         let dirty = self.takes_dirt(light.dirt);
-        self.unshadowed_values(li, closeness);
+        self.unshadowed_values(li);
         let scratch = &mut *self.scratch;
         let shadow_rays = &scratch.to_light;
         let ray = |i: usize| {
@@ -112,23 +109,7 @@ impl FaceTrace<'_> {
             scratch.arrivals.add_light(
                 (li, light, style),
                 arrived,
-                (dirty, true),
-                &samples.points,
-                &mut self.out,
-            );
-        }
-        let scratch = &mut *self.scratch;
-        if !scratch.near.is_empty() {
-            let footprints = &mut scratch.footprints;
-            footprints.clear();
-            for &(i, cells) in scratch.near.iter() {
-                footprints.add(setup.bsp, samples, i, cells, light);
-            }
-            self.counts.shadow_rays += footprints.trace(setup.scene, face.model, &mut self.packet);
-            scratch.arrivals.add_light(
-                (li, light, light.style),
-                footprints.means(),
-                (dirty, false),
+                dirty,
                 &samples.points,
                 &mut self.out,
             );
@@ -181,22 +162,19 @@ impl FaceTrace<'_> {
     }
 
     /// Light `li`'s value at each sample (0 below the gate) and its shadow ray, into the
-    /// scratch buffers; samples so close that the light is averaged over their squares go to
-    /// `near` instead, with their cell counts.
-    fn unshadowed_values(&mut self, li: usize, closeness: Closeness) {
+    /// scratch buffers.
+    fn unshadowed_values(&mut self, li: usize) {
         let samples = self.samples;
         let light = &self.lights[li];
-        // Past both its range and the footprints' reach, a light adds less than the gate at
-        // any angle and the sample needs no ray: its square root and divisions are skipped.
-        // A sample whose ray stands for others at its point is as far as they are.
+        // Past its range, a light adds less than the gate at any angle and the sample needs no
+        // ray: its square root and divisions are skipped. A sample whose ray stands for others
+        // at its point is as far as they are.
         let out_of_reach = if self.setup.cull {
-            let range = self.setup.light_reaches[li].range_squared * (1.0 + RANGE_MARGIN);
-            range.max(closeness.surely_far_squared())
+            self.setup.light_reaches[li].range_squared * (1.0 + RANGE_MARGIN)
         } else {
             f64::INFINITY
         };
         let scratch = &mut *self.scratch;
-        scratch.near.clear();
         for (i, &p) in samples.points.iter().enumerate() {
             scratch.value[i] = 0.0;
             let to_light = light.origin - Vec3::from(p).as_dvec3();
@@ -207,12 +185,6 @@ impl FaceTrace<'_> {
             let Some((dist, dir)) = to_light.length_and_direction() else {
                 continue;
             };
-            let cells = closeness.cells(to_light, dist, samples.normal);
-            if cells > 1 {
-                // Traced on its own below, point by point over the square.
-                scratch.near.push((i, cells));
-                continue;
-            }
             // Kept whatever the value: a sample whose `_phong` normal turns from the light may
             // be the first at a point whose others need the ray.
             scratch.to_light[i] = (

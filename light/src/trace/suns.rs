@@ -130,7 +130,7 @@ impl FaceTrace<'_> {
         };
         for (i, &v) in value.iter().enumerate() {
             if visibility.lit[i] {
-                let a = Arrival::new(Source::Sun(si), i, v, dirty, true);
+                let a = Arrival::new(Source::Sun(si), i, v, dirty);
                 scratch
                     .arrivals
                     .add(a, (lights, suns, &samples.points), &mut self.out);
