@@ -56,21 +56,6 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
     let plan = Plan::new(bsp, &prep, options);
     let traced = plan.direct_light();
     let trace_done = Instant::now();
-    let mut bounce_counts = BounceCounts::default();
-    let bounced = plan.bounced_light(&traced, &mut bounce_counts);
-    let bounce_done = Instant::now();
-    let grid = plan.light_grid()?;
-    let grid_done = Instant::now();
-    let mut stats = plan.stats(&traced, &bounce_counts);
-    if let Some(g) = &grid {
-        stats.grid_points = g.points.len() as u64;
-        stats.grid_points_open = g.points.iter().flatten().count() as u64;
-        stats.grid_rays = g.rays;
-        stats.seconds_lightgrid = (grid_done - bounce_done).as_secs_f64();
-    }
-    let settings = &prep.lights.settings;
-    let to_luxels = plan.to_luxels();
-    let model_light = |models: &[usize]| plan.model_centre_light(models);
     let autominlight = &prep.lights.autominlight;
     // Models whose samples in solid take no light: those that cast shadows, and `-1`.
     let dark_models: Vec<usize> = (prep.lights.shadow_models.iter().copied())
@@ -84,6 +69,27 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
         .filter(|(_, a)| **a == AutoMinlight::Everywhere)
         .map(|(&m, _)| m)
         .collect();
+    let centres = plan.model_centres(&buried_models(
+        &traced,
+        &prep.faces,
+        &dark_models,
+        &everywhere,
+    ));
+    let mut bounce_counts = BounceCounts::default();
+    let (bounced, centre_bounce) = plan.bounced_light(&traced, &centres, &mut bounce_counts);
+    let bounce_done = Instant::now();
+    let grid = plan.light_grid()?;
+    let grid_done = Instant::now();
+    let mut stats = plan.stats(&traced, &bounce_counts);
+    if let Some(g) = &grid {
+        stats.grid_points = g.points.len() as u64;
+        stats.grid_points_open = g.points.iter().flatten().count() as u64;
+        stats.grid_rays = g.rays;
+        stats.seconds_lightgrid = (grid_done - bounce_done).as_secs_f64();
+    }
+    let settings = &prep.lights.settings;
+    let to_luxels = plan.to_luxels();
+    let model_light = plan.model_centre_light(&centres, &centre_bounce);
     let (faces, own_grids) = finish_faces(
         traced,
         &bounced,
@@ -249,9 +255,14 @@ impl<'a> Plan<'a> {
     }
 
     /// Bounced light per face (by index), when bouncing.
-    fn bounced_light(&self, traced: &[Traced], counts: &mut BounceCounts) -> Vec<StyleLuxels> {
+    fn bounced_light(
+        &self,
+        traced: &[Traced],
+        centres: &[ModelCentre],
+        counts: &mut BounceCounts,
+    ) -> (Vec<StyleLuxels>, Vec<CentreLight>) {
         if !self.bouncing {
-            return Vec::new();
+            return (Vec::new(), vec![Vec::new(); centres.len()]);
         }
         if !self.reference() {
             let density = self
@@ -266,8 +277,8 @@ impl<'a> Plan<'a> {
             return bounce_light(
                 self.prep,
                 &self.reflectance,
-                traced,
-                traced,
+                (traced, traced),
+                centres,
                 gathering,
                 counts,
             );
@@ -297,8 +308,8 @@ impl<'a> Plan<'a> {
         bounce_light(
             self.prep,
             &self.reflectance,
-            traced,
-            &field,
+            (traced, &field),
+            centres,
             gathering,
             counts,
         )
@@ -334,36 +345,46 @@ impl<'a> Plan<'a> {
         }
     }
 
-    /// Per brush model of `models`, ericw-tools' estimate of its light ("autominlight"): the
-    /// direct light at the middle of its box or its `_autominlight_target` (moved out of solid
-    /// as a light is; a model whose point no step frees has none) as a grid point takes it,
-    /// without minlight, scaled once more by the range scale as ericw-tools' value is.
-    fn model_centre_light(&self, models: &[usize]) -> ModelLight {
+    /// Where each brush model of `models` takes its estimate of its light (ericw-tools'
+    /// "autominlight"): the middle of its box or its `_autominlight_target`, moved out of solid
+    /// as a light is (a model whose point no step frees has none).
+    fn model_centres(&self, models: &[usize]) -> Vec<ModelCentre> {
         if self.fullbright {
-            return ModelLight::new();
+            return Vec::new();
         }
-        let placed: Vec<(usize, DVec3)> = models
+        models
             .iter()
-            .filter_map(|&m| {
-                let model = self.bsp.models.get(m)?;
+            .filter_map(|&model| {
+                let box_of = self.bsp.models.get(model)?;
                 let corner = |c: [f32; 3]| DVec3::from(c.map(f64::from));
-                let centre = (corner(model.mins) + corner(model.maxs)) / 2.0;
-                let at = self.prep.lights.autominlight_at.get(&m).copied();
-                Some((m, crate::nudge::free_point(self.bsp, at.unwrap_or(centre))?))
+                let centre = (corner(box_of.mins) + corner(box_of.maxs)) / 2.0;
+                let at = self.prep.lights.autominlight_at.get(&model).copied();
+                let point = crate::nudge::free_point(self.bsp, at.unwrap_or(centre))?;
+                let leaf = self.prep.vis.open_leaf_at(self.bsp, point);
+                Some(ModelCentre { model, point, leaf })
             })
-            .collect();
-        let points: Vec<DVec3> = placed.iter().map(|&(_, p)| p).collect();
+            .collect()
+    }
+
+    /// Each model's estimate of its light at its centre ([`Plan::model_centres`]): the direct
+    /// light there as a grid point takes it, without minlight, and the light `bounce` brings it
+    /// (per centre), scaled once more by the range scale as ericw-tools' value is.
+    fn model_centre_light(&self, centres: &[ModelCentre], bounce: &[CentreLight]) -> ModelLight {
+        let points: Vec<DVec3> = centres.iter().map(|c| c.point).collect();
         let sources = GridSources {
             minlight: None,
             ..self.grid_sources()
         };
         let scale = self.prep.lights.settings.range as f32;
-        placed
+        centres
             .iter()
             .zip(light_at(&sources, &points))
-            .filter_map(|(&(m, _), light)| {
-                let light = light?.into_iter().map(|(s, c)| (s, c.map(|v| v * scale)));
-                Some((m, light.collect()))
+            .zip(bounce)
+            .filter_map(|((centre, light), bounce)| {
+                let mut light = light?;
+                add_styles(&mut light, bounce);
+                let light = light.into_iter().map(|(s, c)| (s, c.map(|v| v * scale)));
+                Some((centre.model, light.collect()))
             })
             .collect()
     }
@@ -413,6 +434,47 @@ impl<'a> Plan<'a> {
 /// Light per style (light units) of some brush models, by model.
 type ModelLight = BTreeMap<usize, Vec<(u8, [f32; 3])>>;
 
+/// Light per style at one point, in light units.
+type CentreLight = Vec<(u8, [f32; 3])>;
+
+/// Adds `add` to `sum`, style by style.
+fn add_styles(sum: &mut CentreLight, add: &[(u8, [f32; 3])]) {
+    for &(style, light) in add {
+        match sum.iter_mut().find(|(s, _)| *s == style) {
+            Some((_, to)) => to.iter_mut().zip(light).for_each(|(v, a)| *v += a),
+            None => sum.push((style, light)),
+        }
+    }
+}
+
+/// Where a brush model takes its estimate of its light ([`Plan::model_centres`]).
+struct ModelCentre {
+    model: usize,
+    point: DVec3,
+    /// Its world leaf, when open.
+    leaf: Option<u32>,
+}
+
+/// The brush models whose samples in solid take their model's light (ericw-tools'
+/// autominlight): those with a sample in solid and those `everywhere` names, not the world nor
+/// the `dark` ones.
+fn buried_models(
+    traced: &[Traced],
+    geoms: &[FaceGeom],
+    dark: &[usize],
+    everywhere: &[usize],
+) -> Vec<usize> {
+    let buried: BTreeSet<usize> = traced
+        .iter()
+        .filter_map(|t| t.light.as_ref()?.samples())
+        .filter(|light| light.has_occluded())
+        .map(|light| geoms[light.face].model)
+        .chain(everywhere.iter().copied())
+        .filter(|&m| m != 0 && !dark.contains(&m))
+        .collect();
+    buried.into_iter().collect()
+}
+
 /// What the samples of brush models take where they are inside solid.
 #[derive(Clone, Copy)]
 struct ModelFill<'a> {
@@ -420,8 +482,8 @@ struct ModelFill<'a> {
     dark: &'a [usize],
     /// Models whose every sample takes at least their light (`_autominlight 1`).
     everywhere: &'a [usize],
-    /// The light of the given models (ericw-tools' autominlight).
-    light: &'a (dyn Fn(&[usize]) -> ModelLight + Sync),
+    /// The light of the models whose samples in solid take it (ericw-tools' autominlight).
+    light: &'a ModelLight,
 }
 
 /// Each wanted face's light with its bounced light added, floors applied and samples averaged
@@ -445,15 +507,7 @@ fn finish_faces(
     // ericw-tools' autominlight: the occluded samples of a brush model's faces take the light
     // of the model's middle, where it has one.
     let model_of = |light: &SampleLight| geoms[light.face].model;
-    let buried: BTreeSet<usize> = lit
-        .iter()
-        .filter_map(TracedLight::samples)
-        .filter(|light| light.has_occluded())
-        .map(model_of)
-        .chain(models.everywhere.iter().copied())
-        .filter(|&m| m != 0 && !shadow_models.contains(&m))
-        .collect();
-    let centre_light = (models.light)(&buried.into_iter().collect::<Vec<_>>());
+    let centre_light = models.light;
     let lit: Vec<TracedLight> = lit
         .into_iter()
         .map(|traced| match traced {
@@ -703,11 +757,11 @@ struct Gathering<'p> {
 fn bounce_light(
     prep: &Prepared,
     reflectance: &[Option<[f32; 3]>],
-    traced: &[Traced],
-    field: &[Traced],
+    (traced, field): (&[Traced], &[Traced]),
+    centres: &[ModelCentre],
     gathering: Gathering,
     counts: &mut BounceCounts,
-) -> Vec<StyleLuxels> {
+) -> (Vec<StyleLuxels>, Vec<CentreLight>) {
     let Gathering {
         reference,
         density,
@@ -720,6 +774,7 @@ fn bounce_light(
         light[t.face] = t.reflected.clone().filter(|r| !r.is_empty());
     }
     let mut total: Vec<StyleLuxels> = vec![Vec::new(); n];
+    let mut at_centres: Vec<CentreLight> = vec![Vec::new(); centres.len()];
     for pass in 1..=settings.passes {
         let last = pass == settings.passes;
         let emitting = Field::new(&prep.faces, reflectance, &light, &settings);
@@ -771,6 +826,21 @@ fn bounce_light(
             Some(emitting.gather_face(&prep.scene, receivers, pass, density, c))
         });
         progress.finish();
+        // Every pass's emitters light the brush models' centres too (ericw-tools' estimate of
+        // a model's light includes bounced light).
+        if let Some(points) = &points {
+            let lit: Vec<(CentreLight, BounceCounts)> = centres
+                .par_iter()
+                .map(|c| {
+                    let mut n = BounceCounts::default();
+                    (points.light_at(&prep.scene, c.leaf, c.point, &mut n), n)
+                })
+                .collect();
+            for (sum, (add, c)) in at_centres.iter_mut().zip(lit) {
+                counts.add(&c);
+                add_styles(sum, &add);
+            }
+        }
         for (face, b, c) in at_receivers {
             counts.add(&c);
             if !reference {
@@ -782,7 +852,7 @@ fn bounce_light(
         }
         light = next;
     }
-    total
+    (total, at_centres)
 }
 
 /// One face's light gathered in one pass, and the work it took.

@@ -3050,3 +3050,36 @@ fn mottled_minlight_rises_from_the_floor_by_up_to_48_levels() {
         world_bytes
     );
 }
+
+/// ericw-tools' estimate of a brush model's light (its "autominlight", which luxels in solid
+/// take) includes bounced light: the bottom of a `func_wall` sunk into the floor, every sample
+/// in solid, takes more with bounce than without, and exactly its model's light either way.
+#[test]
+fn a_sunk_brush_models_hidden_face_takes_bounced_light_too() {
+    let wall = map_box([-16.0, -16.0, -136.0], [16.0, 16.0, -96.0]);
+    let light = "{\n\"classname\" \"light\"\n\"origin\" \"0 64 0\"\n\"light\" \"300\"\n}\n";
+    let bsp = room_bsp(&format!(
+        "{{\n\"classname\" \"func_wall\"\n{wall}}}\n{light}"
+    ));
+    let faces = face_geometry(&bsp, |_| DVec3::ZERO, |_| Spacing::Quake).expect("faces");
+    let bottom = faces
+        .iter()
+        .find(|f| f.model == 1 && f.plane.normal.z < -0.99)
+        .expect("the func_wall's bottom")
+        .index;
+    let bottom_light = |bounce: usize| {
+        let mut options = options(Quality::Default);
+        options.overrides.bounce = Some(bounce);
+        let lighting = compute_lighting(&bsp, &options).expect("light");
+        let map = lighting
+            .lightmaps
+            .iter()
+            .find(|m| m.face == bottom)
+            .expect("a lightmap");
+        let luxels = &map.grey[0];
+        assert!(luxels.iter().all(|&l| l == luxels[0]), "{luxels:?}");
+        luxels[0]
+    };
+    let (direct, bounced) = (bottom_light(0), bottom_light(1));
+    assert!(direct > 0 && bounced > direct, "{direct} then {bounced}");
+}

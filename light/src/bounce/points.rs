@@ -193,6 +193,75 @@ impl<'a> PointField<'a> {
     }
 }
 
+impl PointField<'_> {
+    /// The light the emitters send a point in the open (a brush model's middle, for its
+    /// estimate of its light), per style, as ericw-tools' light grid takes it: no surface there,
+    /// so each emitter's `cos θr` is that of the side of a cube facing it most, the largest
+    /// coordinate of the unit direction. Emitters whose faces are not wholly in the PVS of the
+    /// point's leaf (`leaf`) are culled, as for a face.
+    pub fn light_at(
+        &self,
+        scene: &TraceScene,
+        leaf: Option<u32>,
+        p: DVec3,
+        counts: &mut BounceCounts,
+    ) -> Vec<(u8, [f32; 3])> {
+        let pvs = leaf.and_then(|l| self.vis.pvs_of(&[l]));
+        let mut out: Vec<(u8, [f32; 3])> = Vec::new();
+        for e in &self.emitters {
+            if pvs
+                .as_ref()
+                .is_some_and(|pvs| !self.vis.sees_all(pvs, self.vis.face_leafs(e.face)))
+            {
+                continue;
+            }
+            let t = p - e.point;
+            let d2 = t
+                .length_squared()
+                .max(f64::from(MIN_DISTANCE * MIN_DISTANCE));
+            let d = d2.sqrt();
+            let along_e = e.normal.dot(t).max(0.0) / d;
+            let facing_side = t.abs().max_element() / d;
+            let weight =
+                self.kernel * along_e * facing_side / d2.max(HOTSPOT_CLAMP * HOTSPOT_CLAMP);
+            let lights: Vec<(u8, [f32; 3], f64)> = (e.styles.iter())
+                .filter(|(_, color, total)| {
+                    let strongest = f64::from(color[0].max(color[1]).max(color[2]));
+                    strongest * weight * total >= GATE
+                })
+                .copied()
+                .collect();
+            if lights.is_empty() {
+                continue;
+            }
+            let mut packet = RayPacket16::new();
+            let dir = (t / d).as_vec3().to_array();
+            let (start, end) = (
+                crate::trace::RAY_START,
+                (d as f32 - crate::trace::RAY_START).max(0.0),
+            );
+            packet.set(0, e.point.as_vec3().to_array(), dir, start, end);
+            counts.rays += 1;
+            if scene.occluded16(&mut packet, 0) & 1 != 0 {
+                continue;
+            }
+            for (style, color, total) in lights {
+                let at = match out.iter().position(|(s, _)| *s == style) {
+                    Some(at) => at,
+                    None => {
+                        out.push((style, [0.0; 3]));
+                        out.len() - 1
+                    }
+                };
+                for (v, c) in out[at].1.iter_mut().zip(color) {
+                    *v += (weight * total * f64::from(c)) as f32;
+                }
+            }
+        }
+        out
+    }
+}
+
 /// A face's luxels, coordinate by coordinate (so that weighing them vectorises).
 struct Luxels {
     at: [Vec<f32>; 3],

@@ -248,8 +248,9 @@ entity_keys! {
     /// default is the world's shadow), `-1` casts none and `func_detail_illusionary` casts none
     /// unless `1` (the compiler marks their faces in the BSP for light).
     SHADOW: ["_shadow"] on Models, Number, default "`0`";
-    /// ericw-tools' autominlight: the model's samples inside solid take the direct light at the
-    /// middle of its box (or at `_autominlight_target`'s entity), halved as ericw-tools' is.
+    /// ericw-tools' autominlight: the model's samples inside solid take the light at the middle
+    /// of its box (or at `_autominlight_target`'s entity), direct and, with bounce, bounced,
+    /// halved as ericw-tools' is.
     /// `-1`: they take none (they stay dark); `1`: every sample of the model takes at least that
     /// light.
     AUTOMINLIGHT: ["_autominlight"] on Models, Number, default "`0`";
