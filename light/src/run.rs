@@ -778,6 +778,31 @@ fn bounce_light(
     for pass in 1..=settings.passes {
         let last = pass == settings.passes;
         let emitting = Field::new(&prep.faces, reflectance, &light, &settings);
+        let emission = match settings.emission {
+            EmissiveQuality::Medium => Emission::MiddleAndCorners,
+            EmissiveQuality::Low | EmissiveQuality::High => Emission::Middle,
+        };
+        // Faces gather from points at `low` and `medium`; the reference's passes stay with the
+        // surfaces' physics. Brush models' middles take what the points send whatever the faces
+        // gather from: ericw-tools' light grid takes points (at `high`, each face's middle).
+        let gathers_from_points = !reference && settings.emission != EmissiveQuality::High;
+        let points = (gathers_from_points || !centres.is_empty())
+            .then(|| PointField::new(&emitting, &prep.vis, emission));
+        // Every pass's emitters light the brush models' centres too (ericw-tools' estimate of
+        // a model's light includes bounced light).
+        if let Some(points) = &points {
+            let lit: Vec<(CentreLight, BounceCounts)> = centres
+                .par_iter()
+                .map(|c| {
+                    let mut n = BounceCounts::default();
+                    (points.light_at(&prep.scene, c.leaf, c.point, &mut n), n)
+                })
+                .collect();
+            for (sum, (add, c)) in at_centres.iter_mut().zip(lit) {
+                counts.add(&c);
+                add_styles(sum, &add);
+            }
+        }
         if reference {
             // The reference gathers at every sample of the faces it measures.
             let at_samples = gather_faces(traced, |t, c| {
@@ -808,39 +833,16 @@ fn bounce_light(
             .filter(|t| on_channel_1(t))
             .collect();
         let mut next: Vec<Option<StyleLuxels>> = vec![None; n];
-        // The reference's passes stay with the surfaces' physics.
-        let points = match settings.emission {
-            EmissiveQuality::Low => Some(Emission::Middle),
-            EmissiveQuality::Medium => Some(Emission::MiddleAndCorners),
-            EmissiveQuality::High => None,
-        }
-        .filter(|_| !reference)
-        .map(|emission| PointField::new(&emitting, &prep.vis, emission));
         progress.start("bounce", receiving.len());
         let at_receivers = gather_faces(receiving.par_iter().copied(), |t, c| {
             let receivers = t.receivers.as_deref()?;
             progress.advance(1);
-            if let Some(points) = &points {
+            if let Some(points) = points.as_ref().filter(|_| gathers_from_points) {
                 return Some(points.gather_face(&prep.scene, receivers, c));
             }
             Some(emitting.gather_face(&prep.scene, receivers, pass, density, c))
         });
         progress.finish();
-        // Every pass's emitters light the brush models' centres too (ericw-tools' estimate of
-        // a model's light includes bounced light).
-        if let Some(points) = &points {
-            let lit: Vec<(CentreLight, BounceCounts)> = centres
-                .par_iter()
-                .map(|c| {
-                    let mut n = BounceCounts::default();
-                    (points.light_at(&prep.scene, c.leaf, c.point, &mut n), n)
-                })
-                .collect();
-            for (sum, (add, c)) in at_centres.iter_mut().zip(lit) {
-                counts.add(&c);
-                add_styles(sum, &add);
-            }
-        }
         for (face, b, c) in at_receivers {
             counts.add(&c);
             if !reference {
