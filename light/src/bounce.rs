@@ -56,6 +56,17 @@ pub enum EmissiveQuality {
 /// Light per style and luxel (row-major) of one face.
 pub type StyleLuxels = Vec<(u8, Vec<[f32; 3]>)>;
 
+/// Light per style at one point.
+pub type StyleLight = Vec<(u8, [f32; 3])>;
+
+/// Adds `light` in `style` to `sum`.
+pub fn add_style_light(sum: &mut StyleLight, style: u8, light: [f32; 3]) {
+    match sum.iter_mut().find(|(s, _)| *s == style) {
+        Some((_, to)) => to.iter_mut().zip(light).for_each(|(v, a)| *v += a),
+        None => sum.push((style, light)),
+    }
+}
+
 /// Mean colour (0..1) of a texture's full-size mip through `palette`.
 fn texture_mean(tex: &quake_formats::miptex::MipTex, palette: &Palette) -> Option<[f32; 3]> {
     let pixels = tex.mips.as_ref()?.first().filter(|p| !p.is_empty())?;

@@ -435,15 +435,12 @@ impl<'a> Plan<'a> {
 type ModelLight = BTreeMap<usize, Vec<(u8, [f32; 3])>>;
 
 /// Light per style at one point, in light units.
-type CentreLight = Vec<(u8, [f32; 3])>;
+type CentreLight = bounce::StyleLight;
 
 /// Adds `add` to `sum`, style by style.
 fn add_styles(sum: &mut CentreLight, add: &[(u8, [f32; 3])]) {
     for &(style, light) in add {
-        match sum.iter_mut().find(|(s, _)| *s == style) {
-            Some((_, to)) => to.iter_mut().zip(light).for_each(|(v, a)| *v += a),
-            None => sum.push((style, light)),
-        }
+        bounce::add_style_light(sum, style, light);
     }
 }
 

@@ -22,7 +22,10 @@
 use glam::{DVec3, Vec3};
 use quake_formats::geom::Winding;
 
-use super::{BounceCounts, Field, HOTSPOT_CLAMP, Receivers, StyleLuxels, style_luxels};
+use super::{
+    BounceCounts, Field, HOTSPOT_CLAMP, Receivers, StyleLight, StyleLuxels, add_style_light,
+    style_luxels,
+};
 use crate::embree::RayPacket16;
 use crate::faces::FaceGeom;
 use crate::scene::TraceScene;
@@ -205,9 +208,10 @@ impl PointField<'_> {
         leaf: Option<u32>,
         p: DVec3,
         counts: &mut BounceCounts,
-    ) -> Vec<(u8, [f32; 3])> {
+    ) -> StyleLight {
         let pvs = leaf.and_then(|l| self.vis.pvs_of(&[l]));
-        let mut out: Vec<(u8, [f32; 3])> = Vec::new();
+        let mut out = StyleLight::new();
+        let mut packet = RayPacket16::new();
         for e in &self.emitters {
             if pvs
                 .as_ref()
@@ -224,38 +228,24 @@ impl PointField<'_> {
             let facing_side = t.abs().max_element() / d;
             let weight =
                 self.kernel * along_e * facing_side / d2.max(HOTSPOT_CLAMP * HOTSPOT_CLAMP);
-            let lights: Vec<(u8, [f32; 3], f64)> = (e.styles.iter())
-                .filter(|(_, color, total)| {
-                    let strongest = f64::from(color[0].max(color[1]).max(color[2]));
-                    strongest * weight * total >= GATE
-                })
-                .copied()
-                .collect();
-            if lights.is_empty() {
+            let passes = |&&(_, color, total): &&(u8, [f32; 3], f64)| {
+                f64::from(color[0].max(color[1]).max(color[2])) * weight * total >= GATE
+            };
+            if !e.styles.iter().any(|s| passes(&s)) {
                 continue;
             }
-            let mut packet = RayPacket16::new();
-            let dir = (t / d).as_vec3().to_array();
-            let (start, end) = (
-                crate::trace::RAY_START,
-                (d as f32 - crate::trace::RAY_START).max(0.0),
-            );
-            packet.set(0, e.point.as_vec3().to_array(), dir, start, end);
+            // One segment a time: a lone lane is traced as the faces' segments are.
+            packet.clear();
+            let end = (d as f32 - crate::trace::RAY_START).max(0.0);
+            let (from, dir) = (e.point.as_vec3().to_array(), (t / d).as_vec3().to_array());
+            packet.set(0, from, dir, crate::trace::RAY_START, end);
             counts.rays += 1;
             if scene.occluded16(&mut packet, 0) & 1 != 0 {
                 continue;
             }
-            for (style, color, total) in lights {
-                let at = match out.iter().position(|(s, _)| *s == style) {
-                    Some(at) => at,
-                    None => {
-                        out.push((style, [0.0; 3]));
-                        out.len() - 1
-                    }
-                };
-                for (v, c) in out[at].1.iter_mut().zip(color) {
-                    *v += (weight * total * f64::from(c)) as f32;
-                }
+            for &(style, color, total) in e.styles.iter().filter(passes) {
+                let w = weight * total;
+                add_style_light(&mut out, style, color.map(|c| (w * f64::from(c)) as f32));
             }
         }
         out
