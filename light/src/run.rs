@@ -777,7 +777,8 @@ fn bounce_light(
         let emitting = Field::new(&prep.faces, reflectance, &light, &settings);
         let emission = match settings.emission {
             EmissiveQuality::Medium => Emission::MiddleAndCorners,
-            EmissiveQuality::Low | EmissiveQuality::High => Emission::Middle,
+            EmissiveQuality::Low => Emission::Middle,
+            EmissiveQuality::High => Emission::Diced(settings.subdivision),
         };
         // Faces gather from points at `low` and `medium`; the reference's passes stay with the
         // surfaces' physics. Brush models' middles take what the points send whatever the faces

@@ -20,7 +20,7 @@
 //! over a face's luxels (see [`see`]).
 
 use glam::{DVec3, Vec3};
-use quake_formats::geom::Winding;
+use quake_formats::geom::{Plane, Split, Winding};
 
 use super::{
     BounceCounts, Field, HOTSPOT_CLAMP, Receivers, StyleLight, StyleLuxels, add_style_light,
@@ -51,12 +51,15 @@ const MIN_AREA: f64 = 1.0;
 const STRAIGHT: f64 = 0.999;
 
 /// How many points a reflecting face sends its light from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Emission {
     /// One, in front of its middle.
     Middle,
     /// Its middle and each corner.
     MiddleAndCorners,
+    /// The middle of each piece of the face diced by planes across the axes, this many units
+    /// apart (ericw-tools' `-emissivequality high`, `_bouncelightsubdivision`).
+    Diced(f64),
 }
 
 /// One point a reflecting face sends light from.
@@ -376,10 +379,19 @@ fn point_emitters(field: &Field, emission: Emission) -> Vec<PointEmitter> {
         if area < MIN_AREA || corners.is_empty() {
             continue;
         }
-        let mut at = vec![corners.center()];
-        if emission == Emission::MiddleAndCorners {
-            at.extend_from_slice(&corners.points);
-        }
+        let at = match emission {
+            Emission::Middle => vec![corners.center()],
+            Emission::MiddleAndCorners => {
+                let mut at = vec![corners.center()];
+                at.extend_from_slice(&corners.points);
+                at
+            }
+            Emission::Diced(size) => {
+                let mut at = Vec::new();
+                dice(corners.clone(), size, &mut |piece| at.push(piece.center()));
+                at
+            }
+        };
         let share = 1.0 / at.len() as f64;
         let mut styles = Vec::new();
         for (style, luxels) in light {
@@ -429,6 +441,32 @@ fn corners(points: &[DVec3]) -> Winding {
         })
         .map(|i| points[i]);
     Winding::new(kept.collect())
+}
+
+/// Cuts `w` by planes across the axes at multiples of `size` until no piece spans one, and
+/// hands each piece to `piece`. A piece reaching less than a unit past such a plane is not cut
+/// there (as ericw-tools' dicing), so pieces are never slivers along the grid.
+fn dice(w: Winding, size: f64, piece: &mut impl FnMut(&Winding)) {
+    if w.is_empty() {
+        return;
+    }
+    let b = w.bounds();
+    let (lo, hi) = (b.mins.to_array(), b.maxs.to_array());
+    let cell = |c: f64| (c / size).floor();
+    let Some(axis) = (0..3).find(|&a| cell(lo[a] + 1.0) < cell(hi[a] - 1.0)) else {
+        piece(&w);
+        return;
+    };
+    let mut normal = DVec3::ZERO;
+    normal[axis] = 1.0;
+    let plane = Plane::new(normal, size * (1.0 + cell(lo[axis] + 1.0)));
+    match w.into_split(&plane) {
+        Split::Both { front, back } => {
+            dice(front, size, piece);
+            dice(back, size, piece);
+        }
+        Split::Front(w) | Split::Back(w) | Split::On { winding: w, .. } => piece(&w),
+    }
 }
 
 /// Whether a luxel sees an emitter.
@@ -572,6 +610,7 @@ mod tests {
             styled: false,
             dirt: None,
             emission: crate::bounce::EmissiveQuality::Low,
+            subdivision: 64.0,
         };
         point_emitters(&Field::new(&faces, &reflectance, &lit, &settings), emission)
     }
@@ -608,6 +647,63 @@ mod tests {
         assert!(e.iter().all(|p| p.point.z == 1.0));
         let total: f64 = e.iter().map(|p| p.styles[0].2).sum();
         assert!((total - 50.0 * 200.0).abs() < 1e-6, "{total}");
+    }
+
+    #[test]
+    fn high_dices_the_face_and_sends_from_each_piece_middle() {
+        // The 20 × 10 floor diced every 8 units: cuts at x 8 and 16 and y 8 (a piece reaching
+        // less than a unit past a cut, none here, would not be cut).
+        let e = emitters_of([100.0; 3], Emission::Diced(8.0));
+        let mut middles: Vec<(f64, f64)> = e.iter().map(|p| (p.point.x, p.point.y)).collect();
+        middles.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        let expected = [
+            (4.0, 4.0),
+            (4.0, 9.0),
+            (12.0, 4.0),
+            (12.0, 9.0),
+            (18.0, 4.0),
+            (18.0, 9.0),
+        ];
+        assert_eq!(middles.len(), expected.len(), "{middles:?}");
+        for (got, want) in middles.iter().zip(expected) {
+            assert!(
+                (got.0 - want.0).abs() < 1e-9 && (got.1 - want.1).abs() < 1e-9,
+                "{middles:?}"
+            );
+        }
+        assert!(e.iter().all(|p| p.point.z == 1.0));
+        let total: f64 = e.iter().map(|p| p.styles[0].2).sum();
+        assert!((total - 50.0 * 200.0).abs() < 1e-6, "{total}");
+        // Pieces no wider than the face: one point, the middle.
+        assert_eq!(emitters_of([100.0; 3], Emission::Diced(64.0)).len(), 1);
+    }
+
+    #[test]
+    fn dicing_leaves_no_piece_across_a_cut() {
+        let square = Winding::new(vec![
+            DVec3::new(-100.0, -60.0, 5.0),
+            DVec3::new(-100.0, 70.0, 5.0),
+            DVec3::new(90.0, 70.0, 5.0),
+            DVec3::new(90.0, -60.0, 5.0),
+        ]);
+        let mut area = 0.0;
+        let mut pieces = 0;
+        dice(square.clone(), 32.0, &mut |w| {
+            pieces += 1;
+            area += w.area();
+            let b = w.bounds();
+            for axis in 0..2 {
+                let (lo, hi) = (b.mins[axis], b.maxs[axis]);
+                assert!(
+                    ((lo + 1.0) / 32.0).floor() >= ((hi - 1.0) / 32.0).floor(),
+                    "{b:?}"
+                );
+            }
+        });
+        // x: -100..-96, 32 wide up to 64, then 64..90 (7); y: -60..-32, 32 wide up to 64,
+        // then 64..70 (5).
+        assert_eq!(pieces, 7 * 5);
+        assert!((area - square.area()).abs() < 1e-6, "{area}");
     }
 
     proptest::proptest! {

@@ -14,7 +14,6 @@ mod point;
 pub mod projection;
 mod styles;
 mod sun;
-mod unsupported;
 mod worldspawn;
 
 use glam::DVec3;
@@ -79,6 +78,9 @@ pub struct BounceSettings {
     pub dirt: Option<DirtResponse>,
     /// Where reflecting faces send their light from.
     pub emission: EmissiveQuality,
+    /// `_bouncelightsubdivision`: at `high`, the size of the pieces whose middles send a
+    /// face's light to the brush models' middles.
+    pub subdivision: f64,
 }
 
 impl BounceSettings {
@@ -314,7 +316,6 @@ pub fn parse_lights(
     if !out.settings.nolights {
         entities::read_lights(entities, &global, &mut out);
     }
-    out.warnings.extend(unsupported::warnings(entities));
     Ok(out)
 }
 

@@ -89,6 +89,7 @@ pub fn bounce(settings: &Settings, global: &Global) -> BounceSettings {
         styled: settings.bounce_styled,
         dirt: global.dirt.then_some(global.response),
         emission: settings.emissive_quality,
+        subdivision: settings.bounce_light_subdivision,
     }
 }
 
