@@ -19,7 +19,8 @@ use crate::faces::{
 use crate::gather::ModelInput;
 use crate::options::CompileOptions;
 use crate::outside::{
-    FillOutcome, Occupant, OnPlane, Reach, fill_outside, fill_unreached, visible_sides,
+    FillOutcome, Occupant, OnPlane, Reach, fill_from_void, fill_outside, fill_unreached,
+    visible_sides,
 };
 use crate::planes::PlaneSet;
 use crate::portals::{Portals, make_clip_hull_portals, make_cluster_portals, make_portals};
@@ -267,7 +268,8 @@ impl ModelBuild<'_> {
 
     /// Fill the outside of a clip hull's tree, flooding from the world's point entities, then
     /// (as the options ask) what no entity reaches in this hull, and rebuild it from what is
-    /// left.
+    /// left. When no entity stands in this hull's open space, what the void reaches is filled
+    /// all the same (hull 0 is sealed, so it is outside).
     fn fill_hull(&self, tree: &mut Tree, bounds: &Bounds) {
         if bounds.is_empty() {
             return;
@@ -277,7 +279,7 @@ impl ModelBuild<'_> {
         // Entities near walls are inside the grown brushes; that is expected, not worth a
         // warning.
         let mut ignored = Vec::new();
-        if let FillOutcome::Sealed { .. } = fill_outside(
+        match fill_outside(
             tree,
             planes,
             &portals,
@@ -285,12 +287,20 @@ impl ModelBuild<'_> {
             OnPlane::Open,
             &mut ignored,
         ) {
-            // A clip hull has no detail: its clusters are its leaves.
-            if self.options.unreached_fill().is_some() {
-                fill_unreached(tree, planes, &portals, self.occupants, Reach::Leaves);
+            FillOutcome::Sealed { .. } => {
+                // A clip hull has no detail: its clusters are its leaves.
+                if self.options.unreached_fill().is_some() {
+                    fill_unreached(tree, planes, &portals, self.occupants, Reach::Leaves);
+                }
             }
-            *tree = rebuild_from_surfaces(tree, &portals, planes, self.splitting);
+            // Every entity is too near a wall for this hull's box: nothing tells the rooms
+            // apart from what the void reaches, which is all the flood fills.
+            FillOutcome::NoOccupants => {
+                fill_from_void(tree, &portals);
+            }
+            FillOutcome::Leaked(_) => return,
         }
+        *tree = rebuild_from_surfaces(tree, &portals, planes, self.splitting);
     }
 }
 

@@ -177,25 +177,8 @@ pub(crate) fn fill_outside(
     if occupant_of.iter().all(Option::is_none) {
         return FillOutcome::NoOccupants;
     }
-    let contents_of = |cluster: u32| {
-        if cluster == portals.outside {
-            contents::EMPTY
-        } else {
-            cluster_contents(&tree.nodes[cluster as usize])
-        }
-    };
-    let mut reached = vec![false; leaf_count];
-    reached[portals.outside as usize] = true;
-    let mut queue = VecDeque::from([portals.outside]);
-    while let Some(leaf) = queue.pop_front() {
-        for &p in &portals.leaf_portals[leaf as usize] {
-            let next = portals.other(p, leaf);
-            if !reached[next as usize] && !is_opaque(contents_of(next)) {
-                reached[next as usize] = true;
-                queue.push_back(next);
-            }
-        }
-    }
+    let contents_of = |cluster: u32| cluster_contents_of(tree, portals, cluster);
+    let reached = flood_from_void(portals, contents_of);
     let leaking = (0..leaf_count)
         .filter(|&l| reached[l])
         .filter_map(|l| occupant_of[l].map(|o| (o, l as u32)))
@@ -223,6 +206,50 @@ pub(crate) fn fill_outside(
             beyond_brushes,
         });
     }
+    FillOutcome::Sealed {
+        filled: fill_reached(tree, &reached),
+    }
+}
+
+/// Fills what the void reaches in `tree` (a clip hull's, with `portals` its leaf portals)
+/// without asking where any entity is: for a clip hull of a sealed world in which no point
+/// entity stands in open space (each near enough a wall to be inside the grown brushes). A
+/// sealed world's clip hulls are sealed too, so the flood cannot reach the rooms; their open
+/// space stays as it is. Returns the leaves filled.
+pub(crate) fn fill_from_void(tree: &mut Tree, portals: &Portals) -> usize {
+    let reached = flood_from_void(portals, |c| cluster_contents_of(tree, portals, c));
+    fill_reached(tree, &reached)
+}
+
+/// The contents the flood sees in `cluster` of `portals` (the outside is open).
+fn cluster_contents_of(tree: &Tree, portals: &Portals, cluster: u32) -> i32 {
+    if cluster == portals.outside {
+        contents::EMPTY
+    } else {
+        let node = &tree.nodes[cluster as usize];
+        node.cluster.unwrap_or(node.contents)
+    }
+}
+
+/// Per cluster of `portals`, whether the void reaches it through open portals.
+fn flood_from_void(portals: &Portals, contents_of: impl Fn(u32) -> i32) -> Vec<bool> {
+    let mut reached = vec![false; portals.leaf_portals.len()];
+    reached[portals.outside as usize] = true;
+    let mut queue = VecDeque::from([portals.outside]);
+    while let Some(leaf) = queue.pop_front() {
+        for &p in &portals.leaf_portals[leaf as usize] {
+            let next = portals.other(p, leaf);
+            if !reached[next as usize] && !is_opaque(contents_of(next)) {
+                reached[next as usize] = true;
+                queue.push_back(next);
+            }
+        }
+    }
+    reached
+}
+
+/// Makes every cluster `reached` marks solid, with the leaves below it; returns the leaves.
+fn fill_reached(tree: &mut Tree, reached: &[bool]) -> usize {
     let mut filled = 0;
     for (cluster, &r) in reached.iter().enumerate().take(tree.nodes.len()) {
         if r && tree.nodes[cluster].cluster.is_some() {
@@ -233,7 +260,7 @@ pub(crate) fn fill_outside(
             }
         }
     }
-    FillOutcome::Sealed { filled }
+    filled
 }
 
 /// The brush sides of a filled `tree` that face open space: on a portal of `portals` whose

@@ -179,6 +179,11 @@ fn an_illusionary_box_through_an_edge_room_floor() {
     assert_eq!(vis_clusters(&out.portals), 1);
 }
 
+/// The contents of the world's clip hull `hull` at `p`.
+fn hull_contents(bsp: &Bsp, hull: usize, p: [f32; 3]) -> i32 {
+    bsp_compiler::trace::hull_point_contents(bsp, 0, hull, p)
+}
+
 /// The clip nodes of `hull` (1 or 2) in the world.
 fn clip_nodes_of_hull(bsp: &Bsp, hull: usize) -> usize {
     let mut count = 0;
@@ -195,11 +200,11 @@ fn clip_nodes_of_hull(bsp: &Bsp, hull: usize) -> usize {
 /// ericw-tools' `simpleWorldspawnSky`: the room's ceiling is sky. One sky face and five walls;
 /// between 7 nodes (the room cut as one box, then once between sky and room) and 11 (cut at the
 /// sky first, then two open boxes); the shared solid leaf, the room's and the sky's; the void
-/// past every wall and past the sky is solid; no portals. ericw-tools' test asks for 12 clip
-/// nodes, the room's six walls in each clip hull; its own qbsp (2.0.0-alpha11) writes 111 on its
-/// map: the player start lies inside the shambler hull's grown wall (8 units past it, here as
-/// there), so no entity is in that hull's open space and neither tool fills it. The player hull
-/// is filled: six walls.
+/// past every wall and past the sky is solid; no portals; 12 clip nodes, the room's six walls in
+/// each clip hull. The player start lies inside the shambler hull's grown wall (8 units past
+/// it), so no entity is in that hull's open space: its outside is filled from the void all the
+/// same (ericw-tools 2.0.0-alpha11 leaves it unfilled, 111 clip nodes; its test asks for 12),
+/// and the room's open space in it stays open.
 #[test]
 fn a_sky_ceiling_on_an_edge_room() {
     let out = compile_text(&edge_room("sky4", ""));
@@ -226,4 +231,19 @@ fn a_sky_ceiling_on_an_edge_room() {
     }
     assert!(out.portals.portals.is_empty());
     assert_eq!(clip_nodes_of_hull(bsp, 1), 6);
+    assert_eq!(clip_nodes_of_hull(bsp, 2), 6);
+    assert_eq!(bsp.clipnodes.len(), 12);
+    // The room's middle is open in the shambler hull, the void past its walls solid.
+    assert_eq!(
+        hull_contents(bsp, 2, [-24.0, -48.0, 140.0]),
+        contents::EMPTY
+    );
+    assert_eq!(
+        hull_contents(bsp, 2, [-24.0, -48.0, 700.0]),
+        contents::SOLID
+    );
+    assert_eq!(
+        hull_contents(bsp, 2, [8192.0, 8192.0, 8192.0]),
+        contents::SOLID
+    );
 }
