@@ -74,6 +74,7 @@ pub(crate) fn keep_freed_memory(keep: bool) {
 }
 
 fn main() -> ExitCode {
+    quake_formats::cli::end_quietly_on_closed_pipe();
     let cli = Cli::parse_from(batch::command_words(std::env::args()));
     keep_freed_memory(!matches!(cli.command, Command::Vis(_)));
     match run(cli.command) {

@@ -344,3 +344,38 @@ fn a_decompiled_bsp_compiles_again() {
     assert!(out.status.success(), "{stderr}");
     assert!(!stderr.contains("LEAK"), "{stderr}");
 }
+
+/// A listing piped into a reader that stops early (`slipgate wad list X.wad | head -1`) ends
+/// the command quietly, as other tools end, instead of a panic on the closed pipe.
+#[test]
+fn a_reader_that_stops_early_ends_the_listing_quietly() {
+    use quake_formats::wad::Wad;
+    use std::io::{BufRead, BufReader};
+    use std::process::{Command, Stdio};
+    // A listing longer than a pipe holds, so the command is still writing when the reader goes.
+    let demo = std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("maps/slipgate.wad"))
+        .expect("maps/slipgate.wad");
+    let lumps = Wad::read(&demo).expect("a WAD").lumps;
+    let many: Vec<_> = lumps
+        .iter()
+        .cycle()
+        .take(lumps.len() * 200)
+        .cloned()
+        .collect();
+    let wad = scratch("many.wad");
+    std::fs::write(&wad, Wad::new(many).write()).expect("write");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_slipgate"))
+        .args(["wad", "list", wad.to_str().expect("utf8")])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run slipgate");
+    let mut first = String::new();
+    let mut reader = BufReader::new(child.stdout.take().expect("stdout"));
+    reader.read_line(&mut first).expect("the first line");
+    drop(reader);
+    let out = child.wait_with_output().expect("wait");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(first.starts_with("name"), "{first}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}

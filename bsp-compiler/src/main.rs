@@ -11,6 +11,7 @@ struct Cli {
 }
 
 fn main() -> ExitCode {
+    quake_formats::cli::end_quietly_on_closed_pipe();
     let cli = Cli::parse_from(bsp_compiler::cli::join_optional_values(
         quake_formats::cli::normalise_single_dash(std::env::args()),
     ));

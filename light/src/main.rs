@@ -14,6 +14,7 @@ struct Cli {
 }
 
 fn main() {
+    quake_formats::cli::end_quietly_on_closed_pipe();
     let cli = Cli::parse_from(light::cli::join_optional_values(
         quake_formats::cli::normalise_single_dash(std::env::args()),
     ));

@@ -2,6 +2,28 @@
 //! options a stage accepts without acting on them ([`ericw_accepted!`]), and (in
 //! [`crate::progress::terminal`]) progress drawn as a bar.
 
+/// Lets the process end quietly, as other command-line tools do, when whatever reads its
+/// standard output stops reading (`slipgate wad list X.wad | head`): Rust starts programs with
+/// SIGPIPE ignored, and a write to the closed pipe then makes `println!` panic. Call it first
+/// thing in `main`.
+pub fn end_quietly_on_closed_pipe() {
+    #[cfg(unix)]
+    {
+        unsafe extern "C" {
+            fn signal(signum: std::ffi::c_int, handler: usize) -> usize;
+        }
+        /// SIGPIPE's number, 13 on every Unix Rust builds for.
+        const SIGPIPE: std::ffi::c_int = 13;
+        /// `SIG_DFL`: the signal's default action (for SIGPIPE, ending the process).
+        const SIG_DFL: usize = 0;
+        // SAFETY: sets the disposition of one signal to its default, which needs no handler
+        // code; called before the program starts threads or writes anything.
+        unsafe {
+            signal(SIGPIPE, SIG_DFL);
+        }
+    }
+}
+
 /// Whether an option was given on the command line: a flag set, or a value present.
 pub trait Given {
     /// True when the option appeared.

@@ -10,6 +10,7 @@ struct Cli {
 }
 
 fn main() {
+    quake_formats::cli::end_quietly_on_closed_pipe();
     let cli = Cli::parse();
     if let Err(e) = runtime_viewer::cli::run(&cli.args) {
         eprintln!("error: {e:#}");

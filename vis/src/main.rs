@@ -11,6 +11,7 @@ struct Cli {
 }
 
 fn main() -> ExitCode {
+    quake_formats::cli::end_quietly_on_closed_pipe();
     match run(&Cli::parse_from(quake_formats::cli::normalise_single_dash(std::env::args())).args) {
         Ok(_) => ExitCode::SUCCESS,
         Err(e) => {
