@@ -17,7 +17,8 @@ around its sample point clipped to the face polygon. Light is physical: point li
 inverse-square falloff and Lambert's cosine law, spotlight cones, a sun (a directional light
 that arrives through sky faces), sky domes (uniform radiance through sky faces, upper and lower
 hemisphere) and, with --bounce, the diffuse interreflection between surfaces whose albedo is
-their texture's mean colour. Visibility is exact: every shadow ray is traced. The conversion
+their texture's mean colour. Visibility is exact: every shadow ray is traced, and passes the holes
+(palette index 255) of fence textures, whose names begin with `{`, as engines draw them. The conversion
 from Quake's light units is one constant per light kind (see README.md beside this file).
 
 The last line it prints is `rmse R over N drawn luxels; noise S`: R is the area-weighted RMS
@@ -90,7 +91,10 @@ RAY_CHUNK = 1 << 21
 SKY_DISTANCE = 65536.0
 BOUNCE_ITERATION_LIMIT = 32
 BOUNCE_CONVERGED = 0.05  # levels: interreflection stops when no luxel changes more
-CACHE_VERSION = 3
+CACHE_VERSION = 4
+FENCE_TRANSPARENT = 255  # palette index a `{` texture shows as a hole (light passes there)
+FENCE_LAYERS = 16  # holes a ray passes through at most before it counts as blocked
+FENCE_STEP = 1e-3  # units: a ray through a hole goes on from this far past it
 
 
 class BspError(Exception):
@@ -436,6 +440,9 @@ class Scene:
         names = [bsp.texture_name(f) for f in range(nfaces)]
         self.is_sky = np.array([n.startswith("sky") for n in names])
         self.is_liquid = np.array([n.startswith("*") for n in names])
+        # Fences: a `{` texture's holes let light through, as engines draw them.
+        self.is_fence = np.array([n.startswith("{") and bsp.tex_pixels[bsp.tex_miptex[bsp.faces[f]["texinfo"]]]
+                                  is not None for f, n in enumerate(names)], dtype=bool)
         flags = bsp.tex_flags[bsp.faces["texinfo"]]
         in_scene = self.face_model >= 0
         self.occludes = in_scene & ~self.is_liquid
@@ -476,16 +483,18 @@ class Scene:
         return ray
 
     def occluded(self, o, d, maxt):
-        out = np.empty(len(o), dtype=bool)
-        for a in range(0, len(o), RAY_CHUNK):
-            b = min(a + RAY_CHUNK, len(o))
-            hit = self.scene.ray_test(self._rays(o[a:b].astype(np.float32), d[a:b].astype(np.float32),
-                                                 maxt[a:b].astype(np.float32)))
-            out[a:b] = np.array(hit, dtype=bool)
-        return out
+        if not self.is_fence.any():
+            out = np.empty(len(o), dtype=bool)
+            for a in range(0, len(o), RAY_CHUNK):
+                b = min(a + RAY_CHUNK, len(o))
+                hit = self.scene.ray_test(self._rays(o[a:b].astype(np.float32), d[a:b].astype(np.float32),
+                                                     maxt[a:b].astype(np.float32)))
+                out[a:b] = np.array(hit, dtype=bool)
+            return out
+        face, _ = self.first_hit(o, d, maxt)
+        return face >= 0
 
-    def first_hit(self, o, d, maxt):
-        """Face index and distance of the first surface each ray hits (face -1 when none)."""
+    def _first_hit_once(self, o, d, maxt):
         face = np.full(len(o), -1, dtype=np.int64)
         dist = np.full(len(o), np.inf)
         for a in range(0, len(o), RAY_CHUNK):
@@ -498,6 +507,50 @@ class Scene:
             face[a:b][valid] = self.tri_face[prim[valid]]
             dist[a:b][valid] = t[valid]
         return face, dist
+
+    def first_hit(self, o, d, maxt):
+        """Face index and distance of the first surface each ray hits (face -1 when none); a
+        fence's hole is no surface: the ray goes on through it."""
+        face, dist = self._first_hit_once(o, d, maxt)
+        if not self.is_fence.any():
+            return face, dist
+        travelled = np.zeros(len(o))
+        for _ in range(FENCE_LAYERS):
+            hit = np.nonzero(face >= 0)[0]
+            through = hit[self.is_fence[face[hit]]]
+            if len(through):
+                points = o[through] + d[through] * (travelled[through] + dist[through])[:, None]
+                through = through[self.fence_hole(face[through], points)]
+            if not len(through):
+                break
+            travelled[through] += dist[through] + FENCE_STEP
+            left = maxt[through] - travelled[through]
+            f2, d2 = self._first_hit_once(o[through] + d[through] * travelled[through, None], d[through],
+                                          np.maximum(left, 0.0))
+            f2[left <= 0] = -1
+            face[through] = f2
+            dist[through] = d2
+        hit = face >= 0
+        dist[hit] += travelled[hit]
+        return face, dist
+
+    def fence_hole(self, faces, points):
+        """Whether each point (world space) on each fence face lies on a hole of its texture."""
+        bsp = self.bsp
+        local = points - self.face_offset[faces]
+        ti = bsp.faces[faces]["texinfo"]
+        vecs = bsp.tex_vecs[ti]
+        s = np.einsum("ij,ij->i", vecs[:, 0, :3], local) + vecs[:, 0, 3]
+        t = np.einsum("ij,ij->i", vecs[:, 1, :3], local) + vecs[:, 1, 3]
+        out = np.zeros(len(faces), dtype=bool)
+        miptex = bsp.tex_miptex[ti]
+        for m in np.unique(miptex):
+            sel = miptex == m
+            w, h = bsp.tex_sizes[m]
+            x = np.floor(s[sel]).astype(np.int64) % w
+            y = np.floor(t[sel]).astype(np.int64) % h
+            out[sel] = bsp.tex_pixels[m][y * w + x] == FENCE_TRANSPARENT
+        return out
 
 
 # ================================================================================================
