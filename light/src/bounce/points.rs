@@ -50,6 +50,10 @@ const MIN_AREA: f64 = 1.0;
 /// the two edges) are not corners of the face's outline: T-junction points.
 const STRAIGHT: f64 = 0.999;
 
+/// Pieces along a face's longest side at most when it is diced ([`Emission::Diced`]): a map's
+/// `_bouncelightsubdivision 1` would otherwise cut a large floor into millions of points.
+const DICED_ACROSS: f64 = 64.0;
+
 /// How many points a reflecting face sends its light from.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Emission {
@@ -387,6 +391,11 @@ fn point_emitters(field: &Field, emission: Emission) -> Vec<PointEmitter> {
                 at
             }
             Emission::Diced(size) => {
+                // However small the pieces are asked to be, no face is cut into more than about
+                // DICED_ACROSS² of them.
+                let b = corners.bounds();
+                let longest = (b.maxs - b.mins).max_element();
+                let size = size.max(longest / DICED_ACROSS);
                 let mut at = Vec::new();
                 dice(corners.clone(), size, &mut |piece| at.push(piece.center()));
                 at
@@ -599,7 +608,11 @@ mod tests {
     }
 
     fn emitters_of(light: [f32; 3], emission: Emission) -> Vec<PointEmitter> {
-        let faces = [floor()];
+        emitters_of_face(floor(), light, emission)
+    }
+
+    fn emitters_of_face(face: FaceGeom, light: [f32; 3], emission: Emission) -> Vec<PointEmitter> {
+        let faces = [face];
         let reflectance = [Some([0.5; 3])];
         // Two luxels: the mean is `light`.
         let lit = [Some(vec![(0u8, vec![[0.0; 3], light.map(|c| 2.0 * c)])])];
@@ -676,6 +689,23 @@ mod tests {
         assert!((total - 50.0 * 200.0).abs() < 1e-6, "{total}");
         // Pieces no wider than the face: one point, the middle.
         assert_eq!(emitters_of([100.0; 3], Emission::Diced(64.0)).len(), 1);
+        // Pieces asked a unit wide: a piece reaching less than a unit past a cut is not cut
+        // there, so they come two units wide, 10 by 5.
+        assert_eq!(emitters_of([100.0; 3], Emission::Diced(1.0)).len(), 50);
+    }
+
+    #[test]
+    fn a_large_face_diced_finely_keeps_a_bounded_number_of_points() {
+        let points = vec![
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(0.0, 4096.0, 0.0),
+            DVec3::new(4096.0, 4096.0, 0.0),
+            DVec3::new(4096.0, 0.0, 0.0),
+        ];
+        let square = FaceGeom::for_test(0, 0, points, Plane::new(DVec3::Z, 0.0));
+        let e = emitters_of_face(square, [100.0; 3], Emission::Diced(1.0));
+        // 64 pieces along each side, not two million.
+        assert_eq!(e.len(), 64 * 64);
     }
 
     #[test]

@@ -166,9 +166,9 @@ settings! {
     bounce_styled: bool = false, flag "bouncestyled", keys ["_bouncestyled"], range Range::Any;
 
     /// At `--emissivequality high`, the size in units of the pieces each reflecting face is
-    /// diced into, each sending its share of the face's light from its middle, to light the
-    /// brush models' middles (their autominlight) as ericw-tools' points do; the faces
-    /// themselves gather over the whole surfaces.
+    /// diced into (at most 64 along its longest side), each sending its share of the face's
+    /// light from its middle, to light the brush models' middles (their autominlight) as
+    /// ericw-tools' points do; the faces themselves gather over the whole surfaces.
     bounce_light_subdivision: f64 = 64.0, flag "bouncelightsubdivision", keys ["_bouncelightsubdivision"], range Range::Clamp(1.0, 8192.0);
 
     /// Where reflecting faces send bounced light from: `low` one point in front of each face's
