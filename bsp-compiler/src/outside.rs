@@ -148,7 +148,6 @@ pub(crate) fn fill_outside(
 ) -> FillOutcome {
     let leaf_count = portals.leaf_portals.len();
     let mut occupant_of: Vec<Option<usize>> = vec![None; leaf_count];
-    let cluster_contents = |node: &TreeNode| node.cluster.unwrap_or(node.contents);
     for (i, o) in occupants.iter().enumerate() {
         let placement = place(tree, planes, o.origin, on_plane, |c| {
             cluster_contents(&tree.nodes[c as usize])
@@ -226,9 +225,13 @@ fn cluster_contents_of(tree: &Tree, portals: &Portals, cluster: u32) -> i32 {
     if cluster == portals.outside {
         contents::EMPTY
     } else {
-        let node = &tree.nodes[cluster as usize];
-        node.cluster.unwrap_or(node.contents)
+        cluster_contents(&tree.nodes[cluster as usize])
     }
+}
+
+/// A cluster's structural contents (its own, when it is a leaf).
+fn cluster_contents(node: &TreeNode) -> i32 {
+    node.cluster.unwrap_or(node.contents)
 }
 
 /// Per cluster of `portals`, whether the void reaches it through open portals.

@@ -782,7 +782,8 @@ fn bounce_light(
         };
         // Faces gather from points at `low` and `medium`; the reference's passes stay with the
         // surfaces' physics. Brush models' middles take what the points send whatever the faces
-        // gather from: ericw-tools' light grid takes points (at `high`, each face's middle).
+        // gather from: ericw-tools' light grid takes points (at `high`, the middles of each face's
+        // diced pieces).
         let gathers_from_points = !reference && settings.emission != EmissiveQuality::High;
         let points = (gathers_from_points || !centres.is_empty())
             .then(|| PointField::new(&emitting, &prep.vis, emission));

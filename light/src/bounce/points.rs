@@ -50,6 +50,10 @@ const MIN_AREA: f64 = 1.0;
 /// the two edges) are not corners of the face's outline: T-junction points.
 const STRAIGHT: f64 = 0.999;
 
+/// A piece of a face being diced that reaches less than this (units) past a cutting plane is
+/// not cut there ([`dice`]), as ericw-tools dices.
+const DICE_OVERLAP: f64 = 1.0;
+
 /// Pieces along a face's longest side at most when it is diced ([`Emission::Diced`]): a map's
 /// `_bouncelightsubdivision 1` would otherwise cut a large floor into millions of points.
 const DICED_ACROSS: f64 = 64.0;
@@ -453,8 +457,8 @@ fn corners(points: &[DVec3]) -> Winding {
 }
 
 /// Cuts `w` by planes across the axes at multiples of `size` until no piece spans one, and
-/// hands each piece to `piece`. A piece reaching less than a unit past such a plane is not cut
-/// there (as ericw-tools' dicing), so pieces are never slivers along the grid.
+/// hands each piece to `piece`. A piece reaching less than [`DICE_OVERLAP`] past such a plane is
+/// not cut there, so pieces are never slivers along the grid.
 fn dice(w: Winding, size: f64, piece: &mut impl FnMut(&Winding)) {
     if w.is_empty() {
         return;
@@ -462,13 +466,14 @@ fn dice(w: Winding, size: f64, piece: &mut impl FnMut(&Winding)) {
     let b = w.bounds();
     let (lo, hi) = (b.mins.to_array(), b.maxs.to_array());
     let cell = |c: f64| (c / size).floor();
-    let Some(axis) = (0..3).find(|&a| cell(lo[a] + 1.0) < cell(hi[a] - 1.0)) else {
+    let Some(axis) = (0..3).find(|&a| cell(lo[a] + DICE_OVERLAP) < cell(hi[a] - DICE_OVERLAP))
+    else {
         piece(&w);
         return;
     };
     let mut normal = DVec3::ZERO;
     normal[axis] = 1.0;
-    let plane = Plane::new(normal, size * (1.0 + cell(lo[axis] + 1.0)));
+    let plane = Plane::new(normal, size * (1.0 + cell(lo[axis] + DICE_OVERLAP)));
     match w.into_split(&plane) {
         Split::Both { front, back } => {
             dice(front, size, piece);
