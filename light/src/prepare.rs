@@ -23,7 +23,7 @@ use crate::options::Options;
 use crate::phong;
 use crate::reach::LightReaches;
 use crate::scene::{Casters, TraceScene};
-use crate::settings::{Given, SettingWarning};
+use crate::settings::{Given, SettingWarning, Settings};
 use crate::surface;
 use crate::trace::{FaceRules, TraceSetup};
 use crate::visibility::Visibility;
@@ -71,6 +71,7 @@ impl Prepared {
         cull: bool,
         adaptive: bool,
     ) -> TraceSetup<'a> {
+        let directions = crate::output::Outputs::from_settings(&self.lights.settings).directions();
         TraceSetup {
             faces: &self.faces,
             scene: &self.scene,
@@ -84,8 +85,28 @@ impl Prepared {
             sun_distance: self.sun_distance,
             dirt: self.lights.uses_dirt().then_some(self.lights.dirt),
             adaptive,
-            directions: crate::output::Outputs::from_settings(&self.lights.settings).directions(),
+            directions,
+            occluded_light_used: directions || self.lights.bounce.is_on(),
+            faint_budget: if adaptive {
+                faint_budget(&self.lights.settings)
+            } else {
+                0.0
+            },
         }
+    }
+}
+
+/// Lightmap levels by which the probes of a face's faint lights may misjudge a sample,
+/// together: half a level, so no byte moves by more than one.
+const FAINT_LEVELS: f64 = 0.5;
+
+/// [`TraceSetup::faint_budget`] for the map's settings: [`FAINT_LEVELS`] in light units; none
+/// under a gamma, which raises faint light steeply.
+fn faint_budget(settings: &Settings) -> f64 {
+    if settings.gamma != 1.0 || settings.range <= 0.0 {
+        0.0
+    } else {
+        FAINT_LEVELS / settings.range
     }
 }
 

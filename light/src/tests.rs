@@ -1679,9 +1679,25 @@ fn lit_faces(
     rules: &crate::trace::FaceRules,
     bounce: f32,
 ) -> (Vec<Vec<[f32; 3]>>, u64) {
+    let luxels = crate::luxels::ToLuxels::OpenMeans;
+    lit_faces_with(bsp, per_axis, (rules, bounce, luxels), |prep, reaches| {
+        prep.trace_setup(reaches, 0.001, true, adaptive)
+    })
+}
+
+/// As [`lit_faces`], tracing with the setup `setup` makes and finishing `to_luxels`.
+fn lit_faces_with(
+    bsp: &Bsp,
+    per_axis: usize,
+    (rules, bounce, to_luxels): (&crate::trace::FaceRules, f32, crate::luxels::ToLuxels),
+    setup: impl for<'a> Fn(
+        &'a crate::prepare::Prepared,
+        &'a crate::reach::LightReaches,
+    ) -> crate::trace::TraceSetup<'a>,
+) -> (Vec<Vec<[f32; 3]>>, u64) {
     let prep = crate::prepare::prepare(bsp, &Options::default()).expect("prepare");
     let light_reaches = crate::reach::light_reaches(&prep.point_lights, 0.001);
-    let setup = prep.trace_setup(&light_reaches, 0.001, true, adaptive);
+    let setup = setup(&prep, &light_reaches);
     let mut rays = 0;
     let luxels = prep
         .faces
@@ -1697,12 +1713,88 @@ fn lit_faces(
             let light = raw.finish(
                 bounce,
                 crate::trace::HiddenLuxels::FromNeighbours,
-                crate::luxels::ToLuxels::OpenMeans,
+                to_luxels,
             );
             light.styles[0].1.clone()
         })
         .collect();
     (luxels, rays)
+}
+
+/// A right triangle of floor (legs of 256 along x and y) under a box and a light: the corner
+/// of its lightmap past the long side lies more than a luxel off the face (occluded samples).
+fn shaded_triangle_scene(lights: &str) -> Bsp {
+    let mut polys = vec![Poly {
+        points: vec![[0.0, 0.0, 0.0], [0.0, 256.0, 0.0], [256.0, 0.0, 0.0]],
+        normal: [0.0, 0.0, 1.0],
+        sky: false,
+    }];
+    polys.extend(box_faces([32.0, 32.0, 32.0], [96.0, 96.0, 96.0]));
+    synthetic_bsp(
+        &polys,
+        &format!("{{ \"classname\" \"worldspawn\" }}\n{lights}"),
+    )
+}
+
+/// Every lit face's luxels as a run finishes them (occluded samples filled), and the rays
+/// cast, at `per_axis` samples a luxel axis, adaptive, with `change` made to the setup.
+fn traced_as_run(
+    bsp: &Bsp,
+    per_axis: usize,
+    change: fn(&mut crate::trace::TraceSetup<'_>),
+) -> (Vec<Vec<[f32; 3]>>, u64) {
+    let rules = crate::trace::FaceRules::default();
+    let luxels = crate::luxels::ToLuxels::AsEricw { soft_radius: 0 };
+    lit_faces_with(bsp, per_axis, (&rules, 0.0, luxels), |prep, reaches| {
+        let mut setup = prep.trace_setup(reaches, 0.001, true, true);
+        change(&mut setup);
+        setup
+    })
+}
+
+#[test]
+fn occluded_samples_cast_no_rays_when_their_light_is_not_used() {
+    let light = "{ \"classname\" \"light\" \"origin\" \"128 128 192\" \"light\" \"200\" }";
+    let bsp = shaded_triangle_scene(light);
+    for per_axis in [1, 4] {
+        let (all, all_rays) = traced_as_run(&bsp, per_axis, |s| s.occluded_light_used = true);
+        let (open, open_rays) = traced_as_run(&bsp, per_axis, |_| {});
+        assert_eq!(all, open, "{per_axis}x{per_axis}");
+        // At 4x4 this triangle's occluded samples sit where open ones' rays go already.
+        let fewer = if per_axis == 1 {
+            open_rays < all_rays
+        } else {
+            open_rays <= all_rays
+        };
+        assert!(fewer, "{per_axis}: {open_rays}, {all_rays}");
+    }
+}
+
+/// Eight dim lights around the shaded triangle scene, each adding about half a light unit to
+/// the floor, so that a budget of 2 units takes some of them and not the others.
+#[test]
+fn faint_lights_move_no_luxel_by_more_than_the_budget() {
+    let lights: String = (0..8)
+        .map(|k| {
+            let a = f64::from(k) * std::f64::consts::TAU / 8.0;
+            let (x, y) = (128.0 + 400.0 * a.cos(), 128.0 + 400.0 * a.sin());
+            format!(
+                "{{ \"classname\" \"light\" \"origin\" \"{x:.0} {y:.0} 96\" \"light\" \"10\" \
+                 \"delay\" \"2\" \"_anglescale\" \"0\" }}\n"
+            )
+        })
+        .collect();
+    let bsp = shaded_triangle_scene(&lights);
+    for per_axis in [1, 4] {
+        let (full, full_rays) = traced_as_run(&bsp, per_axis, |s| s.faint_budget = 0.0);
+        let (faint, faint_rays) = traced_as_run(&bsp, per_axis, |s| s.faint_budget = 2.0);
+        let worst = worst_red_difference(&full, &faint);
+        assert!(worst <= 2.0, "{per_axis}: {worst}");
+        assert!(
+            faint_rays < full_rays,
+            "{per_axis}: {faint_rays} >= {full_rays}"
+        );
+    }
 }
 
 #[test]

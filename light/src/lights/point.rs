@@ -144,9 +144,36 @@ impl PointLight {
 
     /// Brightness at `dist` units from the light before angle and cone terms.
     pub fn value_at(&self, dist: f64) -> f64 {
+        self.value_with(self.falloff, dist)
+    }
+
+    /// [`PointLight::value_at`] of every distance of `dist`, into `out`. Each falloff has a
+    /// loop of its own, with no branch inside, which the compiler turns into vector
+    /// instructions.
+    pub fn values_at(&self, dist: &[f64], out: &mut [f64]) {
+        let mut fill = |value: &dyn Fn(f64) -> f64| {
+            for (o, &d) in out.iter_mut().zip(dist) {
+                *o = value(d);
+            }
+        };
+        match self.falloff {
+            Falloff::Linear => fill(&|d| self.value_with(Falloff::Linear, d)),
+            Falloff::Inverse => fill(&|d| self.value_with(Falloff::Inverse, d)),
+            Falloff::InverseSquare => fill(&|d| self.value_with(Falloff::InverseSquare, d)),
+            Falloff::Constant => fill(&|d| self.value_with(Falloff::Constant, d)),
+            Falloff::LocalMin => fill(&|d| self.value_with(Falloff::LocalMin, d)),
+            Falloff::InverseSquareSoft => {
+                fill(&|d| self.value_with(Falloff::InverseSquareSoft, d));
+            }
+        }
+    }
+
+    /// [`PointLight::value_at`] as if the light's falloff were `falloff`.
+    #[inline(always)]
+    fn value_with(&self, falloff: Falloff, dist: f64) -> f64 {
         // Distances under one unit are clamped so 1/x stays finite.
         let scaled = (dist * self.atten).max(1.0);
-        match self.falloff {
+        match falloff {
             Falloff::Linear => {
                 if self.light >= 0.0 {
                     (self.light - scaled).max(0.0)
@@ -177,12 +204,31 @@ impl PointLight {
         r / self.atten
     }
 
+    /// The most light units, in any channel, this light adds at a point at least `dist`
+    /// away, at any angle and inside any cone (every falloff dims with distance or not at
+    /// all). `None` for lights whose light is not a sum (local minlight) or whose colour
+    /// varies (a projected picture).
+    pub fn brightest_beyond(&self, dist: f64) -> Option<f64> {
+        if self.falloff == Falloff::LocalMin || self.projector.is_some() {
+            return None;
+        }
+        // `angle_factor`'s largest value, at normal incidence or (for a negative scale) grazing.
+        let angle = 1.0_f64.max(1.0 - self.anglescale);
+        Some(self.value_at(dist).abs() * angle * self.color.abs().max_element())
+    }
+
     /// Brightness this light adds at a point `dist` away in unit direction
     /// `to_point` (from the light), on a surface whose normal makes cosine
     /// `cos_incidence` with the direction back to the light.
     // Inlined into the per-sample loop of every face and light, which lives in another module.
     #[inline]
     pub fn contribution(&self, dist: f64, to_point: DVec3, cos_incidence: f64) -> f64 {
+        self.contribution_of(self.value_at(dist), to_point, cos_incidence)
+    }
+
+    /// [`PointLight::contribution`] at a distance whose [`PointLight::value_at`] is `falloff`.
+    #[inline]
+    pub fn contribution_of(&self, falloff: f64, to_point: DVec3, cos_incidence: f64) -> f64 {
         let angle = if self.falloff == Falloff::LocalMin {
             f64::from(u8::from(cos_incidence > 0.0))
         } else {
@@ -192,7 +238,7 @@ impl PointLight {
         // No early way out for a zero factor: whether a sample faces the light changes from
         // sample to sample, and the product is zero anyway (of either sign, which light units
         // never tell apart: sums start at +0).
-        self.value_at(dist) * angle * spot
+        falloff * angle * spot
     }
 }
 

@@ -77,6 +77,14 @@ pub struct TraceSetup<'a> {
     pub adaptive: bool,
     /// Keep the directions light arrives from (for deluxemaps).
     pub directions: bool,
+    /// The light of a face's occluded samples is used even when the face has open ones (by
+    /// bounce, which reflects every sample's, and by deluxemaps' directions), so they need
+    /// their rays.
+    pub occluded_light_used: bool,
+    /// Light units by which the shadows of a face's faintest lights may be misjudged,
+    /// together, at any sample: those lights are traced with a few probes
+    /// (`VisibilityScratch::trace_faint`). Zero: every light is traced in full.
+    pub faint_budget: f64,
 }
 
 /// What one face takes from the lights (set per brush model).
@@ -161,11 +169,27 @@ impl TraceCounts {
 pub struct TraceScratch {
     arrivals: Arrivals,
     value: Vec<f64>,
-    /// Per sample: the direction and length of its shadow ray to the current light.
-    to_light: Vec<([f32; 3], f32)>,
+    /// The face's sample points, for measuring their distances to lights.
+    points: points::SamplePoints,
+    /// How the current light lies from each sample.
+    toward: points::Toward,
     /// The lights that may reach the face ([`LightReaches::near`]).
     near_lights: Vec<u32>,
+    /// Those of them that are not culled, in the same order.
+    kept_lights: Vec<KeptLight>,
+    /// Indices into `kept_lights`, faintest first.
+    faintest_first: Vec<u32>,
     visibility: VisibilityScratch,
+}
+
+/// A light that may light a face, and how brightly at most.
+#[derive(Debug, Clone, Copy)]
+struct KeptLight {
+    light: u32,
+    /// The most light units it adds to any sample of the face.
+    brightest: f64,
+    /// Traced with a few probes (`VisibilityScratch::trace_faint`).
+    faint: bool,
 }
 
 /// Lights one face's samples: the light per sample, before floors.
@@ -255,10 +279,13 @@ impl<'a> FaceTrace<'a> {
         } else {
             (setup.lights, setup.suns)
         };
-        scratch.visibility.start_face(samples.first_at_same_point());
+        scratch
+            .visibility
+            .start_face(samples, setup.occluded_light_used);
         scratch.arrivals.start_face(dirt.is_some());
         scratch.value.clear();
         scratch.value.resize(n, 0.0);
+        scratch.points.set(&samples.points);
         FaceTrace {
             setup,
             samples,

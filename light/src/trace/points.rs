@@ -3,22 +3,23 @@
 //! Only the lights whose reach may touch the box around the face's samples are looked at
 //! ([`crate::reach::LightReaches`]); each is culled when the face's plane turns from it, when
 //! it is out of range of the box, or when the PVS says it cannot see the face. A light that
-//! remains gets its unshadowed value at every sample, and the samples with a value above the gate
-//! trace their shadow rays ([`super::shadows`]).
+//! remains gets its unshadowed value at every sample (in vectorised passes: [`Toward`]), and
+//! the samples with a value above the gate trace their shadow rays ([`super::shadows`]). The
+//! face's faintest lights, together worth less than [`super::TraceSetup::faint_budget`], trace
+//! a few probes each instead.
 
 use glam::{DVec3, Vec3};
-use quake_formats::geom::DVec3Ext;
 
-use super::{FaceTrace, LIGHT_CLEARANCE};
-use crate::lights::Falloff;
+use super::{FaceTrace, KeptLight, LIGHT_CLEARANCE};
+use crate::embree::RayPacket16;
 use crate::lights::projection::Projector;
+use crate::lights::{Falloff, PointLight};
 use crate::reach::box_distance_squared;
+use crate::samples::FaceSamples;
 
 impl FaceTrace<'_> {
     /// Every point light the face takes, traced into its arrivals.
     pub(super) fn point_lights(&mut self) {
-        let n = self.samples.points.len();
-        self.scratch.to_light.resize(n, ([0.0; 3], 0.0));
         // Only the lights whose reach may touch the samples' box (all of them without culling).
         let mut near_lights = std::mem::take(&mut self.scratch.near_lights);
         near_lights.clear();
@@ -31,6 +32,8 @@ impl FaceTrace<'_> {
         }
         self.counts.pairs += self.lights.len() as u64;
         self.counts.pairs_culled += (self.lights.len() - near_lights.len()) as u64;
+        let mut kept = std::mem::take(&mut self.scratch.kept_lights);
+        kept.clear();
         for li in near_lights.iter().map(|&li| li as usize) {
             // A light lights only the models on one of its channels.
             if self.lights[li].light_channels & self.rules.channels == 0 {
@@ -40,9 +43,51 @@ impl FaceTrace<'_> {
                 self.counts.pairs_culled += 1;
                 continue;
             }
-            self.point_light(li);
+            kept.push(KeptLight {
+                light: li as u32,
+                brightest: f64::INFINITY,
+                faint: false,
+            });
+        }
+        self.mark_faint(&mut kept);
+        for k in &kept {
+            self.point_light(k.light as usize, k.faint);
         }
         self.scratch.near_lights = near_lights;
+        self.scratch.kept_lights = kept;
+    }
+
+    /// Marks the lights too faint on this face to be worth a shadow ray per sample: weakest
+    /// first, as many as fit together in [`super::TraceSetup::faint_budget`], so that however
+    /// their probes misjudge their shadows, no sample gains or loses more than the budget.
+    /// Off in a map with switchable shadows (their styles need every ray).
+    fn mark_faint(&mut self, kept: &mut [KeptLight]) {
+        let budget = self.setup.faint_budget;
+        if budget <= 0.0 || self.setup.scene.switchable_styles().next().is_some() {
+            return;
+        }
+        for k in kept.iter_mut() {
+            let light = &self.lights[k.light as usize];
+            let near = box_distance_squared(&self.bounds, light.origin).sqrt();
+            k.brightest = light.brightest_beyond(near).unwrap_or(f64::INFINITY);
+        }
+        let order = &mut self.scratch.faintest_first;
+        order.clear();
+        order.extend(0..kept.len() as u32);
+        order.sort_by(|&a, &b| {
+            kept[a as usize]
+                .brightest
+                .total_cmp(&kept[b as usize].brightest)
+        });
+        let mut spent = 0.0;
+        for &k in order.iter() {
+            let k = &mut kept[k as usize];
+            spent += k.brightest;
+            if spent > budget {
+                break;
+            }
+            k.faint = true;
+        }
     }
 
     /// Whether light `li` surely adds nothing to the face: behind its plane, out of range of
@@ -64,29 +109,42 @@ impl FaceTrace<'_> {
 
     /// Light `li` on every sample: values and shadow rays, then the arrivals of those it
     /// reaches (in a switchable shadow's style where one blocks it).
-    fn point_light(&mut self, li: usize) {
+    fn point_light(&mut self, li: usize, faint: bool) {
         let (setup, samples, face) = (self.setup, self.samples, self.face);
         let light = &self.lights[li];
         let dirty = self.takes_dirt(light.dirt);
         self.unshadowed_values(li);
         let scratch = &mut *self.scratch;
-        let shadow_rays = &scratch.to_light;
+        let toward = &scratch.toward;
         let ray = |i: usize| {
-            let (dir, length) = shadow_rays[i];
+            let (dir, length) = toward.shadow_ray(i);
             (samples.points[i], dir, length)
         };
-        self.counts.shadow_rays += scratch.visibility.trace(
-            samples,
-            setup.adaptive,
-            &scratch.value,
-            ray,
-            &mut self.packet,
-            |p| {
-                !setup
-                    .scene
-                    .occluded16_by(p, face.model, light.shadow_channels)
-            },
-        );
+        let reaches = |p: &mut RayPacket16| {
+            !setup
+                .scene
+                .occluded16_by(p, face.model, light.shadow_channels)
+        };
+        let (value, visibility) = (&scratch.value, &mut scratch.visibility);
+        self.counts.shadow_rays += if faint {
+            visibility.trace_faint(
+                samples,
+                setup.adaptive,
+                value,
+                ray,
+                &mut self.packet,
+                reaches,
+            )
+        } else {
+            visibility.trace(
+                samples,
+                setup.adaptive,
+                value,
+                ray,
+                &mut self.packet,
+                reaches,
+            )
+        };
         let switchable = light.style == 0
             && light.falloff != Falloff::LocalMin
             && setup.scene.switchable_styles().next().is_some();
@@ -128,9 +186,9 @@ impl FaceTrace<'_> {
         let reached = scratch.visibility.lit.clone();
         let mut open = reached.clone();
         let mut values = scratch.value.clone();
-        let shadow_rays = &scratch.to_light;
+        let toward = &scratch.toward;
         let ray = |i: usize| {
-            let (dir, length) = shadow_rays[i];
+            let (dir, length) = toward.shadow_ray(i);
             (samples.points[i], dir, length)
         };
         for (k, &style) in styles.iter().enumerate() {
@@ -167,40 +225,146 @@ impl FaceTrace<'_> {
         let samples = self.samples;
         let light = &self.lights[li];
         // Past its range, a light adds less than the gate at any angle and the sample needs no
-        // ray: its square root and divisions are skipped. A sample whose ray stands for others
-        // at its point is as far as they are.
+        // ray. A sample whose ray stands for others at its point is as far as they are.
         let out_of_reach = if self.setup.cull {
             self.setup.light_reaches[li].range_squared * (1.0 + RANGE_MARGIN)
         } else {
             f64::INFINITY
         };
         let scratch = &mut *self.scratch;
+        let toward = &mut scratch.toward;
+        toward.measure(&scratch.points, light);
+        let gate = self.setup.gate;
+        let plain = samples.normals.is_empty()
+            && light.spot.is_none()
+            && light.projector.is_none()
+            && light.falloff != Falloff::LocalMin;
+        if plain {
+            toward.plain_values(light, samples, (out_of_reach, gate), &mut scratch.value);
+            return;
+        }
         for (i, &p) in samples.points.iter().enumerate() {
             scratch.value[i] = 0.0;
-            let to_light = light.origin - Vec3::from(p).as_dvec3();
-            if to_light.length_squared() > out_of_reach {
+            let dist = toward.dist[i];
+            if toward.squared[i] > out_of_reach || dist <= MIN_DISTANCE {
                 continue;
             }
-            // One square root per sample and light.
-            let Some((dist, dir)) = to_light.length_and_direction() else {
-                continue;
-            };
-            // Kept whatever the value: a sample whose `_phong` normal turns from the light may
-            // be the first at a point whose others need the ray.
-            scratch.to_light[i] = (
-                dir.as_vec3().to_array(),
-                (dist as f32 - LIGHT_CLEARANCE).max(0.0),
-            );
-            let v = light.contribution(dist, -dir, samples.incidence(i, dir));
+            let dir = toward.direction(i);
+            let cos = samples.incidence(i, dir);
+            let v = light.contribution_of(toward.falloff[i], -dir, cos);
             // A projected picture lights only the samples it falls on.
             let pictured =
                 |picture: &Projector| picture.tint(Vec3::from(p).as_dvec3()) != DVec3::ZERO;
-            if v.abs() >= self.setup.gate && light.projector.as_deref().is_none_or(pictured) {
+            if v.abs() >= gate && light.projector.as_deref().is_none_or(pictured) {
                 scratch.value[i] = v;
             }
         }
     }
 }
+
+/// A face's sample points in `f64`, one array per axis, for [`Toward::measure`].
+#[derive(Debug, Default)]
+pub(super) struct SamplePoints {
+    axes: [Vec<f64>; 3],
+}
+
+impl SamplePoints {
+    pub(super) fn set(&mut self, points: &[[f32; 3]]) {
+        for (k, axis) in self.axes.iter_mut().enumerate() {
+            axis.clear();
+            axis.extend(points.iter().map(|p| f64::from(p[k])));
+        }
+    }
+}
+
+/// Per sample, how a light lies from it: the squared distance, the distance, the unit
+/// direction and the light's falloff at that distance ([`PointLight::value_at`]).
+#[derive(Debug, Default)]
+pub(super) struct Toward {
+    squared: Vec<f64>,
+    dist: Vec<f64>,
+    dir: [Vec<f64>; 3],
+    falloff: Vec<f64>,
+}
+
+impl Toward {
+    /// Measures every sample of `points` against `light`, without a branch, so that the
+    /// compiler turns each pass into vector instructions (the square roots and divisions are
+    /// most of a light's cost on a face). A sample at the light gets a direction of NaNs,
+    /// which [`MIN_DISTANCE`] keeps from use.
+    fn measure(&mut self, points: &SamplePoints, light: &PointLight) {
+        let n = points.axes[0].len();
+        for v in [&mut self.squared, &mut self.dist, &mut self.falloff]
+            .into_iter()
+            .chain(&mut self.dir)
+        {
+            v.resize(n, 0.0);
+        }
+        let [px, py, pz] = &points.axes;
+        let (px, py, pz) = (&px[..n], &py[..n], &pz[..n]);
+        let (squared, dist) = (&mut self.squared[..n], &mut self.dist[..n]);
+        let [dx, dy, dz] = &mut self.dir;
+        let (dx, dy, dz) = (&mut dx[..n], &mut dy[..n], &mut dz[..n]);
+        let o = light.origin;
+        for i in 0..n {
+            // As `DVec3` computes them: the difference, then x² + y² + z² in that order.
+            let (x, y, z) = (o.x - px[i], o.y - py[i], o.z - pz[i]);
+            let sq = x * x + y * y + z * z;
+            let d = sq.sqrt();
+            let inverse = 1.0 / d;
+            squared[i] = sq;
+            dist[i] = d;
+            dx[i] = x * inverse;
+            dy[i] = y * inverse;
+            dz[i] = z * inverse;
+        }
+        light.values_at(dist, &mut self.falloff[..n]);
+    }
+
+    /// The unit direction from sample `i` to the light.
+    fn direction(&self, i: usize) -> DVec3 {
+        DVec3::new(self.dir[0][i], self.dir[1][i], self.dir[2][i])
+    }
+
+    /// Sample `i`'s shadow ray: its direction, and its length, which stops short of the light.
+    fn shadow_ray(&self, i: usize) -> ([f32; 3], f32) {
+        let length = (self.dist[i] as f32 - LIGHT_CLEARANCE).max(0.0);
+        (self.direction(i).as_vec3().to_array(), length)
+    }
+
+    /// Into `value`, `light`'s value at each sample as [`PointLight::contribution`] gives
+    /// it (0 out of reach or under the gate), for a flat face and a light without a cone, a
+    /// picture or local minlight: then it is the same arithmetic at every sample, with no
+    /// branch, and the compiler turns it into vector instructions.
+    fn plain_values(
+        &self,
+        light: &PointLight,
+        samples: &FaceSamples,
+        (out_of_reach, gate): (f64, f64),
+        value: &mut [f64],
+    ) {
+        let n = value.len();
+        let normal = samples.normal;
+        let (two_sided, scale) = (samples.two_sided, light.anglescale);
+        let [dx, dy, dz] = &self.dir;
+        let (dx, dy, dz) = (&dx[..n], &dy[..n], &dz[..n]);
+        let (squared, dist, falloff) = (&self.squared[..n], &self.dist[..n], &self.falloff[..n]);
+        for i in 0..n {
+            // `FaceSamples::incidence`, `angle_factor` and `contribution_of`, term by term.
+            let cos = normal.x * dx[i] + normal.y * dy[i] + normal.z * dz[i];
+            let cos = if two_sided { cos.abs() } else { cos };
+            let facing = scale * cos + (1.0 - scale);
+            let angle = if cos < 0.0 { 0.0 } else { facing };
+            let v = falloff[i] * angle * 1.0;
+            // `&`, not `&&`: no branch.
+            let kept = (squared[i] <= out_of_reach) & (dist[i] > MIN_DISTANCE) & (v.abs() >= gate);
+            value[i] = if kept { v } else { 0.0 };
+        }
+    }
+}
+
+/// A sample closer than this to a light has no direction to it, and takes none of its light.
+const MIN_DISTANCE: f64 = 1e-12;
 
 /// Relative margin on a light's squared range before a sample counts as out of its reach:
 /// covers the rounding of the range and of the sample's squared distance.
@@ -215,4 +379,98 @@ fn styles_in(arrive_in: &[u8]) -> Vec<u8> {
         }
     }
     styles
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn light(origin: DVec3, falloff: Falloff, value: f64, anglescale: f64) -> PointLight {
+        PointLight {
+            origin,
+            light: value,
+            atten: 1.0,
+            falloff,
+            color: DVec3::ONE,
+            style: 0,
+            spot: None,
+            anglescale,
+            dirt: None,
+            bounce: 1.0,
+            light_channels: 1,
+            shadow_channels: 1,
+            entity: 0,
+            projector: None,
+        }
+    }
+
+    fn samples(points: Vec<[f32; 3]>, normal: DVec3, two_sided: bool) -> FaceSamples {
+        let n = points.len();
+        FaceSamples {
+            face: 0,
+            width: n,
+            height: 1,
+            per_axis: 1,
+            normal,
+            points,
+            normals: Vec::new(),
+            two_sided,
+            moved: vec![false; n],
+            apart: vec![false; n],
+            occluded: Vec::new(),
+        }
+    }
+
+    const FALLOFFS: [Falloff; 5] = [
+        Falloff::Linear,
+        Falloff::Inverse,
+        Falloff::InverseSquare,
+        Falloff::Constant,
+        Falloff::InverseSquareSoft,
+    ];
+
+    proptest! {
+        /// The vectorised measure and values give, bit for bit, what
+        /// `PointLight::contribution` gives at each sample's distance and direction.
+        #[test]
+        fn plain_values_are_the_contribution_bit_for_bit(
+            points in prop::collection::vec(prop::array::uniform3(-300.0f32..300.0), 1..40),
+            origin in prop::array::uniform3(-300.0f64..300.0),
+            normal in prop::array::uniform3(-1.0f64..1.0),
+            falloff in 0usize..5,
+            value in -300.0f64..300.0,
+            anglescale in -1.0f64..2.0,
+            two_sided: bool,
+            reach in 0.0f64..200_000.0,
+            gate in 0.0f64..2.0,
+        ) {
+            let normal = DVec3::from(normal).normalize_or(DVec3::Z);
+            let light = light(DVec3::from(origin), FALLOFFS[falloff], value, anglescale);
+            let face = samples(points.clone(), normal, two_sided);
+            let mut coords = SamplePoints::default();
+            coords.set(&points);
+            let mut toward = Toward::default();
+            toward.measure(&coords, &light);
+            let mut got = vec![f64::NAN; points.len()];
+            toward.plain_values(&light, &face, (reach, gate), &mut got);
+            for (i, p) in points.iter().enumerate() {
+                let to_light = light.origin - Vec3::from(*p).as_dvec3();
+                let (sq, dist) = (to_light.length_squared(), to_light.length());
+                let dir = to_light * (1.0 / dist);
+                let want = if sq > reach || dist <= MIN_DISTANCE {
+                    0.0
+                } else {
+                    let v = light.contribution(dist, -dir, face.incidence(i, dir));
+                    if v.abs() >= gate { v } else { 0.0 }
+                };
+                prop_assert_eq!(got[i].to_bits(), want.to_bits(), "sample {}", i);
+                if want != 0.0 {
+                    let (ray, length) = toward.shadow_ray(i);
+                    prop_assert_eq!(ray, dir.as_vec3().to_array());
+                    prop_assert_eq!(length, (dist as f32 - LIGHT_CLEARANCE).max(0.0));
+                }
+            }
+        }
+    }
 }

@@ -1,6 +1,8 @@
 //! Which samples a light reaches: shadow rays 16 to a packet, samples at one point sharing
 //! a ray, and on supersampled faces (or for the many directions of a soft sun) probes first,
-//! with the rays between them traced only where the probes disagree.
+//! with the rays between them traced only where the probes disagree. A light too faint on the
+//! face to matter gets a handful of probes for the whole face, and samples whose light is not
+//! used (in solid, with open samples beside them) cast no ray.
 
 use crate::embree::RayPacket16;
 use crate::grid::SampleGrid;
@@ -27,12 +29,24 @@ pub struct VisibilityScratch {
     todo: Vec<usize>,
     unique: Vec<usize>,
     probes: Vec<Probe>,
+    /// Per sample: its light is not used, so it casts no ray (empty: every sample's is).
+    unused: Vec<bool>,
 }
 
 impl VisibilityScratch {
-    /// Ready for a face whose samples' first-at-the-same-point map is `first_at`.
-    pub fn start_face(&mut self, first_at: Vec<usize>) {
-        self.first_at = first_at;
+    /// Ready for `samples`' face; `occluded_light_used` as [`super::TraceSetup`] says.
+    pub fn start_face(&mut self, samples: &FaceSamples, occluded_light_used: bool) {
+        self.first_at = samples.first_at_same_point();
+        // The light of an occluded sample is replaced by its open neighbours' when the face
+        // has open samples ([`crate::luxels`]): only a face without any needs their rays.
+        self.unused.clear();
+        if !occluded_light_used && samples.occluded.contains(&false) {
+            let (occluded, first_at) = (&samples.occluded, &self.first_at);
+            // A sample sharing the ray of an open one at its point still casts that ray
+            // when asked (see `cast`): dropping it would leave the open one to its probe.
+            self.unused
+                .extend((0..occluded.len()).map(|i| occluded[i] && occluded[first_at[i]]));
+        }
     }
 
     /// Clears what the last light left for a face of `n` samples.
@@ -68,7 +82,9 @@ impl VisibilityScratch {
         self.start_light(n);
         let per = samples.per_luxel();
         if !adaptive || per == 1 {
-            self.todo.extend((0..n).filter(|&i| value[i] != 0.0));
+            let unused = &self.unused;
+            self.todo
+                .extend((0..n).filter(|&i| value[i] != 0.0 && !is_unused(unused, i)));
             return self.cast(&ray, packet, &mut reaches);
         }
         let axis = samples.per_axis;
@@ -102,7 +118,7 @@ impl VisibilityScratch {
                 });
             let first = l * per;
             for (i, &v) in value.iter().enumerate().skip(first).take(per) {
-                if v == 0.0 || i == first + probe_sub {
+                if v == 0.0 || i == first + probe_sub || is_unused(&self.unused, i) {
                     continue;
                 }
                 // Moved points (the luxel overhangs the face, or something
@@ -116,6 +132,58 @@ impl VisibilityScratch {
         }
         rays += self.cast(&ray, packet, &mut reaches);
         rays
+    }
+
+    /// [`VisibilityScratch::trace`] for a light too faint on this face to be worth a ray per
+    /// sample (see `FaceTrace::mark_faint`): a handful of probes (the brightest sample, and
+    /// the probe samples of the corner and middle luxels) decide every sample when they agree;
+    /// when they do not, every sample is traced as `trace` would. A shadow that falls between
+    /// the probes is missed, but the lights this is used for are, together, too faint on the
+    /// face for that to matter.
+    pub fn trace_faint(
+        &mut self,
+        samples: &FaceSamples,
+        adaptive: bool,
+        value: &[f64],
+        ray: impl Fn(usize) -> ([f32; 3], [f32; 3], f32),
+        packet: &mut RayPacket16,
+        mut reaches: impl FnMut(&mut RayPacket16) -> u16,
+    ) -> u64 {
+        let n = value.len();
+        self.start_light(n);
+        let brightest = (0..n)
+            .filter(|&i| value[i] != 0.0)
+            .max_by(|&a, &b| value[a].abs().total_cmp(&value[b].abs()));
+        let Some(brightest) = brightest else {
+            return 0;
+        };
+        let (w, h, per, axis) = (
+            samples.width,
+            samples.height,
+            samples.per_luxel(),
+            samples.per_axis,
+        );
+        let probe_sub = (axis / 2) * axis + axis / 2;
+        let luxel_probes = [
+            (0, 0),
+            (w - 1, 0),
+            (0, h - 1),
+            (w - 1, h - 1),
+            (w / 2, h / 2),
+        ]
+        .map(|(x, y)| (y * w + x) * per + probe_sub);
+        self.todo.push(brightest);
+        self.todo
+            .extend(luxel_probes.into_iter().filter(|&i| value[i] != 0.0));
+        let rays = self.cast(&ray, packet, &mut reaches);
+        let answer = self.lit[brightest];
+        if self.todo.iter().all(|&i| self.lit[i] == answer) {
+            for (lit, &v) in self.lit.iter_mut().zip(value) {
+                *lit = v != 0.0 && answer;
+            }
+            return rays;
+        }
+        rays + self.trace(samples, adaptive, value, ray, packet, reaches)
     }
 
     /// [`VisibilityScratch::trace`] for one of many directions of a sun or
@@ -210,4 +278,9 @@ impl VisibilityScratch {
         }
         rays
     }
+}
+
+/// Sample `i` needs no ray of its own (`unused` as [`VisibilityScratch`] keeps it).
+fn is_unused(unused: &[bool], i: usize) -> bool {
+    unused.get(i).copied().unwrap_or(false)
 }
