@@ -117,16 +117,19 @@ impl VisibilityScratch {
                         .all(|nx| self.probes[ny * w + nx] == probe)
                 });
             let first = l * per;
-            for (i, &v) in value.iter().enumerate().skip(first).take(per) {
-                if v == 0.0 || i == first + probe_sub || is_unused(&self.unused, i) {
-                    continue;
-                }
+            let values = &value[first..first + per];
+            let moved = &samples.moved[first..first + per];
+            let lit = &mut self.lit[first..first + per];
+            let reaches = probe == Probe::Reaches;
+            for k in 0..per {
                 // Moved points (the luxel overhangs the face, or something
                 // rests on it) are off the grid the neighbour test assumes.
-                if uniform && !samples.moved[i] {
-                    self.lit[i] = probe == Probe::Reaches;
-                } else {
-                    self.todo.push(i);
+                if uniform && !moved[k] {
+                    // The probe's own answer included (it is this one).
+                    lit[k] = reaches & (values[k] != 0.0);
+                } else if values[k] != 0.0 && k != probe_sub && !is_unused(&self.unused, first + k)
+                {
+                    self.todo.push(first + k);
                 }
             }
         }
