@@ -14,7 +14,9 @@ use quake_formats::progress::Progress;
 use rayon::prelude::*;
 
 use crate::bounce::points::{Emission, PointField};
-use crate::bounce::{self, BounceCounts, Density, EmissiveQuality, Field, Receivers, StyleLuxels};
+use crate::bounce::{
+    self, BounceCounts, Density, EmissiveQuality, Field, Receivers, StyleLight, StyleLuxels,
+};
 use crate::error::LightError;
 use crate::faces::{FaceGeom, OwnGrid};
 use crate::lightgrid::{GridSources, RawGrid, finish_grid, light_at, trace_grid};
@@ -260,7 +262,7 @@ impl<'a> Plan<'a> {
         traced: &[Traced],
         centres: &[ModelCentre],
         counts: &mut BounceCounts,
-    ) -> (Vec<StyleLuxels>, Vec<CentreLight>) {
+    ) -> (Vec<StyleLuxels>, Vec<StyleLight>) {
         if !self.bouncing {
             return (Vec::new(), vec![Vec::new(); centres.len()]);
         }
@@ -369,7 +371,7 @@ impl<'a> Plan<'a> {
     /// Each model's estimate of its light at its centre ([`Plan::model_centres`]): the direct
     /// light there as a grid point takes it, without minlight, and the light `bounce` brings it
     /// (per centre), scaled once more by the range scale as ericw-tools' value is.
-    fn model_centre_light(&self, centres: &[ModelCentre], bounce: &[CentreLight]) -> ModelLight {
+    fn model_centre_light(&self, centres: &[ModelCentre], bounce: &[StyleLight]) -> ModelLight {
         let points: Vec<DVec3> = centres.iter().map(|c| c.point).collect();
         let sources = GridSources {
             minlight: None,
@@ -432,13 +434,10 @@ impl<'a> Plan<'a> {
 }
 
 /// Light per style (light units) of some brush models, by model.
-type ModelLight = BTreeMap<usize, Vec<(u8, [f32; 3])>>;
-
-/// Light per style at one point, in light units.
-type CentreLight = bounce::StyleLight;
+type ModelLight = BTreeMap<usize, StyleLight>;
 
 /// Adds `add` to `sum`, style by style.
-fn add_styles(sum: &mut CentreLight, add: &[(u8, [f32; 3])]) {
+fn add_styles(sum: &mut StyleLight, add: &[(u8, [f32; 3])]) {
     for &(style, light) in add {
         bounce::add_style_light(sum, style, light);
     }
@@ -758,7 +757,7 @@ fn bounce_light(
     centres: &[ModelCentre],
     gathering: Gathering,
     counts: &mut BounceCounts,
-) -> (Vec<StyleLuxels>, Vec<CentreLight>) {
+) -> (Vec<StyleLuxels>, Vec<StyleLight>) {
     let Gathering {
         reference,
         density,
@@ -771,7 +770,7 @@ fn bounce_light(
         light[t.face] = t.reflected.clone().filter(|r| !r.is_empty());
     }
     let mut total: Vec<StyleLuxels> = vec![Vec::new(); n];
-    let mut at_centres: Vec<CentreLight> = vec![Vec::new(); centres.len()];
+    let mut at_centres: Vec<StyleLight> = vec![Vec::new(); centres.len()];
     for pass in 1..=settings.passes {
         let last = pass == settings.passes;
         let emitting = Field::new(&prep.faces, reflectance, &light, &settings);
@@ -790,7 +789,7 @@ fn bounce_light(
         // Every pass's emitters light the brush models' centres too (ericw-tools' estimate of
         // a model's light includes bounced light).
         if let Some(points) = &points {
-            let lit: Vec<(CentreLight, BounceCounts)> = centres
+            let lit: Vec<(StyleLight, BounceCounts)> = centres
                 .par_iter()
                 .map(|c| {
                     let mut n = BounceCounts::default();
