@@ -86,7 +86,7 @@ impl Prepared {
             dirt: self.lights.uses_dirt().then_some(self.lights.dirt),
             adaptive,
             directions,
-            occluded_light_used: directions || self.lights.bounce.is_on(),
+            raw_light_read: directions || self.lights.bounce.is_on(),
             faint_budget: if adaptive {
                 faint_budget(&self.lights.settings)
             } else {

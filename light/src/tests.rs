@@ -1757,7 +1757,7 @@ fn occluded_samples_cast_no_rays_when_their_light_is_not_used() {
     let light = "{ \"classname\" \"light\" \"origin\" \"128 128 192\" \"light\" \"200\" }";
     let bsp = shaded_triangle_scene(light);
     for per_axis in [1, 4] {
-        let (all, all_rays) = traced_as_run(&bsp, per_axis, |s| s.occluded_light_used = true);
+        let (all, all_rays) = traced_as_run(&bsp, per_axis, |s| s.raw_light_read = true);
         let (open, open_rays) = traced_as_run(&bsp, per_axis, |_| {});
         assert_eq!(all, open, "{per_axis}x{per_axis}");
         // At 4x4 this triangle's occluded samples sit where open ones' rays go already.
@@ -1768,6 +1768,41 @@ fn occluded_samples_cast_no_rays_when_their_light_is_not_used() {
         };
         assert!(fewer, "{per_axis}: {open_rays}, {all_rays}");
     }
+}
+
+/// An inverse-square light that brings the floor at most 9 units, under a minlight of 100:
+/// style 0 is the floor at every sample whatever the light's shadows, so it casts no ray.
+#[test]
+fn lights_under_the_minlight_floor_cast_no_rays() {
+    let light =
+        "{ \"classname\" \"light\" \"origin\" \"64 128 192\" \"light\" \"20\" \"delay\" \"2\" }";
+    let bsp = shaded_triangle_scene(light);
+    let minlight = crate::lights::Minlight {
+        level: 100.0,
+        add: false,
+        color: DVec3::ONE,
+        dirt: None,
+        exclude_texture: None,
+    };
+    let rules = crate::trace::FaceRules {
+        minlight: Some(&minlight),
+        ..Default::default()
+    };
+    let luxels = crate::luxels::ToLuxels::AsEricw { soft_radius: 0 };
+    let lit = |raw_light_read: bool| {
+        lit_faces_with(&bsp, 1, (&rules, 0.0, luxels), |prep, reaches| {
+            crate::trace::TraceSetup {
+                raw_light_read,
+                ..prep.trace_setup(reaches, 0.001, true, true)
+            }
+        })
+    };
+    let (floored, floored_rays) = lit(false);
+    let (traced, traced_rays) = lit(true);
+    assert_eq!(floored, traced);
+    assert!(floored.iter().flatten().all(|l| *l == [100.0; 3]));
+    assert_eq!(floored_rays, 0);
+    assert!(traced_rays > 0);
 }
 
 /// Eight dim lights around the shaded triangle scene, each adding about half a light unit to

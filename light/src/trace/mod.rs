@@ -77,10 +77,10 @@ pub struct TraceSetup<'a> {
     pub adaptive: bool,
     /// Keep the directions light arrives from (for deluxemaps).
     pub directions: bool,
-    /// The light of a face's occluded samples is used even when the face has open ones (by
-    /// bounce, which reflects every sample's, and by deluxemaps' directions), so they need
-    /// their rays.
-    pub occluded_light_used: bool,
+    /// Each sample's light as traced, before the fill of samples in solid and the minlight
+    /// floor, is read (bounce reflects it, deluxemaps keep its directions): then samples in
+    /// solid need their rays, and light under the floor still counts.
+    pub raw_light_read: bool,
     /// Light units by which the shadows of a face's faintest lights may be misjudged,
     /// together, at any sample: those lights are traced with a few probes
     /// (`VisibilityScratch::trace_faint`). Zero: every light is traced in full.
@@ -279,9 +279,7 @@ impl<'a> FaceTrace<'a> {
         } else {
             (setup.lights, setup.suns)
         };
-        scratch
-            .visibility
-            .start_face(samples, setup.occluded_light_used);
+        scratch.visibility.start_face(samples, setup.raw_light_read);
         scratch.arrivals.start_face(dirt.is_some());
         scratch.value.clear();
         scratch.value.resize(n, 0.0);

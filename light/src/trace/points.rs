@@ -49,6 +49,13 @@ impl FaceTrace<'_> {
                 faint: false,
             });
         }
+        self.measure_brightest(&mut kept);
+        if self.floor_hides(&kept) {
+            // Style 0 ends at the minlight floor at every sample, lit or not.
+            let before = kept.len();
+            kept.retain(|k| self.lights[k.light as usize].style != 0);
+            self.counts.pairs_culled += (before - kept.len()) as u64;
+        }
         self.mark_faint(&mut kept);
         for k in &kept {
             self.point_light(k.light as usize, k.faint);
@@ -65,11 +72,6 @@ impl FaceTrace<'_> {
         let budget = self.setup.faint_budget;
         if budget <= 0.0 || self.setup.scene.switchable_styles().next().is_some() {
             return;
-        }
-        for k in kept.iter_mut() {
-            let light = &self.lights[k.light as usize];
-            let near = box_distance_squared(&self.bounds, light.origin).sqrt();
-            k.brightest = light.brightest_beyond(near).unwrap_or(f64::INFINITY);
         }
         let order = &mut self.scratch.faintest_first;
         order.clear();
@@ -88,6 +90,46 @@ impl FaceTrace<'_> {
             }
             k.faint = true;
         }
+    }
+
+    /// Each kept light's [`KeptLight::brightest`] on the face's samples, from the distance to
+    /// their box.
+    fn measure_brightest(&self, kept: &mut [KeptLight]) {
+        for k in kept.iter_mut() {
+            let light = &self.lights[k.light as usize];
+            let near = box_distance_squared(&self.bounds, light.origin).sqrt();
+            k.brightest = light.brightest_beyond(near).unwrap_or(f64::INFINITY);
+        }
+    }
+
+    /// Whether the face's minlight floor is above all the style-0 light the `kept` lights can
+    /// bring together, at every sample: then style 0 is the floor whatever their shadows, and
+    /// they need no rays. Not when the face may see a sun (suns are style 0 too), when the
+    /// floor is darkened by dirt or added rather than a floor, when switchable shadows may move
+    /// light to another style, or when light under the floor is read ([`TraceSetup`]'s
+    /// `raw_light_read`).
+    fn floor_hides(&self, kept: &[KeptLight]) -> bool {
+        let setup = self.setup;
+        let Some(m) = self.rules.minlight else {
+            return false;
+        };
+        let floor = m.level * m.color.min_element();
+        if m.add
+            || m.dirt.is_some()
+            || floor <= 0.0
+            || setup.raw_light_read
+            || !(self.suns.is_empty() || (setup.cull && !setup.vis.may_see_sky(self.face.index)))
+            || setup.scene.switchable_styles().next().is_some()
+        {
+            return false;
+        }
+        let brightest: f64 = kept
+            .iter()
+            .filter(|k| self.lights[k.light as usize].style == 0)
+            .map(|k| k.brightest)
+            .sum();
+        // The margin covers the sums' single precision.
+        brightest * (1.0 + FLOOR_MARGIN) < floor
     }
 
     /// Whether light `li` surely adds nothing to the face: behind its plane, out of range of
@@ -355,6 +397,7 @@ impl Toward {
             let cos = if two_sided { cos.abs() } else { cos };
             let facing = scale * cos + (1.0 - scale);
             let angle = if cos < 0.0 { 0.0 } else { facing };
+            // Times the cone's factor, 1 without a cone, as `contribution_of` multiplies it.
             let v = falloff[i] * angle * 1.0;
             // `&`, not `&&`: no branch.
             let kept = (squared[i] <= out_of_reach) & (dist[i] > MIN_DISTANCE) & (v.abs() >= gate);
@@ -362,6 +405,10 @@ impl Toward {
         }
     }
 }
+
+/// Relative margin by which the most light the lights can bring must stay under a minlight
+/// floor for them to be skipped: more than the rounding of single-precision sums.
+const FLOOR_MARGIN: f64 = 1e-4;
 
 /// A sample closer than this to a light has no direction to it, and takes none of its light.
 const MIN_DISTANCE: f64 = 1e-12;

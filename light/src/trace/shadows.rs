@@ -34,13 +34,13 @@ pub struct VisibilityScratch {
 }
 
 impl VisibilityScratch {
-    /// Ready for `samples`' face; `occluded_light_used` as [`super::TraceSetup`] says.
-    pub fn start_face(&mut self, samples: &FaceSamples, occluded_light_used: bool) {
+    /// Ready for `samples`' face; `raw_light_read` as [`super::TraceSetup`] says.
+    pub fn start_face(&mut self, samples: &FaceSamples, raw_light_read: bool) {
         self.first_at = samples.first_at_same_point();
         // The light of an occluded sample is replaced by its open neighbours' when the face
         // has open samples ([`crate::luxels`]): only a face without any needs their rays.
         self.unused.clear();
-        if !occluded_light_used && samples.occluded.contains(&false) {
+        if !raw_light_read && samples.occluded.contains(&false) {
             let (occluded, first_at) = (&samples.occluded, &self.first_at);
             // A sample sharing the ray of an open one at its point still casts that ray
             // when asked (see `cast`): dropping it would leave the open one to its probe.
