@@ -214,10 +214,10 @@ pub(crate) fn fill_outside(
 /// without asking where any entity is: for a clip hull of a sealed world in which no point
 /// entity stands in open space (each near enough a wall to be inside the grown brushes). A
 /// sealed world's clip hulls are sealed too, so the flood cannot reach the rooms; their open
-/// space stays as it is. Returns the leaves filled.
-pub(crate) fn fill_from_void(tree: &mut Tree, portals: &Portals) -> usize {
+/// space stays as it is.
+pub(crate) fn fill_from_void(tree: &mut Tree, portals: &Portals) {
     let reached = flood_from_void(portals, |c| cluster_contents_of(tree, portals, c));
-    fill_reached(tree, &reached)
+    fill_reached(tree, &reached);
 }
 
 /// The contents the flood sees in `cluster` of `portals` (the outside is open).

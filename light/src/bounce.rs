@@ -530,10 +530,7 @@ pub struct Receivers {
 impl Receivers {
     /// One sample per luxel of `samples`: its middle one (the probe of supersampled faces).
     pub fn new(samples: &FaceSamples, face: &FaceGeom) -> Receivers {
-        let axis = samples.per_axis;
-        let pick = (axis / 2) * axis + axis / 2;
-        let per = samples.per_luxel();
-        let indices = (0..samples.luxels()).map(|l| l * per + pick);
+        let indices = (0..samples.luxels()).map(|l| samples.middle_of(l));
         Receivers {
             face: samples.face,
             model: face.model,

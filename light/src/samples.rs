@@ -71,6 +71,12 @@ impl FaceSamples {
         self.per_axis * self.per_axis
     }
 
+    /// Sample `luxel`'s sub-sample nearest its middle (its probe, on a supersampled face).
+    pub fn middle_of(&self, luxel: usize) -> usize {
+        let axis = self.per_axis;
+        luxel * self.per_luxel() + (axis / 2) * axis + axis / 2
+    }
+
     /// Per sample, the first sample at exactly the same point (itself when
     /// there is none): points moved onto the face often land together, on
     /// an edge or a corner, and need their rays traced only once.

@@ -254,6 +254,11 @@ impl TraceScene {
         self.switchable.iter().map(|(s, _)| *s)
     }
 
+    /// Some model casts a switchable shadow.
+    pub fn has_switchable(&self) -> bool {
+        !self.switchable.is_empty()
+    }
+
     /// Lanes of `packet` (each up to its current `tfar`) that the models of switchable shadow
     /// number `k` block.
     pub fn switchable_blocks16(&self, packet: &mut RayPacket16, k: usize) -> u16 {

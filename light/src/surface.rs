@@ -140,20 +140,8 @@ mod tests {
         let template = |group: i64| SurfaceTemplate {
             texture: "LAVA1".to_string(),
             light: PointLight {
-                origin: DVec3::ZERO,
-                light: 300.0,
-                atten: 1.0,
-                falloff: crate::lights::Falloff::Linear,
-                color: DVec3::ONE,
-                style: 0,
-                spot: None,
-                anglescale: 0.5,
-                dirt: None,
-                bounce: 1.0,
-                light_channels: 1,
-                shadow_channels: 1,
                 entity: 1,
-                projector: None,
+                ..crate::lights::test_light(crate::lights::Falloff::Linear, 300.0)
             },
             offset: 2.0,
             spotlight: false,

@@ -29,6 +29,8 @@ use crate::dirt::{DirtResponse, DirtSampling};
 use crate::error::LightError;
 use crate::faces::Spacing;
 use crate::settings::{ChosenSetting, Overrides, SettingWarning, Settings, World};
+#[cfg(test)]
+pub(crate) use point::test_light;
 pub use point::{Falloff, PointLight, Spot, angle_factor};
 pub use styles::{StyleRange, SwitchableStyles, assign_switchable_styles};
 pub use sun::SunLight;

@@ -43,13 +43,15 @@ impl FaceTrace<'_> {
                 self.counts.pairs_culled += 1;
                 continue;
             }
+            // The most it adds to any sample, from the distance to the samples' box.
+            let light = &self.lights[li];
+            let near = box_distance_squared(&self.bounds, light.origin).sqrt();
             kept.push(KeptLight {
                 light: li as u32,
-                brightest: f64::INFINITY,
+                brightest: light.brightest_beyond(near).unwrap_or(f64::INFINITY),
                 faint: false,
             });
         }
-        self.measure_brightest(&mut kept);
         if self.floor_hides(&kept) {
             // Style 0 ends at the minlight floor at every sample, lit or not.
             let before = kept.len();
@@ -70,7 +72,7 @@ impl FaceTrace<'_> {
     /// Off in a map with switchable shadows (their styles need every ray).
     fn mark_faint(&mut self, kept: &mut [KeptLight]) {
         let budget = self.setup.faint_budget;
-        if budget <= 0.0 || self.setup.scene.switchable_styles().next().is_some() {
+        if budget <= 0.0 || self.setup.scene.has_switchable() {
             return;
         }
         let order = &mut self.scratch.faintest_first;
@@ -92,16 +94,6 @@ impl FaceTrace<'_> {
         }
     }
 
-    /// Each kept light's [`KeptLight::brightest`] on the face's samples, from the distance to
-    /// their box.
-    fn measure_brightest(&self, kept: &mut [KeptLight]) {
-        for k in kept.iter_mut() {
-            let light = &self.lights[k.light as usize];
-            let near = box_distance_squared(&self.bounds, light.origin).sqrt();
-            k.brightest = light.brightest_beyond(near).unwrap_or(f64::INFINITY);
-        }
-    }
-
     /// Whether the face's minlight floor is above all the style-0 light the `kept` lights can
     /// bring together, at every sample: then style 0 is the floor whatever their shadows, and
     /// they need no rays. Not when the face may see a sun (suns are style 0 too), when the
@@ -119,7 +111,7 @@ impl FaceTrace<'_> {
             || floor <= 0.0
             || setup.raw_light_read
             || !(self.suns.is_empty() || (setup.cull && !setup.vis.may_see_sky(self.face.index)))
-            || setup.scene.switchable_styles().next().is_some()
+            || setup.scene.has_switchable()
         {
             return false;
         }
@@ -162,34 +154,30 @@ impl FaceTrace<'_> {
             let (dir, length) = toward.shadow_ray(i);
             (samples.points[i], dir, length)
         };
-        let reaches = |p: &mut RayPacket16| {
+        let mut reaches = |p: &mut RayPacket16| {
             !setup
                 .scene
                 .occluded16_by(p, face.model, light.shadow_channels)
         };
         let (value, visibility) = (&scratch.value, &mut scratch.visibility);
-        self.counts.shadow_rays += if faint {
-            visibility.trace_faint(
-                samples,
-                setup.adaptive,
-                value,
-                ray,
-                &mut self.packet,
-                reaches,
-            )
+        let (decided, rays) = if faint {
+            visibility.probe_faint(samples, value, &ray, &mut self.packet, &mut reaches)
         } else {
-            visibility.trace(
+            (false, 0)
+        };
+        self.counts.shadow_rays += rays;
+        if !decided {
+            self.counts.shadow_rays += visibility.trace(
                 samples,
                 setup.adaptive,
                 value,
                 ray,
                 &mut self.packet,
                 reaches,
-            )
-        };
-        let switchable = light.style == 0
-            && light.falloff != Falloff::LocalMin
-            && setup.scene.switchable_styles().next().is_some();
+            );
+        }
+        let switchable =
+            light.style == 0 && light.falloff != Falloff::LocalMin && setup.scene.has_switchable();
         let n = scratch.value.len();
         let arrive_in = switchable.then(|| {
             let mut arrive_in = vec![0; n];
@@ -436,19 +424,8 @@ mod tests {
     fn light(origin: DVec3, falloff: Falloff, value: f64, anglescale: f64) -> PointLight {
         PointLight {
             origin,
-            light: value,
-            atten: 1.0,
-            falloff,
-            color: DVec3::ONE,
-            style: 0,
-            spot: None,
             anglescale,
-            dirt: None,
-            bounce: 1.0,
-            light_channels: 1,
-            shadow_channels: 1,
-            entity: 0,
-            projector: None,
+            ..crate::lights::test_light(falloff, value)
         }
     }
 

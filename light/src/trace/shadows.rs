@@ -87,18 +87,17 @@ impl VisibilityScratch {
                 .extend((0..n).filter(|&i| value[i] != 0.0 && !is_unused(unused, i)));
             return self.cast(&ray, packet, &mut reaches);
         }
-        let axis = samples.per_axis;
-        let probe_sub = (axis / 2) * axis + axis / 2;
+        let probe_sub = samples.middle_of(0);
         let luxels = samples.luxels();
         self.todo.extend(
             (0..luxels)
-                .map(|l| l * per + probe_sub)
+                .map(|l| samples.middle_of(l))
                 .filter(|&i| value[i] != 0.0),
         );
         let mut rays = self.cast(&ray, packet, &mut reaches);
         self.probes.clear();
         self.probes.extend((0..luxels).map(|l| {
-            let i = l * per + probe_sub;
+            let i = samples.middle_of(l);
             match (value[i] != 0.0, self.lit[i]) {
                 (false, _) => Probe::Missing,
                 (true, true) => Probe::Reaches,
@@ -110,7 +109,7 @@ impl VisibilityScratch {
         for l in 0..luxels {
             let (x, y) = (l % w, l / w);
             let probe = self.probes[l];
-            let uniform = !samples.moved[l * per + probe_sub]
+            let uniform = !samples.moved[samples.middle_of(l)]
                 && probe != Probe::Missing
                 && (y.saturating_sub(1)..(y + 2).min(h)).all(|ny| {
                     (x.saturating_sub(1)..(x + 2).min(w))
@@ -137,56 +136,53 @@ impl VisibilityScratch {
         rays
     }
 
-    /// [`VisibilityScratch::trace`] for a light too faint on this face to be worth a ray per
-    /// sample (see `FaceTrace::mark_faint`): a handful of probes (the brightest sample, and
-    /// the probe samples of the corner and middle luxels) decide every sample when they agree;
-    /// when they do not, every sample is traced as `trace` would. A shadow that falls between
-    /// the probes is missed, but the lights this is used for are, together, too faint on the
-    /// face for that to matter.
-    pub fn trace_faint(
+    /// For a light too faint on this face to be worth a ray per sample (see
+    /// `FaceTrace::mark_faint`): a handful of probes (the brightest sample, and the middles of
+    /// the corner and middle luxels) decide every sample into `lit` when they agree. Returns
+    /// whether they did, and the rays cast; when they did not, the caller traces the light as
+    /// usual ([`VisibilityScratch::trace`]). A shadow that falls between the probes is missed,
+    /// but the lights this is used for are, together, too faint on the face for that to
+    /// matter.
+    pub fn probe_faint(
         &mut self,
         samples: &FaceSamples,
-        adaptive: bool,
         value: &[f64],
-        ray: impl Fn(usize) -> ([f32; 3], [f32; 3], f32),
+        ray: &impl Fn(usize) -> ([f32; 3], [f32; 3], f32),
         packet: &mut RayPacket16,
-        mut reaches: impl FnMut(&mut RayPacket16) -> u16,
-    ) -> u64 {
+        reaches: &mut impl FnMut(&mut RayPacket16) -> u16,
+    ) -> (bool, u64) {
         let n = value.len();
         self.start_light(n);
         let brightest = (0..n)
             .filter(|&i| value[i] != 0.0)
             .max_by(|&a, &b| value[a].abs().total_cmp(&value[b].abs()));
         let Some(brightest) = brightest else {
-            return 0;
+            return (true, 0);
         };
-        let (w, h, per, axis) = (
-            samples.width,
-            samples.height,
-            samples.per_luxel(),
-            samples.per_axis,
-        );
-        let probe_sub = (axis / 2) * axis + axis / 2;
-        let luxel_probes = [
+        let (w, h) = (samples.width, samples.height);
+        let corners = [
             (0, 0),
             (w - 1, 0),
             (0, h - 1),
             (w - 1, h - 1),
             (w / 2, h / 2),
-        ]
-        .map(|(x, y)| (y * w + x) * per + probe_sub);
+        ];
         self.todo.push(brightest);
-        self.todo
-            .extend(luxel_probes.into_iter().filter(|&i| value[i] != 0.0));
-        let rays = self.cast(&ray, packet, &mut reaches);
+        self.todo.extend(
+            corners
+                .map(|(x, y)| samples.middle_of(y * w + x))
+                .into_iter()
+                .filter(|&i| value[i] != 0.0),
+        );
+        let rays = self.cast(ray, packet, reaches);
         let answer = self.lit[brightest];
-        if self.todo.iter().all(|&i| self.lit[i] == answer) {
+        let agreed = self.todo.iter().all(|&i| self.lit[i] == answer);
+        if agreed {
             for (lit, &v) in self.lit.iter_mut().zip(value) {
                 *lit = v != 0.0 && answer;
             }
-            return rays;
         }
-        rays + self.trace(samples, adaptive, value, ray, packet, reaches)
+        (agreed, rays)
     }
 
     /// [`VisibilityScratch::trace`] for one of many directions of a sun or
