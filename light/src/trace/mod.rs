@@ -20,6 +20,7 @@
 //! [`SampleLight::finish`] applies the floors and averages samples to luxels.
 
 mod arrivals;
+mod hulls;
 mod points;
 mod sample_light;
 mod shadows;

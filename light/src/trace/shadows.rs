@@ -1,12 +1,15 @@
 //! Which samples a light reaches: shadow rays 16 to a packet, samples at one point sharing
 //! a ray, and on supersampled faces (or for the many directions of a soft sun) probes first,
-//! with the rays between them traced only where the probes disagree. A light too faint on the
+//! with the rays between them traced only where the probes disagree (on a luxel the probes do
+//! not settle, its hull's corners first: [`super::hulls`]). A light too faint on the
 //! face to matter gets a handful of probes for the whole face, and samples whose light is not
 //! used (in solid, with open samples beside them) cast no ray.
 
 use crate::embree::RayPacket16;
 use crate::grid::SampleGrid;
 use crate::samples::FaceSamples;
+
+use super::hulls::LuxelHulls;
 
 /// What a luxel's probe ray (one sub-sample per luxel) found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -31,12 +34,34 @@ pub struct VisibilityScratch {
     probes: Vec<Probe>,
     /// Per sample: its light is not used, so it casts no ray (empty: every sample's is).
     unused: Vec<bool>,
+    /// Per luxel of a supersampled face: every sample lies on the grid, in the open.
+    on_grid: Vec<bool>,
+    /// The corners of luxels' samples, for the luxels that trace their sub-samples.
+    hulls: LuxelHulls,
+    /// Luxels with samples inside their hull, waiting for its corners' answers.
+    deferred: Vec<usize>,
 }
+
+/// Supersampled faces at least this many samples a luxel across trace the corners of a
+/// luxel's samples before the rest ([`LuxelHulls`]); fewer leave nothing inside them.
+const MIN_HULL_AXIS: usize = 4;
 
 impl VisibilityScratch {
     /// Ready for `samples`' face; `raw_light_read` as [`super::TraceSetup`] says.
     pub fn start_face(&mut self, samples: &FaceSamples, raw_light_read: bool) {
         self.first_at = samples.first_at_same_point();
+        let per = samples.per_luxel();
+        self.on_grid.clear();
+        if per > 1 {
+            let occluded = |i: usize| samples.occluded.get(i).copied().unwrap_or(false);
+            self.on_grid.extend(
+                (0..samples.luxels())
+                    .map(|l| (l * per..(l + 1) * per).all(|i| !samples.moved[i] && !occluded(i))),
+            );
+        }
+        if samples.per_axis >= MIN_HULL_AXIS {
+            self.hulls.start_face(samples);
+        }
         // The light of an occluded sample is replaced by its open neighbours' when the face
         // has open samples ([`crate::luxels`]): only a face without any needs their rays.
         self.unused.clear();
@@ -65,10 +90,13 @@ impl VisibilityScratch {
     /// `adaptive` (supersampled faces only): first one probe ray per luxel;
     /// a luxel whose probe agrees with the probes of all 8 neighbours takes
     /// that answer for all its sub-samples, the others (penumbrae, shadow
-    /// edges, spots where a probe had no ray) trace every sub-sample. A
-    /// straight shadow edge through a luxel always separates its probe from
-    /// a neighbour's; only shadows thinner than a luxel can slip between.
-    /// Moved samples (see [`FaceSamples::moved`]) are always traced.
+    /// edges, spots where a probe had no ray) trace every sub-sample, or, at
+    /// [`MIN_HULL_AXIS`] and above, the corners of their hull first and the
+    /// rest only where the corners disagree ([`LuxelHulls`]). A straight shadow
+    /// edge through a luxel always separates its probe from a neighbour's, and
+    /// two corners of its hull; only shadows thinner than a luxel can slip
+    /// between. Moved samples (see [`FaceSamples::moved`]) are never answered by
+    /// the neighbours' probes.
     pub fn trace(
         &mut self,
         samples: &FaceSamples,
@@ -105,7 +133,9 @@ impl VisibilityScratch {
             }
         }));
         self.todo.clear();
+        self.deferred.clear();
         let (w, h) = (samples.width, samples.height);
+        let hulls_apply = samples.per_axis >= MIN_HULL_AXIS;
         for l in 0..luxels {
             let (x, y) = (l % w, l / w);
             let probe = self.probes[l];
@@ -117,22 +147,73 @@ impl VisibilityScratch {
                 });
             let first = l * per;
             let values = &value[first..first + per];
-            let moved = &samples.moved[first..first + per];
-            let lit = &mut self.lit[first..first + per];
             let reaches = probe == Probe::Reaches;
+            if uniform && self.on_grid[l] {
+                // The probe's own answer included (it is one of them).
+                let lit = &mut self.lit[first..first + per];
+                for (lit, &v) in lit.iter_mut().zip(values) {
+                    *lit = reaches & (v != 0.0);
+                }
+                continue;
+            }
+            let moved = &samples.moved[first..first + per];
+            // Samples inside the hull of a luxel the neighbours do not answer for wait for the
+            // hull's corners.
+            let hull = hulls_apply && !uniform;
+            if hull {
+                self.hulls.ask(samples, l, self.on_grid[l]);
+            }
+            let mut any_inside = false;
             for k in 0..per {
+                let i = first + k;
                 // Moved points (the luxel overhangs the face, or something
                 // rests on it) are off the grid the neighbour test assumes.
                 if uniform && !moved[k] {
-                    // The probe's own answer included (it is this one).
-                    lit[k] = reaches & (values[k] != 0.0);
-                } else if values[k] != 0.0 && k != probe_sub && !is_unused(&self.unused, first + k)
-                {
-                    self.todo.push(first + k);
+                    self.lit[i] = reaches & (values[k] != 0.0);
+                    continue;
                 }
+                if values[k] == 0.0 || k == probe_sub || is_unused(&self.unused, i) {
+                    continue;
+                }
+                if hull && self.hulls.inside(i) {
+                    any_inside = true;
+                } else {
+                    self.todo.push(i);
+                }
+            }
+            if any_inside {
+                self.deferred.push(l);
             }
         }
         rays += self.cast(&ray, packet, &mut reaches);
+        if !self.deferred.is_empty() {
+            self.todo.clear();
+            for &l in &self.deferred {
+                let first = l * per;
+                let corners = self.hulls.corners(l);
+                // The probe (traced first) counts too when it lies inside.
+                let probe_inside = self.hulls.inside(first + probe_sub);
+                let asked = corners
+                    .iter()
+                    .map(|&k| first + usize::from(k))
+                    .chain(probe_inside.then_some(first + probe_sub));
+                let mut answer = None;
+                let agreed = asked
+                    .into_iter()
+                    .all(|i| value[i] != 0.0 && *answer.get_or_insert(self.lit[i]) == self.lit[i]);
+                for k in 0..per {
+                    let i = first + k;
+                    if k == probe_sub || value[i] == 0.0 || !self.hulls.inside(i) {
+                        continue;
+                    }
+                    match answer.filter(|_| agreed) {
+                        Some(lit) => self.lit[i] = lit,
+                        None => self.todo.push(i),
+                    }
+                }
+            }
+            rays += self.cast(&ray, packet, &mut reaches);
+        }
         rays
     }
 
@@ -282,4 +363,48 @@ impl VisibilityScratch {
 /// Sample `i` needs no ray of its own (`unused` as [`VisibilityScratch`] keeps it).
 fn is_unused(unused: &[bool], i: usize) -> bool {
     unused.get(i).copied().unwrap_or(false)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::trace::hulls::tests::luxel_over_edge;
+
+    /// Traces the one luxel of `samples` (every sample lit by a light straight above) with
+    /// rays blocked where `blocked` says of their origin; returns `lit` and the rays cast.
+    fn trace_luxel(samples: &FaceSamples, blocked: fn([f32; 3]) -> bool) -> (Vec<bool>, u64) {
+        let mut scratch = VisibilityScratch::default();
+        scratch.start_face(samples, false);
+        let value = vec![1.0; samples.points.len()];
+        let ray = |i: usize| (samples.points[i], [0.0, 0.0, 1.0], 100.0);
+        let reaches = |p: &mut RayPacket16| {
+            (0..16)
+                .filter(|&lane| p.segment(lane).is_some_and(|(org, ..)| !blocked(org)))
+                .fold(0u16, |mask, lane| mask | 1 << lane)
+        };
+        let rays = scratch.trace(samples, true, &value, ray, &mut RayPacket16::new(), reaches);
+        (scratch.lit, rays)
+    }
+
+    #[test]
+    fn a_luxel_over_an_edge_traces_its_hull_corners_when_they_agree() {
+        // The probe is moved (onto x = 8): the neighbours cannot answer for the luxel.
+        let samples = luxel_over_edge(4, 8.0);
+        let (lit, rays) = trace_luxel(&samples, |_| false);
+        assert!(lit.iter().all(|&l| l));
+        // The probe and the four corners, of twelve places.
+        assert_eq!(rays, 5);
+    }
+
+    #[test]
+    fn a_shadow_edge_between_the_corners_traces_every_sample() {
+        let samples = luxel_over_edge(4, 8.0);
+        let blocked = |p: [f32; 3]| p[1] > 9.0;
+        let (lit, rays) = trace_luxel(&samples, blocked);
+        for (i, p) in samples.points.iter().enumerate() {
+            assert_eq!(lit[i], !blocked(*p), "sample {i} at {p:?}");
+        }
+        // Every distinct place once.
+        assert_eq!(rays, 12);
+    }
 }
