@@ -30,8 +30,9 @@ pub struct LuxelHulls {
     count: Vec<u8>,
     /// Sub-sample indices (within the luxel) of every asked luxel's corners.
     corners: Vec<u8>,
-    /// Per sample: in the plane, inside its luxel's hull (on an edge included), not a corner.
-    inside: Vec<bool>,
+    /// Per luxel, a bit a sample: in the plane, inside the hull (on an edge included), not a
+    /// corner.
+    inside: Vec<u64>,
     /// The grid samples' plane (normal, distance) and the two coordinates its points are told
     /// apart by; `None` when the face has no sample on the grid to find it from (then no luxel
     /// has corners).
@@ -51,7 +52,7 @@ impl LuxelHulls {
         self.count.resize(luxels, 0);
         self.corners.clear();
         self.inside.clear();
-        self.inside.resize(samples.points.len(), false);
+        self.inside.resize(luxels, 0);
         let normal = samples.normal;
         self.plane = samples.moved.iter().position(|&m| !m).map(|i| {
             let distance = normal.dot(point(samples, i));
@@ -78,9 +79,9 @@ impl LuxelHulls {
         &self.corners[start..start + usize::from(self.count[luxel])]
     }
 
-    /// Sample `i` lies inside its asked luxel's hull.
-    pub fn inside(&self, i: usize) -> bool {
-        self.inside[i]
+    /// The samples inside asked `luxel`'s hull, a bit each.
+    pub fn inside(&self, luxel: usize) -> u64 {
+        self.inside[luxel]
     }
 
     fn work_out(&mut self, samples: &FaceSamples, luxel: usize, on_grid: bool) {
@@ -96,9 +97,8 @@ impl LuxelHulls {
             let axis = samples.per_axis;
             let square = [0, axis - 1, axis * (axis - 1), per - 1];
             self.corners.extend(square.map(|k| k as u8));
-            for k in 0..per {
-                self.inside[first + k] = !square.contains(&k);
-            }
+            let all = u64::MAX >> (64 - per);
+            self.inside[luxel] = square.iter().fold(all, |bits, &k| bits & !(1 << k));
         } else {
             let [a, b] = axes;
             let occluded = |i: usize| samples.occluded.get(i).copied().unwrap_or(false);
@@ -113,12 +113,8 @@ impl LuxelHulls {
             }));
             convex_hull(&mut self.points, &mut self.hull);
             self.corners.extend(self.hull.iter().map(|&(_, _, k)| k));
-            for &(_, _, k) in &self.points {
-                self.inside[first + usize::from(k)] = true;
-            }
-            for &(_, _, k) in &self.hull {
-                self.inside[first + usize::from(k)] = false;
-            }
+            let bits = |points: &[(f64, f64, u8)]| points.iter().fold(0u64, |b, p| b | 1 << p.2);
+            self.inside[luxel] = bits(&self.points) & !bits(&self.hull);
         }
         self.start[luxel] = start as u32;
         self.count[luxel] = (self.corners.len() - start) as u8;
@@ -222,7 +218,9 @@ pub(super) mod tests {
         hulls.ask(samples, 0, on_grid);
         let mut corners = hulls.corners(0).to_vec();
         corners.sort_unstable();
-        let inside = (0..samples.points.len()).map(|i| hulls.inside(i)).collect();
+        let inside = (0..samples.points.len())
+            .map(|k| hulls.inside(0) >> k & 1 != 0)
+            .collect();
         (corners, inside)
     }
 

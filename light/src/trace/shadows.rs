@@ -34,12 +34,54 @@ pub struct VisibilityScratch {
     probes: Vec<Probe>,
     /// Per sample: its light is not used, so it casts no ray (empty: every sample's is).
     unused: Vec<bool>,
-    /// Per luxel of a supersampled face: every sample lies on the grid, in the open.
-    on_grid: Vec<bool>,
+    /// Per luxel of a supersampled face, which of its samples are moved, occluded, unused.
+    luxel_bits: Vec<LuxelBits>,
     /// The corners of luxels' samples, for the luxels that trace their sub-samples.
     hulls: LuxelHulls,
     /// Luxels with samples inside their hull, waiting for its corners' answers.
     deferred: Vec<usize>,
+}
+
+/// A supersampled face's luxels have at most this many samples when they are traced
+/// adaptively, one bit each in [`LuxelBits`] (`--extra4` has 16; the reference, which has
+/// more, traces every sample).
+const MAX_ADAPTIVE_SAMPLES: usize = 64;
+
+/// One luxel's samples, a bit each (sample `k` of the luxel is bit `k`).
+#[derive(Debug, Default, Clone, Copy)]
+struct LuxelBits {
+    /// Moved onto the face or out of solid ([`FaceSamples::moved`]).
+    moved: u64,
+    occluded: u64,
+    /// Casting no ray (see [`VisibilityScratch::unused`]).
+    unused: u64,
+}
+
+impl LuxelBits {
+    /// Every sample lies on the grid, in the open.
+    fn on_grid(self) -> bool {
+        self.moved | self.occluded == 0
+    }
+}
+
+/// The bits of `values` that are not zero.
+fn valued(values: &[f64]) -> u64 {
+    let mut bits = 0;
+    for (k, &v) in values.iter().enumerate() {
+        bits |= u64::from(v != 0.0) << k;
+    }
+    bits
+}
+
+/// The positions of the set bits of `bits`, lowest first.
+fn ones(mut bits: u64) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (bits != 0).then(|| {
+            let k = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            k
+        })
+    })
 }
 
 /// Supersampled faces at least this many samples a luxel across trace the corners of a
@@ -51,15 +93,7 @@ impl VisibilityScratch {
     pub fn start_face(&mut self, samples: &FaceSamples, raw_light_read: bool) {
         self.first_at = samples.first_at_same_point();
         let per = samples.per_luxel();
-        self.on_grid.clear();
-        if per > 1 {
-            let occluded = |i: usize| samples.occluded.get(i).copied().unwrap_or(false);
-            self.on_grid.extend(
-                (0..samples.luxels())
-                    .map(|l| (l * per..(l + 1) * per).all(|i| !samples.moved[i] && !occluded(i))),
-            );
-        }
-        if samples.per_axis >= MIN_HULL_AXIS {
+        if samples.per_axis >= MIN_HULL_AXIS && per <= MAX_ADAPTIVE_SAMPLES {
             self.hulls.start_face(samples);
         }
         // The light of an occluded sample is replaced by its open neighbours' when the face
@@ -71,6 +105,21 @@ impl VisibilityScratch {
             // when asked (see `cast`): dropping it would leave the open one to its probe.
             self.unused
                 .extend((0..occluded.len()).map(|i| occluded[i] && occluded[first_at[i]]));
+        }
+        self.luxel_bits.clear();
+        if per > 1 && per <= MAX_ADAPTIVE_SAMPLES {
+            let occluded = |i: usize| samples.occluded.get(i).copied().unwrap_or(false);
+            let unused = &self.unused;
+            self.luxel_bits.extend((0..samples.luxels()).map(|l| {
+                let mut bits = LuxelBits::default();
+                for k in 0..per {
+                    let i = l * per + k;
+                    bits.moved |= u64::from(samples.moved[i]) << k;
+                    bits.occluded |= u64::from(occluded(i)) << k;
+                    bits.unused |= u64::from(is_unused(unused, i)) << k;
+                }
+                bits
+            }));
         }
     }
 
@@ -109,7 +158,7 @@ impl VisibilityScratch {
         let n = value.len();
         self.start_light(n);
         let per = samples.per_luxel();
-        if !adaptive || per == 1 {
+        if !adaptive || per == 1 || per > MAX_ADAPTIVE_SAMPLES {
             let unused = &self.unused;
             self.todo
                 .extend((0..n).filter(|&i| value[i] != 0.0 && !is_unused(unused, i)));
@@ -136,6 +185,8 @@ impl VisibilityScratch {
         self.deferred.clear();
         let (w, h) = (samples.width, samples.height);
         let hulls_apply = samples.per_axis >= MIN_HULL_AXIS;
+        let all = u64::MAX >> (64 - per);
+        let probe_bit = 1u64 << probe_sub;
         for l in 0..luxels {
             let (x, y) = (l % w, l / w);
             let probe = self.probes[l];
@@ -147,41 +198,34 @@ impl VisibilityScratch {
                 });
             let first = l * per;
             let values = &value[first..first + per];
+            let lit = &mut self.lit[first..first + per];
             let reaches = probe == Probe::Reaches;
-            if uniform && self.on_grid[l] {
+            let bits = self.luxel_bits[l];
+            if uniform && bits.on_grid() {
                 // The probe's own answer included (it is one of them).
-                let lit = &mut self.lit[first..first + per];
                 for (lit, &v) in lit.iter_mut().zip(values) {
                     *lit = reaches & (v != 0.0);
                 }
                 continue;
             }
-            let moved = &samples.moved[first..first + per];
+            let valued = valued(values);
+            // Moved points (the luxel overhangs the face, or something rests on it) are off
+            // the grid the neighbour test assumes.
+            let answered = if uniform { all & !bits.moved } else { 0 };
+            for k in ones(answered) {
+                lit[k] = reaches & (valued >> k & 1 != 0);
+            }
+            let wanted = valued & !answered & !probe_bit & !bits.unused;
             // Samples inside the hull of a luxel the neighbours do not answer for wait for the
             // hull's corners.
-            let hull = hulls_apply && !uniform;
-            if hull {
-                self.hulls.ask(samples, l, self.on_grid[l]);
-            }
-            let mut any_inside = false;
-            for k in 0..per {
-                let i = first + k;
-                // Moved points (the luxel overhangs the face, or something
-                // rests on it) are off the grid the neighbour test assumes.
-                if uniform && !moved[k] {
-                    self.lit[i] = reaches & (values[k] != 0.0);
-                    continue;
-                }
-                if values[k] == 0.0 || k == probe_sub || is_unused(&self.unused, i) {
-                    continue;
-                }
-                if hull && self.hulls.inside(i) {
-                    any_inside = true;
-                } else {
-                    self.todo.push(i);
-                }
-            }
-            if any_inside {
+            let inside = if hulls_apply && !uniform {
+                self.hulls.ask(samples, l, bits.on_grid());
+                self.hulls.inside(l)
+            } else {
+                0
+            };
+            self.todo.extend(ones(wanted & !inside).map(|k| first + k));
+            if wanted & inside != 0 {
                 self.deferred.push(l);
             }
         }
@@ -190,26 +234,19 @@ impl VisibilityScratch {
             self.todo.clear();
             for &l in &self.deferred {
                 let first = l * per;
-                let corners = self.hulls.corners(l);
+                let inside = self.hulls.inside(l);
                 // The probe (traced first) counts too when it lies inside.
-                let probe_inside = self.hulls.inside(first + probe_sub);
-                let asked = corners
-                    .iter()
-                    .map(|&k| first + usize::from(k))
-                    .chain(probe_inside.then_some(first + probe_sub));
+                let asked = self.hulls.corners(l).iter().map(|&k| usize::from(k));
+                let asked = asked.chain((inside & probe_bit != 0).then_some(probe_sub));
                 let mut answer = None;
-                let agreed = asked
-                    .into_iter()
-                    .all(|i| value[i] != 0.0 && *answer.get_or_insert(self.lit[i]) == self.lit[i]);
-                for k in 0..per {
+                let agreed = asked.into_iter().all(|k| {
                     let i = first + k;
-                    if k == probe_sub || value[i] == 0.0 || !self.hulls.inside(i) {
-                        continue;
-                    }
-                    match answer.filter(|_| agreed) {
-                        Some(lit) => self.lit[i] = lit,
-                        None => self.todo.push(i),
-                    }
+                    value[i] != 0.0 && *answer.get_or_insert(self.lit[i]) == self.lit[i]
+                });
+                let waiting = valued(&value[first..first + per]) & inside & !probe_bit;
+                match answer.filter(|_| agreed) {
+                    Some(lit) => ones(waiting).for_each(|k| self.lit[first + k] = lit),
+                    None => self.todo.extend(ones(waiting).map(|k| first + k)),
                 }
             }
             rays += self.cast(&ray, packet, &mut reaches);
