@@ -73,6 +73,15 @@ fn valued(values: &[f64]) -> u64 {
     bits
 }
 
+/// A bit for each of `flags` that is set.
+fn bits_of(flags: &[bool]) -> u64 {
+    let mut bits = 0;
+    for (k, &flag) in flags.iter().enumerate() {
+        bits |= u64::from(flag) << k;
+    }
+    bits
+}
+
 /// The positions of the set bits of `bits`, lowest first.
 fn ones(mut bits: u64) -> impl Iterator<Item = usize> {
     std::iter::from_fn(move || {
@@ -108,18 +117,15 @@ impl VisibilityScratch {
         }
         self.luxel_bits.clear();
         if per > 1 && per <= MAX_ADAPTIVE_SAMPLES {
-            let occluded = |i: usize| samples.occluded.get(i).copied().unwrap_or(false);
-            let unused = &self.unused;
-            self.luxel_bits.extend((0..samples.luxels()).map(|l| {
-                let mut bits = LuxelBits::default();
-                for k in 0..per {
-                    let i = l * per + k;
-                    bits.moved |= u64::from(samples.moved[i]) << k;
-                    bits.occluded |= u64::from(occluded(i)) << k;
-                    bits.unused |= u64::from(is_unused(unused, i)) << k;
-                }
-                bits
-            }));
+            // Flags kept empty when none is set (occluded, unused) give no bits.
+            let bits =
+                |flags: &[bool], l: usize| flags.get(l * per..(l + 1) * per).map_or(0, bits_of);
+            self.luxel_bits
+                .extend((0..samples.luxels()).map(|l| LuxelBits {
+                    moved: bits(&samples.moved, l),
+                    occluded: bits(&samples.occluded, l),
+                    unused: bits(&self.unused, l),
+                }));
         }
     }
 
