@@ -103,18 +103,31 @@ impl LuxelHulls {
             let [a, b] = axes;
             let occluded = |i: usize| samples.occluded.get(i).copied().unwrap_or(false);
             self.points.clear();
-            self.points.extend((0..per).filter_map(|k| {
+            // Samples moved onto an edge often land together, one after another: a repeat of
+            // the last point is inside whatever the hull (it has that point's answer).
+            let mut repeats = 0u64;
+            let mut last = None;
+            for k in 0..per {
                 let i = first + k;
                 let p = samples.points[i];
                 // Samples on the grid lie in the plane; a moved one may have left it.
                 let in_plane = !samples.moved[i]
                     || (normal.dot(point(samples, i)) - distance).abs() <= IN_PLANE;
-                (in_plane && !occluded(i)).then(|| (f64::from(p[a]), f64::from(p[b]), k as u8))
-            }));
+                if !in_plane || occluded(i) {
+                    continue;
+                }
+                if last == Some(p) {
+                    repeats |= 1 << k;
+                    continue;
+                }
+                last = Some(p);
+                self.points
+                    .push((f64::from(p[a]), f64::from(p[b]), k as u8));
+            }
             convex_hull(&mut self.points, &mut self.hull);
             self.corners.extend(self.hull.iter().map(|&(_, _, k)| k));
             let bits = |points: &[(f64, f64, u8)]| points.iter().fold(0u64, |b, p| b | 1 << p.2);
-            self.inside[luxel] = bits(&self.points) & !bits(&self.hull);
+            self.inside[luxel] = (bits(&self.points) | repeats) & !bits(&self.hull);
         }
         self.start[luxel] = start as u32;
         self.count[luxel] = (self.corners.len() - start) as u8;
