@@ -70,6 +70,7 @@ mod run;
 mod samples;
 mod scene;
 pub mod settings;
+mod simd;
 mod surface;
 mod trace;
 mod visibility;

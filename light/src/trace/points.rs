@@ -323,6 +323,25 @@ impl Toward {
     /// most of a light's cost on a face). A sample at the light gets a direction of NaNs,
     /// which [`MIN_DISTANCE`] keeps from use.
     fn measure(&mut self, points: &SamplePoints, light: &PointLight) {
+        #[cfg(target_arch = "x86_64")]
+        if crate::simd::has_avx2() {
+            // SAFETY: the CPU runs AVX2.
+            unsafe { self.measure_avx2(points, light) };
+            return;
+        }
+        self.measure_any(points, light);
+    }
+
+    /// [`Toward::measure`] in AVX2's wider vectors ([`crate::simd`]).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn measure_avx2(&mut self, points: &SamplePoints, light: &PointLight) {
+        self.measure_any(points, light);
+    }
+
+    /// [`Toward::measure`] for whatever the build targets.
+    #[inline(always)]
+    fn measure_any(&mut self, points: &SamplePoints, light: &PointLight) {
         let n = points.axes[0].len();
         for v in [&mut self.squared, &mut self.dist, &mut self.falloff]
             .into_iter()
@@ -367,6 +386,37 @@ impl Toward {
     /// picture or local minlight: then it is the same arithmetic at every sample, with no
     /// branch, and the compiler turns it into vector instructions.
     fn plain_values(
+        &self,
+        light: &PointLight,
+        samples: &FaceSamples,
+        bounds: (f64, f64),
+        value: &mut [f64],
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if crate::simd::has_avx2() {
+            // SAFETY: the CPU runs AVX2.
+            unsafe { self.plain_values_avx2(light, samples, bounds, value) };
+            return;
+        }
+        self.plain_values_any(light, samples, bounds, value);
+    }
+
+    /// [`Toward::plain_values`] in AVX2's wider vectors ([`crate::simd`]).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn plain_values_avx2(
+        &self,
+        light: &PointLight,
+        samples: &FaceSamples,
+        bounds: (f64, f64),
+        value: &mut [f64],
+    ) {
+        self.plain_values_any(light, samples, bounds, value);
+    }
+
+    /// [`Toward::plain_values`] for whatever the build targets.
+    #[inline(always)]
+    fn plain_values_any(
         &self,
         light: &PointLight,
         samples: &FaceSamples,
@@ -456,7 +506,8 @@ mod tests {
 
     proptest! {
         /// The vectorised measure and values give, bit for bit, what
-        /// `PointLight::contribution` gives at each sample's distance and direction.
+        /// `PointLight::contribution` gives at each sample's distance and direction, built for
+        /// any x86-64 and in the CPU's wider vectors alike.
         #[test]
         fn plain_values_are_the_contribution_bit_for_bit(
             points in prop::collection::vec(prop::array::uniform3(-300.0f32..300.0), 1..40),
@@ -474,10 +525,17 @@ mod tests {
             let face = samples(points.clone(), normal, two_sided);
             let mut coords = SamplePoints::default();
             coords.set(&points);
+            // The loops as built (any x86-64), and as this CPU runs them (AVX2 where it has it).
+            for portable in [true, false] {
             let mut toward = Toward::default();
-            toward.measure(&coords, &light);
             let mut got = vec![f64::NAN; points.len()];
-            toward.plain_values(&light, &face, (reach, gate), &mut got);
+            if portable {
+                toward.measure_any(&coords, &light);
+                toward.plain_values_any(&light, &face, (reach, gate), &mut got);
+            } else {
+                toward.measure(&coords, &light);
+                toward.plain_values(&light, &face, (reach, gate), &mut got);
+            }
             for (i, p) in points.iter().enumerate() {
                 let to_light = light.origin - Vec3::from(*p).as_dvec3();
                 let (sq, dist) = (to_light.length_squared(), to_light.length());
@@ -488,12 +546,13 @@ mod tests {
                     let v = light.contribution(dist, -dir, face.incidence(i, dir));
                     if v.abs() >= gate { v } else { 0.0 }
                 };
-                prop_assert_eq!(got[i].to_bits(), want.to_bits(), "sample {}", i);
+                prop_assert_eq!(got[i].to_bits(), want.to_bits(), "sample {}, portable {}", i, portable);
                 if want != 0.0 {
                     let (ray, length) = toward.shadow_ray(i);
                     prop_assert_eq!(ray, dir.as_vec3().to_array());
                     prop_assert_eq!(length, (dist as f32 - LIGHT_CLEARANCE).max(0.0));
                 }
+            }
             }
         }
     }
