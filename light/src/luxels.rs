@@ -115,13 +115,7 @@ impl SampleImage {
         if radius == 0 || self.values.is_empty() {
             return;
         }
-        #[cfg(target_arch = "x86_64")]
-        if crate::simd::has_avx2() {
-            // SAFETY: the CPU runs AVX2.
-            unsafe { self.blur_avx2(radius) };
-            return;
-        }
-        self.blur_any(radius);
+        crate::simd::avx2_or!(self.blur_avx2(radius), self.blur_any(radius))
     }
 
     /// [`SampleImage::blur`] in AVX2's wider vectors ([`crate::simd`]).

@@ -14,3 +14,18 @@ pub fn has_avx2() -> bool {
         false
     }
 }
+
+/// The value of `$avx2`, a call of a copy built with `#[target_feature(enable = "avx2")]`, when
+/// the CPU runs AVX2 (returned from the calling function), else of `$any`, the same work as
+/// built: the tail of a function that dispatches to its two copies.
+macro_rules! avx2_or {
+    ($avx2:expr, $any:expr) => {{
+        #[cfg(target_arch = "x86_64")]
+        if $crate::simd::has_avx2() {
+            // SAFETY: the CPU runs AVX2, the one feature the called copy is built for.
+            return unsafe { $avx2 };
+        }
+        $any
+    }};
+}
+pub(crate) use avx2_or;

@@ -19,6 +19,11 @@ use crate::samples::FaceSamples;
 /// it: f32 coordinates of a few thousand units carry about a thousandth.
 const IN_PLANE: f64 = 0.01;
 
+/// A turn of three hull points this small (the cross product of their steps, in square units)
+/// counts as straight on: the middle point is left out of the corners. Sample spacings are a
+/// unit or more, so real turns are far larger.
+const STRAIGHT: f64 = 1e-6;
+
 /// A luxel whose hull is not worked out yet.
 const NOT_YET: u32 = u32::MAX;
 
@@ -97,8 +102,9 @@ impl LuxelHulls {
             let axis = samples.per_axis;
             let square = [0, axis - 1, axis * (axis - 1), per - 1];
             self.corners.extend(square.map(|k| k as u8));
-            let all = u64::MAX >> (64 - per);
-            self.inside[luxel] = square.iter().fold(all, |bits, &k| bits & !(1 << k));
+            self.inside[luxel] = square
+                .iter()
+                .fold(every_sample(per), |bits, &k| bits & !(1 << k));
         } else {
             let [a, b] = axes;
             let occluded = |i: usize| samples.occluded.get(i).copied().unwrap_or(false);
@@ -134,6 +140,11 @@ impl LuxelHulls {
     }
 }
 
+/// One bit for each of a luxel's `per` samples (at most 64).
+pub(super) fn every_sample(per: usize) -> u64 {
+    u64::MAX >> (64 - per)
+}
+
 fn point(samples: &FaceSamples, i: usize) -> DVec3 {
     glam::Vec3::from(samples.points[i]).as_dvec3()
 }
@@ -158,8 +169,6 @@ fn convex_hull(points: &mut [(f64, f64, u8)], hull: &mut Vec<(f64, f64, u8)>) {
         hull.extend(points.first().copied());
         return;
     }
-    // A turn this small (square units) counts as straight on.
-    const STRAIGHT: f64 = 1e-6;
     let turn = |o: (f64, f64, u8), a: (f64, f64, u8), b: (f64, f64, u8)| {
         (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
     };

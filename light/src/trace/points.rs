@@ -323,13 +323,10 @@ impl Toward {
     /// most of a light's cost on a face). A sample at the light gets a direction of NaNs,
     /// which [`MIN_DISTANCE`] keeps from use.
     fn measure(&mut self, points: &SamplePoints, light: &PointLight) {
-        #[cfg(target_arch = "x86_64")]
-        if crate::simd::has_avx2() {
-            // SAFETY: the CPU runs AVX2.
-            unsafe { self.measure_avx2(points, light) };
-            return;
-        }
-        self.measure_any(points, light);
+        crate::simd::avx2_or!(
+            self.measure_avx2(points, light),
+            self.measure_any(points, light)
+        )
     }
 
     /// [`Toward::measure`] in AVX2's wider vectors ([`crate::simd`]).
@@ -392,13 +389,10 @@ impl Toward {
         bounds: (f64, f64),
         value: &mut [f64],
     ) {
-        #[cfg(target_arch = "x86_64")]
-        if crate::simd::has_avx2() {
-            // SAFETY: the CPU runs AVX2.
-            unsafe { self.plain_values_avx2(light, samples, bounds, value) };
-            return;
-        }
-        self.plain_values_any(light, samples, bounds, value);
+        crate::simd::avx2_or!(
+            self.plain_values_avx2(light, samples, bounds, value),
+            self.plain_values_any(light, samples, bounds, value)
+        )
     }
 
     /// [`Toward::plain_values`] in AVX2's wider vectors ([`crate::simd`]).

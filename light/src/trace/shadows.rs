@@ -9,7 +9,7 @@ use crate::embree::RayPacket16;
 use crate::grid::SampleGrid;
 use crate::samples::FaceSamples;
 
-use super::hulls::LuxelHulls;
+use super::hulls::{LuxelHulls, every_sample};
 
 /// What a luxel's probe ray (one sub-sample per luxel) found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -64,22 +64,18 @@ impl LuxelBits {
     }
 }
 
-/// The bits of `values` that are not zero.
-fn valued(values: &[f64]) -> u64 {
+/// A bit for each of `items` that `set` holds of (item `k` is bit `k`).
+fn bits_where<T: Copy>(items: &[T], set: impl Fn(T) -> bool) -> u64 {
     let mut bits = 0;
-    for (k, &v) in values.iter().enumerate() {
-        bits |= u64::from(v != 0.0) << k;
+    for (k, &item) in items.iter().enumerate() {
+        bits |= u64::from(set(item)) << k;
     }
     bits
 }
 
-/// A bit for each of `flags` that is set.
-fn bits_of(flags: &[bool]) -> u64 {
-    let mut bits = 0;
-    for (k, &flag) in flags.iter().enumerate() {
-        bits |= u64::from(flag) << k;
-    }
-    bits
+/// The bits of `values` that are not zero.
+fn valued(values: &[f64]) -> u64 {
+    bits_where(values, |v| v != 0.0)
 }
 
 /// The positions of the set bits of `bits`, lowest first.
@@ -118,8 +114,11 @@ impl VisibilityScratch {
         self.luxel_bits.clear();
         if per > 1 && per <= MAX_ADAPTIVE_SAMPLES {
             // Flags kept empty when none is set (occluded, unused) give no bits.
-            let bits =
-                |flags: &[bool], l: usize| flags.get(l * per..(l + 1) * per).map_or(0, bits_of);
+            let bits = |flags: &[bool], l: usize| {
+                flags
+                    .get(l * per..(l + 1) * per)
+                    .map_or(0, |f| bits_where(f, |set| set))
+            };
             self.luxel_bits
                 .extend((0..samples.luxels()).map(|l| LuxelBits {
                     moved: bits(&samples.moved, l),
@@ -191,12 +190,13 @@ impl VisibilityScratch {
         self.deferred.clear();
         let (w, h) = (samples.width, samples.height);
         let hulls_apply = samples.per_axis >= MIN_HULL_AXIS;
-        let all = u64::MAX >> (64 - per);
+        let all = every_sample(per);
         let probe_bit = 1u64 << probe_sub;
         for l in 0..luxels {
             let (x, y) = (l % w, l / w);
             let probe = self.probes[l];
-            let uniform = !samples.moved[samples.middle_of(l)]
+            let bits = self.luxel_bits[l];
+            let uniform = bits.moved & probe_bit == 0
                 && probe != Probe::Missing
                 && (y.saturating_sub(1)..(y + 2).min(h)).all(|ny| {
                     (x.saturating_sub(1)..(x + 2).min(w))
@@ -206,7 +206,6 @@ impl VisibilityScratch {
             let values = &value[first..first + per];
             let lit = &mut self.lit[first..first + per];
             let reaches = probe == Probe::Reaches;
-            let bits = self.luxel_bits[l];
             if uniform && bits.on_grid() {
                 // The probe's own answer included (it is one of them).
                 for (lit, &v) in lit.iter_mut().zip(values) {
