@@ -961,6 +961,73 @@ impl Scene {
 #[derive(Debug, Clone, Copy)]
 struct ValidMask([i32; 16]);
 
+/// Along one axis, where each lane's segment starts and ends, lowest first; `finite` cleared
+/// for lanes where either end is not finite. Written lane by lane without branches, so it runs
+/// in vectors.
+#[inline(always)]
+fn axis_extent(
+    org: &[f32; 16],
+    dir: &[f32; 16],
+    (tnear, tfar): (&[f32; 16], &[f32; 16]),
+    lows: &mut [f32; 16],
+    highs: &mut [f32; 16],
+    finite: &mut [bool; 16],
+) {
+    for lane in 0..16 {
+        let a = org[lane] + dir[lane] * tnear[lane];
+        let b = org[lane] + dir[lane] * tfar[lane];
+        finite[lane] &= a.is_finite() & b.is_finite();
+        lows[lane] = if a < b { a } else { b };
+        highs[lane] = if a < b { b } else { a };
+    }
+}
+
+/// The boxes around a [`RayPacket16`]'s segments, per axis and lane ([`RayPacket16::segment_boxes`]).
+#[derive(Debug, Clone, Copy)]
+pub struct SegmentBoxes16 {
+    pub mins: [[f32; 16]; 3],
+    pub maxs: [[f32; 16]; 3],
+    /// Active lanes whose segment's ends are not finite (their boxes are empty).
+    pub unbounded: u16,
+}
+
+impl SegmentBoxes16 {
+    /// Bit `i` set if lane `i`'s box meets the box `mins..maxs` (touching counts).
+    #[must_use]
+    pub fn meeting(&self, mins: [f32; 3], maxs: [f32; 3]) -> u16 {
+        let mut meets = [true; 16];
+        for axis in 0..3 {
+            for (lane, m) in meets.iter_mut().enumerate() {
+                *m &= (self.mins[axis][lane] <= maxs[axis]) & (mins[axis] <= self.maxs[axis][lane]);
+            }
+        }
+        meets
+            .iter()
+            .enumerate()
+            .fold(0, |mask, (lane, &m)| mask | (u16::from(m) << lane))
+    }
+
+    /// The box around every lane's box: `(mins, maxs)`, empty (mins above maxs) when all are.
+    #[must_use]
+    pub fn union(&self) -> ([f32; 3], [f32; 3]) {
+        // Plain comparisons: no lane holds a NaN.
+        let least = |lanes: &[f32; 16]| {
+            lanes
+                .iter()
+                .fold(f32::INFINITY, |m, &v| if v < m { v } else { m })
+        };
+        let most = |lanes: &[f32; 16]| {
+            lanes
+                .iter()
+                .fold(f32::NEG_INFINITY, |m, &v| if v > m { v } else { m })
+        };
+        (
+            std::array::from_fn(|axis| least(&self.mins[axis])),
+            std::array::from_fn(|axis| most(&self.maxs[axis])),
+        )
+    }
+}
+
 /// Up to 16 rays for [`Scene::occluded16`], in Embree's structure-of-arrays layout.
 #[derive(Debug, Clone, Copy)]
 pub struct RayPacket16 {
@@ -1043,6 +1110,46 @@ impl RayPacket16 {
                 r.tfar[lane],
             )
         })
+    }
+
+    /// The box around each active lane's segment (from `tnear` to `tfar`), lanes side by side;
+    /// inactive lanes, and lanes whose ends do not compute (an infinite `tfar`), get an empty
+    /// box, the latter their bit in [`SegmentBoxes16::unbounded`].
+    #[must_use]
+    pub fn segment_boxes(&self) -> SegmentBoxes16 {
+        let r = &self.rayhit.ray;
+        // Lanes whose box is kept: active, with finite ends.
+        let mut boxed = self.valid.0.map(|v| v != 0);
+        let mut boxes = SegmentBoxes16 {
+            mins: [[0.0; 16]; 3],
+            maxs: [[0.0; 16]; 3],
+            unbounded: 0,
+        };
+        for (axis, (org, dir)) in [
+            (&r.org_x, &r.dir_x),
+            (&r.org_y, &r.dir_y),
+            (&r.org_z, &r.dir_z),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            axis_extent(
+                org,
+                dir,
+                (&r.tnear, &r.tfar),
+                &mut boxes.mins[axis],
+                &mut boxes.maxs[axis],
+                &mut boxed,
+            );
+        }
+        for (lane, _) in boxed.iter().enumerate().filter(|(_, kept)| !**kept) {
+            boxes.unbounded |= u16::from(self.valid.0[lane] != 0) << lane;
+            for axis in 0..3 {
+                boxes.mins[axis][lane] = f32::INFINITY;
+                boxes.maxs[axis][lane] = f32::NEG_INFINITY;
+            }
+        }
+        boxes
     }
 
     /// The far end of `lane`'s segment: after [`Scene::first_hit_geom16`],

@@ -129,10 +129,13 @@ impl FenceFace {
 /// walk costs about as much on a few small signs as on many faces).
 #[derive(Debug)]
 struct FenceBoxes {
-    all: Bounds,
+    all: Box32,
     /// One per face; empty past [`MAX_FACE_BOXES`] faces, where `all` alone is tested.
-    each: Vec<Bounds>,
+    each: Vec<Box32>,
 }
+
+/// A box in the rays' single precision, `(mins, maxs)`.
+type Box32 = ([f32; 3], [f32; 3]);
 
 /// Room around the boxes for the rounding of a segment's ends (rays are single precision).
 const BOX_MARGIN: f64 = 1.0;
@@ -155,38 +158,41 @@ impl FenceBoxes {
         };
         let each: Vec<Bounds> = faces.map(box_of).collect();
         let all = each.iter().fold(Bounds::EMPTY, |acc, b| acc.union(b));
+        let single = |b: &Bounds| (b.mins.as_vec3().to_array(), b.maxs.as_vec3().to_array());
         FenceBoxes {
-            all,
+            all: single(&all),
             each: if each.len() <= MAX_FACE_BOXES {
-                each
+                each.iter().map(single).collect()
             } else {
                 Vec::new()
             },
         }
     }
 
-    /// Of `lanes` of `packet`, those whose segment's box meets a fence face's box.
+    /// Of `lanes` of `packet`, those whose segment's box meets a fence face's box (and those
+    /// whose segment has no finite box). A face's box is tested lane by lane only when it
+    /// meets the box of all the lanes' segments: a packet's rays are close together, and
+    /// fences are usually a few small signs.
     fn lanes_near(&self, packet: &RayPacket16, lanes: u16) -> u16 {
-        let mut near = 0;
-        for lane in (0..16).filter(|&l| lanes & (1 << l) != 0) {
-            let Some((org, dir, tnear, tfar)) = packet.segment(lane) else {
-                continue;
-            };
-            let (org, dir) = (Vec3::from(org).as_dvec3(), Vec3::from(dir).as_dvec3());
-            let (a, b) = (org + dir * f64::from(tnear), org + dir * f64::from(tfar));
-            let segment = Bounds {
-                mins: a.min(b),
-                maxs: a.max(b),
-            };
-            let finite = a.is_finite() && b.is_finite();
-            if !finite
-                || segment.intersects(&self.all)
-                    && (self.each.is_empty() || self.each.iter().any(|f| segment.intersects(f)))
-            {
-                near |= 1 << lane;
+        let segments = packet.segment_boxes();
+        let unbounded = segments.unbounded & lanes;
+        let mut near = segments.meeting(self.all.0, self.all.1) & lanes;
+        if near == 0 || self.each.is_empty() {
+            return near | unbounded;
+        }
+        let (mins, maxs) = segments.union();
+        let mut by_face = 0;
+        for &(face_mins, face_maxs) in &self.each {
+            let meets_union = (0..3).all(|a| mins[a] <= face_maxs[a] && face_mins[a] <= maxs[a]);
+            if meets_union {
+                by_face |= segments.meeting(face_mins, face_maxs);
+                if by_face & near == near {
+                    break;
+                }
             }
         }
-        near
+        near &= by_face;
+        near | unbounded
     }
 }
 
@@ -297,6 +303,47 @@ mod tests {
             boxes.lanes_near(&packet, 0b0010),
             0b0010,
             "only the lanes asked"
+        );
+    }
+
+    #[test]
+    fn each_lane_is_tested_against_every_face_its_packet_reaches() {
+        // Small signs along a corridor, and rays along it ending beside different signs: the
+        // packet's box meets all of them, each lane only those its own segment reaches.
+        let sign = |x: f64| {
+            [
+                DVec3::new(x, 0.0, 0.0),
+                DVec3::new(x, 8.0, 0.0),
+                DVec3::new(x, 8.0, 8.0),
+                DVec3::new(x, 0.0, 8.0),
+            ]
+        };
+        let signs: Vec<[DVec3; 4]> = (0..10).map(|k| sign(100.0 * f64::from(k))).collect();
+        let boxes = FenceBoxes::new(signs.iter().map(|s| &s[..]));
+        let mut packet = RayPacket16::new();
+        for lane in 0..10 {
+            // From beside sign `lane` (50 units past it) along +x for 40 units: no sign reached.
+            let x = 100.0 * lane as f32 + 50.0;
+            packet.set(lane, [x, 4.0, 4.0], [1.0, 0.0, 0.0], 0.0, 40.0);
+        }
+        // Reaching sign 3 from behind it, and sign 7 from in front.
+        packet.set(10, [280.0, 4.0, 4.0], [1.0, 0.0, 0.0], 0.0, 40.0);
+        packet.set(11, [720.0, 4.0, 4.0], [-1.0, 0.0, 0.0], 0.0, 30.0);
+        // No finite end: walked whatever the boxes say.
+        packet.set(
+            12,
+            [5000.0, 5000.0, 5000.0],
+            [0.0, 0.0, 1.0],
+            0.0,
+            f32::INFINITY,
+        );
+        assert_eq!(boxes.lanes_near(&packet, 0x1fff), 0b1_1100_0000_0000);
+        let segments = packet.segment_boxes();
+        assert_eq!(segments.unbounded, 1 << 12);
+        assert_eq!(
+            segments.meeting([-1e9; 3], [1e9; 3]),
+            0x0fff,
+            "empty boxes meet nothing"
         );
     }
 
