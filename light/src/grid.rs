@@ -71,6 +71,7 @@ impl SampleGrid {
 
     /// The four grid positions around position (gx, gy) (itself first when
     /// it is on the grid), and how far across their cell it lies.
+    #[inline]
     pub fn cell(&self, gx: usize, gy: usize) -> ([(usize, usize); 4], f32, f32) {
         let (x0, x1, fx) = self.cx[gx];
         let (y0, y1, fy) = self.cy[gy];

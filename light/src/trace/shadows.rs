@@ -343,19 +343,25 @@ impl VisibilityScratch {
         }
         let mut rays = self.cast(&ray, packet, &mut reaches);
         self.todo.clear();
-        for i in (0..n).filter(|&i| value[i] != 0.0) {
-            let (corners, _, _) = grid.cell(i % w, i / w);
-            if corners[0] == (i % w, i / w) {
-                continue; // a probe
-            }
-            let corners = corners.map(|(x, y)| y * w + x);
-            let agreed = !samples.apart[i]
-                && corners.iter().all(|&c| probe(c))
-                && corners.iter().all(|&c| self.lit[c] == self.lit[corners[0]]);
-            if agreed {
-                self.lit[i] = self.lit[corners[0]];
-            } else {
-                self.todo.push(i);
+        for y in 0..samples.height {
+            for x in 0..w {
+                let i = y * w + x;
+                if value[i] == 0.0 {
+                    continue;
+                }
+                let (corners, _, _) = grid.cell(x, y);
+                if corners[0] == (x, y) {
+                    continue; // a probe
+                }
+                let corners = corners.map(|(x, y)| y * w + x);
+                let agreed = !samples.apart[i]
+                    && corners.iter().all(|&c| probe(c))
+                    && corners.iter().all(|&c| self.lit[c] == self.lit[corners[0]]);
+                if agreed {
+                    self.lit[i] = self.lit[corners[0]];
+                } else {
+                    self.todo.push(i);
+                }
             }
         }
         rays += self.cast(&ray, packet, &mut reaches);
