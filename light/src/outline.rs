@@ -109,7 +109,10 @@ impl FaceRegion {
             if d.is_nan() || d < 0.0 {
                 return None;
             }
-            nearest = nearest.min(d);
+            // Neither is a NaN: a plain comparison is `min`.
+            if d < nearest {
+                nearest = d;
+            }
         }
         Some(nearest < ON_EDGE)
     }

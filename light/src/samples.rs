@@ -320,18 +320,21 @@ impl SurfaceMap {
         self.grid.scale / self.per_axis as f64
     }
 
-    /// Texture coordinates of sub-sample `sub` (row by row) of the luxel whose middle is at
-    /// `[s0, t0]`.
-    fn sub_sample_st(&self, [s0, t0]: [f64; 2], sub: usize) -> [f64; 2] {
+    /// Texture coordinates of the sub-samples (row by row) of the luxel whose middle is at
+    /// `[s0, t0]`, into `out`.
+    fn sub_samples_st(&self, [s0, t0]: [f64; 2], out: &mut Vec<[f64; 2]>) {
+        out.clear();
         if self.per_axis == 1 {
-            return [s0, t0];
+            out.push([s0, t0]);
+            return;
         }
         let step = self.sample_step();
         let first = -self.grid.scale / 2.0 + step / 2.0;
-        [
-            s0 + first + step * (sub % self.per_axis) as f64,
-            t0 + first + step * (sub / self.per_axis) as f64,
-        ]
+        let (s_first, t_first) = (s0 + first, t0 + first);
+        for row in 0..self.per_axis {
+            let t = t_first + step * row as f64;
+            out.extend((0..self.per_axis).map(|column| [s_first + step * column as f64, t]));
+        }
     }
 }
 
@@ -380,14 +383,15 @@ pub fn face_samples(face: &FaceGeom, per_axis: usize, bsp: &Bsp) -> (FaceSamples
     let mut beyond: Vec<bool> = Vec::with_capacity(count);
     // Luxel by luxel (row-major), each luxel's samples row by row: the order of
     // [`SurfaceMap::sample_st`].
+    let mut sub_st = Vec::with_capacity(per_luxel);
     for y in 0..height {
         for x in 0..width {
             let middle = face.grid.luxel_st(x, y);
             // With several samples a luxel, one test of its middle answers for all of them
             // when the luxel lies well inside the face.
             let inside = per_luxel > 1 && map.luxel_inside(middle);
-            for sub in 0..per_luxel {
-                let [s, t] = map.sub_sample_st(middle, sub);
+            map.sub_samples_st(middle, &mut sub_st);
+            for &[s, t] in &sub_st {
                 let placed = if inside {
                     map.inside(s, t)
                 } else {
