@@ -289,6 +289,36 @@ fn weigh(
     two_sided: bool,
     out: &mut [f32],
 ) {
+    crate::simd::avx2_or!(
+        weigh_avx2(e, luxels, kernel, gate, two_sided, out),
+        weigh_any(e, luxels, kernel, gate, two_sided, out)
+    )
+}
+
+/// [`weigh`] in AVX2's wider vectors ([`crate::simd`]).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn weigh_avx2(
+    e: &PointEmitter,
+    luxels: &Luxels,
+    kernel: f32,
+    gate: f32,
+    two_sided: bool,
+    out: &mut [f32],
+) {
+    weigh_any(e, luxels, kernel, gate, two_sided, out);
+}
+
+/// [`weigh`] for whatever the build targets.
+#[inline(always)]
+fn weigh_any(
+    e: &PointEmitter,
+    luxels: &Luxels,
+    kernel: f32,
+    gate: f32,
+    two_sided: bool,
+    out: &mut [f32],
+) {
     let [ex, ey, ez] = e.point.as_vec3().to_array();
     let [ux, uy, uz] = e.normal.as_vec3().to_array();
     let clamp = (HOTSPOT_CLAMP * HOTSPOT_CLAMP) as f32;
@@ -316,6 +346,23 @@ fn weigh(
             *slot = finish(kernel * along_e * along_r / (d2 * d2.max(clamp)));
         }
     }
+}
+
+/// The largest of `weights` (none is a NaN), 0 for none: lane by lane over blocks of eight, so
+/// that it runs in vectors; a maximum is exact whatever the order.
+fn largest_weight(weights: &[f32]) -> f32 {
+    let mut lanes = [0.0f32; 8];
+    let mut blocks = weights.chunks_exact(8);
+    for block in &mut blocks {
+        for (m, &w) in lanes.iter_mut().zip(block) {
+            *m = if w > *m { w } else { *m };
+        }
+    }
+    let rest = blocks
+        .remainder()
+        .iter()
+        .fold(0.0f32, |m, &w| if w > m { w } else { m });
+    lanes.iter().fold(rest, |m, &w| if w > m { w } else { m })
 }
 
 /// Weights held at once while lighting a face: emitters times luxels.
@@ -347,12 +394,11 @@ fn light_batch(
         .enumerate()
         .map(|(k, e)| {
             let row = &weights[k * n..(k + 1) * n];
-            let (best, w) = row
-                .iter()
-                .enumerate()
-                .fold((0, 0.0), |b, (i, &w)| if w > b.1 { (i, w) } else { b });
-            // The points of one face share its shadows: their weakness adds up.
-            (f64::from(w) * e.max_intensity() < WEAK * e.share).then_some(best)
+            let w = largest_weight(row);
+            // The points of one face share its shadows: their weakness adds up. The segment
+            // goes to the first luxel of the largest weight (the first, when none has any).
+            (f64::from(w) * e.max_intensity() < WEAK * e.share)
+                .then(|| row.iter().position(|&v| v == w).unwrap_or(0))
         })
         .collect();
     let lit = see(scene, r, &from, &weak, points, weights, counts);
@@ -610,6 +656,35 @@ mod tests {
             DVec3::new(10.0, 0.0, 0.0),
         ];
         FaceGeom::for_test(0, 0, points, Plane::new(DVec3::Z, 0.0))
+    }
+
+    proptest::proptest! {
+        /// The blockwise maximum is the plain one, on rows of any length.
+        #[test]
+        fn largest_weight_is_the_maximum(
+            weights in proptest::collection::vec(0.0f32..1e3, 0..40),
+        ) {
+            let plain = weights.iter().fold(0.0f32, |m, &w| if w > m { w } else { m });
+            proptest::prop_assert_eq!(largest_weight(&weights).to_bits(), plain.to_bits());
+        }
+
+        /// Both copies of the weighing give the same bits, one- and two-sided.
+        #[test]
+        fn weigh_copies_agree(
+            at in proptest::collection::vec((-300.0f32..300.0, -300.0f32..300.0, -50.0f32..50.0), 1..40),
+            two_sided in proptest::bool::ANY,
+        ) {
+            let e = &emitters_of([100.0, 50.0, 0.0], Emission::Middle)[0];
+            let points: Vec<[f32; 3]> = at.iter().map(|&(x, y, z)| [x, y, z]).collect();
+            let normals = vec![[0.0, 0.6, -0.8]; points.len()];
+            let luxels = Luxels::new(&points, &normals);
+            let mut any = vec![0.0f32; points.len()];
+            weigh_any(e, &luxels, 0.5, 1e-4, two_sided, &mut any);
+            let mut chosen = vec![0.0f32; points.len()];
+            weigh(e, &luxels, 0.5, 1e-4, two_sided, &mut chosen);
+            let bits = |v: &[f32]| v.iter().map(|w| w.to_bits()).collect::<Vec<_>>();
+            proptest::prop_assert_eq!(bits(&chosen), bits(&any));
+        }
     }
 
     fn emitters_of(light: [f32; 3], emission: Emission) -> Vec<PointEmitter> {
