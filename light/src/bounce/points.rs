@@ -407,7 +407,8 @@ fn light_batch(
         for &(style, color, total) in &e.styles {
             let strongest = f64::from(color[0].max(color[1]).max(color[2]));
             let luxels = style_luxels(out, style, n);
-            for ((luxel, &w), _) in luxels.iter_mut().zip(weights).zip(lit).filter(|(_, l)| **l) {
+            let seen = luxels.iter_mut().zip(weights).zip(lit);
+            for ((luxel, &w), _) in seen.filter(|(_, l)| **l == State::Lit) {
                 let w = f64::from(w) * total;
                 if w > 0.0 && strongest * w >= GATE {
                     for (v, c) in luxel.iter_mut().zip(color) {
@@ -541,7 +542,7 @@ enum State {
 const FIRST_STEP: usize = 4;
 
 /// For each of the points `from` (row-major by point) and each luxel of `r` with a weight
-/// there: whether nothing blocks the segment between them. Coarse to fine: segments to the
+/// there: whether nothing blocks the segment between them ([`State::Lit`]). Coarse to fine: segments to the
 /// luxels of a grid every [`FIRST_STEP`] luxels (and the last row and column) first; then on
 /// each grid of half the step, segments only to luxels whose coarser cell's corners disagree,
 /// the others taking the corners' answer. A shadow narrower than the coarse grid that falls
@@ -556,7 +557,7 @@ fn see(
     points: &[DVec3],
     weights: &[f32],
     counts: &mut BounceCounts,
-) -> Vec<bool> {
+) -> Vec<State> {
     let (w, h) = (r.width, r.height);
     let n = w * h;
     let mut state = vec![State::Unknown; weights.len()];
@@ -636,7 +637,7 @@ fn see(
         }
         step /= 2;
     }
-    state.into_iter().map(|s| s == State::Lit).collect()
+    state
 }
 
 #[cfg(test)]
