@@ -542,13 +542,13 @@ enum State {
 const FIRST_STEP: usize = 4;
 
 /// For each of the points `from` (row-major by point) and each luxel of `r` with a weight
-/// there: whether nothing blocks the segment between them ([`State::Lit`]). Coarse to fine: segments to the
-/// luxels of a grid every [`FIRST_STEP`] luxels (and the last row and column) first; then on
-/// each grid of half the step, segments only to luxels whose coarser cell's corners disagree,
-/// the others taking the corners' answer. A shadow narrower than the coarse grid that falls
-/// between its luxels is missed; bounced light from a point is rarely that sharp. A point
-/// `weak` names (with its strongest luxel) is decided by that luxel's one segment (see
-/// [`WEAK`]). Each step's segments, from every point, go 16 to a packet.
+/// there: whether nothing blocks the segment between them ([`State::Lit`]). Coarse to fine:
+/// segments to the luxels of a grid every [`FIRST_STEP`] luxels (and the last row and column)
+/// first; then on each grid of half the step, segments only to luxels whose coarser cell's
+/// corners disagree, the others taking the corners' answer. A shadow narrower than the coarse
+/// grid that falls between its luxels is missed; bounced light from a point is rarely that
+/// sharp. A point `weak` names (with its strongest luxel) is decided by that luxel's one
+/// segment (see [`WEAK`]). Each step's segments, from every point, go 16 to a packet.
 fn see(
     scene: &TraceScene,
     r: &Receivers,
