@@ -129,18 +129,32 @@ impl<'a> PointField<'a> {
         let Some(pvs) = self.vis.pvs_of(self.vis.face_leafs(face)) else {
             return (0..self.emitters.len() as u32).collect();
         };
-        let mut found = self.unplaced.clone();
+        // Marked in a bit set and read back in order: each emitter once, lowest first (the order
+        // their light is summed in).
+        let mut marked = vec![0u64; self.emitters.len().div_ceil(64)];
+        let mut mark = |list: &[u32]| {
+            for &k in list {
+                marked[k as usize / 64] |= 1 << (k % 64);
+            }
+        };
+        mark(&self.unplaced);
         for (l, list) in self.by_leaf.iter().enumerate().skip(1) {
             if !list.is_empty() && Visibility::holds(&pvs, l as u32) {
-                found.extend_from_slice(list);
+                mark(list);
             }
         }
-        found.sort_unstable();
-        found.dedup();
-        found.retain(|&k| {
-            let e = &self.emitters[k as usize];
-            self.vis.sees_all(&pvs, self.vis.face_leafs(e.face))
-        });
+        let mut found = Vec::new();
+        for (word, &bits) in marked.iter().enumerate() {
+            let mut bits = bits;
+            while bits != 0 {
+                let k = word * 64 + bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                let e = &self.emitters[k];
+                if self.vis.sees_all(&pvs, self.vis.face_leafs(e.face)) {
+                    found.push(k as u32);
+                }
+            }
+        }
         found
     }
 
