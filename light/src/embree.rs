@@ -982,7 +982,8 @@ fn axis_extent(
     }
 }
 
-/// The boxes around a [`RayPacket16`]'s segments, per axis and lane ([`RayPacket16::segment_boxes`]).
+/// The boxes around a [`RayPacket16`]'s segments, per axis and lane
+/// ([`RayPacket16::segment_boxes`]).
 #[derive(Debug, Clone, Copy)]
 pub struct SegmentBoxes16 {
     pub mins: [[f32; 16]; 3],

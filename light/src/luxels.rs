@@ -115,14 +115,10 @@ impl SampleImage {
         if radius == 0 || self.values.is_empty() {
             return;
         }
-        crate::simd::avx2_or!(self.blur_avx2(radius), self.blur_any(radius))
-    }
-
-    /// [`SampleImage::blur`] in AVX2's wider vectors ([`crate::simd`]).
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn blur_avx2(&mut self, radius: usize) {
-        self.blur_any(radius);
+        crate::simd::avx2_or_any(
+            #[inline(always)]
+            || self.blur_any(radius),
+        );
     }
 
     /// [`SampleImage::blur`] for whatever the build targets.

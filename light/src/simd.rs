@@ -15,17 +15,23 @@ pub fn has_avx2() -> bool {
     }
 }
 
-/// The value of `$avx2`, a call of a copy built with `#[target_feature(enable = "avx2")]`, when
-/// the CPU runs AVX2 (returned from the calling function), else of `$any`, the same work as
-/// built: the tail of a function that dispatches to its two copies.
-macro_rules! avx2_or {
-    ($avx2:expr, $any:expr) => {{
-        #[cfg(target_arch = "x86_64")]
-        if $crate::simd::has_avx2() {
-            // SAFETY: the CPU runs AVX2, the one feature the called copy is built for.
-            return unsafe { $avx2 };
-        }
-        $any
-    }};
+/// `work()`, built for AVX2 and run so when the CPU has it, else as the build targets. Callers
+/// pass an `#[inline(always)]` closure calling an `#[inline(always)]` function that holds the
+/// loops: both are inlined into the AVX2 copy, which widens them (a closure left out of line
+/// would run as the build targets in either copy).
+#[inline(always)]
+pub fn avx2_or_any<R>(work: impl FnOnce() -> R) -> R {
+    #[cfg(target_arch = "x86_64")]
+    if has_avx2() {
+        // SAFETY: the CPU runs AVX2, the one feature `in_avx2` is built for.
+        return unsafe { in_avx2(work) };
+    }
+    work()
 }
-pub(crate) use avx2_or;
+
+/// `work()` compiled with AVX2 enabled.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn in_avx2<R>(work: impl FnOnce() -> R) -> R {
+    work()
+}

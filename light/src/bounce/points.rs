@@ -303,24 +303,10 @@ fn weigh(
     two_sided: bool,
     out: &mut [f32],
 ) {
-    crate::simd::avx2_or!(
-        weigh_avx2(e, luxels, kernel, gate, two_sided, out),
-        weigh_any(e, luxels, kernel, gate, two_sided, out)
-    )
-}
-
-/// [`weigh`] in AVX2's wider vectors ([`crate::simd`]).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn weigh_avx2(
-    e: &PointEmitter,
-    luxels: &Luxels,
-    kernel: f32,
-    gate: f32,
-    two_sided: bool,
-    out: &mut [f32],
-) {
-    weigh_any(e, luxels, kernel, gate, two_sided, out);
+    crate::simd::avx2_or_any(
+        #[inline(always)]
+        || weigh_any(e, luxels, kernel, gate, two_sided, out),
+    );
 }
 
 /// [`weigh`] for whatever the build targets.
@@ -686,7 +672,10 @@ mod tests {
         /// Both copies of the weighing give the same bits, one- and two-sided.
         #[test]
         fn weigh_copies_agree(
-            at in proptest::collection::vec((-300.0f32..300.0, -300.0f32..300.0, -50.0f32..50.0), 1..40),
+            at in proptest::collection::vec(
+                (-300.0f32..300.0, -300.0f32..300.0, -50.0f32..50.0),
+                1..40,
+            ),
             two_sided in proptest::bool::ANY,
         ) {
             let e = &emitters_of([100.0, 50.0, 0.0], Emission::Middle)[0];

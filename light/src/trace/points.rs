@@ -323,17 +323,10 @@ impl Toward {
     /// most of a light's cost on a face). A sample at the light gets a direction of NaNs,
     /// which [`MIN_DISTANCE`] keeps from use.
     fn measure(&mut self, points: &SamplePoints, light: &PointLight) {
-        crate::simd::avx2_or!(
-            self.measure_avx2(points, light),
-            self.measure_any(points, light)
-        )
-    }
-
-    /// [`Toward::measure`] in AVX2's wider vectors ([`crate::simd`]).
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn measure_avx2(&mut self, points: &SamplePoints, light: &PointLight) {
-        self.measure_any(points, light);
+        crate::simd::avx2_or_any(
+            #[inline(always)]
+            || self.measure_any(points, light),
+        );
     }
 
     /// [`Toward::measure`] for whatever the build targets.
@@ -389,23 +382,10 @@ impl Toward {
         bounds: (f64, f64),
         value: &mut [f64],
     ) {
-        crate::simd::avx2_or!(
-            self.plain_values_avx2(light, samples, bounds, value),
-            self.plain_values_any(light, samples, bounds, value)
-        )
-    }
-
-    /// [`Toward::plain_values`] in AVX2's wider vectors ([`crate::simd`]).
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn plain_values_avx2(
-        &self,
-        light: &PointLight,
-        samples: &FaceSamples,
-        bounds: (f64, f64),
-        value: &mut [f64],
-    ) {
-        self.plain_values_any(light, samples, bounds, value);
+        crate::simd::avx2_or_any(
+            #[inline(always)]
+            || self.plain_values_any(light, samples, bounds, value),
+        );
     }
 
     /// [`Toward::plain_values`] for whatever the build targets.
@@ -521,32 +501,38 @@ mod tests {
             coords.set(&points);
             // The loops as built (any x86-64), and as this CPU runs them (AVX2 where it has it).
             for portable in [true, false] {
-            let mut toward = Toward::default();
-            let mut got = vec![f64::NAN; points.len()];
-            if portable {
-                toward.measure_any(&coords, &light);
-                toward.plain_values_any(&light, &face, (reach, gate), &mut got);
-            } else {
-                toward.measure(&coords, &light);
-                toward.plain_values(&light, &face, (reach, gate), &mut got);
-            }
-            for (i, p) in points.iter().enumerate() {
-                let to_light = light.origin - Vec3::from(*p).as_dvec3();
-                let (sq, dist) = (to_light.length_squared(), to_light.length());
-                let dir = to_light * (1.0 / dist);
-                let want = if sq > reach || dist <= MIN_DISTANCE {
-                    0.0
+                let mut toward = Toward::default();
+                let mut got = vec![f64::NAN; points.len()];
+                if portable {
+                    toward.measure_any(&coords, &light);
+                    toward.plain_values_any(&light, &face, (reach, gate), &mut got);
                 } else {
-                    let v = light.contribution(dist, -dir, face.incidence(i, dir));
-                    if v.abs() >= gate { v } else { 0.0 }
-                };
-                prop_assert_eq!(got[i].to_bits(), want.to_bits(), "sample {}, portable {}", i, portable);
-                if want != 0.0 {
-                    let (ray, length) = toward.shadow_ray(i);
-                    prop_assert_eq!(ray, dir.as_vec3().to_array());
-                    prop_assert_eq!(length, (dist as f32 - LIGHT_CLEARANCE).max(0.0));
+                    toward.measure(&coords, &light);
+                    toward.plain_values(&light, &face, (reach, gate), &mut got);
                 }
-            }
+                for (i, p) in points.iter().enumerate() {
+                    let to_light = light.origin - Vec3::from(*p).as_dvec3();
+                    let (sq, dist) = (to_light.length_squared(), to_light.length());
+                    let dir = to_light * (1.0 / dist);
+                    let want = if sq > reach || dist <= MIN_DISTANCE {
+                        0.0
+                    } else {
+                        let v = light.contribution(dist, -dir, face.incidence(i, dir));
+                        if v.abs() >= gate { v } else { 0.0 }
+                    };
+                    prop_assert_eq!(
+                        got[i].to_bits(),
+                        want.to_bits(),
+                        "sample {}, portable {}",
+                        i,
+                        portable
+                    );
+                    if want != 0.0 {
+                        let (ray, length) = toward.shadow_ray(i);
+                        prop_assert_eq!(ray, dir.as_vec3().to_array());
+                        prop_assert_eq!(length, (dist as f32 - LIGHT_CLEARANCE).max(0.0));
+                    }
+                }
             }
         }
     }
