@@ -2,6 +2,7 @@
 //! from another brush by a node plane.
 
 use crate::planes::{PlaneId, PlaneSet};
+use crate::sides_memo::{Sides, SidesMemo};
 use quake_formats::geom::{Bounds, MAX_WORLD_COORD, ON_EPSILON, Plane, PlaneSide, Split, Winding};
 
 /// Brush fragments smaller than this (cubic units) are dropped as numerical slivers.
@@ -134,6 +135,8 @@ pub struct Brush {
     /// The entity's `_noclipfaces`: where the brush touches or overlaps brushes of its contents,
     /// the faces of both are kept instead of clipped away (see [`crate::faces`]).
     pub no_clip_faces: bool,
+    /// Which sides of a plane its corners reach, for planes its box cannot answer for.
+    pub sides_memo: SidesMemo,
 }
 
 /// A plane of a brush being built, with the texinfo of its map face.
@@ -194,6 +197,7 @@ impl Brush {
             kind,
             mirror_inside: None,
             no_clip_faces: false,
+            sides_memo: SidesMemo::default(),
         };
         (brush.volume() >= MIN_VOLUME).then_some(brush)
     }
@@ -226,22 +230,41 @@ impl Brush {
     }
 
     /// Which side of `plane` the brush is on: (any point in front, any point behind).
-    pub fn sides_of(&self, plane: &Plane) -> (bool, bool) {
-        // The bounding box decides most cases without touching the vertices.
+    pub fn sides_of(&self, plane: &Plane) -> Sides {
+        self.box_sides(plane)
+            .unwrap_or_else(|| self.corner_sides(plane))
+    }
+
+    /// [`Brush::sides_of`] the canonical plane `id`, the corners' answers remembered.
+    pub fn sides_of_id(&self, id: PlaneId, plane: &Plane) -> Sides {
+        self.box_sides(plane).unwrap_or_else(|| {
+            self.sides_memo
+                .get_or_insert(id, || self.corner_sides(plane))
+        })
+    }
+
+    /// What the bounding box tells of `plane`'s sides: everything, unless the box straddles a
+    /// plane that is not axial.
+    fn box_sides(&self, plane: &Plane) -> Option<Sides> {
         let n = plane.normal;
         let center = self.bounds.center();
         let half = self.bounds.maxs - center;
         let radius = half.x * n.x.abs() + half.y * n.y.abs() + half.z * n.z.abs();
         let d = plane.distance(center);
         if d - radius > -ON_EPSILON {
-            return (d + radius > ON_EPSILON, false);
+            return Some((d + radius > ON_EPSILON, false));
         }
         if d + radius < ON_EPSILON {
-            return (false, d - radius < -ON_EPSILON);
+            return Some((false, d - radius < -ON_EPSILON));
         }
         if plane.axial().is_some() {
-            return (d + radius > ON_EPSILON, d - radius < -ON_EPSILON);
+            return Some((d + radius > ON_EPSILON, d - radius < -ON_EPSILON));
         }
+        None
+    }
+
+    /// Which sides of `plane` the sides' corners reach.
+    fn corner_sides(&self, plane: &Plane) -> Sides {
         let (mut front, mut back) = (false, false);
         for s in &self.sides {
             for &p in &s.winding.points {
@@ -414,6 +437,32 @@ pub(crate) mod tests {
             DVec3::new(64.0, 64.0, 64.0),
             quake_formats::bsp::contents::SOLID,
         )
+    }
+
+    proptest::proptest! {
+        /// A tilted plane through a cube whose box it straddles is answered by the corners, then
+        /// by the memo: the same answer both times, the one `sides_of` gives, for a brush and
+        /// for its copy.
+        #[test]
+        fn remembered_sides_are_the_corners_answer(
+            tilt in proptest::collection::vec(-1.0f64..1.0, 3),
+            dist in -80.0f64..80.0,
+        ) {
+            let mut planes = PlaneSet::new();
+            let cube = solid_cube(&mut planes);
+            let Some(normal) = DVec3::from_slice(&tilt).normalized() else {
+                return Ok(());
+            };
+            let (id, flipped) = planes.insert(&Plane::new(normal, dist));
+            let plane = *planes.get(id);
+            proptest::prop_assert_eq!(flipped, plane.normal.dot(normal) < 0.0);
+            let expected = cube.sides_of(&plane);
+            proptest::prop_assert_eq!(cube.sides_of_id(id, &plane), expected);
+            let remembered = usize::from(cube.box_sides(&plane).is_none());
+            proptest::prop_assert_eq!(cube.sides_memo.len(), remembered);
+            proptest::prop_assert_eq!(cube.sides_of_id(id, &plane), expected);
+            proptest::prop_assert_eq!(cube.clone().sides_of_id(id, &plane), expected);
+        }
     }
 
     #[test]

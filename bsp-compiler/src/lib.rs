@@ -41,6 +41,7 @@ mod planes;
 mod portals;
 pub mod prefab;
 mod region;
+mod sides_memo;
 mod surface_tree;
 pub mod texinfo;
 pub mod trace;

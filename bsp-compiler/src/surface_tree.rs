@@ -259,7 +259,7 @@ impl Builder<'_> {
         best_splitter(
             &candidates,
             surfaces,
-            Surface::sides_of,
+            |s: &Surface, _, plane: &Plane| s.sides_of(plane),
             &on_plane,
             self.planes,
             self.splitting.heuristic,
