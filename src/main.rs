@@ -1,5 +1,6 @@
 //! `slipgate`: the one command. Each subcommand is a thin shell over a library stage.
 
+mod allocator;
 mod build;
 mod decompile;
 mod inspect;
@@ -9,10 +10,8 @@ use anyhow::Result;
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
-// Every stage allocates small per-face buffers on rayon's threads and frees them on others, where
-// glibc's malloc contends; mimalloc serves that pattern well and gives the same output bytes.
 #[global_allocator]
-static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+static ALLOCATOR: allocator::MiMalloc = allocator::MiMalloc;
 
 #[derive(Parser, Debug)]
 #[command(
