@@ -614,8 +614,9 @@ impl Builder<'_> {
             };
         };
         let parallel = brushes.len() >= PARALLEL_BRUSHES;
-        let mut front = Vec::new();
-        let mut back = Vec::new();
+        // Room for every brush on either side: growing by doubling moved each brush again.
+        let mut front = Vec::with_capacity(brushes.len());
+        let mut back = Vec::with_capacity(brushes.len());
         let mut splits = 0;
         for b in brushes {
             let (f, bk) = b.split(plane, self.planes);
@@ -654,10 +655,10 @@ impl Builder<'_> {
     /// within the epsilon of the region's boundary; inside the region such a side bounds
     /// nothing: as a splitter it would make a node with an empty child, and it must not keep
     /// the brush from filling the region.
-    fn fit_to_region(&self, brushes: Vec<Brush>, region: &Region) -> Vec<Brush> {
+    fn fit_to_region(&self, mut brushes: Vec<Brush>, region: &Region) -> Vec<Brush> {
         // A used side lies on a plane above (or was found here to miss a region above), so the
         // region lies inside it.
-        let fit = |mut b: Brush| {
+        let fits = |b: &mut Brush| {
             for s in b.sides.iter_mut().filter(|s| !s.used) {
                 let (front, back) = region.sides_of(self.planes.get(s.plane));
                 // Whether the region reaches out of the brush past the side, and into it.
@@ -668,18 +669,22 @@ impl Builder<'_> {
                 };
                 match (outside, inside) {
                     (true, true) => {}
-                    (true, false) => return None,
+                    (true, false) => return false,
                     (false, _) => s.used = true,
                 }
             }
-            Some(b)
+            true
         };
-        // Above the parallel subtrees this is on every build's path: spread it too.
+        // Above the parallel subtrees this is on every build's path: spread it too (in place:
+        // collecting a filtered parallel iterator joins per-thread vectors).
         if brushes.len() >= PARALLEL_BRUSHES {
-            brushes.into_par_iter().filter_map(fit).collect()
+            let kept: Vec<bool> = brushes.par_iter_mut().map(fits).collect();
+            let mut kept = kept.into_iter();
+            brushes.retain(|_| kept.next() == Some(true));
         } else {
-            brushes.into_iter().filter_map(fit).collect()
+            brushes.retain_mut(fits);
         }
+        brushes
     }
 
     /// `brushes` without what lies in the sliver of `region` that the plane `id` cuts off (see
