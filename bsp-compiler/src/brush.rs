@@ -229,23 +229,20 @@ impl Brush {
             / 3.0
     }
 
-    /// Which side of `plane` the brush is on: (any point in front, any point behind).
-    pub fn sides_of(&self, plane: &Plane) -> Sides {
-        self.box_sides(plane)
-            .unwrap_or_else(|| self.corner_sides(plane))
-    }
-
-    /// [`Brush::sides_of`] the canonical plane `id`, the corners' answers remembered.
-    pub fn sides_of_id(&self, id: PlaneId, plane: &Plane) -> Sides {
-        self.box_sides(plane).unwrap_or_else(|| {
-            self.sides_memo
-                .get_or_insert(id, || self.corner_sides(plane))
-        })
+    /// Which sides of the canonical plane `id` the brush reaches: (any point in front, any point
+    /// behind). The corners' answers are remembered.
+    pub fn sides_of(&self, id: PlaneId, planes: &PlaneSet) -> Sides {
+        let plane = planes.get(id);
+        self.box_sides(plane, planes.is_axial(id))
+            .unwrap_or_else(|| {
+                self.sides_memo
+                    .get_or_insert(id, || self.corner_sides(plane))
+            })
     }
 
     /// What the bounding box tells of `plane`'s sides: everything, unless the box straddles a
-    /// plane that is not axial.
-    fn box_sides(&self, plane: &Plane) -> Option<Sides> {
+    /// plane that is not `axial`.
+    fn box_sides(&self, plane: &Plane, axial: bool) -> Option<Sides> {
         let n = plane.normal;
         let center = self.bounds.center();
         let half = self.bounds.maxs - center;
@@ -257,7 +254,7 @@ impl Brush {
         if d + radius < ON_EPSILON {
             return Some((false, d - radius < -ON_EPSILON));
         }
-        if plane.axial().is_some() {
+        if axial {
             return Some((d + radius > ON_EPSILON, d - radius < -ON_EPSILON));
         }
         None
@@ -283,7 +280,7 @@ impl Brush {
     /// side comes back whole on that side.
     pub fn split(self, id: PlaneId, planes: &PlaneSet) -> (Option<Brush>, Option<Brush>) {
         let plane = *planes.get(id);
-        match self.sides_of(&plane) {
+        match self.sides_of(id, planes) {
             (true, false) => return (Some(self), None),
             (false, true) => return (None, Some(self)),
             // On the plane within epsilon: a sliver; keep it where its bulk is.
@@ -441,8 +438,7 @@ pub(crate) mod tests {
 
     proptest::proptest! {
         /// A tilted plane through a cube whose box it straddles is answered by the corners, then
-        /// by the memo: the same answer both times, the one `sides_of` gives, for a brush and
-        /// for its copy.
+        /// by the memo: the same answer both times, and for the brush's copy.
         #[test]
         fn remembered_sides_are_the_corners_answer(
             tilt in proptest::collection::vec(-1.0f64..1.0, 3),
@@ -456,12 +452,12 @@ pub(crate) mod tests {
             let (id, flipped) = planes.insert(&Plane::new(normal, dist));
             let plane = *planes.get(id);
             proptest::prop_assert_eq!(flipped, plane.normal.dot(normal) < 0.0);
-            let expected = cube.sides_of(&plane);
-            proptest::prop_assert_eq!(cube.sides_of_id(id, &plane), expected);
-            let remembered = usize::from(cube.box_sides(&plane).is_none());
-            proptest::prop_assert_eq!(cube.sides_memo.len(), remembered);
-            proptest::prop_assert_eq!(cube.sides_of_id(id, &plane), expected);
-            proptest::prop_assert_eq!(cube.clone().sides_of_id(id, &plane), expected);
+            let boxed = cube.box_sides(&plane, plane.axial().is_some());
+            let expected = boxed.unwrap_or_else(|| cube.corner_sides(&plane));
+            proptest::prop_assert_eq!(cube.sides_of(id, &planes), expected);
+            proptest::prop_assert_eq!(cube.sides_memo.len(), usize::from(boxed.is_none()));
+            proptest::prop_assert_eq!(cube.sides_of(id, &planes), expected);
+            proptest::prop_assert_eq!(cube.clone().sides_of(id, &planes), expected);
         }
     }
 

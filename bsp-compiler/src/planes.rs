@@ -11,6 +11,9 @@ pub type PlaneId = u32;
 #[derive(Debug, Clone, Default)]
 pub struct PlaneSet {
     planes: Vec<Plane>,
+    /// Whether each plane is axial ([`Plane::axial`]): asked of every plane a brush is tested
+    /// against while choosing splitters.
+    axial: Vec<bool>,
     /// Planes by their distance rounded down, for lookups within [`DIST_EPSILON`].
     by_dist: IntMap<i64, Vec<PlaneId>>,
 }
@@ -47,6 +50,10 @@ impl PlaneSet {
         &self.planes[id as usize]
     }
 
+    pub fn is_axial(&self, id: PlaneId) -> bool {
+        self.axial[id as usize]
+    }
+
     pub fn len(&self) -> usize {
         self.planes.len()
     }
@@ -67,6 +74,7 @@ impl PlaneSet {
         debug_assert!(canon.dist.is_finite() && DIST_EPSILON < 1.0);
         let id = self.planes.len() as PlaneId;
         self.planes.push(canon);
+        self.axial.push(canon.axial().is_some());
         self.by_dist.entry(key).or_default().push(id);
         (id, flipped)
     }

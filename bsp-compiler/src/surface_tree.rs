@@ -259,7 +259,7 @@ impl Builder<'_> {
         best_splitter(
             &candidates,
             surfaces,
-            |s: &Surface, _, plane: &Plane| s.sides_of(plane),
+            |s: &Surface, id| s.sides_of(self.planes.get(id)),
             &on_plane,
             self.planes,
             self.splitting.heuristic,

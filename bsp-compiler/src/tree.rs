@@ -89,8 +89,8 @@ impl SplitHeuristic {
 }
 
 /// The candidate with the lowest [`SplitHeuristic::key`] over a node's `items` (brushes or
-/// surfaces), each telling with `sides_of` which sides of a plane (given with its id) it
-/// reaches. `facing` is the sorted list of planes the items lie on, one entry per item.
+/// surfaces), each telling with `sides_of` which sides of a plane it reaches. `facing` is the
+/// sorted list of planes the items lie on, one entry per item.
 ///
 /// A candidate stops being counted once its key can only come out above the lowest first key
 /// component some candidate has finished with: both heuristics rank splits before all else, and
@@ -98,7 +98,7 @@ impl SplitHeuristic {
 pub fn best_splitter<T: Sync>(
     candidates: &[PlaneId],
     items: &[T],
-    sides_of: impl Fn(&T, PlaneId, &Plane) -> (bool, bool) + Sync,
+    sides_of: impl Fn(&T, PlaneId) -> (bool, bool) + Sync,
     facing: &[PlaneId],
     planes: &PlaneSet,
     heuristic: SplitHeuristic,
@@ -110,7 +110,7 @@ pub fn best_splitter<T: Sync>(
         let limit = bound.load(Ordering::Relaxed);
         let (mut front, mut back, mut split) = (0i64, 0i64, 0i64);
         for item in items {
-            match sides_of(item, id, plane) {
+            match sides_of(item, id) {
                 (true, true) => {
                     split += 1;
                     if heuristic.least_first_key(split, facing) > limit {
@@ -787,7 +787,7 @@ impl Builder<'_> {
         best_splitter(
             &candidates,
             brushes,
-            Brush::sides_of_id,
+            |b: &Brush, id| b.sides_of(id, self.planes),
             &facing_planes,
             self.planes,
             self.splitting.heuristic,
@@ -1121,7 +1121,8 @@ mod tests {
             candidates.sort_unstable();
             candidates.dedup();
             // Spans of x; one lies on a candidate where it starts there.
-            let sides = |&(lo, len): &(i32, i32), _: PlaneId, p: &Plane| {
+            let sides = |&(lo, len): &(i32, i32), id: PlaneId| {
+                let p = planes.get(id);
                 (f64::from(lo + len) > p.dist, f64::from(lo) < p.dist)
             };
             let mut facing: Vec<PlaneId> = spans
@@ -1141,7 +1142,7 @@ mod tests {
                 .map(|&id| {
                     let plane = planes.get(id);
                     let count = |want: (bool, bool)| {
-                        spans.iter().filter(|s| sides(s, id, plane) == want).count() as i64
+                        spans.iter().filter(|s| sides(s, id) == want).count() as i64
                     };
                     let counts = SplitCounts {
                         split: count((true, true)),
