@@ -6,6 +6,7 @@
 use crate::brush::{Brush, BrushKind};
 use crate::planes::{PlaneId, PlaneSet};
 use crate::region::{Region, Sliver};
+use crate::sides_memo::SidesMemo;
 use glam::DVec3;
 use quake_formats::bsp::contents;
 use quake_formats::geom::{Bounds, ON_EPSILON, Plane};
@@ -612,6 +613,10 @@ impl Builder<'_> {
             return BuildNode::Leaf {
                 contents: strongest_contents(brushes.iter()),
                 brushes: if self.keep_brushes {
+                    // No plane is scored against them any more.
+                    for b in &mut brushes {
+                        b.sides_memo = SidesMemo::default();
+                    }
                     brushes
                 } else {
                     Vec::new()
