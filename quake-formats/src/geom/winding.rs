@@ -33,6 +33,25 @@ pub enum Split {
     },
 }
 
+/// Each edge of a winding whose points lie at `dists` from a plane, as (its first point, the
+/// next one, their sides of the plane), each point's side worked out once.
+fn edge_sides(dists: &[f64]) -> impl Iterator<Item = (usize, usize, PlaneSide, PlaneSide)> + '_ {
+    let n = dists.len();
+    let first = dists.first().map(|&d| PlaneSide::of_distance(d));
+    let mut side_i = first.unwrap_or(PlaneSide::On);
+    (0..n).map(move |i| {
+        let j = if i + 1 == n { 0 } else { i + 1 };
+        let side_j = if j == 0 {
+            first.unwrap_or(PlaneSide::On)
+        } else {
+            PlaneSide::of_distance(dists[j])
+        };
+        let edge = (i, j, side_i, side_j);
+        side_i = side_j;
+        edge
+    })
+}
+
 impl Winding {
     /// A winding of `points`, which must already be convex and in clockwise order.
     pub fn new(points: Vec<DVec3>) -> Self {
@@ -223,12 +242,11 @@ impl Winding {
     /// [`Winding::split`] of a winding with points on both sides of `plane` at `dists`.
     fn split_crossing(&self, plane: &Plane, dists: &[f64]) -> Split {
         let n = self.points.len();
-        let side = |i: usize| PlaneSide::of_distance(dists[i]);
         let mut front = Vec::with_capacity(n + 2);
         let mut back = Vec::with_capacity(n + 2);
-        for i in 0..n {
+        for (i, j, side_i, side_j) in edge_sides(dists) {
             let p = self.points[i];
-            match side(i) {
+            match side_i {
                 PlaneSide::On => {
                     front.push(p);
                     back.push(p);
@@ -237,8 +255,7 @@ impl Winding {
                 PlaneSide::Front => front.push(p),
                 _ => back.push(p),
             }
-            let j = (i + 1) % n;
-            if side(j) == PlaneSide::On || side(j) == side(i) {
+            if side_j == PlaneSide::On || side_j == side_i {
                 continue;
             }
             let mid = self.crossing(plane, dists, i, j);
@@ -276,15 +293,12 @@ impl Winding {
 
     /// [`Winding::clip_front`] of a winding with points on both sides of `plane` at `dists`.
     fn front_of_crossing(&self, plane: &Plane, dists: &[f64]) -> Winding {
-        let n = self.points.len();
-        let side = |i: usize| PlaneSide::of_distance(dists[i]);
-        let mut front = Vec::with_capacity(n + 2);
-        for i in 0..n {
-            if side(i) != PlaneSide::Back {
+        let mut front = Vec::with_capacity(self.points.len() + 2);
+        for (i, j, side_i, side_j) in edge_sides(dists) {
+            if side_i != PlaneSide::Back {
                 front.push(self.points[i]);
             }
-            let j = (i + 1) % n;
-            if side(i) == PlaneSide::On || side(j) == PlaneSide::On || side(j) == side(i) {
+            if side_i == PlaneSide::On || side_j == PlaneSide::On || side_j == side_i {
                 continue;
             }
             front.push(self.crossing(plane, dists, i, j));
