@@ -31,6 +31,23 @@ pub fn mark_hidden_sides(brushes: &mut [Brush], planes: &PlaneSet) -> usize {
             .collect(),
     );
     let padded = index.boxes();
+    // Every side is clipped against by each brush its owner overlaps: its outward plane and
+    // exact axis worked out once.
+    let outward: Vec<Vec<Bounding>> = brushes
+        .par_iter()
+        .map(|b| {
+            b.sides
+                .iter()
+                .map(|s| {
+                    let plane = b.outward(s, planes);
+                    Bounding {
+                        plane,
+                        axis: axial_axis(&plane),
+                    }
+                })
+                .collect()
+        })
+        .collect();
     let hidden: Vec<Vec<bool>> = (0..brushes.len())
         .into_par_iter()
         .map(|i| {
@@ -50,7 +67,8 @@ pub fn mark_hidden_sides(brushes: &mut [Brush], planes: &PlaneSet) -> usize {
             covers.sort_unstable();
             me.sides
                 .iter()
-                .map(|s| s.buried || buried(s, me, &covers, brushes, planes))
+                .zip(&outward[i])
+                .map(|(s, own)| s.buried || buried(s, own, &covers, brushes, &outward))
                 .collect()
         })
         .collect();
@@ -64,31 +82,50 @@ pub fn mark_hidden_sides(brushes: &mut [Brush], planes: &PlaneSet) -> usize {
     count
 }
 
-/// Whether `side` of `owner` is entirely inside the brushes `covers`.
+/// A side's outward plane, and the axis it lies exactly along (see [`axial_axis`]).
+struct Bounding {
+    plane: Plane,
+    axis: Option<usize>,
+}
+
+/// A part of a side not yet found covered, with its bounds and, once known, whether it is tiny.
+struct Piece {
+    winding: Winding,
+    bounds: Bounds,
+    tiny: Option<bool>,
+}
+
+/// Whether `side` (whose outward plane is `own`) is entirely inside the brushes `covers`, whose
+/// sides' outward planes `outward` holds.
 fn buried(
     side: &Side,
-    owner: &Brush,
+    own: &Bounding,
     covers: &[usize],
     brushes: &[Brush],
-    planes: &PlaneSet,
+    outward: &[Vec<Bounding>],
 ) -> bool {
-    let own = owner.outward(side, planes);
     // The pieces of the side still uncovered, each with its bounds: a cover only clips the
     // pieces it reaches, so pieces do not multiply by every cover of the whole side.
-    let mut pieces = vec![(side.winding.clone(), side.winding.bounds())];
+    let mut pieces = vec![Piece {
+        winding: side.winding.clone(),
+        bounds: side.winding.bounds(),
+        tiny: None,
+    }];
     let mut clipped = Vec::new();
     for &j in covers {
         let other = &brushes[j];
-        let mut outside = Vec::new();
-        for (w, bounds) in pieces {
-            if !other.bounds.intersects(&bounds) {
-                outside.push((w, bounds));
-                continue;
+        // Pieces are clipped each on its own, so their order does not matter: those the cover
+        // misses stay where they are.
+        let mut k = 0;
+        while k < pieces.len() {
+            if other.bounds.intersects(&pieces[k].bounds) {
+                let piece = pieces.swap_remove(k);
+                clip_outside(piece, &outward[j], own.plane.normal, &mut clipped);
+            } else {
+                k += 1;
             }
-            clip_outside((w, bounds), other, planes, own.normal, &mut clipped);
-            outside.append(&mut clipped);
         }
-        pieces = outside;
+        pieces.append(&mut clipped);
         if pieces.is_empty() {
             return true;
         }
@@ -96,44 +133,51 @@ fn buried(
     false
 }
 
-/// Push the parts of `w` (with its bounds) outside `brush`, each with its bounds. A part lying
-/// on one of its sides counts as inside when the two face each other (touching brushes) and
-/// outside when they face the same way.
-fn clip_outside(
-    (w, bounds): (Winding, Bounds),
-    brush: &Brush,
-    planes: &PlaneSet,
-    facing: DVec3,
-    out: &mut Vec<(Winding, Bounds)>,
-) {
-    let mut rest = w;
-    // `rest`'s bounds and whether it is tiny, computed again only when a split changes it.
+/// Push the parts of `piece` outside the brush whose sides' outward planes are `sides`. A part
+/// lying on one of its sides counts as inside when the two face each other (touching brushes)
+/// and outside when they face the same way.
+fn clip_outside(piece: Piece, sides: &[Bounding], facing: DVec3, out: &mut Vec<Piece>) {
+    let Piece {
+        winding: mut rest,
+        bounds,
+        mut tiny,
+    } = piece;
+    // `rest`'s bounds, computed again only when a split changes it.
     let mut rest_bounds = Some(bounds);
-    let mut tiny = None;
-    for s in &brush.sides {
-        let plane = brush.outward(s, planes);
+    for Bounding { plane, axis } in sides {
         // Classify first: most windings lie wholly on one side, and splitting would copy them.
-        let side = match axial_axis(&plane) {
-            Some(k) => axial_side(&plane, k, rest_bounds.get_or_insert_with(|| rest.bounds())),
-            None => rest.side_of(&plane),
+        let side = match *axis {
+            Some(k) => axial_side(plane, k, rest_bounds.get_or_insert_with(|| rest.bounds())),
+            None => rest.side_of(plane),
         };
         match side {
             PlaneSide::Front => {
-                let b = rest_bounds.unwrap_or_else(|| rest.bounds());
-                out.push((rest, b));
+                let bounds = rest_bounds.unwrap_or_else(|| rest.bounds());
+                out.push(Piece {
+                    winding: rest,
+                    bounds,
+                    tiny,
+                });
                 return;
             }
             PlaneSide::On if plane.normal.dot(facing) > 0.0 => {
-                let b = rest_bounds.unwrap_or_else(|| rest.bounds());
-                out.push((rest, b));
+                let bounds = rest_bounds.unwrap_or_else(|| rest.bounds());
+                out.push(Piece {
+                    winding: rest,
+                    bounds,
+                    tiny,
+                });
                 return;
             }
             PlaneSide::Back | PlaneSide::On => {}
             PlaneSide::Cross => {
-                if let Split::Both { front, back } = rest.split(&plane) {
+                if let Split::Both { front, back } = rest.split(plane) {
                     if !front.is_tiny() {
-                        let b = front.bounds();
-                        out.push((front, b));
+                        out.push(Piece {
+                            bounds: front.bounds(),
+                            winding: front,
+                            tiny: Some(false),
+                        });
                     }
                     rest = back;
                     rest_bounds = None;
