@@ -8,10 +8,11 @@
 //! here, per canonical plane.
 //!
 //! The candidates of one node are scored on several threads at once, all reading the same
-//! brushes, so the memo is a small open-addressed table of atomic slots: each slot is written
-//! once, by compare-and-swap, and an answer is found within [`PROBES`] slots of its home or not
-//! at all. A full neighbourhood drops the answer, which costs only time: what is remembered is
-//! exactly what the corners would say again, so the tree is the same whatever was kept.
+//! brushes, so the memo is a small open-addressed table of atomic slots (and a larger second one
+//! once the first fills): each slot is written once, by compare-and-swap, and an answer is found
+//! within [`PROBES`] slots of its home in a table or not at all. A full neighbourhood in both
+//! drops the answer, which costs only time: what is remembered is exactly what the corners would
+//! say again, so the tree is the same whatever was kept.
 
 use crate::planes::PlaneId;
 use std::sync::OnceLock;
