@@ -288,11 +288,8 @@ impl Brush {
             (true, true) => {}
         }
         // The new face: the plane's polygon inside the brush.
-        let mut cut = Some(Winding::base_for_plane(&plane));
-        for s in &self.sides {
-            let out = self.outward(s, planes);
-            cut = cut.and_then(|w| w.into_front(&out.flipped()));
-        }
+        let inside = self.sides.iter().map(|s| self.outward(s, planes).flipped());
+        let cut = Winding::base_for_plane(&plane).into_front_of_all(inside);
         let Some(cut) = cut.filter(|w| !w.is_tiny()) else {
             // The plane grazes an edge or a corner: the cut is too thin to build on.
             return self.on_both_sides();

@@ -178,12 +178,8 @@ impl Builder {
             box_planes.push(Plane::new(-n, -maxs[axis]));
         }
         for (i, plane) in box_planes.iter().enumerate() {
-            let mut w = Some(Winding::base_for_plane(plane));
-            for (j, other) in box_planes.iter().enumerate() {
-                if i != j {
-                    w = w.and_then(|w| w.into_front(other));
-                }
-            }
+            let others = box_planes.iter().enumerate().filter(|&(j, _)| j != i);
+            let w = Winding::base_for_plane(plane).into_front_of_all(others.map(|(_, p)| *p));
             if let Some(w) = w {
                 self.add(Portal {
                     plane: *plane,
@@ -205,19 +201,16 @@ impl Builder {
         children: [u32; 2],
         above: &[Plane],
     ) {
-        let mut w = Some(Winding::base_for_plane(plane));
-        for keep in above {
-            w = w.and_then(|w| w.into_front(keep));
-        }
-        for &pid in &self.node_portals[node as usize] {
+        let portals = self.node_portals[node as usize].iter().map(|&pid| {
             let p = &self.portals[pid as usize];
-            let keep = if p.nodes[0] == node {
+            if p.nodes[0] == node {
                 p.plane
             } else {
                 p.plane.flipped()
-            };
-            w = w.and_then(|w| w.into_front(&keep));
-        }
+            }
+        });
+        let w =
+            Winding::base_for_plane(plane).into_front_of_all(above.iter().copied().chain(portals));
         if let Some(w) = w.filter(|w| !w.is_tiny()) {
             self.add(Portal {
                 plane: *plane,

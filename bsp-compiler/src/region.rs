@@ -204,10 +204,10 @@ impl Region {
 
 /// `w` (on `own`) cut down to the inside of the other `planes` (outward), if anything is left.
 fn clip_inside(w: Winding, planes: &[Plane], own: &Plane) -> Option<Winding> {
-    planes
+    let others = planes
         .iter()
-        .filter(|p| !p.same_as(own) && !p.same_as(&own.flipped()))
-        .try_fold(w, |w, p| w.into_front(&p.flipped()))
+        .filter(|p| !p.same_as(own) && !p.same_as(&own.flipped()));
+    w.into_front_of_all(others.map(Plane::flipped))
         .filter(|w| !w.is_tiny())
 }
 

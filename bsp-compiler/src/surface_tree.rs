@@ -300,12 +300,9 @@ fn inside_point(planes: &[Plane]) -> Option<DVec3> {
     let mut count = 0usize;
     for (i, plane) in planes.iter().enumerate() {
         // The region's face on this plane looks back into the region.
-        let mut w = Some(Winding::base_for_plane(&plane.flipped()));
-        for (j, other) in planes.iter().enumerate() {
-            if i != j {
-                w = w.and_then(|w| w.into_front(other));
-            }
-        }
+        let others = planes.iter().enumerate().filter(|&(j, _)| j != i);
+        let w =
+            Winding::base_for_plane(&plane.flipped()).into_front_of_all(others.map(|(_, p)| *p));
         for p in w.iter().flat_map(|w| &w.points) {
             sum += *p;
             count += 1;

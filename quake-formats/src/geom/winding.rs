@@ -294,6 +294,13 @@ impl Winding {
     /// [`Winding::clip_front`] of a winding with points on both sides of `plane` at `dists`.
     fn front_of_crossing(&self, plane: &Plane, dists: &[f64]) -> Winding {
         let mut front = Vec::with_capacity(self.points.len() + 2);
+        self.push_front(plane, dists, &mut front);
+        Winding::new(front)
+    }
+
+    /// Push the points of the part in front of `plane` (this winding's points at `dists` from
+    /// it, on both sides) onto `front`.
+    fn push_front(&self, plane: &Plane, dists: &[f64], front: &mut Vec<DVec3>) {
         for (i, j, side_i, side_j) in edge_sides(dists) {
             if side_i != PlaneSide::Back {
                 front.push(self.points[i]);
@@ -303,7 +310,28 @@ impl Winding {
             }
             front.push(self.crossing(plane, dists, i, j));
         }
-        Winding::new(front)
+    }
+
+    /// The part in front of every plane of `planes`: [`Winding::into_front`] by each in turn,
+    /// with two point buffers taking turns instead of a new winding for every cut.
+    pub fn into_front_of_all(self, planes: impl IntoIterator<Item = Plane>) -> Option<Winding> {
+        let mut w = self;
+        let mut spare = Vec::new();
+        for plane in planes {
+            let whole = w.with_distances(&plane, |dists, whole| {
+                if whole == PlaneSide::Cross {
+                    spare.clear();
+                    w.push_front(&plane, dists, &mut spare);
+                }
+                whole
+            });
+            match whole {
+                PlaneSide::Front => {}
+                PlaneSide::Cross => std::mem::swap(&mut w.points, &mut spare),
+                PlaneSide::Back | PlaneSide::On => return None,
+            }
+        }
+        Some(w)
     }
 
     /// True when the winding is too small to matter: fewer than three points, or every edge
@@ -385,6 +413,25 @@ mod tests {
                 Split::Back(_) => None,
             };
             prop_assert_eq!(w.clip_front(&plane, keep_on).map(|w| w.points), front.map(|w| w.points));
+        }
+
+        /// Clipping by several planes with two buffers in turn gives what clipping by each in
+        /// turn does.
+        #[test]
+        fn into_front_of_all_is_into_front_by_each(
+            cuts in proptest::collection::vec(
+                (-1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0, -80.0f64..80.0),
+                0..8,
+            ),
+        ) {
+            let planes: Vec<Plane> = cuts
+                .iter()
+                .filter_map(|&(x, y, z, d)| Some(Plane::new(DVec3::new(x, y, z).normalized()?, d)))
+                .collect();
+            let by_each = planes
+                .iter()
+                .try_fold(square(0.0), |w, plane| w.into_front(plane));
+            prop_assert_eq!(square(0.0).into_front_of_all(planes.iter().copied()), by_each);
         }
 
         /// Giving the winding away changes nothing but the copy.
