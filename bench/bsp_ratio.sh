@@ -6,15 +6,10 @@
 # Usage: [RUNS=5] [SLIPGATE=path/to/slipgate] bench/bsp_ratio.sh [MAP.map ...] (SLIPGATE: another
 # build of the command, instead of building this tree's)
 set -euo pipefail
-root=$(cd "$(dirname "$0")/.." && pwd)
-corpus="$root/../shared/corpus"
+source "$(dirname "$0")/common.sh"
 anchor="$root/../shared/anchors/ericw-tools/bin"
 [ -x "$anchor/qbsp" ] || { echo "SKIPPED: $anchor/qbsp not found" >&2; exit 0; }
-ours=${SLIPGATE:-}
-if [ -z "$ours" ]; then
-  cargo build --release --manifest-path "$root/Cargo.toml" -p slipgate >/dev/null
-  ours="${CARGO_TARGET_DIR:-$root/target}/release/slipgate"
-fi
+ours=$(slipgate_binary)
 maps=("$@")
 if [ ${#maps[@]} -eq 0 ]; then
   mapfile -t maps < <(ls "$corpus"/public/maps/*/*.map)

@@ -5,14 +5,9 @@
 # Usage: [SLIPGATE=path/to/slipgate] bench/callgrind_bsp.sh MAP... (default id/e1m1
 # librequake/start ericw-tools/q1_mountain)
 set -euo pipefail
-root=$(cd "$(dirname "$0")/.." && pwd)
-corpus="$root/../shared/corpus"
+source "$(dirname "$0")/common.sh"
 [ -d "$corpus" ] || { echo "SKIPPED: $corpus not found" >&2; exit 0; }
-bin=${SLIPGATE:-}
-if [ -z "$bin" ]; then
-  cargo build --release --manifest-path "$root/Cargo.toml" -p slipgate >/dev/null
-  bin="${CARGO_TARGET_DIR:-$root/target}/release/slipgate"
-fi
+bin=$(slipgate_binary)
 maps=("$@")
 [ ${#maps[@]} -gt 0 ] || maps=(id/e1m1 librequake/start ericw-tools/q1_mountain)
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT

@@ -19,8 +19,32 @@ const PLAIN_ALIGN: usize = 16;
 
 pub struct MiMalloc;
 
+/// Whether every block of `size` is aligned to `align`: mimalloc's plain entry points serve it.
 fn plain(align: usize, size: usize) -> bool {
     align <= PLAIN_ALIGN && align <= size
+}
+
+/// `plain_alloc(size)` when every block of `size` meets `align` ([`plain`]), else
+/// `aligned(size, align)`.
+///
+/// # Safety
+/// Both must be mimalloc's allocation functions of one kind.
+#[inline(always)]
+unsafe fn by_alignment(
+    size: usize,
+    align: usize,
+    plain_alloc: unsafe extern "C" fn(usize) -> *mut c_void,
+    aligned: unsafe extern "C" fn(usize, usize) -> *mut c_void,
+) -> *mut u8 {
+    // SAFETY: the caller passes mimalloc's functions; the plain one only gets sizes whose
+    // every block is aligned at least as asked.
+    unsafe {
+        if plain(align, size) {
+            plain_alloc(size).cast()
+        } else {
+            aligned(size, align).cast()
+        }
+    }
 }
 
 // SAFETY: each call passes the layout's size and alignment to the mimalloc function that
@@ -28,27 +52,13 @@ fn plain(align: usize, size: usize) -> bool {
 // with `mi_free`, which takes blocks from all of them.
 unsafe impl GlobalAlloc for MiMalloc {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        let (size, align) = (layout.size(), layout.align());
         // SAFETY: see the impl.
-        unsafe {
-            if plain(align, size) {
-                mi_malloc(size).cast()
-            } else {
-                mi_malloc_aligned(size, align).cast()
-            }
-        }
+        unsafe { by_alignment(layout.size(), layout.align(), mi_malloc, mi_malloc_aligned) }
     }
 
     unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        let (size, align) = (layout.size(), layout.align());
         // SAFETY: see the impl.
-        unsafe {
-            if plain(align, size) {
-                mi_zalloc(size).cast()
-            } else {
-                mi_zalloc_aligned(size, align).cast()
-            }
-        }
+        unsafe { by_alignment(layout.size(), layout.align(), mi_zalloc, mi_zalloc_aligned) }
     }
 
     unsafe fn dealloc(&self, ptr: *mut u8, _layout: Layout) {
@@ -57,13 +67,13 @@ unsafe impl GlobalAlloc for MiMalloc {
     }
 
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        let align = layout.align();
+        let (ptr, align) = (ptr.cast::<c_void>(), layout.align());
         // SAFETY: see the impl.
         unsafe {
             if plain(align, new_size) {
-                mi_realloc(ptr.cast::<c_void>(), new_size).cast()
+                mi_realloc(ptr, new_size).cast()
             } else {
-                mi_realloc_aligned(ptr.cast::<c_void>(), new_size, align).cast()
+                mi_realloc_aligned(ptr, new_size, align).cast()
             }
         }
     }

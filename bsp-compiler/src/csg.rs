@@ -150,40 +150,34 @@ fn clip_outside(piece: Piece, sides: &[Bounding], facing: DVec3, out: &mut Vec<P
             Some(k) => axial_side(plane, k, rest_bounds.get_or_insert_with(|| rest.bounds())),
             None => rest.side_of(plane),
         };
-        match side {
-            PlaneSide::Front => {
-                let bounds = rest_bounds.unwrap_or_else(|| rest.bounds());
+        // Outside the brush past this side: in front of it, or lying on it facing the same way.
+        let outside = match side {
+            PlaneSide::Front => true,
+            PlaneSide::On => plane.normal.dot(facing) > 0.0,
+            PlaneSide::Back | PlaneSide::Cross => false,
+        };
+        if outside {
+            let bounds = rest_bounds.unwrap_or_else(|| rest.bounds());
+            out.push(Piece {
+                winding: rest,
+                bounds,
+                tiny,
+            });
+            return;
+        }
+        if side == PlaneSide::Cross
+            && let Split::Both { front, back } = rest.split(plane)
+        {
+            if !front.is_tiny() {
                 out.push(Piece {
-                    winding: rest,
-                    bounds,
-                    tiny,
+                    bounds: front.bounds(),
+                    winding: front,
+                    tiny: Some(false),
                 });
-                return;
             }
-            PlaneSide::On if plane.normal.dot(facing) > 0.0 => {
-                let bounds = rest_bounds.unwrap_or_else(|| rest.bounds());
-                out.push(Piece {
-                    winding: rest,
-                    bounds,
-                    tiny,
-                });
-                return;
-            }
-            PlaneSide::Back | PlaneSide::On => {}
-            PlaneSide::Cross => {
-                if let Split::Both { front, back } = rest.split(plane) {
-                    if !front.is_tiny() {
-                        out.push(Piece {
-                            bounds: front.bounds(),
-                            winding: front,
-                            tiny: Some(false),
-                        });
-                    }
-                    rest = back;
-                    rest_bounds = None;
-                    tiny = None;
-                }
-            }
+            rest = back;
+            rest_bounds = None;
+            tiny = None;
         }
         if *tiny.get_or_insert_with(|| rest.is_tiny()) {
             return;
