@@ -6,6 +6,7 @@ use crate::content_flags::ContentFlags;
 use crate::faces::ModelFace;
 use crate::gather::MapTexInfo;
 use crate::hulls::emit_clipnodes;
+use crate::int_hash::IntMap;
 use crate::model::ModelOutput;
 use crate::planes::{PlaneId, PlaneSet};
 use crate::texinfo::TextureRole;
@@ -21,7 +22,6 @@ use quake_formats::entities::{Entity, write_entities};
 use quake_formats::geom::{Bounds, Plane};
 use quake_formats::prt::{PortalFile, PrtPortal};
 use quake_formats::{Bsp, BspVersion};
-use std::collections::HashMap;
 
 pub(crate) struct EmitInput<'a> {
     pub models: &'a [ModelOutput],
@@ -256,12 +256,12 @@ pub(crate) fn emit(mut input: EmitInput) -> Emitted {
     bsp.edges.push([0, 0]); // edge 0 cannot be negated, so it is never used
     // Keyed by the contents the face is seen from too: only faces seen from the same contents
     // share an edge (see `ModelFace::seen_from`), each once each way.
-    let mut edge_index: HashMap<(u32, u32, i32), (u32, bool)> = HashMap::new();
-    let mut node_faces: HashMap<(usize, u32), (u32, u32)> = HashMap::new();
-    let mut leaf_faces: HashMap<(usize, u32), Vec<u32>> = HashMap::new();
+    let mut edge_index: IntMap<(u32, u32, i32), (u32, bool)> = IntMap::default();
+    let mut node_faces: IntMap<(usize, u32), (u32, u32)> = IntMap::default();
+    let mut leaf_faces: IntMap<(usize, u32), Vec<u32>> = IntMap::default();
     // The bounds of the faces each leaf lists away from where they are seen (behind fences):
     // engines that cull a leaf by its bounds must not cull them.
-    let mut leaf_growth: HashMap<(usize, u32), Bounds> = HashMap::new();
+    let mut leaf_growth: IntMap<(usize, u32), Bounds> = IntMap::default();
     let mut model_faces: Vec<(u32, u32)> = vec![(0, 0); input.models.len()];
     let mut phong = Vec::with_capacity(pending.len());
     let mut flags = Vec::with_capacity(pending.len());
@@ -347,7 +347,7 @@ pub(crate) fn emit(mut input: EmitInput) -> Emitted {
     // Nodes, leaves and models.
     bsp.leafs.push(Leaf::SHARED_SOLID);
     let mut leaf_contents = vec![ContentFlags::SOLID];
-    let mut world_leaf_index: HashMap<u32, u32> = HashMap::new();
+    let mut world_leaf_index: IntMap<u32, u32> = IntMap::default();
     for (mi, m) in input.models.iter().enumerate() {
         let (first_face, num_faces) = model_faces[mi];
         let leaves_before = bsp.leafs.len();
@@ -360,7 +360,7 @@ pub(crate) fn emit(mut input: EmitInput) -> Emitted {
             node_faces: &node_faces,
             leaf_faces: &leaf_faces,
             leaf_growth: &leaf_growth,
-            leaf_index: HashMap::new(),
+            leaf_index: IntMap::default(),
             leaf_contents: &mut leaf_contents,
             transwater: input.transwater,
         };
@@ -443,11 +443,11 @@ struct TreeWriter<'a, 'b> {
     solid: &'a [bool],
     bsp: &'b mut Bsp,
     planes: &'b mut PlaneTable<'a>,
-    node_faces: &'b HashMap<(usize, u32), (u32, u32)>,
-    leaf_faces: &'b HashMap<(usize, u32), Vec<u32>>,
-    leaf_growth: &'b HashMap<(usize, u32), Bounds>,
+    node_faces: &'b IntMap<(usize, u32), (u32, u32)>,
+    leaf_faces: &'b IntMap<(usize, u32), Vec<u32>>,
+    leaf_growth: &'b IntMap<(usize, u32), Bounds>,
     /// Tree leaf to BSP leaf.
-    leaf_index: HashMap<u32, u32>,
+    leaf_index: IntMap<u32, u32>,
     /// Each written leaf's extended content flags, in leaf order.
     leaf_contents: &'b mut Vec<ContentFlags>,
     /// Liquids are detail and translucent ([`EmitInput::transwater`]).
@@ -537,7 +537,7 @@ impl TreeWriter<'_, '_> {
 /// vis does not look across a liquid's surface (see [`vis_class`]).
 fn world_portal_file(
     world: &ModelOutput,
-    leaf_index: &HashMap<u32, u32>,
+    leaf_index: &IntMap<u32, u32>,
     vis_leafs: i32,
     transwater: bool,
 ) -> PortalFile {
@@ -568,7 +568,7 @@ fn world_portal_file(
     // Clusters in tree order, each with the vis leaves below it; a cluster is open to sight when
     // one of its leaves is.
     let mut clusters = Vec::new();
-    let mut cluster_of: HashMap<u32, (u32, bool, i32)> = HashMap::new();
+    let mut cluster_of: IntMap<u32, (u32, bool, i32)> = IntMap::default();
     let mut stack = vec![0u32];
     while let Some(n) = stack.pop() {
         let node = &tree[n as usize];

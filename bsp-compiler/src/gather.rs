@@ -10,6 +10,7 @@ use crate::brush::{Brush, BrushKind, BrushPlane, BrushShape};
 use crate::brushlist::{self, ListedBrush};
 use crate::faces::{MIN_SQUARENESS, projection_squareness};
 use crate::hulls::{HULL_BOXES, bevelled_planes, grown_planes};
+use crate::int_hash::IntMap;
 use crate::leak::MapBrushRef;
 use crate::map::{MapBrush, MapEntity, MapFile};
 use crate::options::CompileOptions;
@@ -27,7 +28,6 @@ use quake_formats::bsp::face_tone::FaceTone;
 use quake_formats::bsp::phong::{self, FacePhong};
 use quake_formats::geom::Bounds;
 use rayon::prelude::*;
-use std::collections::HashMap;
 
 /// Each model's brushes, with what the rest of the compile needs to name them.
 pub(crate) struct Gathered {
@@ -394,9 +394,9 @@ type TexInfoKey = (
 #[derive(Default)]
 pub(crate) struct TexInfoTable {
     pub names: Vec<String>,
-    name_index: HashMap<String, u32>,
+    name_index: IntMap<String, u32>,
     pub infos: Vec<MapTexInfo>,
-    info_index: HashMap<TexInfoKey, u32>,
+    info_index: IntMap<TexInfoKey, u32>,
 }
 
 impl TexInfoTable {

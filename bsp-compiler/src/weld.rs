@@ -29,14 +29,22 @@ pub(crate) fn cell_and_neighbours([x, y, z]: [i64; 3]) -> impl Iterator<Item = [
 
 impl VertexWelder {
     fn cell(p: DVec3) -> [i64; 3] {
-        // Cells several epsilons wide; neighbours are searched, so the size only affects speed.
+        // Cells several epsilons wide; the cells a point's epsilon box reaches are searched, so
+        // the size only affects speed.
         let c = |v: f64| (v / (POINT_EPSILON * 16.0)).floor() as i64;
         [c(p.x), c(p.y), c(p.z)]
     }
 
     pub fn weld(&mut self, p: DVec3) -> u32 {
         let cell = Self::cell(p);
-        let found = cell_and_neighbours(cell)
+        // Every point within the epsilon lies in a cell its box (doubled against rounding)
+        // reaches: one cell mostly, at most eight, searched in the order of the 27 around it.
+        let reach = DVec3::splat(2.0 * POINT_EPSILON);
+        let (lo, hi) = (Self::cell(p - reach), Self::cell(p + reach));
+        let found = (lo[0]..=hi[0])
+            .flat_map(|x| {
+                (lo[1]..=hi[1]).flat_map(move |y| (lo[2]..=hi[2]).map(move |z| [x, y, z]))
+            })
             .filter_map(|c| self.cells.get(&c))
             .flatten()
             .find(|&&id| self.positions[id as usize].near(p, POINT_EPSILON));

@@ -106,9 +106,13 @@ impl PortalFile {
 
     /// The file's text: PRT2 when `clusters` is set, PRT1 otherwise.
     pub fn write(&self) -> String {
-        let mut out = match &self.clusters {
-            None => format!("PRT1\n{}\n{}\n", self.num_leafs, self.portals.len()),
-            Some(c) => format!(
+        use std::fmt::Write;
+        let mut out = String::new();
+        // Writing into a String cannot fail.
+        let _ = match &self.clusters {
+            None => write!(out, "PRT1\n{}\n{}\n", self.num_leafs, self.portals.len()),
+            Some(c) => write!(
+                out,
                 "PRT2\n{}\n{}\n{}\n",
                 self.num_leafs,
                 c.len(),
@@ -116,25 +120,16 @@ impl PortalFile {
             ),
         };
         for p in &self.portals {
-            out.push_str(&format!(
-                "{} {} {}",
-                p.winding.len(),
-                p.leafs[0],
-                p.leafs[1]
-            ));
+            let _ = write!(out, "{} {} {}", p.winding.len(), p.leafs[0], p.leafs[1]);
             for v in &p.winding.points {
-                out.push_str(&format!(
-                    " ({} {} {} )",
-                    fmt_coord(v.x),
-                    fmt_coord(v.y),
-                    fmt_coord(v.z)
-                ));
+                // Coordinates as the f32 they are read back as.
+                let _ = write!(out, " ({} {} {} )", v.x as f32, v.y as f32, v.z as f32);
             }
             out.push('\n');
         }
         for leafs in self.clusters.iter().flatten() {
             for leaf in leafs {
-                out.push_str(&format!("{leaf} "));
+                let _ = write!(out, "{leaf} ");
             }
             out.push_str("-1\n");
         }
@@ -163,10 +158,6 @@ fn parse_cluster(line: usize, text: &str, num_leafs: u32) -> Result<Vec<u32>> {
 }
 
 /// Coordinates as the shortest text that reads back to the same `f32` (what vis gets anyway).
-fn fmt_coord(v: f64) -> String {
-    format!("{}", v as f32)
-}
-
 fn parse_portal(line: usize, text: &str, num_ends: u32) -> Result<PrtPortal> {
     let err = |detail: String| FormatError::Syntax { line, detail };
     let cleaned = text.replace(['(', ')'], " ");
