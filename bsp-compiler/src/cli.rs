@@ -401,12 +401,15 @@ fn compile_and_write(args: &Args) -> Result<Option<crate::CompileStats>> {
             pts_path.display()
         );
     }
-    let bytes = out.bsp.write().context("encoding the BSP")?;
-    write_atomic(&bsp_path, &bytes)?;
-    if out.leak.is_none() || args.keepprt {
-        write_atomic(&prt_path, out.portals.write().as_bytes())?;
-    } else {
-        remove_stale(&prt_path)?;
+    // The two files' bytes are made side by side; they are written in order, BSP first.
+    let (bytes, prt) = rayon::join(
+        || out.bsp.write(),
+        || (out.leak.is_none() || args.keepprt).then(|| out.portals.write()),
+    );
+    write_atomic(&bsp_path, &bytes.context("encoding the BSP")?)?;
+    match prt {
+        Some(text) => write_atomic(&prt_path, text.as_bytes())?,
+        None => remove_stale(&prt_path)?,
     }
     if args.noextendedcontentflags {
         remove_stale(&content_path)?;

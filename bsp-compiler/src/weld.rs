@@ -7,6 +7,7 @@ use glam::DVec3;
 use quake_formats::bsp::contents;
 use quake_formats::geom::DVec3Ext;
 use quake_formats::geom::{Bounds, ON_EPSILON, POINT_EPSILON};
+use rayon::prelude::*;
 
 /// Distance from an edge within which a vertex counts as lying on it.
 pub const TJUNCTION_EPSILON: f64 = 0.02;
@@ -145,9 +146,19 @@ pub fn fix_tjunctions(
             grid.merge(v, into);
         }
         let mut changed = !collapsed.is_empty();
-        for (poly, &class) in polygons.iter_mut().zip(classes) {
+        // What lies inside each edge depends only on the positions and the grid, which the
+        // insertions below leave alone: found for every polygon at once, then inserted in order
+        // (an insertion gives the vertex its polygon's class, which later polygons may take).
+        let inside: Vec<Vec<EdgeVertex>> = polygons
+            .par_iter()
+            .map(|poly| grid.inside_edges(poly))
+            .collect();
+        for ((poly, &class), inside) in polygons.iter_mut().zip(classes).zip(inside) {
+            if inside.is_empty() {
+                continue;
+            }
             let before = poly.clone();
-            let added = grid.insert_edge_vertices(poly, class);
+            let added = grid.insert_edge_vertices(poly, class, &inside);
             if added == 0 {
                 continue;
             }
@@ -202,6 +213,13 @@ fn collapse_short_edges(positions: &[DVec3], polygons: &mut [Vec<u32>]) -> Vec<(
     same.keys().map(|&v| (v, root(&same, v))).collect()
 }
 
+/// A vertex found inside edge `edge` (from corner `edge` to the next) of a polygon.
+#[derive(Debug, Clone, Copy)]
+struct EdgeVertex {
+    edge: usize,
+    vertex: u32,
+}
+
 /// The vertices of a set of polygons bucketed by position, for finding those near an edge, each
 /// with the [`WeldClass`] bits of the polygons it belongs to.
 struct TJunctionGrid<'a> {
@@ -245,24 +263,51 @@ impl<'a> TJunctionGrid<'a> {
         *self.owners.entry(into).or_default() |= bits;
     }
 
-    /// Insert into `poly`, a polygon of `class`, every vertex lying inside one of its edges that
-    /// belongs to a class it takes; how many were inserted. An inserted vertex belongs to
-    /// `class` from then on: a face that welds with this polygon meets it there too.
-    fn insert_edge_vertices(&mut self, poly: &mut Vec<u32>, class: WeldClass) -> usize {
+    /// Every vertex inside one of `poly`'s edges ([`TJunctionGrid::vertices_inside`]), edge by
+    /// edge, each edge's in order along it.
+    fn inside_edges(&self, poly: &[u32]) -> Vec<EdgeVertex> {
+        let mut found = Vec::new();
+        let mut on_edge = Vec::new();
+        for k in 0..poly.len() {
+            self.vertices_inside(poly[k], poly[(k + 1) % poly.len()], &mut on_edge);
+            found.extend(
+                on_edge
+                    .iter()
+                    .map(|&(_, vertex)| EdgeVertex { edge: k, vertex }),
+            );
+        }
+        found
+    }
+
+    /// Insert into `poly`, a polygon of `class`, every vertex of `inside` (its
+    /// [`TJunctionGrid::inside_edges`]) that belongs to a class it takes; how many were
+    /// inserted. An inserted vertex belongs to `class` from then on: a face that welds with this
+    /// polygon meets it there too.
+    fn insert_edge_vertices(
+        &mut self,
+        poly: &mut Vec<u32>,
+        class: WeldClass,
+        inside: &[EdgeVertex],
+    ) -> usize {
         let takes = class.takes();
         let mut inserted = 0;
-        let mut out = Vec::with_capacity(poly.len());
-        let mut on_edge: Vec<(f64, u32)> = Vec::new();
-        for k in 0..poly.len() {
-            let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+        let mut out = Vec::with_capacity(poly.len() + inside.len());
+        let mut rest = inside;
+        for (k, &a) in poly.iter().enumerate() {
             out.push(a);
-            self.vertices_inside(a, b, &mut on_edge);
-            on_edge.retain(|(_, v)| self.owners.get(v).is_some_and(|&bits| bits & takes != 0));
-            for (_, v) in &on_edge {
-                *self.owners.entry(*v).or_default() |= class.bit();
+            let on_edge = rest.partition_point(|e| e.edge == k);
+            // An edge lists a vertex once, so marking each as it is taken tests the others
+            // as they were.
+            for e in &rest[..on_edge] {
+                if let Some(bits) = self.owners.get_mut(&e.vertex)
+                    && *bits & takes != 0
+                {
+                    *bits |= class.bit();
+                    out.push(e.vertex);
+                    inserted += 1;
+                }
             }
-            inserted += on_edge.len();
-            out.extend(on_edge.iter().map(|&(_, v)| v));
+            rest = &rest[on_edge..];
         }
         *poly = out;
         inserted
