@@ -5,9 +5,9 @@
 use crate::brushlist::brush_list_lump;
 use crate::content_flags::ContentFlags;
 use crate::editor::{OmittedLayer, omitted_layers, without_editor_keys};
-use crate::emit::{EmitInput, emit};
+use crate::emit::{DrawingInput, DrawnBsp, EmitInput, ModelDrawing, emit, emit_drawing};
 use crate::faces::{
-    FaceStats, FaceTexInfo, MIN_SQUARENESS, cut_for_lightmaps, projection_squareness,
+    FaceStats, FaceTexInfo, MIN_SQUARENESS, ModelFace, cut_for_lightmaps, projection_squareness,
 };
 use crate::gather::{
     EntityBrushes, Gathered, ModelInput, TexInfoTable, gather, map_brush, submodel_origin,
@@ -15,7 +15,9 @@ use crate::gather::{
 use crate::leak::LeakReport;
 use crate::lightmap_grid::{LightmapGridStats, agree_on_lightmap_grid};
 use crate::map::{MapEntity, MapError, MapFile, parse_map, read_map_text};
-use crate::model::{MODEL_PHASES, MODEL_WORK_PER_BRUSH, ModelOutput, build_model};
+use crate::model::{
+    Clipped, Drawn, MODEL_PHASES, MODEL_WORK_PER_BRUSH, ModelOutput, assemble, split_model,
+};
 use crate::options::CompileOptions;
 use crate::outside::{FillOutcome, Occupant};
 use crate::planes::PlaneSet;
@@ -219,10 +221,26 @@ pub fn compile(
     timings.push(("brushes".to_string(), t.elapsed().as_secs_f64()));
 
     let t = Instant::now();
+    let texture_list = TextureList::of_map(
+        map.entities
+            .iter()
+            .flat_map(|e| &e.brushes)
+            .flat_map(|b| &b.faces)
+            .map(|f| f.texture.as_str()),
+    );
     // The WADs are read while the models are built: reading a map's texture WADs (megabytes
     // each) waits on the disk and on fresh memory, which the models' threads need not.
-    let (results, (wads, wad_warnings)) = rayon::join(
-        || build_models(models, &planes, &table, &occupants, options),
+    let (built, (wads, wad_warnings)) = rayon::join(
+        || {
+            build_models(
+                models,
+                &planes,
+                &mut table,
+                &occupants,
+                texture_list,
+                options,
+            )
+        },
         || {
             let mut wad_warnings = Vec::new();
             let wads = WadSet::load(
@@ -234,6 +252,14 @@ pub fn compile(
         },
     );
     timings.push(("models (wall)".to_string(), t.elapsed().as_secs_f64()));
+    let Built {
+        models: results,
+        drawing,
+        table,
+        squared_up,
+        after_subdivide,
+        drawing_time,
+    } = built;
     let mut leak = None;
     let mut phase_sums = [0.0; 6];
     let mut outputs = Vec::with_capacity(results.len());
@@ -258,12 +284,12 @@ pub fn compile(
         }
         outputs.push(out);
     }
-    stats.face_stats.squared_up =
-        square_up_projections(&mut outputs, &planes, &mut table, options.subdivide);
-    stats.face_stats.after_subdivide = outputs.iter().map(|o| o.faces.len()).sum();
+    stats.face_stats.squared_up = squared_up;
+    stats.face_stats.after_subdivide = after_subdivide;
     for (name, sum) in MODEL_PHASES.iter().zip(phase_sums) {
         timings.push((format!("  {name} (sum over models)"), sum));
     }
+    timings.push(("  hull 0 written".to_string(), drawing_time));
     stats.leaked = leak.is_some();
 
     let t = Instant::now();
@@ -276,25 +302,15 @@ pub fn compile(
         },
         zero_size: options.missing_textures_as_zero_size,
     });
-    let emitted = emit(EmitInput {
-        models: &outputs,
-        planes: &planes,
-        texinfos: &table.infos,
-        texture_names: &table.names,
-        texture_list: TextureList::of_map(
-            map.entities
-                .iter()
-                .flat_map(|e| &e.brushes)
-                .flat_map(|b| &b.faces)
-                .map(|f| f.texture.as_str()),
-        ),
-        wads: &wads,
-        entities: &lump_entities(&map, &left_out, options),
-        version: options.version,
-        transwater: options.transwater,
-        max_edges: options.max_edges,
-        warnings: &mut warnings,
-    });
+    let emitted = emit(
+        drawing,
+        EmitInput {
+            models: &outputs,
+            wads: &wads,
+            entities: &lump_entities(&map, &left_out, options),
+            warnings: &mut warnings,
+        },
+    );
     let mut bsp = emitted.bsp;
     stats.lightmap_grid = agree_on_lightmap_grid(&mut bsp);
     if options.brush_list {
@@ -371,15 +387,106 @@ fn wide_faces(bsp: &Bsp) -> Option<Warning> {
     })
 }
 
-/// Build every model (in parallel), the world flooding from `occupants`.
-fn build_models(
+/// Every model built, its hull 0 and faces written into the BSP ([`emit_drawing`]) while the
+/// clip hulls still build: nothing of hull 0's writing needs them, and their trees take longer.
+/// The world floods from `occupants`.
+fn build_models<'t>(
     models: Vec<ModelInput>,
-    planes: &PlaneSet,
-    table: &TexInfoTable,
+    planes: &'t PlaneSet,
+    table: &'t mut TexInfoTable,
     occupants: &[Occupant],
+    texture_list: TextureList,
     options: &CompileOptions,
-) -> Vec<(ModelOutput, Vec<Warning>)> {
-    let face_texinfos: Vec<FaceTexInfo> = table
+) -> Built<'t> {
+    let face_texinfos = face_texinfos(table);
+    let progress = &options.progress;
+    progress.start(
+        "models",
+        models.iter().map(ModelInput::work).sum::<usize>() * MODEL_WORK_PER_BRUSH,
+    );
+    let occupants_of = |i: usize| if i == 0 { occupants } else { &[] };
+    let (jobs, clip_jobs): (Vec<_>, Vec<_>) =
+        models.into_iter().map(|m| split_model(m, options)).unzip();
+    let (hull_zero, clipped) = rayon::join(
+        || {
+            let mut drawn: Vec<Drawn> = jobs
+                .into_par_iter()
+                .enumerate()
+                .map(|(i, job)| job.build(planes, &face_texinfos, options, occupants_of(i)))
+                .collect();
+            let t = Instant::now();
+            let squared_up = square_up_projections(
+                drawn.iter_mut().map(|d| &mut d.hull.faces),
+                planes,
+                table,
+                options.subdivide,
+            );
+            let table: &TexInfoTable = table;
+            let models: Vec<ModelDrawing> = drawn
+                .iter()
+                .map(|d| ModelDrawing {
+                    tree: &d.hull.tree,
+                    portals: &d.hull.portals,
+                    cluster_portals: d.hull.cluster_portals.as_ref(),
+                    faces: &d.hull.faces,
+                    bounds: d.bounds(),
+                })
+                .collect();
+            let drawing = emit_drawing(DrawingInput {
+                models: &models,
+                planes,
+                texinfos: &table.infos,
+                texture_names: &table.names,
+                texture_list,
+                version: options.version,
+                max_edges: options.max_edges,
+                transwater: options.transwater,
+            });
+            let face_stats = (squared_up, models.iter().map(|m| m.faces.len()).sum());
+            (drawn, drawing, table, face_stats, t.elapsed().as_secs_f64())
+        },
+        || {
+            clip_jobs
+                .into_par_iter()
+                .enumerate()
+                .map(|(i, job)| job.build(planes, options, occupants_of(i)))
+                .collect::<Vec<Clipped>>()
+        },
+    );
+    progress.finish();
+    let (drawn, drawing, table, (squared_up, after_subdivide), drawing_time) = hull_zero;
+    Built {
+        models: drawn
+            .into_iter()
+            .zip(clipped)
+            .map(|(d, c)| assemble(d, c))
+            .collect(),
+        drawing,
+        table,
+        squared_up,
+        after_subdivide,
+        drawing_time,
+    }
+}
+
+/// What [`build_models`] gives back.
+struct Built<'t> {
+    /// Each model's output and warnings.
+    models: Vec<(ModelOutput, Vec<Warning>)>,
+    /// The BSP as far as hull 0 writes it.
+    drawing: DrawnBsp<'t>,
+    /// The texinfo table, with the texinfos of squared-up faces.
+    table: &'t TexInfoTable,
+    /// Faces whose texture projection was squared up, and the faces after that cut them.
+    squared_up: usize,
+    after_subdivide: usize,
+    /// Seconds spent squaring up and writing hull 0.
+    drawing_time: f64,
+}
+
+/// What the faces of a model need of each texinfo.
+fn face_texinfos(table: &TexInfoTable) -> Vec<FaceTexInfo> {
+    table
         .infos
         .iter()
         .map(|i| FaceTexInfo {
@@ -387,22 +494,7 @@ fn build_models(
             role: i.role,
             special: i.is_special(),
         })
-        .collect();
-    let progress = &options.progress;
-    progress.start(
-        "models",
-        models.iter().map(ModelInput::work).sum::<usize>() * MODEL_WORK_PER_BRUSH,
-    );
-    let results = models
-        .into_par_iter()
-        .enumerate()
-        .map(|(i, m)| {
-            let occ: &[Occupant] = if i == 0 { occupants } else { &[] };
-            build_model(m, planes, &face_texinfos, options, occ)
-        })
-        .collect();
-    progress.finish();
-    results
+        .collect()
 }
 
 /// A warning for each brush entity left without brushes to build.
@@ -592,8 +684,8 @@ pub(crate) fn lump_entities(
 /// the tree left between brushes, textured from a side on another plane) Quake's own projection
 /// of that texture for its plane, as ericw-tools' qbsp repairs such sides, then cut it for its
 /// lightmap. Returns how many faces it squared up.
-fn square_up_projections(
-    outputs: &mut [ModelOutput],
+fn square_up_projections<'a>(
+    models: impl Iterator<Item = &'a mut Vec<ModelFace>>,
     planes: &PlaneSet,
     table: &mut TexInfoTable,
     subdivide: f64,
@@ -604,9 +696,9 @@ fn square_up_projections(
         scale: [1.0; 2],
     };
     let mut squared = 0;
-    for out in outputs {
-        let mut faces = Vec::with_capacity(out.faces.len());
-        for mut f in std::mem::take(&mut out.faces) {
+    for model_faces in models {
+        let mut faces = Vec::with_capacity(model_faces.len());
+        for mut f in std::mem::take(model_faces) {
             let normal = f.normal(planes);
             let info = table.infos[f.texinfo as usize];
             if projection_squareness(&info.vecs, normal) >= MIN_SQUARENESS {
@@ -624,7 +716,7 @@ fn square_up_projections(
             };
             cut_for_lightmaps(f, &squared_info, subdivide, &mut faces);
         }
-        out.faces = faces;
+        *model_faces = faces;
     }
     squared
 }

@@ -9,34 +9,58 @@ use crate::hulls::emit_clipnodes;
 use crate::int_hash::IntMap;
 use crate::model::ModelOutput;
 use crate::planes::{PlaneId, PlaneSet};
+use crate::portals::Portals;
 use crate::texinfo::TextureRole;
 use crate::tree::{Tree, engine_contents, is_see_through, vis_class};
 use crate::wad_lookup::{TextureList, WadSet};
 use crate::warnings::Warning;
 use crate::weld::{VertexWelder, WeldClass, cut_to_max_vertices, fix_tjunctions};
 use glam::DVec3;
+use quake_formats::bsp::face_flags::FaceFlags;
+use quake_formats::bsp::face_minlight::FaceMinlight;
+use quake_formats::bsp::face_tone::FaceTone;
 use quake_formats::bsp::leaf_flags::LeafFlags;
 use quake_formats::bsp::limits::QUAKESPASM_MAX_WARP_FACE_VERTS;
+use quake_formats::bsp::phong::FacePhong;
 use quake_formats::bsp::{BspPlane, Face, Leaf, Model, Node, TexInfo, contents, texinfo_flags};
 use quake_formats::entities::{Entity, write_entities};
 use quake_formats::geom::{Bounds, Plane};
 use quake_formats::prt::{PortalFile, PrtPortal};
 use quake_formats::{Bsp, BspVersion};
 
-pub(crate) struct EmitInput<'a> {
-    pub models: &'a [ModelOutput],
-    pub planes: &'a PlaneSet,
-    pub texinfos: &'a [MapTexInfo],
-    pub texture_names: &'a [String],
-    /// The texture lump's order; the textures of `texture_names` are found in it.
+/// What [`emit_drawing`] reads: every model's hull 0 (tree, portals, faces), and the tables
+/// they name.
+pub(crate) struct DrawingInput<'m, 't> {
+    pub models: &'m [ModelDrawing<'m>],
+    pub planes: &'t PlaneSet,
+    pub texinfos: &'t [MapTexInfo],
+    pub texture_names: &'t [String],
+    /// The texture lump's order; the textures of `texture_names` are found in it (and added to
+    /// it when missing).
     pub texture_list: TextureList,
-    pub wads: &'a WadSet,
-    pub entities: &'a [Entity],
     pub version: BspVersion,
-    /// Vis looks through liquids' surfaces ([`crate::CompileOptions::transwater`]).
-    pub transwater: bool,
     /// Faces with more edges are cut ([`crate::CompileOptions::max_edges`]; 0: never).
     pub max_edges: usize,
+    /// Vis looks through liquids' surfaces ([`crate::CompileOptions::transwater`]).
+    pub transwater: bool,
+}
+
+/// One model's hull 0: its tree, the portals around its leaves (and its clusters', when detail
+/// split them), the faces on its nodes, and its bounds.
+pub(crate) struct ModelDrawing<'a> {
+    pub tree: &'a Tree,
+    pub portals: &'a Portals,
+    pub cluster_portals: Option<&'a Portals>,
+    pub faces: &'a [ModelFace],
+    pub bounds: Bounds,
+}
+
+/// What [`emit`] reads besides what [`emit_drawing`] wrote.
+pub(crate) struct EmitInput<'a> {
+    /// Each model's bounds ([`ModelOutput::bounds`]) and clip hulls.
+    pub models: &'a [ModelOutput],
+    pub wads: &'a WadSet,
+    pub entities: &'a [Entity],
     pub warnings: &'a mut Vec<Warning>,
 }
 
@@ -165,7 +189,12 @@ struct PendingFace<'a> {
     vertices: Vec<u32>,
 }
 
-pub(crate) fn emit(mut input: EmitInput) -> Emitted {
+/// Hull 0 of every model written: vertices (welded, T-junctions fixed), edges, faces and the
+/// planes and texinfos they name (numbered first, in face order); nodes and leaves (their planes
+/// numbered by [`emit`], after each model's faces and before its clip nodes' as qbsp numbers
+/// them); and the world's portal file. Needs nothing of the clip hulls, which may still be
+/// building.
+pub(crate) fn emit_drawing<'t>(mut input: DrawingInput<'_, 't>) -> DrawnBsp<'t> {
     let mut bsp = Bsp::new(input.version);
     let mut planes = PlaneTable {
         source: input.planes,
@@ -191,7 +220,7 @@ pub(crate) fn emit(mut input: EmitInput) -> Emitted {
         .models
         .iter()
         .zip(&solids)
-        .map(|(m, s)| node_order(&m.tree, s))
+        .map(|(m, s)| node_order(m.tree, s))
         .collect();
     let mut welder = VertexWelder::default();
     let mut pending = Vec::new();
@@ -343,20 +372,18 @@ pub(crate) fn emit(mut input: EmitInput) -> Emitted {
             }
         }
     }
-
-    // Nodes, leaves and models.
+    // Nodes and leaves.
     bsp.leafs.push(Leaf::SHARED_SOLID);
     let mut leaf_contents = vec![ContentFlags::SOLID];
     let mut world_leaf_index: IntMap<u32, u32> = IntMap::default();
+    let mut trees = Vec::with_capacity(input.models.len());
     for (mi, m) in input.models.iter().enumerate() {
-        let (first_face, num_faces) = model_faces[mi];
-        let leaves_before = bsp.leafs.len();
+        let (first_node, leaves_before) = (bsp.nodes.len(), bsp.leafs.len());
         let mut w = TreeWriter {
             model: mi,
-            output: m,
+            drawing: m,
             solid: &solids[mi],
             bsp: &mut bsp,
-            planes: &mut planes,
             node_faces: &node_faces,
             leaf_faces: &leaf_faces,
             leaf_growth: &leaf_growth,
@@ -367,9 +394,8 @@ pub(crate) fn emit(mut input: EmitInput) -> Emitted {
         let (mut head, head_bounds) = w.node(0);
         if head < 0 {
             // Engines start at a node: give a one-leaf model a node with the leaf on both sides.
-            let plane = w.planes.push(&Plane::new(DVec3::new(0.0, 0.0, 1.0), 0.0));
             w.bsp.nodes.push(Node {
-                plane,
+                plane: ONE_LEAF_PLANE,
                 children: [head, head],
                 mins: head_bounds.mins.as_vec3().to_array(),
                 maxs: head_bounds.maxs.as_vec3().to_array(),
@@ -381,6 +407,102 @@ pub(crate) fn emit(mut input: EmitInput) -> Emitted {
         if mi == 0 {
             world_leaf_index = std::mem::take(&mut w.leaf_index);
         }
+        trees.push(WrittenTree {
+            head,
+            nodes: first_node..bsp.nodes.len(),
+            vis_leafs: (bsp.leafs.len() - leaves_before) as i32,
+        });
+    }
+    let portals = world_portal_file(
+        &input.models[0],
+        &world_leaf_index,
+        trees[0].vis_leafs,
+        input.transwater,
+    );
+    DrawnBsp {
+        bsp,
+        planes,
+        textures,
+        texture_list: input.texture_list,
+        trees,
+        leaf_contents,
+        portals,
+        model_faces,
+        face_lumps: FaceLumps {
+            phong,
+            flags,
+            surflight_groups,
+            minlights,
+            channels,
+            tones,
+        },
+        tjunction_vertices,
+    }
+}
+
+/// Each written face's entry of the per-face BSPX lumps, in face order.
+struct FaceLumps {
+    phong: Vec<FacePhong>,
+    flags: Vec<FaceFlags>,
+    surflight_groups: Vec<i32>,
+    minlights: Vec<FaceMinlight>,
+    channels: Vec<u32>,
+    tones: Vec<FaceTone>,
+}
+
+/// Where [`emit_drawing`] wrote a model's hull 0.
+struct WrittenTree {
+    /// The head node.
+    head: i32,
+    /// Its nodes, whose planes are still [`PlaneId`]s ([`ONE_LEAF_PLANE`] for a one-leaf
+    /// model's node).
+    nodes: std::ops::Range<usize>,
+    /// How many leaves it wrote.
+    vis_leafs: i32,
+}
+
+/// The plane of the node [`emit_drawing`] gives a one-leaf model until [`emit`] writes it: a
+/// plane of its own (z = 0), not one of the map's.
+const ONE_LEAF_PLANE: u32 = u32::MAX;
+
+/// The BSP as far as [`emit_drawing`] writes it, and what [`emit`] needs to finish it.
+pub(crate) struct DrawnBsp<'a> {
+    bsp: Bsp,
+    planes: PlaneTable<'a>,
+    textures: TextureTable<'a>,
+    texture_list: TextureList,
+    trees: Vec<WrittenTree>,
+    /// Each written leaf's extended content flags, in leaf order.
+    leaf_contents: Vec<ContentFlags>,
+    /// The world's portal file.
+    portals: PortalFile,
+    model_faces: Vec<(u32, u32)>,
+    face_lumps: FaceLumps,
+    tjunction_vertices: usize,
+}
+
+/// The rest of the BSP after [`emit_drawing`]: each model's node planes numbered, then its clip
+/// nodes written (as qbsp numbers planes); models, textures and the other lumps.
+pub(crate) fn emit(drawn: DrawnBsp, input: EmitInput) -> Emitted {
+    let DrawnBsp {
+        mut bsp,
+        mut planes,
+        textures,
+        texture_list,
+        trees,
+        leaf_contents,
+        portals,
+        model_faces,
+        face_lumps,
+        tjunction_vertices,
+    } = drawn;
+    for ((m, tree), (first_face, num_faces)) in input.models.iter().zip(&trees).zip(model_faces) {
+        for node in &mut bsp.nodes[tree.nodes.clone()] {
+            node.plane = match node.plane {
+                ONE_LEAF_PLANE => planes.push(&Plane::new(DVec3::new(0.0, 0.0, 1.0), 0.0)),
+                id => planes.get(id),
+            };
+        }
         let mut clip_heads = [contents::EMPTY; 2];
         for (hull, tree) in m.hulls.iter().enumerate() {
             clip_heads[hull] = emit_clipnodes(tree, &mut |id| planes.get(id), &mut bsp.clipnodes);
@@ -390,8 +512,8 @@ pub(crate) fn emit(mut input: EmitInput) -> Emitted {
             mins: written.mins.as_vec3().to_array(),
             maxs: written.maxs.as_vec3().to_array(),
             origin: [0.0; 3],
-            head_nodes: [head, clip_heads[0], clip_heads[1], 0],
-            vis_leafs: (bsp.leafs.len() - leaves_before) as i32,
+            head_nodes: [tree.head, clip_heads[0], clip_heads[1], 0],
+            vis_leafs: tree.vis_leafs,
             first_face,
             num_faces,
         });
@@ -402,17 +524,16 @@ pub(crate) fn emit(mut input: EmitInput) -> Emitted {
         }
     }
 
-    bsp.textures.textures =
-        input
-            .wads
-            .texture_lump(&input.texture_list, &textures.shown, input.warnings);
+    bsp.textures.textures = input
+        .wads
+        .texture_lump(&texture_list, &textures.shown, input.warnings);
     bsp.texinfo = textures.out_infos;
-    bsp.set_phong_faces(&phong);
-    bsp.set_face_flags(&flags);
-    bsp.set_surflight_groups(&surflight_groups);
-    bsp.set_face_minlights(&minlights);
-    bsp.set_face_channels(&channels);
-    bsp.set_face_tones(&tones);
+    bsp.set_phong_faces(&face_lumps.phong);
+    bsp.set_face_flags(&face_lumps.flags);
+    bsp.set_surflight_groups(&face_lumps.surflight_groups);
+    bsp.set_face_minlights(&face_lumps.minlights);
+    bsp.set_face_channels(&face_lumps.channels);
+    bsp.set_face_tones(&face_lumps.tones);
     let leaf_flags: Vec<LeafFlags> = leaf_contents
         .iter()
         .map(|c| LeafFlags {
@@ -422,13 +543,6 @@ pub(crate) fn emit(mut input: EmitInput) -> Emitted {
     bsp.set_leaf_flags(&leaf_flags);
     bsp.planes = planes.planes;
     bsp.set_entity_text(&write_entities(input.entities));
-
-    let portals = world_portal_file(
-        &input.models[0],
-        &world_leaf_index,
-        bsp.models[0].vis_leafs,
-        input.transwater,
-    );
     Emitted {
         bsp,
         portals,
@@ -437,12 +551,12 @@ pub(crate) fn emit(mut input: EmitInput) -> Emitted {
     }
 }
 
+/// Writes a model's hull 0 nodes (their planes left as [`PlaneId`]s) and leaves.
 struct TreeWriter<'a, 'b> {
     model: usize,
-    output: &'a ModelOutput,
+    drawing: &'a ModelDrawing<'a>,
     solid: &'a [bool],
     bsp: &'b mut Bsp,
-    planes: &'b mut PlaneTable<'a>,
     node_faces: &'b IntMap<(usize, u32), (u32, u32)>,
     leaf_faces: &'b IntMap<(usize, u32), Vec<u32>>,
     leaf_growth: &'b IntMap<(usize, u32), Bounds>,
@@ -450,7 +564,7 @@ struct TreeWriter<'a, 'b> {
     leaf_index: IntMap<u32, u32>,
     /// Each written leaf's extended content flags, in leaf order.
     leaf_contents: &'b mut Vec<ContentFlags>,
-    /// Liquids are detail and translucent ([`EmitInput::transwater`]).
+    /// Liquids are detail and translucent ([`DrawingInput::transwater`]).
     transwater: bool,
 }
 
@@ -462,22 +576,22 @@ impl TreeWriter<'_, '_> {
     /// included: a node's bounds hold its whole region, and the head node's the model's brushes
     /// grown by the outside box's margin. All are rounded outward to whole units.
     fn node(&mut self, n: u32) -> (i32, Bounds) {
-        let tree = &self.output.tree;
+        let tree = &self.drawing.tree;
         if self.solid[n as usize] {
             let region = tree
                 .leaves_below(n)
                 .into_iter()
                 .fold(Bounds::EMPTY, |acc, l| {
-                    acc.union(&self.output.portals.leaf_bounds(l))
+                    acc.union(&self.drawing.portals.leaf_bounds(l))
                 });
             return (-1, whole_units(region));
         }
         let node = &tree.nodes[n as usize];
         let Some(plane) = node.plane else {
-            let bounds = self.output.portals.leaf_bounds(n);
+            let bounds = self.drawing.portals.leaf_bounds(n);
             // A sliver leaf whose portals were all too small to keep: fall back to the model's box.
             let bounds = if bounds.is_empty() {
-                self.output.bounds
+                self.drawing.bounds
             } else {
                 bounds
             };
@@ -514,7 +628,7 @@ impl TreeWriter<'_, '_> {
             .copied()
             .unwrap_or((0, 0));
         self.bsp.nodes.push(Node {
-            plane: self.planes.get(plane),
+            plane,
             children: [0, 0],
             mins: [0.0; 3],
             maxs: [0.0; 3],
@@ -536,7 +650,7 @@ impl TreeWriter<'_, '_> {
 /// the world has detail, PRT2 between its clusters (structural leaves). Without `transwater`
 /// vis does not look across a liquid's surface (see [`vis_class`]).
 fn world_portal_file(
-    world: &ModelOutput,
+    world: &ModelDrawing,
     leaf_index: &IntMap<u32, u32>,
     vis_leafs: i32,
     transwater: bool,
@@ -544,7 +658,7 @@ fn world_portal_file(
     let tree = &world.tree.nodes;
     let num_leafs = vis_leafs.max(0) as u32;
     let across = |a: i32, b: i32| transwater || vis_class(a) == vis_class(b);
-    let Some(cluster_portals) = &world.cluster_portals else {
+    let Some(cluster_portals) = world.cluster_portals else {
         let mut portals = Vec::new();
         for p in &world.portals.portals {
             let (Some(&a), Some(&b)) = (leaf_index.get(&p.nodes[0]), leaf_index.get(&p.nodes[1]))

@@ -1,7 +1,8 @@
 //! One model from its brushes to its trees and faces: the world and every brush entity go
 //! through this on their own (in parallel).
 //!
-//! CSG marks the brush sides other brushes bury. Then two pipelines run side by side. Hull 0,
+//! Two pipelines run side by side, each first marking with CSG the brush sides other brushes
+//! bury ([`split_model`] parts the brushes, [`assemble`] joins the results). Hull 0,
 //! the drawing tree: built, portalised (and, when detail split its structural leaves, portalised
 //! again by clusters), its outside flooded from the world's point entities and filled, with the
 //! space no entity reaches; a sealed world's tree is then built again, split by the sides that
@@ -31,7 +32,7 @@ use glam::DVec3;
 use quake_formats::geom::Bounds;
 use std::time::Instant;
 
-/// Progress units [`build_model`] reports per brush of [`ModelInput::work`]: one for its CSG,
+/// Progress units a model's pipelines report per brush of [`ModelInput::work`]: one for its CSG,
 /// one for its tree, one for filling and faces.
 pub(crate) const MODEL_WORK_PER_BRUSH: usize = 3;
 
@@ -42,9 +43,6 @@ pub(crate) const MODEL_PHASES: [&str; 6] = ["tree", "portals", "outside", "faces
 pub(crate) struct ModelOutput {
     pub tree: Tree,
     pub portals: Portals,
-    /// Portals between the structural leaves, when detail split some of them.
-    pub cluster_portals: Option<Portals>,
-    pub faces: Vec<ModelFace>,
     pub hulls: [Tree; 2],
     pub bounds: Bounds,
     pub fill: Option<FillOutcome>,
@@ -53,62 +51,148 @@ pub(crate) struct ModelOutput {
     pub timings: [f64; 6],
 }
 
-/// Build model `m`. `occupants` are the world's point entities (none for brush entities).
-pub(crate) fn build_model(
-    m: ModelInput,
-    planes: &PlaneSet,
-    texinfos: &[FaceTexInfo],
-    options: &CompileOptions,
-    occupants: &[Occupant],
-) -> (ModelOutput, Vec<Warning>) {
-    let mut warnings = Vec::new();
-    let mut timings = [0.0; 6];
-    let build = ModelBuild {
-        planes,
-        texinfos,
-        options,
-        occupants,
-        splitting: Splitting {
-            heuristic: options.heuristic,
-            max_node_size: options.max_node_size,
-        },
+/// A model's brushes, split between its two pipelines: hull 0 ([`DrawingJob`]) and the clip
+/// hulls ([`ClipJob`]), which build side by side and are put together by [`assemble`].
+pub(crate) fn split_model(m: ModelInput, options: &CompileOptions) -> (DrawingJob, ClipJob) {
+    let shape = ModelShape {
         bounds: model_bounds(&m),
         // Only the world is flooded from the point entities.
         fills: m.entity == 0 && options.fill,
     };
-    let progress = &options.progress;
-    let t = Instant::now();
-    let mut brushes = m.brushes;
-    let [mut h1, mut h2] = m.hull_brushes;
-    for list in [&mut brushes, &mut h1, &mut h2] {
-        mark_hidden_sides(list, planes);
-        progress.advance(list.len());
-    }
-    timings[5] = t.elapsed().as_secs_f64();
-    // Hull 0 and the clip hulls side by side, neither waiting for the other.
-    let (drawing, (hulls, filled_hulls, hull_time)) = rayon::join(
-        || build.drawing_hull(brushes, &mut warnings),
-        || {
-            let t = Instant::now();
-            let (hulls, filled) = build.clip_hulls([h1, h2]);
-            (hulls, filled, t.elapsed().as_secs_f64())
+    (
+        DrawingJob {
+            shape,
+            brushes: m.brushes,
         },
-    );
+        ClipJob {
+            shape,
+            brushes: m.hull_brushes,
+        },
+    )
+}
+
+/// What both of a model's pipelines know of it.
+#[derive(Debug, Clone, Copy)]
+struct ModelShape {
+    /// The model's bounds ([`model_bounds`]).
+    bounds: Bounds,
+    /// Its outside is flooded and filled (the world, unless `-nofill`).
+    fills: bool,
+}
+
+/// A model's brushes for hull 0.
+pub(crate) struct DrawingJob {
+    shape: ModelShape,
+    brushes: Vec<Brush>,
+}
+
+/// A model's grown brushes for hulls 1 and 2.
+pub(crate) struct ClipJob {
+    shape: ModelShape,
+    brushes: [Vec<Brush>; 2],
+}
+
+/// Hull 0 of a model built, with its warnings and the seconds of its CSG.
+pub(crate) struct Drawn {
+    pub hull: DrawingHull,
+    pub warnings: Vec<Warning>,
+    shape: ModelShape,
+    csg_time: f64,
+}
+
+/// The clip hulls of a model built, and for the world filled on copies (kept when hull 0 is
+/// sealed), with the seconds of their CSG and of the rest.
+pub(crate) struct Clipped {
+    hulls: [Tree; 2],
+    filled: Option<[Tree; 2]>,
+    csg_time: f64,
+    time: f64,
+}
+
+impl Drawn {
+    /// The model's bounds ([`model_bounds`]).
+    pub(crate) fn bounds(&self) -> Bounds {
+        self.shape.bounds
+    }
+}
+
+impl DrawingJob {
+    /// CSG, then hull 0 built ([`ModelBuild::drawing_hull`]). `occupants` are the world's point
+    /// entities (none for brush entities).
+    pub(crate) fn build(
+        self,
+        planes: &PlaneSet,
+        texinfos: &[FaceTexInfo],
+        options: &CompileOptions,
+        occupants: &[Occupant],
+    ) -> Drawn {
+        let t = Instant::now();
+        let mut brushes = self.brushes;
+        mark_hidden_sides(&mut brushes, planes);
+        options.progress.advance(brushes.len());
+        let csg_time = t.elapsed().as_secs_f64();
+        let mut warnings = Vec::new();
+        let hull = ModelBuild::new(planes, texinfos, options, occupants, self.shape)
+            .drawing_hull(brushes, &mut warnings);
+        Drawn {
+            hull,
+            warnings,
+            shape: self.shape,
+            csg_time,
+        }
+    }
+}
+
+impl ClipJob {
+    /// CSG, then the clip hulls built ([`ModelBuild::clip_hulls`]).
+    pub(crate) fn build(
+        self,
+        planes: &PlaneSet,
+        options: &CompileOptions,
+        occupants: &[Occupant],
+    ) -> Clipped {
+        let t = Instant::now();
+        let mut brushes = self.brushes;
+        for list in &mut brushes {
+            mark_hidden_sides(list, planes);
+            options.progress.advance(list.len());
+        }
+        let csg_time = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let (hulls, filled) =
+            ModelBuild::new(planes, &[], options, occupants, self.shape).clip_hulls(brushes);
+        Clipped {
+            hulls,
+            filled,
+            csg_time,
+            time: t.elapsed().as_secs_f64(),
+        }
+    }
+}
+
+/// A model's output from its two pipelines; its warnings.
+pub(crate) fn assemble(drawn: Drawn, clipped: Clipped) -> (ModelOutput, Vec<Warning>) {
+    let Drawn {
+        hull: drawing,
+        warnings,
+        shape,
+        csg_time,
+    } = drawn;
     let sealed = matches!(drawing.fill, Some(FillOutcome::Sealed { .. }));
-    let hulls = match filled_hulls {
+    let hulls = match clipped.filled {
         Some(filled) if sealed => filled,
-        _ => hulls,
+        _ => clipped.hulls,
     };
+    let mut timings = [0.0; 6];
     timings[..4].copy_from_slice(&drawing.times);
-    timings[4] = hull_time;
+    timings[4] = clipped.time;
+    timings[5] = csg_time + clipped.csg_time;
     (
         ModelOutput {
             tree: drawing.tree,
             portals: drawing.portals,
-            cluster_portals: drawing.cluster_portals,
-            faces: drawing.faces,
             hulls,
-            bounds: build.bounds,
+            bounds: shape.bounds,
             fill: drawing.fill,
             face_stats: drawing.face_stats,
             timings,
@@ -130,14 +214,37 @@ struct ModelBuild<'a> {
     fills: bool,
 }
 
+impl<'a> ModelBuild<'a> {
+    fn new(
+        planes: &'a PlaneSet,
+        texinfos: &'a [FaceTexInfo],
+        options: &'a CompileOptions,
+        occupants: &'a [Occupant],
+        shape: ModelShape,
+    ) -> Self {
+        ModelBuild {
+            planes,
+            texinfos,
+            options,
+            occupants,
+            splitting: Splitting {
+                heuristic: options.heuristic,
+                max_node_size: options.max_node_size,
+            },
+            bounds: shape.bounds,
+            fills: shape.fills,
+        }
+    }
+}
+
 /// Hull 0 of a model, built: [`ModelOutput`]'s parts of it, and the seconds of its first four
 /// [`MODEL_PHASES`].
-struct DrawingHull {
-    tree: Tree,
-    portals: Portals,
-    cluster_portals: Option<Portals>,
+pub(crate) struct DrawingHull {
+    pub tree: Tree,
+    pub portals: Portals,
+    pub cluster_portals: Option<Portals>,
     fill: Option<FillOutcome>,
-    faces: Vec<ModelFace>,
+    pub faces: Vec<ModelFace>,
     face_stats: FaceStats,
     times: [f64; 4],
 }
