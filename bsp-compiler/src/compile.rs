@@ -354,6 +354,7 @@ pub fn compile(
         path: source.path.clone(),
         refused,
     })?;
+    drop_in_background((outputs, wads, map));
     Ok(CompileOutput {
         bsp,
         portals: emitted.portals,
@@ -362,6 +363,15 @@ pub fn compile(
         warnings,
         stats,
     })
+}
+
+/// Free `value` on a thread of its own: the models' trees and portals are hundreds of thousands
+/// of small blocks, and freeing them need not hold up writing the files.
+fn drop_in_background<T: Send + 'static>(value: T) {
+    // Should no thread start, the closure and `value` with it are dropped here.
+    let _ = std::thread::Builder::new()
+        .name("free".to_string())
+        .spawn(move || drop(value));
 }
 
 /// The faces without `TEX_SPECIAL` wider than WinQuake accepts, when there are any (faces too
