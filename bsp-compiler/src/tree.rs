@@ -592,11 +592,11 @@ impl Builder<'_> {
             let Some(plane) = self.choose_splitter(&brushes, phase) else {
                 break (None, false);
             };
-            if let Some(parts) = region.split_cleanly(self.planes.get(plane)) {
-                break (Some((plane, parts)), false);
-            }
             if !self.clean_splits {
                 break (Some((plane, region.split(self.planes.get(plane)))), false);
+            }
+            if let Some(parts) = region.split_cleanly(self.planes.get(plane)) {
+                break (Some((plane, parts)), false);
             }
             // Rare: choose again with the sliver given to the rest of the region.
             brushes = self.absorb_sliver(brushes, plane, &region);
