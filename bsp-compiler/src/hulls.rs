@@ -78,8 +78,13 @@ pub fn bevelled_planes(brush: &Brush, planes: &PlaneSet) -> Vec<Plane> {
                 let Some(n) = dir.cross(a).normalized() else {
                     continue;
                 };
+                // Along an axis, the bevel is a side of the bounding box, listed above (its
+                // distance is the same extreme of the same points).
+                if Plane::new(n, 0.0).axial().is_some() {
+                    continue;
+                }
                 for n in [n, -n] {
-                    let bevel = supporting_plane(Plane::snap_normal(n), &points);
+                    let bevel = supporting_plane(n, &points);
                     if bevel.distance(p) >= -ON_EPSILON {
                         push_unique(&mut list, bevel);
                     }
