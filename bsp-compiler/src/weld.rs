@@ -37,21 +37,27 @@ impl VertexWelder {
     }
 
     pub fn weld(&mut self, p: DVec3) -> u32 {
-        let cell = Self::cell(p);
         // Every point within the epsilon lies in a cell its box (doubled against rounding)
         // reaches: one cell mostly, at most eight, searched in the order of the 27 around it.
         let reach = DVec3::splat(2.0 * POINT_EPSILON);
         let (lo, hi) = (Self::cell(p - reach), Self::cell(p + reach));
-        let found = (lo[0]..=hi[0])
-            .flat_map(|x| {
-                (lo[1]..=hi[1]).flat_map(move |y| (lo[2]..=hi[2]).map(move |z| [x, y, z]))
-            })
-            .filter_map(|c| self.cells.get(&c))
-            .flatten()
-            .find(|&&id| self.positions[id as usize].near(p, POINT_EPSILON));
-        if let Some(&id) = found {
-            return id;
+        for x in lo[0]..=hi[0] {
+            for y in lo[1]..=hi[1] {
+                for z in lo[2]..=hi[2] {
+                    let Some(ids) = self.cells.get(&[x, y, z]) else {
+                        continue;
+                    };
+                    let positions = &self.positions;
+                    if let Some(&id) = ids
+                        .iter()
+                        .find(|&&id| positions[id as usize].near(p, POINT_EPSILON))
+                    {
+                        return id;
+                    }
+                }
+            }
         }
+        let cell = Self::cell(p);
         let id = self.positions.len() as u32;
         self.positions.push(p);
         self.cells.entry(cell).or_default().push(id);
