@@ -160,6 +160,7 @@ impl ClipJob {
         let csg_time = t.elapsed().as_secs_f64();
         let t = Instant::now();
         let (hulls, filled) =
+            // The clip hulls make no faces: no texinfos.
             ModelBuild::new(planes, &[], options, occupants, self.shape).clip_hulls(brushes);
         Clipped {
             hulls,

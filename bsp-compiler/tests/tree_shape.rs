@@ -247,3 +247,30 @@ fn a_sky_ceiling_on_an_edge_room() {
         contents::SOLID
     );
 }
+
+/// A brush entity of clip brushes only draws nothing: its hull 0 is one leaf, which engines
+/// reach through a node of its own with that leaf on both sides, on a plane of its own (z = 0),
+/// numbered once the world's nodes have theirs and before the entity's clip nodes name theirs.
+#[test]
+fn a_model_of_clip_brushes_gets_a_node_of_its_own() {
+    let clip = box_brush([0.0, -96.0, -112.0], [64.0, -32.0, -64.0], "clip");
+    let out = compile_text(&room_map_with(false, "", &brush_entity("func_wall", &clip)));
+    let bsp = &out.bsp;
+    assert_eq!(bsp.models.len(), 2);
+    let model = &bsp.models[1];
+    let head = &bsp.nodes[model.head_nodes[0] as usize];
+    assert!(head.children[0] < 0);
+    assert_eq!(head.children[0], head.children[1]);
+    let plane = &bsp.planes[head.plane as usize];
+    assert_eq!((plane.normal, plane.dist), ([0.0, 0.0, 1.0], 0.0));
+    // The world's node planes come first, then this one, then the entity's clip nodes' planes.
+    let world_planes = bsp.models[0].head_nodes[0] as usize..model.head_nodes[0] as usize;
+    let last_world_plane = bsp.nodes[world_planes]
+        .iter()
+        .map(|n| n.plane)
+        .max()
+        .expect("world nodes");
+    assert!(head.plane > last_world_plane);
+    let clip_head = &bsp.clipnodes[model.head_nodes[1] as usize];
+    assert!(clip_head.plane > head.plane);
+}
