@@ -197,7 +197,9 @@ impl<'a> Lexer<'a> {
         self.skip_blank();
         let start = self.pos;
         while let Some(&c) = self.text.get(self.pos) {
-            if c.is_ascii_whitespace() || (stop_at_brackets && b"()[]{}\"".contains(&c)) {
+            if c.is_ascii_whitespace()
+                || (stop_at_brackets && matches!(c, b'(' | b')' | b'[' | b']' | b'{' | b'}' | b'"'))
+            {
                 break;
             }
             self.pos += 1;
@@ -205,6 +207,22 @@ impl<'a> Lexer<'a> {
         // Bytes come from a &str and we only stop at ASCII, so this is valid UTF-8.
         std::str::from_utf8(&self.text[start..self.pos]).unwrap_or("")
     }
+}
+
+/// A finite number as `f64`'s parser reads `word`. Most of a map's numbers are whole (`-128`):
+/// up to 15 digits, below 2^53, they are read digit by digit into the same value (`-0` too).
+fn map_number(word: &str) -> Option<f64> {
+    let (negative, digits) = match word.strip_prefix('-') {
+        Some(digits) => (true, digits),
+        None => (false, word),
+    };
+    if (1..=15).contains(&digits.len()) && digits.bytes().all(|b| b.is_ascii_digit()) {
+        let whole = digits
+            .bytes()
+            .fold(0u64, |n, b| n * 10 + u64::from(b - b'0')) as f64;
+        return Some(if negative { -whole } else { whole });
+    }
+    word.parse::<f64>().ok().filter(|v| v.is_finite())
 }
 
 struct Parser<'a> {
@@ -247,9 +265,9 @@ impl Parser<'_> {
         self.lex.skip_blank();
         let (line, column) = (self.lex.line, self.lex.column());
         let word = self.lex.word(true);
-        match word.parse::<f64>() {
-            Ok(v) if v.is_finite() => Ok(v),
-            _ => {
+        match map_number(word) {
+            Some(v) => Ok(v),
+            None => {
                 let mut e = self.error(if word.is_empty() {
                     "expected a number".to_string()
                 } else {
@@ -396,6 +414,43 @@ impl Parser<'_> {
 
 #[cfg(test)]
 mod tests {
+    use proptest::prelude::*;
+
+    proptest! {
+        /// Whole numbers read digit by digit are the values `f64`'s parser gives, bit for bit.
+        #[test]
+        fn whole_numbers_read_as_f64_reads_them(n in -999_999_999_999_999i64..=999_999_999_999_999, zeros in 0usize..3, minus in any::<bool>()) {
+            let digits = format!("{}{}", "0".repeat(zeros), n.unsigned_abs());
+            let word = if minus || n < 0 { format!("-{digits}") } else { digits };
+            let expected = word.parse::<f64>().ok();
+            prop_assert_eq!(super::map_number(&word).map(f64::to_bits), expected.map(f64::to_bits));
+        }
+    }
+
+    #[test]
+    fn map_numbers_past_the_whole_ones() {
+        for word in [
+            "-0",
+            "0",
+            "-",
+            "",
+            "1.5",
+            "-2.25e3",
+            "+7",
+            "0x10",
+            "1234567890123456",
+            "inf",
+            "nan",
+        ] {
+            let expected = word.parse::<f64>().ok().filter(|v| v.is_finite());
+            assert_eq!(
+                super::map_number(word).map(f64::to_bits),
+                expected.map(f64::to_bits),
+                "{word}"
+            );
+        }
+    }
+
     use super::*;
 
     fn parse(text: &str) -> Result<MapFile, MapError> {
