@@ -9,14 +9,12 @@
 #   start.bsp LibreQuake start, the corpus BSP itself.
 # Usage: bench/agreement_bsps.sh [OUT]
 set -euo pipefail
-root=$(cd "$(dirname "$0")/.." && pwd)
-shared="$root/../shared"
-anchor="$shared/anchors/ericw-tools/bin"
+source "$(dirname "$0")/common.sh"
+anchor="$root/../shared/anchors/ericw-tools/bin"
 [ -x "$anchor/qbsp" ] || { echo "SKIPPED: $anchor/qbsp not found" >&2; exit 0; }
 out="${1:-/tmp/agree}"
 mkdir -p "$out"
-cargo build --release --manifest-path "$root/Cargo.toml" -p slipgate >/dev/null
-slipgate="${CARGO_TARGET_DIR:-$root/target}/release/slipgate"
+slipgate=$(slipgate_binary)
 
 # A 16x16 grey picture as an uncompressed 24-bit TGA.
 grey_tga() {
@@ -32,22 +30,22 @@ id_map() {
   local name=$1; shift
   rm -f "$pictures"/*
   # Texture names: the word after a map face's three points.
-  sed -n 's/^ *(.*) *(.*) *(.*) *\([^ ]*\) .*/\1/p' "$shared/corpus/public/maps/id/$name.map" \
+  sed -n 's/^ *(.*) *(.*) *(.*) *\([^ ]*\) .*/\1/p' "$corpus/public/maps/id/$name.map" \
     | sort -u | while read -r texture; do
       grey_tga > "$pictures/${texture/\*/#}.tga"
     done
   "$slipgate" wad build "$pictures" "$out/$name-placeholder.wad" >/dev/null 2>&1
   sed "s#\"wad\"[[:space:]]*\"[^\"]*\"#\"wad\" \"$out/$name-placeholder.wad\"#" \
-    "$shared/corpus/public/maps/id/$name.map" > "$out/$name.map"
+    "$corpus/public/maps/id/$name.map" > "$out/$name.map"
   (cd "$out" && "$anchor/qbsp" "$name.map" >/dev/null && "$anchor/vis" "$@" "$name.bsp" >/dev/null)
 }
 id_map e1m1
 for name in e1m2 e2m5 dm2; do id_map "$name" -fast; done
 
-sed 's#\.\./\.\./\.\./\.\./texture-wads/##g' "$shared/corpus/public/maps/librequake/e1m3.map" \
+sed 's#\.\./\.\./\.\./\.\./texture-wads/##g' "$corpus/public/maps/librequake/e1m3.map" \
   > "$out/e1m3.map"
-(cd "$out" && "$anchor/qbsp" -wadpath "$shared/corpus/wads/librequake" e1m3.map >/dev/null \
+(cd "$out" && "$anchor/qbsp" -wadpath "$corpus/wads/librequake" e1m3.map >/dev/null \
   && "$anchor/vis" -fast e1m3.bsp >/dev/null)
 
-cp "$shared/corpus/public/bsp/librequake/start.bsp" "$out/start.bsp"
+cp "$corpus/public/bsp/librequake/start.bsp" "$out/start.bsp"
 echo "$out/e1m1.bsp $out/e1m2.bsp $out/e2m5.bsp $out/dm2.bsp $out/e1m3.bsp $out/start.bsp"

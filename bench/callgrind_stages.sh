@@ -4,14 +4,9 @@
 # cost speed (the move to glam quotes them). Slow: about half an hour per binary.
 # Usage: bench/callgrind_stages.sh [SLIPGATE_BINARY] [OUT_DIR]
 set -euo pipefail
-root=$(cd "$(dirname "$0")/.." && pwd)
-corpus="$root/../shared/corpus"
+source "$(dirname "$0")/common.sh"
 [ -d "$corpus" ] || { echo "SKIPPED: $corpus not found" >&2; exit 0; }
-bin=${1:-}
-if [ -z "$bin" ]; then
-  cargo build --release --manifest-path "$root/Cargo.toml" -p slipgate >/dev/null
-  bin="${CARGO_TARGET_DIR:-$root/target}/release/slipgate"
-fi
+bin=${1:-$(slipgate_binary)}
 out=${2:-$root/target/callgrind}
 mkdir -p "$out"
 export RAYON_NUM_THREADS=1

@@ -5,10 +5,9 @@
 # report.md, report.json, report.html and the plots into OUT (default target/report).
 # Usage: [RUNS=3] [OUT=DIR] bench/corpus.sh [MAP.map ...]
 set -euo pipefail
-root=$(cd "$(dirname "$0")/.." && pwd)
+source "$(dirname "$0")/common.sh"
 anchor="$root/../shared/anchors/ericw-tools/bin"
-cargo build --release --manifest-path "$root/Cargo.toml" -p slipgate >/dev/null
-slipgate="${CARGO_TARGET_DIR:-$root/target}/release/slipgate"
+slipgate=$(slipgate_binary)
 args=(--runs "${RUNS:-3}" --out-dir "${OUT:-$root/target/report}")
 if [ -x "$anchor/qbsp" ]; then
   args+=(--anchor "$anchor")

@@ -6,7 +6,7 @@
 # flat columns. Prints a Markdown table; bench/results/bsp-compiler-scaling.md comes from it.
 # Usage: [RUNS=3] [SIZES="1000 2000 4000 8000"] bench/csg_scaling.sh
 set -euo pipefail
-root=$(cd "$(dirname "$0")/.." && pwd)
+source "$(dirname "$0")/common.sh"
 cargo build --release --manifest-path "$root/Cargo.toml" -p slipgate -p slipgate-mapgen >/dev/null
 bin="${CARGO_TARGET_DIR:-$root/target}/release"
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT

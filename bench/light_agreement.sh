@@ -5,7 +5,7 @@
 # differ most (light/examples/ericw_agreement.rs). bench/results/light-agreement.md comes from it.
 # Usage: [OURS="--extra4 --soft"] [ERICW="-extra4 -soft"] [WORST=20] bench/light_agreement.sh MAP.bsp...
 set -euo pipefail
-root=$(cd "$(dirname "$0")/.." && pwd)
+source "$(dirname "$0")/common.sh"
 anchor="$root/../shared/anchors/ericw-tools/bin/light"
 [ -x "$anchor" ] || { echo "SKIPPED: $anchor not found" >&2; exit 0; }
 cargo build --release --manifest-path "$root/Cargo.toml" -p slipgate -p slipgate-light --bins \

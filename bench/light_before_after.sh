@@ -6,7 +6,7 @@
 # Usage: [ROUNDS=3] [OURS="--bounce"] [ERICW="-bounce"] bench/light_before_after.sh BEFORE AFTER MAP.bsp...
 set -euo pipefail
 [ $# -ge 3 ] || { sed -n '2,7s/^# \{0,1\}//p' "$0"; exit 2; }
-root=$(cd "$(dirname "$0")/.." && pwd)
+source "$(dirname "$0")/common.sh"
 anchor="$root/../shared/anchors/ericw-tools/bin/light"
 [ -x "$anchor" ] || { echo "SKIPPED: $anchor not found" >&2; exit 0; }
 before=$1; after=$2; shift 2

@@ -8,11 +8,10 @@
 # (vised BSPs; nothing is written beside them). OURS and ERICW are each tool's options for the
 # same settings, e.g. OURS="--extra4 --soft --bounce --dirt" ERICW="-extra4 -soft -bounce -dirt".
 set -euo pipefail
-root=$(cd "$(dirname "$0")/.." && pwd)
+source "$(dirname "$0")/common.sh"
 anchor="$root/../shared/anchors/ericw-tools/bin/light"
 [ -x "$anchor" ] || { echo "SKIPPED: $anchor not found" >&2; exit 0; }
-cargo build --release --manifest-path "$root/Cargo.toml" -p slipgate >/dev/null
-ours="${CARGO_TARGET_DIR:-$root/target}/release/slipgate"
+ours=$(slipgate_binary)
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
 runs="$work/runs.txt"
 # Milliseconds matter: a default-quality e1m1 run takes a tenth of a second.

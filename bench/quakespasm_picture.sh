@@ -8,7 +8,7 @@
 set -euo pipefail
 [ $# -eq 4 ] || { sed -n '2,7p' "$0" >&2; exit 2; }
 bsp=$1 origin=$2 yaw=$3 out=$4
-root=$(cd "$(dirname "$0")/.." && pwd)
+source "$(dirname "$0")/common.sh"
 id1="$root/../shared/engine/id1"
 client=$(command -v quakespasm || echo /usr/games/quakespasm)
 for need in "$id1" "$client" "$(command -v xvfb-run || true)"; do

@@ -8,8 +8,7 @@
 # (set NO_ANCHOR=1 to skip it: it takes minutes), and compared the same way.
 # Usage: [NO_ANCHOR=1] bench/visual_check.sh [OUT_DIR]
 set -euo pipefail
-root=$(cd "$(dirname "$0")/.." && pwd)
-corpus="$root/../shared/corpus"
+source "$(dirname "$0")/common.sh"
 [ -d "$corpus" ] || { echo "SKIPPED: $corpus not found"; exit 0; }
 out=${1:-$(mktemp -d)}
 mkdir -p "$out"
