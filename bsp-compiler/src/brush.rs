@@ -29,8 +29,8 @@ pub struct Side {
 /// face and a bevel a millionth of a radian apart): the first of them keeps it. Dropping both
 /// would leave the brush without that side, bounded further out by its other planes.
 fn clip_behind(w: Winding, plane: &Plane, other: &Plane, other_first: bool) -> Option<Winding> {
-    w.into_front_unless_on(&other.flipped())
-        .unwrap_or_else(|on| (!other_first && plane.normal.dot(other.normal) > 0.0).then_some(on))
+    let keep_on = !other_first && plane.normal.dot(other.normal) > 0.0;
+    w.into_front_keeping_on(&other.flipped(), keep_on)
 }
 
 /// What a brush does to the tree's structure.

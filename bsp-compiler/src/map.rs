@@ -414,6 +414,7 @@ impl Parser<'_> {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
     use proptest::prelude::*;
 
     proptest! {
@@ -423,7 +424,7 @@ mod tests {
             let digits = format!("{}{}", "0".repeat(zeros), n.unsigned_abs());
             let word = if minus || n < 0 { format!("-{digits}") } else { digits };
             let expected = word.parse::<f64>().ok();
-            prop_assert_eq!(super::map_number(&word).map(f64::to_bits), expected.map(f64::to_bits));
+            prop_assert_eq!(map_number(&word).map(f64::to_bits), expected.map(f64::to_bits));
         }
     }
 
@@ -444,14 +445,12 @@ mod tests {
         ] {
             let expected = word.parse::<f64>().ok().filter(|v| v.is_finite());
             assert_eq!(
-                super::map_number(word).map(f64::to_bits),
+                map_number(word).map(f64::to_bits),
                 expected.map(f64::to_bits),
                 "{word}"
             );
         }
     }
-
-    use super::*;
 
     fn parse(text: &str) -> Result<MapFile, MapError> {
         parse_map(Path::new("t.map"), text)

@@ -122,7 +122,8 @@ impl PortalFile {
         for p in &self.portals {
             let _ = write!(out, "{} {} {}", p.winding.len(), p.leafs[0], p.leafs[1]);
             for v in &p.winding.points {
-                // Coordinates as the f32 they are read back as.
+                // Each coordinate as the shortest text that reads back to the same `f32` (what
+                // vis gets anyway).
                 let _ = write!(out, " ({} {} {} )", v.x as f32, v.y as f32, v.z as f32);
             }
             out.push('\n');
@@ -157,7 +158,6 @@ fn parse_cluster(line: usize, text: &str, num_leafs: u32) -> Result<Vec<u32>> {
     Err(err("cluster leaf list does not end with -1".to_string()))
 }
 
-/// Coordinates as the shortest text that reads back to the same `f32` (what vis gets anyway).
 fn parse_portal(line: usize, text: &str, num_ends: u32) -> Result<PrtPortal> {
     let err = |detail: String| FormatError::Syntax { line, detail };
     let cleaned = text.replace(['(', ')'], " ");

@@ -283,31 +283,19 @@ impl Winding {
     /// given away: one wholly in front comes back as it is, without a copy, and each point's
     /// distance is measured once (classifying first and then clipping measured twice).
     pub fn into_front(self, plane: &Plane) -> Option<Winding> {
-        self.into_front_unless_on(plane).unwrap_or(None)
+        self.into_front_keeping_on(plane, false)
     }
 
-    /// [`Winding::into_front`], unless the winding lies on `plane` (within [`ON_EPSILON`]):
-    /// then it comes back whole as the error, for the caller to decide, from the one pass over
-    /// its points that finds where it lies.
-    pub fn into_front_unless_on(self, plane: &Plane) -> Result<Option<Winding>, Winding> {
-        enum Clip {
-            Whole,
-            Part(Winding),
-            Nothing,
-            On,
-        }
-        let clip = self.with_distances(plane, |dists, whole| match whole {
-            PlaneSide::Front => Clip::Whole,
-            PlaneSide::Cross => Clip::Part(self.front_of_crossing(plane, dists)),
-            PlaneSide::Back => Clip::Nothing,
-            PlaneSide::On => Clip::On,
+    /// [`Winding::into_front`], and a winding lying on `plane` (within [`ON_EPSILON`]) kept whole
+    /// when `keep_on` is set, as [`Winding::clip_front`] keeps it.
+    pub fn into_front_keeping_on(self, plane: &Plane, keep_on: bool) -> Option<Winding> {
+        let clipped = self.with_distances(plane, |dists, whole| match whole {
+            PlaneSide::Front => None,
+            PlaneSide::On => (!keep_on).then_some(None),
+            PlaneSide::Cross => Some(Some(self.front_of_crossing(plane, dists))),
+            PlaneSide::Back => Some(None),
         });
-        match clip {
-            Clip::Whole => Ok(Some(self)),
-            Clip::Part(front) => Ok(Some(front)),
-            Clip::Nothing => Ok(None),
-            Clip::On => Err(self),
-        }
+        clipped.unwrap_or(Some(self))
     }
 
     /// [`Winding::clip_front`] of a winding with points on both sides of `plane` at `dists`.
