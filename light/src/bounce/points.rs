@@ -179,6 +179,13 @@ impl<'a> PointField<'a> {
         let mut lighting: Vec<&PointEmitter> = Vec::new();
         let mut weights: Vec<f32> = Vec::with_capacity(BATCH + n);
         let at = Luxels::new(&r.points, &r.normals);
+        // One normal for every luxel (a flat one-sided face): the receiving cosine is bounded
+        // by the emitter's height over the luxels too.
+        let flat_normal = (!r.two_sided)
+            .then(|| r.normals.first())
+            .flatten()
+            .filter(|&&first| r.normals.iter().all(|&m| m == first))
+            .map(|&m| Vec3::from(m).as_dvec3());
         for k in self.in_sight_of(r.face) {
             let e = &self.emitters[k as usize];
             if e.face == r.face || (!r.two_sided && plane.distance(e.point) <= 0.0) {
@@ -192,6 +199,11 @@ impl<'a> PointField<'a> {
             let max_total = e.max_intensity();
             let nearest = e.point.clamp(lo, hi).distance_squared(e.point);
             if self.kernel * max_total / nearest.max(HOTSPOT_CLAMP * HOTSPOT_CLAMP) < GATE {
+                continue;
+            }
+            if flat_normal
+                .is_some_and(|n_r| under_gate(e, n_r, (lo, hi), self.kernel * max_total / GATE))
+            {
                 continue;
             }
             let start = weights.len();
@@ -275,6 +287,31 @@ impl PointField<'_> {
         }
         out
     }
+}
+
+/// Slack on the bounds of [`under_gate`], in units, for the single precision [`weigh`] works
+/// in (coordinates within a few thousand units: their rounding is well under this).
+const BOUND_SLACK: f64 = 0.01;
+
+/// Whether every luxel in the box `(lo, hi)` of a flat one-sided face with normal `n_r` takes
+/// from `e` a weight [`weigh`] sets to zero, `scale` being the kernel times the emitter's
+/// intensity over the gate: `cos θe · d` is at most the largest of `n_e · (c − e)` over the
+/// box's corners `c`, `cos θr · d` at most that of `−n_r · (c − e)` (both linear, so largest
+/// at a corner), and `d` at least the box's distance, each widened by [`BOUND_SLACK`] and the
+/// product by a thousandth for the rounding of single precision.
+fn under_gate(e: &PointEmitter, n_r: DVec3, (lo, hi): (DVec3, DVec3), scale: f64) -> bool {
+    let most_along = |n: DVec3| {
+        let (a, b) = (n * (lo - e.point), n * (hi - e.point));
+        a.max(b).element_sum() + BOUND_SLACK
+    };
+    let (along_e, along_r) = (most_along(e.normal), most_along(-n_r));
+    if along_e <= 0.0 || along_r <= 0.0 {
+        return true;
+    }
+    let near = (e.point.clamp(lo, hi).distance(e.point) - BOUND_SLACK).max(f64::from(MIN_DISTANCE));
+    let d2 = near * near;
+    let clamp = HOTSPOT_CLAMP * HOTSPOT_CLAMP;
+    scale * along_e * along_r / (d2 * d2.max(clamp)) * 1.001 < 1.0
 }
 
 /// A face's luxels, coordinate by coordinate (so that weighing them vectorises).
@@ -562,51 +599,63 @@ fn see(
     let n = w * h;
     let mut state = vec![State::Unknown; weights.len()];
     let mut packet = RayPacket16::new();
-    let mut rays: Vec<usize> = Vec::new();
+    // Segments to trace: (emitter, luxel).
+    let mut rays: Vec<(usize, usize)> = Vec::new();
     let mut step = FIRST_STEP;
     while step >= 1 {
+        // Per column and per row, the ends of the coarser grid's cell it lies in.
         let coarse = step * 2;
-        let cell = |x: usize, size: usize| {
-            let lo = x / coarse * coarse;
-            (lo, (lo + coarse).min(size - 1))
+        let cells = |size: usize| -> Vec<(usize, usize)> {
+            (0..size)
+                .map(|x| {
+                    let lo = x / coarse * coarse;
+                    (lo, (lo + coarse).min(size - 1))
+                })
+                .collect()
         };
+        let (cell_x, cell_y) = (cells(w), cells(h));
         let (xs, ys) = (crate::grid::grid(w, step), crate::grid::grid(h, step));
         rays.clear();
         for (k, weak) in weak.iter().enumerate() {
             let at = k * n;
-            if let Some(best) = weak {
+            if let Some(best) = *weak {
                 if step == FIRST_STEP {
-                    rays.push(at + best);
+                    rays.push((k, best));
                 }
                 continue;
             }
+            let state_of = |state: &[State], x: usize, y: usize| state[at + y * w + x];
             for &y in &ys {
+                let (y0, y1) = cell_y[y];
                 for &x in &xs {
                     let j = at + y * w + x;
                     if weights[j] == 0.0 || state[j] != State::Unknown {
                         continue;
                     }
                     if step == FIRST_STEP {
-                        rays.push(j);
+                        rays.push((k, y * w + x));
                         continue;
                     }
-                    let ((x0, x1), (y0, y1)) = (cell(x, w), cell(y, h));
-                    let mut known = [(x0, y0), (x1, y0), (x0, y1), (x1, y1)]
-                        .into_iter()
-                        .map(|(x, y)| state[at + y * w + x])
-                        .filter(|&s| s != State::Unknown);
+                    let (x0, x1) = cell_x[x];
+                    let corners = [
+                        state_of(&state, x0, y0),
+                        state_of(&state, x1, y0),
+                        state_of(&state, x0, y1),
+                        state_of(&state, x1, y1),
+                    ];
+                    let mut known = corners.into_iter().filter(|&s| s != State::Unknown);
                     match known.next() {
                         Some(a) if known.all(|s| s == a) => state[j] = a,
-                        _ => rays.push(j),
+                        _ => rays.push((k, y * w + x)),
                     }
                 }
             }
         }
         for chunk in rays.chunks(16) {
             packet.clear();
-            for (lane, &j) in chunk.iter().enumerate() {
-                let origin = from[j / n];
-                let to = points[j % n] - origin;
+            for (lane, &(k, i)) in chunk.iter().enumerate() {
+                let origin = from[k];
+                let to = points[i] - origin;
                 let dist = to.length().max(f64::from(MIN_DISTANCE));
                 packet.set(
                     lane,
@@ -619,8 +668,8 @@ fn see(
             }
             let blocked = scene.occluded16(&mut packet, r.model);
             counts.rays += chunk.len() as u64;
-            for (lane, &j) in chunk.iter().enumerate() {
-                state[j] = if blocked & (1 << lane) != 0 {
+            for (lane, &(k, i)) in chunk.iter().enumerate() {
+                state[k * n + i] = if blocked & (1 << lane) != 0 {
                     State::Blocked
                 } else {
                     State::Lit
@@ -667,6 +716,44 @@ mod tests {
         ) {
             let plain = weights.iter().fold(0.0f32, |m, &w| if w > m { w } else { m });
             proptest::prop_assert_eq!(largest_weight(&weights).to_bits(), plain.to_bits());
+        }
+
+        /// Where [`under_gate`] says a flat face's luxels take nothing from an emitter, the
+        /// weighing gives every one of them zero: culling by the bound changes no luxel.
+        #[test]
+        fn under_gate_culls_only_what_weighing_zeroes(
+            at in proptest::collection::vec((-200.0f32..200.0, -200.0f32..200.0), 1..30),
+            offset in (-3000.0f32..3000.0, -3000.0f32..3000.0, -3000.0f32..3000.0),
+            tilt in (-1.0f64..1.0, -1.0f64..1.0, 0.05f64..1.0),
+            emitter in (-400.0f64..400.0, -400.0f64..400.0, -2.0f64..40.0),
+            intensity in 0.01f64..1e6,
+        ) {
+            let n_r = DVec3::new(tilt.0, tilt.1, tilt.2).normalize();
+            let (u, v) = (n_r.any_orthonormal_pair().0, n_r.any_orthonormal_pair().1);
+            let base = Vec3::new(offset.0, offset.1, offset.2).as_dvec3();
+            let points: Vec<[f32; 3]> = at
+                .iter()
+                .map(|&(x, y)| (base + u * f64::from(x) + v * f64::from(y) + n_r).as_vec3().to_array())
+                .collect();
+            let normals = vec![n_r.as_vec3().to_array(); points.len()];
+            let mut e = emitters_of([100.0, 50.0, 0.0], Emission::Middle).remove(0);
+            e.point = base + u * emitter.0 + v * emitter.1 + n_r * emitter.2;
+            e.normal = (u * 0.3 + n_r * 0.7).normalize();
+            e.styles[0].2 = intensity;
+            let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+            for &p in &points {
+                let p = Vec3::from(p).as_dvec3();
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+            let kernel = 0.5;
+            let n_r32 = Vec3::from(normals[0]).as_dvec3();
+            if under_gate(&e, n_r32, (lo, hi), kernel * intensity / GATE) {
+                let luxels = Luxels::new(&points, &normals);
+                let mut weights = vec![1.0f32; points.len()];
+                weigh(&e, &luxels, kernel as f32, (GATE / intensity) as f32, false, &mut weights);
+                proptest::prop_assert!(weights.iter().all(|&w| w == 0.0), "{:?}", weights);
+            }
         }
 
         /// Both copies of the weighing give the same bits, one- and two-sided.
