@@ -6,7 +6,6 @@ use crate::content_flags::ContentFlags;
 use crate::faces::ModelFace;
 use crate::gather::MapTexInfo;
 use crate::hulls::emit_clipnodes;
-use crate::int_hash::IntMap;
 use crate::model::ModelOutput;
 use crate::planes::{PlaneId, PlaneSet};
 use crate::portals::Portals;
@@ -25,6 +24,7 @@ use quake_formats::bsp::phong::FacePhong;
 use quake_formats::bsp::{BspPlane, Face, Leaf, Model, Node, TexInfo, contents, texinfo_flags};
 use quake_formats::entities::{Entity, write_entities};
 use quake_formats::geom::{Bounds, Plane};
+use quake_formats::int_hash::IntMap;
 use quake_formats::prt::{PortalFile, PrtPortal};
 use quake_formats::{Bsp, BspVersion};
 

@@ -10,7 +10,6 @@ use crate::brush::{Brush, BrushKind, BrushPlane, BrushShape};
 use crate::brushlist::{self, ListedBrush};
 use crate::faces::{MIN_SQUARENESS, projection_squareness};
 use crate::hulls::{HULL_BOXES, bevelled_planes, grown_planes};
-use crate::int_hash::IntMap;
 use crate::leak::MapBrushRef;
 use crate::map::{MapBrush, MapEntity, MapFile};
 use crate::options::CompileOptions;
@@ -27,6 +26,7 @@ use quake_formats::bsp::face_minlight::FaceMinlight;
 use quake_formats::bsp::face_tone::FaceTone;
 use quake_formats::bsp::phong::{self, FacePhong};
 use quake_formats::geom::Bounds;
+use quake_formats::int_hash::IntMap;
 use rayon::prelude::*;
 
 /// Each model's brushes, with what the rest of the compile needs to name them.

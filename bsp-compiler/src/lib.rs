@@ -29,7 +29,6 @@ pub mod faces;
 mod gather;
 pub mod hull_check;
 mod hulls;
-mod int_hash;
 pub mod leak;
 pub mod lightmap_grid;
 pub mod map;

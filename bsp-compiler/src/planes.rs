@@ -3,8 +3,8 @@
 //! Engines take a fast path for axial planes that assumes the normal points along +axis, so every
 //! plane is stored with its largest normal component positive; users keep a `flipped` flag.
 
-use crate::int_hash::IntMap;
 use quake_formats::geom::{DIST_EPSILON, Plane};
+use quake_formats::int_hash::IntMap;
 
 pub type PlaneId = u32;
 

@@ -1,12 +1,12 @@
 //! Shared vertices: welding equal points and inserting the vertices that lie on another face's
 //! edge (T-junctions), which would otherwise show as cracks.
 
-use crate::int_hash::IntMap;
 use crate::tree::{DETAIL_WALL, engine_contents};
 use glam::DVec3;
 use quake_formats::bsp::contents;
 use quake_formats::geom::DVec3Ext;
 use quake_formats::geom::{Bounds, ON_EPSILON, POINT_EPSILON};
+use quake_formats::int_hash::IntMap;
 use rayon::prelude::*;
 
 /// Distance from an edge within which a vertex counts as lying on it.

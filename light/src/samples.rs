@@ -26,6 +26,7 @@ use glam::{DMat3, DVec3, Vec3};
 use quake_formats::Bsp;
 use quake_formats::bsp::contents;
 use quake_formats::extents::LuxelGrid;
+use quake_formats::int_hash::IntMap;
 
 use crate::faces::{FaceGeom, FaceKind};
 use crate::outline::{FaceRegion, ON_EDGE};
@@ -101,30 +102,16 @@ impl FaceSamples {
 
 /// Per point, the first of `points` at exactly the same place (itself when there is none).
 /// Points on the texture grid are all distinct: only moved ones (`moved[i]`, true past its
-/// end) can meet.
+/// end) can meet. Taken in order, the first point of each place is the one its bits are
+/// hashed to.
 fn first_at_same_point(points: &[[f32; 3]], moved: &[bool]) -> Vec<usize> {
     let mut first: Vec<usize> = (0..points.len()).collect();
-    // A face has at most a few million samples (its extents pass the stage gate; 16x16 per
-    // luxel at most), so an index fits in the key's low 32 bits.
-    debug_assert!(u32::try_from(points.len()).is_ok());
-    // One integer per point, its coordinates' bits above its index, sorts in the order of
-    // (point, index) with one comparison each. Room for all (most are moved): a filtered
-    // collect would grow in steps.
-    let mut keys: Vec<u128> = Vec::with_capacity(points.len());
-    keys.extend(
-        (0..points.len())
-            .filter(|&i| moved.get(i).copied().unwrap_or(true))
-            .map(|i| {
-                let [x, y, z] = points[i].map(|c| u128::from(c.to_bits()));
-                x << 96 | y << 64 | z << 32 | i as u128
-            }),
-    );
-    keys.sort_unstable();
-    let index = |key: u128| (key & u128::from(u32::MAX)) as usize;
-    for pair in keys.windows(2) {
-        if pair[0] >> 32 == pair[1] >> 32 {
-            first[index(pair[1])] = first[index(pair[0])];
-        }
+    let is_moved = |i: usize| moved.get(i).copied().unwrap_or(true);
+    let count = (0..points.len()).filter(|&i| is_moved(i)).count();
+    let mut at: IntMap<[u32; 3], usize> =
+        IntMap::with_capacity_and_hasher(count, Default::default());
+    for i in (0..points.len()).filter(|&i| is_moved(i)) {
+        first[i] = *at.entry(points[i].map(f32::to_bits)).or_insert(i);
     }
     first
 }

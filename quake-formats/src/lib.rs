@@ -5,7 +5,8 @@
 //! [`palette`], [`entities`], [`prt`] (portal files), [`pts`] (pointfiles), [`lit`] (coloured
 //! lightmaps), [`visrle`] (PVS row compression), [`extents`] (lightmap extents of a face) and
 //! [`geom`] (f64 vectors, planes, windings and the epsilon policy); [`rng`] is the seeded
-//! generator the tools sample with, and [`progress`] the one way every stage reports progress.
+//! generator the tools sample with, [`progress`] the one way every stage reports progress, and
+//! [`int_hash`] the hasher of maps keyed by small integers.
 
 #![warn(missing_docs)]
 
@@ -19,6 +20,7 @@ mod error;
 pub mod extents;
 pub mod fsutil;
 pub mod geom;
+pub mod int_hash;
 mod layout;
 pub mod lit;
 pub mod miptex;

@@ -1,7 +1,8 @@
-//! A fast hasher for maps keyed by small integers (grid cells, vertex numbers). std's SipHash
-//! resists collisions an attacker picks, which a map file cannot do to these keys, at several
-//! times the cost; welding looks up a grid cell for every vertex and edge. It is deterministic,
-//! as SipHash's random keys are not, but nothing may depend on a map's iteration order anyway.
+//! A fast hasher for maps keyed by small integers (grid cells, vertex numbers, a point's
+//! bits). std's SipHash resists collisions an attacker picks, which a map file cannot do to
+//! these keys, at several times the cost; the compiler's welding looks up a grid cell for every
+//! vertex and edge. It is deterministic, as SipHash's random keys are not, but nothing may
+//! depend on a map's iteration order anyway.
 
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
