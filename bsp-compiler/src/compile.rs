@@ -16,7 +16,7 @@ use crate::leak::LeakReport;
 use crate::lightmap_grid::{LightmapGridStats, agree_on_lightmap_grid};
 use crate::map::{MapEntity, MapError, MapFile, parse_map, read_map_text};
 use crate::model::{
-    Clipped, Drawn, MODEL_PHASES, MODEL_WORK_PER_BRUSH, ModelOutput, assemble, split_model,
+    Clipped, Drawn, MODEL_PHASES, MODEL_WORK_PER_BRUSH, ModelOutput, Written, assemble, split_model,
 };
 use crate::options::CompileOptions;
 use crate::outside::{FillOutcome, Occupant};
@@ -453,7 +453,10 @@ fn build_models<'t>(
                 transwater: options.transwater,
             });
             let face_stats = (squared_up, models.iter().map(|m| m.faces.len()).sum());
-            (drawn, drawing, table, face_stats, t.elapsed().as_secs_f64())
+            let time = t.elapsed().as_secs_f64();
+            drop(models);
+            let written: Vec<Written> = drawn.into_iter().map(Drawn::written).collect();
+            (written, drawing, table, face_stats, time)
         },
         || {
             clip_jobs
@@ -464,9 +467,9 @@ fn build_models<'t>(
         },
     );
     progress.finish();
-    let (drawn, drawing, table, (squared_up, after_subdivide), drawing_time) = hull_zero;
+    let (written, drawing, table, (squared_up, after_subdivide), drawing_time) = hull_zero;
     Built {
-        models: drawn
+        models: written
             .into_iter()
             .zip(clipped)
             .map(|(d, c)| assemble(d, c))
@@ -522,8 +525,8 @@ fn warn_empty_brush_entities(map: &MapFile, models: &[ModelInput], warnings: &mu
 impl CompileStats {
     /// Count what one built model adds.
     fn add_model(&mut self, out: &ModelOutput) {
-        self.splits += out.tree.splits;
-        self.portals += out.portals.portals.len();
+        self.splits += out.splits;
+        self.portals += out.portals;
         let fs = &mut self.face_stats;
         fs.from_portals += out.face_stats.from_portals;
         fs.untextured += out.face_stats.untextured;

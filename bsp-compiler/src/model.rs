@@ -41,8 +41,9 @@ pub(crate) const MODEL_PHASES: [&str; 6] = ["tree", "portals", "outside", "faces
 
 /// One model's trees and faces.
 pub(crate) struct ModelOutput {
-    pub tree: Tree,
-    pub portals: Portals,
+    /// Nodes of hull 0's tree that split a brush, and its portals.
+    pub splits: usize,
+    pub portals: usize,
     pub hulls: [Tree; 2],
     pub bounds: Bounds,
     pub fill: Option<FillOutcome>,
@@ -109,10 +110,44 @@ pub(crate) struct Clipped {
     time: f64,
 }
 
+/// What [`assemble`] takes of a model's hull 0 once it is written ([`Drawn::written`]): its
+/// tree, portals and faces are gone.
+pub(crate) struct Written {
+    splits: usize,
+    portals: usize,
+    fill: Option<FillOutcome>,
+    face_stats: FaceStats,
+    times: [f64; 4],
+    warnings: Vec<Warning>,
+    shape: ModelShape,
+    csg_time: f64,
+}
+
 impl Drawn {
     /// The model's bounds ([`model_bounds`]).
     pub(crate) fn bounds(&self) -> Bounds {
         self.shape.bounds
+    }
+
+    /// What stays once hull 0 is written: the tree, portals and faces are freed here, while
+    /// the clip hulls still build.
+    pub(crate) fn written(self) -> Written {
+        let Drawn {
+            hull,
+            warnings,
+            shape,
+            csg_time,
+        } = self;
+        Written {
+            splits: hull.tree.splits,
+            portals: hull.portals.portals.len(),
+            fill: hull.fill,
+            face_stats: hull.face_stats,
+            times: hull.times,
+            warnings,
+            shape,
+            csg_time,
+        }
     }
 }
 
@@ -172,30 +207,34 @@ impl ClipJob {
 }
 
 /// A model's output from its two pipelines; its warnings.
-pub(crate) fn assemble(drawn: Drawn, clipped: Clipped) -> (ModelOutput, Vec<Warning>) {
-    let Drawn {
-        hull: drawing,
+pub(crate) fn assemble(written: Written, clipped: Clipped) -> (ModelOutput, Vec<Warning>) {
+    let Written {
+        splits,
+        portals,
+        fill,
+        face_stats,
+        times,
         warnings,
         shape,
         csg_time,
-    } = drawn;
-    let sealed = matches!(drawing.fill, Some(FillOutcome::Sealed { .. }));
+    } = written;
+    let sealed = matches!(fill, Some(FillOutcome::Sealed { .. }));
     let hulls = match clipped.filled {
         Some(filled) if sealed => filled,
         _ => clipped.hulls,
     };
     let mut timings = [0.0; 6];
-    timings[..4].copy_from_slice(&drawing.times);
+    timings[..4].copy_from_slice(&times);
     timings[4] = clipped.time;
     timings[5] = csg_time + clipped.csg_time;
     (
         ModelOutput {
-            tree: drawing.tree,
-            portals: drawing.portals,
+            splits,
+            portals,
             hulls,
             bounds: shape.bounds,
-            fill: drawing.fill,
-            face_stats: drawing.face_stats,
+            fill,
+            face_stats,
             timings,
         },
         warnings,
