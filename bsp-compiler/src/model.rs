@@ -41,8 +41,9 @@ pub(crate) const MODEL_PHASES: [&str; 6] = ["tree", "portals", "outside", "faces
 
 /// One model's trees and faces.
 pub(crate) struct ModelOutput {
-    /// Nodes of hull 0's tree that split a brush, and its portals.
+    /// How many times building hull 0's tree split a brush in two.
     pub splits: usize,
+    /// Hull 0's portals.
     pub portals: usize,
     pub hulls: [Tree; 2],
     pub bounds: Bounds,
