@@ -157,11 +157,6 @@ impl Visibility {
         Some(union)
     }
 
-    /// Whether a row or union of rows (from [`Visibility::pvs_of`]) holds `leaf`.
-    pub fn holds(pvs: &[u8], leaf: u32) -> bool {
-        bit(pvs, leaf)
-    }
-
     /// Whether `pvs` (from [`Visibility::pvs_of`]) may see every one of `leafs` (liquid leaves
     /// always count as seen; no leaves: cannot tell, seen). Not conservative: bounced light from
     /// a point culls an emitter whose face is only partly in sight, as ericw-tools culls it.

@@ -80,6 +80,8 @@ pub struct PointEmitter {
     pub styles: Vec<(u8, [f32; 3], f64)>,
     /// Its share of its face's light (1 over the face's points).
     pub share: f64,
+    /// Its intensity in its brightest style.
+    brightest: f64,
 }
 
 /// The point emitters of one pass, and where they stand.
@@ -138,9 +140,15 @@ impl<'a> PointField<'a> {
             }
         };
         mark(&self.unplaced);
-        for (l, list) in self.by_leaf.iter().enumerate().skip(1) {
-            if !list.is_empty() && Visibility::holds(&pvs, l as u32) {
-                mark(list);
+        // The leaves in the PVS, bit by bit (bit `k` is leaf `k + 1`).
+        for (byte, &bits) in pvs.iter().enumerate() {
+            let mut bits = bits;
+            while bits != 0 {
+                let leaf = byte * 8 + bits.trailing_zeros() as usize + 1;
+                bits &= bits - 1;
+                if let Some(list) = self.by_leaf.get(leaf) {
+                    mark(list);
+                }
             }
         }
         let mut found = Vec::new();
@@ -408,7 +416,7 @@ const BATCH: usize = 1 << 15;
 impl PointEmitter {
     /// Its intensity in its brightest style.
     fn max_intensity(&self) -> f64 {
-        self.styles.iter().map(|s| s.2).fold(0.0, f64::max)
+        self.brightest
     }
 }
 
@@ -515,12 +523,14 @@ fn point_emitters(field: &Field, emission: Emission) -> Vec<PointEmitter> {
             continue;
         }
         let normal = face.plane.normal;
+        let brightest = styles.iter().map(|s| s.2).fold(0.0, f64::max);
         out.extend(at.into_iter().map(|p| PointEmitter {
             face: f,
             point: p + normal,
             normal,
             styles: styles.clone(),
             share,
+            brightest,
         }));
     }
     out
@@ -740,6 +750,7 @@ mod tests {
             e.point = base + u * emitter.0 + v * emitter.1 + n_r * emitter.2;
             e.normal = (u * 0.3 + n_r * 0.7).normalize();
             e.styles[0].2 = intensity;
+            e.brightest = intensity;
             let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
             for &p in &points {
                 let p = Vec3::from(p).as_dvec3();
