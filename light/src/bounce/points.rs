@@ -73,14 +73,14 @@ pub enum Emission {
 /// One point a reflecting face sends light from.
 #[derive(Debug, Clone)]
 pub struct PointEmitter {
-    pub face: usize,
-    pub point: DVec3,
-    pub normal: DVec3,
+    face: usize,
+    point: DVec3,
+    normal: DVec3,
     /// Per style: the colour and the intensity.
-    pub styles: Vec<(u8, [f32; 3], f64)>,
+    styles: Vec<(u8, [f32; 3], f64)>,
     /// Its share of its face's light (1 over the face's points).
-    pub share: f64,
-    /// Its intensity in its brightest style.
+    share: f64,
+    /// Its intensity in its brightest style (of `styles`, which nothing changes after).
     brightest: f64,
 }
 
@@ -189,10 +189,10 @@ impl<'a> PointField<'a> {
         let at = Luxels::new(&r.points, &r.normals);
         // One normal for every luxel (a flat one-sided face): the receiving cosine is bounded
         // by the emitter's height over the luxels too.
-        let flat_normal = (!r.two_sided)
-            .then(|| r.normals.first())
-            .flatten()
-            .filter(|&&first| r.normals.iter().all(|&m| m == first))
+        let flat_normal = r
+            .normals
+            .first()
+            .filter(|&&first| !r.two_sided && r.normals.iter().all(|&m| m == first))
             .map(|&m| Vec3::from(m).as_dvec3());
         for k in self.in_sight_of(r.face) {
             let e = &self.emitters[k as usize];
@@ -301,12 +301,16 @@ impl PointField<'_> {
 /// in (coordinates within a few thousand units: their rounding is well under this).
 const BOUND_SLACK: f64 = 0.01;
 
+/// Relative slack on [`under_gate`]'s bound for the rounding of [`weigh`]'s single-precision
+/// products and quotient (each off by a few parts in ten million).
+const BOUND_ROUNDING: f64 = 1e-3;
+
 /// Whether every luxel in the box `(lo, hi)` of a flat one-sided face with normal `n_r` takes
 /// from `e` a weight [`weigh`] sets to zero, `scale` being the kernel times the emitter's
 /// intensity over the gate: `cos θe · d` is at most the largest of `n_e · (c − e)` over the
 /// box's corners `c`, `cos θr · d` at most that of `−n_r · (c − e)` (both linear, so largest
 /// at a corner), and `d` at least the box's distance, each widened by [`BOUND_SLACK`] and the
-/// product by a thousandth for the rounding of single precision.
+/// product by [`BOUND_ROUNDING`].
 fn under_gate(e: &PointEmitter, n_r: DVec3, (lo, hi): (DVec3, DVec3), scale: f64) -> bool {
     let most_along = |n: DVec3| {
         let (a, b) = (n * (lo - e.point), n * (hi - e.point));
@@ -319,7 +323,7 @@ fn under_gate(e: &PointEmitter, n_r: DVec3, (lo, hi): (DVec3, DVec3), scale: f64
     let near = (e.point.clamp(lo, hi).distance(e.point) - BOUND_SLACK).max(f64::from(MIN_DISTANCE));
     let d2 = near * near;
     let clamp = HOTSPOT_CLAMP * HOTSPOT_CLAMP;
-    scale * along_e * along_r / (d2 * d2.max(clamp)) * 1.001 < 1.0
+    scale * along_e * along_r / (d2 * d2.max(clamp)) * (1.0 + BOUND_ROUNDING) < 1.0
 }
 
 /// A face's luxels, coordinate by coordinate (so that weighing them vectorises).
