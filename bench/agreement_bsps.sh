@@ -10,7 +10,7 @@
 # Usage: bench/agreement_bsps.sh [OUT]
 set -euo pipefail
 source "$(dirname "$0")/common.sh"
-anchor="$root/../shared/anchors/ericw-tools/bin"
+anchor="$anchor_bin"
 [ -x "$anchor/qbsp" ] || { echo "SKIPPED: $anchor/qbsp not found" >&2; exit 0; }
 out="${1:-/tmp/agree}"
 mkdir -p "$out"

@@ -7,7 +7,7 @@
 # build of the command, instead of building this tree's)
 set -euo pipefail
 source "$(dirname "$0")/common.sh"
-anchor="$root/../shared/anchors/ericw-tools/bin"
+anchor="$anchor_bin"
 [ -x "$anchor/qbsp" ] || { echo "SKIPPED: $anchor/qbsp not found" >&2; exit 0; }
 ours=$(slipgate_binary)
 maps=("$@")

@@ -6,7 +6,7 @@
 # Usage: [RUNS=3] [OUT=DIR] bench/corpus.sh [MAP.map ...]
 set -euo pipefail
 source "$(dirname "$0")/common.sh"
-anchor="$root/../shared/anchors/ericw-tools/bin"
+anchor="$anchor_bin"
 slipgate=$(slipgate_binary)
 args=(--runs "${RUNS:-3}" --out-dir "${OUT:-$root/target/report}")
 if [ -x "$anchor/qbsp" ]; then

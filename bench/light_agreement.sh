@@ -6,7 +6,7 @@
 # Usage: [OURS="--extra4 --soft"] [ERICW="-extra4 -soft"] [WORST=20] bench/light_agreement.sh MAP.bsp...
 set -euo pipefail
 source "$(dirname "$0")/common.sh"
-anchor="$root/../shared/anchors/ericw-tools/bin/light"
+anchor="$anchor_bin/light"
 [ -x "$anchor" ] || { echo "SKIPPED: $anchor not found" >&2; exit 0; }
 cargo build --release --manifest-path "$root/Cargo.toml" -p slipgate -p slipgate-light --bins \
   --example ericw_agreement >/dev/null

@@ -7,7 +7,7 @@
 set -euo pipefail
 [ $# -ge 3 ] || { sed -n '2,7s/^# \{0,1\}//p' "$0"; exit 2; }
 source "$(dirname "$0")/common.sh"
-anchor="$root/../shared/anchors/ericw-tools/bin/light"
+anchor="$anchor_bin/light"
 [ -x "$anchor" ] || { echo "SKIPPED: $anchor not found" >&2; exit 0; }
 before=$1; after=$2; shift 2
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT

@@ -9,7 +9,7 @@
 # same settings, e.g. OURS="--extra4 --soft --bounce --dirt" ERICW="-extra4 -soft -bounce -dirt".
 set -euo pipefail
 source "$(dirname "$0")/common.sh"
-anchor="$root/../shared/anchors/ericw-tools/bin/light"
+anchor="$anchor_bin/light"
 [ -x "$anchor" ] || { echo "SKIPPED: $anchor not found" >&2; exit 0; }
 ours=$(slipgate_binary)
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT

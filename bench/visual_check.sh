@@ -15,7 +15,7 @@ mkdir -p "$out"
 cargo build --release --manifest-path "$root/Cargo.toml" -p slipgate -p slipgate-viewer \
   --example compare_lighting >/dev/null
 bin="${CARGO_TARGET_DIR:-$root/target}/release"
-anchor="$root/../shared/anchors/ericw-tools/bin"
+anchor="$anchor_bin"
 palette="$corpus/palette/palette.lmp"
 for m in start e1m3; do
   cp "$corpus/public/maps/librequake/$m.map" "$out/$m.map"
