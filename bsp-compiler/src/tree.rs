@@ -79,12 +79,15 @@ impl SplitHeuristic {
         }
     }
 
-    /// The least first component of [`SplitHeuristic::key`] a candidate that splits at least
-    /// `split` items and lies on `facing` of them can reach.
-    fn least_first_key(self, split: i64, facing: i64) -> i64 {
+    /// A number that orders candidates as the start of [`SplitHeuristic::key`] does, for a
+    /// candidate that splits `split` items, lies on `facing` of them and leaves `imbalance`
+    /// more whole on one side than on the other: lower is better, and a higher number is a
+    /// higher key. With `imbalance` 0 it is the least a candidate still being counted can reach.
+    fn key_prefix(self, split: i64, facing: i64, imbalance: i64) -> i64 {
         match self {
-            SplitHeuristic::FewestSplits => split,
-            SplitHeuristic::Balanced => 5 * (split - facing),
+            // (split, -facing); facing never reaches 2^31 (one per item).
+            SplitHeuristic::FewestSplits => (split << 32) + ((1 << 31) - facing),
+            SplitHeuristic::Balanced => 5 * (split - facing) + imbalance,
         }
     }
 }
@@ -93,9 +96,10 @@ impl SplitHeuristic {
 /// surfaces), each telling with `sides_of` which sides of a plane it reaches. `facing` is the
 /// sorted list of planes the items lie on, one entry per item.
 ///
-/// A candidate stops being counted once its key can only come out above the lowest first key
-/// component some candidate has finished with: both heuristics rank splits before all else, and
-/// splits only add up, so it cannot win.
+/// A candidate stops being counted (or is not counted at all) once its key can only come out
+/// above the key of some finished candidate, compared on [`SplitHeuristic::key_prefix`]: both
+/// heuristics rank splits before all else (the fewest-splits one then the items lying on the
+/// plane, which are known before counting), and splits only add up, so it cannot win.
 pub fn best_splitter<T: Sync>(
     candidates: &[PlaneId],
     items: &[T],
@@ -108,12 +112,15 @@ pub fn best_splitter<T: Sync>(
     let score = |&(facing, id): &(i64, PlaneId)| {
         let plane = planes.get(id);
         let limit = bound.load(Ordering::Relaxed);
+        if heuristic.key_prefix(0, facing, 0) > limit {
+            return None;
+        }
         let (mut front, mut back, mut split) = (0i64, 0i64, 0i64);
         for item in items {
             match sides_of(item, id) {
                 (true, true) => {
                     split += 1;
-                    if heuristic.least_first_key(split, facing) > limit {
+                    if heuristic.key_prefix(split, facing, 0) > limit {
                         return None;
                     }
                 }
@@ -129,7 +136,10 @@ pub fn best_splitter<T: Sync>(
             back,
         };
         let key = heuristic.key(plane, counts);
-        bound.fetch_min(key.0, Ordering::Relaxed);
+        bound.fetch_min(
+            heuristic.key_prefix(split, facing, (front - back).abs()),
+            Ordering::Relaxed,
+        );
         Some((key, id))
     };
     // Planes many items lie on first: they tend to split few, and the sooner a good candidate
