@@ -53,9 +53,9 @@ pub struct FaceGeom {
     pub origin: DVec3,
     pub extents: LightmapExtents,
     /// The lit faces of the same model on the same plane reached from this one across at most
-    /// [`CONTINUATION_HOPS`] shared edges, as outlines: where a luxel past this face's edge
-    /// finds the surface it stands over. Each lit face's outline is made once and shared.
-    pub continuations: Vec<Arc<FaceRegion>>,
+    /// [`CONTINUATION_HOPS`] shared edges: where a luxel past this face's edge finds the surface
+    /// it stands over.
+    pub continuations: Arc<Continuations>,
     /// Its own outline, as its continuations share it (lit faces, once
     /// [`attach_continuations`] has filled it in).
     pub outline: Option<Arc<FaceRegion>>,
@@ -157,7 +157,7 @@ impl FaceGeom {
             vecs: [[0.0; 4]; 2],
             origin: DVec3::ZERO,
             extents,
-            continuations: Vec::new(),
+            continuations: Arc::default(),
             outline: None,
             grid: LuxelGrid::vanilla(&extents, &[[0.0; 4]; 2]),
             own_grid: None,
@@ -266,7 +266,7 @@ pub fn unlinked_face_geometry(
                 vecs: ti.vecs,
                 origin,
                 extents,
-                continuations: Vec::new(),
+                continuations: Arc::default(),
                 outline: None,
                 grid: own.map_or_else(|| LuxelGrid::vanilla(&extents, &ti.vecs), |(_, g)| g),
                 own_grid: own.map(|(kind, _)| kind),
@@ -287,10 +287,45 @@ type EdgeKey = ([i64; 3], [i64; 3]);
 /// its plane (ericw-tools follows a point across at most three).
 pub const CONTINUATION_HOPS: usize = 3;
 
+/// The faces a sample point past a face's edge may walk onto: the face itself (first) and the
+/// lit faces of its model on its plane within [`CONTINUATION_HOPS`] shared edges of it, each as
+/// its outline and, edge by edge, which of them lies across that edge. A point walks as
+/// ericw-tools walks it: across the edge [`FaceRegion::edge_to_cross`] picks, onto the face
+/// there, at most [`CONTINUATION_HOPS`] times.
+#[derive(Debug, Clone, Default)]
+pub struct Continuations {
+    regions: Vec<Arc<FaceRegion>>,
+    /// Per region, per edge: the region across it, when it is one of them.
+    across: Vec<Vec<Option<u32>>>,
+}
+
+impl Continuations {
+    /// How many faces continue the face (itself not counted).
+    pub fn len(&self) -> usize {
+        self.regions.len().saturating_sub(1)
+    }
+
+    /// Whether no face continues the face.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Region `k`'s outline (0: the face's own).
+    pub fn region(&self, k: usize) -> Option<&FaceRegion> {
+        self.regions.get(k).map(|r| &**r)
+    }
+
+    /// The region across edge `edge` of region `k`, if any.
+    pub fn across(&self, k: usize, edge: usize) -> Option<usize> {
+        let next = self.across.get(k)?.get(edge).copied().flatten()?;
+        Some(next as usize)
+    }
+}
+
 /// What [`continuations`] finds: per face, its continuations and its own outline (lit faces
 /// only), made once and shared by the faces it continues.
 pub struct Links {
-    continuations: Vec<Vec<Arc<FaceRegion>>>,
+    continuations: Vec<Arc<Continuations>>,
     outlines: Vec<Option<Arc<FaceRegion>>>,
 }
 
@@ -299,17 +334,17 @@ pub struct Links {
 pub fn continuations(faces: &[FaceGeom]) -> Links {
     let key = |p: DVec3| (p / SAME_CORNER).round().as_i64vec3().to_array();
     let lit = |f: &&FaceGeom| f.kind == FaceKind::Lit;
-    // Every lit face under each of its edges, sorted by edge: one allocation of the exact size
-    // (fresh memory costs more than the keys do to compute).
+    // Every lit face's edges, sorted by edge: one allocation of the exact size (fresh memory
+    // costs more than the keys do to compute).
     let edges = faces.iter().filter(lit).map(|f| f.points.len()).sum();
-    let mut by_edge: Vec<(EdgeKey, usize)> = Vec::with_capacity(edges);
+    let mut by_edge: Vec<(EdgeKey, usize, u32)> = Vec::with_capacity(edges);
     let mut corners: Vec<[i64; 3]> = Vec::new();
     for f in faces.iter().filter(lit) {
         corners.clear();
         corners.extend(f.points.iter().map(|&p| key(p)));
         for (i, &a) in corners.iter().enumerate() {
             let b = corners[(i + 1) % corners.len()];
-            by_edge.push(((a.min(b), a.max(b)), f.index));
+            by_edge.push(((a.min(b), a.max(b)), f.index, i as u32));
         }
     }
     by_edge.par_sort_unstable();
@@ -318,14 +353,18 @@ pub fn continuations(faces: &[FaceGeom]) -> Links {
             && a.plane.normal.dot(b.plane.normal) > 1.0 - 1e-6
             && (a.plane.dist - b.plane.dist).abs() < SAME_CORNER
     };
-    // The faces under one edge are a run of `by_edge`: each is beside the others on its plane.
+    // The faces under one edge are a run of `by_edge`: each is beside the others on its plane,
+    // and the first of them (in face order, as ericw-tools finds it) lies across the edge.
+    let mut across: Vec<Vec<Option<u32>>> =
+        faces.iter().map(|f| vec![None; f.points.len()]).collect();
     // As (face, neighbour) pairs, sorted: each face's neighbours are a run of them.
     let mut beside: Vec<(u32, u32)> = Vec::new();
     for run in by_edge.chunk_by(|a, b| a.0 == b.0) {
-        for &(_, f) in run {
-            for &(_, g) in run {
+        for &(_, f, edge) in run {
+            for &(_, g, _) in run {
                 if g != f && same_plane(&faces[f], &faces[g]) {
                     beside.push((f as u32, g as u32));
+                    across[f][edge as usize].get_or_insert(g as u32);
                 }
             }
         }
@@ -356,8 +395,10 @@ pub fn continuations(faces: &[FaceGeom]) -> Links {
         .map_init(
             || (Vec::new(), Vec::new(), Vec::new()),
             |(reached, ring, next): &mut (Vec<usize>, Vec<usize>, Vec<usize>), f| {
+                let Some(own) = &outlines[f] else {
+                    return Arc::default();
+                };
                 reached.clear();
-                reached.push(f);
                 ring.clear();
                 ring.push(f);
                 for _ in 0..CONTINUATION_HOPS {
@@ -365,26 +406,42 @@ pub fn continuations(faces: &[FaceGeom]) -> Links {
                     next.extend(ring.iter().flat_map(|&g| neighbours(g)));
                     next.sort_unstable();
                     next.dedup();
-                    next.retain(|g| !reached.contains(g));
+                    next.retain(|&g| g != f && !reached.contains(&g));
                     reached.extend_from_slice(next);
                     std::mem::swap(ring, next);
                 }
+                reached.retain(|&g| outlines[g].is_some());
                 reached.sort_unstable();
+                // The face first, then the others in order: a face's place among them.
+                let local = |g: usize| {
+                    if g == f {
+                        Some(0)
+                    } else {
+                        reached.binary_search(&g).ok().map(|i| i as u32 + 1)
+                    }
+                };
                 // An outline's inward normals come from the plane it is seen on: a continuation
                 // on a plane whose normal differs in its last bits gets an outline of its own.
                 let normal = faces[f].plane.normal;
-                reached
-                    .iter()
-                    .filter(|&&g| g != f)
-                    .filter_map(|&g| match &outlines[g] {
-                        Some(r) if faces[g].plane.normal == normal => Some(r.clone()),
-                        Some(_) => Some(Arc::new(FaceRegion::from_points(
-                            faces[g].points.clone(),
-                            normal,
-                        ))),
-                        None => None,
+                let mut regions = vec![own.clone()];
+                regions.extend(reached.iter().filter_map(|&g| match &outlines[g] {
+                    Some(r) if faces[g].plane.normal == normal => Some(r.clone()),
+                    Some(_) => Some(Arc::new(FaceRegion::from_points(
+                        faces[g].points.clone(),
+                        normal,
+                    ))),
+                    None => None,
+                }));
+                let across = std::iter::once(&f)
+                    .chain(reached.iter())
+                    .map(|&g| {
+                        across[g]
+                            .iter()
+                            .map(|next| next.and_then(|n| local(n as usize)))
+                            .collect()
                     })
-                    .collect()
+                    .collect();
+                Arc::new(Continuations { regions, across })
             },
         )
         .collect();

@@ -18,47 +18,18 @@ pub struct FaceRegion {
     inward: Vec<DVec3>,
     /// Per edge: the step from `points[i]` to the next and its squared length.
     edges: Vec<(DVec3, f64)>,
-    /// The mean of the corners, and the square of a distance from it past which no point is
-    /// [`FaceRegion::contains`]'s (infinite when the corners' angles are too sharp to say).
+    /// The mean of the corners.
     centre: DVec3,
-    reach2: f64,
 }
 
-/// How far outside an edge (units) a point still counts as inside ([`FaceRegion::contains`]).
-const CONTAINS_SLACK: f64 = 1e-6;
+/// How far past an edge (units) a sample point still counts as inside its face and stays where
+/// the grid puts it, as ericw-tools counts it (its `POINT_EQUAL_EPSILON`).
+pub const INSIDE_SLACK: f64 = 0.05;
 
 /// Room (units) [`FaceRegion::holds_disc`] leaves for rounding: the points it vouches for are
 /// computed apart from the disc's centre, each edge distance rounded on its own, at map
 /// coordinates where that rounding is below a billionth of a unit.
 const DISC_MARGIN: f64 = 1e-6;
-
-/// The square of a distance from `centre` beyond which no point is within [`CONTAINS_SLACK`]
-/// (and the rounding of the edge test) of every edge's inner side: the farthest corner, plus
-/// how far pushing each edge out that much moves a corner (more at a sharper corner), plus room
-/// for rounding. Infinite for a degenerate edge or a corner sharper than a thousandth of a
-/// radian, where no such bound is worth having.
-fn reach2(points: &[DVec3], inward: &[DVec3], centre: DVec3) -> f64 {
-    let n = points.len();
-    if n < 3 || inward.contains(&DVec3::ZERO) {
-        return f64::INFINITY;
-    }
-    // The sharpest corner, by the square of half its angle's sine: at points[i], between edge
-    // i - 1 and edge i.
-    let mut sharpest2 = f64::INFINITY;
-    for i in 0..n {
-        let (before, after) = (inward[(i + n - 1) % n], inward[i]);
-        sharpest2 = sharpest2.min((1.0 + before.dot(after)) / 2.0);
-    }
-    if sharpest2.is_nan() || sharpest2 <= 1e-6 {
-        return f64::INFINITY;
-    }
-    let farthest2 = points
-        .iter()
-        .map(|p| p.distance_squared(centre))
-        .fold(0.0, f64::max);
-    let reach = farthest2.sqrt() + 2.0 * CONTAINS_SLACK / sharpest2.sqrt() + 1e-3;
-    reach * reach
-}
 
 impl FaceRegion {
     pub fn from_points(points: Vec<DVec3>, normal: DVec3) -> FaceRegion {
@@ -77,13 +48,11 @@ impl FaceRegion {
                 (ab, ab.dot(ab))
             })
             .collect();
-        let reach2 = reach2(&points, &inward, centre);
         FaceRegion {
             points,
             inward,
             edges,
             centre,
-            reach2,
         }
     }
 
@@ -92,21 +61,14 @@ impl FaceRegion {
         self.centre
     }
 
-    /// Whether `p` (a point on the face's plane) is inside the region or on its edge.
-    pub fn contains(&self, p: DVec3) -> bool {
-        // Far from the region, no edge need be looked at.
-        p.distance_squared(self.centre) <= self.reach2
-            && (self.points.iter().zip(&self.inward)).all(|(&a, m)| m.dot(p - a) >= -CONTAINS_SLACK)
-    }
-
-    /// For `p` (a point on the face's plane) inside the region or on its edge, no edge's
-    /// inward distance negative: whether it lies on the outline ([`FaceRegion::on_edge`]);
+    /// For `p` (a point on the face's plane) inside the region, on its edge or less than
+    /// [`INSIDE_SLACK`] past it: whether it lies on the outline ([`FaceRegion::on_edge`]);
     /// `None` for any other point, which [`FaceRegion::nearest`] moves.
     pub fn inside_on_edge(&self, p: DVec3) -> Option<bool> {
         let mut nearest = f64::INFINITY;
         for (&a, m) in self.points.iter().zip(&self.inward) {
             let d = m.dot(p - a);
-            if d.is_nan() || d < 0.0 {
+            if d.is_nan() || d < -INSIDE_SLACK {
                 return None;
             }
             // Neither is a NaN: a plain comparison is `min`.
@@ -137,6 +99,34 @@ impl FaceRegion {
     #[cfg(test)]
     pub fn nearest(&self, p: DVec3) -> DVec3 {
         self.nearest_on_edge(p).0
+    }
+
+    /// The edge a point `p` past the region (on its plane) crosses to the face beyond, as
+    /// ericw-tools picks it: of the edges `p` lies behind (or less than [`INSIDE_SLACK`] in front
+    /// of), the one it lies least far past the ends of, measured from the edge's first corner
+    /// when past its second (ericw-tools' measure); the first such edge on a tie. Degenerate
+    /// edges are passed over.
+    pub fn edge_to_cross(&self, p: DVec3) -> Option<usize> {
+        let mut best = None;
+        let mut best_past = f64::INFINITY;
+        let edges = self.points.iter().zip(&self.inward).zip(&self.edges);
+        for (edge, ((&a, m), &(ab, len2))) in edges.enumerate() {
+            let ap = p - a;
+            if m.dot(ap) >= INSIDE_SLACK || *m == DVec3::ZERO || len2 <= 0.0 {
+                continue;
+            }
+            let t = ap.dot(ab) / len2;
+            if (0.0..=1.0).contains(&t) {
+                // Beside the edge: no other can come out nearer, and the first such one wins.
+                return Some(edge);
+            }
+            let past = t.abs() * len2.sqrt();
+            if past < best_past {
+                best_past = past;
+                best = Some(edge);
+            }
+        }
+        best
     }
 
     /// Inward distance of `p` from edge `edge`'s line.
@@ -204,6 +194,44 @@ mod tests {
         })
     }
 
+    /// The rectangle (0, 0)-(40, 10) on the plane z = 64, its corners counter-clockwise from
+    /// the origin: edge 0 along the bottom, 1 up the right side, 2 along the top, 3 down the
+    /// left side.
+    fn strip() -> FaceRegion {
+        let corners = [(0.0, 0.0), (40.0, 0.0), (40.0, 10.0), (0.0, 10.0)];
+        let points = corners.map(|(x, y)| DVec3::new(x, y, 64.0)).to_vec();
+        FaceRegion::from_points(points, DVec3::Z)
+    }
+
+    /// A point less than ericw-tools' `POINT_EQUAL_EPSILON` past an edge stays where it is,
+    /// on the edge; one farther past is moved.
+    #[test]
+    fn a_point_just_past_an_edge_counts_as_inside_on_the_edge() {
+        let region = strip();
+        assert_eq!(
+            region.inside_on_edge(DVec3::new(20.0, -0.04, 64.0)),
+            Some(true)
+        );
+        assert_eq!(region.inside_on_edge(DVec3::new(20.0, -0.06, 64.0)), None);
+        assert_eq!(
+            region.inside_on_edge(DVec3::new(20.0, 5.0, 64.0)),
+            Some(false)
+        );
+    }
+
+    /// A point past a corner crosses the edge it lies least far past the ends of, measured as
+    /// ericw-tools measures it: from the edge's first corner when it lies past the second. Past
+    /// the top right corner at (45, 11) that is the top edge (5 units before its first corner),
+    /// not the right side (1 unit past its end, but 11 from its first corner).
+    #[test]
+    fn the_edge_crossed_is_the_one_least_past_its_ends_as_ericw_tools_measures() {
+        let region = strip();
+        assert_eq!(region.edge_to_cross(DVec3::new(20.0, -3.0, 64.0)), Some(0));
+        assert_eq!(region.edge_to_cross(DVec3::new(45.0, 11.0, 64.0)), Some(2));
+        assert_eq!(region.edge_to_cross(DVec3::new(45.0, -1.0, 64.0)), Some(1));
+        assert_eq!(region.edge_to_cross(DVec3::new(20.0, 5.0, 64.0)), None);
+    }
+
     proptest! {
         /// Looking only at the edges a point is outside of finds the same nearest point.
         #[test]
@@ -224,28 +252,6 @@ mod tests {
             } else {
                 let want = nearest_of_every_edge(&region, p);
                 prop_assert!(((p - got).length() - (p - want).length()).abs() < 1e-9);
-            }
-        }
-
-        /// The distance bound never turns away a point the edges take, near the outline too.
-        #[test]
-        fn contains_takes_what_every_edge_takes(
-            angles in proptest::collection::vec(0.0f64..std::f64::consts::TAU, 3..9),
-            radius in 1.0f64..500.0,
-            x in -800.0f64..800.0,
-            y in -800.0f64..800.0,
-            toward in 0usize..9,
-            nudge in -1e-5f64..1e-5,
-        ) {
-            let region = circle_region(angles, radius, 0.01);
-            prop_assume!(region.is_some());
-            let region = region.expect("assumed");
-            // A point anywhere, and one just off a corner.
-            let corner = region.points[toward % region.points.len()];
-            for p in [DVec3::new(x, y, 64.0), corner + DVec3::new(nudge, -nudge, 0.0)] {
-                let by_edges = (region.points.iter().zip(&region.inward))
-                    .all(|(&a, m)| m.dot(p - a) >= -CONTAINS_SLACK);
-                prop_assert_eq!(region.contains(p), by_edges);
             }
         }
 

@@ -4,11 +4,13 @@
 //! One point per luxel of the face's grid (Quake's 16 texels, or the face's own:
 //! world-aligned, or another power of two texels), or `n x n` per luxel when
 //! supersampling, found by inverting the grid's projection onto the face's
-//! plane. A point past the face's edge that lands on a face continuing it (same
-//! model, same plane, at most three shared edges away) stays there. Another point outside the face
-//! (a luxel past its edge, e.g. under a wall standing on a floor) moves to the
-//! nearest point of the face's outline, unless that is more than a luxel away (the far
-//! corners of a triangle's lightmap, which no pixel shows): such a point is occluded.
+//! plane. A point less than 0.05 units past the face's edge counts as inside it. One farther
+//! past walks as ericw-tools walks it: across the edge it lies least far past the ends of onto
+//! the face continuing the plane there (same model, same plane), and on, at most three times;
+//! it stays where it lands inside one. Otherwise (a luxel past the edge, e.g. under a wall
+//! standing on a floor) it moves to the nearest point of the outline of the last face it
+//! reached, unless that is more than a luxel away (the far corners of a triangle's lightmap,
+//! which no pixel shows): such a point is occluded.
 //! Points are then lifted [`SURFACE_OFFSET`] units off the surface. One that is then
 //! inside the world's solid (on the edge under the wall, behind a fixture on the face)
 //! is nudged half a unit along each axis into the open when that frees it, else it is
@@ -28,7 +30,7 @@ use quake_formats::bsp::contents;
 use quake_formats::extents::LuxelGrid;
 use quake_formats::int_hash::IntMap;
 
-use crate::faces::{FaceGeom, FaceKind};
+use crate::faces::{CONTINUATION_HOPS, Continuations, FaceGeom, FaceKind};
 use crate::outline::{FaceRegion, ON_EDGE};
 
 /// Distance of sample points in front of their face, in map units.
@@ -180,7 +182,7 @@ pub struct SurfaceMap {
     to_world: Option<TextureToWorld>,
     outline: Arc<FaceRegion>,
     /// The faces continuing this one past its edges ([`FaceGeom::continuations`]).
-    continuations: Vec<Arc<FaceRegion>>,
+    continuations: Arc<Continuations>,
     origin: DVec3,
     lift: DVec3,
     grid: LuxelGrid,
@@ -248,24 +250,44 @@ impl SurfaceMap {
                 beyond: false,
             };
         }
-        if !self.outline.contains(on_plane)
-            && self.continuations.iter().any(|c| c.contains(on_plane))
-        {
-            return Placed {
-                at: on_plane + self.lift,
-                moved: false,
-                on_edge: false,
-                beyond: false,
+        // Past the edge: across it onto the face continuing the plane there, if one does, and
+        // so on; the point stays where it lands inside one, else it moves onto the outline of
+        // the last face it reached.
+        let mut region = &*self.outline;
+        let mut at = 0;
+        let hops = if self.continuations.is_empty() {
+            0
+        } else {
+            CONTINUATION_HOPS
+        };
+        for _ in 0..hops {
+            let Some(next) = region
+                .edge_to_cross(on_plane)
+                .and_then(|edge| self.continuations.across(at, edge))
+            else {
+                break;
             };
+            let Some(beyond_edge) = self.continuations.region(next) else {
+                break;
+            };
+            (region, at) = (beyond_edge, next);
+            if region.inside_on_edge(on_plane).is_some() {
+                return Placed {
+                    at: on_plane + self.lift,
+                    moved: false,
+                    on_edge: false,
+                    beyond: false,
+                };
+            }
         }
-        let (on_face, onto) = self.outline.nearest_on_edge(on_plane);
+        let (on_face, onto) = region.nearest_on_edge(on_plane);
         let step = on_face - on_plane;
         let along = |axis: [f64; 4]| DVec3::new(axis[0], axis[1], axis[2]).dot(step);
         let [ds, dt] = self.grid.axes.map(along);
         // A point moved onto an edge lies on it: that edge's distance says so without the
         // others'.
-        let on_edge = onto.is_some_and(|edge| self.outline.distance(edge, on_face) < ON_EDGE)
-            || self.outline.on_edge(on_face);
+        let on_edge = onto.is_some_and(|edge| region.distance(edge, on_face) < ON_EDGE)
+            || region.on_edge(on_face);
         Placed {
             at: on_face + self.lift,
             moved: on_face != on_plane,

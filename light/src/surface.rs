@@ -131,7 +131,7 @@ mod tests {
             vecs,
             origin: DVec3::ZERO,
             extents,
-            continuations: Vec::new(),
+            continuations: Default::default(),
             outline: None,
             grid: quake_formats::extents::LuxelGrid::vanilla(&extents, &vecs),
             own_grid: None,

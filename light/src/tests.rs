@@ -343,6 +343,23 @@ fn samples_past_an_edge_follow_the_plane_across_faces() {
     assert_eq!(second_row_over_the_plane(&polys), (2, true));
 }
 
+/// Regression: a luxel past a face's edge and past the face continuing the plane there as well
+/// was moved back onto the face's own outline; ericw-tools walks it across the edge onto the
+/// continuing face and moves it onto that face's outline, where the surface it stands over ends.
+/// Here the luxel row the grid puts at y 16 lies past a strip 8 wide and past the 4-wide strip beside
+/// it: it belongs at the far edge of the second strip (y 12), not at the first one's (y 8).
+#[test]
+fn samples_past_the_continuing_face_move_onto_its_outline() {
+    let polys = [floor_strip(0.0, 8.0), floor_strip(8.0, 12.0)];
+    let bsp = synthetic_bsp(&polys, "{ \"classname\" \"worldspawn\" }");
+    let faces = face_geometry(&bsp, |_| DVec3::ZERO, |_| Spacing::Quake).expect("faces");
+    let (samples, _) = face_samples(&faces[0], 1, &bsp);
+    assert_eq!(samples.height, 2);
+    let past: Vec<&[f32; 3]> = samples.points.iter().filter(|p| p[1] > 8.0).collect();
+    assert_eq!(past.len(), samples.width);
+    assert!(past.iter().all(|p| p[1] == 12.0 && p[2] == 1.0), "{past:?}");
+}
+
 #[test]
 fn sample_points_invert_an_angled_projection() {
     // A sloped face with a skewed, off-grid texture projection.
@@ -698,8 +715,8 @@ fn start_bsp_default_against_reference() {
     // half a unit out of solid beside it. The largest differences are where that one point
     // takes a light a few units away (the `_surface` copies beside start's fixtures) or
     // misses it.
-    assert!(e.rmse < 10.0, "{e:?}");
-    assert!(e4.rmse < 4.2, "{e4:?}");
+    assert!(e.rmse < 10.5, "{e:?}");
+    assert!(e4.rmse < 2.6, "{e4:?}");
     assert!(e4.rmse < e.rmse, "{e4:?} {e:?}");
 }
 
