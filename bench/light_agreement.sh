@@ -2,7 +2,8 @@
 # Per-face agreement of our light with ericw-tools' (../shared/anchors/ericw-tools) on copies of
 # the same vised BSPs at the same setting: for each map, the share of faces whose mean light is
 # within 5 levels of ericw-tools', the faces only one tool gives a lightmap, and the faces that
-# differ most (light/examples/ericw_agreement.rs). bench/results/light-agreement.md comes from it.
+# differ most (light/examples/ericw_agreement.rs). The `MAP.texinfo.json` ericw-tools' qbsp writes
+# beside a BSP goes with both copies. bench/results/light-agreement.md comes from it.
 # Usage: [OURS="--extra4 --soft"] [ERICW="-extra4 -soft"] [WORST=20] bench/light_agreement.sh MAP.bsp...
 set -euo pipefail
 source "$(dirname "$0")/common.sh"
@@ -15,6 +16,13 @@ work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
 for bsp in "$@"; do
   name=$(basename "$bsp" .bsp)
   cp "$bsp" "$work/ours.bsp"; cp "$bsp" "$work/ericw.bsp"
+  rm -f "$work"/*.texinfo.json
+  # The per-face keys ericw-tools' qbsp writes beside its BSP (`_phong`, `_minlight`, ...): both
+  # tools read them as a mapper's light run would.
+  if [ -f "${bsp%.bsp}.texinfo.json" ]; then
+    cp "${bsp%.bsp}.texinfo.json" "$work/ours.texinfo.json"
+    cp "${bsp%.bsp}.texinfo.json" "$work/ericw.texinfo.json"
+  fi
   # shellcheck disable=SC2086 # the option strings are split on purpose
   "$target/slipgate" light ${OURS:-} "$work/ours.bsp" >/dev/null 2>&1
   # shellcheck disable=SC2086

@@ -183,7 +183,7 @@ pub fn face_geometry(
     spacing_of: impl Fn(usize) -> Spacing + Sync,
 ) -> Result<Vec<FaceGeom>, LightError> {
     let mut faces = unlinked_face_geometry(bsp, origin_of, spacing_of)?;
-    let links = continuations(&faces);
+    let links = continuations(&faces, |_, _| false);
     attach_continuations(&mut faces, links);
     Ok(faces)
 }
@@ -283,6 +283,11 @@ const SAME_CORNER: f64 = 0.01;
 /// An edge by its two corners on the [`SAME_CORNER`] grid, the lesser first.
 type EdgeKey = ([i64; 3], [i64; 3]);
 
+/// Whether two planes are one, facing the same way, as far as faces continuing each other go.
+pub fn one_plane(a: &Plane, b: &Plane) -> bool {
+    a.normal.dot(b.normal) > 1.0 - 1e-6 && (a.dist - b.dist).abs() < SAME_CORNER
+}
+
 /// How many shared edges a sample past a face's edge may cross to the faces continuing it on
 /// its plane (ericw-tools follows a point across at most three).
 pub const CONTINUATION_HOPS: usize = 3;
@@ -295,8 +300,12 @@ pub const CONTINUATION_HOPS: usize = 3;
 #[derive(Debug, Clone, Default)]
 pub struct Continuations {
     regions: Vec<Arc<FaceRegion>>,
+    /// Per region: its face and the plane it looks out of.
+    faces: Vec<(u32, Plane)>,
     /// Per region, per edge: the region across it, when it is one of them.
     across: Vec<Vec<Option<u32>>>,
+    /// Whether some region is smoothed with the face (`_phong`) or on another plane.
+    smoothed: bool,
 }
 
 impl Continuations {
@@ -315,6 +324,17 @@ impl Continuations {
         self.regions.get(k).map(|r| &**r)
     }
 
+    /// Whether a point may walk onto a face smoothed with this one (`_phong`): it then stands
+    /// on that face, maybe on another plane, and takes its normal.
+    pub fn smoothed(&self) -> bool {
+        self.smoothed
+    }
+
+    /// Region `k`'s face and the plane it looks out of.
+    pub fn face(&self, k: usize) -> Option<(usize, &Plane)> {
+        self.faces.get(k).map(|(f, plane)| (*f as usize, plane))
+    }
+
     /// The region across edge `edge` of region `k`, if any.
     pub fn across(&self, k: usize, edge: usize) -> Option<usize> {
         let next = self.across.get(k)?.get(edge).copied().flatten()?;
@@ -329,9 +349,13 @@ pub struct Links {
     outlines: Vec<Option<Arc<FaceRegion>>>,
 }
 
-/// Each lit face's [`FaceGeom::continuations`]: the lit faces of its model on its plane reached
-/// across at most [`CONTINUATION_HOPS`] shared edges.
-pub fn continuations(faces: &[FaceGeom]) -> Links {
+/// Each lit face's [`FaceGeom::continuations`]: the lit faces reached across at most
+/// [`CONTINUATION_HOPS`] shared edges, each of its predecessor's model and plane or `smooths`
+/// with it (`_phong`).
+pub fn continuations(
+    faces: &[FaceGeom],
+    smooths: impl Fn(&FaceGeom, &FaceGeom) -> bool + Sync,
+) -> Links {
     let key = |p: DVec3| (p / SAME_CORNER).round().as_i64vec3().to_array();
     let lit = |f: &&FaceGeom| f.kind == FaceKind::Lit;
     // Every lit face's edges, sorted by edge: one allocation of the exact size (fresh memory
@@ -348,11 +372,8 @@ pub fn continuations(faces: &[FaceGeom]) -> Links {
         }
     }
     by_edge.par_sort_unstable();
-    let same_plane = |a: &FaceGeom, b: &FaceGeom| {
-        a.model == b.model
-            && a.plane.normal.dot(b.plane.normal) > 1.0 - 1e-6
-            && (a.plane.dist - b.plane.dist).abs() < SAME_CORNER
-    };
+    let same_plane =
+        |a: &FaceGeom, b: &FaceGeom| a.model == b.model && one_plane(&a.plane, &b.plane);
     // The faces under one edge are a run of `by_edge`: each is beside the others on its plane,
     // and the first of them (in face order, as ericw-tools finds it) lies across the edge.
     let mut across: Vec<Vec<Option<u32>>> =
@@ -362,7 +383,7 @@ pub fn continuations(faces: &[FaceGeom]) -> Links {
     for run in by_edge.chunk_by(|a, b| a.0 == b.0) {
         for &(_, f, edge) in run {
             for &(_, g, _) in run {
-                if g != f && same_plane(&faces[f], &faces[g]) {
+                if g != f && (same_plane(&faces[f], &faces[g]) || smooths(&faces[f], &faces[g])) {
                     beside.push((f as u32, g as u32));
                     across[f][edge as usize].get_or_insert(g as u32);
                 }
@@ -421,17 +442,23 @@ pub fn continuations(faces: &[FaceGeom]) -> Links {
                     }
                 };
                 // An outline's inward normals come from the plane it is seen on: a continuation
-                // on a plane whose normal differs in its last bits gets an outline of its own.
+                // on the face's plane whose normal differs in its last bits gets an outline of
+                // its own; one on another plane (a smoothed neighbour) keeps its own.
                 let normal = faces[f].plane.normal;
                 let mut regions = vec![own.clone()];
                 regions.extend(reached.iter().filter_map(|&g| match &outlines[g] {
                     Some(r) if faces[g].plane.normal == normal => Some(r.clone()),
+                    Some(r) if !same_plane(&faces[f], &faces[g]) => Some(r.clone()),
                     Some(_) => Some(Arc::new(FaceRegion::from_points(
                         faces[g].points.clone(),
                         normal,
                     ))),
                     None => None,
                 }));
+                let planes = std::iter::once(&f)
+                    .chain(reached.iter())
+                    .map(|&g| (g as u32, faces[g].plane))
+                    .collect();
                 let across = std::iter::once(&f)
                     .chain(reached.iter())
                     .map(|&g| {
@@ -441,7 +468,15 @@ pub fn continuations(faces: &[FaceGeom]) -> Links {
                             .collect()
                     })
                     .collect();
-                Arc::new(Continuations { regions, across })
+                let smoothed = reached
+                    .iter()
+                    .any(|&g| smooths(&faces[f], &faces[g]) || !same_plane(&faces[f], &faces[g]));
+                Arc::new(Continuations {
+                    regions,
+                    faces: planes,
+                    across,
+                    smoothed,
+                })
             },
         )
         .collect();

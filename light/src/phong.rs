@@ -3,12 +3,14 @@
 //! `func_group` the compiler recorded in the `SLIPGATE_PHONG` lump), so a
 //! column made of flat faces is lit like a round one. Each face corner gets the mean of the
 //! normals of the entity's faces that meet there and lie within the phong
-//! angle of the face, weighted by the angle each face spans at that corner.
-//! Inside a face the corner normals are blended with mean value
-//! coordinates. Only the angle-of-incidence term uses them; shadows and
-//! culling keep the flat face.
+//! angle of the face, each weighted by the angle it spans at that corner times its area.
+//! Inside a face the corner normals are blended by barycentric coordinates over a fan of
+//! triangles from its first corner (mean value coordinates for a point nudged off the face),
+//! both as ericw-tools does. A sample past a face's edge walks onto the faces smoothed with it
+//! and takes the normal of the one it stands on (`samples.rs`). Only the angle-of-incidence
+//! term uses them; shadows and culling keep the flat face.
 
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 use quake_formats::geom::DVec3Ext;
 use std::collections::HashMap;
 
@@ -16,6 +18,8 @@ use quake_formats::bsp::phong::FacePhong;
 use quake_formats::geom::Bounds;
 
 use crate::faces::{FaceGeom, FaceKind};
+use crate::outline::INSIDE_SLACK;
+use crate::samples::FaceSamples;
 
 /// A point this close to a face (plane and outline) touches it.
 const TOUCH_EPSILON: f64 = 0.05;
@@ -175,7 +179,6 @@ pub fn corner_normals(faces: &[FaceGeom], groups: &PhongGroups) -> Vec<Option<Ve
                 }
             }
         }
-        let cos_limit = |concave: bool| angles.for_joint(concave).to_radians().cos();
         for f in members {
             let normal = f.plane.normal;
             let corners = f
@@ -185,13 +188,11 @@ pub fn corner_normals(faces: &[FaceGeom], groups: &PhongGroups) -> Vec<Option<Ve
                     let mut sum = DVec3::ZERO;
                     for &m in grid.get(&cell_of(p)).into_iter().flatten() {
                         let g = members[m];
-                        // Concave: the other face rises in front of this one.
-                        let concave = f.plane.distance(centroid(&g.points)) > TOUCH_EPSILON;
-                        if g.plane.normal.dot(normal) < cos_limit(concave) - 1e-9 {
+                        if !within_angle(f, g, angles) {
                             continue;
                         }
                         if let Some(w) = angle_at(&g.points, g.plane.normal, g.plane.dist, p) {
-                            sum += g.plane.normal * w;
+                            sum += g.plane.normal * (w * area(&g.points));
                         }
                     }
                     sum.normalized().unwrap_or(normal)
@@ -203,17 +204,121 @@ pub fn corner_normals(faces: &[FaceGeom], groups: &PhongGroups) -> Vec<Option<Ve
     out
 }
 
+/// Whether face `g`'s normal is within the smoothing angle of `f`'s (the concave one where `g`
+/// rises in front of `f`).
+fn within_angle(f: &FaceGeom, g: &FaceGeom, angles: PhongAngles) -> bool {
+    let concave = f.plane.distance(centroid(&g.points)) > TOUCH_EPSILON;
+    let cos_limit = angles.for_joint(concave).to_radians().cos();
+    g.plane.normal.dot(f.plane.normal) >= cos_limit - 1e-9
+}
+
+impl PhongGroups {
+    /// Whether faces `f` and `g` are smoothed together: in one group, their normals within its
+    /// angle.
+    pub fn smooths(&self, f: &FaceGeom, g: &FaceGeom) -> bool {
+        let group = |face: &FaceGeom| self.of_face.get(face.index).copied().flatten();
+        match (group(f), group(g)) {
+            (Some(a), Some(b)) if a == b => self
+                .angles
+                .get(a)
+                .is_some_and(|&angles| within_angle(f, g, angles)),
+            _ => false,
+        }
+    }
+}
+
+/// The area of the convex polygon `points`.
+fn area(points: &[DVec3]) -> f64 {
+    let Some(&first) = points.first() else {
+        return 0.0;
+    };
+    let doubled = points.windows(2).skip(1).fold(DVec3::ZERO, |acc, w| {
+        acc + (w[0] - first).cross(w[1] - first)
+    });
+    doubled.length() / 2.0
+}
+
 /// The mean of `points`.
 fn centroid(points: &[DVec3]) -> DVec3 {
     points.iter().fold(DVec3::ZERO, |a, &p| a + p) / points.len().max(1) as f64
 }
 
+/// The `_phong` normal at each of `samples` (of `faces[samples.face]`), from the corner normals
+/// of the face each stands on; `None` for a face not smoothed.
+pub fn sample_normals(
+    samples: &FaceSamples,
+    faces: &[FaceGeom],
+    corner_normals: &[Option<Vec<DVec3>>],
+) -> Option<Vec<[f32; 3]>> {
+    let corners_of = |f: usize| corner_normals.get(f).and_then(Option::as_ref);
+    let own = corners_of(samples.face)?;
+    let geom = faces.get(samples.face)?;
+    let normals = samples.points.iter().enumerate().map(|(i, &p)| {
+        // A sample on a face without normals of its own (a continuing face outside the group)
+        // takes this face's.
+        let (geom, corners) = samples
+            .landed
+            .get(i)
+            .map(|&f| f as usize)
+            .filter(|&f| f != samples.face)
+            .and_then(|f| Some((faces.get(f)?, corners_of(f)?)))
+            .unwrap_or((geom, own));
+        interpolate(geom, corners, Vec3::from(p).as_dvec3())
+            .as_vec3()
+            .to_array()
+    });
+    Some(normals.collect())
+}
+
 /// The smooth normal at `p` (on or just off the face) from the face's
-/// `corners` normals, by mean value coordinates of `p` projected onto the
-/// face's plane (a point outside the face takes the nearest edge's blend).
+/// `corners` normals, as ericw-tools blends them: the face cut into a fan of triangles from
+/// its first corner, and `p` (projected onto the face's plane) blended by its barycentric
+/// coordinates in the first triangle holding it (within [`INSIDE_SLACK`] of its edges). A point
+/// no triangle holds (one nudged off the face) takes mean value coordinates, which blend
+/// smoothly outside the face too.
 pub fn interpolate(face: &FaceGeom, corners: &[DVec3], p: DVec3) -> DVec3 {
     let n = face.plane.normal;
     let q = p - n * face.plane.distance(p);
+    fan_blend(&face.points, corners, n, q).unwrap_or_else(|| mean_value_blend(face, corners, q))
+}
+
+/// The blend of `corners` at `q` (on the plane of `points`, whose normal is `n`) by the
+/// barycentric coordinates of the first triangle of the fan from `points[0]` that holds it.
+/// Degenerate triangles are passed over.
+fn fan_blend(points: &[DVec3], corners: &[DVec3], n: DVec3, q: DVec3) -> Option<DVec3> {
+    let (&a, &na) = (points.first()?, corners.first()?);
+    for i in 2..points.len().min(corners.len()) {
+        let (b, c) = (points[i - 1], points[i]);
+        let centre = (a + b + c) / 3.0;
+        let holds = [(a, b), (b, c), (c, a)].iter().all(|&(from, to)| {
+            n.cross(to - from).normalized().is_some_and(|m| {
+                let inward = if m.dot(centre - from) < 0.0 { -m } else { m };
+                inward.dot(q - from) >= -INSIDE_SLACK
+            })
+        });
+        if !holds {
+            continue;
+        }
+        let (ab, ac, aq) = (b - a, c - a, q - a);
+        let (d00, d01, d11) = (ab.dot(ab), ab.dot(ac), ac.dot(ac));
+        let (d20, d21) = (aq.dot(ab), aq.dot(ac));
+        let denom = d00 * d11 - d01 * d01;
+        let v = (d11 * d20 - d01 * d21) / denom;
+        let w = (d00 * d21 - d01 * d20) / denom;
+        let u = 1.0 - v - w;
+        if !(u.is_finite() && v.is_finite() && w.is_finite()) {
+            continue;
+        }
+        let blend = na * u + corners[i - 1] * v + corners[i] * w;
+        return Some(blend.normalized().unwrap_or(n));
+    }
+    None
+}
+
+/// The blend of `corners` at `q` (on the face's plane) by mean value coordinates (a point
+/// outside the face takes the nearest edge's blend).
+fn mean_value_blend(face: &FaceGeom, corners: &[DVec3], q: DVec3) -> DVec3 {
+    let n = face.plane.normal;
     let pts = &face.points;
     let count = pts.len();
     let spokes: Vec<DVec3> = pts.iter().map(|&v| v - q).collect();
@@ -278,6 +383,21 @@ mod tests {
         assert!(mid.near(DVec3::new(0.0, 0.0, 1.0), 1e-9), "{mid:?}");
         let left = interpolate(&f, &corners, DVec3::new(2.0, 5.0, 0.0));
         assert!(left.x < 0.0 && left.x > tilt(-0.5).x, "{left:?}");
+    }
+
+    /// As ericw-tools blends them: over the fan of triangles from the first corner, so inside
+    /// the first triangle (corners 0, 1, 2) the fourth corner's normal plays no part.
+    #[test]
+    fn interpolation_blends_over_a_fan_from_the_first_corner() {
+        let f = square();
+        let up = DVec3::Z;
+        let odd = DVec3::new(1.0, 0.0, 1.0).normalized().expect("unit");
+        let corners = [up, up, up, odd];
+        // (2, 8) lies in the triangle (0, 0), (0, 10), (10, 10).
+        let inside_first = interpolate(&f, &corners, DVec3::new(2.0, 8.0, 1.0));
+        assert!(inside_first.near(up, 1e-12), "{inside_first:?}");
+        let inside_second = interpolate(&f, &corners, DVec3::new(8.0, 2.0, 1.0));
+        assert!(inside_second.x > 0.0, "{inside_second:?}");
     }
 
     #[test]

@@ -247,16 +247,16 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
         fences: &fences,
         channels: &face_channels,
     };
+    let lump = bsp.phong_faces().map_err(LightError::BspxLump)?;
+    let groups = phong::groups(&faces, &map_lights.phong, lump.as_deref());
     // Embree builds its tree on its own threads while ours link the faces.
     let (scene, links) = rayon::join(
         || TraceScene::build(&device, &faces, &casters),
-        || continuations(&faces),
+        || continuations(&faces, |f, g| groups.smooths(f, g)),
     );
     let scene = scene?;
     attach_continuations(&mut faces, links);
     let vis = Visibility::new(bsp, &faces);
-    let lump = bsp.phong_faces().map_err(LightError::BspxLump)?;
-    let groups = phong::groups(&faces, &map_lights.phong, lump.as_deref());
     let phong = phong::corner_normals(&faces, &groups);
     let in_liquid = |p: DVec3| {
         let leaf = bsp.leaf_at(p.as_vec3().to_array());

@@ -2,7 +2,7 @@
 //! bounced light, finish each face (bounce added, floors applied, samples averaged to luxels)
 //! and count what was done; then turn light units into bytes and write them into the BSP.
 
-use glam::{DVec3, Vec3};
+use glam::DVec3;
 use std::collections::{BTreeMap, BTreeSet};
 use std::time::Instant;
 
@@ -705,8 +705,8 @@ fn trace_faces(
         .map_init(TraceScratch::default, |reuse, &f| {
             let geom = &prep.faces[f];
             let (mut samples, placement) = face_samples(geom, per_axis, bsp);
-            if let Some(corners) = &prep.phong[f] {
-                samples.normals = phong_normals(&samples, geom, corners);
+            if let Some(normals) = phong::sample_normals(&samples, &prep.faces, &prep.phong) {
+                samples.normals = normals;
             }
             let rules = face_rules(&prep.lights, geom);
             let (light, counts) = trace_face(setup, &samples, &rules, reuse);
@@ -869,19 +869,6 @@ fn gather_faces<'t>(
             let mut counts = BounceCounts::default();
             let light = gather(t, &mut counts)?;
             Some((t.face, light, counts))
-        })
-        .collect()
-}
-
-/// The `_phong` normal at each of `samples`, from its face's corner normals `corners`.
-fn phong_normals(samples: &FaceSamples, geom: &FaceGeom, corners: &[glam::DVec3]) -> Vec<[f32; 3]> {
-    samples
-        .points
-        .iter()
-        .map(|&p| {
-            phong::interpolate(geom, corners, Vec3::from(p).as_dvec3())
-                .as_vec3()
-                .to_array()
         })
         .collect()
 }

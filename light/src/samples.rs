@@ -30,7 +30,7 @@ use quake_formats::bsp::contents;
 use quake_formats::extents::LuxelGrid;
 use quake_formats::int_hash::IntMap;
 
-use crate::faces::{CONTINUATION_HOPS, Continuations, FaceGeom, FaceKind};
+use crate::faces::{CONTINUATION_HOPS, Continuations, FaceGeom, FaceKind, one_plane};
 use crate::outline::{FaceRegion, ON_EDGE};
 
 /// Distance of sample points in front of their face, in map units.
@@ -63,6 +63,9 @@ pub struct FaceSamples {
     /// Per sample: no place to measure light (inside solid, or far past the face's edge), so
     /// its light does not count (empty: no sample is).
     pub occluded: Vec<bool>,
+    /// Per sample: the face it stands on, this one unless it walked off onto a face continuing
+    /// or smoothed with it (empty: every sample stands on this one).
+    pub landed: Vec<u32>,
 }
 
 impl FaceSamples {
@@ -202,6 +205,8 @@ pub struct Placed {
     pub on_edge: bool,
     /// It was more than a luxel outside the face: no pixel shows its light.
     pub beyond: bool,
+    /// The face it ended on, when it walked off this one onto another.
+    pub face: Option<u32>,
 }
 
 impl SurfaceMap {
@@ -237,6 +242,7 @@ impl SurfaceMap {
                 moved: false,
                 on_edge: false,
                 beyond: false,
+                face: None,
             };
         };
         let on_plane = m.point(s, t) + self.origin;
@@ -248,7 +254,11 @@ impl SurfaceMap {
                 moved: false,
                 on_edge,
                 beyond: false,
+                face: None,
             };
+        }
+        if self.continuations.smoothed() {
+            return self.onto_smoothed_faces(on_plane);
         }
         // Past the edge: across it onto the face continuing the plane there, if one does, and
         // so on; the point stays where it lands inside one, else it moves onto the outline of
@@ -277,11 +287,68 @@ impl SurfaceMap {
                     moved: false,
                     on_edge: false,
                     beyond: false,
+                    face: None,
                 };
             }
         }
-        let (on_face, onto) = region.nearest_on_edge(on_plane);
-        let step = on_face - on_plane;
+        self.onto_outline(region, on_plane, self.lift, None)
+    }
+
+    /// [`SurfaceMap::place`] of a point `on_plane` past the edge of a face smoothed with some of
+    /// the faces around it: the walk goes onto those too, the point projected onto each one's
+    /// plane (lifted off the plane it leaves, as ericw-tools projects it), and it stands on the
+    /// face it ends on.
+    fn onto_smoothed_faces(&self, on_plane: DVec3) -> Placed {
+        let (mut region, mut at, mut point) = (&*self.outline, 0, on_plane);
+        for _ in 0..CONTINUATION_HOPS {
+            let Some(next) = region
+                .edge_to_cross(point)
+                .and_then(|edge| self.continuations.across(at, edge))
+            else {
+                break;
+            };
+            let (Some(beyond_edge), Some((_, current)), Some((_, next_plane))) = (
+                self.continuations.region(next),
+                self.continuations.face(at),
+                self.continuations.face(next),
+            ) else {
+                break;
+            };
+            if !one_plane(current, next_plane) {
+                // Onto a smoothed face's plane, as ericw-tools moves it: the point lifted off
+                // this plane, projected onto that one.
+                let lifted = point + current.normal * SURFACE_OFFSET;
+                point = lifted - next_plane.normal * next_plane.distance(lifted);
+            }
+            (region, at) = (beyond_edge, next);
+            if region.inside_on_edge(point).is_some() {
+                return Placed {
+                    at: point + self.lift_at(at),
+                    moved: point != on_plane,
+                    on_edge: false,
+                    beyond: false,
+                    face: self.landed_on(at),
+                };
+            }
+        }
+        let moved = self.onto_outline(region, point, self.lift_at(at), self.landed_on(at));
+        Placed {
+            moved: moved.moved || point != on_plane,
+            ..moved
+        }
+    }
+
+    /// A point `point` outside `region` (on its plane) moved onto its outline and lifted by
+    /// `lift`: occluded when that is more than a luxel away.
+    fn onto_outline(
+        &self,
+        region: &FaceRegion,
+        point: DVec3,
+        lift: DVec3,
+        face: Option<u32>,
+    ) -> Placed {
+        let (on_face, onto) = region.nearest_on_edge(point);
+        let step = on_face - point;
         let along = |axis: [f64; 4]| DVec3::new(axis[0], axis[1], axis[2]).dot(step);
         let [ds, dt] = self.grid.axes.map(along);
         // A point moved onto an edge lies on it: that edge's distance says so without the
@@ -289,11 +356,33 @@ impl SurfaceMap {
         let on_edge = onto.is_some_and(|edge| region.distance(edge, on_face) < ON_EDGE)
             || region.on_edge(on_face);
         Placed {
-            at: on_face + self.lift,
-            moved: on_face != on_plane,
+            at: on_face + lift,
+            moved: on_face != point,
             on_edge,
             beyond: longer_than(ds, dt, self.grid.scale),
+            face,
         }
+    }
+
+    /// The lift off continuation `k`'s face: this face's own on its plane.
+    fn lift_at(&self, k: usize) -> DVec3 {
+        if k == 0 {
+            return self.lift;
+        }
+        match (self.continuations.face(0), self.continuations.face(k)) {
+            (Some((_, own)), Some((_, plane))) if !one_plane(own, plane) => {
+                plane.normal * SURFACE_OFFSET
+            }
+            _ => self.lift,
+        }
+    }
+
+    /// The face a point that ended on continuation `k` stands on, when not this one.
+    fn landed_on(&self, k: usize) -> Option<u32> {
+        if k == 0 {
+            return None;
+        }
+        self.continuations.face(k).map(|(f, _)| f as u32)
     }
 
     /// Whether every sample of the luxel whose middle is at `[s0, t0]` lies inside the face
@@ -320,6 +409,7 @@ impl SurfaceMap {
             moved: false,
             on_edge: false,
             beyond: false,
+            face: None,
         }
     }
 
@@ -390,6 +480,8 @@ pub fn face_samples(face: &FaceGeom, per_axis: usize, bsp: &Bsp) -> (FaceSamples
     let mut moved: Vec<bool> = Vec::with_capacity(count);
     let mut apart: Vec<bool> = Vec::with_capacity(count);
     let mut beyond: Vec<bool> = Vec::with_capacity(count);
+    // Samples that walked off the face, and the face each stands on.
+    let mut walked: Vec<(usize, u32)> = Vec::new();
     // Luxel by luxel (row-major), each luxel's samples row by row: the order of
     // [`SurfaceMap::sample_st`].
     let mut sub_st = Vec::with_capacity(per_luxel);
@@ -406,11 +498,21 @@ pub fn face_samples(face: &FaceGeom, per_axis: usize, bsp: &Bsp) -> (FaceSamples
                 } else {
                     map.place(s, t)
                 };
+                if let Some(other) = placed.face {
+                    walked.push((points.len(), other));
+                }
                 points.push(placed.at.as_vec3().to_array());
                 moved.push(placed.moved);
                 apart.push(placed.on_edge);
                 beyond.push(placed.beyond);
             }
+        }
+    }
+    let mut landed: Vec<u32> = Vec::new();
+    if !walked.is_empty() {
+        landed = vec![face.index as u32; count];
+        for (i, other) in walked {
+            landed[i] = other;
         }
     }
     let mut counts = PlacementCounts {
@@ -461,6 +563,7 @@ pub fn face_samples(face: &FaceGeom, per_axis: usize, bsp: &Bsp) -> (FaceSamples
             moved,
             apart,
             occluded,
+            landed,
         },
         counts,
     )

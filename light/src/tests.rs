@@ -892,9 +892,10 @@ fn column_scene(world_keys: &str) -> Bsp {
     synthetic_bsp(&polys, &ents)
 }
 
-/// For each pair of neighbouring column faces that both face the light, the
-/// difference between the lit values of the two samples nearest their
-/// shared edge at mid height (light units).
+/// For each pair of neighbouring column faces that both face the light, how fast the light
+/// changes across their shared edge (between the two samples standing on the faces nearest it,
+/// at mid height) over how fast it changes at most between neighbouring samples within either
+/// face: near 1 where the light turns smoothly over the edge, far above where it steps.
 fn edge_jumps(world_keys: &str) -> Vec<f64> {
     let bsp = column_scene(world_keys);
     let prep = crate::prepare::prepare(&bsp, &Options::default()).expect("prepare");
@@ -909,16 +910,9 @@ fn edge_jumps(world_keys: &str) -> Vec<f64> {
         .map(|f| {
             let geom = &prep.faces[f];
             let (mut samples, _) = face_samples(geom, 1, &bsp);
-            if let Some(corners) = &prep.phong[f] {
-                samples.normals = samples
-                    .points
-                    .iter()
-                    .map(|&p| {
-                        crate::phong::interpolate(geom, corners, Vec3::from(p).as_dvec3())
-                            .as_vec3()
-                            .to_array()
-                    })
-                    .collect();
+            if let Some(normals) = crate::phong::sample_normals(&samples, &prep.faces, &prep.phong)
+            {
+                samples.normals = normals;
             }
             let rules = crate::trace::FaceRules::default();
             let mut scratch = crate::trace::TraceScratch::default();
@@ -928,16 +922,25 @@ fn edge_jumps(world_keys: &str) -> Vec<f64> {
                 crate::trace::HiddenLuxels::FromNeighbours,
                 crate::luxels::ToLuxels::OpenMeans,
             );
+            // Samples that walked off the face onto its neighbour stand for that face.
+            let own = |i: usize| samples.landed.get(i).is_none_or(|&g| g as usize == f);
             samples
                 .points
                 .iter()
                 .zip(&light.styles[0].1)
-                .map(|(&p, v)| (Vec3::from(p).as_dvec3(), f64::from(v[0])))
+                .enumerate()
+                .filter(|&(i, _)| own(i))
+                .map(|(_, (&p, v))| (Vec3::from(p).as_dvec3(), f64::from(v[0])))
                 .filter(|(p, _)| (p.z - 64.0).abs() <= 8.0)
                 .collect()
         })
         .collect();
     let mut jumps = Vec::new();
+    let steepest = |row: &[(DVec3, f64)]| {
+        row.windows(2)
+            .map(|w| (w[1].1 - w[0].1).abs() / (w[1].0 - w[0].0).length())
+            .fold(0.0, f64::max)
+    };
     for k in 0..8 {
         let (a, b) = (&rows[k], &rows[(k + 1) % 8]);
         if a.iter().chain(b).any(|&(_, v)| v <= 0.0) {
@@ -947,12 +950,13 @@ fn edge_jumps(world_keys: &str) -> Vec<f64> {
         let ang = (k as f64 + 1.5) * std::f64::consts::TAU / 8.0;
         let edge = DVec3::new(256.0 + 64.0 * ang.cos(), 256.0 + 64.0 * ang.sin(), 64.0);
         let nearest = |row: &[(DVec3, f64)]| {
-            row.iter()
+            *row.iter()
                 .min_by(|x, y| (x.0 - edge).length().total_cmp(&(y.0 - edge).length()))
-                .map(|x| x.1)
                 .expect("samples")
         };
-        jumps.push((nearest(a) - nearest(b)).abs());
+        let ((pa, va), (pb, vb)) = (nearest(a), nearest(b));
+        let across = (va - vb).abs() / (pa - pb).length().max(1e-3);
+        jumps.push(across / steepest(a).max(steepest(b)).max(1e-3));
     }
     jumps
 }
@@ -963,10 +967,37 @@ fn phong_smooths_a_column_without_facet_bands() {
     let smooth = edge_jumps("\"_phong\" \"1\"");
     assert!(flat.len() >= 2, "{flat:?}");
     assert_eq!(flat.len(), smooth.len());
-    // Flat facets 45 degrees apart: a cosine step of tens of units at each edge.
-    assert!(flat.iter().all(|&j| j > 30.0), "{flat:?}");
-    // Smoothed: both sides of an edge use (nearly) the same normal there.
-    assert!(smooth.iter().all(|&j| j < 8.0), "{smooth:?}");
+    // Flat facets 45 degrees apart: a cosine step at each edge, far steeper than the light
+    // changes within a face.
+    assert!(flat.iter().all(|&j| j > 10.0), "{flat:?}");
+    // Smoothed: across an edge the light changes no faster than within the faces.
+    assert!(smooth.iter().all(|&j| j < 1.5), "{smooth:?}");
+}
+
+/// Regression: on a `_phong` column a luxel past a face's edge was moved back onto that edge;
+/// ericw-tools walks it onto the face smoothed with it beyond the edge, on that face's plane,
+/// where it takes that face's normal. Without `_phong` the faces do not continue each other.
+#[test]
+fn samples_past_a_phong_face_walk_onto_the_smoothed_face() {
+    let walked = |world_keys: &str| {
+        let bsp = column_scene(world_keys);
+        let prep = crate::prepare::prepare(&bsp, &Options::default()).expect("prepare");
+        let (samples, _) = face_samples(&prep.faces[1], 1, &bsp);
+        let mut on_others = 0;
+        for (i, &g) in samples.landed.iter().enumerate() {
+            if g == 1 {
+                continue;
+            }
+            on_others += 1;
+            // Lifted a unit off the other face's plane (half a unit more or less if nudged).
+            let p = Vec3::from(samples.points[i]).as_dvec3();
+            let off = prep.faces[g as usize].plane.distance(p);
+            assert!((0.4..=1.6).contains(&off), "sample {i} on face {g}: {off}");
+        }
+        on_others
+    };
+    assert!(walked("\"_phong\" \"1\"") > 0);
+    assert_eq!(walked(""), 0);
 }
 
 /// Culling is exact: on a `_phong` column, the faces just past the light's terminator have the

@@ -230,6 +230,7 @@ pub(super) mod tests {
             moved,
             apart: vec![false; n],
             occluded: Vec::new(),
+            landed: Vec::new(),
         }
     }
 

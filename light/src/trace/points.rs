@@ -467,6 +467,7 @@ mod tests {
             moved: vec![false; n],
             apart: vec![false; n],
             occluded: Vec::new(),
+            landed: Vec::new(),
         }
     }
 
