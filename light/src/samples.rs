@@ -6,8 +6,9 @@
 //! supersampling, found by inverting the grid's projection onto the face's
 //! plane. A point less than 0.05 units past the face's edge counts as inside it. One farther
 //! past walks as ericw-tools walks it: across the edge it lies least far past the ends of onto
-//! the face continuing the plane there (same model, same plane), and on, at most three times;
-//! it stays where it lands inside one. Otherwise (a luxel past the edge, e.g. under a wall
+//! the face continuing the plane there (same model, same plane) or, on a `_phong` face, a face
+//! smoothed with it (the point, lifted off its plane, projected onto that face's), and on, at
+//! most three times; it stays where it lands inside one, standing on that face. Otherwise (a luxel past the edge, e.g. under a wall
 //! standing on a floor) it moves to the nearest point of the outline of the last face it
 //! reached, unless that is more than a luxel away (the far corners of a triangle's lightmap,
 //! which no pixel shows): such a point is occluded.
@@ -257,6 +258,8 @@ impl SurfaceMap {
                 face: None,
             };
         }
+        // The walk along one plane stays apart from the one across smoothed faces: most points
+        // past an edge take it, without the other's planes and faces to keep.
         if self.continuations.smoothed() {
             return self.onto_smoothed_faces(on_plane);
         }
