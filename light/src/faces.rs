@@ -335,8 +335,13 @@ impl Continuations {
         self.faces.get(k).map(|(f, plane)| (*f as usize, plane))
     }
 
-    /// The region across edge `edge` of region `k`, if any.
-    pub fn across(&self, k: usize, edge: usize) -> Option<usize> {
+    /// The region a point `p` past region `k` (on its plane) walks onto: the one across the
+    /// edge [`FaceRegion::edge_to_cross`] picks, if any.
+    pub fn next(&self, k: usize, p: DVec3) -> Option<usize> {
+        if self.is_empty() {
+            return None;
+        }
+        let edge = self.region(k)?.edge_to_cross(p)?;
         let next = self.across.get(k)?.get(edge).copied().flatten()?;
         Some(next as usize)
     }

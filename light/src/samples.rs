@@ -268,19 +268,12 @@ impl SurfaceMap {
         // the last face it reached.
         let mut region = &*self.outline;
         let mut at = 0;
-        let hops = if self.continuations.is_empty() {
-            0
-        } else {
-            CONTINUATION_HOPS
-        };
-        for _ in 0..hops {
-            let Some(next) = region
-                .edge_to_cross(on_plane)
-                .and_then(|edge| self.continuations.across(at, edge))
+        for _ in 0..CONTINUATION_HOPS {
+            let Some((next, beyond_edge)) = self
+                .continuations
+                .next(at, on_plane)
+                .and_then(|next| Some((next, self.continuations.region(next)?)))
             else {
-                break;
-            };
-            let Some(beyond_edge) = self.continuations.region(next) else {
                 break;
             };
             (region, at) = (beyond_edge, next);
@@ -304,10 +297,7 @@ impl SurfaceMap {
     fn onto_smoothed_faces(&self, on_plane: DVec3) -> Placed {
         let (mut region, mut at, mut point) = (&*self.outline, 0, on_plane);
         for _ in 0..CONTINUATION_HOPS {
-            let Some(next) = region
-                .edge_to_cross(point)
-                .and_then(|edge| self.continuations.across(at, edge))
-            else {
+            let Some(next) = self.continuations.next(at, point) else {
                 break;
             };
             let (Some(beyond_edge), Some((_, current)), Some((_, next_plane))) = (
