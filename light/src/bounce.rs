@@ -8,7 +8,8 @@
 //! with `scale` = 0.5 × `_bouncescale`: ericw-tools' bounce kernel (its 128-unit hotspot clamp
 //! and factor 0.5), integrated over the surfaces instead of taken at one point per face. A
 //! liquid's surface receives as ericw-tools' two-sided receivers do: from both sides, with
-//! `cosθp` taken as 1. Each further pass reflects the light the previous pass brought.
+//! `cosθp` taken as 1. Each further pass reflects the light the previous pass brought, as the
+//! face shows it: times its dirt factor, none from samples inside solid (as ericw-tools).
 //!
 //! The fast method is a final gather with the reference's estimator: receivers on a grid of
 //! every few luxels ([`Density`]) each cast stratified cosine-distributed rays; a ray reads the

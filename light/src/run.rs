@@ -668,6 +668,9 @@ struct Traced {
     receivers: Option<Box<Receivers>>,
     /// The light it reflects (when bouncing and the face reflects).
     reflected: Option<StyleLuxels>,
+    /// Per luxel, the share of a pass's bounced light it reflects in the next
+    /// ([`crate::trace::SampleLight::passed_on`]; `None`: all of it).
+    passed_on: Option<Vec<f32>>,
     placement: PlacementCounts,
     counts: TraceCounts,
     sample_count: u64,
@@ -711,8 +714,9 @@ fn trace_faces(
             let rules = face_rules(&prep.lights, geom);
             let (light, counts) = trace_face(setup, &samples, &rules, reuse);
             progress.advance(1);
-            let reflected =
-                (keep.bouncing && keep.reflectance[f].is_some()).then(|| light.reflected(styled));
+            let reflects = keep.bouncing && keep.reflectance[f].is_some();
+            let reflected = reflects.then(|| light.reflected(styled));
+            let passed_on = reflects.then(|| light.passed_on()).flatten();
             let light = keep.wanted[f].then(|| match keep.finish {
                 Some(to_luxels) if geom.model == 0 => {
                     TracedLight::Luxels(light.finish(&[], HiddenLuxels::FromNeighbours, to_luxels))
@@ -726,6 +730,7 @@ fn trace_faces(
                     .bouncing
                     .then(|| Box::new(Receivers::new(&samples, geom))),
                 reflected,
+                passed_on,
                 placement,
                 counts,
                 sample_count: samples.points.len() as u64,
@@ -768,6 +773,10 @@ fn bounce_light(
     let mut light: Vec<Option<StyleLuxels>> = vec![None; n];
     for t in field {
         light[t.face] = t.reflected.clone().filter(|r| !r.is_empty());
+    }
+    let mut shares: Vec<Option<&[f32]>> = vec![None; n];
+    for t in field {
+        shares[t.face] = t.passed_on.as_deref();
     }
     let mut total: Vec<StyleLuxels> = vec![Vec::new(); n];
     let mut at_centres: Vec<StyleLight> = vec![Vec::new(); centres.len()];
@@ -847,12 +856,25 @@ fn bounce_light(
                 bounce::accumulate(&mut total[face], &b);
             }
             if reflectance[face].is_some() && !b.is_empty() {
-                next[face] = Some(b);
+                next[face] = Some(passed_on(b, shares[face]));
             }
         }
         light = next;
     }
     (total, at_centres)
+}
+
+/// The part of a pass's bounced light `received` that a face reflects in the next: each
+/// luxel's times its `share`.
+fn passed_on(mut received: StyleLuxels, share: Option<&[f32]>) -> StyleLuxels {
+    if let Some(share) = share {
+        for (_, luxels) in &mut received {
+            for (v, &f) in luxels.iter_mut().zip(share) {
+                *v = v.map(|c| c * f);
+            }
+        }
+    }
+    received
 }
 
 /// One face's light gathered in one pass, and the work it took.

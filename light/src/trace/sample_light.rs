@@ -308,6 +308,31 @@ impl SampleLight {
         out
     }
 
+    /// Per luxel, the share of the bounced light it receives that it sends on to the next pass:
+    /// the mean over its samples of the dirt factor, a sample inside solid counting 0, as
+    /// ericw-tools' faces pass on the bounced light their open samples show. `None` when every
+    /// luxel passes on all of it.
+    pub fn passed_on(&self) -> Option<Vec<f32>> {
+        if self.bounce_dirt.is_empty() && !self.has_occluded() {
+            return None;
+        }
+        let samples = self.width * self.height * self.per_luxel;
+        let share = |i: usize| {
+            if self.occluded.get(i).copied().unwrap_or(false) {
+                0.0
+            } else {
+                self.bounce_dirt.get(i).copied().unwrap_or(1.0)
+            }
+        };
+        let per = self.per_luxel.max(1);
+        Some(
+            (0..samples)
+                .step_by(per)
+                .map(|first| (first..first + per).map(share).sum::<f32>() / per as f32)
+                .collect(),
+        )
+    }
+
     /// Adds `bounce` (per style, per luxel (given to each of the luxel's
     /// samples) or per sample, times each sample's dirt factor), applies
     /// minlight and the floors, and turns samples into luxels as `to_luxels` says, filling
@@ -410,5 +435,49 @@ impl SampleLight {
                 .directions
                 .map_or_else(Vec::new, |d| d.luxel_directions(per)),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two luxels of 2 × 2 samples each (samples of a luxel are consecutive).
+    fn two_luxels(bounce_dirt: Vec<f32>, occluded: Vec<bool>) -> SampleLight {
+        SampleLight {
+            face: 0,
+            width: 2,
+            height: 1,
+            per_luxel: 4,
+            sums: StyleBuffers::new(8),
+            floors: StyleBuffers::none_yet(8),
+            added_minlight: None,
+            no_bounce: None,
+            bounce_dirt,
+            directions: None,
+            occluded,
+            max_sample: None,
+            color_scale: None,
+        }
+    }
+
+    #[test]
+    fn a_luxel_passes_on_the_bounce_its_open_samples_show_after_dirt() {
+        assert_eq!(two_luxels(Vec::new(), vec![false; 8]).passed_on(), None);
+        let open = vec![false; 8];
+        let dirt = vec![1.0, 0.5, 1.0, 0.5, 0.25, 0.25, 0.25, 0.25];
+        assert_eq!(
+            two_luxels(dirt.clone(), open).passed_on(),
+            Some(vec![0.75, 0.25])
+        );
+        // A sample inside solid passes on nothing, with or without dirt.
+        let mut solid = vec![false; 8];
+        solid[0] = true;
+        solid[5] = true;
+        assert_eq!(
+            two_luxels(Vec::new(), solid.clone()).passed_on(),
+            Some(vec![0.75, 0.75])
+        );
+        assert_eq!(two_luxels(dirt, solid).passed_on(), Some(vec![0.5, 0.1875]));
     }
 }
