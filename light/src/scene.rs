@@ -284,6 +284,14 @@ impl TraceScene {
         self.occluded16_by(packet, model, 1)
     }
 
+    /// [`TraceScene::occluded16`] for a packet whose lanes run in many directions from many
+    /// origins (bounced light's segments from several reflecting faces): Embree is told they are
+    /// incoherent, which answers the same and traverses such packets faster (coherent
+    /// packets, as a light's rays to one face, go faster the other way).
+    pub fn occluded16_scattered(&self, packet: &mut RayPacket16, model: usize) -> u16 {
+        self.blocked16(packet, model, 1, false)
+    }
+
     /// [`TraceScene::occluded16`] for the rays of a light whose shadow channels are
     /// `shadow_channels`: the world and the faces on channel 1 block them when it has channel
     /// 1, the faces on other channels when it shares one of theirs.
@@ -293,9 +301,20 @@ impl TraceScene {
         model: usize,
         shadow_channels: u32,
     ) -> u16 {
+        self.blocked16(packet, model, shadow_channels, true)
+    }
+
+    /// [`TraceScene::occluded16_by`], with the shared scene's query `coherent` or not.
+    fn blocked16(
+        &self,
+        packet: &mut RayPacket16,
+        model: usize,
+        shadow_channels: u32,
+        coherent: bool,
+    ) -> u16 {
         let mut blocked = 0;
         if shadow_channels & 1 != 0 {
-            let opaque = self.scene.occluded16(packet, true);
+            let opaque = self.scene.occluded16(packet, coherent);
             // Only the lanes the opaque faces let through can be blocked by a fence; Embree
             // has set the others' tfar to -inf, so the second query skips them too.
             blocked = opaque | self.fences_block16(packet, !opaque);

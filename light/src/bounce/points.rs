@@ -680,7 +680,7 @@ fn see(
                     (dist as f32 - crate::trace::RAY_START).max(0.0),
                 );
             }
-            let blocked = scene.occluded16(&mut packet, r.model);
+            let blocked = scene.occluded16_scattered(&mut packet, r.model);
             counts.rays += chunk.len() as u64;
             for (lane, &(k, i)) in chunk.iter().enumerate() {
                 state[k * n + i] = if blocked & (1 << lane) != 0 {
