@@ -1818,6 +1818,50 @@ fn occluded_samples_cast_no_rays_when_their_light_is_not_used() {
     }
 }
 
+/// A world face whose every sample lies inside solid (a face buried in a wall, which ericw-tools'
+/// qbsp keeps for detail brushes and no engine draws) takes no light from lights, suns or bounce,
+/// and casts no ray for them: ericw-tools lights no sample in solid, and writes no lightmap for
+/// such a face. It takes minlight, as there.
+#[test]
+fn a_world_face_wholly_inside_solid_takes_only_minlight() {
+    let light = "{ \"classname\" \"light\" \"origin\" \"128 128 192\" \"light\" \"400\" }";
+    let bsp = shaded_triangle_scene(light);
+    let prep = crate::prepare::prepare(&bsp, &Options::default()).expect("prepare");
+    let light_reaches = crate::reach::light_reaches(&prep.point_lights, 0.001);
+    let setup = prep.trace_setup(&light_reaches, 0.001, true, true);
+    let floor = &prep.faces[0];
+    let minlight = crate::lights::Minlight {
+        level: 20.0,
+        add: false,
+        color: DVec3::ONE,
+        dirt: None,
+        exclude_texture: None,
+    };
+    let luxels = crate::luxels::ToLuxels::AsEricw { soft_radius: 0 };
+    let lit = |buried: bool, minlight: Option<&crate::lights::Minlight>| {
+        let (mut samples, _) = face_samples(floor, 1, &bsp);
+        if buried {
+            samples.occluded = vec![true; samples.points.len()];
+        }
+        let rules = crate::trace::FaceRules {
+            minlight,
+            ..Default::default()
+        };
+        let mut scratch = crate::trace::TraceScratch::default();
+        let (raw, counts) = crate::trace::trace_face(&setup, &samples, &rules, &mut scratch);
+        let bounced = [(0, vec![[50.0; 3]; samples.width * samples.height])];
+        let light = raw.finish(&bounced, crate::trace::HiddenLuxels::FromNeighbours, luxels);
+        (light.styles[0].1.clone(), counts.shadow_rays)
+    };
+    let (open, open_rays) = lit(false, None);
+    assert!(open.iter().any(|l| l[0] > 60.0) && open_rays > 0);
+    let (buried, buried_rays) = lit(true, None);
+    assert!(buried.iter().all(|l| l[0] == 0.0), "{buried:?}");
+    assert_eq!(buried_rays, 0);
+    let (floored, _) = lit(true, Some(&minlight));
+    assert!(floored.iter().all(|l| l[0] == 20.0), "{floored:?}");
+}
+
 /// An inverse-square light that brings the floor at most 9 units, under a minlight of 100:
 /// style 0 is the floor at every sample whatever the light's shadows, so it casts no ray.
 #[test]

@@ -272,7 +272,12 @@ impl<'a> FaceTrace<'a> {
         // Dirt is measured after the shadow rays, only where some light that
         // takes it arrives (many samples are dark).
         let dirt = setup.dirt.filter(|_| rules.dirt);
-        let (lights, suns) = if rules.minlight_only {
+        // A world face with every sample inside solid (buried in a wall, never drawn) takes
+        // no light but minlight, as ericw-tools' samples in solid take none.
+        let buried = setup.faces[samples.face].model == 0
+            && !samples.occluded.is_empty()
+            && !samples.occluded.contains(&false);
+        let (lights, suns) = if rules.minlight_only || buried {
             (&[][..], &[][..])
         } else if rules.channels & 1 == 0 {
             // Suns are on channel 1.

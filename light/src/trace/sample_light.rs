@@ -163,7 +163,8 @@ fn luxel_means(values: Vec<[f32; 3]>, per: usize) -> Vec<[f32; 3]> {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum HiddenLuxels {
     /// Its neighbours' light, as [`ToLuxels`] fills it (ericw-tools fills a world face's so);
-    /// a face with every sample occluded keeps the means of all of them.
+    /// a face with every sample occluded keeps the means of all of them (a world face's: its
+    /// minlight alone, as no light reaches a sample inside solid).
     FromNeighbours,
     /// Nothing yet (zero): a brush model's are filled from the whole model afterwards.
     Later,
@@ -334,7 +335,7 @@ impl SampleLight {
     }
 
     /// Adds `bounce` (per style, per luxel (given to each of the luxel's
-    /// samples) or per sample, times each sample's dirt factor), applies
+    /// samples not inside solid) or per sample, times each sample's dirt factor), applies
     /// minlight and the floors, and turns samples into luxels as `to_luxels` says, filling
     /// luxels whose every sample is occluded as `hidden` says.
     pub fn finish(
@@ -356,7 +357,11 @@ impl SampleLight {
             let sums = self.sums.get(*style);
             let step = if luxels.len() == sums.len() { 1 } else { per };
             for (i, s) in sums.iter_mut().enumerate() {
-                let Some(b) = luxels.get(i / step) else {
+                // Bounced light reaches no sample inside solid (as lights and suns do not).
+                let Some(b) = luxels
+                    .get(i / step)
+                    .filter(|_| !self.occluded.get(i).copied().unwrap_or(false))
+                else {
                     continue;
                 };
                 let f = dirt.get(i).copied().unwrap_or(1.0);
