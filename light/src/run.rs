@@ -771,11 +771,9 @@ fn bounce_light(
     let settings = prep.lights.bounce;
     let n = prep.faces.len();
     let mut light: Vec<Option<StyleLuxels>> = vec![None; n];
-    for t in field {
-        light[t.face] = t.reflected.clone().filter(|r| !r.is_empty());
-    }
     let mut shares: Vec<Option<&[f32]>> = vec![None; n];
     for t in field {
+        light[t.face] = t.reflected.clone().filter(|r| !r.is_empty());
         shares[t.face] = t.passed_on.as_deref();
     }
     let mut total: Vec<StyleLuxels> = vec![Vec::new(); n];

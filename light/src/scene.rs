@@ -286,8 +286,9 @@ impl TraceScene {
 
     /// [`TraceScene::occluded16`] for a packet whose lanes run in many directions from many
     /// origins (bounced light's segments from several reflecting faces): Embree is told they are
-    /// incoherent, which answers the same and traverses such packets faster (coherent
-    /// packets, as a light's rays to one face, go faster the other way).
+    /// incoherent, which traverses such packets faster (coherent packets, as a light's rays to
+    /// one face, go faster the other way); a segment that grazes an edge may come out the
+    /// other way.
     pub fn occluded16_scattered(&self, packet: &mut RayPacket16, model: usize) -> u16 {
         self.blocked16(packet, model, 1, false)
     }
