@@ -2,7 +2,9 @@
 //! one of the leaves that hold the face is in the PVS of the light's leaf, and
 //! a face can only see the sky if one of its leaves sees a leaf holding a sky
 //! face. Anything without vis data (no vis lump, a leaf without a row, a
-//! light in solid, a brush-model face) is treated as visible. Bounced light from
+//! light in solid, a brush-model face) is treated as visible; a world face that no leaf
+//! holds (buried in solid, where ericw-tools' qbsp keeps some detail faces) is seen from no
+//! leaf, as ericw-tools' empty PVS for it says. Bounced light from
 //! points ([`crate::bounce::points`]) is the exception: it follows ericw-tools'
 //! rule, which is not conservative (see [`Visibility::sees_all`]).
 
@@ -26,6 +28,9 @@ pub struct Visibility {
     rows: Vec<Option<Vec<u8>>>,
     /// World leaves holding each face (empty for brush-model faces).
     face_leafs: Vec<Vec<u32>>,
+    /// Per face: a world face no leaf holds, in a map with vis data (buried in solid: seen
+    /// from nowhere).
+    unheld: Vec<bool>,
     /// Per leaf: its PVS holds a leaf with a sky face.
     leaf_sees_sky: Vec<bool>,
     /// Each leaf that holds sky faces, with the box around them.
@@ -86,9 +91,16 @@ impl Visibility {
                 Some(row) => sky_leafs.iter().any(|&s| s as usize == leaf || bit(row, s)),
             })
             .collect();
+        let has_vis = rows.iter().any(Option::is_some);
+        let unheld = faces
+            .iter()
+            .zip(&face_leafs)
+            .map(|(f, leafs)| has_vis && f.model == 0 && leafs.is_empty())
+            .collect();
         Visibility {
             rows,
             face_leafs,
+            unheld,
             leaf_sees_sky,
             sky_leaf_bounds,
             leaf_contents: bsp.leafs.iter().map(|l| l.contents).collect(),
@@ -109,9 +121,24 @@ impl Visibility {
 
     /// False only if vis data proves nothing in `light_leaf` can see `face`.
     /// Light crossing a liquid surface is never culled: some vis tools treat
-    /// liquids as opaque, but light passes through them.
+    /// liquids as opaque, but light passes through them. A world face no leaf holds
+    /// ([`Visibility::unheld`]) is seen from no leaf with vis data, as ericw-tools' empty PVS
+    /// for it says (a light in solid, sky or a liquid still may reach it).
     pub fn may_reach(&self, light_leaf: Option<u32>, face: usize) -> bool {
+        if self.unheld(face) {
+            return light_leaf.is_none_or(|l| {
+                !matches!(self.rows.get(l as usize), Some(Some(_)))
+                    || self.is_liquid(l)
+                    || self.leaf_contents.get(l as usize) == Some(&contents::SKY)
+            });
+        }
         self.may_reach_leafs(light_leaf, &self.face_leafs[face])
+    }
+
+    /// Whether `face` is a world face that no leaf holds in a map with vis data: buried in
+    /// solid, drawn from nowhere (ericw-tools' qbsp keeps some such detail faces).
+    pub fn unheld(&self, face: usize) -> bool {
+        self.unheld.get(face).copied().unwrap_or(false)
     }
 
     /// False only if vis data proves nothing in `light_leaf` can see any of `leafs` (none:
@@ -272,6 +299,26 @@ mod tests {
         // Regression: marksurfaces listing a door's faces made lights skip the door.
         assert!(vis.may_reach(Some(1), 1));
         assert!(vis.may_reach(None, 0), "light in solid: no culling");
+    }
+
+    /// A world face no leaf holds (buried in solid) is culled for a light in any leaf with a
+    /// PVS row, as ericw-tools' empty PVS for it culls; a light in solid still may reach it, and
+    /// without vis data nothing is culled.
+    #[test]
+    fn a_world_face_no_leaf_holds_is_seen_from_no_leaf() {
+        let (bsp, mut faces) = two_rooms(contents::EMPTY);
+        faces.push(face(2, 0));
+        let vis = Visibility::new(&bsp, &faces);
+        assert!(vis.unheld(2) && !vis.unheld(0) && !vis.unheld(1));
+        assert!(!vis.may_reach(Some(1), 2) && !vis.may_reach(Some(2), 2));
+        assert!(vis.may_reach(None, 2), "light in solid");
+        let mut no_vis = bsp.clone();
+        no_vis.visibility.clear();
+        for leaf in &mut no_vis.leafs {
+            leaf.vis_offset = -1;
+        }
+        let vis = Visibility::new(&no_vis, &faces);
+        assert!(!vis.unheld(2) && vis.may_reach(Some(1), 2));
     }
 
     #[test]

@@ -126,8 +126,12 @@ impl<'a> PointField<'a> {
     }
 
     /// The emitters that may light face `face`: all of them unless vis data tells, else those
-    /// whose faces lie wholly in the face's PVS.
+    /// whose faces lie wholly in the face's PVS (none for a world face no leaf holds).
     fn in_sight_of(&self, face: usize) -> Vec<u32> {
+        // A face no leaf holds sees nothing (ericw-tools' empty PVS for it).
+        if self.vis.unheld(face) {
+            return Vec::new();
+        }
         let Some(pvs) = self.vis.pvs_of(self.vis.face_leafs(face)) else {
             return (0..self.emitters.len() as u32).collect();
         };
