@@ -165,10 +165,8 @@ impl FaceGeom {
     }
 
     /// The mean of the vertices (inside the face: faces are convex).
-    #[cfg(test)]
     pub fn centroid(&self) -> DVec3 {
-        let sum = self.points.iter().fold(DVec3::ZERO, |a, &p| a + p);
-        sum / self.points.len().max(1) as f64
+        quake_formats::geom::polygon_center(&self.points)
     }
 }
 
@@ -283,9 +281,13 @@ const SAME_CORNER: f64 = 0.01;
 /// An edge by its two corners on the [`SAME_CORNER`] grid, the lesser first.
 type EdgeKey = ([i64; 3], [i64; 3]);
 
+/// Two faces whose unit normals' dot product is within this of 1 face the same way (with their
+/// distances within [`SAME_CORNER`], they lie on one plane).
+const SAME_NORMAL: f64 = 1e-6;
+
 /// Whether two planes are one, facing the same way, as far as faces continuing each other go.
 pub fn one_plane(a: &Plane, b: &Plane) -> bool {
-    a.normal.dot(b.normal) > 1.0 - 1e-6 && (a.dist - b.dist).abs() < SAME_CORNER
+    a.normal.dot(b.normal) > 1.0 - SAME_NORMAL && (a.dist - b.dist).abs() < SAME_CORNER
 }
 
 /// How many shared edges a sample past a face's edge may cross to the faces continuing it on
@@ -299,13 +301,20 @@ pub const CONTINUATION_HOPS: usize = 3;
 /// there, at most [`CONTINUATION_HOPS`] times.
 #[derive(Debug, Clone, Default)]
 pub struct Continuations {
-    regions: Vec<Arc<FaceRegion>>,
-    /// Per region: its face and the plane it looks out of.
-    faces: Vec<(u32, Plane)>,
-    /// Per region, per edge: the region across it, when it is one of them.
-    across: Vec<Vec<Option<u32>>>,
+    regions: Vec<Region>,
     /// Whether some region is smoothed with the face (`_phong`) or on another plane.
     smoothed: bool,
+}
+
+/// One face a point may walk onto, as [`Continuations`] holds it.
+#[derive(Debug, Clone)]
+struct Region {
+    outline: Arc<FaceRegion>,
+    face: u32,
+    /// The plane the face looks out of.
+    plane: Plane,
+    /// Per edge: the region across it, when it is one of them.
+    across: Vec<Option<u32>>,
 }
 
 impl Continuations {
@@ -321,7 +330,7 @@ impl Continuations {
 
     /// Region `k`'s outline (0: the face's own).
     pub fn region(&self, k: usize) -> Option<&FaceRegion> {
-        self.regions.get(k).map(|r| &**r)
+        self.regions.get(k).map(|r| &*r.outline)
     }
 
     /// Whether a point may walk onto a face smoothed with this one (`_phong`): it then stands
@@ -332,7 +341,7 @@ impl Continuations {
 
     /// Region `k`'s face and the plane it looks out of.
     pub fn face(&self, k: usize) -> Option<(usize, &Plane)> {
-        self.faces.get(k).map(|(f, plane)| (*f as usize, plane))
+        self.regions.get(k).map(|r| (r.face as usize, &r.plane))
     }
 
     /// The region a point `p` past region `k` (on its plane) walks onto: the one across the
@@ -341,8 +350,9 @@ impl Continuations {
         if self.is_empty() {
             return None;
         }
-        let edge = self.region(k)?.edge_to_cross(p)?;
-        let next = self.across.get(k)?.get(edge).copied().flatten()?;
+        let region = self.regions.get(k)?;
+        let edge = region.outline.edge_to_cross(p)?;
+        let next = region.across.get(edge).copied().flatten()?;
         Some(next as usize)
     }
 }
@@ -450,8 +460,7 @@ pub fn continuations(
                 // on the face's plane whose normal differs in its last bits gets an outline of
                 // its own; one on another plane (a smoothed neighbour) keeps its own.
                 let normal = faces[f].plane.normal;
-                let mut regions = vec![own.clone()];
-                regions.extend(reached.iter().filter_map(|&g| match &outlines[g] {
+                let outline_of = |g: usize| match &outlines[g] {
                     Some(r) if faces[g].plane.normal == normal => Some(r.clone()),
                     Some(r) if !same_plane(&faces[f], &faces[g]) => Some(r.clone()),
                     Some(_) => Some(Arc::new(FaceRegion::from_points(
@@ -459,29 +468,25 @@ pub fn continuations(
                         normal,
                     ))),
                     None => None,
-                }));
-                let planes = std::iter::once(&f)
+                };
+                let regions = std::iter::once(&f)
                     .chain(reached.iter())
-                    .map(|&g| (g as u32, faces[g].plane))
-                    .collect();
-                let across = std::iter::once(&f)
-                    .chain(reached.iter())
-                    .map(|&g| {
-                        across[g]
-                            .iter()
-                            .map(|next| next.and_then(|n| local(n as usize)))
-                            .collect()
+                    .filter_map(|&g| {
+                        Some(Region {
+                            outline: if g == f { own.clone() } else { outline_of(g)? },
+                            face: g as u32,
+                            plane: faces[g].plane,
+                            across: across[g]
+                                .iter()
+                                .map(|next| next.and_then(|n| local(n as usize)))
+                                .collect(),
+                        })
                     })
                     .collect();
                 let smoothed = reached
                     .iter()
                     .any(|&g| smooths(&faces[f], &faces[g]) || !same_plane(&faces[f], &faces[g]));
-                Arc::new(Continuations {
-                    regions,
-                    faces: planes,
-                    across,
-                    smoothed,
-                })
+                Arc::new(Continuations { regions, smoothed })
             },
         )
         .collect();

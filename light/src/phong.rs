@@ -15,7 +15,7 @@ use quake_formats::geom::DVec3Ext;
 use std::collections::HashMap;
 
 use quake_formats::bsp::phong::FacePhong;
-use quake_formats::geom::Bounds;
+use quake_formats::geom::{Bounds, polygon_area};
 
 use crate::faces::{FaceGeom, FaceKind};
 use crate::outline::INSIDE_SLACK;
@@ -23,6 +23,9 @@ use crate::samples::FaceSamples;
 
 /// A point this close to a face (plane and outline) touches it.
 const TOUCH_EPSILON: f64 = 0.05;
+/// Two faces whose normals' angle is the smoothing angle to within this much of its cosine are
+/// within it (the rounding of a cosine of degrees).
+const ANGLE_SLACK: f64 = 1e-9;
 /// Grid cell size of the lookup of faces near a point.
 const CELL: f64 = 64.0;
 
@@ -179,6 +182,7 @@ pub fn corner_normals(faces: &[FaceGeom], groups: &PhongGroups) -> Vec<Option<Ve
                 }
             }
         }
+        let areas: Vec<f64> = members.iter().map(|g| polygon_area(&g.points)).collect();
         for f in members {
             let normal = f.plane.normal;
             let corners = f
@@ -192,7 +196,7 @@ pub fn corner_normals(faces: &[FaceGeom], groups: &PhongGroups) -> Vec<Option<Ve
                             continue;
                         }
                         if let Some(w) = angle_at(&g.points, g.plane.normal, g.plane.dist, p) {
-                            sum += g.plane.normal * (w * area(&g.points));
+                            sum += g.plane.normal * (w * areas[m]);
                         }
                     }
                     sum.normalized().unwrap_or(normal)
@@ -207,9 +211,9 @@ pub fn corner_normals(faces: &[FaceGeom], groups: &PhongGroups) -> Vec<Option<Ve
 /// Whether face `g`'s normal is within the smoothing angle of `f`'s (the concave one where `g`
 /// rises in front of `f`).
 fn within_angle(f: &FaceGeom, g: &FaceGeom, angles: PhongAngles) -> bool {
-    let concave = f.plane.distance(centroid(&g.points)) > TOUCH_EPSILON;
+    let concave = f.plane.distance(g.centroid()) > TOUCH_EPSILON;
     let cos_limit = angles.for_joint(concave).to_radians().cos();
-    g.plane.normal.dot(f.plane.normal) >= cos_limit - 1e-9
+    g.plane.normal.dot(f.plane.normal) >= cos_limit - ANGLE_SLACK
 }
 
 impl PhongGroups {
@@ -225,22 +229,6 @@ impl PhongGroups {
             _ => false,
         }
     }
-}
-
-/// The area of the convex polygon `points`.
-fn area(points: &[DVec3]) -> f64 {
-    let Some(&first) = points.first() else {
-        return 0.0;
-    };
-    let doubled = points.windows(2).skip(1).fold(DVec3::ZERO, |acc, w| {
-        acc + (w[0] - first).cross(w[1] - first)
-    });
-    doubled.length() / 2.0
-}
-
-/// The mean of `points`.
-fn centroid(points: &[DVec3]) -> DVec3 {
-    points.iter().fold(DVec3::ZERO, |a, &p| a + p) / points.len().max(1) as f64
 }
 
 /// The `_phong` normal at each of `samples` (of `faces[samples.face]`), from the corner normals

@@ -20,7 +20,7 @@
 //! over a face's luxels (see [`see`]).
 
 use glam::{DVec3, Vec3};
-use quake_formats::geom::{Plane, Split, Winding};
+use quake_formats::geom::{Plane, Split, Winding, polygon_area};
 
 use super::{
     BounceCounts, Field, HOTSPOT_CLAMP, Receivers, StyleLight, StyleLuxels, add_style_light,
@@ -482,7 +482,7 @@ fn point_emitters(field: &Field, emission: Emission) -> Vec<PointEmitter> {
         else {
             continue;
         };
-        let area = Winding::new(face.points.clone()).area();
+        let area = polygon_area(&face.points);
         let corners = corners(&face.points);
         if area < MIN_AREA || corners.is_empty() {
             continue;
@@ -949,7 +949,7 @@ mod tests {
                 along.sort_by(f64::total_cmp);
                 points.extend(along.iter().map(|&t| corner.lerp(next, t)));
             }
-            let area = Winding::new(points.clone()).area();
+            let area = polygon_area(&points);
             proptest::prop_assert!((area - w * h).abs() < 1e-6 * w * h);
             let found = corners(&points);
             proptest::prop_assert_eq!(found.len(), 4, "{:?}", found);

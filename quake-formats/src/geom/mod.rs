@@ -35,7 +35,7 @@ mod winding;
 pub use bounds::Bounds;
 pub use direction::DVec3Ext;
 pub use plane::{Plane, PlaneSide};
-pub use winding::{Split, Winding};
+pub use winding::{Split, Winding, polygon_area, polygon_center};
 
 /// Distance within which a point lies on a plane.
 pub const ON_EPSILON: f64 = 0.01;

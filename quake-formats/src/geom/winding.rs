@@ -52,6 +52,21 @@ fn edge_sides(dists: &[f64]) -> impl Iterator<Item = (usize, usize, PlaneSide, P
     })
 }
 
+/// The mean of the convex polygon `points` (the origin for none).
+pub fn polygon_center(points: &[DVec3]) -> DVec3 {
+    let sum = points.iter().fold(DVec3::ZERO, |acc, &p| acc + p);
+    sum / points.len().max(1) as f64
+}
+
+/// The area of the convex polygon `points`, in square map units.
+pub fn polygon_area(points: &[DVec3]) -> f64 {
+    let mut total = DVec3::ZERO;
+    for i in 2..points.len() {
+        total += (points[i - 1] - points[0]).cross(points[i] - points[0]);
+    }
+    total.length() * 0.5
+}
+
 impl Winding {
     /// A winding of `points`, which must already be convex and in clockwise order.
     pub fn new(points: Vec<DVec3>) -> Self {
@@ -107,19 +122,12 @@ impl Winding {
 
     /// The mean of the points (the origin for an empty winding).
     pub fn center(&self) -> DVec3 {
-        let sum = self.points.iter().fold(DVec3::ZERO, |acc, &p| acc + p);
-        sum / self.points.len().max(1) as f64
+        polygon_center(&self.points)
     }
 
     /// Area in square map units.
     pub fn area(&self) -> f64 {
-        let mut total = DVec3::ZERO;
-        for i in 2..self.points.len() {
-            let d1 = self.points[i - 1] - self.points[0];
-            let d2 = self.points[i] - self.points[0];
-            total += d1.cross(d2);
-        }
-        total.length() * 0.5
+        polygon_area(&self.points)
     }
 
     /// The plane the winding lies on, from its (clockwise) point order.
