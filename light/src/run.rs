@@ -716,7 +716,10 @@ fn trace_faces(
             progress.advance(1);
             let reflects = keep.bouncing && keep.reflectance[f].is_some();
             let reflected = reflects.then(|| light.reflected(styled));
-            let passed_on = reflects.then(|| light.passed_on()).flatten();
+            // Only a later pass reads what a face passes on.
+            let passed_on = (reflects && prep.lights.bounce.passes > 1)
+                .then(|| light.passed_on())
+                .flatten();
             let light = keep.wanted[f].then(|| match keep.finish {
                 Some(to_luxels) if geom.model == 0 => {
                     TracedLight::Luxels(light.finish(&[], HiddenLuxels::FromNeighbours, to_luxels))
