@@ -5,7 +5,7 @@
 #             Their WAD (id1's gfx/base.wad) is not free, so each map is compiled with a
 #             placeholder WAD of flat grey 16x16 textures under its texture names: light needs
 #             the names (liquids, sky) and not the pictures.
-#   e1m3.bsp  LibreQuake e1m3 with the corpus WADs (vis -fast).
+#   e1m3.bsp, e3m4.bsp  LibreQuake e1m3 and e3m4 with the corpus WADs (vis -fast).
 #   start.bsp LibreQuake start, the corpus BSP itself.
 # Usage: bench/agreement_bsps.sh [OUT]
 set -euo pipefail
@@ -42,10 +42,12 @@ id_map() {
 id_map e1m1
 for name in e1m2 e2m5 dm2; do id_map "$name" -fast; done
 
-sed 's#\.\./\.\./\.\./\.\./texture-wads/##g' "$corpus/public/maps/librequake/e1m3.map" \
-  > "$out/e1m3.map"
-(cd "$out" && "$anchor/qbsp" -wadpath "$corpus/wads/librequake" e1m3.map >/dev/null \
-  && "$anchor/vis" -fast e1m3.bsp >/dev/null)
+for name in e1m3 e3m4; do
+  sed 's#\.\./\.\./\.\./\.\./texture-wads/##g' "$corpus/public/maps/librequake/$name.map" \
+    > "$out/$name.map"
+  (cd "$out" && "$anchor/qbsp" -wadpath "$corpus/wads/librequake" "$name.map" >/dev/null \
+    && "$anchor/vis" -fast "$name.bsp" >/dev/null)
+done
 
 cp "$corpus/public/bsp/librequake/start.bsp" "$out/start.bsp"
-echo "$out/e1m1.bsp $out/e1m2.bsp $out/e2m5.bsp $out/dm2.bsp $out/e1m3.bsp $out/start.bsp"
+echo "$out/e1m1.bsp $out/e1m2.bsp $out/e2m5.bsp $out/dm2.bsp $out/e1m3.bsp $out/e3m4.bsp $out/start.bsp"
