@@ -38,7 +38,7 @@ pub struct Visibility {
     leaf_contents: Vec<i32>,
 }
 
-fn bit(row: &[u8], leaf: u32) -> bool {
+pub fn bit(row: &[u8], leaf: u32) -> bool {
     // Leaf 0 (the shared solid leaf) has no bit.
     leaf > 0
         && row
@@ -189,6 +189,13 @@ impl Visibility {
     /// a point culls an emitter whose face is only partly in sight, as ericw-tools culls it.
     pub fn sees_all(&self, pvs: &[u8], leafs: &[u32]) -> bool {
         leafs.iter().all(|&l| bit(pvs, l) || self.is_liquid(l))
+    }
+
+    /// Whether an emitter on a face held by `leafs` is in sight of `pvs` (from
+    /// [`Visibility::pvs_of`]) for bounced light from points: one of its leaves is in the PVS and
+    /// [`Visibility::sees_all`] of them (a face no leaf holds, a brush model's: in sight).
+    pub fn in_pvs(&self, pvs: &[u8], leafs: &[u32]) -> bool {
+        leafs.is_empty() || (leafs.iter().any(|&l| bit(pvs, l)) && self.sees_all(pvs, leafs))
     }
 
     /// False only if vis data proves `face` cannot see any sky face.

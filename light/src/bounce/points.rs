@@ -29,7 +29,7 @@ use super::{
 use crate::embree::RayPacket16;
 use crate::faces::FaceGeom;
 use crate::scene::TraceScene;
-use crate::visibility::Visibility;
+use crate::visibility::{Visibility, bit};
 
 /// Contributions below this many light units, in every channel, count as none (ericw-tools'
 /// gate for bounced light).
@@ -87,10 +87,12 @@ pub struct PointEmitter {
 /// The point emitters of one pass, and where they stand.
 pub struct PointField<'a> {
     emitters: Vec<PointEmitter>,
-    /// Per world leaf, the emitters whose faces it holds.
-    by_leaf: Vec<Vec<u32>>,
-    /// Emitters on faces no leaf holds (brush models): in sight of everything.
-    unplaced: Vec<u32>,
+    /// The emitters' points, normals and intensities column by column, for [`may_light`].
+    columns: EmitterColumns,
+    /// The emitters [`GROUP`] at a time, from the first.
+    groups: Vec<EmitterGroup>,
+    /// Per emitter, the one leaf that holds its face ([`NO_LEAF`]: none, or several).
+    leaf: Vec<u32>,
     faces: &'a [FaceGeom],
     vis: &'a Visibility,
     kernel: f64,
@@ -100,74 +102,53 @@ impl<'a> PointField<'a> {
     /// The points `field`'s reflecting faces send their light from.
     pub fn new(field: &Field<'a>, vis: &'a Visibility, emission: Emission) -> PointField<'a> {
         let emitters = point_emitters(field, emission);
-        let mut by_leaf: Vec<Vec<u32>> = Vec::new();
-        let mut unplaced = Vec::new();
-        for (k, e) in emitters.iter().enumerate() {
-            let leafs = vis.face_leafs(e.face);
-            if leafs.is_empty() {
-                unplaced.push(k as u32);
-            }
-            for &l in leafs {
-                let l = l as usize;
-                if by_leaf.len() <= l {
-                    by_leaf.resize(l + 1, Vec::new());
-                }
-                by_leaf[l].push(k as u32);
-            }
-        }
+        let leaf = emitters
+            .iter()
+            .map(|e| match vis.face_leafs(e.face) {
+                &[l] => l,
+                _ => NO_LEAF,
+            })
+            .collect();
+        let groups = emitters
+            .chunks(GROUP)
+            .map(|group| EmitterGroup::new(group, |f| vis.face_leafs(f)))
+            .collect();
         PointField {
+            columns: EmitterColumns::new(&emitters),
+            groups,
+            leaf,
             emitters,
-            by_leaf,
-            unplaced,
             faces: field.faces,
             vis,
             kernel: field.kernel,
         }
     }
 
-    /// The emitters that may light face `face`: all of them unless vis data tells, else those
-    /// whose faces lie wholly in the face's PVS (none for a world face no leaf holds).
-    fn in_sight_of(&self, face: usize) -> Vec<u32> {
+    /// What vis data says of the emitters face `face` may see.
+    fn sight(&self, face: usize) -> Sight {
         // A face no leaf holds sees nothing (ericw-tools' empty PVS for it).
         if self.vis.unheld(face) {
-            return Vec::new();
+            return Sight::Nothing;
         }
-        let Some(pvs) = self.vis.pvs_of(self.vis.face_leafs(face)) else {
-            return (0..self.emitters.len() as u32).collect();
-        };
-        // Marked in a bit set and read back in order: each emitter once, lowest first (the order
-        // their light is summed in).
-        let mut marked = vec![0u64; self.emitters.len().div_ceil(64)];
-        let mut mark = |list: &[u32]| {
-            for &k in list {
-                marked[k as usize / 64] |= 1 << (k % 64);
-            }
-        };
-        mark(&self.unplaced);
-        // The leaves in the PVS, bit by bit (bit `k` is leaf `k + 1`).
-        for (byte, &bits) in pvs.iter().enumerate() {
-            let mut bits = bits;
-            while bits != 0 {
-                let leaf = byte * 8 + bits.trailing_zeros() as usize + 1;
-                bits &= bits - 1;
-                if let Some(list) = self.by_leaf.get(leaf) {
-                    mark(list);
-                }
-            }
+        match self.vis.pvs_of(self.vis.face_leafs(face)) {
+            Some(pvs) => Sight::Pvs(pvs),
+            None => Sight::Everything,
         }
-        let mut found = Vec::new();
-        for (word, &bits) in marked.iter().enumerate() {
-            let mut bits = bits;
-            while bits != 0 {
-                let k = word * 64 + bits.trailing_zeros() as usize;
-                bits &= bits - 1;
-                let e = &self.emitters[k];
-                if self.vis.sees_all(&pvs, self.vis.face_leafs(e.face)) {
-                    found.push(k as u32);
-                }
-            }
+    }
+
+    /// Whether emitter `k` is in `sight`.
+    fn in_sight(&self, k: usize, sight: &Sight) -> bool {
+        match sight {
+            Sight::Nothing => false,
+            Sight::Everything => true,
+            Sight::Pvs(pvs) => match self.leaf[k] {
+                NO_LEAF => self
+                    .vis
+                    .in_pvs(pvs, self.vis.face_leafs(self.emitters[k].face)),
+                // One leaf: in sight when it is in the PVS (liquid or not).
+                leaf => bit(pvs, leaf),
+            },
         }
-        found
     }
 
     /// The light the emitters send each luxel of `r`, per style.
@@ -198,21 +179,33 @@ impl<'a> PointField<'a> {
             .first()
             .filter(|&&first| !r.two_sided && r.normals.iter().all(|&m| m == first))
             .map(|&m| Vec3::from(m).as_dvec3());
-        for k in self.in_sight_of(r.face) {
-            let e = &self.emitters[k as usize];
-            if e.face == r.face || (!r.two_sided && plane.distance(e.point) <= 0.0) {
+        let sight = self.sight(r.face);
+        let cull = Cull {
+            plane,
+            two_sided: r.two_sided,
+            lo,
+            hi,
+            kernel: self.kernel,
+        };
+        // The emitters a group at a time: the cheap tests on all of them at once, then sight.
+        let mut candidates = Vec::new();
+        for (g, group) in self.groups.iter().enumerate() {
+            if !group.may_light(&cull) || !group.in_sight(&sight) {
                 continue;
             }
-            // The receiver's box wholly behind the emitter.
-            let far_corner = DVec3::select(e.normal.cmpgt(DVec3::ZERO), hi, lo);
-            if e.normal.dot(far_corner - e.point) < 0.0 {
-                continue;
+            let first = g * GROUP;
+            let mut bits = may_light(&self.columns, first, &cull);
+            while bits != 0 {
+                let k = first + bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                if self.emitters[k].face != r.face && self.in_sight(k, &sight) {
+                    candidates.push(k);
+                }
             }
+        }
+        for k in candidates {
+            let e = &self.emitters[k];
             let max_total = e.max_intensity();
-            let nearest = e.point.clamp(lo, hi).distance_squared(e.point);
-            if self.kernel * max_total / nearest.max(HOTSPOT_CLAMP * HOTSPOT_CLAMP) < GATE {
-                continue;
-            }
             if flat_normal
                 .is_some_and(|n_r| under_gate(e, n_r, (lo, hi), self.kernel * max_total / GATE))
             {
@@ -299,6 +292,191 @@ impl PointField<'_> {
         }
         out
     }
+}
+
+/// [`PointField`]'s mark of an emitter whose face is not in exactly one leaf.
+const NO_LEAF: u32 = u32::MAX;
+
+/// The emitters vis data lets a face see.
+enum Sight {
+    /// None: the face is in no leaf.
+    Nothing,
+    /// Those whose faces are in this PVS ([`Visibility::in_pvs`]).
+    Pvs(Vec<u8>),
+    /// All: vis data cannot tell.
+    Everything,
+}
+
+/// A receiving face, for [`may_light`]: its plane, whether it takes light from both sides, its
+/// luxels' box, and the bounce kernel.
+struct Cull {
+    plane: Plane,
+    two_sided: bool,
+    lo: DVec3,
+    hi: DVec3,
+    kernel: f64,
+}
+
+/// Emitters' points, normals and brightest intensities, coordinate by coordinate.
+struct EmitterColumns {
+    at: [Vec<f64>; 3],
+    normal: [Vec<f64>; 3],
+    brightest: Vec<f64>,
+}
+
+impl EmitterColumns {
+    fn new(emitters: &[PointEmitter]) -> EmitterColumns {
+        let column = |f: &dyn Fn(&PointEmitter) -> f64| emitters.iter().map(f).collect();
+        EmitterColumns {
+            at: [
+                column(&|e| e.point.x),
+                column(&|e| e.point.y),
+                column(&|e| e.point.z),
+            ],
+            normal: [
+                column(&|e| e.normal.x),
+                column(&|e| e.normal.y),
+                column(&|e| e.normal.z),
+            ],
+            brightest: column(&|e| e.brightest),
+        }
+    }
+}
+
+/// Emitters are culled this many at a time (a bit each of a `u64`): consecutive emitters are
+/// on faces the compiler wrote one after another, close together, so a group's bounds often
+/// rule all of them out at once.
+const GROUP: usize = 64;
+
+/// Relative slack on [`EmitterGroup::may_light`]'s bounds for their rounding (the emitters' own
+/// tests round a little differently).
+const GROUP_ROUNDING: f64 = 1e-6;
+
+/// What a face's cull asks of a [`GROUP`] of emitters at once.
+struct EmitterGroup {
+    /// The box around their points.
+    lo: DVec3,
+    hi: DVec3,
+    /// Their largest intensity.
+    brightest: f64,
+    /// The leaves that hold their faces (`None`: one face is in no leaf, in sight of all).
+    leafs: Option<Vec<u32>>,
+}
+
+impl EmitterGroup {
+    /// The group of `group`, whose faces `face_leafs` holds.
+    fn new<'v>(group: &[PointEmitter], face_leafs: impl Fn(usize) -> &'v [u32]) -> EmitterGroup {
+        let (mut lo, mut hi, mut brightest) = (DVec3::INFINITY, DVec3::NEG_INFINITY, 0.0f64);
+        let mut leafs = Some(Vec::new());
+        for e in group {
+            (lo, hi, brightest) = (lo.min(e.point), hi.max(e.point), brightest.max(e.brightest));
+            let of_face = face_leafs(e.face);
+            match &mut leafs {
+                Some(all) if !of_face.is_empty() => all.extend_from_slice(of_face),
+                _ => leafs = None,
+            }
+        }
+        if let Some(all) = &mut leafs {
+            all.sort_unstable();
+            all.dedup();
+        }
+        EmitterGroup {
+            lo,
+            hi,
+            brightest,
+            leafs,
+        }
+    }
+
+    /// False when none of the group can pass [`may_light`]: every point of its box is behind a
+    /// one-sided face, or its brightest is too dim for the gate at the box's distance from the
+    /// face's luxels.
+    fn may_light(&self, cull: &Cull) -> bool {
+        let normal = cull.plane.normal;
+        // The box's corner farthest in front of the plane.
+        let front = DVec3::select(normal.cmpgt(DVec3::ZERO), self.hi, self.lo);
+        let slack = GROUP_ROUNDING * (1.0 + front.abs().max_element() + cull.plane.dist.abs());
+        if !cull.two_sided && cull.plane.distance(front) < -slack {
+            return false;
+        }
+        // The gaps between the two boxes along each axis (0 where they overlap).
+        let gap = (cull.lo - self.hi).max(self.lo - cull.hi).max(DVec3::ZERO);
+        let clamp = HOTSPOT_CLAMP * HOTSPOT_CLAMP;
+        let bound = cull.kernel * self.brightest / gap.length_squared().max(clamp);
+        bound * (1.0 + GROUP_ROUNDING) >= GATE
+    }
+
+    /// False when `sight` holds none of the group ([`PointField::in_sight`] wants one of an
+    /// emitter's leaves in the PVS).
+    fn in_sight(&self, sight: &Sight) -> bool {
+        match (sight, &self.leafs) {
+            (Sight::Nothing, _) => false,
+            (Sight::Pvs(pvs), Some(leafs)) => leafs.iter().any(|&l| bit(pvs, l)),
+            _ => true,
+        }
+    }
+}
+
+/// Of the (up to) [`GROUP`] emitters from `first`, bit `i` set for each that may light a luxel of
+/// `cull`'s face: in front of it (unless it is two-sided), facing a corner of its luxels' box,
+/// and near enough to the box for its brightest intensity to pass the [`GATE`]. Branch-free
+/// over the columns, so that it runs in vectors.
+fn may_light(columns: &EmitterColumns, first: usize, cull: &Cull) -> u64 {
+    crate::simd::avx2_or_any(
+        #[inline(always)]
+        || may_light_any(columns, first, cull),
+    )
+}
+
+/// [`may_light`] for whatever the build targets.
+#[inline(always)]
+fn may_light_any(columns: &EmitterColumns, first: usize, cull: &Cull) -> u64 {
+    let end = (first + GROUP).min(columns.brightest.len());
+    let [px, py, pz] = columns.at.each_ref().map(|c| &c[first..end]);
+    let [ux, uy, uz] = columns.normal.each_ref().map(|c| &c[first..end]);
+    let brightest = &columns.brightest[first..end];
+    let n = brightest.len();
+    let (px, py, pz, ux, uy, uz) = (&px[..n], &py[..n], &pz[..n], &ux[..n], &uy[..n], &uz[..n]);
+    let (normal, dist) = (cull.plane.normal, cull.plane.dist);
+    let (lo, hi) = (cull.lo, cull.hi);
+    let clamp = HOTSPOT_CLAMP * HOTSPOT_CLAMP;
+    // Comparisons and selects rather than `f64::max`, `||` and `if`: the same values here (no
+    // NaN), and they run in vectors.
+    let pick = |c: bool, a: f64, b: f64| if c { a } else { b };
+    let inside = |v: f64, lo: f64, hi: f64| {
+        let v = pick(v > lo, v, lo);
+        pick(v < hi, v, hi)
+    };
+    let mut keep = [0u8; GROUP];
+    for (i, slot) in keep[..n].iter_mut().enumerate() {
+        let (x, y, z) = (px[i], py[i], pz[i]);
+        // The sums as `Plane::distance` and glam's dot products make them.
+        let in_front = normal.x * x + normal.y * y + normal.z * z - dist > 0.0;
+        // The corner of the box farthest along the emitter's normal.
+        let (fx, fy, fz) = (
+            pick(ux[i] > 0.0, hi.x, lo.x),
+            pick(uy[i] > 0.0, hi.y, lo.y),
+            pick(uz[i] > 0.0, hi.z, lo.z),
+        );
+        let facing = ux[i] * (fx - x) + uy[i] * (fy - y) + uz[i] * (fz - z) >= 0.0;
+        let (dx, dy, dz) = (
+            inside(x, lo.x, hi.x) - x,
+            inside(y, lo.y, hi.y) - y,
+            inside(z, lo.z, hi.z) - z,
+        );
+        let nearest = dx * dx + dy * dy + dz * dz;
+        let bright = cull.kernel * brightest[i] / pick(nearest > clamp, nearest, clamp) >= GATE;
+        *slot = u8::from((in_front | cull.two_sided) & facing & bright);
+    }
+    let mut bits = 0u64;
+    for (byte, group) in keep.chunks_exact(8).enumerate() {
+        let packed = group
+            .iter()
+            .enumerate()
+            .fold(0u64, |b, (i, &k)| b | u64::from(k) << i);
+        bits |= packed << (byte * 8);
+    }
+    bits
 }
 
 /// Slack on the bounds of [`under_gate`], in units, for the single precision [`weigh`] works
@@ -772,6 +950,67 @@ mod tests {
                 let mut weights = vec![1.0f32; points.len()];
                 weigh(&e, &luxels, kernel as f32, (GATE / intensity) as f32, false, &mut weights);
                 proptest::prop_assert!(weights.iter().all(|&w| w == 0.0), "{:?}", weights);
+            }
+        }
+
+        /// The column-wise cull keeps exactly the emitters the plain tests keep (in front of a
+        /// one-sided face, facing its box, bright enough at its distance), and a group is
+        /// ruled out whole only when none of them is kept.
+        #[test]
+        fn may_light_keeps_what_the_plain_tests_keep(
+            emitters in proptest::collection::vec(
+                (
+                    (-600.0f64..600.0, -600.0f64..600.0, -600.0f64..600.0),
+                    (-1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0),
+                    0.0f64..3e3,
+                ),
+                1..150,
+            ),
+            tilt in (-1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0),
+            dist in -300.0f64..300.0,
+            corner in (-400.0f64..400.0, -400.0f64..400.0, -400.0f64..400.0),
+            size in (0.0f64..200.0, 0.0f64..200.0, 0.0f64..200.0),
+            two_sided in proptest::bool::ANY,
+        ) {
+            let unit = |(x, y, z): (f64, f64, f64)| DVec3::new(x, y, z).try_normalize();
+            let emitters: Vec<PointEmitter> = emitters
+                .iter()
+                .map(|&((x, y, z), n, brightest)| PointEmitter {
+                    face: 0,
+                    point: DVec3::new(x, y, z),
+                    normal: unit(n).unwrap_or(DVec3::Z),
+                    styles: Vec::new(),
+                    share: 1.0,
+                    brightest,
+                })
+                .collect();
+            let lo = DVec3::new(corner.0, corner.1, corner.2);
+            let cull = Cull {
+                plane: Plane::new(unit(tilt).unwrap_or(DVec3::X), dist),
+                two_sided,
+                lo,
+                hi: lo + DVec3::new(size.0, size.1, size.2),
+                kernel: 0.5,
+            };
+            let plain = |e: &PointEmitter| {
+                let far = DVec3::select(e.normal.cmpgt(DVec3::ZERO), cull.hi, cull.lo);
+                let nearest = e.point.clamp(cull.lo, cull.hi).distance_squared(e.point);
+                (cull.two_sided || cull.plane.distance(e.point) > 0.0)
+                    && e.normal.dot(far - e.point) >= 0.0
+                    && cull.kernel * e.brightest / nearest.max(HOTSPOT_CLAMP * HOTSPOT_CLAMP)
+                        >= GATE
+            };
+            let columns = EmitterColumns::new(&emitters);
+            for (g, group) in emitters.chunks(GROUP).enumerate() {
+                let first = g * GROUP;
+                let expected = group
+                    .iter()
+                    .enumerate()
+                    .fold(0u64, |bits, (i, e)| bits | u64::from(plain(e)) << i);
+                proptest::prop_assert_eq!(may_light(&columns, first, &cull), expected);
+                if !EmitterGroup::new(group, |_| &[]).may_light(&cull) {
+                    proptest::prop_assert_eq!(expected, 0);
+                }
             }
         }
 
