@@ -80,9 +80,9 @@ fn texture_mean(tex: &quake_formats::miptex::MipTex, palette: &Palette) -> Optio
     Some(sum.map(|s| (s as f64 / pixels.len() as f64 / 255.0) as f32))
 }
 
-/// Per face, what it reflects (`None`: nothing): faces with a lightmap that are in the shadow
-/// scene (the world and `_shadow 1` models) and whose model has no `_bounce 0`. Sky and liquids
-/// reflect nothing. The colour is the texture's mean colour blended with
+/// Per face, what it reflects (`None`: nothing): faces with a lightmap that block light outright
+/// (of the world and `_shadow 1` models; not shadowless faces, fences or switchable shadows)
+/// and whose model has no `_bounce 0`. Sky and liquids reflect nothing. The colour is the texture's mean colour blended with
 /// [`GREY_REFLECTANCE`] by `color_scale`; a texture without pixels counts as grey.
 pub fn face_reflectance(
     bsp: &Bsp,
@@ -101,10 +101,18 @@ pub fn face_reflectance(
         .iter()
         .map(|f| {
             let in_scene = f.model == 0 || lights.shadow_models.contains(&f.model);
-            let merged_no_bounce = lights.face_flags.get(f.index).is_some_and(|m| m.no_bounce);
+            let flags = lights.face_flags.get(f.index);
+            let merged_no_bounce = flags.is_some_and(|m| m.no_bounce);
+            // Only faces that block light outright reflect, as in ericw-tools: not those that
+            // cast no shadow (`_shadow -1`, `func_detail_illusionary`), fences (whose texels
+            // let light through) or switchable shadows.
+            let solid_caster = !flags.is_some_and(|m| m.no_shadow)
+                && !f.texture.starts_with('{')
+                && !lights.switchable.shadows.iter().any(|&(m, _)| m == f.model);
             // A face off the world's light channel reflects nothing, as in ericw-tools.
             if f.kind != FaceKind::Lit
                 || !in_scene
+                || !solid_caster
                 || merged_no_bounce
                 || lights.no_bounce_models.contains(&f.model)
                 || lights.channels_of(f) != 1

@@ -2233,6 +2233,39 @@ fn bounce_lights_the_underside_of_the_box_only_when_asked() {
     }
 }
 
+/// Only faces that block light outright reflect bounced light, as in ericw-tools: a slab
+/// that casts no shadow (`func_detail_illusionary`, `_shadow -1`) or whose shadow is
+/// switchable reflects none; the same slab as plain detail, or a `_shadow 1` model, does.
+#[test]
+fn only_faces_that_cast_a_solid_shadow_reflect_bounced_light() {
+    let slab_reflects = |classname: &str, keys: &str| {
+        let bsp = slab_bsp(classname, keys, "wall");
+        let prep = crate::prepare::prepare(&bsp, &Options::default()).expect("prepare");
+        let palette = quake_formats::palette::Palette::slipgate();
+        let reflectance =
+            crate::bounce::face_reflectance(&bsp, &prep.faces, &prep.lights, &palette);
+        // The slab's top: it faces the light, 48 units under the room's middle.
+        let top = prep
+            .faces
+            .iter()
+            .find(|f| f.plane.normal.z > 0.99 && (f.centroid().z + 48.0).abs() < 0.5)
+            .expect("the slab's top");
+        reflectance[top.index].is_some()
+    };
+    assert!(slab_reflects("func_detail", ""));
+    assert!(slab_reflects("func_wall", "\"_shadow\" \"1\""));
+    assert!(
+        !slab_reflects("func_wall", ""),
+        "a model casts no shadow unless asked"
+    );
+    assert!(!slab_reflects("func_detail_illusionary", ""));
+    assert!(!slab_reflects("func_detail", "\"_shadow\" \"-1\""));
+    assert!(!slab_reflects(
+        "func_wall",
+        "\"_shadow\" \"1\" \"_switchableshadow\" \"1\""
+    ));
+}
+
 #[test]
 fn bounce_is_close_to_the_reference_and_never_black_where_it_is_lit() {
     // The reference integrates over the reflecting surfaces, as `high` gathers.

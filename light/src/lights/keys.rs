@@ -246,7 +246,8 @@ entity_keys! {
     /// has no faces, casts the shadow of its brushes (read from the BSP's tree). `0` or `-1`: a
     /// model casts none. On brushes merged into the world (`func_detail*`, `func_group`, whose
     /// default is the world's shadow), `-1` casts none and `func_detail_illusionary` casts none
-    /// unless `1` (the compiler marks their faces in the BSP for light).
+    /// unless `1` (the compiler marks their faces in the BSP for light). Faces that cast no shadow
+    /// reflect no bounced light either.
     SHADOW: ["_shadow"] on Models, Number, default "`0`";
     /// ericw-tools' autominlight: the model's samples inside solid take the light at the middle
     /// of its box (or at `_autominlight_target`'s entity), direct and, with bounce, bounced,
