@@ -188,11 +188,20 @@ fn mix(mut x: u64) -> u64 {
     x ^ (x >> 31)
 }
 
+/// A number in [0, 1) from the bits of `bits`.
+fn unit_of(bits: u64) -> f64 {
+    (bits >> 11) as f64 / (1u64 << 53) as f64
+}
+
+/// A number in [0, 1) from `key`.
+fn unit(key: u64) -> f64 {
+    unit_of(mix(key))
+}
+
 /// Two numbers in [0, 1) from `key`.
 fn jitter(key: u64) -> (f64, f64) {
     let h = mix(key);
-    let unit = |bits: u64| (bits >> 11) as f64 / (1u64 << 53) as f64;
-    (unit(h), unit(mix(h ^ 0x9e37_79b9_7f4a_7c15)))
+    (unit_of(h), unit_of(mix(h ^ 0x9e37_79b9_7f4a_7c15)))
 }
 
 /// Sine and cosine of `turns` of a full turn (0 ≤ `turns` < 1), within 1e-10 of `sin_cos`:

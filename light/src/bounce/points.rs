@@ -36,8 +36,9 @@ use crate::visibility::{Visibility, bit};
 const GATE: f64 = 0.01;
 
 /// An emitter that brings no luxel of a face more than this many light units is seen or not
-/// by the whole face at once: a segment to the luxel it lights most decides. Where its
-/// shadow crosses the face, luxels are off by at most this much light.
+/// by the whole face at once: a segment to one luxel, drawn in proportion to what each takes
+/// ([`weighted_pick`]), decides. Where its shadow crosses the face, luxels are off by at most
+/// this much light, and the face's light is right on average.
 const WEAK: f64 = 0.5;
 
 /// Points nearer than this (units) to an emitter count as this near (ericw-tools' floor).
@@ -579,27 +580,74 @@ fn weigh_any(
     }
 }
 
-/// The largest of `weights` (none is a NaN), 0 for none: lane by lane over blocks of eight, so
-/// that it runs in vectors; a maximum is exact whatever the order.
-fn largest_weight(weights: &[f32]) -> f32 {
-    let mut lanes = [0.0f32; 8];
+/// The largest of `weights` (none is a NaN, none negative), 0 for none, and their sum: lane by
+/// lane over blocks of eight, so that it runs in vectors; a maximum is exact whatever the
+/// order.
+fn largest_and_total(weights: &[f32]) -> (f32, f32) {
+    let (mut most, mut sums) = ([0.0f32; 8], [0.0f32; 8]);
     let mut blocks = weights.chunks_exact(8);
     for block in &mut blocks {
-        for (m, &w) in lanes.iter_mut().zip(block) {
+        for ((m, s), &w) in most.iter_mut().zip(&mut sums).zip(block) {
             *m = if w > *m { w } else { *m };
+            *s += w;
         }
     }
-    let rest = blocks
-        .remainder()
+    let rest = blocks.remainder();
+    let largest = rest
         .iter()
+        .chain(&most)
         .fold(0.0f32, |m, &w| if w > m { w } else { m });
-    lanes.iter().fold(rest, |m, &w| if w > m { w } else { m })
+    (largest, rest.iter().chain(&sums).sum())
+}
+
+/// The luxel whose segment decides a weak emitter's visibility (see [`WEAK`]): drawn by `key`
+/// with a chance in proportion to its weight (`total` the weights' sum), so that over the weak
+/// emitters a face sees, the light let through is on average what a segment to every luxel
+/// would let through. (The luxel an emitter lights most is where the face comes nearest it,
+/// often against the geometry the emitter's own face meets, and is blocked more often than
+/// the face's luxels are: deciding by it darkened bounce, the more so in later passes, where
+/// most emitters are weak.) The first luxel when none has any weight.
+fn weighted_pick(weights: &[f32], total: f32, key: u64) -> usize {
+    if total <= 0.0 {
+        return 0;
+    }
+    let target = (super::unit(key) * f64::from(total)) as f32;
+    let mut sum = 0.0f32;
+    let mut blocks = weights.chunks_exact(8);
+    let mut start = 0;
+    for block in &mut blocks {
+        let s: f32 = block.iter().sum();
+        if sum + s > target {
+            break;
+        }
+        sum += s;
+        start += 8;
+    }
+    for (i, &w) in weights.iter().enumerate().skip(start) {
+        sum += w;
+        if sum > target {
+            return i;
+        }
+    }
+    // Rounding left the target past the sum: the last luxel with weight.
+    weights.iter().rposition(|&w| w > 0.0).unwrap_or(0)
 }
 
 /// Weights held at once while lighting a face: emitters times luxels.
 const BATCH: usize = 1 << 15;
 
 impl PointEmitter {
+    /// The key of its draws for the face `receiver`: of the two faces and where the point is
+    /// (not of threads or the order faces are lit in).
+    fn key(&self, receiver: usize) -> u64 {
+        let [x, y, z] = self.point.to_array().map(f64::to_bits);
+        super::point_key(
+            receiver,
+            self.face,
+            (x ^ y.rotate_left(21) ^ z.rotate_left(42)) as usize,
+        )
+    }
+
     /// Its intensity in its brightest style.
     fn max_intensity(&self) -> f64 {
         self.brightest
@@ -625,11 +673,10 @@ fn light_batch(
         .enumerate()
         .map(|(k, e)| {
             let row = &weights[k * n..(k + 1) * n];
-            let w = largest_weight(row);
-            // The points of one face share its shadows: their weakness adds up. The segment
-            // goes to the first luxel of the largest weight (the first, when none has any).
+            let (w, total) = largest_and_total(row);
+            // The points of one face share its shadows: their weakness adds up.
             (f64::from(w) * e.max_intensity() < WEAK * e.share)
-                .then(|| row.iter().position(|&v| v == w).unwrap_or(0))
+                .then(|| weighted_pick(row, total, e.key(r.face)))
         })
         .collect();
     let lit = see(scene, r, &from, &weak, points, weights, counts);
@@ -780,7 +827,7 @@ const FIRST_STEP: usize = 4;
 /// first; then on each grid of half the step, segments only to luxels whose coarser cell's
 /// corners disagree, the others taking the corners' answer. A shadow narrower than the coarse
 /// grid that falls between its luxels is missed; bounced light from a point is rarely that
-/// sharp. A point `weak` names (with its strongest luxel) is decided by that luxel's one
+/// sharp. A point `weak` names (with the luxel drawn for it) is decided by that luxel's one
 /// segment (see [`WEAK`]). Each step's segments, from every point, go 16 to a packet.
 fn see(
     scene: &TraceScene,
@@ -911,7 +958,25 @@ mod tests {
             weights in proptest::collection::vec(0.0f32..1e3, 0..40),
         ) {
             let plain = weights.iter().fold(0.0f32, |m, &w| if w > m { w } else { m });
-            proptest::prop_assert_eq!(largest_weight(&weights).to_bits(), plain.to_bits());
+            let (largest, total) = largest_and_total(&weights);
+            proptest::prop_assert_eq!(largest.to_bits(), plain.to_bits());
+            let sum: f32 = weights.iter().sum();
+            proptest::prop_assert!((total - sum).abs() <= 1e-3 * sum.max(1.0));
+        }
+
+        /// A weak emitter's segment goes to a luxel with weight, whatever the draw.
+        #[test]
+        fn the_picked_luxel_has_weight(
+            weights in proptest::collection::vec(
+                proptest::prop_oneof![proptest::strategy::Just(0.0f32), 0.0f32..1e3], 1..60),
+            key in proptest::num::u64::ANY,
+        ) {
+            let (_, total) = largest_and_total(&weights);
+            let i = weighted_pick(&weights, total, key);
+            proptest::prop_assert!(i < weights.len());
+            if total > 0.0 {
+                proptest::prop_assert!(weights[i] > 0.0, "{i} {weights:?}");
+            }
         }
 
         /// Where [`under_gate`] says a flat face's luxels take nothing from an emitter, the
@@ -1055,6 +1120,25 @@ mod tests {
             subdivision: 64.0,
         };
         point_emitters(&Field::new(&faces, &reflectance, &lit, &settings), emission)
+    }
+
+    /// A weak emitter is seen or not by the face as the segment to one luxel drawn in
+    /// proportion to the weights says: over many emitters, each luxel decides its share, not
+    /// only the one lit most (which, against the emitter's own face, is blocked more often).
+    #[test]
+    fn weak_segments_go_to_luxels_in_proportion_to_their_weight() {
+        let weights = [1.0, 0.0, 3.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 4.0];
+        let (largest, total) = largest_and_total(&weights);
+        assert_eq!((largest, total), (4.0, 8.0));
+        let mut picks = [0usize; 10];
+        for key in 0..8000 {
+            picks[weighted_pick(&weights, total, crate::bounce::point_key(7, key, 1))] += 1;
+        }
+        for (i, &w) in weights.iter().enumerate() {
+            let expected = 1000.0 * f64::from(w);
+            assert!((picks[i] as f64 - expected).abs() <= 120.0, "{picks:?}");
+        }
+        assert_eq!(weighted_pick(&[0.0; 3], 0.0, 5), 0);
     }
 
     #[test]
