@@ -38,6 +38,7 @@ pub struct Visibility {
     leaf_contents: Vec<i32>,
 }
 
+/// Whether PVS row `row` (bit `j` = leaf `j + 1`) holds `leaf`.
 pub fn bit(row: &[u8], leaf: u32) -> bool {
     // Leaf 0 (the shared solid leaf) has no bit.
     leaf > 0
