@@ -82,8 +82,9 @@ fn texture_mean(tex: &quake_formats::miptex::MipTex, palette: &Palette) -> Optio
 
 /// Per face, what it reflects (`None`: nothing): faces with a lightmap that block light outright
 /// (of the world and `_shadow 1` models; not shadowless faces, fences or switchable shadows)
-/// and whose model has no `_bounce 0`. Sky and liquids reflect nothing. The colour is the texture's mean colour blended with
-/// [`GREY_REFLECTANCE`] by `color_scale`; a texture without pixels counts as grey.
+/// and whose model has no `_bounce 0`. Sky and liquids reflect nothing. The colour is the
+/// texture's mean colour blended with [`GREY_REFLECTANCE`] by `color_scale`; a texture without
+/// pixels counts as grey.
 pub fn face_reflectance(
     bsp: &Bsp,
     faces: &[FaceGeom],
@@ -107,7 +108,7 @@ pub fn face_reflectance(
             // cast no shadow (`_shadow -1`, `func_detail_illusionary`), fences (whose texels
             // let light through) or switchable shadows.
             let solid_caster = !flags.is_some_and(|m| m.no_shadow)
-                && !f.texture.starts_with('{')
+                && !f.is_fence()
                 && !lights.switchable.shadows.iter().any(|&(m, _)| m == f.model);
             // A face off the world's light channel reflects nothing, as in ericw-tools.
             if f.kind != FaceKind::Lit

@@ -164,6 +164,11 @@ impl FaceGeom {
         }
     }
 
+    /// Whether its texture is a fence's (a `{` name: its transparent texels let light through).
+    pub fn is_fence(&self) -> bool {
+        self.texture.starts_with('{')
+    }
+
     /// The mean of the vertices (inside the face: faces are convex).
     pub fn centroid(&self) -> DVec3 {
         quake_formats::geom::polygon_center(&self.points)

@@ -91,7 +91,7 @@ impl TexelMask {
 pub fn fence_masks(bsp: &Bsp, faces: &[FaceGeom]) -> Vec<(usize, Arc<TexelMask>)> {
     let mut by_texture: HashMap<&str, Option<Arc<TexelMask>>> = HashMap::new();
     let mut out = Vec::new();
-    for f in faces.iter().filter(|f| f.texture.starts_with('{')) {
+    for f in faces.iter().filter(|f| f.is_fence()) {
         let mask = by_texture.entry(&f.texture).or_insert_with(|| {
             let index = bsp.textures.find(&f.texture)?;
             let mip = bsp.textures.textures.get(index)?.as_ref()?;
