@@ -11,7 +11,7 @@ use quake_formats::geom::Plane;
 use rayon::prelude::*;
 
 use crate::error::LightError;
-use crate::outline::FaceRegion;
+use crate::outline::{Edges, FaceRegion};
 
 /// What a face is for lighting and shadowing.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -355,9 +355,15 @@ impl Continuations {
         if self.is_empty() {
             return None;
         }
-        let region = self.regions.get(k)?;
-        let edge = region.outline.edge_to_cross(p)?;
-        let next = region.across.get(edge).copied().flatten()?;
+        self.across(
+            k,
+            self.regions.get(k)?.outline.edge_to_cross(p, Edges::All)?,
+        )
+    }
+
+    /// The region across edge `edge` of region `k`, if any.
+    pub fn across(&self, k: usize, edge: usize) -> Option<usize> {
+        let next = self.regions.get(k)?.across.get(edge).copied().flatten()?;
         Some(next as usize)
     }
 }

@@ -32,7 +32,7 @@ use quake_formats::extents::LuxelGrid;
 use quake_formats::int_hash::IntMap;
 
 use crate::faces::{CONTINUATION_HOPS, Continuations, FaceGeom, FaceKind, one_plane};
-use crate::outline::{FaceRegion, ON_EDGE};
+use crate::outline::{Edges, FaceRegion, ON_EDGE};
 
 /// Distance of sample points in front of their face, in map units.
 pub const SURFACE_OFFSET: f64 = 1.0;
@@ -234,9 +234,10 @@ impl SurfaceMap {
         self.outline.centre() + self.lift
     }
 
-    /// Where the sample for grid coordinates (s, t) goes. Without a usable projection: the
+    /// Where the sample for grid coordinates (s, t) goes, `near` being the face's edges its
+    /// luxel comes near ([`SurfaceMap::edges_near_luxel`]). Without a usable projection: the
     /// centre.
-    pub fn place(&self, s: f64, t: f64) -> Placed {
+    pub fn place(&self, s: f64, t: f64, near: Edges) -> Placed {
         let Some(m) = &self.to_world else {
             return Placed {
                 at: self.centre(),
@@ -248,8 +249,8 @@ impl SurfaceMap {
         };
         let on_plane = m.point(s, t) + self.origin;
         // Most points lie inside the face: then it is where they stay, and one pass over the
-        // edges tells all (the tests below would each find the same).
-        if let Some(on_edge) = self.outline.inside_on_edge(on_plane) {
+        // edges near the luxel tells all (the tests below would each find the same).
+        if let Some(on_edge) = self.outline.inside_on_edge(on_plane, near) {
             return Placed {
                 at: on_plane + self.lift,
                 moved: false,
@@ -269,15 +270,20 @@ impl SurfaceMap {
         let mut region = &*self.outline;
         let mut at = 0;
         for _ in 0..CONTINUATION_HOPS {
-            let Some((next, beyond_edge)) = self
-                .continuations
-                .next(at, on_plane)
+            if self.continuations.is_empty() {
+                break;
+            }
+            // On the face's own outline (the first region) only the edges near the luxel can
+            // be crossed.
+            let edge = region.edge_to_cross(on_plane, if at == 0 { near } else { Edges::All });
+            let Some((next, beyond_edge)) = edge
+                .and_then(|edge| self.continuations.across(at, edge))
                 .and_then(|next| Some((next, self.continuations.region(next)?)))
             else {
                 break;
             };
             (region, at) = (beyond_edge, next);
-            if region.inside_on_edge(on_plane).is_some() {
+            if region.inside_on_edge(on_plane, Edges::All).is_some() {
                 return Placed {
                     at: on_plane + self.lift,
                     moved: false,
@@ -287,7 +293,8 @@ impl SurfaceMap {
                 };
             }
         }
-        self.onto_outline(region, on_plane, self.lift, None)
+        let onto = region.nearest_on_edge(on_plane, if at == 0 { near } else { Edges::All });
+        self.onto_edge(region, on_plane, onto, self.lift, None)
     }
 
     /// [`SurfaceMap::place`] of a point `on_plane` past the edge of a face smoothed with some of
@@ -314,7 +321,7 @@ impl SurfaceMap {
                 point = lifted - next_plane.normal * next_plane.distance(lifted);
             }
             (region, at) = (beyond_edge, next);
-            if region.inside_on_edge(point).is_some() {
+            if region.inside_on_edge(point, Edges::All).is_some() {
                 return Placed {
                     at: point + self.lift_at(at),
                     moved: point != on_plane,
@@ -324,23 +331,25 @@ impl SurfaceMap {
                 };
             }
         }
-        let moved = self.onto_outline(region, point, self.lift_at(at), self.landed_on(at));
+        let onto = region.nearest_on_edge(point, Edges::All);
+        let moved = self.onto_edge(region, point, onto, self.lift_at(at), self.landed_on(at));
         Placed {
             moved: moved.moved || point != on_plane,
             ..moved
         }
     }
 
-    /// A point `point` outside `region` (on its plane) moved onto its outline and lifted by
-    /// `lift`: occluded when that is more than a luxel away.
-    fn onto_outline(
+    /// A point `point` outside `region` (on its plane) moved onto its outline, at the point
+    /// and edge [`FaceRegion::nearest_on_edge`] found, and lifted by `lift`: occluded when
+    /// that is more than a luxel away.
+    fn onto_edge(
         &self,
         region: &FaceRegion,
         point: DVec3,
+        (on_face, onto): (DVec3, Option<usize>),
         lift: DVec3,
         face: Option<u32>,
     ) -> Placed {
-        let (on_face, onto) = region.nearest_on_edge(point);
         let step = on_face - point;
         let along = |axis: [f64; 4]| DVec3::new(axis[0], axis[1], axis[2]).dot(step);
         let [ds, dt] = self.grid.axes.map(along);
@@ -378,32 +387,22 @@ impl SurfaceMap {
         self.continuations.face(k).map(|(f, _)| f as u32)
     }
 
-    /// Whether every sample of the luxel whose middle is at `[s0, t0]` lies inside the face
-    /// and off its outline, where [`SurfaceMap::place`] leaves it: each is then
-    /// [`SurfaceMap::inside`]'s, without a look at the face's edges.
-    fn luxel_inside(&self, [s0, t0]: [f64; 2]) -> bool {
+    /// The edges of the face that the samples of the luxel whose middle is at `[s0, t0]` may
+    /// lie on or past ([`FaceRegion::edges_near_disc`], listed in `near`): the only ones
+    /// [`SurfaceMap::place`] needs for them. A luxel well inside the face has none.
+    fn edges_near_luxel<'a>(&self, [s0, t0]: [f64; 2], near: &'a mut Vec<usize>) -> Edges<'a> {
         let Some(m) = &self.to_world else {
-            return false;
+            return Edges::All;
         };
+        if self.per_axis == 1 {
+            // The one sample: a pass over the edges for the luxel would only precede its own.
+            return Edges::All;
+        }
         // The samples lie within the luxel's half-diagonal of its middle.
         let radius = self.footprint_radius * self.per_axis as f64;
         self.outline
-            .holds_disc(m.point(s0, t0) + self.origin, radius)
-    }
-
-    /// [`SurfaceMap::place`] of a point known to lie inside the face and off its outline.
-    fn inside(&self, s: f64, t: f64) -> Placed {
-        let Some(m) = &self.to_world else {
-            return self.place(s, t);
-        };
-        let on_plane = m.point(s, t) + self.origin;
-        Placed {
-            at: on_plane + self.lift,
-            moved: false,
-            on_edge: false,
-            beyond: false,
-            face: None,
-        }
+            .edges_near_disc(m.point(s0, t0) + self.origin, radius, near);
+        Edges::Near(near)
     }
 
     /// Grid units (texels, or luxels of a face's own grid) along each axis one sample stands
@@ -478,19 +477,16 @@ pub fn face_samples(face: &FaceGeom, per_axis: usize, bsp: &Bsp) -> (FaceSamples
     // Luxel by luxel (row-major), each luxel's samples row by row: the order of
     // [`SurfaceMap::sample_st`].
     let mut sub_st = Vec::with_capacity(per_luxel);
+    let mut near = Vec::new();
     for y in 0..height {
         for x in 0..width {
             let middle = face.grid.luxel_st(x, y);
-            // With several samples a luxel, one test of its middle answers for all of them
-            // when the luxel lies well inside the face.
-            let inside = per_luxel > 1 && map.luxel_inside(middle);
+            // With several samples a luxel, one pass over the face's edges for its middle
+            // leaves the few its samples need testing against.
+            let edges = map.edges_near_luxel(middle, &mut near);
             map.sub_samples_st(middle, &mut sub_st);
             for &[s, t] in &sub_st {
-                let placed = if inside {
-                    map.inside(s, t)
-                } else {
-                    map.place(s, t)
-                };
+                let placed = map.place(s, t, edges);
                 if let Some(other) = placed.face {
                     walked.push((points.len(), other));
                 }
