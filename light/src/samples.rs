@@ -517,14 +517,27 @@ pub fn face_samples(face: &FaceGeom, per_axis: usize, bsp: &Bsp) -> (FaceSamples
         let (lo, hi) = box_of(&points);
         WalkStart::for_box(bsp, lo.map(|c| c - 1.0), hi.map(|c| c + 1.0))
     });
+    // Samples moved onto one point (of an edge where a wall stands on the face) are in solid
+    // alike, and nudged alike: the first one's nudge serves the rest. Points on the grid are
+    // all distinct.
+    let mut nudges: IntMap<[u32; 3], Option<[f32; 3]>> = IntMap::default();
     for i in 0..count {
         if beyond[i] {
             occluded[i] = true;
         } else if solid[i] {
-            match nudge_start
-                .flatten()
-                .and_then(|start| nudged(bsp, &start, points[i]))
-            {
+            let nudge_of = |p| {
+                nudge_start
+                    .flatten()
+                    .and_then(|start| nudged(bsp, &start, p))
+            };
+            let nudge = if moved[i] {
+                *nudges
+                    .entry(points[i].map(f32::to_bits))
+                    .or_insert_with(|| nudge_of(points[i]))
+            } else {
+                nudge_of(points[i])
+            };
+            match nudge {
                 Some(p) => {
                     points[i] = p;
                     moved[i] = true;
