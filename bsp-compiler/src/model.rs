@@ -9,7 +9,8 @@
 //! face open space first (as ericw-tools does), so that planes facing the void only cut solid
 //! space and collapse away, portalised and filled again; faces are made where leaf contents
 //! change, merged, and cut where their lightmaps would grow too large. The two clip hulls: built,
-//! and for the world filled the same way, on copies kept when hull 0 finds the world sealed.
+//! and for a sealed world filled the same way (on copies when hull 0 has yet to tell whether the
+//! world is sealed, kept when it is).
 
 use crate::brush::Brush;
 use crate::csg::mark_hidden_sides;
@@ -30,6 +31,7 @@ use crate::tree::{Splitting, Tree, build_clip_hull_tree, build_tree, rebuild_tre
 use crate::warnings::Warning;
 use glam::DVec3;
 use quake_formats::geom::Bounds;
+use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
 /// Progress units a model's pipelines report per brush of [`ModelInput::work`]: one for its CSG,
@@ -61,17 +63,27 @@ pub(crate) fn split_model(m: ModelInput, options: &CompileOptions) -> (DrawingJo
         // Only the world is flooded from the point entities.
         fills: m.entity == 0 && options.fill,
     };
+    let sealed = Arc::new(OnceLock::new());
     (
         DrawingJob {
             shape,
             brushes: m.brushes,
+            sealed: Arc::clone(&sealed),
         },
         ClipJob {
             shape,
             brushes: m.hull_brushes,
+            sealed,
         },
     )
 }
+
+/// Whether hull 0 of a model that [`fills`] came out sealed: set by its pipeline once its first
+/// flood is done (a second tree only replaces the first when sealed too), read by the clip
+/// hulls' pipeline, which fills its hulls only for a sealed world.
+///
+/// [`fills`]: ModelShape::fills
+type SealedVerdict = Arc<OnceLock<bool>>;
 
 /// What both of a model's pipelines know of it.
 #[derive(Debug, Clone, Copy)]
@@ -86,12 +98,14 @@ struct ModelShape {
 pub(crate) struct DrawingJob {
     shape: ModelShape,
     brushes: Vec<Brush>,
+    sealed: SealedVerdict,
 }
 
 /// A model's grown brushes for hulls 1 and 2.
 pub(crate) struct ClipJob {
     shape: ModelShape,
     brushes: [Vec<Brush>; 2],
+    sealed: SealedVerdict,
 }
 
 /// Hull 0 of a model built, with its warnings and the seconds of its CSG.
@@ -102,13 +116,26 @@ pub(crate) struct Drawn {
     csg_time: f64,
 }
 
-/// The clip hulls of a model built, and for the world filled on copies (kept when hull 0 is
-/// sealed), with the seconds of their CSG and of the rest.
+/// The clip hulls of a model built, and for a sealed world filled, with the seconds of their CSG
+/// and of the rest.
 pub(crate) struct Clipped {
-    hulls: [Tree; 2],
-    filled: Option<[Tree; 2]>,
+    hulls: ClipHulls,
     csg_time: f64,
     time: f64,
+}
+
+/// A model's clip hulls (1 and 2) as [`ModelBuild::clip_hulls`] leaves them.
+enum ClipHulls {
+    /// Built; the model is not filled, or hull 0 found the world open.
+    Unfilled([Tree; 2]),
+    /// Built and filled: hull 0 found the world sealed.
+    Filled([Tree; 2]),
+    /// Built, and filled on copies while hull 0 had yet to tell: the copies are kept when it is
+    /// sealed.
+    Both {
+        unfilled: [Tree; 2],
+        filled: [Tree; 2],
+    },
 }
 
 /// What [`assemble`] takes of a model's hull 0 once it is written ([`Drawn::written`]): its
@@ -168,8 +195,11 @@ impl DrawingJob {
         options.progress.advance(brushes.len());
         let csg_time = t.elapsed().as_secs_f64();
         let mut warnings = Vec::new();
-        let hull = ModelBuild::new(planes, texinfos, options, occupants, self.shape)
-            .drawing_hull(brushes, &mut warnings);
+        let hull = ModelBuild::new(planes, texinfos, options, occupants, self.shape).drawing_hull(
+            brushes,
+            &self.sealed,
+            &mut warnings,
+        );
         Drawn {
             hull,
             warnings,
@@ -195,12 +225,12 @@ impl ClipJob {
         }
         let csg_time = t.elapsed().as_secs_f64();
         let t = Instant::now();
-        let (hulls, filled) =
+        let hulls =
             // The clip hulls make no faces: no texinfos.
-            ModelBuild::new(planes, &[], options, occupants, self.shape).clip_hulls(brushes);
+            ModelBuild::new(planes, &[], options, occupants, self.shape)
+                .clip_hulls(brushes, &self.sealed);
         Clipped {
             hulls,
-            filled,
             csg_time,
             time: t.elapsed().as_secs_f64(),
         }
@@ -220,9 +250,10 @@ pub(crate) fn assemble(written: Written, clipped: Clipped) -> (ModelOutput, Vec<
         csg_time,
     } = written;
     let sealed = matches!(fill, Some(FillOutcome::Sealed { .. }));
-    let hulls = match clipped.filled {
-        Some(filled) if sealed => filled,
-        _ => clipped.hulls,
+    let hulls = match clipped.hulls {
+        ClipHulls::Unfilled(hulls) | ClipHulls::Filled(hulls) => hulls,
+        ClipHulls::Both { filled, .. } if sealed => filled,
+        ClipHulls::Both { unfilled, .. } => unfilled,
     };
     let mut timings = [0.0; 6];
     timings[..4].copy_from_slice(&times);
@@ -297,7 +328,12 @@ impl ModelBuild<'_> {
     /// collapse away.
     ///
     /// [`fills`]: ModelBuild::fills
-    fn drawing_hull(&self, brushes: Vec<Brush>, warnings: &mut Vec<Warning>) -> DrawingHull {
+    fn drawing_hull(
+        &self,
+        brushes: Vec<Brush>,
+        sealed: &OnceLock<bool>,
+        warnings: &mut Vec<Warning>,
+    ) -> DrawingHull {
         let (planes, options) = (self.planes, self.options);
         let mut times = [0.0; 4];
         let count = brushes.len();
@@ -314,6 +350,10 @@ impl ModelBuild<'_> {
         let mut fill = self
             .fills
             .then(|| self.fill_world(&mut tree, &portals, cluster_portals.as_ref(), warnings));
+        if let Some(outcome) = &fill {
+            // Set once, here only.
+            let _ = sealed.set(matches!(outcome, FillOutcome::Sealed { .. }));
+        }
         times[2] = t.elapsed().as_secs_f64();
         if let (Some(FillOutcome::Sealed { .. }), Some(brushes)) = (&fill, world_brushes) {
             let t = Instant::now();
@@ -381,14 +421,14 @@ impl ModelBuild<'_> {
         outcome
     }
 
-    /// The clip hulls' trees of `grown` (hulls 1 and 2), and when the model [`fills`], the same
-    /// trees with their outsides filled: a sealed world's clip hulls are sealed too (grown
-    /// brushes only close gaps further), and filled each collapses into one solid leaf instead
-    /// of many clip nodes. They are filled on copies while hull 0 is still finding out whether
-    /// the world is sealed; the caller keeps them only when it is.
+    /// The clip hulls' trees of `grown` (hulls 1 and 2), with their outsides filled when the
+    /// model [`fills`] and hull 0 finds it `sealed`: a sealed world's clip hulls are sealed too
+    /// (grown brushes only close gaps further), and filled each collapses into one solid leaf
+    /// instead of many clip nodes. While hull 0 has yet to tell, they are filled on copies, which
+    /// the caller keeps only when it is sealed; an open world's are not filled at all.
     ///
     /// [`fills`]: ModelBuild::fills
-    fn clip_hulls(&self, grown: [Vec<Brush>; 2]) -> ([Tree; 2], Option<[Tree; 2]>) {
+    fn clip_hulls(&self, grown: [Vec<Brush>; 2], sealed: &OnceLock<bool>) -> ClipHulls {
         let count = grown[0].len() + grown[1].len();
         let bounds = grown.each_ref().map(|list| {
             list.iter()
@@ -400,18 +440,31 @@ impl ModelBuild<'_> {
             || build_clip_hull_tree(h1, planes, splitting),
             || build_clip_hull_tree(h2, planes, splitting),
         );
-        let hulls = [a, b];
-        let filled = self.fills.then(|| {
-            let mut filled = hulls.clone();
-            let [f1, f2] = &mut filled;
+        let mut hulls = [a, b];
+        let fill = |hulls: &mut [Tree; 2]| {
+            let [f1, f2] = hulls;
             rayon::join(
                 || self.fill_hull(f1, &bounds[0]),
                 || self.fill_hull(f2, &bounds[1]),
             );
-            filled
-        });
+        };
+        let out = match (self.fills, sealed.get()) {
+            (false, _) | (true, Some(false)) => ClipHulls::Unfilled(hulls),
+            (true, Some(true)) => {
+                fill(&mut hulls);
+                ClipHulls::Filled(hulls)
+            }
+            (true, None) => {
+                let mut filled = hulls.clone();
+                fill(&mut filled);
+                ClipHulls::Both {
+                    unfilled: hulls,
+                    filled,
+                }
+            }
+        };
         self.options.progress.advance(count);
-        (hulls, filled)
+        out
     }
 
     /// Fill the outside of a clip hull's tree, flooding from the world's point entities, then
