@@ -3,6 +3,7 @@
 
 use crate::planes::{PlaneId, PlaneSet};
 use crate::sides_memo::{Sides, SidesMemo};
+use glam::DVec3;
 use quake_formats::geom::{Bounds, MAX_WORLD_COORD, ON_EPSILON, Plane, PlaneSide, Split, Winding};
 
 /// Brush fragments smaller than this (cubic units) are dropped as numerical slivers.
@@ -136,6 +137,76 @@ pub struct Brush {
     pub sides_memo: SidesMemo,
 }
 
+/// A canonical plane with what [`BrushProbe::sides_of`] needs of it, worked out once for the many
+/// brushes a candidate splitter is tested against.
+#[derive(Debug, Clone, Copy)]
+pub struct PlaneProbe<'a> {
+    id: PlaneId,
+    plane: &'a Plane,
+    /// The normal's components without their signs: how far a box reaches along it.
+    abs_normal: DVec3,
+    axial: bool,
+}
+
+impl<'a> PlaneProbe<'a> {
+    pub fn new(id: PlaneId, planes: &'a PlaneSet) -> PlaneProbe<'a> {
+        let plane = planes.get(id);
+        PlaneProbe {
+            id,
+            plane,
+            abs_normal: plane.normal.abs(),
+            axial: planes.is_axial(id),
+        }
+    }
+}
+
+/// A brush with its bounding box's centre and half size, worked out once for the many planes it
+/// is tested against.
+#[derive(Debug, Clone, Copy)]
+pub struct BrushProbe<'a> {
+    pub brush: &'a Brush,
+    center: DVec3,
+    half: DVec3,
+}
+
+impl<'a> BrushProbe<'a> {
+    pub fn new(brush: &'a Brush) -> BrushProbe<'a> {
+        let center = brush.bounds.center();
+        BrushProbe {
+            brush,
+            center,
+            half: brush.bounds.maxs - center,
+        }
+    }
+
+    /// [`Brush::sides_of`]: the box's answer, else the corners' (remembered).
+    pub fn sides_of(&self, plane: &PlaneProbe) -> Sides {
+        self.box_sides(plane).unwrap_or_else(|| {
+            self.brush
+                .sides_memo
+                .get_or_insert(plane.id, || self.brush.corner_sides(plane.plane))
+        })
+    }
+
+    /// What the bounding box tells of the plane's sides: everything, unless the box straddles a
+    /// plane that is not axial.
+    fn box_sides(&self, plane: &PlaneProbe) -> Option<Sides> {
+        let (n, half) = (plane.abs_normal, self.half);
+        let radius = half.x * n.x + half.y * n.y + half.z * n.z;
+        let d = plane.plane.distance(self.center);
+        if d - radius > -ON_EPSILON {
+            return Some((d + radius > ON_EPSILON, false));
+        }
+        if d + radius < ON_EPSILON {
+            return Some((false, d - radius < -ON_EPSILON));
+        }
+        if plane.axial {
+            return Some((d + radius > ON_EPSILON, d - radius < -ON_EPSILON));
+        }
+        None
+    }
+}
+
 /// A plane of a brush being built, with the texinfo of its map face.
 #[derive(Debug, Clone, Copy)]
 pub struct BrushPlane {
@@ -229,32 +300,7 @@ impl Brush {
     /// Which sides of the canonical plane `id` the brush reaches: (any point in front, any point
     /// behind). The corners' answers are remembered.
     pub fn sides_of(&self, id: PlaneId, planes: &PlaneSet) -> Sides {
-        let plane = planes.get(id);
-        self.box_sides(plane, planes.is_axial(id))
-            .unwrap_or_else(|| {
-                self.sides_memo
-                    .get_or_insert(id, || self.corner_sides(plane))
-            })
-    }
-
-    /// What the bounding box tells of `plane`'s sides: everything, unless the box straddles a
-    /// plane that is not `axial`.
-    fn box_sides(&self, plane: &Plane, axial: bool) -> Option<Sides> {
-        let n = plane.normal;
-        let center = self.bounds.center();
-        let half = self.bounds.maxs - center;
-        let radius = half.x * n.x.abs() + half.y * n.y.abs() + half.z * n.z.abs();
-        let d = plane.distance(center);
-        if d - radius > -ON_EPSILON {
-            return Some((d + radius > ON_EPSILON, false));
-        }
-        if d + radius < ON_EPSILON {
-            return Some((false, d - radius < -ON_EPSILON));
-        }
-        if axial {
-            return Some((d + radius > ON_EPSILON, d - radius < -ON_EPSILON));
-        }
-        None
+        BrushProbe::new(self).sides_of(&PlaneProbe::new(id, planes))
     }
 
     /// Which sides of `plane` the sides' corners reach.
@@ -446,7 +492,7 @@ pub(crate) mod tests {
             let (id, flipped) = planes.insert(&Plane::new(normal, dist));
             let plane = *planes.get(id);
             proptest::prop_assert_eq!(flipped, plane.normal.dot(normal) < 0.0);
-            let boxed = cube.box_sides(&plane, plane.axial().is_some());
+            let boxed = BrushProbe::new(&cube).box_sides(&PlaneProbe::new(id, &planes));
             let expected = boxed.unwrap_or_else(|| cube.corner_sides(&plane));
             proptest::prop_assert_eq!(cube.sides_of(id, &planes), expected);
             proptest::prop_assert_eq!(cube.sides_memo.len(), usize::from(boxed.is_none()));

@@ -259,7 +259,8 @@ impl Builder<'_> {
         best_splitter(
             &candidates,
             surfaces,
-            |s: &Surface, id| s.sides_of(self.planes.get(id)),
+            |id| self.planes.get(id),
+            |s: &Surface, plane| s.sides_of(plane),
             &on_plane,
             self.planes,
             self.splitting.heuristic,

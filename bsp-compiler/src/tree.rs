@@ -3,7 +3,7 @@
 //! This does the CSG implicitly: hidden faces between touching or overlapping brushes never
 //! become faces, because faces are only made where leaf contents change (see [`crate::faces`]).
 
-use crate::brush::{Brush, BrushKind};
+use crate::brush::{Brush, BrushKind, BrushProbe, PlaneProbe};
 use crate::planes::{PlaneId, PlaneSet};
 use crate::region::{Region, Sliver};
 use crate::sides_memo::SidesMemo;
@@ -93,17 +93,19 @@ impl SplitHeuristic {
 }
 
 /// The candidate with the lowest [`SplitHeuristic::key`] over a node's `items` (brushes or
-/// surfaces), each telling with `sides_of` which sides of a plane it reaches. `facing` is the
-/// sorted list of planes the items lie on, one entry per item.
+/// surfaces), each telling with `sides_of(item, &prepare(plane))` which sides of a plane it
+/// reaches (what `prepare` works out of a candidate serves every item). `facing` is the sorted
+/// list of planes the items lie on, one entry per item.
 ///
 /// A candidate stops being counted (or is not counted at all) once its key can only come out
 /// above the key of some finished candidate, compared on [`SplitHeuristic::key_prefix`]: both
 /// heuristics rank splits before all else (the fewest-splits one then the items lying on the
 /// plane, which are known before counting), and splits only add up, so it cannot win.
-pub fn best_splitter<T: Sync>(
+pub fn best_splitter<T: Sync, P>(
     candidates: &[PlaneId],
     items: &[T],
-    sides_of: impl Fn(&T, PlaneId) -> (bool, bool) + Sync,
+    prepare: impl Fn(PlaneId) -> P + Sync,
+    sides_of: impl Fn(&T, &P) -> (bool, bool) + Sync,
     facing: &[PlaneId],
     planes: &PlaneSet,
     heuristic: SplitHeuristic,
@@ -115,9 +117,10 @@ pub fn best_splitter<T: Sync>(
         if heuristic.key_prefix(0, facing, 0) > limit {
             return None;
         }
+        let prepared = prepare(id);
         let (mut front, mut back, mut split) = (0i64, 0i64, 0i64);
         for item in items {
-            match sides_of(item, id) {
+            match sides_of(item, &prepared) {
                 (true, true) => {
                     split += 1;
                     if heuristic.key_prefix(split, facing, 0) > limit {
@@ -807,12 +810,13 @@ impl Builder<'_> {
         // The largest brushes first: they are the likeliest to be split, so a candidate that
         // cannot win is found out sooner (the counts do not depend on the order).
         let size = |b: &Brush| (b.bounds.maxs - b.bounds.mins).element_sum();
-        let mut by_size: Vec<&Brush> = brushes.iter().collect();
-        by_size.sort_by(|a, b| size(b).total_cmp(&size(a)));
+        let mut by_size: Vec<BrushProbe> = brushes.iter().map(BrushProbe::new).collect();
+        by_size.sort_by(|a, b| size(b.brush).total_cmp(&size(a.brush)));
         best_splitter(
             &candidates,
             &by_size,
-            |b: &&Brush, id| b.sides_of(id, self.planes),
+            |id| PlaneProbe::new(id, self.planes),
+            BrushProbe::sides_of,
             &facing_planes,
             self.planes,
             self.splitting.heuristic,
@@ -1179,7 +1183,15 @@ mod tests {
                 })
                 .min()
                 .map(|(_, id)| id);
-            let chosen = best_splitter(&candidates, &spans, sides, &facing, &planes, heuristic);
+            let chosen = best_splitter(
+                &candidates,
+                &spans,
+                |id| id,
+                |span, &id| sides(span, id),
+                &facing,
+                &planes,
+                heuristic,
+            );
             proptest::prop_assert_eq!(chosen, exhaustive);
         }
     }
