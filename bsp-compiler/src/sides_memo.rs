@@ -20,7 +20,8 @@ use std::sync::atomic::{AtomicU32, Ordering};
 
 /// The tables a brush may make, the second only when the first is full around an answer's home:
 /// most brushes need none or the first; grown terrain brushes meet a thousand planes and more.
-/// (A lookup past a full neighbourhood of the first costs more the more tables there are.)
+/// A brush with a second table is one that meets many planes, so lookups try it first: most of
+/// its answers are there, and the first's full neighbourhoods would be walked for nothing.
 const TABLE_SIZES: [usize; 2] = [256, 4096];
 /// How far from its home slot an answer may be kept.
 const PROBES: usize = 8;
@@ -47,16 +48,16 @@ impl SidesMemo {
             (0..PROBES).map(move |i| (home + i) & (size - 1))
         };
         let tables = self.0.get_or_init(Default::default);
-        // Slots are never emptied: an empty one on the way means the answer is in no table
-        // (it would have taken that slot, or one before it).
-        'look: for table in tables.iter().map_while(OnceLock::get) {
+        // Slots are never emptied: an empty one on the way means the answer is not in that
+        // table (it would have taken that slot, or one before it).
+        for table in tables.iter().rev().filter_map(OnceLock::get) {
             for i in probes(table.len()) {
                 let slot = table[i].load(Ordering::Relaxed);
                 if slot >> 2 == key {
                     return (slot & 2 != 0, slot & 1 != 0);
                 }
                 if slot == 0 {
-                    break 'look;
+                    break;
                 }
             }
         }
