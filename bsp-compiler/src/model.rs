@@ -561,3 +561,80 @@ fn model_faces(
     }
     (faces, stats)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::brush::tests::box_brush;
+    use crate::hulls::{HULL_BOXES, bevelled_planes, grown_planes};
+    use quake_formats::bsp::contents;
+
+    /// The six walls of a closed room 512 units wide, grown for each clip hull.
+    fn grown_room(planes: &mut PlaneSet) -> [Vec<Brush>; 2] {
+        let (lo, hi) = (-256.0, 256.0);
+        let mut walls = Vec::new();
+        for axis in 0..3 {
+            for (a, b) in [(lo - 16.0, lo), (hi, hi + 16.0)] {
+                let (mut mins, mut maxs) = (DVec3::splat(lo - 16.0), DVec3::splat(hi + 16.0));
+                mins[axis] = a;
+                maxs[axis] = b;
+                walls.push(box_brush(planes, mins, maxs, contents::SOLID));
+            }
+        }
+        HULL_BOXES.map(|(mins, maxs)| {
+            walls
+                .iter()
+                .map(|w| {
+                    let faces = grown_planes(&bevelled_planes(w, planes), mins, maxs);
+                    Brush::from_planes(&faces, planes, contents::SOLID, w.source).expect("grown")
+                })
+                .collect()
+        })
+    }
+
+    /// Whether hull 0 has told the clip hulls' pipeline if the world is sealed or not, the trees
+    /// it keeps are the ones it keeps when it fills copies before knowing.
+    #[test]
+    fn clip_hulls_are_the_same_whenever_hull_0_tells_whether_the_world_is_sealed() {
+        let mut planes = PlaneSet::new();
+        let mut grown = grown_room(&mut planes);
+        for list in &mut grown {
+            mark_hidden_sides(list, &planes);
+        }
+        let options = CompileOptions::default();
+        let occupants = [Occupant {
+            entity: 1,
+            classname: "info_player_start".to_string(),
+            origin: DVec3::new(10.0, 20.0, 30.0),
+            line: 1,
+        }];
+        let shape = ModelShape {
+            bounds: Bounds {
+                mins: DVec3::splat(-272.0),
+                maxs: DVec3::splat(272.0),
+            },
+            fills: true,
+        };
+        let build = ModelBuild::new(&planes, &[], &options, &occupants, shape);
+        let told = |sealed: Option<bool>| {
+            let verdict = OnceLock::new();
+            if let Some(sealed) = sealed {
+                let _ = verdict.set(sealed);
+            }
+            build.clip_hulls(grown.clone(), &verdict)
+        };
+        let ClipHulls::Both { unfilled, filled } = told(None) else {
+            panic!("filled on copies while hull 0 has not told");
+        };
+        let ClipHulls::Filled(sealed) = told(Some(true)) else {
+            panic!("filled in place for a sealed world");
+        };
+        let ClipHulls::Unfilled(open) = told(Some(false)) else {
+            panic!("not filled for an open world");
+        };
+        assert_eq!(sealed, filled);
+        assert_eq!(open, unfilled);
+        // Filling did something: the void around the room is solid.
+        assert_ne!(filled, unfilled);
+    }
+}
