@@ -179,7 +179,8 @@ pub fn mid_split(
     let middle = bounds.center()[axis];
     candidates
         .iter()
-        .filter(|&&id| planes.get(id).axial() == Some(axis))
+        // The set's flag first: most candidates are not axial, and it is kept for each plane.
+        .filter(|&&id| planes.is_axial(id) && planes.get(id).axial() == Some(axis))
         .min_by(|&&a, &&b| {
             let da = (planes.get(a).dist - middle).abs();
             let db = (planes.get(b).dist - middle).abs();
