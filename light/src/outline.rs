@@ -103,7 +103,9 @@ impl FaceRegion {
     /// Conservative: `p`'s distance from an edge is held a margin above, for the rounding of
     /// the points' own tests. No edge near: the region holds the disc.
     pub fn edges_near_disc(&self, p: DVec3, radius: f64, near: &mut Vec<usize>) {
-        let clear = radius.max(INSIDE_SLACK) + ON_EDGE + DISC_MARGIN;
+        // A point of the disc lies at most `radius` nearer an edge than `p`: it must still be
+        // INSIDE_SLACK in (so not crossed) and off the outline.
+        let clear = radius + INSIDE_SLACK.max(ON_EDGE) + DISC_MARGIN;
         near.clear();
         // A NaN distance (a broken face) counts as near: its points' own tests decide.
         let is_near = |line: &EdgeLine| {
@@ -354,14 +356,20 @@ mod tests {
             prop_assume!(region.is_some());
             let region = region.expect("assumed");
             let centre = DVec3::new(x, y, 64.0);
-            // Radii at which one edge is only just far, within a rounding.
-            let barely = (0..region.lines.len())
-                .map(|k| region.distance(k, centre) - ON_EDGE - DISC_MARGIN * 1.5);
+            // Radii at which one edge is only just far, or a little less than INSIDE_SLACK
+            // from being so, within a rounding.
+            let barely = (0..region.lines.len()).flat_map(|k| {
+                let d = region.distance(k, centre) - DISC_MARGIN * 1.5;
+                [d - INSIDE_SLACK, d - ON_EDGE]
+            });
             let mut near = Vec::new();
             for r in std::iter::once(disc).chain(barely).filter(|&r| r >= 0.0) {
                 region.edges_near_disc(centre, r, &mut near);
-                for &(angle, along) in &at {
-                    let p = centre + DVec3::new(angle.cos(), angle.sin(), 0.0) * r * along;
+                // Points at random in the disc, and the ones of its rim nearest each edge.
+                let random = at.iter().map(|&(angle, along)| DVec3::new(angle.cos(), angle.sin(), 0.0) * along);
+                let nearest = region.lines.iter().map(|line| -line.inward);
+                for step in random.chain(nearest) {
+                    let p = centre + step * r;
                     prop_assert_eq!(
                         region.inside_on_edge(p, Edges::Near(&near)),
                         region.inside_on_edge(p, Edges::All)
