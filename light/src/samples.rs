@@ -269,10 +269,12 @@ impl SurfaceMap {
         // the last face it reached.
         let mut region = &*self.outline;
         let mut at = 0;
-        for _ in 0..CONTINUATION_HOPS {
-            if self.continuations.is_empty() {
-                break;
-            }
+        let hops = if self.continuations.is_empty() {
+            0
+        } else {
+            CONTINUATION_HOPS
+        };
+        for _ in 0..hops {
             // On the face's own outline (the first region) only the edges near the luxel can
             // be crossed.
             let edge = region.edge_to_cross(on_plane, if at == 0 { near } else { Edges::All });
