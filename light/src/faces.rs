@@ -8,6 +8,7 @@ use quake_formats::Bsp;
 use quake_formats::bsp::texinfo_flags;
 use quake_formats::extents::{LightmapExtents, LuxelGrid};
 use quake_formats::geom::Plane;
+use quake_formats::int_hash::IntMap;
 use rayon::prelude::*;
 
 use crate::error::LightError;
@@ -283,8 +284,9 @@ pub fn unlinked_face_geometry(
 /// Corners closer than this (units) are the same corner.
 const SAME_CORNER: f64 = 0.01;
 
-/// An edge by its two corners on the [`SAME_CORNER`] grid, the lesser first.
-type EdgeKey = ([i64; 3], [i64; 3]);
+/// An edge by its two corners' numbers (corners on the [`SAME_CORNER`] grid, numbered as first
+/// met), the lesser in the high half.
+type EdgeKey = u64;
 
 /// Two faces whose unit normals' dot product is within this of 1 face the same way (with their
 /// distances within [`SAME_CORNER`], they lie on one plane).
@@ -306,26 +308,32 @@ pub const CONTINUATION_HOPS: usize = 3;
 /// there, at most [`CONTINUATION_HOPS`] times.
 #[derive(Debug, Clone, Default)]
 pub struct Continuations {
-    regions: Vec<Region>,
+    /// The face, then the faces it may walk onto in face order: region `k` is face `faces[k]`.
+    faces: Vec<u32>,
+    /// The outlines of regions whose shared one is seen from a plane whose normal differs in
+    /// its last bits from this face's (an outline's inward normals come from its plane).
+    own_outlines: Vec<(u32, Arc<FaceRegion>)>,
     /// Whether some region is smoothed with the face (`_phong`) or on another plane.
     smoothed: bool,
+    /// What every face's regions look up.
+    shared: Arc<SharedRegions>,
 }
 
-/// One face a point may walk onto, as [`Continuations`] holds it.
-#[derive(Debug, Clone)]
-struct Region {
-    outline: Arc<FaceRegion>,
-    face: u32,
-    /// The plane the face looks out of.
-    plane: Plane,
-    /// Per edge: the region across it, when it is one of them.
+/// Per face, what the faces continuing it share: its outline (lit faces), its plane and the
+/// face across each of its edges, of its model on its plane or smoothed with it.
+#[derive(Debug, Default)]
+struct SharedRegions {
+    outlines: Vec<Option<Arc<FaceRegion>>>,
+    planes: Vec<Plane>,
+    /// Face `f`'s edges are `across[first_edge[f]..first_edge[f + 1]]`.
     across: Vec<Option<u32>>,
+    first_edge: Vec<usize>,
 }
 
 impl Continuations {
     /// How many faces continue the face (itself not counted).
     pub fn len(&self) -> usize {
-        self.regions.len().saturating_sub(1)
+        self.faces.len().saturating_sub(1)
     }
 
     /// Whether no face continues the face.
@@ -335,7 +343,11 @@ impl Continuations {
 
     /// Region `k`'s outline (0: the face's own).
     pub fn region(&self, k: usize) -> Option<&FaceRegion> {
-        self.regions.get(k).map(|r| &*r.outline)
+        if let Some((_, own)) = self.own_outlines.iter().find(|(at, _)| *at as usize == k) {
+            return Some(own);
+        }
+        let face = *self.faces.get(k)? as usize;
+        self.shared.outlines.get(face)?.as_deref()
     }
 
     /// Whether a point may walk onto a face smoothed with this one (`_phong`): it then stands
@@ -346,7 +358,8 @@ impl Continuations {
 
     /// Region `k`'s face and the plane it looks out of.
     pub fn face(&self, k: usize) -> Option<(usize, &Plane)> {
-        self.regions.get(k).map(|r| (r.face as usize, &r.plane))
+        let face = *self.faces.get(k)? as usize;
+        Some((face, self.shared.planes.get(face)?))
     }
 
     /// The region a point `p` past region `k` (on its plane) walks onto: the one across the
@@ -355,16 +368,25 @@ impl Continuations {
         if self.is_empty() {
             return None;
         }
-        self.across(
-            k,
-            self.regions.get(k)?.outline.edge_to_cross(p, Edges::All)?,
-        )
+        self.across(k, self.region(k)?.edge_to_cross(p, Edges::All)?)
     }
 
     /// The region across edge `edge` of region `k`, if any.
     pub fn across(&self, k: usize, edge: usize) -> Option<usize> {
-        let next = self.regions.get(k)?.across.get(edge).copied().flatten()?;
-        Some(next as usize)
+        let face = *self.faces.get(k)? as usize;
+        let shared = &*self.shared;
+        let edges = *shared.first_edge.get(face)?..*shared.first_edge.get(face + 1)?;
+        let next = shared.across.get(edges)?.get(edge).copied().flatten()?;
+        self.region_of(next)
+    }
+
+    /// Face `face`'s place among the regions, if it is one.
+    fn region_of(&self, face: u32) -> Option<usize> {
+        let (&own, others) = self.faces.split_first()?;
+        if face == own {
+            return Some(0);
+        }
+        others.binary_search(&face).ok().map(|i| i + 1)
     }
 }
 
@@ -385,33 +407,47 @@ pub fn continuations(
     let key = |p: DVec3| (p / SAME_CORNER).round().as_i64vec3().to_array();
     let lit = |f: &&FaceGeom| f.kind == FaceKind::Lit;
     // Every lit face's edges, sorted by edge: one allocation of the exact size (fresh memory
-    // costs more than the keys do to compute).
+    // costs more than the keys do to compute). Corners are numbered first, so the sort moves
+    // small records and compares one word.
     let edges = faces.iter().filter(lit).map(|f| f.points.len()).sum();
-    let mut by_edge: Vec<(EdgeKey, usize, u32)> = Vec::with_capacity(edges);
-    let mut corners: Vec<[i64; 3]> = Vec::new();
+    let mut number: IntMap<[i64; 3], u32> =
+        IntMap::with_capacity_and_hasher(edges, Default::default());
+    let mut by_edge: Vec<(EdgeKey, u32, u32)> = Vec::with_capacity(edges);
+    let mut corners: Vec<u32> = Vec::new();
     for f in faces.iter().filter(lit) {
         corners.clear();
-        corners.extend(f.points.iter().map(|&p| key(p)));
+        for &p in &f.points {
+            let next = number.len() as u32;
+            corners.push(*number.entry(key(p)).or_insert(next));
+        }
         for (i, &a) in corners.iter().enumerate() {
             let b = corners[(i + 1) % corners.len()];
-            by_edge.push(((a.min(b), a.max(b)), f.index, i as u32));
+            let edge = u64::from(a.min(b)) << 32 | u64::from(a.max(b));
+            by_edge.push((edge, f.index as u32, i as u32));
         }
     }
-    by_edge.par_sort_unstable();
+    drop(number);
+    by_edge.sort_unstable();
     let same_plane =
         |a: &FaceGeom, b: &FaceGeom| a.model == b.model && one_plane(&a.plane, &b.plane);
     // The faces under one edge are a run of `by_edge`: each is beside the others on its plane,
     // and the first of them (in face order, as ericw-tools finds it) lies across the edge.
-    let mut across: Vec<Vec<Option<u32>>> =
-        faces.iter().map(|f| vec![None; f.points.len()]).collect();
+    let mut first_edge = Vec::with_capacity(faces.len() + 1);
+    first_edge.push(0);
+    for f in faces {
+        first_edge.push(first_edge.last().copied().unwrap_or(0) + f.points.len());
+    }
+    let mut across: Vec<Option<u32>> = vec![None; first_edge.last().copied().unwrap_or(0)];
     // As (face, neighbour) pairs, sorted: each face's neighbours are a run of them.
     let mut beside: Vec<(u32, u32)> = Vec::new();
     for run in by_edge.chunk_by(|a, b| a.0 == b.0) {
         for &(_, f, edge) in run {
+            let f = f as usize;
             for &(_, g, _) in run {
+                let g = g as usize;
                 if g != f && (same_plane(&faces[f], &faces[g]) || smooths(&faces[f], &faces[g])) {
                     beside.push((f as u32, g as u32));
-                    across[f][edge as usize].get_or_insert(g as u32);
+                    across[first_edge[f] + edge as usize].get_or_insert(g as u32);
                 }
             }
         }
@@ -437,14 +473,20 @@ pub fn continuations(
         .par_iter()
         .map(|f| (f.kind == FaceKind::Lit).then(|| Arc::new(f.region())))
         .collect();
+    let shared = Arc::new(SharedRegions {
+        outlines,
+        planes: faces.iter().map(|f| f.plane).collect(),
+        across,
+        first_edge,
+    });
     let continuations = (0..faces.len())
         .into_par_iter()
         .map_init(
             || (Vec::new(), Vec::new(), Vec::new()),
             |(reached, ring, next): &mut (Vec<usize>, Vec<usize>, Vec<usize>), f| {
-                let Some(own) = &outlines[f] else {
+                if shared.outlines[f].is_none() {
                     return Arc::default();
-                };
+                }
                 reached.clear();
                 ring.clear();
                 ring.push(f);
@@ -457,53 +499,39 @@ pub fn continuations(
                     reached.extend_from_slice(next);
                     std::mem::swap(ring, next);
                 }
-                reached.retain(|&g| outlines[g].is_some());
+                reached.retain(|&g| shared.outlines[g].is_some());
                 reached.sort_unstable();
-                // The face first, then the others in order: a face's place among them.
-                let local = |g: usize| {
-                    if g == f {
-                        Some(0)
-                    } else {
-                        reached.binary_search(&g).ok().map(|i| i as u32 + 1)
-                    }
-                };
                 // An outline's inward normals come from the plane it is seen on: a continuation
                 // on the face's plane whose normal differs in its last bits gets an outline of
                 // its own; one on another plane (a smoothed neighbour) keeps its own.
                 let normal = faces[f].plane.normal;
-                let outline_of = |g: usize| match &outlines[g] {
-                    Some(r) if faces[g].plane.normal == normal => Some(r.clone()),
-                    Some(r) if !same_plane(&faces[f], &faces[g]) => Some(r.clone()),
-                    Some(_) => Some(Arc::new(FaceRegion::from_points(
-                        faces[g].points.clone(),
-                        normal,
-                    ))),
-                    None => None,
-                };
-                let regions = std::iter::once(&f)
-                    .chain(reached.iter())
-                    .filter_map(|&g| {
-                        Some(Region {
-                            outline: if g == f { own.clone() } else { outline_of(g)? },
-                            face: g as u32,
-                            plane: faces[g].plane,
-                            across: across[g]
-                                .iter()
-                                .map(|next| next.and_then(|n| local(n as usize)))
-                                .collect(),
-                        })
+                let own_outlines = (reached.iter().enumerate())
+                    .filter(|&(_, &g)| {
+                        faces[g].plane.normal != normal && same_plane(&faces[f], &faces[g])
+                    })
+                    .map(|(i, &g)| {
+                        let seen = FaceRegion::from_points(faces[g].points.clone(), normal);
+                        (i as u32 + 1, Arc::new(seen))
                     })
                     .collect();
                 let smoothed = reached
                     .iter()
                     .any(|&g| smooths(&faces[f], &faces[g]) || !same_plane(&faces[f], &faces[g]));
-                Arc::new(Continuations { regions, smoothed })
+                Arc::new(Continuations {
+                    faces: std::iter::once(f)
+                        .chain(reached.iter().copied())
+                        .map(|g| g as u32)
+                        .collect(),
+                    own_outlines,
+                    smoothed,
+                    shared: shared.clone(),
+                })
             },
         )
         .collect();
     Links {
         continuations,
-        outlines,
+        outlines: shared.outlines.clone(),
     }
 }
 
