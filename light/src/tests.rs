@@ -343,6 +343,45 @@ fn samples_past_an_edge_follow_the_plane_across_faces() {
     assert_eq!(second_row_over_the_plane(&polys), (2, true));
 }
 
+/// A face's continuations number the faces it may walk onto, itself first and the others in
+/// face order, and say edge by edge which of them lies across, in that numbering, though every
+/// face's continuations look the edges up in one shared table.
+#[test]
+fn continuations_number_the_faces_across_each_edge_from_the_face_itself() {
+    let polys = [
+        floor_strip(0.0, 4.0),
+        floor_strip(4.0, 8.0),
+        floor_strip(8.0, 256.0),
+    ];
+    let bsp = synthetic_bsp(&polys, "{ \"classname\" \"worldspawn\" }");
+    let faces = face_geometry(&bsp, |_| DVec3::ZERO, |_| Spacing::Quake).expect("faces");
+    let face_of = |c: &crate::faces::Continuations, k: usize| c.face(k).map(|(f, _)| f);
+    let crossed = |c: &crate::faces::Continuations, k: usize| {
+        let mut to: Vec<usize> = (0..4).filter_map(|edge| c.across(k, edge)).collect();
+        to.sort_unstable();
+        to
+    };
+    let middle = &faces[1].continuations;
+    assert_eq!(middle.len(), 2);
+    assert_eq!(
+        [0, 1, 2].map(|k| face_of(middle, k)),
+        [Some(1), Some(0), Some(2)]
+    );
+    // The middle strip's long edges lead to both neighbours; each neighbour's back to it.
+    assert_eq!(crossed(middle, 0), [1, 2]);
+    assert_eq!(crossed(middle, 1), [0]);
+    assert_eq!(crossed(middle, 2), [0]);
+    // Seen from the first strip, the same faces have other numbers.
+    let first = &faces[0].continuations;
+    assert_eq!(
+        [0, 1, 2].map(|k| face_of(first, k)),
+        [Some(0), Some(1), Some(2)]
+    );
+    assert_eq!(crossed(first, 0), [1]);
+    assert_eq!(crossed(first, 1), [0, 2]);
+    assert!(first.region(2).is_some() && first.region(3).is_none());
+}
+
 /// Regression: a luxel past a face's edge and past the face continuing the plane there as well
 /// was moved back onto the face's own outline; ericw-tools walks it across the edge onto the
 /// continuing face and moves it onto that face's outline, where the surface it stands over ends.
