@@ -511,12 +511,14 @@ pub fn face_samples(face: &FaceGeom, per_axis: usize, bsp: &Bsp) -> (FaceSamples
         ..PlacementCounts::default()
     };
     // A luxel's samples, or a run of a row's luxels with one sample each, lie close together.
-    let solid = solid_points_in_tiles(bsp, &points, (per_axis * per_axis).max(16));
+    let tile = (per_axis * per_axis).max(16);
+    let (tiles, all) = tile_boxes(&points, tile);
+    let solid = solid_in_tiles(bsp, &points, tile, &tiles, all);
     let mut occluded = vec![false; count];
     // The nudges of points in solid walk the tree from where a box round all the points, and
     // half a unit more, parts.
     let nudge_start = solid.contains(&true).then(|| {
-        let (lo, hi) = box_of(&points);
+        let (lo, hi) = all;
         WalkStart::for_box(bsp, lo.map(|c| c - 1.0), hi.map(|c| c + 1.0))
     });
     // Samples moved onto one point (of an edge where a wall stands on the face) are in solid
@@ -613,7 +615,7 @@ const ON_PLANE: f32 = 0.1;
 /// the per-point test, so the shared walk ends where [`solid_at`]'s would.
 const SHARED_WALK_MARGIN: f32 = 0.25;
 
-/// A node of the world BSP where the shared walk of [`solid_points_in_tiles`]
+/// A node of the world BSP where the shared walk of [`solid_in_tiles`]
 /// arrives for every point inside a box: walks of points inside that box
 /// (the nudges of one face's samples in solid) start there instead of at the
 /// root, and end where they would have. A box inside another one is on one
@@ -683,23 +685,34 @@ fn solid_below(bsp: &Bsp, mut node: i32, p: [f32; 3], mut depth: usize) -> bool 
             .is_some_and(|l| l.contents == contents::SOLID || l.contents == contents::SKY)
 }
 
+/// [`solid_in_tiles`] of `points`, boxes and all.
+#[cfg(test)]
+pub(crate) fn solid_points_in_tiles(bsp: &Bsp, points: &[[f32; 3]], tile: usize) -> Vec<bool> {
+    let (tiles, all) = tile_boxes(points, tile);
+    solid_in_tiles(bsp, points, tile, &tiles, all)
+}
+
 /// Whether each of `points` is in solid ([`solid_at`]), for points that lie in tiles of `tile`
-/// consecutive points close together (a luxel's samples). The points share the walk from the
-/// root down to the first node whose plane passes between them; then each tile shares the walk
-/// on down to where its own points part, so a tile inside one leaf costs one walk, not one a
-/// point.
-pub fn solid_points_in_tiles(bsp: &Bsp, points: &[[f32; 3]], tile: usize) -> Vec<bool> {
+/// consecutive points close together (a luxel's samples), whose boxes are `tiles` and the box
+/// of them all `all` ([`tile_boxes`]). The points share the walk from the root down to the
+/// first node whose plane passes between them; then each tile shares the walk on down to where
+/// its own points part, so a tile inside one leaf costs one walk, not one a point.
+fn solid_in_tiles(
+    bsp: &Bsp,
+    points: &[[f32; 3]],
+    tile: usize,
+    tiles: &[PointBox],
+    (lo, hi): PointBox,
+) -> Vec<bool> {
     let Some(root) = WalkStart::root(bsp) else {
         return vec![false; points.len()];
     };
     if points.is_empty() {
         return Vec::new();
     }
-    let (lo, hi) = box_of(points);
     let node = shared_walk(bsp, root.node, lo, hi);
     let mut solid = Vec::with_capacity(points.len());
-    for tile in points.chunks(tile.max(1)) {
-        let (lo, hi) = box_of(tile);
+    for (tile, &(lo, hi)) in points.chunks(tile.max(1)).zip(tiles) {
         let node = shared_walk(bsp, node, lo, hi);
         let mut budget = OPEN_BOX_NODES;
         if box_is_open(bsp, node, lo, hi, &mut budget) == Some(true) {
@@ -756,8 +769,31 @@ fn box_distances(plane: &quake_formats::bsp::BspPlane, lo: [f32; 3], hi: [f32; 3
     (near, far)
 }
 
+/// A box, `(lo, hi)`.
+type PointBox = ([f32; 3], [f32; 3]);
+
+/// The boxes of `points` taken `tile` at a time, in order, and the box of them all (lo above
+/// hi for no points): the same box as [`box_of`] of them all, in one pass.
+fn tile_boxes(points: &[[f32; 3]], tile: usize) -> (Vec<PointBox>, PointBox) {
+    let tiles: Vec<PointBox> = points.chunks(tile.max(1)).map(box_of).collect();
+    // The comparisons of `box_of`, tile by tile in the points' order: the least and greatest
+    // coordinates, and of equal ones (0 and -0) the first met.
+    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for (tile_lo, tile_hi) in &tiles {
+        for a in 0..3 {
+            if tile_lo[a] < lo[a] {
+                lo[a] = tile_lo[a];
+            }
+            if tile_hi[a] > hi[a] {
+                hi[a] = tile_hi[a];
+            }
+        }
+    }
+    (tiles, (lo, hi))
+}
+
 /// The box of `points` (not empty).
-fn box_of(points: &[[f32; 3]]) -> ([f32; 3], [f32; 3]) {
+fn box_of(points: &[[f32; 3]]) -> PointBox {
     let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
     for p in points {
         for a in 0..3 {
@@ -843,6 +879,24 @@ mod tests {
                 };
                 prop_assert_eq!(got[i], want, "point {}", i);
             }
+        }
+
+        /// The box of all the points made from the tiles' boxes is the box of the points, bit
+        /// for bit: the first of equal coordinates (0 and -0) kept, NaN coordinates ignored,
+        /// tiles of NaN alone included.
+        #[test]
+        fn the_tiles_boxes_make_the_box_of_all_the_points(
+            coords in proptest::collection::vec(
+                prop_oneof![Just(0.0f32), Just(-0.0), Just(f32::NAN), -4.0f32..4.0],
+                0..120,
+            ),
+            tile in 1usize..20,
+        ) {
+            let points: Vec<[f32; 3]> = coords.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+            let (tiles, all) = tile_boxes(&points, tile);
+            let bits = |(lo, hi): PointBox| (lo.map(f32::to_bits), hi.map(f32::to_bits));
+            prop_assert_eq!(bits(all), bits(box_of(&points)));
+            prop_assert_eq!(tiles.len(), points.chunks(tile).len());
         }
     }
 }
