@@ -772,41 +772,42 @@ fn box_distances(plane: &quake_formats::bsp::BspPlane, lo: [f32; 3], hi: [f32; 3
 /// A box, `(lo, hi)`.
 type PointBox = ([f32; 3], [f32; 3]);
 
-/// The boxes of `points` taken `tile` at a time, in order, and the box of them all (lo above
-/// hi for no points): the same box as [`box_of`] of them all, in one pass.
+/// The boxes of `points` taken `tile` at a time, in order, and the box of them all: the same
+/// box as [`box_of`] of them all, in one pass over the points.
 fn tile_boxes(points: &[[f32; 3]], tile: usize) -> (Vec<PointBox>, PointBox) {
     let tiles: Vec<PointBox> = points.chunks(tile.max(1)).map(box_of).collect();
-    // The comparisons of `box_of`, tile by tile in the points' order: the least and greatest
-    // coordinates, and of equal ones (0 and -0) the first met.
-    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    for (tile_lo, tile_hi) in &tiles {
-        for a in 0..3 {
-            if tile_lo[a] < lo[a] {
-                lo[a] = tile_lo[a];
-            }
-            if tile_hi[a] > hi[a] {
-                hi[a] = tile_hi[a];
-            }
-        }
+    // Tile by tile in the points' order, the comparisons `box_of` makes point by point.
+    let mut all = EMPTY_BOX;
+    for &tile in &tiles {
+        widen(&mut all, tile);
     }
-    (tiles, (lo, hi))
+    (tiles, all)
 }
 
-/// The box of `points` (not empty).
+/// The box of no points: lo above hi.
+const EMPTY_BOX: PointBox = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+
+/// The box of `points` (lo above hi for none).
 fn box_of(points: &[[f32; 3]]) -> PointBox {
-    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    for p in points {
-        for a in 0..3 {
-            // As `min` and `max` take them, a NaN coordinate changing nothing.
-            if p[a] < lo[a] {
-                lo[a] = p[a];
-            }
-            if p[a] > hi[a] {
-                hi[a] = p[a];
-            }
+    let mut b = EMPTY_BOX;
+    for &p in points {
+        widen(&mut b, (p, p));
+    }
+    b
+}
+
+/// `b` widened to hold the box `lo..hi`: a lesser `lo` or greater `hi` coordinate replaces
+/// `b`'s, so of equal ones (0 and -0) the first met stays, and, as `min` and `max` take them,
+/// a NaN coordinate changes nothing.
+fn widen(b: &mut PointBox, (lo, hi): PointBox) {
+    for a in 0..3 {
+        if lo[a] < b.0[a] {
+            b.0[a] = lo[a];
+        }
+        if hi[a] > b.1[a] {
+            b.1[a] = hi[a];
         }
     }
-    (lo, hi)
 }
 
 /// From `node` down, the first node whose plane passes between the corners
