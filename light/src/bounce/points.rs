@@ -167,12 +167,11 @@ impl<'a> PointField<'a> {
             lo = lo.min(p);
             hi = hi.max(p);
         }
-        // The emitters that may light some luxel, and each luxel's weight from each (row-major
-        // by emitter), a batch at a time.
+        // The emitters that may light some luxel, and each luxel's weight from each, a batch
+        // at a time.
         let mut out = StyleLuxels::new();
-        let mut lighting: Vec<&PointEmitter> = Vec::new();
-        let mut weights: Vec<f32> = Vec::with_capacity(BATCH + n);
-        let at = Luxels::new(&r.points, &r.normals);
+        let mut rows = WeightRows::new(n);
+        let at = Luxels::new(&r.points, &r.normals, rows.stride);
         // One normal for every luxel (a flat one-sided face): the receiving cosine is bounded
         // by the emitter's height over the luxels too.
         let flat_normal = r
@@ -212,29 +211,14 @@ impl<'a> PointField<'a> {
             {
                 continue;
             }
-            let start = weights.len();
-            weights.resize(start + n, 0.0);
             let gate = (GATE / max_total) as f32;
-            weigh(
-                e,
-                &at,
-                self.kernel as f32,
-                gate,
-                r.two_sided,
-                &mut weights[start..],
-            );
-            if weights[start..].iter().all(|&w| w == 0.0) {
-                weights.truncate(start);
-                continue;
-            }
-            lighting.push(e);
-            if weights.len() >= BATCH {
-                light_batch(scene, r, &points, &lighting, &weights, &mut out, counts);
-                lighting.clear();
-                weights.clear();
+            rows.push(e, &at, self.kernel as f32, gate, r.two_sided);
+            if rows.weights.len() >= BATCH {
+                light_batch(scene, r, &points, &rows, &mut out, counts);
+                rows.clear();
             }
         }
-        light_batch(scene, r, &points, &lighting, &weights, &mut out, counts);
+        light_batch(scene, r, &points, &rows, &mut out, counts);
         out
     }
 }
@@ -509,19 +493,90 @@ fn under_gate(e: &PointEmitter, n_r: DVec3, (lo, hi): (DVec3, DVec3), scale: f64
     scale * along_e * along_r / (d2 * d2.max(clamp)) * (1.0 + BOUND_ROUNDING) < 1.0
 }
 
-/// A face's luxels, coordinate by coordinate (so that weighing them vectorises).
+/// A face's luxels, coordinate by coordinate (so that weighing them vectorises), each column
+/// padded with zeros to a given length.
 struct Luxels {
     at: [Vec<f32>; 3],
     normal: [Vec<f32>; 3],
 }
 
 impl Luxels {
-    fn new(points: &[[f32; 3]], normals: &[[f32; 3]]) -> Luxels {
-        let axis = |v: &[[f32; 3]], k: usize| v.iter().map(|p| p[k]).collect();
+    fn new(points: &[[f32; 3]], normals: &[[f32; 3]], padded: usize) -> Luxels {
+        let axis = |v: &[[f32; 3]], k: usize| {
+            let mut column: Vec<f32> = v.iter().map(|p| p[k]).collect();
+            column.resize(padded.max(v.len()), 0.0);
+            column
+        };
         Luxels {
             at: [0, 1, 2].map(|k| axis(points, k)),
             normal: [0, 1, 2].map(|k| axis(normals, k)),
         }
+    }
+}
+
+/// Rows of [`WeightRows`] are padded to a multiple of this many weights: a face's luxels are
+/// then weighed in whole vectors of eight, with no one-at-a-time tail for the last few (most
+/// faces have a few dozen luxels, and a few hundred thousand emitters to weigh them for).
+const ROW_LANES: usize = 8;
+
+/// The emitters that light a face's luxels, with each one's weight at each luxel (a row per
+/// emitter, [`WeightRows::stride`] long: the luxels' weights, then zeros), and the largest of
+/// its weights and their sum, worked out as it is weighed.
+struct WeightRows<'e> {
+    luxels: usize,
+    stride: usize,
+    emitters: Vec<WeighedEmitter<'e>>,
+    weights: Vec<f32>,
+}
+
+/// An emitter of a [`WeightRows`], with [`largest_and_total`] of its weights.
+struct WeighedEmitter<'e> {
+    emitter: &'e PointEmitter,
+    largest: f32,
+    total: f32,
+}
+
+impl<'e> WeightRows<'e> {
+    /// No rows yet, for a face of `luxels` luxels.
+    fn new(luxels: usize) -> WeightRows<'e> {
+        let stride = luxels.next_multiple_of(ROW_LANES);
+        WeightRows {
+            luxels,
+            stride,
+            emitters: Vec::new(),
+            weights: Vec::with_capacity(BATCH + stride),
+        }
+    }
+
+    /// Weighs the luxels `at` for emitter `e` ([`weigh`]) and keeps its row, unless every weight
+    /// is 0.
+    fn push(&mut self, e: &'e PointEmitter, at: &Luxels, kernel: f32, gate: f32, two_sided: bool) {
+        let start = self.weights.len();
+        self.weights.resize(start + self.stride, 0.0);
+        let row = &mut self.weights[start..];
+        weigh(e, at, kernel, gate, two_sided, row);
+        row[self.luxels..].fill(0.0);
+        // Weights are 0 or at least the gate: the largest is 0 only when all are.
+        let (largest, total) = largest_and_total(&row[..self.luxels]);
+        if largest == 0.0 {
+            self.weights.truncate(start);
+            return;
+        }
+        self.emitters.push(WeighedEmitter {
+            emitter: e,
+            largest,
+            total,
+        });
+    }
+
+    /// The weights of row `k`'s emitter at the luxels.
+    fn row(&self, k: usize) -> &[f32] {
+        &self.weights[k * self.stride..][..self.luxels]
+    }
+
+    fn clear(&mut self) {
+        self.emitters.clear();
+        self.weights.clear();
     }
 }
 
@@ -557,24 +612,26 @@ fn weigh_any(
     let [px, py, pz] = &luxels.at;
     let [nx, ny, nz] = &luxels.normal;
     let n = out.len();
-    let (px, py, pz, nx, ny, nz) = (&px[..n], &py[..n], &pz[..n], &nx[..n], &ny[..n], &nz[..n]);
     // cos θe · cos θr / max(d, 128)², without a square root for one-sided faces; one loop per
-    // kind of face, each free of branches.
-    let along = |i: usize| (px[i] - ex, py[i] - ey, pz[i] - ez);
+    // kind of face, each free of branches and of index checks (zipped columns), so that it
+    // runs in whole vectors with a tail only for a row that is not a multiple of eight long.
+    let at = px[..n].iter().zip(&py[..n]).zip(&pz[..n]);
+    let along = |((x, y), z): ((&f32, &f32), &f32)| (x - ex, y - ey, z - ez);
     let finish = |w: f32| if w < gate { 0.0 } else { w };
     if two_sided {
-        for (i, slot) in out.iter_mut().enumerate() {
-            let (tx, ty, tz) = along(i);
+        for (slot, p) in out.iter_mut().zip(at) {
+            let (tx, ty, tz) = along(p);
             let d2 = (tx * tx + ty * ty + tz * tz).max(MIN_DISTANCE * MIN_DISTANCE);
             let along_e = (ux * tx + uy * ty + uz * tz).max(0.0);
             *slot = finish(kernel * along_e * d2.sqrt() / (d2 * d2.max(clamp)));
         }
     } else {
-        for (i, slot) in out.iter_mut().enumerate() {
-            let (tx, ty, tz) = along(i);
+        let normals = nx[..n].iter().zip(&ny[..n]).zip(&nz[..n]);
+        for ((slot, p), ((mx, my), mz)) in out.iter_mut().zip(at).zip(normals) {
+            let (tx, ty, tz) = along(p);
             let d2 = (tx * tx + ty * ty + tz * tz).max(MIN_DISTANCE * MIN_DISTANCE);
             let along_e = (ux * tx + uy * ty + uz * tz).max(0.0);
-            let along_r = (-(nx[i] * tx + ny[i] * ty + nz[i] * tz)).max(0.0);
+            let along_r = (-(mx * tx + my * ty + mz * tz)).max(0.0);
             *slot = finish(kernel * along_e * along_r / (d2 * d2.max(clamp)));
         }
     }
@@ -654,34 +711,38 @@ impl PointEmitter {
     }
 }
 
-/// Adds to `out` (per style and luxel of `r`, at `points`) the light of `lighting`, whose
-/// weights at each luxel are `weights` (row-major by emitter), where nothing blocks it.
+/// Adds to `out` (per style and luxel of `r`, at `points`) the light of the emitters of
+/// `rows`, at their weights, where nothing blocks it.
 fn light_batch(
     scene: &TraceScene,
     r: &Receivers,
     points: &[DVec3],
-    lighting: &[&PointEmitter],
-    weights: &[f32],
+    rows: &WeightRows,
     out: &mut StyleLuxels,
     counts: &mut BounceCounts,
 ) {
     let n = points.len();
-    let from: Vec<DVec3> = lighting.iter().map(|e| e.point).collect();
+    let from: Vec<DVec3> = rows.emitters.iter().map(|w| w.emitter.point).collect();
     // A weak emitter's visibility is one segment's, to the luxel it lights most.
-    let weak: Vec<Option<usize>> = lighting
+    let weak: Vec<Option<usize>> = rows
+        .emitters
         .iter()
         .enumerate()
-        .map(|(k, e)| {
-            let row = &weights[k * n..(k + 1) * n];
-            let (w, total) = largest_and_total(row);
+        .map(|(k, w)| {
+            let e = w.emitter;
             // The points of one face share its shadows: their weakness adds up.
-            (f64::from(w) * e.max_intensity() < WEAK * e.share)
-                .then(|| weighted_pick(row, total, e.key(r.face)))
+            (f64::from(w.largest) * e.max_intensity() < WEAK * e.share)
+                .then(|| weighted_pick(rows.row(k), w.total, e.key(r.face)))
         })
         .collect();
-    let lit = see(scene, r, &from, &weak, points, weights, counts);
-    for (k, e) in lighting.iter().enumerate() {
-        let (weights, lit) = (&weights[k * n..(k + 1) * n], &lit[k * n..(k + 1) * n]);
+    let lit = see(scene, r, &from, &weak, points, rows, counts);
+    for (k, weighed) in rows.emitters.iter().enumerate() {
+        let (e, lit) = (weighed.emitter, &lit[k * n..(k + 1) * n]);
+        // A weak emitter's segment decided for every luxel.
+        if weak[k].is_some_and(|best| lit[best] == State::Blocked) {
+            continue;
+        }
+        let weights = rows.row(k);
         for &(style, color, total) in &e.styles {
             let strongest = f64::from(color[0].max(color[1]).max(color[2]));
             let luxels = style_luxels(out, style, n);
@@ -835,12 +896,12 @@ fn see(
     from: &[DVec3],
     weak: &[Option<usize>],
     points: &[DVec3],
-    weights: &[f32],
+    rows: &WeightRows,
     counts: &mut BounceCounts,
 ) -> Vec<State> {
     let (w, h) = (r.width, r.height);
     let n = w * h;
-    let mut state = vec![State::Unknown; weights.len()];
+    let mut state = vec![State::Unknown; rows.emitters.len() * n];
     let mut packet = RayPacket16::new();
     // Segments to trace: (emitter, luxel).
     let mut rays: Vec<(usize, usize)> = Vec::new();
@@ -868,11 +929,12 @@ fn see(
                 continue;
             }
             let state_of = |state: &[State], x: usize, y: usize| state[at + y * w + x];
+            let weights = rows.row(k);
             for &y in &ys {
                 let (y0, y1) = cell_y[y];
                 for &x in &xs {
                     let j = at + y * w + x;
-                    if weights[j] == 0.0 || state[j] != State::Unknown {
+                    if weights[y * w + x] == 0.0 || state[j] != State::Unknown {
                         continue;
                     }
                     if step == FIRST_STEP {
@@ -1011,10 +1073,55 @@ mod tests {
             let kernel = 0.5;
             let n_r32 = Vec3::from(normals[0]).as_dvec3();
             if under_gate(&e, n_r32, (lo, hi), kernel * intensity / GATE) {
-                let luxels = Luxels::new(&points, &normals);
+                let luxels = Luxels::new(&points, &normals, points.len());
                 let mut weights = vec![1.0f32; points.len()];
                 weigh(&e, &luxels, kernel as f32, (GATE / intensity) as f32, false, &mut weights);
                 proptest::prop_assert!(weights.iter().all(|&w| w == 0.0), "{:?}", weights);
+            }
+        }
+
+        /// A face's row of weights, weighed in whole vectors over luxels padded to a multiple of
+        /// eight, holds for each luxel the weight weighing it alone gives, bit for bit, then
+        /// zeros; with the largest and the sum of those weights. A row of zeros is not kept.
+        #[test]
+        fn padded_rows_weigh_each_luxel_as_weighing_it_alone_does(
+            luxels in proptest::collection::vec(
+                ((-300.0f32..300.0, -300.0f32..300.0, -300.0f32..300.0), (-1.0f32..1.0, -1.0f32..1.0)),
+                1..40,
+            ),
+            emitter in (-300.0f64..300.0, -300.0f64..300.0, 0.0f64..300.0),
+            two_sided in proptest::bool::ANY,
+        ) {
+            let points: Vec<[f32; 3]> = luxels.iter().map(|&((x, y, z), _)| [x, y, z]).collect();
+            let normals: Vec<[f32; 3]> = luxels
+                .iter()
+                .map(|&(_, (a, b))| Vec3::new(a, b, 1.0).normalize().to_array())
+                .collect();
+            let mut e = emitters_of([100.0, 50.0, 0.0], Emission::Middle).remove(0);
+            e.point = DVec3::new(emitter.0, emitter.1, emitter.2);
+            let (kernel, gate) = (0.5f32, 1e-6f32);
+            let mut rows = WeightRows::new(points.len());
+            let at = Luxels::new(&points, &normals, rows.stride);
+            rows.push(&e, &at, kernel, gate, two_sided);
+            let alone: Vec<f32> = (0..points.len())
+                .map(|i| {
+                    let one = Luxels::new(&points[i..=i], &normals[i..=i], 1);
+                    let mut w = [f32::NAN];
+                    weigh(&e, &one, kernel, gate, two_sided, &mut w);
+                    w[0]
+                })
+                .collect();
+            if alone.iter().all(|&w| w == 0.0) {
+                proptest::prop_assert!(rows.emitters.is_empty() && rows.weights.is_empty());
+            } else {
+                proptest::prop_assert_eq!(rows.stride % ROW_LANES, 0);
+                proptest::prop_assert_eq!(rows.weights.len(), rows.stride);
+                let bits = |w: &[f32]| w.iter().map(|w| w.to_bits()).collect::<Vec<_>>();
+                proptest::prop_assert_eq!(bits(rows.row(0)), bits(&alone));
+                proptest::prop_assert!(rows.weights[points.len()..].iter().all(|&w| w == 0.0));
+                let (largest, total) = largest_and_total(&alone);
+                proptest::prop_assert_eq!(rows.emitters[0].largest, largest);
+                proptest::prop_assert_eq!(rows.emitters[0].total, total);
             }
         }
 
@@ -1091,7 +1198,7 @@ mod tests {
             let e = &emitters_of([100.0, 50.0, 0.0], Emission::Middle)[0];
             let points: Vec<[f32; 3]> = at.iter().map(|&(x, y, z)| [x, y, z]).collect();
             let normals = vec![[0.0, 0.6, -0.8]; points.len()];
-            let luxels = Luxels::new(&points, &normals);
+            let luxels = Luxels::new(&points, &normals, points.len());
             let mut any = vec![0.0f32; points.len()];
             weigh_any(e, &luxels, 0.5, 1e-4, two_sided, &mut any);
             let mut chosen = vec![0.0f32; points.len()];
