@@ -24,7 +24,6 @@ use quake_formats::geom::{Plane, Split, Winding, polygon_area};
 
 use super::{
     BounceCounts, Field, HOTSPOT_CLAMP, Receivers, StyleLight, StyleLuxels, add_style_light,
-    style_luxels,
 };
 use crate::embree::RayPacket16;
 use crate::faces::FaceGeom;
@@ -169,7 +168,7 @@ impl<'a> PointField<'a> {
         }
         // The emitters that may light some luxel, and each luxel's weight from each, a batch
         // at a time.
-        let mut out = StyleLuxels::new();
+        let mut out = StyleColumns::default();
         let mut rows = WeightRows::new(n);
         let at = Luxels::new(&r.points, &r.normals, rows.stride);
         // One normal for every luxel (a flat one-sided face): the receiving cosine is bounded
@@ -219,7 +218,7 @@ impl<'a> PointField<'a> {
             }
         }
         light_batch(scene, r, &points, &rows, &mut out, counts);
-        out
+        out.into_luxels()
     }
 }
 
@@ -711,6 +710,69 @@ impl PointEmitter {
     }
 }
 
+/// A face's light per style, channel by channel (so that adding to it runs in vectors).
+#[derive(Default)]
+struct StyleColumns(Vec<(u8, [Vec<f32>; 3])>);
+
+impl StyleColumns {
+    /// The channels of `style`'s light at `n` luxels, made dark if it has none yet.
+    fn style(&mut self, style: u8, n: usize) -> &mut [Vec<f32>; 3] {
+        let k = match self.0.iter().position(|(s, _)| *s == style) {
+            Some(k) => k,
+            None => {
+                self.0.push((style, std::array::from_fn(|_| vec![0.0; n])));
+                self.0.len() - 1
+            }
+        };
+        &mut self.0[k].1
+    }
+
+    fn into_luxels(self) -> StyleLuxels {
+        let luxel = |[r, g, b]: &[Vec<f32>; 3], i: usize| [r[i], g[i], b[i]];
+        self.0
+            .into_iter()
+            .map(|(style, c)| (style, (0..c[0].len()).map(|i| luxel(&c, i)).collect()))
+            .collect()
+    }
+}
+
+/// Adds to `light` the light of an emitter of colour `color` and intensity `total` at each
+/// luxel whose segment is lit and which it brings at least the gate, at `weights`.
+fn add_lit(light: &mut [Vec<f32>; 3], weights: &[f32], lit: &[State], color: [f32; 3], total: f64) {
+    crate::simd::avx2_or_any(
+        #[inline(always)]
+        || add_lit_any(light, weights, lit, color, total),
+    );
+}
+
+/// [`add_lit`] for whatever the build targets.
+#[inline(always)]
+fn add_lit_any(
+    [r, g, b]: &mut [Vec<f32>; 3],
+    weights: &[f32],
+    lit: &[State],
+    color: [f32; 3],
+    total: f64,
+) {
+    let strongest = f64::from(color[0].max(color[1]).max(color[2]));
+    let [cr, cg, cb] = color.map(f64::from);
+    let n = weights.len();
+    let luxels = r[..n].iter_mut().zip(&mut g[..n]).zip(&mut b[..n]);
+    // Without branches: a luxel that takes nothing adds a zero, which leaves it as it was
+    // (light here is never -0).
+    for (((r, g), b), (&w, &l)) in luxels.zip(weights.iter().zip(lit)) {
+        let w = f64::from(w) * total;
+        let w = if (l == State::Lit) & (w > 0.0) & (strongest * w >= GATE) {
+            w
+        } else {
+            0.0
+        };
+        *r += (w * cr) as f32;
+        *g += (w * cg) as f32;
+        *b += (w * cb) as f32;
+    }
+}
+
 /// Adds to `out` (per style and luxel of `r`, at `points`) the light of the emitters of
 /// `rows`, at their weights, where nothing blocks it.
 fn light_batch(
@@ -718,7 +780,7 @@ fn light_batch(
     r: &Receivers,
     points: &[DVec3],
     rows: &WeightRows,
-    out: &mut StyleLuxels,
+    out: &mut StyleColumns,
     counts: &mut BounceCounts,
 ) {
     let n = points.len();
@@ -742,19 +804,8 @@ fn light_batch(
         if weak[k].is_some_and(|best| lit[best] == State::Blocked) {
             continue;
         }
-        let weights = rows.row(k);
         for &(style, color, total) in &e.styles {
-            let strongest = f64::from(color[0].max(color[1]).max(color[2]));
-            let luxels = style_luxels(out, style, n);
-            let seen = luxels.iter_mut().zip(weights).zip(lit);
-            for ((luxel, &w), _) in seen.filter(|(_, l)| **l == State::Lit) {
-                let w = f64::from(w) * total;
-                if w > 0.0 && strongest * w >= GATE {
-                    for (v, c) in luxel.iter_mut().zip(color) {
-                        *v += (w * f64::from(c)) as f32;
-                    }
-                }
-            }
+            add_lit(out.style(style, n), rows.row(k), lit, color, total);
         }
     }
 }
@@ -871,12 +922,25 @@ fn dice(w: Winding, size: f64, piece: &mut impl FnMut(&Winding)) {
     }
 }
 
-/// Whether a luxel sees an emitter.
+/// Whether a luxel sees an emitter. The known answers are one bit each, so that the bits of
+/// several luxels or-ed together tell whether those known agree ([`State::agreed`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[repr(u8)]
 enum State {
-    Unknown,
-    Lit,
-    Blocked,
+    Unknown = 0,
+    Lit = 1,
+    Blocked = 2,
+}
+
+impl State {
+    /// The answer of those of `states` that are known, when there are some and they agree.
+    fn agreed(states: [State; 4]) -> Option<State> {
+        match states.iter().fold(0, |bits, &s| bits | s as u8) {
+            1 => Some(State::Lit),
+            2 => Some(State::Blocked),
+            _ => None,
+        }
+    }
 }
 
 /// The coarsest grid's step, in luxels, at which [`see`] starts.
@@ -948,10 +1012,9 @@ fn see(
                         state_of(&state, x0, y1),
                         state_of(&state, x1, y1),
                     ];
-                    let mut known = corners.into_iter().filter(|&s| s != State::Unknown);
-                    match known.next() {
-                        Some(a) if known.all(|s| s == a) => state[j] = a,
-                        _ => rays.push((k, y * w + x)),
+                    match State::agreed(corners) {
+                        Some(a) => state[j] = a,
+                        None => rays.push((k, y * w + x)),
                     }
                 }
             }
@@ -1125,6 +1188,45 @@ mod tests {
             }
         }
 
+        /// Adding a row's light without branches changes, bit for bit, what adding it to the lit
+        /// luxels it brings at least the gate changes, and nothing else.
+        #[test]
+        fn adding_lit_light_in_columns_adds_only_to_lit_luxels_over_the_gate(
+            luxels in proptest::collection::vec(
+                (
+                    proptest::prop_oneof![proptest::strategy::Just(0.0f32), 0.0f32..1e-3, 0.0f32..10.0],
+                    0u8..3,
+                    (0.0f32..100.0, 0.0f32..100.0, 0.0f32..100.0),
+                ),
+                0..40,
+            ),
+            color in (0.0f32..1.0, 0.0f32..1.0, 0.0f32..1.0),
+            total in 0.0f64..1e4,
+        ) {
+            let state = |s: u8| [State::Unknown, State::Lit, State::Blocked][usize::from(s)];
+            let weights: Vec<f32> = luxels.iter().map(|l| l.0).collect();
+            let lit: Vec<State> = luxels.iter().map(|l| state(l.1)).collect();
+            let color = [color.0, color.1, color.2];
+            let mut plain: Vec<[f32; 3]> = luxels.iter().map(|l| [l.2.0, l.2.1, l.2.2]).collect();
+            let strongest = f64::from(color[0].max(color[1]).max(color[2]));
+            for ((v, &w), &l) in plain.iter_mut().zip(&weights).zip(&lit) {
+                let w = f64::from(w) * total;
+                if l == State::Lit && w > 0.0 && strongest * w >= GATE {
+                    for (v, c) in v.iter_mut().zip(color) {
+                        *v += (w * f64::from(c)) as f32;
+                    }
+                }
+            }
+            let mut columns: [Vec<f32>; 3] =
+                std::array::from_fn(|c| luxels.iter().map(|l| [l.2.0, l.2.1, l.2.2][c]).collect());
+            add_lit(&mut columns, &weights, &lit, color, total);
+            for (i, v) in plain.iter().enumerate() {
+                for c in 0..3 {
+                    proptest::prop_assert_eq!(columns[c][i].to_bits(), v[c].to_bits());
+                }
+            }
+        }
+
         /// The column-wise cull keeps exactly the emitters the plain tests keep (in front of a
         /// one-sided face, facing its box, bright enough at its distance), and a group is
         /// ruled out whole only when none of them is kept.
@@ -1227,6 +1329,30 @@ mod tests {
             subdivision: 64.0,
         };
         point_emitters(&Field::new(&faces, &reflectance, &lit, &settings), emission)
+    }
+
+    /// Four luxels' answers agree when those known are all the same: as many as are known.
+    #[test]
+    fn corners_agree_when_every_known_one_says_the_same() {
+        let all = [State::Unknown, State::Lit, State::Blocked];
+        for a in all {
+            for b in all {
+                for c in all {
+                    for d in all {
+                        let mut known = [a, b, c, d].into_iter().filter(|&s| s != State::Unknown);
+                        let plain = match known.next() {
+                            Some(first) if known.all(|s| s == first) => Some(first),
+                            _ => None,
+                        };
+                        assert_eq!(
+                            State::agreed([a, b, c, d]),
+                            plain,
+                            "{a:?} {b:?} {c:?} {d:?}"
+                        );
+                    }
+                }
+            }
+        }
     }
 
     /// A weak emitter is seen or not by the face as the segment to one luxel drawn in
