@@ -727,6 +727,7 @@ impl StyleColumns {
         &mut self.0[k].1
     }
 
+    /// The light per style, luxel by luxel.
     fn into_luxels(self) -> StyleLuxels {
         let luxel = |[r, g, b]: &[Vec<f32>; 3], i: usize| [r[i], g[i], b[i]];
         self.0
@@ -785,7 +786,7 @@ fn light_batch(
 ) {
     let n = points.len();
     let from: Vec<DVec3> = rows.emitters.iter().map(|w| w.emitter.point).collect();
-    // A weak emitter's visibility is one segment's, to the luxel it lights most.
+    // A weak emitter's visibility is one segment's, to a luxel drawn by weight.
     let weak: Vec<Option<usize>> = rows
         .emitters
         .iter()
