@@ -212,7 +212,7 @@ impl<'a> PointField<'a> {
             }
             let gate = (GATE / max_total) as f32;
             rows.push(e, &at, self.kernel as f32, gate, r.two_sided);
-            if rows.weights.len() >= BATCH {
+            if rows.is_full() {
                 light_batch(scene, r, &points, &rows, &mut out, counts);
                 rows.clear();
             }
@@ -573,6 +573,11 @@ impl<'e> WeightRows<'e> {
         &self.weights[k * self.stride..][..self.luxels]
     }
 
+    /// Whether it holds a batch's worth of weights ([`BATCH`]).
+    fn is_full(&self) -> bool {
+        self.weights.len() >= BATCH
+    }
+
     fn clear(&mut self) {
         self.emitters.clear();
         self.weights.clear();
@@ -717,14 +722,7 @@ struct StyleColumns(Vec<(u8, [Vec<f32>; 3])>);
 impl StyleColumns {
     /// The channels of `style`'s light at `n` luxels, made dark if it has none yet.
     fn style(&mut self, style: u8, n: usize) -> &mut [Vec<f32>; 3] {
-        let k = match self.0.iter().position(|(s, _)| *s == style) {
-            Some(k) => k,
-            None => {
-                self.0.push((style, std::array::from_fn(|_| vec![0.0; n])));
-                self.0.len() - 1
-            }
-        };
-        &mut self.0[k].1
+        super::style_entry(&mut self.0, style, || std::array::from_fn(|_| vec![0.0; n]))
     }
 
     /// The light per style, luxel by luxel.
