@@ -229,19 +229,11 @@ pub fn compile(
             .map(|f| f.texture.as_str()),
     );
     // The WADs are read while the models are built: reading a map's texture WADs (megabytes
-    // each) waits on the disk and on fresh memory, which the models' threads need not.
-    let (built, (wads, wad_warnings)) = rayon::join(
-        || {
-            build_models(
-                models,
-                &planes,
-                &mut table,
-                &occupants,
-                texture_list,
-                options,
-            )
-        },
-        || {
+    // each) waits on the disk and on fresh memory, which the models' threads need not. On a
+    // thread of its own, not the models' pool: a pool thread reading them would start on the
+    // world's clip hulls, the longest job, only when the reading is done.
+    let (built, (wads, wad_warnings)) = std::thread::scope(|scope| {
+        let reading = scope.spawn(|| {
             let mut wad_warnings = Vec::new();
             let wads = WadSet::load(
                 &map.entities[0].entity,
@@ -249,8 +241,20 @@ pub fn compile(
                 &mut wad_warnings,
             );
             (wads, wad_warnings)
-        },
-    );
+        });
+        let built = build_models(
+            models,
+            &planes,
+            &mut table,
+            &occupants,
+            texture_list,
+            options,
+        );
+        let read = reading
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        (built, read)
+    });
     timings.push(("models (wall)".to_string(), t.elapsed().as_secs_f64()));
     let Built {
         models: results,
