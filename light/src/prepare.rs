@@ -249,14 +249,17 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
     };
     let lump = bsp.phong_faces().map_err(LightError::BspxLump)?;
     let groups = phong::groups(&faces, &map_lights.phong, lump.as_deref());
-    // Embree builds its tree on its own threads while ours link the faces.
-    let (scene, links) = rayon::join(
-        || TraceScene::build(&device, &faces, &casters),
+    // Embree builds its tree on its own threads while ours link the faces, the longer job; the
+    // visibility tables are read while they link.
+    let ((scene, vis), links) = rayon::join(
+        || {
+            let scene = TraceScene::build(&device, &faces, &casters);
+            (scene, Visibility::new(bsp, &faces))
+        },
         || continuations(&faces, |f, g| groups.smooths(f, g)),
     );
     let scene = scene?;
     attach_continuations(&mut faces, links);
-    let vis = Visibility::new(bsp, &faces);
     let phong = phong::corner_normals(&faces, &groups);
     let in_liquid = |p: DVec3| {
         let leaf = bsp.leaf_at(p.as_vec3().to_array());
