@@ -297,6 +297,14 @@ pub fn run(args: &Args) -> anyhow::Result<Option<crate::Stats>> {
     for note in args.ericw_only.notes() {
         eprintln!("note: {note}");
     }
+    // Opening Embree's library takes milliseconds, which reading and checking the BSP need not
+    // wait for: on a thread of its own, it is open when the scene is made. Should it fail, making
+    // the device says why.
+    if !args.onlyents {
+        std::thread::spawn(|| {
+            let _ = crate::embree::sys::load();
+        });
+    }
     match args.threads {
         Some(n) => rayon::ThreadPoolBuilder::new()
             .num_threads(usize::from(n))
