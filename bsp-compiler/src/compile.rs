@@ -232,16 +232,21 @@ pub fn compile(
     // each) waits on the disk and on fresh memory, which the models' threads need not. On a
     // thread of its own, not the models' pool: a pool thread reading them would start on the
     // world's clip hulls, the longest job, only when the reading is done.
+    let read_wads = || {
+        let mut wad_warnings = Vec::new();
+        let wads = WadSet::load(
+            &map.entities[0].entity,
+            &wad_search(source, options),
+            &mut wad_warnings,
+        );
+        (wads, wad_warnings)
+    };
     let (built, (wads, wad_warnings)) = std::thread::scope(|scope| {
-        let reading = scope.spawn(|| {
-            let mut wad_warnings = Vec::new();
-            let wads = WadSet::load(
-                &map.entities[0].entity,
-                &wad_search(source, options),
-                &mut wad_warnings,
-            );
-            (wads, wad_warnings)
-        });
+        // Should no thread start, they are read after the models.
+        let reading = std::thread::Builder::new()
+            .name("wads".to_string())
+            .spawn_scoped(scope, read_wads)
+            .ok();
         let built = build_models(
             models,
             &planes,
@@ -250,9 +255,12 @@ pub fn compile(
             texture_list,
             options,
         );
-        let read = reading
-            .join()
-            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        let read = match reading {
+            Some(thread) => thread
+                .join()
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic)),
+            None => read_wads(),
+        };
         (built, read)
     });
     timings.push(("models (wall)".to_string(), t.elapsed().as_secs_f64()));

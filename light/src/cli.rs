@@ -298,12 +298,14 @@ pub fn run(args: &Args) -> anyhow::Result<Option<crate::Stats>> {
         eprintln!("note: {note}");
     }
     // Opening Embree's library takes milliseconds, which reading and checking the BSP need not
-    // wait for: on a thread of its own, it is open when the scene is made. Should it fail, making
-    // the device says why.
+    // wait for: on a thread of its own, it is open when the scene is made. Should it fail (or
+    // no thread start), making the device opens it, or says why it cannot.
     if !args.onlyents {
-        std::thread::spawn(|| {
-            let _ = crate::embree::sys::load();
-        });
+        let _ = std::thread::Builder::new()
+            .name("embree-open".to_string())
+            .spawn(|| {
+                let _ = crate::embree::sys::load();
+            });
     }
     match args.threads {
         Some(n) => rayon::ThreadPoolBuilder::new()
