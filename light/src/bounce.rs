@@ -596,20 +596,7 @@ pub fn add_light(
 
 /// `out`'s luxels of `style` (`n` of them), added dark if it has none yet.
 pub fn style_luxels(out: &mut StyleLuxels, style: u8, n: usize) -> &mut [[f32; 3]] {
-    style_entry(out, style, || vec![[0.0; 3]; n]).as_mut_slice()
-}
-
-/// The light of `style` in a list of light per style, added as `dark()` makes it if the list
-/// has none yet.
-pub fn style_entry<T>(styles: &mut Vec<(u8, T)>, style: u8, dark: impl FnOnce() -> T) -> &mut T {
-    let k = match styles.iter().position(|(s, _)| *s == style) {
-        Some(k) => k,
-        None => {
-            styles.push((style, dark()));
-            styles.len() - 1
-        }
-    };
-    &mut styles[k].1
+    crate::styles::entry(out, style, || vec![[0.0; 3]; n]).as_mut_slice()
 }
 
 /// Adds `b` into `a`, style by style.

@@ -304,7 +304,7 @@ pub fn run(args: &Args) -> anyhow::Result<Option<crate::Stats>> {
         let _ = std::thread::Builder::new()
             .name("embree-open".to_string())
             .spawn(|| {
-                let _ = crate::embree::sys::load();
+                let _ = crate::embree::open_library();
             });
     }
     match args.threads {

@@ -497,6 +497,15 @@ fn device_config(threads: usize, extra: &str) -> String {
     }
 }
 
+/// Opens Embree's library (and TBB's), which the first device otherwise opens: milliseconds of
+/// dynamic loading that may run beside other work.
+///
+/// # Errors
+/// Why the library cannot be opened.
+pub fn open_library() -> Result<(), EmbreeError> {
+    sys::load().map_err(EmbreeError::Unavailable)
+}
+
 /// An Embree device; cheap to clone (reference counted).
 #[derive(Clone)]
 pub struct Device {
@@ -541,7 +550,7 @@ impl Device {
     /// Fails if Embree cannot create a device (e.g. unsupported CPU, or an
     /// `isa` in `extra` that this CPU lacks).
     pub fn with_options(threads: usize, extra: &str) -> Result<Self, EmbreeError> {
-        sys::load().map_err(EmbreeError::Unavailable)?;
+        open_library()?;
         let hw = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
         let threads = if threads == 0 { hw } else { threads.min(hw) };
         let config = CString::new(device_config(threads, extra))

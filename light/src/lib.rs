@@ -71,6 +71,7 @@ mod samples;
 mod scene;
 pub mod settings;
 mod simd;
+mod styles;
 mod surface;
 mod trace;
 mod visibility;

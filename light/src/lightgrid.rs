@@ -303,14 +303,7 @@ struct StyleSums(Vec<(u8, [f64; 3])>);
 
 impl StyleSums {
     fn slot(&mut self, style: u8) -> &mut [f64; 3] {
-        let at = match self.0.iter().position(|(s, _)| *s == style) {
-            Some(at) => at,
-            None => {
-                self.0.push((style, [0.0; 3]));
-                self.0.len() - 1
-            }
-        };
-        &mut self.0[at].1
+        crate::styles::entry(&mut self.0, style, || [0.0; 3])
     }
 
     fn add(&mut self, style: u8, value: f64, color: DVec3) {

@@ -150,14 +150,7 @@ impl TraceScene {
                 continue;
             }
             if let (FaceKind::Lit, Some(style)) = (f.kind, switchable_style(f)) {
-                let at = match switchable_meshes.iter().position(|(s, _)| *s == style) {
-                    Some(at) => at,
-                    None => {
-                        switchable_meshes.push((style, Mesh::default()));
-                        switchable_meshes.len() - 1
-                    }
-                };
-                switchable_meshes[at].1.add(f);
+                crate::styles::entry(&mut switchable_meshes, style, Mesh::default).add(f);
                 continue;
             }
             match f.kind {

@@ -722,7 +722,7 @@ struct StyleColumns(Vec<(u8, [Vec<f32>; 3])>);
 impl StyleColumns {
     /// The channels of `style`'s light at `n` luxels, made dark if it has none yet.
     fn style(&mut self, style: u8, n: usize) -> &mut [Vec<f32>; 3] {
-        super::style_entry(&mut self.0, style, || std::array::from_fn(|_| vec![0.0; n]))
+        crate::styles::entry(&mut self.0, style, || std::array::from_fn(|_| vec![0.0; n]))
     }
 
     /// The light per style, luxel by luxel.

@@ -32,14 +32,8 @@ impl StyleBuffers {
     }
 
     pub fn get(&mut self, style: u8) -> &mut Vec<[f32; 3]> {
-        let i = match self.styles.iter().position(|(s, _)| *s == style) {
-            Some(i) => i,
-            None => {
-                self.styles.push((style, vec![[0.0; 3]; self.len]));
-                self.styles.len() - 1
-            }
-        };
-        &mut self.styles[i].1
+        let len = self.len;
+        crate::styles::entry(&mut self.styles, style, || vec![[0.0; 3]; len])
     }
 }
 
