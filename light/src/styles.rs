@@ -1,5 +1,5 @@
 //! Light kept per light style: short lists of `(style, value)` pairs, in the order the styles
-//! were first met (a face takes at most four styles, so a scan beats a map).
+//! were first met (a face takes at most four styles, a map a few dozen: a scan beats hashing).
 
 /// The value of `style` in `list`, added as `dark()` makes it when the list has none yet.
 pub fn entry<T>(list: &mut Vec<(u8, T)>, style: u8, dark: impl FnOnce() -> T) -> &mut T {
