@@ -38,7 +38,7 @@ const GATE: f64 = 0.01;
 /// by the whole face at once: a segment to one luxel, drawn in proportion to what each takes
 /// ([`weighted_pick`]), decides. Where its shadow crosses the face, luxels are off by at most
 /// this much light, and the face's light is right on average.
-const WEAK: f64 = 0.5;
+const WEAK: f64 = 1.0;
 
 /// Points nearer than this (units) to an emitter count as this near (ericw-tools' floor).
 const MIN_DISTANCE: f32 = 0.01;
