@@ -253,7 +253,7 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
     // visibility tables are read while they link.
     let ((scene, vis), links) = rayon::join(
         || {
-            let scene = TraceScene::build(&device, &faces, &casters);
+            let scene = TraceScene::build(&device, &faces, &casters, map_lights.bounce.is_on());
             (scene, Visibility::new(bsp, &faces))
         },
         || continuations(&faces, |f, g| groups.smooths(f, g)),

@@ -13,6 +13,8 @@
 //! models and of the entities merged into the world) get a scene per mask: they block the rays
 //! of the lights whose shadow channels share a bit with it ([`TraceScene::occluded16_by`]), and
 //! the shared scene (the world, on channel 1) only those of lights with channel 1 among them.
+//! With bounce on, the shared scene is built twice: sealed (Embree's robust mode, for the rays of
+//! lights and suns) and not, for the many segments of bounced light.
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -44,6 +46,9 @@ pub enum SkyFilter {
 /// A committed scene and the geometry id of its sky faces.
 pub struct TraceScene {
     pub scene: Scene,
+    /// `scene`'s faces again, built for speed rather than sealed seams, for bounced light's
+    /// segments ([`TraceScene::occluded16_scattered`]); when asked for.
+    segments: Option<Scene>,
     sky_geom: u32,
     /// The sky faces alone, to find where a sun ray meets the sky first.
     sky_only: Option<Scene>,
@@ -96,7 +101,8 @@ impl TraceScene {
     /// of `casters.models` and the polygons `casters.solids`; each of
     /// `casters.self_shadow_models` that is not also in `casters.models` gets a scene of its own
     /// faces, and each switchable style one of its models' faces. Liquids are left out (they
-    /// let light through).
+    /// let light through). With `segments`, the shared scene is built a second time for
+    /// bounced light's segments ([`TraceScene::occluded16_scattered`]).
     ///
     /// # Errors
     /// The Embree error if building fails.
@@ -104,6 +110,7 @@ impl TraceScene {
         device: &Device,
         faces: &[FaceGeom],
         casters: &Casters,
+        segments: bool,
     ) -> Result<TraceScene, LightError> {
         let Casters {
             shadowless,
@@ -221,11 +228,21 @@ impl TraceScene {
         } else {
             Some(sky.commit(device)?)
         };
-        let mut builder = SceneBuilder::new(device)?;
-        builder.add_triangle_mesh(&opaque.vertices, &opaque.triangles)?;
-        let sky_geom = builder.add_triangle_mesh(&sky.vertices, &sky.triangles)?;
+        let shared = || -> Result<(SceneBuilder, u32), LightError> {
+            let mut builder = SceneBuilder::new(device)?;
+            builder.add_triangle_mesh(&opaque.vertices, &opaque.triangles)?;
+            let sky_geom = builder.add_triangle_mesh(&sky.vertices, &sky.triangles)?;
+            Ok((builder, sky_geom))
+        };
+        let (builder, sky_geom) = shared()?;
+        let segments = if segments {
+            Some(shared()?.0.commit_unsealed()?)
+        } else {
+            None
+        };
         Ok(TraceScene {
             scene: builder.commit()?,
+            segments,
             sky_geom,
             sky_only,
             sky_texture_of,
@@ -280,10 +297,13 @@ impl TraceScene {
     /// [`TraceScene::occluded16`] for a packet whose lanes run in many directions from many
     /// origins (bounced light's segments from several reflecting faces): Embree is told they are
     /// incoherent, which traverses such packets faster (coherent packets, as a light's rays to
-    /// one face, go faster the other way); a segment that grazes an edge may come out the
-    /// other way.
+    /// one face, go faster the other way), and they go through the shared faces built without
+    /// sealed seams when the scene has them: a segment that meets an edge exactly may pass
+    /// between its triangles, giving one luxel a little of one emitter's bounced light that
+    /// the sealed build would block.
     pub fn occluded16_scattered(&self, packet: &mut RayPacket16, model: usize) -> u16 {
-        self.blocked16(packet, model, 1, false)
+        let shared = self.segments.as_ref().unwrap_or(&self.scene);
+        self.blocked16(shared, packet, model, 1, false)
     }
 
     /// [`TraceScene::occluded16`] for the rays of a light whose shadow channels are
@@ -295,12 +315,14 @@ impl TraceScene {
         model: usize,
         shadow_channels: u32,
     ) -> u16 {
-        self.blocked16(packet, model, shadow_channels, true)
+        self.blocked16(&self.scene, packet, model, shadow_channels, true)
     }
 
-    /// [`TraceScene::occluded16_by`], with the shared scene's query `coherent` or not.
+    /// [`TraceScene::occluded16_by`], the shared faces being `shared` (`scene` or `segments`),
+    /// queried `coherent` or not.
     fn blocked16(
         &self,
+        shared: &Scene,
         packet: &mut RayPacket16,
         model: usize,
         shadow_channels: u32,
@@ -308,7 +330,7 @@ impl TraceScene {
     ) -> u16 {
         let mut blocked = 0;
         if shadow_channels & 1 != 0 {
-            let opaque = self.scene.occluded16(packet, coherent);
+            let opaque = shared.occluded16(packet, coherent);
             // Only the lanes the opaque faces let through can be blocked by a fence; Embree
             // has set the others' tfar to -inf, so the second query skips them too.
             blocked = opaque | self.fences_block16(packet, !opaque);
