@@ -251,9 +251,12 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
     let groups = phong::groups(&faces, &map_lights.phong, lump.as_deref());
     // Embree builds its tree on its own threads while ours link the faces, the longer job; the
     // visibility tables are read while they link.
+    // The reference traces every ray against the sealed scene.
+    let unsealed = (map_lights.bounce.is_on() || map_lights.uses_dirt())
+        && options.quality != crate::quality::Quality::Reference;
     let ((scene, vis), links) = rayon::join(
         || {
-            let scene = TraceScene::build(&device, &faces, &casters, map_lights.bounce.is_on());
+            let scene = TraceScene::build(&device, &faces, &casters, unsealed);
             (scene, Visibility::new(bsp, &faces))
         },
         || continuations(&faces, |f, g| groups.smooths(f, g)),

@@ -13,8 +13,9 @@
 //! models and of the entities merged into the world) get a scene per mask: they block the rays
 //! of the lights whose shadow channels share a bit with it ([`TraceScene::occluded16_by`]), and
 //! the shared scene (the world, on channel 1) only those of lights with channel 1 among them.
-//! With bounce on, the shared scene is built twice: sealed (Embree's robust mode, for the rays of
-//! lights and suns) and not, for the many segments of bounced light.
+//! With bounce or dirt on, the shared scene is built twice: sealed (Embree's robust mode, for the
+//! rays of lights and suns) and not, for the many rays of which one slipping through a seam
+//! costs little: bounced light's segments and dirt's rays.
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -47,8 +48,9 @@ pub enum SkyFilter {
 pub struct TraceScene {
     pub scene: Scene,
     /// `scene`'s faces again, built for speed rather than sealed seams, for bounced light's
-    /// segments ([`TraceScene::occluded16_scattered`]); when asked for.
-    segments: Option<Scene>,
+    /// segments ([`TraceScene::occluded16_scattered`]) and dirt's rays
+    /// ([`TraceScene::opaque_hits16`]); when asked for.
+    unsealed: Option<Scene>,
     sky_geom: u32,
     /// The sky faces alone, to find where a sun ray meets the sky first.
     sky_only: Option<Scene>,
@@ -101,8 +103,8 @@ impl TraceScene {
     /// of `casters.models` and the polygons `casters.solids`; each of
     /// `casters.self_shadow_models` that is not also in `casters.models` gets a scene of its own
     /// faces, and each switchable style one of its models' faces. Liquids are left out (they
-    /// let light through). With `segments`, the shared scene is built a second time for
-    /// bounced light's segments ([`TraceScene::occluded16_scattered`]).
+    /// let light through). With `unsealed`, the shared scene is built a second time without
+    /// Embree's robust mode, for bounced light's segments and dirt's rays.
     ///
     /// # Errors
     /// The Embree error if building fails.
@@ -110,7 +112,7 @@ impl TraceScene {
         device: &Device,
         faces: &[FaceGeom],
         casters: &Casters,
-        segments: bool,
+        unsealed: bool,
     ) -> Result<TraceScene, LightError> {
         let Casters {
             shadowless,
@@ -235,14 +237,14 @@ impl TraceScene {
             Ok((builder, sky_geom))
         };
         let (builder, sky_geom) = shared()?;
-        let segments = if segments {
+        let unsealed = if unsealed {
             Some(shared()?.0.commit_unsealed()?)
         } else {
             None
         };
         Ok(TraceScene {
             scene: builder.commit()?,
-            segments,
+            unsealed,
             sky_geom,
             sky_only,
             sky_texture_of,
@@ -267,6 +269,12 @@ impl TraceScene {
     /// Some model casts a switchable shadow.
     pub fn has_switchable(&self) -> bool {
         !self.switchable.is_empty()
+    }
+
+    /// The shared faces for rays of which one slipping through a seam costs little: the
+    /// unsealed build when there is one (its sky has the same geometry id).
+    fn fast_scene(&self) -> &Scene {
+        self.unsealed.as_ref().unwrap_or(&self.scene)
     }
 
     /// Lanes of `packet` (each up to its current `tfar`) that the models of switchable shadow
@@ -302,8 +310,7 @@ impl TraceScene {
     /// between its triangles, giving one luxel a little of one emitter's bounced light that
     /// the sealed build would block.
     pub fn occluded16_scattered(&self, packet: &mut RayPacket16, model: usize) -> u16 {
-        let shared = self.segments.as_ref().unwrap_or(&self.scene);
-        self.blocked16(shared, packet, model, 1, false)
+        self.blocked16(self.fast_scene(), packet, model, 1, false)
     }
 
     /// [`TraceScene::occluded16`] for the rays of a light whose shadow channels are
@@ -318,7 +325,7 @@ impl TraceScene {
         self.blocked16(&self.scene, packet, model, shadow_channels, true)
     }
 
-    /// [`TraceScene::occluded16_by`], the shared faces being `shared` (`scene` or `segments`),
+    /// [`TraceScene::occluded16_by`], the shared faces being `shared` (`scene` or `unsealed`),
     /// queried `coherent` or not.
     fn blocked16(
         &self,
@@ -455,7 +462,9 @@ impl TraceScene {
     /// For each active lane of `packet`, cast from a face of brush model `model` on light
     /// channels `channels`, the distance to the first surface if that is an opaque one (not
     /// sky), among what shares a light channel with the face (dirt: faces on other channels
-    /// neither take it from the world nor give it).
+    /// neither take it from the world nor give it). The shared faces are the unsealed ones when
+    /// the scene has them: a dirt ray that meets an edge exactly may pass between its
+    /// triangles, one ray of a sample's many.
     pub fn opaque_hits16(
         &self,
         packet: &mut RayPacket16,
@@ -484,7 +493,7 @@ impl TraceScene {
         model: usize,
         out: &mut [Option<f32>; 16],
     ) {
-        let ids = self.scene.first_hit_geom16(packet, true);
+        let ids = self.fast_scene().first_hit_geom16(packet, true);
         for (lane, id) in ids.iter().enumerate() {
             if *id != self.sky_geom && *id != sys::RTC_INVALID_GEOMETRY_ID {
                 out[lane] = Some(packet.tfar(lane));
