@@ -249,11 +249,12 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
     };
     let lump = bsp.phong_faces().map_err(LightError::BspxLump)?;
     let groups = phong::groups(&faces, &map_lights.phong, lump.as_deref());
-    // Embree builds its tree on its own threads while ours link the faces, the longer job; the
-    // visibility tables are read while they link.
-    // The reference traces every ray against the sealed scene.
+    // Bounce's and dirt's rays may go through an unsealed copy of the shared faces; the
+    // reference traces every ray against the sealed scene.
     let unsealed = (map_lights.bounce.is_on() || map_lights.uses_dirt())
         && options.quality != crate::quality::Quality::Reference;
+    // Embree builds its tree on its own threads while ours link the faces, the longer job; the
+    // visibility tables are read while they link.
     let ((scene, vis), links) = rayon::join(
         || {
             let scene = TraceScene::build(&device, &faces, &casters, unsealed);
