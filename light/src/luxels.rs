@@ -110,7 +110,8 @@ impl SampleImage {
 
     /// Box-blurs the image `radius` samples each way, edges clamped (step 2). The clamped box
     /// is separable: rows, then columns. Each sample sums its taps in the same order (the
-    /// nearest edge sample standing in for those past it), tap by tap over a whole row at once.
+    /// nearest edge sample standing in for those past it), tap by tap over a whole row at once,
+    /// then over whole runs of rows.
     fn blur(&mut self, radius: usize) {
         if radius == 0 || self.values.is_empty() {
             return;
@@ -132,39 +133,43 @@ impl SampleImage {
             }
         };
         let mut rows = vec![[0.0f32; 3]; w * h];
+        // A row with `radius` copies of its edge samples on either side: tap d of sample x
+        // reads sample x + d of it, the row's sample x + d - radius held to the row.
+        let mut padded = vec![[0.0f32; 3]; w + 2 * radius];
         for (src, dst) in self.values.chunks_exact(w).zip(rows.chunks_exact_mut(w)) {
+            let (left, rest) = padded.split_at_mut(radius);
+            let (middle, right) = rest.split_at_mut(w);
+            left.fill(src[0]);
+            middle.copy_from_slice(src);
+            right.fill(src[w - 1]);
             for d in 0..=2 * radius {
-                // Tap d of sample x reads sample x + d - radius, held to the row.
-                let before = radius.saturating_sub(d).min(w);
-                let past = d.saturating_sub(radius).min(w - before);
-                let (left, rest) = dst.split_at_mut(before);
-                let (middle, right) = rest.split_at_mut(w - before - past);
-                for acc in left {
-                    add(acc, &src[0]);
-                }
-                if !middle.is_empty() {
-                    let from = before + d - radius;
-                    let taps = &src[from..][..middle.len()];
-                    add(middle.as_flattened_mut(), taps.as_flattened());
-                }
-                for acc in right {
-                    add(acc, &src[w - 1]);
-                }
+                add(dst.as_flattened_mut(), padded[d..][..w].as_flattened());
             }
             for a in dst.as_flattened_mut() {
                 *a /= taps;
             }
         }
-        let mut column_sums = vec![0.0f32; 3 * w];
-        for (y, dst) in self.values.chunks_exact_mut(w).enumerate() {
-            column_sums.fill(0.0);
-            for d in 0..=2 * radius {
-                let from = (y + d).saturating_sub(radius).min(h - 1);
-                add(&mut column_sums, rows[from * w..][..w].as_flattened());
+        // Tap d of row y reads row y + d - radius, held to the image: the rows between the
+        // held ones are read as one run, the image's rows being consecutive.
+        let row = 3 * w;
+        let (sums, rows) = (self.values.as_flattened_mut(), rows.as_flattened());
+        sums.fill(0.0);
+        for d in 0..=2 * radius {
+            let first = radius.saturating_sub(d).min(h);
+            let end = (h + radius).saturating_sub(d).clamp(first, h);
+            for y in 0..first {
+                add(&mut sums[y * row..][..row], &rows[..row]);
             }
-            for (out, acc) in dst.as_flattened_mut().iter_mut().zip(&column_sums) {
-                *out = acc / taps;
+            if end > first {
+                let (from, run) = (first + d - radius, (end - first) * row);
+                add(&mut sums[first * row..][..run], &rows[from * row..][..run]);
             }
+            for y in end..h {
+                add(&mut sums[y * row..][..row], &rows[(h - 1) * row..][..row]);
+            }
+        }
+        for a in sums {
+            *a /= taps;
         }
     }
 

@@ -153,20 +153,23 @@ fn deposit(
     out: &mut SampleLight,
 ) {
     let local_min = light.falloff == Falloff::LocalMin;
-    let color = |i: usize| match light.projector {
-        None => light.color,
-        Some(_) => light.color_at(glam::Vec3::from(points[i]).as_dvec3()),
-    };
-    let target = if local_min {
-        &mut out.floors
+    // Without a projector every sample takes the light's one colour.
+    let fixed = light.projector.is_none().then_some(light.color);
+    let color =
+        |i: usize| fixed.unwrap_or_else(|| light.color_at(glam::Vec3::from(points[i]).as_dvec3()));
+    if local_min {
+        let buffer = out.floors.get(style);
+        for (i, value) in arrived.clone() {
+            for (o, c) in buffer[i].iter_mut().zip(color(i).to_array()) {
+                *o = o.max((value * c) as f32);
+            }
+        }
     } else {
-        &mut out.sums
-    };
-    let buffer = target.get(style);
-    for (i, value) in arrived.clone() {
-        for (o, c) in buffer[i].iter_mut().zip(color(i).to_array()) {
-            let add = (value * c) as f32;
-            *o = if local_min { o.max(add) } else { *o + add };
+        let buffer = out.sums.get(style);
+        for (i, value) in arrived.clone() {
+            for (o, c) in buffer[i].iter_mut().zip(color(i).to_array()) {
+                *o += (value * c) as f32;
+            }
         }
     }
     if let Some(d) = out.directions.as_mut().filter(|_| !local_min) {

@@ -191,9 +191,10 @@ impl FaceTrace<'_> {
         let scratch = &mut *self.scratch;
         let (lit, value) = (&scratch.visibility.lit, &scratch.value);
         for style in styles {
-            let arrived = (0..value.len())
-                .filter(|&i| lit[i] && arrive_in.as_ref().is_none_or(|a| a[i] == style))
-                .map(|i| (i, value[i]));
+            let arrived = lit.iter().zip(value).enumerate();
+            let arrived = arrived
+                .filter(|&(i, (&lit, _))| lit && arrive_in.as_ref().is_none_or(|a| a[i] == style))
+                .map(|(i, (_, &v))| (i, v));
             scratch.arrivals.add_light(
                 (li, light, style),
                 arrived,

@@ -64,13 +64,28 @@ impl LuxelBits {
     }
 }
 
-/// A bit for each of `items` that `set` holds of (item `k` is bit `k`).
+/// A bit for each of `items` (at most 64) that `set` holds of (item `k` is bit `k`). Whole
+/// eights of items are answered as the bytes of one word, which the compiler compares
+/// together; a loop shifting each answer into place on its own keeps it from doing so.
 fn bits_where<T: Copy>(items: &[T], set: impl Fn(T) -> bool) -> u64 {
     let mut bits = 0;
-    for (k, &item) in items.iter().enumerate() {
-        bits |= u64::from(set(item)) << k;
+    let mut eights = items.chunks_exact(8);
+    let mut at = 0;
+    for eight in eights.by_ref().take(8) {
+        let word = u64::from_le_bytes(std::array::from_fn(|k| u8::from(set(eight[k]))));
+        bits |= byte_bits(word) << at;
+        at += 8;
+    }
+    for (k, &item) in eights.remainder().iter().enumerate() {
+        bits |= u64::from(set(item)) << (at + k);
     }
     bits
+}
+
+/// The eight bytes of `word`, each 0 or 1, as eight bits (byte `k` is bit `k`).
+fn byte_bits(word: u64) -> u64 {
+    // Each byte's bit is carried to the top byte by the multiplication, at its own place.
+    word.wrapping_mul(0x0102_0408_1020_4080) >> 56
 }
 
 /// The bits of `values` that are not zero.
@@ -417,6 +432,22 @@ fn is_unused(unused: &[bool], i: usize) -> bool {
 mod tests {
     use super::*;
     use crate::trace::hulls::tests::luxel_over_edge;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// Gathered eight at a time, the bits are those of each item in turn.
+        #[test]
+        fn bits_where_sets_bit_k_for_item_k(values in proptest::collection::vec(
+            prop_oneof![Just(0.0f64), Just(-0.0), Just(f64::NAN), -2.0f64..2.0],
+            0..=64,
+        )) {
+            let one_by_one = values
+                .iter()
+                .enumerate()
+                .fold(0u64, |bits, (k, &v)| bits | u64::from(v != 0.0) << k);
+            prop_assert_eq!(valued(&values), one_by_one);
+        }
+    }
 
     /// Traces the one luxel of `samples` (every sample lit by a light straight above) with
     /// rays blocked where `blocked` says of their origin; returns `lit` and the rays cast.
