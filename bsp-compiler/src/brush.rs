@@ -180,6 +180,7 @@ impl<'a> BrushProbe<'a> {
     }
 
     /// [`Brush::sides_of`]: the box's answer, else the corners' (remembered).
+    #[inline(always)]
     pub fn sides_of(&self, plane: &PlaneProbe) -> Sides {
         self.box_sides(plane).unwrap_or_else(|| {
             self.brush
@@ -190,6 +191,7 @@ impl<'a> BrushProbe<'a> {
 
     /// What the bounding box tells of the plane's sides: everything, unless the box straddles a
     /// plane that is not axial.
+    #[inline(always)]
     fn box_sides(&self, plane: &PlaneProbe) -> Option<Sides> {
         let (n, half) = (plane.abs_normal, self.half);
         let radius = half.x * n.x + half.y * n.y + half.z * n.z;

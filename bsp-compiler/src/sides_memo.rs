@@ -22,67 +22,88 @@ use std::sync::atomic::{AtomicU32, Ordering};
 /// most brushes need none or the first; grown terrain brushes meet a thousand planes and more.
 /// A brush with a second table is one that meets many planes, so lookups try it first: most of
 /// its answers are there, and the first's full neighbourhoods would be walked for nothing.
-const TABLE_SIZES: [usize; 2] = [256, 4096];
+const SMALL: usize = 256;
+/// The second table's slots.
+const LARGE: usize = 4096;
 /// How far from its home slot an answer may be kept.
 const PROBES: usize = 8;
 
-type Table = OnceLock<Box<[AtomicU32]>>;
-
-/// Answers by plane: no table until a brush's corners are first asked.
+/// Answers by plane: no table until a brush's corners are first asked. The tables have fixed
+/// sizes, so finding a slot takes no bounds check.
 #[derive(Default)]
-pub struct SidesMemo(OnceLock<Box<[Table; TABLE_SIZES.len()]>>);
+pub struct SidesMemo {
+    small: OnceLock<Box<[AtomicU32; SMALL]>>,
+    large: OnceLock<Box<[AtomicU32; LARGE]>>,
+}
 
 /// Which sides of a plane something reaches: (in front, behind).
 pub type Sides = (bool, bool);
 
+/// A table's slots, for each the id plus one above the two answer bits; 0 is empty.
+fn empty_table<const N: usize>() -> Box<[AtomicU32; N]> {
+    Box::new(std::array::from_fn(|_| AtomicU32::new(0)))
+}
+
+/// The slots an answer for `key` may take in a table of `N` slots (a power of two), in order.
+fn probes<const N: usize>(key: u32) -> impl Iterator<Item = usize> {
+    let home = (key.wrapping_mul(0x9E37_79B9) >> 16) as usize;
+    (0..PROBES).map(move |i| (home + i) & (N - 1))
+}
+
+/// The answer for `key` in `table`, if it holds one. Slots are never emptied: an empty one on
+/// the way means the answer is not there (it would have taken that slot, or one before it).
+fn find<const N: usize>(table: &[AtomicU32; N], key: u32) -> Option<Sides> {
+    for i in probes::<N>(key) {
+        let slot = table[i].load(Ordering::Relaxed);
+        if slot >> 2 == key {
+            return Some((slot & 2 != 0, slot & 1 != 0));
+        }
+        if slot == 0 {
+            return None;
+        }
+    }
+    None
+}
+
+/// Keeps `value` for `key` in `table`: whether it is held (by this call or by another thread
+/// that answered the same question first, with the same answer).
+fn keep<const N: usize>(table: &[AtomicU32; N], key: u32, value: u32) -> bool {
+    probes::<N>(key).any(|i| {
+        match table[i].compare_exchange(0, value, Ordering::Relaxed, Ordering::Relaxed) {
+            Ok(_) => true,
+            Err(held) => held >> 2 == key,
+        }
+    })
+}
+
 impl SidesMemo {
     /// The answer for plane `id`, remembered or worked out by `corners` (and then remembered).
     pub fn get_or_insert(&self, id: PlaneId, corners: impl FnOnce() -> Sides) -> Sides {
-        // A slot holds the id plus one above the two answer bits; 0 is empty.
         let Some(key) = id.checked_add(1).filter(|k| k >> 30 == 0) else {
             return corners();
         };
-        // Sizes are powers of two.
-        let probes = |size: usize| {
-            let home = (key.wrapping_mul(0x9E37_79B9) >> 16) as usize;
-            (0..PROBES).map(move |i| (home + i) & (size - 1))
-        };
-        let tables = self.0.get_or_init(Default::default);
-        // Slots are never emptied: an empty one on the way means the answer is not in that
-        // table (it would have taken that slot, or one before it).
-        for table in tables.iter().rev().filter_map(OnceLock::get) {
-            for i in probes(table.len()) {
-                let slot = table[i].load(Ordering::Relaxed);
-                if slot >> 2 == key {
-                    return (slot & 2 != 0, slot & 1 != 0);
-                }
-                if slot == 0 {
-                    break;
-                }
-            }
+        if let Some(sides) = self.large.get().and_then(|t| find(t, key)) {
+            return sides;
+        }
+        if let Some(sides) = self.small.get().and_then(|t| find(t, key)) {
+            return sides;
         }
         let sides = corners();
         let value = key << 2 | u32::from(sides.0) << 1 | u32::from(sides.1);
-        for (table, &size) in tables.iter().zip(&TABLE_SIZES) {
-            let table = table.get_or_init(|| (0..size).map(|_| AtomicU32::new(0)).collect());
-            for i in probes(size) {
-                match table[i].compare_exchange(0, value, Ordering::Relaxed, Ordering::Relaxed) {
-                    Ok(_) => return sides,
-                    // Another thread answered the same question first, with the same answer.
-                    Err(held) if held >> 2 == key => return sides,
-                    Err(_) => {}
-                }
-            }
+        if !keep(self.small.get_or_init(empty_table), key, value) {
+            keep(self.large.get_or_init(empty_table), key, value);
         }
         sides
     }
 
     /// How many answers are kept.
     pub fn len(&self) -> usize {
-        let tables = self.0.get().into_iter().flat_map(|t| t.iter());
-        tables
-            .filter_map(OnceLock::get)
-            .flat_map(|table| table.iter())
+        let small = self.small.get().map(|t| t.as_slice());
+        let large = self.large.get().map(|t| t.as_slice());
+        [small, large]
+            .into_iter()
+            .flatten()
+            .flatten()
             .filter(|s| s.load(Ordering::Relaxed) != 0)
             .count()
     }
@@ -91,21 +112,21 @@ impl SidesMemo {
 /// A copy answers as the original does (the same corners).
 impl Clone for SidesMemo {
     fn clone(&self) -> SidesMemo {
-        let copy = SidesMemo::default();
-        if let Some(tables) = self.0.get() {
-            let copied = tables.each_ref().map(|table| {
-                let copied = Table::new();
-                if let Some(slots) = table.get() {
-                    let slots = slots
-                        .iter()
-                        .map(|s| AtomicU32::new(s.load(Ordering::Relaxed)));
-                    let _ = copied.set(slots.collect());
-                }
-                copied
-            });
-            let _ = copy.0.set(Box::new(copied));
+        fn copied<const N: usize>(
+            table: &OnceLock<Box<[AtomicU32; N]>>,
+        ) -> OnceLock<Box<[AtomicU32; N]>> {
+            let copy = OnceLock::new();
+            if let Some(slots) = table.get() {
+                let slots =
+                    std::array::from_fn(|i| AtomicU32::new(slots[i].load(Ordering::Relaxed)));
+                let _ = copy.set(Box::new(slots));
+            }
+            copy
         }
-        copy
+        SidesMemo {
+            small: copied(&self.small),
+            large: copied(&self.large),
+        }
     }
 }
 
@@ -159,6 +180,6 @@ mod tests {
                 );
             }
         }
-        assert!(memo.len() <= TABLE_SIZES.iter().sum());
+        assert!(memo.len() <= SMALL + LARGE);
     }
 }
