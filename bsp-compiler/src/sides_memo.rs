@@ -46,6 +46,7 @@ fn empty_table<const N: usize>() -> Box<[AtomicU32; N]> {
 
 /// The slots an answer for `key` may take in a table of `N` slots (a power of two), in order.
 fn probes<const N: usize>(key: u32) -> impl Iterator<Item = usize> {
+    const { assert!(N.is_power_of_two()) };
     let home = (key.wrapping_mul(0x9E37_79B9) >> 16) as usize;
     (0..PROBES).map(move |i| (home + i) & (N - 1))
 }

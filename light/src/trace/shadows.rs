@@ -68,6 +68,7 @@ impl LuxelBits {
 /// eights of items are answered as the bytes of one word, which the compiler compares
 /// together; a loop shifting each answer into place on its own keeps it from doing so.
 fn bits_where<T: Copy>(items: &[T], set: impl Fn(T) -> bool) -> u64 {
+    debug_assert!(items.len() <= 64, "{} items", items.len());
     let mut bits = 0;
     let mut eights = items.chunks_exact(8);
     let mut at = 0;
