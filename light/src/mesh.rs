@@ -1,6 +1,8 @@
 //! Faces fan-triangulated into the buffers Embree takes: the opaque, sky and per-model scenes
 //! ([`crate::scene`]) and the fence scene ([`crate::fence`]) are each built from one.
 
+use std::collections::HashSet;
+
 use glam::DVec3;
 
 use crate::embree::{Device, Scene, SceneBuilder};
@@ -43,6 +45,37 @@ impl Mesh {
         self.add_polygon(&face.points, face.index as u32);
     }
 
+    /// `faces` with their outlines thinned: a point on a straight run of a face's outline is
+    /// left out unless it is a corner of another of `faces`. Such points were put there for
+    /// faces outside the mesh (a wall standing on a sky face's edge) and cut the fan into long
+    /// slivers whose boxes overlap, which slows every ray through the mesh; the edges the
+    /// faces share keep the same points on both sides, so the mesh stays sealed.
+    pub(crate) fn thinned(faces: &[&FaceGeom]) -> Mesh {
+        let key = |p: &DVec3| p.as_vec3().to_array().map(f32::to_bits);
+        let corners: HashSet<[u32; 3]> = faces
+            .iter()
+            .flat_map(|f| {
+                let points = &f.points;
+                (0..points.len())
+                    .filter(move |&i| is_corner(points, i))
+                    .map(move |i| key(&points[i]))
+            })
+            .collect();
+        let mut mesh = Mesh::with_room_for(faces.iter().copied());
+        let mut kept = Vec::new();
+        for f in faces {
+            kept.clear();
+            kept.extend(
+                (0..f.points.len())
+                    .filter(|&i| is_corner(&f.points, i) || corners.contains(&key(&f.points[i])))
+                    .map(|i| f.points[i]),
+            );
+            let outline = if kept.len() >= 3 { &kept } else { &f.points };
+            mesh.add_polygon(outline, f.index as u32);
+        }
+        mesh
+    }
+
     /// A convex polygon, fan-triangulated, its triangles marked as `face`'s.
     pub(crate) fn add_polygon(&mut self, points: &[DVec3], face: u32) {
         let base = self.vertices.len() as u32;
@@ -52,5 +85,90 @@ impl Mesh {
             self.triangles.push([base, base + i, base + i + 1]);
             self.faces.push(face);
         }
+    }
+}
+
+/// How far (units) from the line through its neighbours a point of a face's outline may lie and
+/// still be on a straight run of it: well above the rounding of a BSP's f32 vertices.
+const ON_RUN: f64 = 0.01;
+
+/// Whether point `i` of the polygon `points` is a corner: off the line through its neighbours.
+fn is_corner(points: &[DVec3], i: usize) -> bool {
+    let n = points.len();
+    if n < 3 {
+        return true;
+    }
+    let (before, at, after) = (points[(i + n - 1) % n], points[i], points[(i + 1) % n]);
+    let run = after - before;
+    let length = run.length();
+    length == 0.0 || run.cross(at - before).length() >= ON_RUN * length
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use quake_formats::geom::Plane;
+
+    fn sky(index: usize, points: &[[f64; 2]]) -> FaceGeom {
+        let points = points
+            .iter()
+            .map(|&[x, y]| DVec3::new(x, y, 256.0))
+            .collect();
+        FaceGeom::for_test(index, 0, points, Plane::new(DVec3::NEG_Z, -256.0))
+    }
+
+    /// The outline of `face` in `mesh`, as its triangles' points.
+    fn points_of(mesh: &Mesh, face: u32) -> HashSet<[u32; 3]> {
+        mesh.triangles
+            .iter()
+            .zip(&mesh.faces)
+            .filter(|&(_, &f)| f == face)
+            .flat_map(|(t, _)| {
+                t.iter()
+                    .map(|&v| mesh.vertices[v as usize].map(f32::to_bits))
+            })
+            .collect()
+    }
+
+    #[test]
+    fn thinning_drops_junctions_for_other_meshes_and_keeps_shared_corners() {
+        // Face 0 has a point on its east edge for a wall outside the mesh (at y = 40) and one on
+        // its north edge that is face 1's corner (at x = 64).
+        let big = sky(
+            0,
+            &[
+                [0.0, 0.0],
+                [128.0, 0.0],
+                [128.0, 40.0],
+                [128.0, 128.0],
+                [64.0, 128.0],
+                [0.0, 128.0],
+            ],
+        );
+        let small = sky(
+            1,
+            &[[64.0, 128.0], [128.0, 128.0], [128.0, 192.0], [64.0, 192.0]],
+        );
+        let mesh = Mesh::thinned(&[&big, &small]);
+        let key = |x: f32, y: f32| [x, y, 256.0].map(f32::to_bits);
+        let outline = points_of(&mesh, 0);
+        assert!(
+            !outline.contains(&key(128.0, 40.0)),
+            "the wall's junction is left out"
+        );
+        assert!(
+            outline.contains(&key(64.0, 128.0)),
+            "the other sky face's corner stays"
+        );
+        assert_eq!(outline.len(), 5);
+        assert_eq!(mesh.faces.iter().filter(|&&f| f == 0).count(), 3);
+        assert_eq!(points_of(&mesh, 1).len(), 4);
+    }
+
+    #[test]
+    fn a_face_with_every_point_on_a_run_keeps_its_outline() {
+        let flat = sky(0, &[[0.0, 0.0], [64.0, 0.0], [128.0, 0.0]]);
+        let mesh = Mesh::thinned(&[&flat]);
+        assert_eq!(mesh.vertices.len(), 3);
     }
 }

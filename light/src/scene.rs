@@ -209,8 +209,14 @@ impl TraceScene {
                 Some((model, k))
             })
             .collect();
+        // The sky faces alone: thinned, none of the walls that stand on them being there.
+        let sky_faces: Vec<&FaceGeom> = faces
+            .iter()
+            .filter(|f| f.kind == FaceKind::Sky && f.model == 0)
+            .collect();
+        let sky_alone = Mesh::thinned(&sky_faces);
         let mut sky_textures: Vec<String> = Vec::new();
-        let sky_texture_of = sky
+        let sky_texture_of = sky_alone
             .faces
             .iter()
             .map(|&f| {
@@ -228,7 +234,7 @@ impl TraceScene {
         let sky_only = if sky.triangles.is_empty() {
             None
         } else {
-            Some(sky.commit(device)?)
+            Some(sky_alone.commit(device)?)
         };
         let shared = || -> Result<(SceneBuilder, u32), LightError> {
             let mut builder = SceneBuilder::new(device)?;
