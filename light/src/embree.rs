@@ -984,9 +984,9 @@ impl Scene {
 #[derive(Debug, Clone, Copy)]
 struct ValidMask([i32; 16]);
 
-/// Along one axis, where each lane's segment starts and ends, lowest first; `finite` cleared
-/// for lanes where either end is not finite. Written lane by lane without branches, so it runs
-/// in vectors.
+/// Along one axis, where each lane's segment starts and ends, lowest first; `finite` (all
+/// bits set or none) cleared for lanes where either end is not finite. Written lane by lane
+/// without branches, so it runs in vectors.
 #[inline(always)]
 fn axis_extent(
     org: &[f32; 16],
@@ -994,12 +994,16 @@ fn axis_extent(
     (tnear, tfar): (&[f32; 16], &[f32; 16]),
     lows: &mut [f32; 16],
     highs: &mut [f32; 16],
-    finite: &mut [bool; 16],
+    finite: &mut [u32; 16],
 ) {
     for lane in 0..16 {
         let a = org[lane] + dir[lane] * tnear[lane];
         let b = org[lane] + dir[lane] * tfar[lane];
-        finite[lane] &= a.is_finite() & b.is_finite();
+        finite[lane] &= if a.is_finite() & b.is_finite() {
+            u32::MAX
+        } else {
+            0
+        };
         lows[lane] = if a < b { a } else { b };
         highs[lane] = if a < b { b } else { a };
     }
@@ -1018,6 +1022,7 @@ pub struct SegmentBoxes16 {
 impl SegmentBoxes16 {
     /// Bit `i` set if lane `i`'s box meets the box `mins..maxs` (touching counts).
     #[must_use]
+    #[inline(always)]
     pub fn meeting(&self, mins: [f32; 3], maxs: [f32; 3]) -> u16 {
         let mut meets = [true; 16];
         for axis in 0..3 {
@@ -1033,6 +1038,7 @@ impl SegmentBoxes16 {
 
     /// The box around every lane's box: `(mins, maxs)`, empty (mins above maxs) when all are.
     #[must_use]
+    #[inline(always)]
     pub fn union(&self) -> ([f32; 3], [f32; 3]) {
         // Plain comparisons: no lane holds a NaN.
         let least = |lanes: &[f32; 16]| {
@@ -1140,10 +1146,11 @@ impl RayPacket16 {
     /// inactive lanes, and lanes whose ends do not compute (an infinite `tfar`), get an empty
     /// box, the latter their bit in [`SegmentBoxes16::unbounded`].
     #[must_use]
+    #[inline(always)]
     pub fn segment_boxes(&self) -> SegmentBoxes16 {
         let r = &self.rayhit.ray;
-        // Lanes whose box is kept: active, with finite ends.
-        let mut boxed = self.valid.0.map(|v| v != 0);
+        // Lanes whose box is kept (all bits set): active, with finite ends.
+        let mut boxed = self.valid.0.map(|v| if v != 0 { u32::MAX } else { 0 });
         let mut boxes = SegmentBoxes16 {
             mins: [[0.0; 16]; 3],
             maxs: [[0.0; 16]; 3],
@@ -1166,13 +1173,20 @@ impl RayPacket16 {
                 &mut boxed,
             );
         }
-        for (lane, _) in boxed.iter().enumerate().filter(|(_, kept)| !**kept) {
-            boxes.unbounded |= u16::from(self.valid.0[lane] != 0) << lane;
-            for axis in 0..3 {
-                boxes.mins[axis][lane] = f32::INFINITY;
-                boxes.maxs[axis][lane] = f32::NEG_INFINITY;
+        // The other lanes' boxes emptied by masks, lane by lane, so this too runs in vectors.
+        let pick = |kept: u32, v: f32, empty: f32| {
+            f32::from_bits((v.to_bits() & kept) | (empty.to_bits() & !kept))
+        };
+        for axis in 0..3 {
+            for (lane, &kept) in boxed.iter().enumerate() {
+                let (lo, hi) = (boxes.mins[axis][lane], boxes.maxs[axis][lane]);
+                boxes.mins[axis][lane] = pick(kept, lo, f32::INFINITY);
+                boxes.maxs[axis][lane] = pick(kept, hi, f32::NEG_INFINITY);
             }
         }
+        boxes.unbounded = (0..16).fold(0, |m, lane| {
+            m | u16::from(self.valid.0[lane] != 0 && boxed[lane] == 0) << lane
+        });
         boxes
     }
 

@@ -174,6 +174,15 @@ impl FenceBoxes {
     /// meets the box of all the lanes' segments: a packet's rays are close together, and
     /// fences are usually a few small signs.
     fn lanes_near(&self, packet: &RayPacket16, lanes: u16) -> u16 {
+        crate::simd::avx2_or_any(
+            #[inline(always)]
+            || self.lanes_near_any(packet, lanes),
+        )
+    }
+
+    /// [`FenceBoxes::lanes_near`] for whatever the build targets.
+    #[inline(always)]
+    fn lanes_near_any(&self, packet: &RayPacket16, lanes: u16) -> u16 {
         let segments = packet.segment_boxes();
         let unbounded = segments.unbounded & lanes;
         let mut near = segments.meeting(self.all.0, self.all.1) & lanes;
@@ -214,10 +223,15 @@ impl Fences {
         if faces.is_empty() {
             return Ok(None);
         }
-        let mut mesh = Mesh::default();
+        // Thinned: the walls around a fence put points on its edges that only slow its rays.
+        let numbered: Vec<(&FaceGeom, u32)> = faces
+            .iter()
+            .zip(0..)
+            .map(|((face, _), k)| (*face, k))
+            .collect();
+        let mesh = Mesh::thinned(&numbered);
         let mut fence_faces = Vec::with_capacity(faces.len());
-        for (k, (face, mask)) in faces.iter().enumerate() {
-            mesh.add_polygon(&face.points, k as u32);
+        for (face, mask) in faces {
             fence_faces.push(FenceFace {
                 mask: mask.clone(),
                 vecs: face.vecs,

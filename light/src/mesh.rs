@@ -45,25 +45,26 @@ impl Mesh {
         self.add_polygon(&face.points, face.index as u32);
     }
 
-    /// `faces` with their outlines thinned: a point on a straight run of a face's outline is
+    /// `faces` (each with the number its triangles are marked with) with their outlines
+    /// thinned: a point on a straight run of a face's outline is
     /// left out unless it is a corner of another of `faces`. Such points were put there for
     /// faces outside the mesh (a wall standing on a sky face's edge) and cut the fan into long
     /// slivers whose boxes overlap, which slows every ray through the mesh; the edges the
     /// faces share keep the same points on both sides, so the mesh stays sealed.
-    pub(crate) fn thinned(faces: &[&FaceGeom]) -> Mesh {
+    pub(crate) fn thinned(faces: &[(&FaceGeom, u32)]) -> Mesh {
         let key = |p: &DVec3| p.as_vec3().to_array().map(f32::to_bits);
         let corners: HashSet<[u32; 3]> = faces
             .iter()
-            .flat_map(|f| {
+            .flat_map(|(f, _)| {
                 let points = &f.points;
                 (0..points.len())
                     .filter(move |&i| is_corner(points, i))
                     .map(move |i| key(&points[i]))
             })
             .collect();
-        let mut mesh = Mesh::with_room_for(faces.iter().copied());
+        let mut mesh = Mesh::with_room_for(faces.iter().map(|&(f, _)| f));
         let mut kept = Vec::new();
-        for f in faces {
+        for &(f, id) in faces {
             kept.clear();
             kept.extend(
                 (0..f.points.len())
@@ -71,7 +72,7 @@ impl Mesh {
                     .map(|i| f.points[i]),
             );
             let outline = if kept.len() >= 3 { &kept } else { &f.points };
-            mesh.add_polygon(outline, f.index as u32);
+            mesh.add_polygon(outline, id);
         }
         mesh
     }
@@ -149,7 +150,7 @@ mod tests {
             1,
             &[[64.0, 128.0], [128.0, 128.0], [128.0, 192.0], [64.0, 192.0]],
         );
-        let mesh = Mesh::thinned(&[&big, &small]);
+        let mesh = Mesh::thinned(&[(&big, 0), (&small, 1)]);
         let key = |x: f32, y: f32| [x, y, 256.0].map(f32::to_bits);
         let outline = points_of(&mesh, 0);
         assert!(
@@ -168,7 +169,7 @@ mod tests {
     #[test]
     fn a_face_with_every_point_on_a_run_keeps_its_outline() {
         let flat = sky(0, &[[0.0, 0.0], [64.0, 0.0], [128.0, 0.0]]);
-        let mesh = Mesh::thinned(&[&flat]);
+        let mesh = Mesh::thinned(&[(&flat, 0)]);
         assert_eq!(mesh.vertices.len(), 3);
     }
 }

@@ -210,9 +210,10 @@ impl TraceScene {
             })
             .collect();
         // The sky faces alone: thinned, none of the walls that stand on them being there.
-        let sky_faces: Vec<&FaceGeom> = faces
+        let sky_faces: Vec<(&FaceGeom, u32)> = faces
             .iter()
             .filter(|f| f.kind == FaceKind::Sky && f.model == 0)
+            .map(|f| (f, f.index as u32))
             .collect();
         let sky_alone = Mesh::thinned(&sky_faces);
         let mut sky_textures: Vec<String> = Vec::new();
