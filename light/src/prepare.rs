@@ -257,7 +257,8 @@ pub fn prepare(bsp: &Bsp, options: &Options) -> Result<Prepared, LightError> {
     // visibility tables are read while they link.
     let ((scene, vis), links) = rayon::join(
         || {
-            let scene = TraceScene::build(&device, &faces, &casters, unsealed);
+            let for_suns = !map_lights.suns.is_empty();
+            let scene = TraceScene::build(&device, &faces, &casters, unsealed, for_suns);
             (scene, Visibility::new(bsp, &faces))
         },
         || continuations(&faces, |f, g| groups.smooths(f, g)),

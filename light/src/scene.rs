@@ -54,6 +54,9 @@ pub struct TraceScene {
     sky_geom: u32,
     /// The sky faces alone, to find where a sun ray meets the sky first.
     sky_only: Option<Scene>,
+    /// `scene`'s faces without the sky, for what blocks a sun ray before it meets the sky
+    /// (built for maps with suns and sky).
+    opaque_only: Option<Scene>,
     /// Per triangle of `sky_only`, its texture's index in `sky_textures`.
     sky_texture_of: Vec<u16>,
     /// The names of the sky faces' textures.
@@ -104,7 +107,8 @@ impl TraceScene {
     /// `casters.self_shadow_models` that is not also in `casters.models` gets a scene of its own
     /// faces, and each switchable style one of its models' faces. Liquids are left out (they
     /// let light through). With `unsealed`, the shared scene is built a second time without
-    /// Embree's robust mode, for bounced light's segments and dirt's rays.
+    /// Embree's robust mode, for bounced light's segments and dirt's rays; with `for_suns`, its
+    /// opaque faces once more without the sky, for sun rays.
     ///
     /// # Errors
     /// The Embree error if building fails.
@@ -113,6 +117,7 @@ impl TraceScene {
         faces: &[FaceGeom],
         casters: &Casters,
         unsealed: bool,
+        for_suns: bool,
     ) -> Result<TraceScene, LightError> {
         let Casters {
             shadowless,
@@ -244,6 +249,11 @@ impl TraceScene {
             Ok((builder, sky_geom))
         };
         let (builder, sky_geom) = shared()?;
+        let opaque_only = if for_suns && sky_only.is_some() {
+            Some(opaque.commit(device)?)
+        } else {
+            None
+        };
         let unsealed = if unsealed {
             Some(shared()?.0.commit_unsealed()?)
         } else {
@@ -254,6 +264,7 @@ impl TraceScene {
             unsealed,
             sky_geom,
             sky_only,
+            opaque_only,
             sky_texture_of,
             sky_textures,
             opaque_faces: opaque.faces,
@@ -409,7 +420,8 @@ impl TraceScene {
     /// Bit `i` set if lane `i` of `packet`, cast from a face of `model`,
     /// reaches a sky face `filter` lets through before anything else.
     /// First where each ray meets the sky (sky faces alone, a small scene),
-    /// then whether anything blocks it before that: an occlusion query,
+    /// then whether anything blocks it before that: an occlusion query on
+    /// the faces without the sky (whose long faces would only slow it),
     /// which stops at any hit, where one closest-hit query over everything
     /// must rule out every nearer surface.
     pub fn sees_sky16(&self, packet: &mut RayPacket16, model: usize, filter: SkyFilter) -> u16 {
@@ -429,7 +441,8 @@ impl TraceScene {
             .fold(0, |m, i| m | (1 << i));
         // Just short of the sky hit, so the sky face itself does not block.
         packet.keep_shortened(sky, SKY_HIT_SHORTEN);
-        let opaque = self.scene.occluded16(packet, true);
+        let blockers = self.opaque_only.as_ref().unwrap_or(&self.scene);
+        let opaque = blockers.occluded16(packet, true);
         let blocked = opaque | self.fences_block16(packet, !opaque);
         sky & !blocked
             & !self.own_occluded16(packet, model)
