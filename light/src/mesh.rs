@@ -46,11 +46,11 @@ impl Mesh {
     }
 
     /// `faces` (each with the number its triangles are marked with) with their outlines
-    /// thinned: a point on a straight run of a face's outline is
-    /// left out unless it is a corner of another of `faces`. Such points were put there for
-    /// faces outside the mesh (a wall standing on a sky face's edge) and cut the fan into long
-    /// slivers whose boxes overlap, which slows every ray through the mesh; the edges the
-    /// faces share keep the same points on both sides, so the mesh stays sealed.
+    /// thinned: a point on a straight run of a face's outline is left out unless it is a corner
+    /// of another of `faces`. Such points were put there for faces outside the mesh (a wall
+    /// standing on a sky face's edge) and cut the fan into long slivers whose boxes overlap,
+    /// which slows every ray through the mesh; the edges the faces share keep the same points
+    /// on both sides, so the mesh stays sealed.
     pub(crate) fn thinned(faces: &[(&FaceGeom, u32)]) -> Mesh {
         let key = |p: &DVec3| p.as_vec3().to_array().map(f32::to_bits);
         let corners: HashSet<[u32; 3]> = faces

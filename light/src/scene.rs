@@ -421,7 +421,7 @@ impl TraceScene {
     /// reaches a sky face `filter` lets through before anything else.
     /// First where each ray meets the sky (sky faces alone, a small scene),
     /// then whether anything blocks it before that: an occlusion query on
-    /// the faces without the sky (whose long faces would only slow it),
+    /// the faces without the sky (whose slivers would only slow it),
     /// which stops at any hit, where one closest-hit query over everything
     /// must rule out every nearer surface.
     pub fn sees_sky16(&self, packet: &mut RayPacket16, model: usize, filter: SkyFilter) -> u16 {
