@@ -4,6 +4,7 @@
 use std::collections::HashSet;
 
 use glam::DVec3;
+use quake_formats::geom::ON_EPSILON;
 
 use crate::embree::{Device, Scene, SceneBuilder};
 use crate::error::LightError;
@@ -89,11 +90,8 @@ impl Mesh {
     }
 }
 
-/// How far (units) from the line through its neighbours a point of a face's outline may lie and
-/// still be on a straight run of it: well above the rounding of a BSP's f32 vertices.
-const ON_RUN: f64 = 0.01;
-
-/// Whether point `i` of the polygon `points` is a corner: off the line through its neighbours.
+/// Whether point `i` of the polygon `points` is a corner: farther than [`ON_EPSILON`] (well
+/// above the rounding of a BSP's f32 vertices) off the line through its neighbours.
 fn is_corner(points: &[DVec3], i: usize) -> bool {
     let n = points.len();
     if n < 3 {
@@ -102,7 +100,7 @@ fn is_corner(points: &[DVec3], i: usize) -> bool {
     let (before, at, after) = (points[(i + n - 1) % n], points[i], points[(i + 1) % n]);
     let run = after - before;
     let length = run.length();
-    length == 0.0 || run.cross(at - before).length() >= ON_RUN * length
+    length == 0.0 || run.cross(at - before).length() >= ON_EPSILON * length
 }
 
 #[cfg(test)]
