@@ -54,23 +54,31 @@ impl Mesh {
     /// on both sides, so the mesh stays sealed.
     pub(crate) fn thinned(faces: &[(&FaceGeom, u32)]) -> Mesh {
         let key = |p: &DVec3| p.as_vec3().to_array().map(f32::to_bits);
+        // Per face, which of its points are its corners: asked once, used twice.
+        let own: Vec<Vec<bool>> = faces
+            .iter()
+            .map(|(f, _)| {
+                (0..f.points.len())
+                    .map(|i| is_corner(&f.points, i))
+                    .collect()
+            })
+            .collect();
         let corners: HashSet<[u32; 3]> = faces
             .iter()
-            .flat_map(|(f, _)| {
-                let points = &f.points;
-                (0..points.len())
-                    .filter(move |&i| is_corner(points, i))
-                    .map(move |i| key(&points[i]))
-            })
+            .zip(&own)
+            .flat_map(|((f, _), own)| f.points.iter().zip(own).filter(|(_, c)| **c))
+            .map(|(p, _)| key(p))
             .collect();
         let mut mesh = Mesh::with_room_for(faces.iter().map(|&(f, _)| f));
         let mut kept = Vec::new();
-        for &(f, id) in faces {
+        for (&(f, id), own) in faces.iter().zip(&own) {
             kept.clear();
             kept.extend(
-                (0..f.points.len())
-                    .filter(|&i| is_corner(&f.points, i) || corners.contains(&key(&f.points[i])))
-                    .map(|i| f.points[i]),
+                f.points
+                    .iter()
+                    .zip(own)
+                    .filter(|&(p, &corner)| corner || corners.contains(&key(p)))
+                    .map(|(&p, _)| p),
             );
             let outline = if kept.len() >= 3 { &kept } else { &f.points };
             mesh.add_polygon(outline, id);

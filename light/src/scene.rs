@@ -147,6 +147,8 @@ impl TraceScene {
             Mesh::with_room_for(faces.iter().filter(|f| f.kind == FaceKind::Lit && casts(f)));
         let mut fence_faces = Vec::new();
         let mut sky = Mesh::default();
+        // The world's sky faces, numbered by face, for the sky-alone scene.
+        let mut sky_faces: Vec<(&FaceGeom, u32)> = Vec::new();
         let mut own_meshes: HashMap<usize, Mesh> = HashMap::new();
         let mut world_only = Mesh::default();
         let mut switchable_meshes: Vec<(u8, Mesh)> = Vec::new();
@@ -176,7 +178,10 @@ impl TraceScene {
                 FaceKind::Lit if self_shadow_models.contains(&f.model) => {
                     own_meshes.entry(f.model).or_default().add(f);
                 }
-                FaceKind::Sky if f.model == 0 => sky.add(f),
+                FaceKind::Sky if f.model == 0 => {
+                    sky.add(f);
+                    sky_faces.push((f, f.index as u32));
+                }
                 _ => {}
             }
         }
@@ -215,11 +220,6 @@ impl TraceScene {
             })
             .collect();
         // The sky faces alone: thinned, none of the walls that stand on them being there.
-        let sky_faces: Vec<(&FaceGeom, u32)> = faces
-            .iter()
-            .filter(|f| f.kind == FaceKind::Sky && f.model == 0)
-            .map(|f| (f, f.index as u32))
-            .collect();
         let sky_alone = Mesh::thinned(&sky_faces);
         let mut sky_textures: Vec<String> = Vec::new();
         let sky_texture_of = sky_alone
