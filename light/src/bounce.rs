@@ -62,10 +62,8 @@ pub type StyleLight = Vec<(u8, [f32; 3])>;
 
 /// Adds `light` in `style` to `sum`.
 pub fn add_style_light(sum: &mut StyleLight, style: u8, light: [f32; 3]) {
-    match sum.iter_mut().find(|(s, _)| *s == style) {
-        Some((_, to)) => to.iter_mut().zip(light).for_each(|(v, a)| *v += a),
-        None => sum.push((style, light)),
-    }
+    let to = crate::styles::entry(sum, style, || [0.0; 3]);
+    to.iter_mut().zip(light).for_each(|(v, a)| *v += a);
 }
 
 /// Mean colour (0..1) of a texture's full-size mip through `palette`.
@@ -602,15 +600,11 @@ pub fn style_luxels(out: &mut StyleLuxels, style: u8, n: usize) -> &mut [[f32; 3
 /// Adds `b` into `a`, style by style.
 pub fn accumulate(a: &mut StyleLuxels, b: &StyleLuxels) {
     for (style, values) in b {
-        match a.iter_mut().find(|(s, _)| s == style) {
-            Some((_, dst)) => {
-                for (d, v) in dst.iter_mut().zip(values) {
-                    for k in 0..3 {
-                        d[k] += v[k];
-                    }
-                }
+        let dst = style_luxels(a, *style, values.len());
+        for (d, v) in dst.iter_mut().zip(values) {
+            for k in 0..3 {
+                d[k] += v[k];
             }
-            None => a.push((*style, values.clone())),
         }
     }
 }

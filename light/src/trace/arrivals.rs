@@ -157,20 +157,13 @@ fn deposit(
     let fixed = light.projector.is_none().then_some(light.color);
     let color =
         |i: usize| fixed.unwrap_or_else(|| light.color_at(glam::Vec3::from(points[i]).as_dvec3()));
+    // A local minlight raises the floor to its light; any other light adds to the sum.
     if local_min {
-        let buffer = out.floors.get(style);
-        for (i, value) in arrived.clone() {
-            for (o, c) in buffer[i].iter_mut().zip(color(i).to_array()) {
-                *o = o.max((value * c) as f32);
-            }
-        }
+        let floors = out.floors.get(style);
+        combine_into(floors, arrived.clone(), &color, |o, v| *o = o.max(v));
     } else {
-        let buffer = out.sums.get(style);
-        for (i, value) in arrived.clone() {
-            for (o, c) in buffer[i].iter_mut().zip(color(i).to_array()) {
-                *o += (value * c) as f32;
-            }
-        }
+        let sums = out.sums.get(style);
+        combine_into(sums, arrived.clone(), &color, |o, v| *o += v);
     }
     if let Some(d) = out.directions.as_mut().filter(|_| !local_min) {
         for (i, value) in arrived.clone() {
@@ -186,6 +179,21 @@ fn deposit(
             for (o, c) in buffer[i].iter_mut().zip(color(i).to_array()) {
                 *o += (value * c * kept_share) as f32;
             }
+        }
+    }
+}
+
+/// Each `(i, value)` of `arrived` (the light's colour at sample `i` times `value`) combined
+/// channel by channel into sample `i` of `buffer`.
+fn combine_into(
+    buffer: &mut [[f32; 3]],
+    arrived: impl Iterator<Item = (usize, f64)>,
+    color: impl Fn(usize) -> glam::DVec3,
+    combine: impl Fn(&mut f32, f32),
+) {
+    for (i, value) in arrived {
+        for (o, c) in buffer[i].iter_mut().zip(color(i).to_array()) {
+            combine(o, (value * c) as f32);
         }
     }
 }
