@@ -160,10 +160,10 @@ fn deposit(
     // A local minlight raises the floor to its light; any other light adds to the sum.
     if local_min {
         let floors = out.floors.get(style);
-        combine_into(floors, arrived.clone(), &color, |o, v| *o = o.max(v));
+        combine_into(floors, arrived.clone(), color, |o, v| *o = o.max(v));
     } else {
         let sums = out.sums.get(style);
-        combine_into(sums, arrived.clone(), &color, |o, v| *o += v);
+        combine_into(sums, arrived.clone(), color, |o, v| *o += v);
     }
     if let Some(d) = out.directions.as_mut().filter(|_| !local_min) {
         for (i, value) in arrived.clone() {
