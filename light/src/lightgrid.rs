@@ -395,7 +395,7 @@ fn trace_run(src: &GridSources, sky: &LeafSky, points: &[DVec3]) -> (Vec<RawPoin
     let mut lanes = Vec::with_capacity(points.len());
     if !bounds.is_empty() {
         let mut near = Vec::new();
-        src.reaches.near(&bounds, &mut near);
+        src.reaches.near(&bounds, &mut Vec::new(), &mut near);
         for &li in &near {
             let light = &src.lights[li as usize];
             let light_leaf = src.light_leafs[li as usize];

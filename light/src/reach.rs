@@ -140,17 +140,31 @@ impl LightReaches {
         })
     }
 
-    /// Into `out`, in ascending order: every light whose reach may touch `b`.
-    pub fn near(&self, b: &Bounds, out: &mut Vec<u32>) {
-        out.clear();
-        out.extend(&self.everywhere);
+    /// Into `out`, in ascending order: every light whose reach may touch `b`. `seen` is
+    /// scratch: a bit per light, set as the cubes name it (a light reaching many cubes is named
+    /// by each), read in order at the end.
+    pub fn near(&self, b: &Bounds, seen: &mut Vec<u64>, out: &mut Vec<u32>) {
+        seen.clear();
+        seen.resize(self.each.len().div_ceil(64), 0);
+        let mut mark = |lights: &[u32]| {
+            for &li in lights {
+                seen[li as usize / 64] |= 1 << (li % 64);
+            }
+        };
+        mark(&self.everywhere);
         if let Some(range) = self.cube_range(b.mins, b.maxs) {
             for c in self.cubes_in(range) {
-                out.extend(&self.cubes[c]);
+                mark(&self.cubes[c]);
             }
         }
-        out.sort_unstable();
-        out.dedup();
+        out.clear();
+        for (word, &bits) in seen.iter().enumerate() {
+            let mut bits = bits;
+            while bits != 0 {
+                out.push(word as u32 * 64 + bits.trailing_zeros());
+                bits &= bits - 1;
+            }
+        }
     }
 }
 
@@ -200,7 +214,7 @@ mod tests {
             let mins = DVec3::new(corner.0, corner.1, corner.2);
             let b = Bounds { mins, maxs: mins + DVec3::new(size.0, size.1, size.2) };
             let mut near = Vec::new();
-            reaches.near(&b, &mut near);
+            reaches.near(&b, &mut Vec::new(), &mut near);
             proptest::prop_assert!(near.windows(2).all(|w| w[0] < w[1]));
             for (li, r) in reaches.each.iter().enumerate() {
                 if box_distance_squared(&b, r.origin) <= r.range_squared {

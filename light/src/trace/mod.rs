@@ -174,8 +174,9 @@ pub struct TraceScratch {
     points: points::SamplePoints,
     /// How the current light lies from each sample.
     toward: points::Toward,
-    /// The lights that may reach the face ([`LightReaches::near`]).
+    /// The lights that may reach the face ([`LightReaches::near`]), and its scratch.
     near_lights: Vec<u32>,
+    near_seen: Vec<u64>,
     /// Those of them that are not culled, in the same order.
     kept_lights: Vec<KeptLight>,
     /// Indices into `kept_lights`, faintest first.

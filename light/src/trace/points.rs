@@ -24,9 +24,11 @@ impl FaceTrace<'_> {
         let mut near_lights = std::mem::take(&mut self.scratch.near_lights);
         near_lights.clear();
         if self.setup.cull && !self.lights.is_empty() {
-            self.setup
-                .light_reaches
-                .near(&self.bounds, &mut near_lights);
+            self.setup.light_reaches.near(
+                &self.bounds,
+                &mut self.scratch.near_seen,
+                &mut near_lights,
+            );
         } else {
             near_lights.extend(0..self.lights.len() as u32);
         }
