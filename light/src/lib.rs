@@ -35,6 +35,7 @@
 #![warn(missing_docs)]
 
 mod bench;
+mod bits;
 mod bounce;
 #[cfg(feature = "cli")]
 pub mod cli;

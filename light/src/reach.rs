@@ -11,6 +11,7 @@
 use glam::DVec3;
 use quake_formats::geom::Bounds;
 
+use crate::bits::ones;
 use crate::lights::PointLight;
 
 /// Where a light is and how far it reaches, packed for the per-face cull (a map tests about
@@ -159,11 +160,7 @@ impl LightReaches {
         }
         out.clear();
         for (word, &bits) in seen.iter().enumerate() {
-            let mut bits = bits;
-            while bits != 0 {
-                out.push(word as u32 * 64 + bits.trailing_zeros());
-                bits &= bits - 1;
-            }
+            out.extend(ones(bits).map(|k| (word * 64 + k) as u32));
         }
     }
 }

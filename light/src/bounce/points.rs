@@ -25,6 +25,7 @@ use quake_formats::geom::{Plane, Split, Winding, polygon_area};
 use super::{
     BounceCounts, Field, HOTSPOT_CLAMP, Receivers, StyleLight, StyleLuxels, add_style_light,
 };
+use crate::bits::ones;
 use crate::embree::RayPacket16;
 use crate::faces::FaceGeom;
 use crate::scene::TraceScene;
@@ -193,10 +194,7 @@ impl<'a> PointField<'a> {
                 continue;
             }
             let first = g * GROUP;
-            let mut bits = may_light(&self.columns, first, &cull);
-            while bits != 0 {
-                let k = first + bits.trailing_zeros() as usize;
-                bits &= bits - 1;
+            for k in ones(may_light(&self.columns, first, &cull)).map(|k| first + k) {
                 if self.emitters[k].face != r.face && self.in_sight(k, &sight) {
                     candidates.push(k);
                 }

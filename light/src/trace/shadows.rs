@@ -5,6 +5,7 @@
 //! face to matter gets a handful of probes for the whole face, and samples whose light is not
 //! used (in solid, with open samples beside them) cast no ray.
 
+use crate::bits::ones;
 use crate::embree::RayPacket16;
 use crate::grid::SampleGrid;
 use crate::samples::FaceSamples;
@@ -92,17 +93,6 @@ fn byte_bits(word: u64) -> u64 {
 /// The bits of `values` that are not zero.
 fn valued(values: &[f64]) -> u64 {
     bits_where(values, |v| v != 0.0)
-}
-
-/// The positions of the set bits of `bits`, lowest first.
-fn ones(mut bits: u64) -> impl Iterator<Item = usize> {
-    std::iter::from_fn(move || {
-        (bits != 0).then(|| {
-            let k = bits.trailing_zeros() as usize;
-            bits &= bits - 1;
-            k
-        })
-    })
 }
 
 /// Supersampled faces at least this many samples a luxel across trace the corners of a
