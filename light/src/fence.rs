@@ -174,7 +174,7 @@ impl FenceBoxes {
     /// meets the box of all the lanes' segments: a packet's rays are close together, and
     /// fences are usually a few small signs.
     fn lanes_near(&self, packet: &RayPacket16, lanes: u16) -> u16 {
-        crate::simd::avx2_or_any(
+        crate::simd::widest(
             #[inline(always)]
             || self.lanes_near_any(packet, lanes),
         )

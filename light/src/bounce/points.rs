@@ -404,7 +404,7 @@ impl EmitterGroup {
 /// and near enough to the box for its brightest intensity to pass the [`GATE`]. Branch-free
 /// over the columns, so that it runs in vectors.
 fn may_light(columns: &EmitterColumns, first: usize, cull: &Cull) -> u64 {
-    crate::simd::avx2_or_any(
+    crate::simd::widest(
         #[inline(always)]
         || may_light_any(columns, first, cull),
     )
@@ -592,7 +592,7 @@ fn weigh(
     two_sided: bool,
     out: &mut [f32],
 ) {
-    crate::simd::avx2_or_any(
+    crate::simd::widest(
         #[inline(always)]
         || weigh_any(e, luxels, kernel, gate, two_sided, out),
     );
@@ -736,7 +736,7 @@ impl StyleColumns {
 /// Adds to `light` the light of an emitter of colour `color` and intensity `total` at each
 /// luxel whose segment is lit and which it brings at least the gate, at `weights`.
 fn add_lit(light: &mut [Vec<f32>; 3], weights: &[f32], lit: &[State], color: [f32; 3], total: f64) {
-    crate::simd::avx2_or_any(
+    crate::simd::widest(
         #[inline(always)]
         || add_lit_any(light, weights, lit, color, total),
     );

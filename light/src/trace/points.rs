@@ -326,7 +326,7 @@ impl Toward {
     /// most of a light's cost on a face). A sample at the light gets a direction of NaNs,
     /// which [`MIN_DISTANCE`] keeps from use.
     fn measure(&mut self, points: &SamplePoints, light: &PointLight) {
-        crate::simd::avx2_or_any(
+        crate::simd::widest(
             #[inline(always)]
             || self.measure_any(points, light),
         );
@@ -385,7 +385,7 @@ impl Toward {
         bounds: (f64, f64),
         value: &mut [f64],
     ) {
-        crate::simd::avx2_or_any(
+        crate::simd::widest(
             #[inline(always)]
             || self.plain_values_any(light, samples, bounds, value),
         );
@@ -503,17 +503,18 @@ mod tests {
             let face = samples(points.clone(), normal, two_sided);
             let mut coords = SamplePoints::default();
             coords.set(&points);
-            // The loops as built (any x86-64), and as this CPU runs them (AVX2 where it has it).
-            for portable in [true, false] {
-                let mut toward = Toward::default();
-                let mut got = vec![f64::NAN; points.len()];
-                if portable {
+            // The loops as each vector build this CPU runs compiles them.
+            let each = crate::simd::builds_here(
+                #[inline(always)]
+                || {
+                    let mut toward = Toward::default();
+                    let mut got = vec![f64::NAN; points.len()];
                     toward.measure_any(&coords, &light);
                     toward.plain_values_any(&light, &face, (reach, gate), &mut got);
-                } else {
-                    toward.measure(&coords, &light);
-                    toward.plain_values(&light, &face, (reach, gate), &mut got);
-                }
+                    (toward, got)
+                },
+            );
+            for (build, (toward, got)) in each {
                 for (i, p) in points.iter().enumerate() {
                     let to_light = light.origin - Vec3::from(*p).as_dvec3();
                     let (sq, dist) = (to_light.length_squared(), to_light.length());
@@ -527,9 +528,9 @@ mod tests {
                     prop_assert_eq!(
                         got[i].to_bits(),
                         want.to_bits(),
-                        "sample {}, portable {}",
+                        "sample {}, {:?}",
                         i,
-                        portable
+                        build
                     );
                     if want != 0.0 {
                         let (ray, length) = toward.shadow_ray(i);
