@@ -17,7 +17,7 @@ pub enum Build {
 
 /// The widest build this CPU runs (the standard library asks the CPU once and keeps the
 /// answer).
-pub fn widest_build() -> Build {
+fn widest_build() -> Build {
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::is_x86_feature_detected as has;
