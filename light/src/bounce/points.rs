@@ -1214,12 +1214,24 @@ mod tests {
                     }
                 }
             }
-            let mut columns: [Vec<f32>; 3] =
-                std::array::from_fn(|c| luxels.iter().map(|l| [l.2.0, l.2.1, l.2.2][c]).collect());
-            add_lit(&mut columns, &weights, &lit, color, total);
-            for (i, v) in plain.iter().enumerate() {
-                for c in 0..3 {
-                    proptest::prop_assert_eq!(columns[c][i].to_bits(), v[c].to_bits());
+            // As each vector build this CPU runs compiles it.
+            let each = crate::simd::builds_here(
+                #[inline(always)]
+                || {
+                    let mut columns: [Vec<f32>; 3] = std::array::from_fn(|c| {
+                        luxels.iter().map(|l| [l.2.0, l.2.1, l.2.2][c]).collect()
+                    });
+                    add_lit_any(&mut columns, &weights, &lit, color, total);
+                    columns
+                },
+            );
+            for (build, columns) in each {
+                for (i, v) in plain.iter().enumerate() {
+                    for c in 0..3 {
+                        proptest::prop_assert_eq!(
+                            columns[c][i].to_bits(), v[c].to_bits(), "{:?}", build
+                        );
+                    }
                 }
             }
         }
@@ -1278,14 +1290,21 @@ mod tests {
                     .iter()
                     .enumerate()
                     .fold(0u64, |bits, (i, e)| bits | u64::from(plain(e)) << i);
-                proptest::prop_assert_eq!(may_light(&columns, first, &cull), expected);
+                let each = crate::simd::builds_here(
+                    #[inline(always)]
+                    || may_light_any(&columns, first, &cull),
+                );
+                for (build, kept) in each {
+                    proptest::prop_assert_eq!(kept, expected, "{:?}", build);
+                }
                 if !EmitterGroup::new(group, |_| &[]).may_light(&cull) {
                     proptest::prop_assert_eq!(expected, 0);
                 }
             }
         }
 
-        /// Both copies of the weighing give the same bits, one- and two-sided.
+        /// Every vector build of the weighing this CPU runs gives the baseline's bits, one- and
+        /// two-sided.
         #[test]
         fn weigh_copies_agree(
             at in proptest::collection::vec(
@@ -1300,10 +1319,18 @@ mod tests {
             let luxels = Luxels::new(&points, &normals, points.len());
             let mut any = vec![0.0f32; points.len()];
             weigh_any(e, &luxels, 0.5, 1e-4, two_sided, &mut any);
-            let mut chosen = vec![0.0f32; points.len()];
-            weigh(e, &luxels, 0.5, 1e-4, two_sided, &mut chosen);
+            let each = crate::simd::builds_here(
+                #[inline(always)]
+                || {
+                    let mut weights = vec![0.0f32; points.len()];
+                    weigh_any(e, &luxels, 0.5, 1e-4, two_sided, &mut weights);
+                    weights
+                },
+            );
             let bits = |v: &[f32]| v.iter().map(|w| w.to_bits()).collect::<Vec<_>>();
-            proptest::prop_assert_eq!(bits(&chosen), bits(&any));
+            for (build, weights) in each {
+                proptest::prop_assert_eq!(bits(&weights), bits(&any), "{:?}", build);
+            }
         }
     }
 
