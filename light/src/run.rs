@@ -4,6 +4,7 @@
 
 use glam::DVec3;
 use std::collections::{BTreeMap, BTreeSet};
+use std::sync::{Mutex, PoisonError};
 use std::time::Instant;
 
 use quake_formats::Bsp;
@@ -41,7 +42,10 @@ use crate::trace::{
 /// # Errors
 /// A BSP light cannot read safely, bad entities or faces, or an Embree failure.
 pub fn compute_lighting(bsp: &Bsp, options: &Options) -> Result<Lighting, LightError> {
-    Ok(finish_lighting(&trace_lighting(bsp, options)?))
+    let raw = trace_lighting(bsp, options)?;
+    let lighting = finish_lighting(&raw);
+    drop_in_background(raw);
+    Ok(lighting)
 }
 
 /// Traces every lit face of `bsp` (or `options.only_faces`): light units per
@@ -120,7 +124,7 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
     stats.seconds_total = start.elapsed().as_secs_f64();
     let rays = stats.shadow_rays + stats.sun_rays + stats.dirt_rays + stats.bounce_rays;
     stats.rays_per_second = rays as f64 / (stats.seconds_trace + stats.seconds_bounce).max(1e-9);
-    Ok(RawLighting {
+    let raw = RawLighting {
         faces,
         own_grids,
         entity_text: prep.entity_text.clone(),
@@ -133,7 +137,16 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
         chosen_settings: prep.lights.chosen_settings.clone(),
         warnings: prep.lights.warnings.clone(),
         stats,
-    })
+    };
+    drop(plan);
+    drop_in_background(prep);
+    Ok(raw)
+}
+
+/// Frees `value` on a worker thread when one is free: what follows need not wait for it (the
+/// scene and every face's geometry take milliseconds to free, on one thread).
+fn drop_in_background<T: Send + 'static>(value: T) {
+    rayon::spawn(move || drop(value));
 }
 
 /// What a run traces, and how.
@@ -703,44 +716,84 @@ fn trace_faces(
 ) -> Vec<Traced> {
     let per_axis = quality.samples_per_axis();
     let styled = prep.lights.bounce.styled;
+    let spare = Mutex::new(Vec::new());
     faces
         .par_iter()
-        .map_init(TraceScratch::default, |reuse, &f| {
-            let geom = &prep.faces[f];
-            let (mut samples, placement) = face_samples(geom, per_axis, bsp);
-            if let Some(normals) = phong::sample_normals(&samples, &prep.faces, &prep.phong) {
-                samples.normals = normals;
-            }
-            let rules = face_rules(&prep.lights, geom);
-            let (light, counts) = trace_face(setup, &samples, &rules, reuse);
-            progress.advance(1);
-            let reflects = keep.bouncing && keep.reflectance[f].is_some();
-            let reflected = reflects.then(|| light.reflected(styled));
-            // Only a later pass reads what a face passes on.
-            let passed_on = (reflects && prep.lights.bounce.passes > 1)
-                .then(|| light.passed_on())
-                .flatten();
-            let light = keep.wanted[f].then(|| match keep.finish {
-                Some(to_luxels) if geom.model == 0 => {
-                    TracedLight::Luxels(light.finish(&[], HiddenLuxels::FromNeighbours, to_luxels))
+        // Small batches, so neither thread is left with a long run of faces while the other has
+        // none; each batch borrows a thread's scratch, grown by the faces before it.
+        .with_max_len(FACES_PER_BATCH)
+        .map_init(
+            || Lease::take(&spare),
+            |reuse, &f| {
+                let geom = &prep.faces[f];
+                let (mut samples, placement) = face_samples(geom, per_axis, bsp);
+                if let Some(normals) = phong::sample_normals(&samples, &prep.faces, &prep.phong) {
+                    samples.normals = normals;
                 }
-                _ => TracedLight::Samples(Box::new(light)),
-            });
-            Traced {
-                face: f,
-                light,
-                receivers: keep
-                    .bouncing
-                    .then(|| Box::new(Receivers::new(&samples, geom))),
-                reflected,
-                passed_on,
-                placement,
-                counts,
-                sample_count: samples.points.len() as u64,
-                samples: (keep.samples && keep.wanted[f]).then(|| Box::new(samples)),
-            }
-        })
+                let rules = face_rules(&prep.lights, geom);
+                let (light, counts) = trace_face(setup, &samples, &rules, reuse.scratch());
+                progress.advance(1);
+                let reflects = keep.bouncing && keep.reflectance[f].is_some();
+                let reflected = reflects.then(|| light.reflected(styled));
+                // Only a later pass reads what a face passes on.
+                let passed_on = (reflects && prep.lights.bounce.passes > 1)
+                    .then(|| light.passed_on())
+                    .flatten();
+                let light = keep.wanted[f].then(|| match keep.finish {
+                    Some(to_luxels) if geom.model == 0 => TracedLight::Luxels(light.finish(
+                        &[],
+                        HiddenLuxels::FromNeighbours,
+                        to_luxels,
+                    )),
+                    _ => TracedLight::Samples(Box::new(light)),
+                });
+                Traced {
+                    face: f,
+                    light,
+                    receivers: keep
+                        .bouncing
+                        .then(|| Box::new(Receivers::new(&samples, geom))),
+                    reflected,
+                    passed_on,
+                    placement,
+                    counts,
+                    sample_count: samples.points.len() as u64,
+                    samples: (keep.samples && keep.wanted[f]).then(|| Box::new(samples)),
+                }
+            },
+        )
         .collect()
+}
+
+/// The most faces a thread traces before it may take more (see [`trace_faces`]).
+const FACES_PER_BATCH: usize = 32;
+
+/// A [`TraceScratch`] lent to one batch of faces, given back to `spare` when the batch is done.
+struct Lease<'a> {
+    scratch: Option<TraceScratch>,
+    spare: &'a Mutex<Vec<TraceScratch>>,
+}
+
+impl<'a> Lease<'a> {
+    fn take(spare: &'a Mutex<Vec<TraceScratch>>) -> Lease<'a> {
+        let held = spare.lock().unwrap_or_else(PoisonError::into_inner).pop();
+        Lease {
+            scratch: Some(held.unwrap_or_default()),
+            spare,
+        }
+    }
+
+    fn scratch(&mut self) -> &mut TraceScratch {
+        self.scratch.get_or_insert_with(TraceScratch::default)
+    }
+}
+
+impl Drop for Lease<'_> {
+    fn drop(&mut self) {
+        if let Some(scratch) = self.scratch.take() {
+            (self.spare.lock().unwrap_or_else(PoisonError::into_inner)).push(scratch);
+        }
+    }
 }
 
 /// How [`bounce_light`] gathers, and where it counts the faces it has done.
@@ -998,4 +1051,27 @@ pub fn update_entities_only(bsp: &mut Bsp) -> Result<usize, LightError> {
         bsp.set_entity_text(&write_entities(&entities));
     }
     Ok(assigned.count)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A batch's scratch goes back to the spares when the batch is done, for the next batch to
+    /// take; batches at once each get one of their own.
+    #[test]
+    fn leased_scratch_is_given_back_and_taken_again() {
+        let spare = Mutex::new(Vec::new());
+        {
+            let mut first = Lease::take(&spare);
+            let second = Lease::take(&spare);
+            first.scratch();
+            assert!(spare.lock().unwrap().is_empty());
+            drop(second);
+            assert_eq!(spare.lock().unwrap().len(), 1);
+        }
+        assert_eq!(spare.lock().unwrap().len(), 2);
+        let _again = Lease::take(&spare);
+        assert_eq!(spare.lock().unwrap().len(), 1);
+    }
 }
