@@ -76,7 +76,10 @@ fn main() -> ExitCode {
     quake_formats::cli::end_quietly_on_closed_pipe();
     let cli = Cli::parse_from(batch::command_words(std::env::args()));
     keep_freed_memory(!matches!(cli.command, Command::Vis(_)));
-    match run(cli.command) {
+    let result = run(cli.command);
+    // No thread may still be freeing light's Embree scenes while the process ends.
+    light::wait_for_background_frees();
+    match result {
         Ok(code) => code,
         Err(e) => {
             eprintln!("error: {e:#}");

@@ -94,7 +94,7 @@ pub use output::{FaceLightmap, Outputs, grey_lit};
 pub use quality::Quality;
 pub use run::{
     LightFiles, apply_lighting, compute_lighting, finish_lighting, trace_lighting,
-    update_entities_only,
+    update_entities_only, wait_for_background_frees,
 };
 pub use trace::FaceLight;
 

@@ -4,7 +4,7 @@
 
 use glam::DVec3;
 use std::collections::{BTreeMap, BTreeSet};
-use std::sync::{Mutex, PoisonError};
+use std::sync::{Condvar, Mutex, PoisonError};
 use std::time::Instant;
 
 use quake_formats::Bsp;
@@ -145,8 +145,46 @@ pub fn trace_lighting(bsp: &Bsp, options: &Options) -> Result<RawLighting, Light
 
 /// Frees `value` on a worker thread when one is free: what follows need not wait for it (the
 /// scene and every face's geometry take milliseconds to free, on one thread).
+/// [`wait_for_background_frees`] waits for it.
 fn drop_in_background<T: Send + 'static>(value: T) {
-    rayon::spawn(move || drop(value));
+    *lock(&BACKGROUND_FREES.count) += 1;
+    rayon::spawn(move || {
+        drop(value);
+        let mut count = lock(&BACKGROUND_FREES.count);
+        *count -= 1;
+        if *count == 0 {
+            BACKGROUND_FREES.done.notify_all();
+        }
+    });
+}
+
+/// How many values [`drop_in_background`] has yet to free, and the signal when none is left.
+struct BackgroundFrees {
+    count: Mutex<usize>,
+    done: Condvar,
+}
+
+static BACKGROUND_FREES: BackgroundFrees = BackgroundFrees {
+    count: Mutex::new(0),
+    done: Condvar::new(),
+};
+
+fn lock<T>(mutex: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    mutex.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// Waits until the values light handed to worker threads to free are freed (most often they
+/// already are): a program calls it before it ends, so that no thread is still releasing an
+/// Embree scene while the process unloads Embree. Not from a worker of the pool light ran in,
+/// which may be the one thread that would free them.
+pub fn wait_for_background_frees() {
+    let mut count = lock(&BACKGROUND_FREES.count);
+    while *count > 0 {
+        count = BACKGROUND_FREES
+            .done
+            .wait(count)
+            .unwrap_or_else(PoisonError::into_inner);
+    }
 }
 
 /// What a run traces, and how.
@@ -776,7 +814,7 @@ struct Lease<'a> {
 
 impl<'a> Lease<'a> {
     fn take(spare: &'a Mutex<Vec<TraceScratch>>) -> Lease<'a> {
-        let held = spare.lock().unwrap_or_else(PoisonError::into_inner).pop();
+        let held = lock(spare).pop();
         Lease {
             scratch: Some(held.unwrap_or_default()),
             spare,
@@ -791,7 +829,7 @@ impl<'a> Lease<'a> {
 impl Drop for Lease<'_> {
     fn drop(&mut self) {
         if let Some(scratch) = self.scratch.take() {
-            (self.spare.lock().unwrap_or_else(PoisonError::into_inner)).push(scratch);
+            lock(self.spare).push(scratch);
         }
     }
 }
@@ -1056,6 +1094,27 @@ pub fn update_entities_only(bsp: &mut Bsp) -> Result<usize, LightError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// What is handed to a worker to free is freed once the wait returns.
+    #[test]
+    fn waiting_for_background_frees_sees_them_done() {
+        use std::sync::Arc;
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        struct Counted(Arc<AtomicUsize>);
+        impl Drop for Counted {
+            fn drop(&mut self) {
+                // Slow enough that the wait would see it pending.
+                std::thread::sleep(std::time::Duration::from_millis(20));
+                self.0.fetch_add(1, Ordering::SeqCst);
+            }
+        }
+        let freed = Arc::new(AtomicUsize::new(0));
+        for _ in 0..3 {
+            drop_in_background(Counted(Arc::clone(&freed)));
+        }
+        wait_for_background_frees();
+        assert_eq!(freed.load(Ordering::SeqCst), 3);
+    }
 
     /// A batch's scratch goes back to the spares when the batch is done, for the next batch to
     /// take; batches at once each get one of their own.
