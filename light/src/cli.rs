@@ -307,23 +307,17 @@ pub fn run(args: &Args) -> anyhow::Result<Option<crate::Stats>> {
                 let _ = crate::embree::open_library();
             });
     }
-    // The frees light left to its workers are waited for while the pool that runs them lives.
-    match args.threads {
-        Some(n) => {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(usize::from(n))
-                .build()
-                .context("starting the worker threads")?;
-            let stats = pool.install(|| run_with_current_threads(args));
-            crate::wait_for_background_frees();
-            stats
-        }
-        None => {
-            let stats = run_with_current_threads(args);
-            crate::wait_for_background_frees();
-            stats
-        }
-    }
+    let stats = match args.threads {
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(usize::from(n))
+            .build()
+            .context("starting the worker threads")?
+            .install(|| run_with_current_threads(args)),
+        None => run_with_current_threads(args),
+    };
+    // On this thread, not the pool's: a pool's spawned frees run even after it is dropped.
+    crate::wait_for_background_frees();
+    stats
 }
 
 fn run_with_current_threads(args: &Args) -> anyhow::Result<Option<crate::Stats>> {

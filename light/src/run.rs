@@ -769,7 +769,7 @@ fn trace_faces(
                     samples.normals = normals;
                 }
                 let rules = face_rules(&prep.lights, geom);
-                let (light, counts) = trace_face(setup, &samples, &rules, reuse.scratch());
+                let (light, counts) = trace_face(setup, &samples, &rules, &mut reuse.scratch);
                 progress.advance(1);
                 let reflects = keep.bouncing && keep.reflectance[f].is_some();
                 let reflected = reflects.then(|| light.reflected(styled));
@@ -808,29 +808,20 @@ const FACES_PER_BATCH: usize = 32;
 
 /// A [`TraceScratch`] lent to one batch of faces, given back to `spare` when the batch is done.
 struct Lease<'a> {
-    scratch: Option<TraceScratch>,
+    scratch: TraceScratch,
     spare: &'a Mutex<Vec<TraceScratch>>,
 }
 
 impl<'a> Lease<'a> {
     fn take(spare: &'a Mutex<Vec<TraceScratch>>) -> Lease<'a> {
-        let held = lock(spare).pop();
-        Lease {
-            scratch: Some(held.unwrap_or_default()),
-            spare,
-        }
-    }
-
-    fn scratch(&mut self) -> &mut TraceScratch {
-        self.scratch.get_or_insert_with(TraceScratch::default)
+        let scratch = lock(spare).pop().unwrap_or_default();
+        Lease { scratch, spare }
     }
 }
 
 impl Drop for Lease<'_> {
     fn drop(&mut self) {
-        if let Some(scratch) = self.scratch.take() {
-            lock(self.spare).push(scratch);
-        }
+        lock(self.spare).push(std::mem::take(&mut self.scratch));
     }
 }
 
@@ -1122,12 +1113,12 @@ mod tests {
     fn leased_scratch_is_given_back_and_taken_again() {
         let spare = Mutex::new(Vec::new());
         {
-            let mut first = Lease::take(&spare);
+            let first = Lease::take(&spare);
             let second = Lease::take(&spare);
-            first.scratch();
             assert!(spare.lock().unwrap().is_empty());
             drop(second);
             assert_eq!(spare.lock().unwrap().len(), 1);
+            drop(first);
         }
         assert_eq!(spare.lock().unwrap().len(), 2);
         let _again = Lease::take(&spare);
